@@ -1,0 +1,5 @@
+"""cloudcore: the cloudview engine.
+
+Model, shading, LOD policy and statistics are plain numpy; only the `gl`
+sub-package touches OpenGL.
+"""

@@ -1,0 +1,55 @@
+"""The `cloudview` command: the editor, or a headless tool named by a subcommand.
+
+Headless subcommands never import the GUI; bad input is one line on stderr and
+exit status 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from cloudcore.errors import SceneError
+
+DEFAULT_SCENE = Path(__file__).resolve().parents[2] / "resources" / "scenes" / "valley.toml"
+
+
+class _OneLineParser(argparse.ArgumentParser):
+    def error(self, message):
+        self.exit(2, f"{self.prog}: error: {message} (see --help)\n")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    from cloudcore.cli import shade
+
+    parser = _OneLineParser(prog="cloudview", description="Real-time volumetric particle clouds.")
+    commands = parser.add_subparsers(dest="command", parser_class=_OneLineParser, metavar="COMMAND")
+    shade.add_parser(commands)
+    return parser
+
+
+def main(argv=None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    parser = build_parser()
+    if not argv or argv[0] not in parser._subparsers._group_actions[0].choices and not argv[0].startswith("-"):
+        argv = _main_job(argv)
+    args = parser.parse_args(argv)
+    if args.command is None:
+        parser.print_help()
+        return 0
+    try:
+        return int(args.run(args) or 0)
+    except SceneError as error:
+        print(f"cloudview: error: {error}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("cloudview: interrupted", file=sys.stderr)
+        return 130
+
+
+def _main_job(argv: list[str]) -> list[str]:
+    """`cloudview [SCENE]`: the editor once it exists; until then the most complete headless job."""
+    scene = argv[0] if argv else str(DEFAULT_SCENE)
+    print("cloudview: the editor is not built yet; shading the scene headless instead.", file=sys.stderr)
+    return ["shade", scene, *argv[1:]]

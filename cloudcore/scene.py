@@ -1,0 +1,173 @@
+"""The scene model: immutable records with numpy arrays, float64.
+
+Edits make new records (`dataclasses.replace`), which keeps undo cheap and lets
+the renderer compare identities to see what changed.  Validation happens where
+input enters (`cloudcore.scenefile`); these types only normalise.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+
+import numpy as np
+
+Vec3 = tuple[float, float, float]
+
+
+def _frozen_array(value, columns: int) -> np.ndarray:
+    array = np.array(value, dtype=np.float64).reshape(-1, columns)
+    array.flags.writeable = False
+    return array
+
+
+class _Record:
+    """Equality field by field, with numpy arrays compared by value."""
+
+    def __eq__(self, other):
+        if type(other) is not type(self):
+            return NotImplemented
+        for f in dataclasses.fields(self):
+            a, b = getattr(self, f.name), getattr(other, f.name)
+            if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+                if a is None or b is None or not np.array_equal(a, b):
+                    return False
+            elif a != b:
+                return False
+        return True
+
+    __hash__ = object.__hash__
+
+
+@dataclass(frozen=True)
+class Camera:
+    position: Vec3 = (0.0, 500.0, 3000.0)
+    look_at: Vec3 = (0.0, 700.0, 0.0)
+    fov_y_deg: float = 60.0
+
+
+@dataclass(frozen=True)
+class Light:
+    """A directional light; `direction` points from the scene toward the light (unit)."""
+
+    direction: Vec3
+    color: Vec3 = (1.0, 1.0, 1.0)
+    intensity: float = 1.0
+
+
+@dataclass(frozen=True)
+class Lighting:
+    """Either a time of day (sun, skylight and ambient follow) or explicit lights."""
+
+    time_of_day: float | None = 15.5
+    lights: tuple[Light, ...] = ()
+    ambient: Vec3 | None = None
+
+
+@dataclass(frozen=True)
+class Shading:
+    albedo: float = 0.9
+    optical_depth: float = 8.0
+    phase: str = "rayleigh"
+    g: float = 0.0
+
+
+@dataclass(frozen=True, eq=False)
+class Cloud(_Record):
+    """Particles as rows (x, y, z, radius); optional per-cloud shading overrides."""
+
+    name: str
+    particles: np.ndarray = field(default_factory=lambda: _frozen_array((), 4))
+    particles_file: str | None = None
+    optical_depth: float | None = None
+    albedo: float | None = None
+    color: Vec3 = (1.0, 1.0, 1.0)
+
+    def __post_init__(self):
+        object.__setattr__(self, "particles", _frozen_array(self.particles, 4))
+
+    @property
+    def centres(self) -> np.ndarray:
+        return self.particles[:, :3]
+
+    @property
+    def radii(self) -> np.ndarray:
+        return self.particles[:, 3]
+
+    def bounding_sphere(self) -> tuple[np.ndarray, float]:
+        """Centre of the particles' box and the radius that encloses every splat."""
+        if len(self.particles) == 0:
+            return np.zeros(3), 0.0
+        low = (self.centres - self.radii[:, None]).min(axis=0)
+        high = (self.centres + self.radii[:, None]).max(axis=0)
+        centre = 0.5 * (low + high)
+        reach = np.linalg.norm(self.centres - centre, axis=1) + self.radii
+        return centre, float(reach.max())
+
+
+@dataclass(frozen=True)
+class Terrain:
+    """A procedural heightfield (`cloudcore.terrain`) or a mesh file."""
+
+    kind: str = "heightfield"
+    size: tuple[float, float] = (6000.0, 6000.0)
+    resolution: int = 174
+    height: float = 650.0
+    seed: int = 7
+    mesh: str | None = None
+    color: Vec3 = (0.32, 0.42, 0.22)
+
+
+@dataclass(frozen=True, eq=False)
+class SceneObject(_Record):
+    """An opaque object: a mesh file or a built-in primitive, static or on a keyframed path."""
+
+    name: str
+    mesh: str | None = None
+    primitive: str | None = None
+    scale: float = 1.0
+    position: Vec3 = (0.0, 0.0, 0.0)
+    path: np.ndarray | None = None  # rows (t, x, y, z)
+    color: Vec3 = (0.75, 0.75, 0.78)
+
+    def __post_init__(self):
+        if self.path is not None:
+            object.__setattr__(self, "path", _frozen_array(self.path, 4))
+
+
+@dataclass(frozen=True, eq=False)
+class CameraPath(_Record):
+    """Keys as rows (t, px, py, pz, lx, ly, lz): time, eye position, look-at point."""
+
+    name: str
+    keys: np.ndarray
+
+    def __post_init__(self):
+        object.__setattr__(self, "keys", _frozen_array(self.keys, 7))
+
+    @property
+    def duration(self) -> float:
+        return float(self.keys[-1, 0] - self.keys[0, 0])
+
+
+@dataclass(frozen=True)
+class Scene:
+    camera: Camera = Camera()
+    lighting: Lighting = Lighting()
+    shading: Shading = Shading()
+    clouds: tuple[Cloud, ...] = ()
+    terrain: Terrain | None = None
+    objects: tuple[SceneObject, ...] = ()
+    camera_paths: tuple[CameraPath, ...] = ()
+    description: str = ""
+
+    @property
+    def particle_count(self) -> int:
+        return sum(len(c.particles) for c in self.clouds)
+
+    def camera_path(self, name: str) -> CameraPath:
+        for path in self.camera_paths:
+            if path.name == name:
+                return path
+        known = ", ".join(p.name for p in self.camera_paths) or "none"
+        raise KeyError(f"no camera path named {name!r}; the scene has: {known}")

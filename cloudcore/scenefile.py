@@ -1,0 +1,416 @@
+"""Scene files: TOML in, TOML out, nothing half-loaded, saves atomic.
+
+The format is documented in docs/scene-format.md.  Every problem is a
+`SceneError` naming the file, the field (as a dotted path such as
+`clouds[3].particles`) and what is wrong; unknown keys are refused with the
+valid ones listed, so a typo never passes silently.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import tempfile
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import tomlkit
+
+from cloudcore.errors import SceneError
+from cloudcore.phase import MAX_ABS_G, PHASE_NAMES
+from cloudcore.scene import Camera, CameraPath, Cloud, Light, Lighting, Scene, SceneObject, Shading, Terrain
+
+PRIMITIVES = ("box", "sphere", "aircraft")
+TERRAIN_KINDS = ("heightfield", "mesh")
+#: TOML arrays are slow to parse; clouds larger than this are saved to .npy.
+INLINE_PARTICLE_LIMIT = 64
+
+
+class _Table:
+    """Typed access to one TOML table; remembers which keys were read."""
+
+    def __init__(self, source: str, field: str, data):
+        if not isinstance(data, dict):
+            raise SceneError(source, field, f"expected a table, got {type(data).__name__}")
+        self.source, self.field, self.data = source, field, data
+
+    def path(self, key: str) -> str:
+        return f"{self.field}.{key}" if self.field else key
+
+    def fail(self, key: str, problem: str):
+        raise SceneError(self.source, self.path(key), problem)
+
+    def reject_unknown(self, known: tuple[str, ...]):
+        for key in self.data:
+            if key not in known:
+                self.fail(key, f"unknown key; valid keys: {', '.join(known)}")
+
+    def has(self, key: str) -> bool:
+        return key in self.data
+
+    def raw(self, key: str, default=None):
+        return self.data.get(key, default)
+
+    def number(self, key, default=None, *, low=-math.inf, high=math.inf, low_open=False):
+        if key not in self.data:
+            if default is None:
+                self.fail(key, "required number is missing")
+            return default
+        value = self.data[key]
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            self.fail(key, f"expected a number, got {value!r}")
+        value = float(value)
+        if not math.isfinite(value):
+            self.fail(key, f"must be finite, got {value}")
+        if value < low or (low_open and value == low) or value > high:
+            bound = "(" if low_open else "["
+            self.fail(key, f"must be within {bound}{low}, {high}], got {value}")
+        return value
+
+    def integer(self, key, default, *, low, high):
+        value = self.data.get(key, default)
+        if isinstance(value, bool) or not isinstance(value, int):
+            self.fail(key, f"expected an integer, got {value!r}")
+        if not low <= value <= high:
+            self.fail(key, f"must be within [{low}, {high}], got {value}")
+        return value
+
+    def string(self, key, default=None, *, choices=None):
+        if key not in self.data:
+            if default is None:
+                self.fail(key, "required string is missing")
+            return default
+        value = self.data[key]
+        if not isinstance(value, str):
+            self.fail(key, f"expected a string, got {value!r}")
+        if choices is not None and value not in choices:
+            self.fail(key, f"{value!r} is not one of: {', '.join(choices)}")
+        return value
+
+    def matrix(self, key, columns: int, *, allow_empty=False) -> np.ndarray:
+        value = self.data.get(key)
+        if value is None:
+            self.fail(key, "required array is missing")
+        return _checked_matrix(value, columns, self.source, self.path(key), allow_empty)
+
+    def vector(self, key, default=None, *, low=-math.inf, high=math.inf, unit=False):
+        if key not in self.data:
+            if default is None:
+                self.fail(key, "required 3-vector is missing")
+            return default
+        row = _checked_matrix([self.data[key]], 3, self.source, self.path(key), False)[0]
+        if np.any(row < low) or np.any(row > high):
+            self.fail(key, f"components must be within [{low}, {high}], got {row.tolist()}")
+        if unit:
+            length = float(np.linalg.norm(row))
+            if not length > 0:
+                self.fail(key, "direction must not be the zero vector")
+            row = row / length
+        return tuple(float(x) for x in row)
+
+    def tables(self, key) -> list["_Table"]:
+        value = self.data.get(key, [])
+        if not isinstance(value, list):
+            self.fail(key, "expected an array of tables ([[...]])")
+        return [_Table(self.source, f"{self.path(key)}[{i}]", item) for i, item in enumerate(value)]
+
+
+def _checked_matrix(value, columns, source, field, allow_empty) -> np.ndarray:
+    try:
+        array = np.array(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise SceneError(source, field, f"expected rows of {columns} numbers") from None
+    if array.size == 0 and allow_empty:
+        return np.zeros((0, columns))
+    if array.ndim != 2 or array.shape[1] != columns:
+        raise SceneError(source, field, f"expected rows of {columns} numbers, got shape {array.shape}")
+    bad = np.flatnonzero(~np.isfinite(array).all(axis=1))
+    if bad.size:
+        raise SceneError(source, field, f"row {bad[0]} is not finite: {array[bad[0]].tolist()}")
+    return array
+
+
+# ---------------------------------------------------------------- loading
+
+
+def load_scene(path) -> Scene:
+    """Read and validate a scene file; raise SceneError on any problem."""
+    path = Path(path)
+    source = str(path)
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise SceneError(source, "(file)", "no such file") from None
+    except (OSError, UnicodeDecodeError) as error:
+        raise SceneError(source, "(file)", f"cannot read: {error}") from None
+    except tomllib.TOMLDecodeError as error:
+        raise SceneError(source, "(toml)", str(error)) from None
+    return scene_from_dict(data, source, path.parent)
+
+
+def scene_from_dict(data: dict, source: str = "<scene>", base_dir=Path(".")) -> Scene:
+    root = _Table(source, "", data)
+    root.reject_unknown(("description", "camera", "lighting", "shading", "clouds", "terrain", "objects",
+                         "camera_paths"))
+    clouds = tuple(_cloud(t, Path(base_dir)) for t in root.tables("clouds"))
+    _unique_names(root, "clouds", clouds)
+    objects = tuple(_object(t) for t in root.tables("objects"))
+    _unique_names(root, "objects", objects)
+    paths = tuple(_camera_path(t) for t in root.tables("camera_paths"))
+    _unique_names(root, "camera_paths", paths)
+    return Scene(
+        camera=_camera(_Table(source, "camera", root.raw("camera", {}))),
+        lighting=_lighting(_Table(source, "lighting", root.raw("lighting", {}))),
+        shading=_shading(_Table(source, "shading", root.raw("shading", {}))),
+        clouds=clouds,
+        terrain=_terrain(_Table(source, "terrain", root.raw("terrain"))) if root.has("terrain") else None,
+        objects=objects,
+        camera_paths=paths,
+        description=root.string("description", ""),
+    )
+
+
+def _unique_names(root: _Table, key: str, items) -> None:
+    seen = set()
+    for i, item in enumerate(items):
+        if item.name in seen:
+            raise SceneError(root.source, f"{key}[{i}].name", f"duplicate name {item.name!r}")
+        seen.add(item.name)
+
+
+def _camera(t: _Table) -> Camera:
+    t.reject_unknown(("position", "look_at", "fov_y_deg"))
+    default = Camera()
+    position = t.vector("position", default.position)
+    look_at = t.vector("look_at", default.look_at)
+    if np.allclose(position, look_at, rtol=0, atol=0):
+        t.fail("look_at", "must differ from position")
+    return Camera(position, look_at, t.number("fov_y_deg", default.fov_y_deg, low=1.0, high=170.0))
+
+
+def _lighting(t: _Table) -> Lighting:
+    t.reject_unknown(("time_of_day", "lights", "ambient"))
+    lights = []
+    for lt in t.tables("lights"):
+        lt.reject_unknown(("direction", "color", "intensity"))
+        lights.append(Light(lt.vector("direction", unit=True), lt.vector("color", (1.0, 1.0, 1.0), low=0.0),
+                            lt.number("intensity", 1.0, low=0.0)))
+    # Explicit lights replace the sun and skylight; a time of day still sets the sky.
+    if t.has("time_of_day"):
+        time_of_day = t.number("time_of_day", low=0.0, high=24.0)
+    else:
+        time_of_day = None if lights else Lighting().time_of_day
+    ambient = t.vector("ambient", None, low=0.0) if t.has("ambient") else None
+    return Lighting(time_of_day, tuple(lights), ambient)
+
+
+def _shading(t: _Table) -> Shading:
+    t.reject_unknown(("albedo", "optical_depth", "phase", "g"))
+    d = Shading()
+    return Shading(
+        albedo=t.number("albedo", d.albedo, low=0.0, high=1.0),
+        optical_depth=t.number("optical_depth", d.optical_depth, low=0.0),
+        phase=t.string("phase", d.phase, choices=PHASE_NAMES),
+        g=t.number("g", d.g, low=-MAX_ABS_G, high=MAX_ABS_G),
+    )
+
+
+def _cloud(t: _Table, base_dir: Path) -> Cloud:
+    t.reject_unknown(("name", "particles", "particles_file", "optical_depth", "albedo", "color"))
+    name = t.string("name")
+    if t.has("particles") == t.has("particles_file"):
+        t.fail("particles", "give exactly one of particles (inline) or particles_file (.npy)")
+    if t.has("particles"):
+        particles, particles_file = t.matrix("particles", 4, allow_empty=True), None
+    else:
+        particles_file = t.string("particles_file")
+        particles = _read_particles(t, base_dir / particles_file)
+    bad = np.flatnonzero(particles[:, 3] <= 0)
+    if bad.size:
+        field = "particles" if particles_file is None else "particles_file"
+        t.fail(field, f"radius must be > 0 (row {bad[0]} has {particles[bad[0], 3]})")
+    return Cloud(
+        name=name,
+        particles=particles,
+        particles_file=particles_file,
+        optical_depth=t.number("optical_depth", None, low=0.0) if t.has("optical_depth") else None,
+        albedo=t.number("albedo", None, low=0.0, high=1.0) if t.has("albedo") else None,
+        color=t.vector("color", (1.0, 1.0, 1.0), low=0.0),
+    )
+
+
+def _read_particles(t: _Table, file: Path) -> np.ndarray:
+    try:
+        array = np.load(file, allow_pickle=False)
+    except FileNotFoundError:
+        t.fail("particles_file", f"{file}: no such file")
+    except (OSError, ValueError, EOFError) as error:
+        t.fail("particles_file", f"{file}: not a readable .npy ({error})")
+    if not isinstance(array, np.ndarray) or array.dtype.kind not in "fiu":
+        t.fail("particles_file", f"{file}: expected a numeric array")
+    return _checked_matrix(array, 4, t.source, t.path("particles_file"), True)
+
+
+def _terrain(t: _Table) -> Terrain:
+    t.reject_unknown(("kind", "size", "resolution", "height", "seed", "mesh", "color"))
+    d = Terrain()
+    kind = t.string("kind", d.kind, choices=TERRAIN_KINDS)
+    size = t.raw("size", list(d.size))
+    if not (isinstance(size, list) and len(size) == 2):
+        t.fail("size", f"expected [size_x, size_z] in metres, got {size!r}")
+    sx = _Table(t.source, t.path("size"), {"x": size[0], "z": size[1]})
+    return Terrain(
+        kind=kind,
+        size=(sx.number("x", low=0.0, low_open=True), sx.number("z", low=0.0, low_open=True)),
+        resolution=t.integer("resolution", d.resolution, low=2, high=4096),
+        height=t.number("height", d.height, low=0.0),
+        seed=t.integer("seed", d.seed, low=0, high=2**31 - 1),
+        mesh=t.string("mesh") if kind == "mesh" else None,
+        color=t.vector("color", d.color, low=0.0, high=1.0),
+    )
+
+
+def _object(t: _Table) -> SceneObject:
+    t.reject_unknown(("name", "mesh", "primitive", "scale", "position", "path", "color"))
+    if t.has("mesh") == t.has("primitive"):
+        t.fail("mesh", "give exactly one of mesh (a file) or primitive")
+    path = None
+    if t.has("path"):
+        path = t.matrix("path", 4)
+        _check_times(t, "path", path[:, 0])
+    return SceneObject(
+        name=t.string("name"),
+        mesh=t.string("mesh") if t.has("mesh") else None,
+        primitive=t.string("primitive", choices=PRIMITIVES) if t.has("primitive") else None,
+        scale=t.number("scale", 1.0, low=0.0, low_open=True),
+        position=t.vector("position", (0.0, 0.0, 0.0)),
+        path=path,
+        color=t.vector("color", SceneObject("").color, low=0.0, high=1.0),
+    )
+
+
+def _camera_path(t: _Table) -> CameraPath:
+    t.reject_unknown(("name", "keys"))
+    keys = t.matrix("keys", 7)
+    if len(keys) < 2:
+        t.fail("keys", "a camera path needs at least 2 keys")
+    _check_times(t, "keys", keys[:, 0])
+    if np.any(np.all(keys[:, 1:4] == keys[:, 4:7], axis=1)):
+        t.fail("keys", "a key looks at its own position")
+    return CameraPath(t.string("name"), keys)
+
+
+def _check_times(t: _Table, key: str, times: np.ndarray) -> None:
+    if np.any(np.diff(times) <= 0):
+        t.fail(key, "key times must increase strictly")
+
+
+# ---------------------------------------------------------------- saving
+
+
+def scene_to_dict(scene: Scene) -> dict:
+    """The TOML document for `scene` (particles of clouds with a particles_file are not inlined)."""
+    c, s = scene.camera, scene.shading
+    data: dict = {}
+    if scene.description:
+        data["description"] = scene.description
+    data["camera"] = {"position": list(c.position), "look_at": list(c.look_at), "fov_y_deg": c.fov_y_deg}
+    lighting: dict = {}
+    if scene.lighting.time_of_day is not None:
+        lighting["time_of_day"] = scene.lighting.time_of_day
+    if scene.lighting.ambient is not None:
+        lighting["ambient"] = list(scene.lighting.ambient)
+    if scene.lighting.lights:
+        lighting["lights"] = [{"direction": list(l.direction), "color": list(l.color), "intensity": l.intensity}
+                              for l in scene.lighting.lights]
+    data["lighting"] = lighting
+    data["shading"] = {"albedo": s.albedo, "optical_depth": s.optical_depth, "phase": s.phase, "g": s.g}
+    if scene.terrain is not None:
+        t = scene.terrain
+        terrain = {"kind": t.kind, "size": list(t.size), "resolution": t.resolution, "height": t.height,
+                   "seed": t.seed, "color": list(t.color)}
+        if t.mesh is not None:
+            terrain["mesh"] = t.mesh
+        data["terrain"] = terrain
+    data["clouds"] = [_cloud_dict(cloud) for cloud in scene.clouds]
+    data["objects"] = [_object_dict(o) for o in scene.objects]
+    data["camera_paths"] = [{"name": p.name, "keys": _rows(p.keys)} for p in scene.camera_paths]
+    return {k: v for k, v in data.items() if v != []}
+
+
+def _cloud_dict(cloud: Cloud) -> dict:
+    out: dict = {"name": cloud.name}
+    if cloud.particles_file is not None:
+        out["particles_file"] = cloud.particles_file
+    else:
+        out["particles"] = _rows(cloud.particles)
+    for key in ("optical_depth", "albedo"):
+        if getattr(cloud, key) is not None:
+            out[key] = getattr(cloud, key)
+    out["color"] = list(cloud.color)
+    return out
+
+
+def _object_dict(o: SceneObject) -> dict:
+    out: dict = {"name": o.name}
+    out["mesh" if o.mesh is not None else "primitive"] = o.mesh if o.mesh is not None else o.primitive
+    out.update(scale=o.scale, position=list(o.position), color=list(o.color))
+    if o.path is not None:
+        out["path"] = _rows(o.path)
+    return out
+
+
+def _rows(matrix: np.ndarray):
+    """A matrix as a TOML array with one row per line, the way people read it."""
+    array = tomlkit.array()
+    array.extend(matrix.tolist())
+    return array.multiline(True)
+
+
+def particles_file_for(scene_path, cloud_name: str) -> str:
+    """Where `save_scene` puts a large cloud's particles, relative to the scene file."""
+    safe = "".join(ch if ch.isalnum() or ch in "-_" else "_" for ch in cloud_name)
+    return f"{Path(scene_path).stem}.particles/{safe}.npy"
+
+
+def save_scene(scene: Scene, path) -> Scene:
+    """Write `scene` to `path` atomically; return the scene as saved.
+
+    Clouds with more than INLINE_PARTICLE_LIMIT particles and no particles_file
+    get one beside the scene.  Particle files are written first, each by
+    write-then-rename, so the TOML never names a missing or partial file; the
+    TOML itself is replaced last, in one rename.
+    """
+    path = Path(path)
+    saved_clouds = []
+    for cloud in scene.clouds:
+        relative = cloud.particles_file
+        if relative is None and len(cloud.particles) > INLINE_PARTICLE_LIMIT:
+            relative = particles_file_for(path, cloud.name)
+        if relative is not None:
+            target = path.parent / relative
+            target.parent.mkdir(parents=True, exist_ok=True)
+            _atomic_write(target, lambda f, p=cloud.particles: np.save(f, np.asarray(p, dtype=np.float64)))
+            cloud = Cloud(cloud.name, cloud.particles, relative, cloud.optical_depth, cloud.albedo, cloud.color)
+        saved_clouds.append(cloud)
+    saved = Scene(scene.camera, scene.lighting, scene.shading, tuple(saved_clouds), scene.terrain,
+                  scene.objects, scene.camera_paths, scene.description)
+    document = tomlkit.dumps(scene_to_dict(saved)).encode("utf-8")
+    _atomic_write(path, lambda f: f.write(document))
+    return saved
+
+
+def _atomic_write(path: Path, write) -> None:
+    """Write through a temporary file in the same folder, fsync, then rename over `path`."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as f:
+            write(f)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(temporary, path)
+    except BaseException:
+        Path(temporary).unlink(missing_ok=True)
+        raise

@@ -1,0 +1,347 @@
+"""Harris multiple forward scattering: the light that reaches each particle.
+
+Harris, "Real-Time Cloud Rendering for Games", GDC 2002, section 2.2.1, eq. 4,
+and the illumination pass of figure 4: particles are visited in light order
+(nearest the light first) over a light-plane "frame buffer" cleared to 1.  Each
+particle reads the value at its own centre (its incident light I_k), then is
+splatted with
+
+    value = sigma_k * I_k * K_k(x) + (1 - alpha_k * K_k(x)) * value
+
+where alpha_k = 1 - exp(-tau_k), sigma_k = a_k tau_k p(0) / (4 pi) and K is the
+splat kernel (`cloudcore.kernel`).
+
+Stability.  Where sigma_k > alpha_k (tau above about 9.3 at albedo 0.9 with
+Rayleigh) the literal recurrence sends on more light than reached the particle.
+We use sigma_eff = min(sigma_k, alpha_k): identical to the paper wherever it is
+stable, continuous in tau, and it makes every blend a convex combination of the
+old value and I_k <= 1, so all values stay in [0, 1].  An optically thick
+particle then forward-scatters everything it stops, which is where the paper's
+own trend (thicker particles pass on more) is heading.  The eye pass uses the
+same cap (`scattering_coefficient`), with the phase function for the view.
+
+Two methods:
+
+* "exact": the frame buffer is sampled only at the particle centres, which is all
+  that is ever read.  Each overlap (source j, later target i) is an affine map
+  v -> A v + B on the value at i; affine maps compose associatively, so once all
+  of a target's sources are known its value is a segmented scan over its
+  sources in light order.  Targets become ready in dependency levels (Kahn's
+  algorithm), so the Python loop runs over levels, not particles.
+* "raster": Harris's frame buffer as a grid, walked in depth slabs; particles in
+  one slab read the grid together and are splatted together with
+  order-independent compositing.  Faster and approximate; see `docs/shading.md`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from cloudcore.kernel import splat_kernel
+from cloudcore.phase import check_phase, phase_function
+
+METHODS = ("exact", "raster")
+FOUR_PI = 4.0 * np.pi
+
+#: raster grid cells across the widest axis of a cloud's light-plane footprint.
+DEFAULT_RASTER_RESOLUTION = 48
+#: raster depth-slab thickness as a fraction of the cloud's median particle radius;
+#: thin slabs cost little and remove most of the in-slab self-shadowing error
+#: (docs/shading.md has the sweep).
+DEFAULT_SLAB_FRACTION = 0.05
+
+
+def scattering_coefficient(optical_depth, albedo, phase: str = "rayleigh", g: float = 0.0) -> np.ndarray:
+    """a tau / (4 pi), capped at alpha / p(0) so that no particle creates light.
+
+    Multiply by p(cos_theta) for the scattering factor in any direction: forward
+    (light pass) it gives sigma_eff = min(sigma, alpha); toward the eye (Harris
+    eq. 5) it gives S_k / I_k.
+    """
+    tau = np.asarray(optical_depth, dtype=np.float64)
+    alpha = -np.expm1(-tau)
+    p_forward = float(phase_function(1.0, phase, g))
+    return np.minimum(np.asarray(albedo, dtype=np.float64) * tau / FOUR_PI, alpha / p_forward)
+
+
+def incident_light(
+    positions,
+    radii,
+    optical_depth,
+    albedo,
+    light_dir,
+    *,
+    phase: str = "rayleigh",
+    g: float = 0.0,
+    method: str = "exact",
+    groups=None,
+    resolution: int = DEFAULT_RASTER_RESOLUTION,
+) -> np.ndarray:
+    """Fraction of the light from `light_dir` that reaches each particle centre, float64 (N,).
+
+    positions (N, 3); radii (N,); optical_depth (N,) = tau through the centre;
+    albedo (N,) in [0, 1]; light_dir (3,) points from the scene toward the light.
+    `groups` (N,) ints, optional: particles only shadow particles of their own
+    group (Harris shades each cloud on its own), so many clouds shade in one call.
+    Scalars broadcast for radii, optical_depth and albedo.
+    """
+    positions, radii, tau, albedo, light = _validated(positions, radii, optical_depth, albedo, light_dir)
+    check_phase(phase, g)
+    if method not in METHODS:
+        raise ValueError(f"unknown shading method {method!r}; valid: {', '.join(METHODS)}")
+    n = len(positions)
+    if n == 0:
+        return np.zeros(0)
+    groups = np.zeros(n, dtype=np.int64) if groups is None else np.asarray(groups).reshape(n)
+
+    u, v = _light_plane_axes(light)
+    plane = np.stack([positions @ u, positions @ v], axis=1)
+    toward_light = positions @ light
+    alpha = -np.expm1(-tau)
+    sigma = scattering_coefficient(tau, albedo, phase, g) * float(phase_function(1.0, phase, g))
+    if method == "exact":
+        result = _incident_exact(plane, toward_light, radii, alpha, sigma, groups)
+    else:
+        result = _incident_raster(plane, toward_light, radii, alpha, sigma, groups, int(resolution))
+    # Every step is a convex combination of values in [0, 1]; clip only rounding.
+    return np.clip(result, 0.0, 1.0)
+
+
+def _validated(positions, radii, optical_depth, albedo, light_dir):
+    positions = np.asarray(positions, dtype=np.float64)
+    if positions.ndim != 2 or positions.shape[1] != 3:
+        raise ValueError(f"positions must have shape (N, 3), got {positions.shape}")
+    n = len(positions)
+
+    def per_particle(name, value):
+        array = np.asarray(value, dtype=np.float64)
+        if array.ndim == 0:
+            array = np.full(n, float(array))
+        if array.shape != (n,):
+            raise ValueError(f"{name} must have shape ({n},) or be a scalar, got {array.shape}")
+        if not np.all(np.isfinite(array)):
+            raise ValueError(f"{name} must be finite (found NaN or Inf)")
+        return array
+
+    radii = per_particle("radii", radii)
+    tau = per_particle("optical_depth", optical_depth)
+    albedo = per_particle("albedo", albedo)
+    if not np.all(np.isfinite(positions)):
+        raise ValueError("positions must be finite (found NaN or Inf)")
+    if np.any(radii < 0):
+        raise ValueError("radii must be >= 0")
+    if np.any(tau < 0):
+        raise ValueError("optical_depth must be >= 0")
+    if np.any((albedo < 0) | (albedo > 1)):
+        raise ValueError("albedo must be within [0, 1]")
+    light = np.asarray(light_dir, dtype=np.float64)
+    if light.shape != (3,) or not np.all(np.isfinite(light)):
+        raise ValueError(f"light_dir must be a finite 3-vector, got {light_dir!r}")
+    length = np.linalg.norm(light)
+    if not length > 0:
+        raise ValueError("light_dir must not be the zero vector")
+    return positions, radii, tau, albedo, light / length
+
+
+def _light_plane_axes(light: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Two unit vectors spanning the plane perpendicular to `light` (the light's view)."""
+    helper = np.eye(3)[np.argmin(np.abs(light))]
+    u = np.cross(light, helper)
+    u /= np.linalg.norm(u)
+    return u, np.cross(light, u)
+
+
+def _overlaps_in_light_order(plane: np.ndarray, radii: np.ndarray):
+    """Pairs (i, j), i < j, of particles already sorted in light order, with j inside i's splat.
+
+    Returns (source i, target j, K_i(x_j)).  One radius-wide pair query when the
+    radii are alike; otherwise sources are bucketed by radius octave so that one
+    huge particle among tiny ones does not make every query as wide as itself.
+    """
+    tree = cKDTree(plane)
+    positive = radii > 0
+    if not positive.any():
+        return np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0)
+    largest, smallest = radii.max(), radii[positive].min()
+    if largest <= 4.0 * smallest:
+        pairs = tree.query_pairs(float(largest), output_type="ndarray")
+        source, target = pairs.min(axis=1), pairs.max(axis=1)
+        distance = np.linalg.norm(plane[source] - plane[target], axis=1)
+    else:
+        octave = np.floor(np.log2(np.where(positive, radii, 1.0))).astype(np.int64)
+        found_source, found_target, found_distance = [], [], []
+        for band in np.unique(octave[positive]):
+            in_band = np.flatnonzero((octave == band) & positive)
+            found = cKDTree(plane[in_band]).sparse_distance_matrix(
+                tree, float(radii[in_band].max()), output_type="ndarray")
+            found_source.append(in_band[found["i"]])
+            found_target.append(found["j"])
+            found_distance.append(found["v"])
+        source, target, distance = (np.concatenate(x) for x in (found_source, found_target, found_distance))
+        later = source < target
+        source, target, distance = source[later], target[later], distance[later]
+    inside = distance < radii[source]
+    source, target = source[inside], target[inside]
+    return source, target, splat_kernel(distance[inside] / radii[source])
+
+
+def _incident_exact(plane, toward_light, radii, alpha, sigma, groups):
+    incident = np.ones(len(plane))
+    for members in _split_by_value(groups):
+        # ties (coincident particles) keep their index order
+        order = members[np.argsort(-toward_light[members], kind="stable")]
+        incident[order] = _incident_exact_sorted(plane[order], radii[order], alpha[order], sigma[order])
+    return incident
+
+
+def _incident_exact_sorted(plane, radii, alpha, sigma):
+    """Exact incident light of one group whose particles are in light order."""
+    n = len(plane)
+    source, target, weight = _overlaps_in_light_order(plane, radii)
+
+    by_target = np.argsort(target * n + source)
+    in_source, in_weight = source[by_target], weight[by_target]
+    in_count = np.bincount(target, minlength=n)
+    in_start = np.cumsum(in_count) - in_count
+
+    by_source = np.argsort(source, kind="stable")
+    out_target = target[by_source]
+    out_count = np.bincount(source, minlength=n)
+    out_start = np.cumsum(out_count) - out_count
+
+    incident = np.ones(n)
+    waiting = in_count.copy()
+    ready = np.flatnonzero(waiting == 0)
+    while ready.size:
+        lit = ready[in_count[ready] > 0]
+        if lit.size:
+            edges = _concatenated_ranges(in_start[lit], in_count[lit])
+            src, w = in_source[edges], in_weight[edges]
+            through, scattered = _compose_segments(
+                1.0 - alpha[src] * w, sigma[src] * incident[src] * w, in_count[lit]
+            )
+            incident[lit] = through + scattered  # the frame buffer starts at 1
+        released = out_target[_concatenated_ranges(out_start[ready], out_count[ready])]
+        np.subtract.at(waiting, released, 1)
+        ready = np.unique(released[waiting[released] == 0])
+    return incident
+
+
+def _concatenated_ranges(starts: np.ndarray, counts: np.ndarray) -> np.ndarray:
+    """concatenate(arange(s, s + c) for s, c in zip(starts, counts)), vectorised."""
+    total = int(counts.sum())
+    if total == 0:
+        return np.zeros(0, dtype=np.int64)
+    ends = np.cumsum(counts)
+    offsets = np.repeat(starts - (ends - counts), counts)
+    return np.arange(total) + offsets
+
+
+def _compose_segments(through: np.ndarray, scattered: np.ndarray, lengths: np.ndarray):
+    """Compose v -> through * v + scattered along each segment, first element applied first.
+
+    Inclusive Hillis-Steele scan in log2(longest segment) vectorised passes;
+    returns the composite (through, scattered) of each segment.
+    """
+    through, scattered = through.copy(), scattered.copy()
+    ends = np.cumsum(lengths)
+    head = np.repeat(ends - lengths, lengths)
+    position = np.arange(len(through))
+    step = 1
+    longest = int(lengths.max())
+    while step < longest:
+        k = position[position - step >= head]
+        earlier_through, earlier_scattered = through[k - step], scattered[k - step]
+        scattered[k] = through[k] * earlier_scattered + scattered[k]
+        through[k] = through[k] * earlier_through
+        step *= 2
+    return through[ends - 1], scattered[ends - 1]
+
+
+# ---------------------------------------------------------------- raster
+
+
+def _incident_raster(plane, toward_light, radii, alpha, sigma, groups, resolution):
+    """Harris's light-plane frame buffer, one grid per group, visited in depth slabs.
+
+    Inside a slab the splats composite order-independently: transmittance
+    T = prod(1 - alpha K) and in-scattered light (1 - T) times the extinction-
+    weighted mean of sigma I / alpha.  One splat alone gives the exact blend;
+    overlapping ones stay within [0, 1].
+    """
+    if resolution < 2:
+        raise ValueError(f"raster resolution must be >= 2, got {resolution}")
+    n = len(plane)
+    origin = np.zeros((n, 2))
+    cell = np.ones(n)
+    grid_offset = np.zeros(n, dtype=np.int64)
+    slab = np.zeros(n, dtype=np.int64)
+    total_cells = 0
+    for group in np.unique(groups):
+        members = np.flatnonzero(groups == group)
+        low = (plane[members] - radii[members, None]).min(axis=0)
+        high = (plane[members] + radii[members, None]).max(axis=0)
+        size = max(float((high - low).max()), np.finfo(float).tiny)
+        origin[members] = low
+        cell[members] = size / resolution
+        grid_offset[members] = total_cells
+        total_cells += resolution * resolution
+        thickness = DEFAULT_SLAB_FRACTION * float(np.median(radii[members]))
+        depth = toward_light[members].max() - toward_light[members]
+        slab[members] = (depth / thickness).astype(np.int64) if thickness > 0 else 0
+
+    grid = np.ones(total_cells)
+    incident = np.ones(n)
+    centre = (plane - origin) / cell[:, None]  # in cells
+    for members in _split_by_value(slab):
+        incident[members] = _bilinear(grid, grid_offset[members], resolution, centre[members])
+        cells, weight, owner = _footprints(centre[members], radii[members] / cell[members], resolution)
+        if cells.size == 0:
+            continue
+        cells = cells + grid_offset[members][owner]
+        owner = members[owner]
+        extinction = alpha[owner] * weight
+        log_through = np.bincount(cells, np.log(np.maximum(1.0 - extinction, 1e-300)), total_cells)
+        weighted_extinction = np.bincount(cells, extinction, total_cells)
+        weighted_source = np.bincount(cells, sigma[owner] * incident[owner] * weight, total_cells)
+        touched = np.flatnonzero(weighted_extinction > 0)
+        through = np.exp(log_through[touched])
+        source = weighted_source[touched] / weighted_extinction[touched] * (1.0 - through)
+        grid[touched] = through * grid[touched] + source
+    return incident
+
+
+def _split_by_value(values: np.ndarray):
+    """Index arrays of equal `values`, in increasing value order."""
+    order = np.argsort(values, kind="stable")
+    bounds = np.flatnonzero(np.diff(values[order])) + 1
+    return np.split(order, bounds)
+
+
+def _bilinear(grid, offset, resolution, point):
+    """Grid values (cell centres at i + 0.5) at continuous cell coordinates, clamped to the grid."""
+    p = np.clip(point - 0.5, 0.0, resolution - 1.0)
+    i0 = np.minimum(p.astype(np.int64), resolution - 2)
+    f = p - i0
+    def at(dx, dy):
+        return grid[offset + (i0[:, 1] + dy) * resolution + i0[:, 0] + dx]
+    return ((at(0, 0) * (1 - f[:, 0]) + at(1, 0) * f[:, 0]) * (1 - f[:, 1])
+            + (at(0, 1) * (1 - f[:, 0]) + at(1, 1) * f[:, 0]) * f[:, 1])
+
+
+def _footprints(centre, radius, resolution):
+    """Cells whose centres lie inside each splat: (cell index, kernel weight, owning splat)."""
+    low = np.clip(np.floor(centre - radius[:, None]).astype(np.int64), 0, resolution - 1)
+    high = np.clip(np.ceil(centre + radius[:, None]).astype(np.int64), 0, resolution - 1)
+    span = high - low + 1
+    count = span[:, 0] * span[:, 1]
+    owner = np.repeat(np.arange(len(centre)), count)
+    local = np.arange(int(count.sum())) - np.repeat(np.cumsum(count) - count, count)
+    x = low[owner, 0] + local % span[owner, 0]
+    y = low[owner, 1] + local // span[owner, 0]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        d = np.hypot(x + 0.5 - centre[owner, 0], y + 0.5 - centre[owner, 1]) / radius[owner]
+    weight = splat_kernel(np.where(radius[owner] > 0, d, np.inf))
+    keep = weight > 0
+    return (y * resolution + x)[keep], weight[keep], owner[keep]

@@ -1,0 +1,71 @@
+"""Procedural heightfield terrain: a valley with noisy ridges, deterministic from a seed.
+
+Noise comes from an integer hash, not a random generator, so the same
+parameters give the same heights on every numpy version and platform.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from cloudcore.scene import Terrain
+
+_OCTAVES = 6
+
+
+def _hash01(ix: np.ndarray, iz: np.ndarray, seed: int) -> np.ndarray:
+    """A value in [0, 1) per integer lattice point (splitmix-style integer mixing)."""
+    h = (ix.astype(np.uint64) * np.uint64(0x9E3779B97F4A7C15)
+         ^ iz.astype(np.uint64) * np.uint64(0xC2B2AE3D27D4EB4F)
+         ^ np.uint64(seed) * np.uint64(0x165667B19E3779F9))
+    h ^= h >> np.uint64(31)
+    h *= np.uint64(0xBF58476D1CE4E5B9)
+    h ^= h >> np.uint64(29)
+    return (h >> np.uint64(11)).astype(np.float64) / float(1 << 53)
+
+
+def _value_noise(x: np.ndarray, z: np.ndarray, seed: int) -> np.ndarray:
+    """Smoothly interpolated lattice noise in [-1, 1]."""
+    x0, z0 = np.floor(x), np.floor(z)
+    fx, fz = x - x0, z - z0
+    sx, sz = fx * fx * (3 - 2 * fx), fz * fz * (3 - 2 * fz)
+    ix, iz = x0.astype(np.int64), z0.astype(np.int64)
+    with np.errstate(over="ignore"):
+        c00, c10 = _hash01(ix, iz, seed), _hash01(ix + 1, iz, seed)
+        c01, c11 = _hash01(ix, iz + 1, seed), _hash01(ix + 1, iz + 1, seed)
+    top = c00 + (c10 - c00) * sx
+    bottom = c01 + (c11 - c01) * sx
+    return 2.0 * (top + (bottom - top) * sz) - 1.0
+
+
+def height_at(terrain: Terrain, x, z) -> np.ndarray:
+    """Terrain height (metres) at world (x, z); the valley runs along z."""
+    x, z = np.asarray(x, dtype=np.float64), np.asarray(z, dtype=np.float64)
+    half_x = 0.5 * terrain.size[0]
+    across = np.clip(np.abs(x) / half_x, 0.0, 1.0)
+    valley = across ** 1.6
+    wavelength = 0.35 * min(terrain.size)
+    noise = np.zeros(np.broadcast(x, z).shape)
+    amplitude, total = 1.0, 0.0
+    for octave in range(_OCTAVES):
+        noise += amplitude * _value_noise(x / wavelength, z / wavelength, terrain.seed + 101 * octave)
+        total += amplitude
+        amplitude *= 0.5
+        wavelength *= 0.5
+    ridges = 0.55 + 0.45 * noise / total
+    return terrain.height * (0.08 + 0.92 * valley * ridges) + 0.05 * terrain.height * noise / total
+
+
+def heightfield_mesh(terrain: Terrain) -> tuple[np.ndarray, np.ndarray]:
+    """Vertices (R*R, 3) and triangles (2 (R-1)^2, 3) of the heightfield, centred on the origin."""
+    n = terrain.resolution
+    xs = np.linspace(-0.5 * terrain.size[0], 0.5 * terrain.size[0], n)
+    zs = np.linspace(-0.5 * terrain.size[1], 0.5 * terrain.size[1], n)
+    x, z = np.meshgrid(xs, zs)
+    vertices = np.stack([x, height_at(terrain, x, z), z], axis=-1).reshape(-1, 3)
+    i = np.arange(n - 1)
+    corner = (i[:, None] * n + i[None, :]).ravel()
+    # counter-clockwise seen from above (+y) so the faces point up
+    first = np.stack([corner, corner + n, corner + 1], axis=1)
+    second = np.stack([corner + 1, corner + n, corner + n + 1], axis=1)
+    return vertices, np.concatenate([first, second]).astype(np.int64)
