@@ -1,0 +1,30 @@
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from cloudcore.scene import Camera, CameraPath, Cloud, Light, Lighting, Scene, SceneObject, Shading, Terrain
+
+ROOT = Path(__file__).resolve().parents[1]
+VALLEY = ROOT / "resources" / "scenes" / "valley.toml"
+
+
+@pytest.fixture
+def small_scene() -> Scene:
+    """A scene that touches every field: inline and file particles, explicit lights, objects, paths."""
+    rng = np.random.default_rng(4)
+    small = np.column_stack([rng.normal(size=(12, 3)) * 50 + [0, 800, 0], rng.uniform(10, 20, 12)])
+    large = np.column_stack([rng.normal(size=(200, 3)) * 80 + [400, 900, 0], rng.uniform(15, 30, 200)])
+    return Scene(
+        camera=Camera((0.0, 500.0, 1500.0), (0.0, 800.0, 0.0), 55.0),
+        lighting=Lighting(time_of_day=None, ambient=(0.1, 0.1, 0.12),
+                          lights=(Light((0.0, 1.0, 0.0), (1.0, 0.9, 0.8), 1.0),
+                                  Light((0.6, 0.8, 0.0), (0.5, 0.6, 1.0), 0.3))),
+        shading=Shading(albedo=0.8, optical_depth=6.5, phase="henyey-greenstein", g=0.7),
+        clouds=(Cloud("small", small, optical_depth=3.0, color=(1.0, 0.95, 0.9)), Cloud("large", large, albedo=0.95)),
+        terrain=Terrain(size=(2000.0, 3000.0), resolution=33, height=300.0, seed=3),
+        objects=(SceneObject("crate", primitive="box", scale=12.5, position=(10.0, 700.0, 5.0)),
+                 SceneObject("plane", primitive="aircraft", path=np.array([[0, 0, 900, 0], [10, 500, 900, 0]]))),
+        camera_paths=(CameraPath("orbit", np.array([[0, 0, 500, 1500, 0, 800, 0], [5, 1500, 600, 0, 0, 800, 0]])),),
+        description="every field",
+    )

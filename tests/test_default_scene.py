@@ -1,0 +1,60 @@
+"""The default scene: what issue 2 promises about resources/scenes/valley.toml."""
+
+import numpy as np
+import pytest
+
+from cloudcore.lighting import elevation_deg, sun_direction
+from cloudcore.paths import sample
+from cloudcore.scenefile import load_scene
+from cloudcore.terrain import heightfield_mesh
+from conftest import VALLEY
+
+
+@pytest.fixture(scope="module")
+def valley():
+    return load_scene(VALLEY)
+
+
+def inside_clouds(scene, point):
+    """Names of the clouds with a particle whose core (half radius) contains `point`."""
+    return {c.name for c in scene.clouds
+            if np.any(np.linalg.norm(c.centres - point, axis=1) < 0.5 * c.radii)}
+
+
+def test_after_harris_figure_3(valley):
+    assert len(valley.clouds) == 34
+    assert 85_000 <= valley.particle_count <= 95_000
+    vertices, faces = heightfield_mesh(valley.terrain)
+    assert 55_000 <= len(faces) <= 65_000
+    assert np.all(np.isfinite(vertices))
+    assert elevation_deg(sun_direction(valley.lighting.time_of_day)) > 10  # afternoon sun, well up
+    assert 12 < valley.lighting.time_of_day < 18
+
+
+def test_clouds_hang_above_the_terrain(valley):
+    vertices, _ = heightfield_mesh(valley.terrain)
+    lowest_cloud = min(float((c.centres[:, 1] - c.radii).min()) for c in valley.clouds)
+    assert lowest_cloud > vertices[:, 1].max() * 0.9
+
+
+def test_flythrough_lasts_about_30_s_and_passes_through_two_clouds(valley):
+    path = valley.camera_path("flythrough")
+    assert 25 <= path.duration <= 35
+    visited = set()
+    for t in np.arange(path.keys[0, 0], path.keys[-1, 0], 0.05):
+        visited |= inside_clouds(valley, sample(path.keys, t)[:3])
+    assert len(visited) >= 2
+
+
+def test_aircraft_path_crosses_a_cloud(valley):
+    (aircraft,) = [o for o in valley.objects if o.primitive == "aircraft"]
+    crossed = set()
+    for t in np.arange(aircraft.path[0, 0], aircraft.path[-1, 0], 0.05):
+        crossed |= inside_clouds(valley, sample(aircraft.path, t))
+    assert crossed
+
+
+def test_terrain_is_deterministic(valley):
+    a, _ = heightfield_mesh(valley.terrain)
+    b, _ = heightfield_mesh(valley.terrain)
+    np.testing.assert_array_equal(a, b)

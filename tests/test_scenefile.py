@@ -1,0 +1,165 @@
+"""Scene files: lossless round trips, clear refusals, atomic saves."""
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+import tomllib
+
+import cloudcore.scenefile as scenefile
+from cloudcore.errors import SceneError
+from cloudcore.scenefile import load_scene, save_scene, scene_to_dict
+from conftest import VALLEY
+
+
+def test_round_trip_is_lossless(tmp_path, small_scene):
+    saved = save_scene(small_scene, tmp_path / "s.toml")
+    loaded = load_scene(tmp_path / "s.toml")
+    assert loaded == saved
+    assert loaded.clouds[0].particles_file is None  # 12 particles stay inline
+    assert loaded.clouds[1].particles_file == "s.particles/large.npy"
+    for original, again in zip(small_scene.clouds, loaded.clouds):
+        np.testing.assert_array_equal(original.particles, again.particles)  # bit for bit
+    save_scene(loaded, tmp_path / "again.toml")
+    assert (tmp_path / "again.toml").read_text().replace("again.particles", "s.particles") == \
+        (tmp_path / "s.toml").read_text()
+
+
+def test_default_scene_round_trips(tmp_path):
+    scene = load_scene(VALLEY)
+    save_scene(scene, tmp_path / "valley.toml")
+    assert load_scene(tmp_path / "valley.toml") == scene
+
+
+def test_awkward_floats_survive(tmp_path, small_scene):
+    from dataclasses import replace
+    particles = np.array([[0.1 + 0.2, 1e-300, -2.5e17, 1e-6], [1 / 3, 5e-324, 1e6, 1e6]])
+    scene = replace(small_scene, clouds=(replace(small_scene.clouds[0], particles=particles),))
+    save_scene(scene, tmp_path / "f.toml")
+    np.testing.assert_array_equal(load_scene(tmp_path / "f.toml").clouds[0].particles, particles)
+
+
+BASE = """
+[camera]
+position = [0.0, 500.0, 1500.0]
+look_at = [0.0, 800.0, 0.0]
+[lighting]
+time_of_day = 14.0
+[[clouds]]
+name = "a"
+particles = [[0.0, 800.0, 0.0, 20.0], [10.0, 810.0, 0.0, 25.0]]
+[[camera_paths]]
+name = "p"
+keys = [[0, 0, 500, 1500, 0, 800, 0], [5, 100, 500, 1500, 0, 800, 0]]
+"""
+
+MALFORMED = [
+    # (old text, new text, field named in the error, problem named in the error)
+    ("[0.0, 800.0, 0.0, 20.0]", "[0.0, 800.0, 0.0, -20.0]", "clouds[0].particles", "radius must be > 0"),
+    ("[0.0, 800.0, 0.0, 20.0]", "[0.0, nan, 0.0, 20.0]", "clouds[0].particles", "not finite"),
+    ("[0.0, 800.0, 0.0, 20.0]", "[0.0, 800.0, 20.0]", "clouds[0].particles", "rows of 4"),
+    ("[0.0, 800.0, 0.0, 20.0]", "[0.0, \"x\", 0.0, 20.0]", "clouds[0].particles", "rows of 4"),
+    ('name = "a"', 'name = "a"\noptical_depth = -1.0', "clouds[0].optical_depth", "within"),
+    ('name = "a"', 'name = "a"\nalbedo = 1.5', "clouds[0].albedo", "within"),
+    ('name = "a"', "", "clouds[0].name", "missing"),
+    ('name = "a"', 'name = "a"\nparticles_file = "x.npy"', "clouds[0].particles", "exactly one"),
+    ("time_of_day = 14.0", "time_of_day = 25.0", "lighting.time_of_day", "within"),
+    ("time_of_day = 14.0", 'time_of_day = "noon"', "lighting.time_of_day", "expected a number"),
+    ("time_of_day = 14.0", "time_of_day = inf", "lighting.time_of_day", "finite"),
+    ("[lighting]", "[shading]\nphase = \"mie\"\n[lighting]", "shading.phase", "rayleigh"),
+    ("[lighting]", "[shading]\ng = 1.0\n[lighting]", "shading.g", "within"),
+    ("[lighting]", "[shading]\noptical_depth = -8.0\n[lighting]", "shading.optical_depth", "within"),
+    ("[lighting]", "[shading]\nalbedo = nan\n[lighting]", "shading.albedo", "finite"),
+    ("[lighting]", "[shading]\nalbdo = 0.5\n[lighting]", "shading.albdo", "unknown key"),
+    ("look_at = [0.0, 800.0, 0.0]", "look_at = [0.0, 500.0, 1500.0]", "camera.look_at", "differ"),
+    ("look_at = [0.0, 800.0, 0.0]", "look_at = [0.0, 800.0]", "camera.look_at", "rows of 3"),
+    ("[camera]", "[camera]\nfov_y_deg = 0.0", "camera.fov_y_deg", "within"),
+    ("time_of_day = 14.0", "time_of_day = 14.0\n[[lighting.lights]]\ndirection = [0, 0, 0]",
+     "lighting.lights[0].direction", "zero vector"),
+    ("[5, 100, 500", "[0, 100, 500", "camera_paths[0].keys", "increase strictly"),
+    ('name = "p"', 'name = "p"\nspeed = 3', "camera_paths[0].speed", "unknown key"),
+    ("[camera]", "[[objects]]\nname = \"o\"\nprimitive = \"teapot\"\n[camera]", "objects[0].primitive", "aircraft"),
+    ("[camera]", "[[objects]]\nname = \"o\"\nprimitive = \"box\"\nscale = 0\n[camera]", "objects[0].scale", "within"),
+    ("[camera]", "[[objects]]\nname = \"o\"\n[camera]", "objects[0].mesh", "exactly one"),
+    ("[camera]", "[terrain]\nresolution = 1\n[camera]", "terrain.resolution", "within"),
+    ("[camera]", "[terrain]\nsize = [100.0]\n[camera]", "terrain.size", "size_x"),
+    ("[camera]", "colour = 3\n[camera]", "colour", "unknown key"),
+    ("[[camera_paths]]", "[[clouds]]\nname = \"a\"\nparticles = []\n[[camera_paths]]", "clouds[1].name", "duplicate"),
+    ("[lighting]", "[lighting", "(toml)", "line"),
+]
+
+
+@pytest.mark.parametrize("old, new, field, problem", MALFORMED)
+def test_malformed_scene_names_file_field_and_problem(tmp_path, old, new, field, problem):
+    assert old in BASE
+    path = tmp_path / "bad.toml"
+    path.write_text(BASE.replace(old, new, 1))
+    with pytest.raises(SceneError) as caught:
+        load_scene(path)
+    assert caught.value.source == str(path)
+    assert caught.value.field == field
+    assert problem in caught.value.problem
+    assert str(caught.value).startswith(f"{path}: {field}: ")
+
+
+def test_base_scene_is_valid(tmp_path):
+    (tmp_path / "ok.toml").write_text(BASE)
+    assert len(load_scene(tmp_path / "ok.toml").clouds) == 1
+
+
+@pytest.mark.parametrize("content, problem", [
+    (None, "no such file"),
+    (b"\x93NUMPY\x01\x00", "not a readable .npy"),
+    ("truncated", "not a readable .npy"),
+    ("3 columns", "rows of 4"),
+    ("strings", "numeric array"),
+])
+def test_bad_particle_files_are_refused(tmp_path, content, problem):
+    npy = tmp_path / "p.npy"
+    if content == "truncated":
+        np.save(npy, np.ones((100, 4)))
+        npy.write_bytes(npy.read_bytes()[:-37])
+    elif content == "3 columns":
+        np.save(npy, np.ones((5, 3)))
+    elif content == "strings":
+        np.save(npy, np.array(["a", "b"]))
+    elif content is not None:
+        npy.write_bytes(content)
+    (tmp_path / "s.toml").write_text('[[clouds]]\nname = "c"\nparticles_file = "p.npy"\n')
+    with pytest.raises(SceneError, match=problem) as caught:
+        load_scene(tmp_path / "s.toml")
+    assert caught.value.field == "clouds[0].particles_file"
+
+
+def test_failed_save_leaves_the_previous_file_intact(tmp_path, small_scene, monkeypatch):
+    path = tmp_path / "s.toml"
+    save_scene(small_scene, path)
+    before = path.read_bytes()
+
+    def crash(*args, **kwargs):
+        raise OSError("disk full")
+
+    monkeypatch.setattr(scenefile.tomlkit, "dumps", crash)
+    with pytest.raises(OSError):
+        save_scene(small_scene, path)
+    assert path.read_bytes() == before
+    assert [p.name for p in tmp_path.iterdir() if p.suffix == ".tmp"] == []
+
+
+def test_saved_document_is_plain_toml(tmp_path, small_scene):
+    save_scene(small_scene, tmp_path / "s.toml")
+    data = tomllib.loads((tmp_path / "s.toml").read_text())
+    assert data["shading"]["phase"] == "henyey-greenstein"
+    assert set(scene_to_dict(small_scene)) >= {"camera", "lighting", "shading", "clouds", "objects", "camera_paths"}
+
+
+def test_cli_refuses_a_malformed_scene_in_one_line_with_status_2(tmp_path):
+    path = tmp_path / "bad.toml"
+    path.write_text(BASE.replace("20.0]", "-20.0]", 1))
+    result = subprocess.run([sys.executable, "-m", "cloudcore.cli", "shade", str(path)],
+                            capture_output=True, text=True)
+    assert result.returncode == 2
+    assert result.stderr.strip().splitlines() == [
+        f"cloudview: error: {path}: clouds[0].particles: radius must be > 0 (row 0 has -20.0)"]
+    assert "Traceback" not in result.stderr
