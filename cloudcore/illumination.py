@@ -11,7 +11,7 @@ import numpy as np
 
 from cloudcore.lighting import active_lights
 from cloudcore.scene import Cloud, Shading
-from cloudcore.shading import incident_light
+from cloudcore.shading import DEFAULT_RASTER_RESOLUTION, incident_light
 
 
 def cloud_optics(cloud: Cloud, shading: Shading) -> tuple[np.ndarray, np.ndarray]:
@@ -22,7 +22,8 @@ def cloud_optics(cloud: Cloud, shading: Shading) -> tuple[np.ndarray, np.ndarray
     return np.full(n, tau), np.full(n, albedo)
 
 
-def illuminate_clouds(clouds, shading: Shading, lights, method: str = "exact") -> list[np.ndarray]:
+def illuminate_clouds(clouds, shading: Shading, lights, method: str = "exact", *,
+                      resolution: int = DEFAULT_RASTER_RESOLUTION) -> list[np.ndarray]:
     """Incident light (N_i, L) of each cloud for each light that contributes (`active_lights`).
 
     All clouds go through one `incident_light` call per light, each its own
@@ -41,7 +42,8 @@ def illuminate_clouds(clouds, shading: Shading, lights, method: str = "exact") -
     groups = np.repeat(np.arange(len(clouds)), counts)
     columns = [
         incident_light(positions, radii, tau, albedo, light.direction,
-                       phase=shading.phase, g=shading.g, method=method, groups=groups)
+                       phase=shading.phase, g=shading.g, method=method, groups=groups,
+                       resolution=resolution)
         for light in lights
     ]
     incident = np.stack(columns, axis=1) if columns else np.zeros((len(positions), 0))
