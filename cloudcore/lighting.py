@@ -104,7 +104,8 @@ def scene_lights(lighting: Lighting) -> tuple[tuple[Light, ...], np.ndarray]:
     if lighting.lights:
         ambient = NIGHT_AMBIENT if lighting.ambient is None else np.asarray(lighting.ambient, float)
         return lighting.lights, ambient
-    lights, ambient = daylight(lighting.time_of_day)
+    hours = Lighting().time_of_day if lighting.time_of_day is None else lighting.time_of_day
+    lights, ambient = daylight(hours)
     return lights, (ambient if lighting.ambient is None else np.asarray(lighting.ambient, float))
 
 

@@ -155,9 +155,10 @@ def _light_plane_axes(light: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def _overlaps_in_light_order(plane: np.ndarray, radii: np.ndarray):
     """Pairs (i, j), i < j, of particles already sorted in light order, with j inside i's splat.
 
-    Returns (source i, target j, K_i(x_j)).  One radius-wide pair query when the
-    radii are alike; otherwise sources are bucketed by radius octave so that one
-    huge particle among tiny ones does not make every query as wide as itself.
+    Returns (source i, target j, K_i(x_j)) sorted by target, then source.  One
+    radius-wide pair query when the radii are alike; otherwise sources are
+    bucketed by radius octave so that one huge particle among tiny ones does not
+    make every query as wide as itself.
     """
     tree = cKDTree(plane)
     positive = radii > 0
@@ -165,43 +166,52 @@ def _overlaps_in_light_order(plane: np.ndarray, radii: np.ndarray):
         return np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0)
     largest, smallest = radii.max(), radii[positive].min()
     if largest <= 4.0 * smallest:
-        pairs = tree.query_pairs(float(largest), output_type="ndarray")
-        source, target = pairs.min(axis=1), pairs.max(axis=1)
-        distance = np.linalg.norm(plane[source] - plane[target], axis=1)
+        pairs = tree.query_pairs(float(largest), output_type="ndarray")  # i < j guaranteed
+        source, target = pairs[:, 0], pairs[:, 1]
     else:
         octave = np.floor(np.log2(np.where(positive, radii, 1.0))).astype(np.int64)
-        found_source, found_target, found_distance = [], [], []
+        found_source, found_target = [], []
         for band in np.unique(octave[positive]):
             in_band = np.flatnonzero((octave == band) & positive)
             found = cKDTree(plane[in_band]).sparse_distance_matrix(
                 tree, float(radii[in_band].max()), output_type="ndarray")
             found_source.append(in_band[found["i"]])
             found_target.append(found["j"])
-            found_distance.append(found["v"])
-        source, target, distance = (np.concatenate(x) for x in (found_source, found_target, found_distance))
+        source, target = np.concatenate(found_source), np.concatenate(found_target)
         later = source < target
-        source, target, distance = source[later], target[later], distance[later]
-    inside = distance < radii[source]
-    source, target = source[inside], target[inside]
-    return source, target, splat_kernel(distance[inside] / radii[source])
+        source, target = source[later], target[later]
+    offset = plane[target] - plane[source]
+    squared = offset[:, 0] ** 2 + offset[:, 1] ** 2
+    inside = squared < radii[source] ** 2
+    source, target, squared = source[inside], target[inside], squared[inside]
+    by_target = np.argsort(target * len(plane) + source)
+    source, target = source[by_target], target[by_target]
+    return source, target, splat_kernel(np.sqrt(squared[by_target]) / radii[source])
 
 
 def _incident_exact(plane, toward_light, radii, alpha, sigma, groups):
-    incident = np.ones(len(plane))
-    for members in _split_by_value(groups):
-        # ties (coincident particles) keep their index order
-        order = members[np.argsort(-toward_light[members], kind="stable")]
-        incident[order] = _incident_exact_sorted(plane[order], radii[order], alpha[order], sigma[order])
+    """Exact incident light: overlaps found per group, all groups' levels walked together."""
+    n = len(plane)
+    # group-major light order; ties (coincident particles) keep their index order
+    order = np.lexsort((np.arange(n), -toward_light, groups))
+    plane, radii, alpha, sigma = plane[order], radii[order], alpha[order], sigma[order]
+    sources, targets, weights = [], [], []
+    bounds = np.flatnonzero(np.diff(groups[order])) + 1
+    for start, stop in zip(np.concatenate([[0], bounds]), np.concatenate([bounds, [n]])):
+        source, target, weight = _overlaps_in_light_order(plane[start:stop], radii[start:stop])
+        sources.append(source + start)
+        targets.append(target + start)
+        weights.append(weight)
+    incident = np.empty(n)
+    incident[order] = _incident_in_light_order(np.concatenate(sources), np.concatenate(targets),
+                                               np.concatenate(weights), alpha, sigma)
     return incident
 
 
-def _incident_exact_sorted(plane, radii, alpha, sigma):
-    """Exact incident light of one group whose particles are in light order."""
-    n = len(plane)
-    source, target, weight = _overlaps_in_light_order(plane, radii)
-
-    by_target = np.argsort(target * n + source)
-    in_source, in_weight = source[by_target], weight[by_target]
+def _incident_in_light_order(source, target, weight, alpha, sigma):
+    """Walk the overlap graph (sources before targets, sorted by target) in dependency levels."""
+    n = len(alpha)
+    in_source, in_weight = source, weight  # already sorted by target, then source
     in_count = np.bincount(target, minlength=n)
     in_start = np.cumsum(in_count) - in_count
 

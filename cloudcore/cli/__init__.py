@@ -20,19 +20,19 @@ class _OneLineParser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message} (see --help)\n")
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser() -> tuple[argparse.ArgumentParser, argparse._SubParsersAction]:
     from cloudcore.cli import shade
 
     parser = _OneLineParser(prog="cloudview", description="Real-time volumetric particle clouds.")
     commands = parser.add_subparsers(dest="command", parser_class=_OneLineParser, metavar="COMMAND")
     shade.add_parser(commands)
-    return parser
+    return parser, commands
 
 
 def main(argv=None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
-    parser = build_parser()
-    if not argv or argv[0] not in parser._subparsers._group_actions[0].choices and not argv[0].startswith("-"):
+    parser, commands = build_parser()
+    if not argv or (argv[0] not in commands.choices and not argv[0].startswith("-")):
         argv = _main_job(argv)
     args = parser.parse_args(argv)
     if args.command is None:

@@ -1,0 +1,1 @@
+"""app: the imgui-bundle editor. GUI only: it edits scene state and calls cloudcore."""
