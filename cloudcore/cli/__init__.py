@@ -21,11 +21,12 @@ class _OneLineParser(argparse.ArgumentParser):
 
 
 def build_parser() -> tuple[argparse.ArgumentParser, argparse._SubParsersAction]:
-    from cloudcore.cli import shade
+    from cloudcore.cli import render, shade
 
     parser = _OneLineParser(prog="cloudview", description="Real-time volumetric particle clouds.")
     commands = parser.add_subparsers(dest="command", parser_class=_OneLineParser, metavar="COMMAND")
     shade.add_parser(commands)
+    render.add_parser(commands)
     return parser, commands
 
 
@@ -50,6 +51,8 @@ def main(argv=None) -> int:
 
 def _main_job(argv: list[str]) -> list[str]:
     """`cloudview [SCENE]`: the editor once it exists; until then the most complete headless job."""
-    scene = argv[0] if argv else str(DEFAULT_SCENE)
-    print("cloudview: the editor is not built yet; shading the scene headless instead.", file=sys.stderr)
-    return ["shade", scene, *argv[1:]]
+    scene = Path(argv[0] if argv else DEFAULT_SCENE)
+    out = Path("out") / f"{scene.stem}.png"
+    print(f"cloudview: the editor is not built yet; rendering {scene} headless to {out} instead.",
+          file=sys.stderr)
+    return ["render", str(scene), "--out", str(out), *argv[1:]]

@@ -1,0 +1,75 @@
+"""View and projection matrices of a `cloudcore.scene.Camera`, and frustum culling (numpy).
+
+OpenGL conventions: right-handed eye space looking down -z with y up, clip
+space depth in [-1, 1].  `projection_matrix` is the same matrix pyrender builds
+for a `PerspectiveCamera` with a far plane, so depths written by pyrender's
+world pass and by our own passes compare correctly.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from cloudcore.scene import Camera
+
+#: metres; 1 m near and 100 km far keep 24-bit depth resolution near 0.5 m at 3 km.
+NEAR_PLANE_M = 1.0
+FAR_PLANE_M = 1.0e5
+_WORLD_UP = np.array([0.0, 1.0, 0.0])
+
+
+def camera_pose(camera: Camera) -> np.ndarray:
+    """Camera-to-world 4x4: columns are the camera's right, up and back axes and its position."""
+    eye = np.asarray(camera.position, dtype=np.float64)
+    forward = np.asarray(camera.look_at, dtype=np.float64) - eye
+    forward /= np.linalg.norm(forward)
+    right = np.cross(forward, _WORLD_UP)
+    if np.linalg.norm(right) < 1e-9:
+        # looking straight up or down: any horizontal right axis will do; take east
+        right = np.array([1.0, 0.0, 0.0])
+    right /= np.linalg.norm(right)
+    up = np.cross(right, forward)
+    pose = np.eye(4)
+    pose[:3, 0], pose[:3, 1], pose[:3, 2], pose[:3, 3] = right, up, -forward, eye
+    return pose
+
+
+def view_matrix(camera: Camera) -> np.ndarray:
+    """World-to-eye 4x4 (the inverse of `camera_pose`, computed without a general inverse)."""
+    pose = camera_pose(camera)
+    rotation = pose[:3, :3].T
+    view = np.eye(4)
+    view[:3, :3] = rotation
+    view[:3, 3] = -rotation @ pose[:3, 3]
+    return view
+
+
+def projection_matrix(fov_y_deg: float, aspect: float,
+                      near: float = NEAR_PLANE_M, far: float = FAR_PLANE_M) -> np.ndarray:
+    """OpenGL perspective projection, vertical field of view in degrees, aspect = width / height."""
+    focal = 1.0 / np.tan(0.5 * np.radians(fov_y_deg))
+    projection = np.zeros((4, 4))
+    projection[0, 0] = focal / aspect
+    projection[1, 1] = focal
+    projection[2, 2] = (far + near) / (near - far)
+    projection[2, 3] = 2.0 * far * near / (near - far)
+    projection[3, 2] = -1.0
+    return projection
+
+
+def frustum_planes(view_projection: np.ndarray) -> np.ndarray:
+    """The six planes (a, b, c, d) of the clip volume, normals inward and unit length.
+
+    Gribb and Hartmann: a point x is inside plane i when planes[i] . (x, 1) >= 0.
+    """
+    rows = view_projection
+    planes = np.array([rows[3] + rows[0], rows[3] - rows[0],
+                       rows[3] + rows[1], rows[3] - rows[1],
+                       rows[3] + rows[2], rows[3] - rows[2]])
+    return planes / np.linalg.norm(planes[:, :3], axis=1, keepdims=True)
+
+
+def spheres_in_frustum(planes: np.ndarray, centres: np.ndarray, radii: np.ndarray) -> np.ndarray:
+    """Boolean (N,): which spheres are at least partly inside the frustum (conservative)."""
+    distances = centres @ planes[:, :3].T + planes[:, 3]
+    return np.all(distances >= -radii[:, None], axis=1)

@@ -1,0 +1,69 @@
+"""GLSL programs built from the .glsl files in `shaders/`, with constants injected as #defines.
+
+Constants shared with the numpy side (such as the splat sharpness) are
+injected rather than written twice, so the two cannot drift apart.  Compile
+and link errors raise with the driver's log and the file name.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from OpenGL import GL
+
+SHADER_DIR = Path(__file__).with_name("shaders")
+
+
+class ShaderError(RuntimeError):
+    """A shader failed to compile or a program failed to link."""
+
+
+def build_program(name: str, defines: dict[str, float] | None = None) -> int:
+    """Compile shaders/NAME.vert.glsl and NAME.frag.glsl and link them; returns the program id."""
+    stages = [(GL.GL_VERTEX_SHADER, f"{name}.vert.glsl"), (GL.GL_FRAGMENT_SHADER, f"{name}.frag.glsl")]
+    shaders = [_compile(kind, file, defines or {}) for kind, file in stages]
+    program = GL.glCreateProgram()
+    for shader in shaders:
+        GL.glAttachShader(program, shader)
+    GL.glLinkProgram(program)
+    for shader in shaders:
+        GL.glDetachShader(program, shader)
+        GL.glDeleteShader(shader)
+    if not GL.glGetProgramiv(program, GL.GL_LINK_STATUS):
+        log = _text(GL.glGetProgramInfoLog(program))
+        GL.glDeleteProgram(program)
+        raise ShaderError(f"program {name!r} failed to link:\n{log}")
+    return program
+
+
+def _compile(kind: int, file: str, defines: dict[str, float]) -> int:
+    source = (SHADER_DIR / file).read_text()
+    version, _, body = source.partition("\n")
+    if not version.startswith("#version"):
+        raise ShaderError(f"{file}: the first line must be the #version directive")
+    lines = [version] + [f"#define {key} {float(value)!r}" for key, value in defines.items()]
+    # keep the driver's line numbers pointing into the file
+    lines.append("#line 2")
+    shader = GL.glCreateShader(kind)
+    GL.glShaderSource(shader, "\n".join(lines) + "\n" + body)
+    GL.glCompileShader(shader)
+    if not GL.glGetShaderiv(shader, GL.GL_COMPILE_STATUS):
+        log = _text(GL.glGetShaderInfoLog(shader))
+        GL.glDeleteShader(shader)
+        raise ShaderError(f"{file} failed to compile:\n{log}")
+    return shader
+
+
+def _text(log) -> str:
+    return log.decode(errors="replace") if isinstance(log, bytes) else str(log)
+
+
+def set_matrix(program: int, name: str, matrix) -> None:
+    """Upload a 4x4 numpy matrix (row-major, as numpy stores it) to a mat4 uniform."""
+    GL.glUniformMatrix4fv(GL.glGetUniformLocation(program, name), 1, GL.GL_TRUE,
+                          np.ascontiguousarray(matrix, dtype=np.float32))
+
+
+def set_vec3(program: int, name: str, value) -> None:
+    GL.glUniform3f(GL.glGetUniformLocation(program, name), *(float(v) for v in value))

@@ -1,0 +1,90 @@
+"""The world pass: terrain through pyrender (flat, lighting baked per vertex) over the sky.
+
+pyrender's PBR shader costs 70-90 ms a frame on llvmpipe; baking the lights into
+vertex colours and drawing with RenderFlags.FLAT costs about a quarter of that
+(measured: /work/shared/ENVIRONMENT.md).  pyrender writes the depth buffer the
+cloud pass tests against; one full-screen pass then composites its colour over
+the sky gradient into the linear target (shaders/world.frag.glsl).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import trimesh
+from OpenGL import GL
+
+from cloudcore.camera import FAR_PLANE_M, NEAR_PLANE_M, camera_pose
+from cloudcore.gl.context import HeadlessContext
+from cloudcore.gl.programs import build_program, set_matrix, set_vec3
+from cloudcore.gl.pyrender_compat import pyrender
+from cloudcore.colour import srgb_encode
+from cloudcore.lighting import active_lights
+from cloudcore.scene import Camera, Terrain
+from cloudcore.terrain import heightfield_mesh
+
+
+def terrain_vertex_colours(vertices, faces, base_colour, lights, ambient) -> np.ndarray:
+    """Linear RGB per vertex: base * (ambient + sum over lights of colour * intensity * max(0, n.l))."""
+    normals = trimesh.Trimesh(vertices, faces, process=False).vertex_normals
+    irradiance = np.broadcast_to(np.asarray(ambient, dtype=np.float64), (len(vertices), 3)).copy()
+    for light in active_lights(lights):
+        cosine = np.maximum(normals @ np.asarray(light.direction, dtype=np.float64), 0.0)
+        irradiance += cosine[:, None] * np.asarray(light.color) * light.intensity
+    return np.asarray(base_colour, dtype=np.float64) * irradiance
+
+
+class WorldPass:
+    """Terrain and sky for one terrain and one lighting; rebuild it when either changes."""
+
+    def __init__(self, terrain: Terrain | None, lights, ambient, sky_zenith, sky_horizon):
+        self._sky_zenith = np.asarray(sky_zenith, dtype=np.float64)
+        self._sky_horizon = np.asarray(sky_horizon, dtype=np.float64)
+        self._composite_program = build_program("world")
+        # core profile draws nothing without a vertex array, even one with no attributes
+        self._fullscreen_vertex_array = GL.glGenVertexArrays(1)
+        self._scene = None
+        if terrain is not None:
+            self._scene, self._camera_node = self._terrain_scene(terrain, lights, ambient)
+
+    @staticmethod
+    def _terrain_scene(terrain: Terrain, lights, ambient):
+        if terrain.kind != "heightfield":
+            raise ValueError(f"the GL prototype draws heightfield terrain only, not {terrain.kind!r}")
+        vertices, faces = heightfield_mesh(terrain)
+        colours = terrain_vertex_colours(vertices, faces, terrain.color, lights, ambient)
+        # encoded, because pyrender's 8-bit framebuffer would band linear colour in the shadows
+        primitive = pyrender.Primitive(positions=vertices.astype(np.float32), indices=faces.astype(np.uint32),
+                                       color_0=srgb_encode(colours).astype(np.float32))
+        scene = pyrender.Scene(bg_color=(0.0, 0.0, 0.0, 0.0))
+        scene.add(pyrender.Mesh([primitive]))
+        camera = pyrender.PerspectiveCamera(yfov=np.radians(60.0), znear=NEAR_PLANE_M, zfar=FAR_PLANE_M)
+        return scene, scene.add(camera)
+
+    def draw(self, context: HeadlessContext, camera: Camera, view_projection: np.ndarray) -> None:
+        """Fill the render target: terrain colour and depth where there is terrain, sky elsewhere."""
+        if self._scene is None:
+            context.clear_world()
+        else:
+            # the aspect ratio comes from the viewport, as in our projection_matrix
+            self._camera_node.camera.yfov = np.radians(camera.fov_y_deg)
+            self._scene.set_pose(self._camera_node, camera_pose(camera))
+            context.render_pyrender_scene(self._scene, pyrender.RenderFlags.FLAT)
+        program = self._composite_program
+        GL.glUseProgram(program)
+        GL.glActiveTexture(GL.GL_TEXTURE0)
+        GL.glBindTexture(GL.GL_TEXTURE_2D, context.world_texture)
+        GL.glUniform1i(GL.glGetUniformLocation(program, "world_texture"), 0)
+        set_matrix(program, "inverse_view_projection", np.linalg.inv(view_projection))
+        set_vec3(program, "zenith_colour", self._sky_zenith)
+        set_vec3(program, "horizon_colour", self._sky_horizon)
+        GL.glDisable(GL.GL_BLEND)
+        GL.glDisable(GL.GL_CULL_FACE)
+        GL.glDisable(GL.GL_DEPTH_TEST)  # colour everywhere; the depth pyrender wrote stays
+        GL.glBindVertexArray(self._fullscreen_vertex_array)
+        GL.glDrawArrays(GL.GL_TRIANGLES, 0, 3)
+        GL.glBindVertexArray(0)
+
+    def close(self) -> None:
+        """Free the GL objects (the context must be current); pyrender frees the mesh with its context."""
+        GL.glDeleteProgram(self._composite_program)
+        GL.glDeleteVertexArrays(1, [self._fullscreen_vertex_array])
