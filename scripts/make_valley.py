@@ -71,7 +71,8 @@ def build() -> Scene:
     aircraft_path = np.array([[t, *(crossed + [x, 30.0 * np.sin(t / 6.0), 0.0])]
                               for t, x in zip(np.linspace(0, 30, 7), np.linspace(-900, 900, 7))])
     return Scene(
-        camera=Camera(tuple(start), tuple(first), 60.0),
+        # an establishing view up the valley; the flythrough has its own keys
+        camera=Camera((450.0, 330.0, 2900.0), (-250.0, 850.0, -600.0), 60.0),
         lighting=Lighting(time_of_day=15.5),
         shading=Shading(),
         clouds=clouds,
