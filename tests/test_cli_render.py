@@ -1,0 +1,56 @@
+"""`cloudview render`: a PNG and stats from the command line; bad arguments are one line, status 2."""
+
+import json
+import subprocess
+import sys
+
+import imageio.v3 as iio
+import numpy as np
+import pytest
+
+from conftest import VALLEY
+
+
+def run_cli(*args):
+    return subprocess.run([sys.executable, "-m", "cloudcore.cli", *args], capture_output=True, text=True)
+
+
+@pytest.fixture(scope="module")
+def rendered(tmp_path_factory):
+    out = tmp_path_factory.mktemp("render")
+    result = run_cli("render", str(VALLEY), "--out", str(out / "v.png"), "--width", "96", "--height", "64",
+                     "--camera-path", "flythrough", "--t", "4", "--time", "17", "--stats", str(out / "v.json"))
+    if result.returncode != 0 and "EGL" in result.stderr:
+        pytest.skip("no headless OpenGL (EGL) context")
+    return result, out
+
+
+def test_render_writes_the_png_and_the_stats(rendered):
+    result, out = rendered
+    assert result.returncode == 0, result.stderr
+    image = iio.imread(out / "v.png")
+    assert image.shape == (64, 96, 3) and image.dtype == np.uint8
+    stats = json.loads((out / "v.json").read_text())
+    assert {"frame_ms", "world_ms", "cloud_ms", "particles_drawn", "clouds_drawn", "clouds_culled"} <= set(stats)
+    assert stats["clouds_drawn"] + stats["clouds_culled"] == 34
+    assert str(out / "v.png") in result.stdout
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--width", "0"], "--width"),
+    (["--time", "25"], "--time: time_of_day: must be within [0, 24]"),
+    (["--camera-path", "nowhere"], "no camera path named 'nowhere'"),
+    (["--mode", "sideways"], "--mode"),
+])
+def test_bad_render_arguments_exit_2_in_one_line(tmp_path, args, message):
+    result = run_cli("render", str(VALLEY), "--out", str(tmp_path / "x.png"), *args)
+    assert result.returncode == 2
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and message in lines[0], result.stderr
+    assert not (tmp_path / "x.png").exists()
+
+
+def test_render_imports_no_gui():
+    code = ("import sys; from cloudcore.cli import main; import cloudcore.cli.render; "
+            "assert not [m for m in sys.modules if m.startswith(('imgui_bundle', 'app'))]")
+    assert subprocess.run([sys.executable, "-c", code]).returncode == 0
