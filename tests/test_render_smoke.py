@@ -4,32 +4,15 @@ Skipped where no EGL context can be made (no libEGL, no Mesa driver).
 """
 
 import dataclasses
-import os
 
 import numpy as np
 import pytest
 
 from cloudcore.scene import Camera
 from cloudcore.scenefile import load_scene
-from conftest import VALLEY
+from conftest import RENDER_HEIGHT as HEIGHT, RENDER_WIDTH as WIDTH, VALLEY
 
-# PyOpenGL picks its platform on first import: headless needs EGL
-os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
-
-WIDTH, HEIGHT = 160, 120
 STATS_KEYS = {"frame_ms", "world_ms", "cloud_ms", "particles_drawn", "clouds_drawn", "clouds_culled"}
-
-
-@pytest.fixture(scope="module")
-def renderer():
-    try:
-        from cloudcore.gl import FrameRenderer
-
-        frame_renderer = FrameRenderer(WIDTH, HEIGHT)
-    except Exception as error:  # no EGL here: any failure to make a context means "cannot test"
-        pytest.skip(f"no headless OpenGL (EGL) context: {error}")
-    yield frame_renderer
-    frame_renderer.close()
 
 
 @pytest.fixture(scope="module")

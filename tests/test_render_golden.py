@@ -1,0 +1,90 @@
+"""Golden images of the full-3D renderer at 160x120, compared with committed PNGs.
+
+Tolerance: PSNR >= 40 dB and no channel off by more than 12 levels of 255, so
+llvmpipe builds and GPUs may differ by rounding but not by a visible change.
+On failure the numbers are printed and tests/_failures/ gets the rendered
+image, the golden and an amplified diff.  Goldens are made on llvmpipe and
+rewritten only on purpose:
+
+    ./run tests tests/test_render_golden.py --regenerate-goldens
+"""
+
+import dataclasses
+from pathlib import Path
+
+import imageio.v3 as iio
+import numpy as np
+import pytest
+
+from cloudcore.imagecompare import compare, diff_image
+from cloudcore.lighting import sun_direction
+from cloudcore.paths import sample
+from cloudcore.scene import Camera, Scene
+from cloudcore.scenefile import load_scene
+from conftest import VALLEY
+
+GOLDEN = Path(__file__).parent / "golden"
+FAILURES = Path(__file__).parent / "_failures"
+MIN_PSNR_DB = 40.0
+MAX_ABS = 12
+
+
+@pytest.fixture(scope="module")
+def valley():
+    return load_scene(VALLEY)
+
+
+def into_the_sun(scene: Scene) -> Camera:
+    """Behind the cloud nearest the start, looking through it toward the 15:30 sun."""
+    heart = scene.clouds[0].centres.mean(axis=0)
+    toward_sun = sun_direction(15.5)
+    eye = heart - 900.0 * toward_sun
+    return Camera(tuple(eye), tuple(heart + 100.0 * toward_sun), 60.0)
+
+
+def inside_a_cloud(scene: Scene) -> Camera:
+    at = sample(scene.camera_path("flythrough").keys, 9.0)  # the path's first cloud
+    return Camera(tuple(at[:3]), tuple(at[3:]), 60.0)
+
+
+VIEWS = {
+    "default_view": lambda s: (s, None, None),
+    "into_the_sun": lambda s: (s, None, into_the_sun(s)),
+    "inside_a_cloud": lambda s: (s, None, inside_a_cloud(s)),
+    "sunset": lambda s: (s, 18.6, None),
+    "midnight": lambda s: (s, 0.0, None),
+    "empty_scene": lambda s: (Scene(camera=s.camera), 15.5, None),
+}
+
+
+@pytest.mark.parametrize("name", VIEWS)
+def test_render_matches_golden(name, renderer, valley, request):
+    scene, hours, camera = VIEWS[name](valley)
+    image, _ = renderer.render(scene, time_of_day=hours, camera=camera)
+    golden_path = GOLDEN / f"{name}.png"
+    if request.config.getoption("--regenerate-goldens"):
+        GOLDEN.mkdir(exist_ok=True)
+        iio.imwrite(golden_path, image)
+        pytest.skip(f"regenerated {golden_path}")
+    assert golden_path.exists(), f"no golden {golden_path}: run with --regenerate-goldens on purpose"
+    golden = iio.imread(golden_path)
+    difference = compare(image, golden)
+    if not difference.within(MIN_PSNR_DB, MAX_ABS):
+        FAILURES.mkdir(exist_ok=True)
+        iio.imwrite(FAILURES / f"{name}-actual.png", image)
+        iio.imwrite(FAILURES / f"{name}-expected.png", golden)
+        iio.imwrite(FAILURES / f"{name}-diff.png", diff_image(image, golden))
+        pytest.fail(f"{name}: {difference} (limits: PSNR >= {MIN_PSNR_DB} dB, max |diff| <= {MAX_ABS}); "
+                    f"images in {FAILURES}")
+    # every golden shows something: no NaN-black frame, no flat colour
+    assert image.max(axis=2).min() > 0 and image.std() > 1.0
+
+
+def test_comparison_catches_a_planted_defect(valley, renderer):
+    image, _ = renderer.render(valley)
+    damaged = image.copy()
+    damaged[50:60, 70:80] = 255 - damaged[50:60, 70:80]
+    difference = compare(image, damaged)
+    assert not difference.within(MIN_PSNR_DB, MAX_ABS)
+    spot = diff_image(image, damaged)[..., 0]
+    assert spot[50:60, 70:80].min() > 0 and spot.sum() == spot[50:60, 70:80].sum()
