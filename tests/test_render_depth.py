@@ -1,0 +1,56 @@
+"""Depth interplay of the world and cloud passes: a hill hides a cloud behind it, not one in front."""
+
+import numpy as np
+import pytest
+
+from cloudcore.scene import Camera, Cloud, Lighting, Scene, Terrain
+from cloudcore.terrain import height_at
+
+TERRAIN = Terrain(size=(2000.0, 2000.0), resolution=65, height=600.0, seed=3)
+EYE = np.array([0.0, 120.0, 0.0])
+
+
+def puff(centre) -> Cloud:
+    rng = np.random.default_rng(1)
+    offsets = rng.normal(size=(60, 3)) * 25.0
+    return Cloud("puff", np.column_stack([np.asarray(centre) + offsets, np.full(60, 30.0)]))
+
+
+def line_of_sight_blocked(target) -> bool:
+    points = EYE + np.linspace(0.02, 0.98, 400)[:, None] * (np.asarray(target) - EYE)
+    return bool(np.any(height_at(TERRAIN, points[:, 0], points[:, 2]) > points[:, 1]))
+
+
+def scene_with(*clouds, terrain=TERRAIN) -> Scene:
+    # look east, up the valley's side, at the ridge
+    camera = Camera(tuple(EYE), (1000.0, 250.0, 0.0), 50.0)
+    return Scene(camera=camera, lighting=Lighting(time_of_day=12.0), clouds=clouds, terrain=terrain)
+
+
+@pytest.fixture(scope="module")
+def renders(renderer):
+    in_front = [330.0, float(height_at(TERRAIN, 330.0, 0.0)) + 100.0, 0.0]
+    behind = [980.0, float(height_at(TERRAIN, 980.0, 0.0)) - 180.0, 0.0]
+    # the whole of the hidden puff (every particle's top) is out of sight behind the hill
+    assert all(line_of_sight_blocked(p[:3] + [0.0, p[3], 0.0]) for p in puff(behind).particles)
+    assert not line_of_sight_blocked(in_front)
+    images = {name: renderer.render(scene_with(*clouds))[0] for name, clouds in
+              {"none": (), "in_front": (puff(in_front),), "behind": (puff(behind),)}.items()}
+    images["behind_without_hill"] = renderer.render(scene_with(puff(behind), terrain=None))[0]
+    images["none_without_hill"] = renderer.render(scene_with(terrain=None))[0]
+    return images
+
+
+def test_the_hidden_cloud_is_in_view_once_the_hill_is_gone(renders):
+    difference = np.abs(renders["behind_without_hill"].astype(int) - renders["none_without_hill"].astype(int))
+    assert (difference.max(axis=2) > 10).sum() > 50
+
+
+def test_a_cloud_behind_the_hill_is_hidden_by_it(renders):
+    difference = np.abs(renders["behind"].astype(int) - renders["none"].astype(int))
+    assert difference.max() <= 1
+
+
+def test_a_cloud_in_front_of_the_hill_covers_it(renders):
+    difference = np.abs(renders["in_front"].astype(int) - renders["none"].astype(int)).max(axis=2)
+    assert (difference > 10).sum() > 50
