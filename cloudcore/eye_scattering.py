@@ -21,6 +21,7 @@ import numpy as np
 from cloudcore.illumination import cloud_optics, illuminate_clouds
 from cloudcore.lighting import active_lights
 from cloudcore.phase import phase_function
+from cloudcore.ramps import smoothstep
 from cloudcore.scene import Shading
 from cloudcore.shading import scattering_coefficient
 
@@ -28,11 +29,6 @@ from cloudcore.shading import scattering_coefficient
 #: camera inside one never gets a screen-filling quad.
 FADE_START_RADII = 0.5
 FADE_END_RADII = 1.5
-
-
-def smoothstep(edge0, edge1, x) -> np.ndarray:
-    t = np.clip((x - edge0) / (edge1 - edge0), 0.0, 1.0)
-    return t * t * (3.0 - 2.0 * t)
 
 
 class ParticleShading:

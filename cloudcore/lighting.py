@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from cloudcore.ramps import smoothstep
 from cloudcore.scene import Light, Lighting
 
 LATITUDE_DEG = 45.0
@@ -47,11 +48,6 @@ def elevation_deg(direction) -> float:
     return float(np.degrees(np.arcsin(np.clip(direction[1], -1.0, 1.0))))
 
 
-def _smoothstep(edge0: float, edge1: float, x: float) -> float:
-    t = np.clip((x - edge0) / (edge1 - edge0), 0.0, 1.0)
-    return float(t * t * (3.0 - 2.0 * t))
-
-
 def air_mass(elevation: float) -> float:
     """Kasten-Young relative air mass; the horizon value below it (the beam is faded there)."""
     e = max(elevation, 0.0)
@@ -62,18 +58,18 @@ def sun_beam(elevation: float) -> tuple[np.ndarray, float]:
     """(colour normalised to a max channel of 1, intensity) of the direct sun."""
     transmitted = np.exp(-BEAM_EXTINCTION * air_mass(elevation))
     peak = float(transmitted.max())
-    return transmitted / peak, peak * _smoothstep(SUN_FADE_DEG, 0.0, elevation)
+    return transmitted / peak, peak * smoothstep(SUN_FADE_DEG, 0.0, elevation)
 
 
 def golden_hour(elevation: float) -> float:
     """1 with the sun on the horizon, 0 once it is 15 degrees up (and at night)."""
-    return _smoothstep(-6.0, 0.0, elevation) * (1.0 - _smoothstep(2.0, 15.0, elevation))
+    return smoothstep(-6.0, 0.0, elevation) * (1.0 - smoothstep(2.0, 15.0, elevation))
 
 
 def sky_colors(hours: float) -> tuple[np.ndarray, np.ndarray]:
     """Linear RGB (zenith, horizon) of the sky background, consistent with the sun."""
     elevation = elevation_deg(sun_direction(hours))
-    day = _smoothstep(-8.0, 6.0, elevation)
+    day = smoothstep(-8.0, 6.0, elevation)
     sunset = golden_hour(elevation)
     zenith = NIGHT_AMBIENT * 0.8 + day * np.array([0.16, 0.32, 0.72])
     horizon = NIGHT_AMBIENT + day * np.array([0.55, 0.68, 0.85])
@@ -90,7 +86,7 @@ def daylight(hours: float) -> tuple[tuple[Light, ...], np.ndarray]:
     zenith, horizon = sky_colors(hours)
     sunset = golden_hour(elevation)
     sky_tint = (1 - sunset) * np.array([0.55, 0.70, 1.0]) + sunset * np.array([1.0, 0.55, 0.65])
-    sky_intensity = 0.35 * _smoothstep(-8.0, 8.0, elevation)
+    sky_intensity = 0.35 * smoothstep(-8.0, 8.0, elevation)
     lights = (
         Light(tuple(direction), tuple(sun_color), sun_intensity),
         Light((0.0, 1.0, 0.0), tuple(sky_tint), sky_intensity),

@@ -36,7 +36,8 @@ class _Record:
                 return False
         return True
 
-    __hash__ = object.__hash__
+    # value equality over arrays has no matching cheap hash; records are compared, never hashed
+    __hash__ = None
 
 
 @dataclass(frozen=True)

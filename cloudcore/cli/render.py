@@ -17,8 +17,8 @@ def add_parser(commands) -> None:
     parser = commands.add_parser("render", help="render one frame to a PNG, headless")
     parser.add_argument("scene", help="scene file (.toml)")
     parser.add_argument("--out", required=True, type=Path, help="PNG to write")
-    parser.add_argument("--width", type=_positive_int, default=640)
-    parser.add_argument("--height", type=_positive_int, default=480)
+    parser.add_argument("--width", type=pixel_count, default=640)
+    parser.add_argument("--height", type=pixel_count, default=480)
     parser.add_argument("--mode", choices=("full",), default="full", help="cloud drawing mode")
     parser.add_argument("--time", type=float, help="time of day in hours, overriding the scene's")
     parser.add_argument("--camera-path", help="take the camera from this path of the scene")
@@ -27,7 +27,8 @@ def add_parser(commands) -> None:
     parser.set_defaults(run=run)
 
 
-def _positive_int(text: str) -> int:
+def pixel_count(text: str) -> int:
+    """An image side in pixels; argparse names this function in its refusal."""
     value = int(text)
     if not 1 <= value <= 16384:
         raise ValueError(text)
