@@ -19,7 +19,8 @@ def run_cli(*args):
 def rendered(tmp_path_factory):
     out = tmp_path_factory.mktemp("render")
     result = run_cli("render", str(VALLEY), "--out", str(out / "v.png"), "--width", "96", "--height", "64",
-                     "--camera-path", "flythrough", "--t", "4", "--time", "17", "--stats", str(out / "v.json"))
+                     "--camera-path", "flythrough", "--t", "4", "--time", "17", "--stats", str(out / "v.json"),
+                     "--overdraw", str(out / "heat.png"))
     if result.returncode != 0 and "EGL" in result.stderr:
         pytest.skip("no headless OpenGL (EGL) context")
     return result, out
@@ -31,7 +32,10 @@ def test_render_writes_the_png_and_the_stats(rendered):
     image = iio.imread(out / "v.png")
     assert image.shape == (64, 96, 3) and image.dtype == np.uint8
     stats = json.loads((out / "v.json").read_text())
-    assert {"frame_ms", "world_ms", "cloud_ms", "particles_drawn", "clouds_drawn", "clouds_culled"} <= set(stats)
+    assert {"frame_ms", "world_ms", "cloud_ms", "particles_drawn", "clouds_drawn", "clouds_culled",
+            "overdraw_mean", "overdraw_max", "overdraw_analytic"} <= set(stats)
+    assert stats["overdraw_max"] >= stats["overdraw_mean"] > 0
+    assert iio.imread(out / "heat.png").shape == (64, 96, 3)
     assert stats["clouds_drawn"] + stats["clouds_culled"] == 34
     assert str(out / "v.png") in result.stdout
 

@@ -8,6 +8,7 @@ import os
 from pathlib import Path
 
 from cloudcore.errors import SceneError
+from cloudcore.overdraw import heat_map
 from cloudcore.paths import sample
 from cloudcore.scene import Camera
 from cloudcore.scenefile import load_scene
@@ -23,7 +24,8 @@ def add_parser(commands) -> None:
     parser.add_argument("--time", type=float, help="time of day in hours, overriding the scene's")
     parser.add_argument("--camera-path", help="take the camera from this path of the scene")
     parser.add_argument("--t", type=float, default=0.0, help="seconds along --camera-path")
-    parser.add_argument("--stats", type=Path, help="write frame statistics here (JSON)")
+    parser.add_argument("--overdraw", type=Path, help="write the overdraw heat map here (PNG)")
+    parser.add_argument("--stats", type=Path, help="write frame statistics, overdraw included, here (JSON)")
     parser.set_defaults(run=run)
 
 
@@ -51,15 +53,32 @@ def run(args) -> int:
     os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
     import imageio.v3 as iio
 
-    from cloudcore.gl import render_full
+    from cloudcore.gl import FrameRenderer
 
-    image, stats = render_full(scene, args.width, args.height, time_of_day=args.time, camera=camera)
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    iio.imwrite(args.out, image)
+    with FrameRenderer(args.width, args.height) as renderer:
+        image, stats = renderer.render(scene, time_of_day=args.time, camera=camera)
+        if args.overdraw or args.stats:
+            counts, overdraw = renderer.measure_overdraw()
+            stats |= overdraw
+    _write(args.out, lambda path: iio.imwrite(path, image))
+    if args.overdraw:
+        _write(args.overdraw, lambda path: iio.imwrite(path, heat_map(counts)))
     if args.stats:
-        args.stats.write_text(json.dumps(stats, indent=2) + "\n")
+        _write(args.stats, lambda path: path.write_text(json.dumps(stats, indent=2) + "\n"))
     print(f"wrote {args.out} ({args.width}x{args.height}): frame {stats['frame_ms']:.1f} ms "
           f"(world {stats['world_ms']:.1f}, clouds {stats['cloud_ms']:.1f}), "
           f"{stats['particles_drawn']} particles, {stats['clouds_drawn']} clouds drawn, "
           f"{stats['clouds_culled']} culled")
+    if "overdraw_mean" in stats:
+        print(f"overdraw: mean {stats['overdraw_mean']:.2f}, max {stats['overdraw_max']:.0f} "
+              f"(analytic estimate {stats['overdraw_analytic']:.2f})")
     return 0
+
+
+def _write(path: Path, write) -> None:
+    """Create the parent folder, then write; an unwritable path is a one-line error."""
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        write(path)
+    except OSError as error:
+        raise SceneError(str(path), "output", error.strerror or str(error)) from None

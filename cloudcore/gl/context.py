@@ -28,12 +28,12 @@ class HeadlessContext:
         self.width, self.height = int(width), int(height)
         self.renderer = pyrender.OffscreenRenderer(self.width, self.height)
         self.make_current()
-        self._colour, self._depth = GL.glGenRenderbuffers(2)
+        self._colour, self.depth_renderbuffer = GL.glGenRenderbuffers(2)
         GL.glBindRenderbuffer(GL.GL_RENDERBUFFER, self._colour)
         GL.glRenderbufferStorage(GL.GL_RENDERBUFFER, GL.GL_RGBA16F, self.width, self.height)
-        GL.glBindRenderbuffer(GL.GL_RENDERBUFFER, self._depth)
+        GL.glBindRenderbuffer(GL.GL_RENDERBUFFER, self.depth_renderbuffer)
         GL.glRenderbufferStorage(GL.GL_RENDERBUFFER, GL.GL_DEPTH_COMPONENT24, self.width, self.height)
-        self.framebuffer = _framebuffer(colour_renderbuffer=self._colour, depth_renderbuffer=self._depth)
+        self.framebuffer = _framebuffer(colour_renderbuffer=self._colour, depth_renderbuffer=self.depth_renderbuffer)
 
         self.world_texture = GL.glGenTextures(1)
         GL.glBindTexture(GL.GL_TEXTURE_2D, self.world_texture)
@@ -94,7 +94,7 @@ class HeadlessContext:
             return
         self.make_current()
         GL.glDeleteFramebuffers(2, [self.framebuffer, self._world_framebuffer])
-        GL.glDeleteRenderbuffers(2, [self._colour, self._depth])
+        GL.glDeleteRenderbuffers(2, [self._colour, self.depth_renderbuffer])
         GL.glDeleteTextures([self.world_texture])
         self.renderer.delete()
         self.renderer = None

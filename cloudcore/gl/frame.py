@@ -14,13 +14,15 @@ import time
 import numpy as np
 from OpenGL import GL
 
-from cloudcore.camera import projection_matrix, view_matrix
+from cloudcore.camera import NEAR_PLANE_M, projection_matrix, view_matrix
 from cloudcore.gl.context import HeadlessContext
 from cloudcore.eye_scattering import ParticleShading
 from cloudcore.gl.splats import SplatPass
 from cloudcore.colour import linear_to_srgb8
+from cloudcore.gl.targets import TextureTarget
 from cloudcore.gl.world import WorldPass
 from cloudcore.lighting import scene_lights, sky_colors
+from cloudcore.overdraw import analytic_overdraw, overdraw_statistics
 from cloudcore.scene import Camera, Lighting, Scene
 
 #: the sky needs an hour even when explicit lights replace the sun.
@@ -36,6 +38,8 @@ class FrameRenderer:
         self._splats = SplatPass()
         self._world, self._world_source = None, None
         self._particles, self._particles_source = None, None
+        self._overdraw_target = None
+        self._last_view_projection = None
 
     def render(self, scene: Scene, *, time_of_day: float | None = None, camera: Camera | None = None,
                illumination_method: str = "exact") -> tuple[np.ndarray, dict]:
@@ -63,6 +67,7 @@ class FrameRenderer:
 
         view = view_matrix(camera)
         projection = projection_matrix(camera.fov_y_deg, self.context.width / self.context.height)
+        self._last_view_projection = view, projection
         start = time.perf_counter()
         self._world.draw(self.context, camera, projection @ view)
         GL.glFinish()
@@ -74,10 +79,35 @@ class FrameRenderer:
                   "cloud_ms": 1e3 * (done - world_done)}
         return linear_to_srgb8(self.context.read_linear_rgb()), stats
 
+    def measure_overdraw(self) -> tuple[np.ndarray, dict]:
+        """(fragments per pixel (height, width) float32, statistics) of the last rendered frame's clouds.
+
+        Replays the cloud pass into a float counter that shares the frame's
+        depth, so fragments hidden by terrain are not counted; the analytic
+        estimate of the same frame is reported beside the measurement.
+        """
+        if self._last_view_projection is None:
+            raise RuntimeError("render a frame before measuring its overdraw")
+        view, projection = self._last_view_projection
+        self.context.make_current()
+        if self._overdraw_target is None:
+            self._overdraw_target = TextureTarget(self.context.width, self.context.height, GL.GL_R32F,
+                                                  depth_renderbuffer=self.context.depth_renderbuffer)
+        self._overdraw_target.bind_cleared()
+        self._splats.count_fragments(view, projection)
+        counts = self._overdraw_target.read()
+        self.context.bind_target()
+        stats = overdraw_statistics(counts)
+        stats["overdraw_analytic"] = analytic_overdraw(self._splats.drawn_centres, self._splats.drawn_radii,
+                                                       view, projection, NEAR_PLANE_M)
+        return counts, stats
+
     def close(self) -> None:
         if self.context.renderer is None:
             return
         self.context.make_current()
+        if self._overdraw_target is not None:
+            self._overdraw_target.close()
         self._splats.close()
         if self._world is not None:
             self._world.close()

@@ -3,8 +3,10 @@
 Per frame: clouds whose bounding sphere misses the view frustum are dropped,
 the remaining particles (of all clouds together, since clouds interpenetrate
 in depth) are sorted far to near from the eye, coloured for this eye
-(`ParticleShading.seen_from`) and drawn in one instanced call.  The depth
-test hides splats behind terrain; splats do not write depth.
+(`ParticleShading.seen_from`) and drawn in one instanced call; particles the
+near fade has made fully transparent are left out.  The depth test hides
+splats behind terrain; splats do not write depth.  `count_fragments` replays
+the last draw with a shader that writes 1 per fragment, for overdraw.
 """
 
 from __future__ import annotations
@@ -27,6 +29,10 @@ _INSTANCE_FLOATS = 8
 class SplatPass:
     def __init__(self):
         self._program = build_program("splat", {"SPLAT_SHARPNESS": SPLAT_SHARPNESS})
+        self._counting_program = build_program("splat", {"SPLAT_SHARPNESS": SPLAT_SHARPNESS, "COUNT_FRAGMENTS": 1})
+        self._instance_count = 0
+        #: the last draw's particles (world centres, radii), for the analytic overdraw estimate
+        self.drawn_centres, self.drawn_radii = np.zeros((0, 3)), np.zeros(0)
         self._vertex_array = GL.glGenVertexArrays(1)
         self._corner_buffer, self._instance_buffer = GL.glGenBuffers(2)
         GL.glBindVertexArray(self._vertex_array)
@@ -53,30 +59,39 @@ class SplatPass:
         eye = np.asarray(eye, dtype=np.float64)
         far_to_near = indices[np.argsort(-np.linalg.norm(particles.centres[indices] - eye, axis=1))]
         colour, alpha = particles.seen_from(eye, far_to_near)
-        instances = np.empty((len(far_to_near), _INSTANCE_FLOATS), dtype=np.float32)
-        instances[:, :3] = particles.centres[far_to_near]
-        instances[:, 3] = particles.radii[far_to_near]
-        instances[:, 4:7] = colour
-        instances[:, 7] = alpha
+        seen = alpha > 0.0
+        drawn = far_to_near[seen]
+        instances = np.empty((len(drawn), _INSTANCE_FLOATS), dtype=np.float32)
+        instances[:, :3] = particles.centres[drawn]
+        instances[:, 3] = particles.radii[drawn]
+        instances[:, 4:7] = colour[seen]
+        instances[:, 7] = alpha[seen]
+        self._instance_count = len(instances)
+        self.drawn_centres, self.drawn_radii = particles.centres[drawn], particles.radii[drawn]
         if len(instances):
-            self._draw_instances(instances, view, projection)
+            GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self._instance_buffer)
+            GL.glBufferData(GL.GL_ARRAY_BUFFER, instances.nbytes, instances, GL.GL_STREAM_DRAW)
+            self._draw_instances(self._program, view, projection)
         return {"particles_drawn": len(instances), "clouds_drawn": int(visible.sum()),
                 "clouds_culled": int((~visible).sum())}
 
-    def _draw_instances(self, instances: np.ndarray, view: np.ndarray, projection: np.ndarray) -> None:
-        GL.glUseProgram(self._program)
-        set_matrix(self._program, "view", view)
-        set_matrix(self._program, "projection", projection)
-        GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self._instance_buffer)
-        GL.glBufferData(GL.GL_ARRAY_BUFFER, instances.nbytes, instances, GL.GL_STREAM_DRAW)
+    def count_fragments(self, view: np.ndarray, projection: np.ndarray) -> None:
+        """Redraw the last frame's splats adding 1 per fragment into the bound (float) target."""
+        if self._instance_count:
+            self._draw_instances(self._counting_program, view, projection, additive=True)
+
+    def _draw_instances(self, program: int, view: np.ndarray, projection: np.ndarray, additive=False) -> None:
+        GL.glUseProgram(program)
+        set_matrix(program, "view", view)
+        set_matrix(program, "projection", projection)
         GL.glEnable(GL.GL_DEPTH_TEST)
         GL.glDepthFunc(GL.GL_LESS)
         GL.glDepthMask(GL.GL_FALSE)
         GL.glDisable(GL.GL_CULL_FACE)
         GL.glEnable(GL.GL_BLEND)
-        GL.glBlendFunc(GL.GL_ONE, GL.GL_ONE_MINUS_SRC_ALPHA)
+        GL.glBlendFunc(GL.GL_ONE, GL.GL_ONE if additive else GL.GL_ONE_MINUS_SRC_ALPHA)
         GL.glBindVertexArray(self._vertex_array)
-        GL.glDrawArraysInstanced(GL.GL_TRIANGLE_STRIP, 0, 4, len(instances))
+        GL.glDrawArraysInstanced(GL.GL_TRIANGLE_STRIP, 0, 4, self._instance_count)
         GL.glBindVertexArray(0)
         GL.glDisable(GL.GL_BLEND)
         GL.glDepthMask(GL.GL_TRUE)
@@ -84,5 +99,6 @@ class SplatPass:
     def close(self) -> None:
         """Free the GL objects (the context must be current)."""
         GL.glDeleteProgram(self._program)
+        GL.glDeleteProgram(self._counting_program)
         GL.glDeleteBuffers(2, [self._corner_buffer, self._instance_buffer])
         GL.glDeleteVertexArrays(1, [self._vertex_array])

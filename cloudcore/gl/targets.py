@@ -1,0 +1,62 @@
+"""Offscreen render targets: a colour texture, optionally sharing a depth renderbuffer.
+
+Used for the overdraw counter (R32F, sharing the frame's depth so hidden
+fragments are not counted), impostor textures and screen layers (RGBA16F,
+premultiplied linear colour).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from OpenGL import GL
+
+#: bytes per texel of the formats used here, for texture-memory statistics
+_TEXEL_BYTES = {GL.GL_RGBA16F: 8, GL.GL_R32F: 4}
+_READ_FORMAT = {GL.GL_RGBA16F: (GL.GL_RGBA, 4), GL.GL_R32F: (GL.GL_RED, 1)}
+
+
+class TextureTarget:
+    """A framebuffer whose colour attachment is a linear-filtered texture of `internal_format`."""
+
+    def __init__(self, width: int, height: int, internal_format=GL.GL_RGBA16F, depth_renderbuffer: int | None = None):
+        self.width, self.height, self.internal_format = int(width), int(height), internal_format
+        self.texture = GL.glGenTextures(1)
+        GL.glBindTexture(GL.GL_TEXTURE_2D, self.texture)
+        GL.glTexStorage2D(GL.GL_TEXTURE_2D, 1, internal_format, self.width, self.height)
+        GL.glTexParameteri(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_MIN_FILTER, GL.GL_LINEAR)
+        GL.glTexParameteri(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_MAG_FILTER, GL.GL_LINEAR)
+        GL.glTexParameteri(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_WRAP_S, GL.GL_CLAMP_TO_EDGE)
+        GL.glTexParameteri(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_WRAP_T, GL.GL_CLAMP_TO_EDGE)
+        self.framebuffer = GL.glGenFramebuffers(1)
+        GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, self.framebuffer)
+        GL.glFramebufferTexture2D(GL.GL_FRAMEBUFFER, GL.GL_COLOR_ATTACHMENT0, GL.GL_TEXTURE_2D, self.texture, 0)
+        if depth_renderbuffer is not None:
+            GL.glFramebufferRenderbuffer(GL.GL_FRAMEBUFFER, GL.GL_DEPTH_ATTACHMENT, GL.GL_RENDERBUFFER,
+                                         depth_renderbuffer)
+        status = GL.glCheckFramebufferStatus(GL.GL_FRAMEBUFFER)
+        if status != GL.GL_FRAMEBUFFER_COMPLETE:
+            raise RuntimeError(f"framebuffer incomplete (status 0x{int(status):x})")
+
+    @property
+    def nbytes(self) -> int:
+        return self.width * self.height * _TEXEL_BYTES[self.internal_format]
+
+    def bind_cleared(self) -> None:
+        """Draw into this target from now on, starting from transparent black (depth untouched)."""
+        GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, self.framebuffer)
+        GL.glViewport(0, 0, self.width, self.height)
+        GL.glClearColor(0.0, 0.0, 0.0, 0.0)
+        GL.glClear(GL.GL_COLOR_BUFFER_BIT)
+
+    def read(self) -> np.ndarray:
+        """The texture as float32 (height, width[, channels]), top row first."""
+        layout, channels = _READ_FORMAT[self.internal_format]
+        GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, self.framebuffer)
+        GL.glPixelStorei(GL.GL_PACK_ALIGNMENT, 1)
+        data = GL.glReadPixels(0, 0, self.width, self.height, layout, GL.GL_FLOAT)
+        pixels = np.frombuffer(data, dtype=np.float32).reshape(self.height, self.width, channels)
+        return (pixels[::-1, :, 0] if channels == 1 else pixels[::-1]).copy()
+
+    def close(self) -> None:
+        GL.glDeleteFramebuffers(1, [self.framebuffer])
+        GL.glDeleteTextures([self.texture])

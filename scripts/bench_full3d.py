@@ -1,0 +1,84 @@
+"""Full-3D frame time and overdraw of a scene at several sizes: the record impostors must beat. JSON out.
+
+    python scripts/bench_full3d.py [resources/scenes/valley.toml] [--sizes 640x480,1600x1200]
+                                   [--path flythrough --frames 8] [--json out/bench_full3d.json]
+
+For each size renders the scene's camera view, then --frames views spread along
+--path (if given), after one warm-up frame that pays the shading precompute;
+reports frame, world-pass and cloud-pass times (mean and median, timed to
+glFinish, read-back excluded) and measured and analytic overdraw.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import os
+import platform
+from pathlib import Path
+
+import numpy as np
+
+os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
+
+from cloudcore.gl import FrameRenderer  # noqa: E402  (needs the platform chosen above)
+from cloudcore.paths import sample  # noqa: E402
+from cloudcore.scenefile import load_scene  # noqa: E402
+
+DEFAULT_SCENE = Path(__file__).resolve().parents[1] / "resources" / "scenes" / "valley.toml"
+_TIMES = ("frame_ms", "world_ms", "cloud_ms")
+
+
+def cameras(scene, path_name: str | None, frames: int):
+    yield scene.camera
+    if path_name:
+        keys = scene.camera_path(path_name).keys
+        for t in np.linspace(keys[0, 0], keys[-1, 0], frames):
+            at = sample(keys, t)
+            yield dataclasses.replace(scene.camera, position=tuple(at[:3]), look_at=tuple(at[3:]))
+
+
+def bench_size(scene, width: int, height: int, views) -> dict:
+    samples = []
+    with FrameRenderer(width, height) as renderer:
+        renderer.render(scene, camera=views[0])  # pays the shading precompute and shader compiles
+        for camera in views:
+            _, stats = renderer.render(scene, camera=camera)
+            stats |= renderer.measure_overdraw()[1]
+            samples.append(stats)
+    summary = {"width": width, "height": height, "frames": len(samples),
+               "particles_drawn_mean": float(np.mean([s["particles_drawn"] for s in samples]))}
+    for key in _TIMES:
+        summary[f"{key}_mean"] = float(np.mean([s[key] for s in samples]))
+        summary[f"{key}_median"] = float(np.median([s[key] for s in samples]))
+    summary["overdraw_mean"] = float(np.mean([s["overdraw_mean"] for s in samples]))
+    summary["overdraw_max"] = float(np.max([s["overdraw_max"] for s in samples]))
+    summary["overdraw_analytic_mean"] = float(np.mean([s["overdraw_analytic"] for s in samples]))
+    summary["per_frame"] = samples
+    return summary
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("scene", nargs="?", default=str(DEFAULT_SCENE))
+    parser.add_argument("--sizes", default="640x480,1600x1200")
+    parser.add_argument("--path", help="also time views along this camera path")
+    parser.add_argument("--frames", type=int, default=8, help="views along --path")
+    parser.add_argument("--json", type=Path, help="write the results here as well as to stdout")
+    args = parser.parse_args()
+
+    scene = load_scene(args.scene)
+    views = list(cameras(scene, args.path, args.frames))
+    sizes = [tuple(int(v) for v in size.split("x")) for size in args.sizes.split(",")]
+    result = {"scene": str(args.scene), "path": args.path, "machine": platform.processor() or platform.machine(),
+              "runs": [bench_size(scene, w, h, views) for w, h in sizes]}
+    text = json.dumps(result, indent=2)
+    if args.json:
+        args.json.parent.mkdir(parents=True, exist_ok=True)
+        args.json.write_text(text + "\n")
+    print(json.dumps([{k: v for k, v in run.items() if k != "per_frame"} for run in result["runs"]], indent=2))
+
+
+if __name__ == "__main__":
+    main()
