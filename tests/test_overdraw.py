@@ -6,6 +6,7 @@ import pytest
 from cloudcore.camera import NEAR_PLANE_M, projection_matrix, view_matrix
 from cloudcore.overdraw import analytic_overdraw, heat_map, overdraw_statistics
 from cloudcore.scene import Camera, Cloud, Scene
+from cloudcore.settings import FULL_3D
 
 CAMERA = Camera((0.0, 0.0, 1000.0), (0.0, 0.0, 0.0), 60.0)
 
@@ -38,13 +39,13 @@ def test_statistics_and_heat_map_of_known_counts():
 
 def test_counted_fragments_match_the_disc_and_stack(renderer):
     one = splat_scene([0.0, 0.0, 0.0, 150.0])
-    renderer.render(one, time_of_day=12.0)
+    renderer.render(one, time_of_day=12.0, settings=FULL_3D)
     counts, stats = renderer.measure_overdraw()
     assert stats["overdraw_max"] == 1.0
     # pixel coverage of a disc ~1,700 pixels large agrees with its area within rasterisation error
     assert stats["overdraw_mean"] == pytest.approx(stats["overdraw_analytic"], rel=0.03)
 
-    renderer.render(splat_scene([0.0, 0.0, 0.0, 150.0], [0.0, 0.0, 0.0, 150.0]), time_of_day=12.0)
+    renderer.render(splat_scene([0.0, 0.0, 0.0, 150.0], [0.0, 0.0, 0.0, 150.0]), time_of_day=12.0, settings=FULL_3D)
     counts_two, _ = renderer.measure_overdraw()
     assert np.array_equal(counts_two, 2 * counts)
 

@@ -1,9 +1,13 @@
-"""Depth interplay of the world and cloud passes: a hill hides a cloud behind it, not one in front."""
+"""Depth interplay of the world and cloud passes: a hill hides a cloud behind it, not one in front.
+
+Both as full 3D and as impostors (a quad through the cloud's centre, depth-tested like the splats).
+"""
 
 import numpy as np
 import pytest
 
 from cloudcore.scene import Camera, Cloud, Lighting, Scene, Terrain
+from cloudcore.settings import FULL_3D, RenderSettings
 from cloudcore.terrain import height_at
 
 TERRAIN = Terrain(size=(2000.0, 2000.0), resolution=65, height=600.0, seed=3)
@@ -27,17 +31,18 @@ def scene_with(*clouds, terrain=TERRAIN) -> Scene:
     return Scene(camera=camera, lighting=Lighting(time_of_day=12.0), clouds=clouds, terrain=terrain)
 
 
-@pytest.fixture(scope="module")
-def renders(renderer):
+@pytest.fixture(scope="module", params=[FULL_3D, RenderSettings(mode="impostor")], ids=["full", "impostor"])
+def renders(renderer, request):
     in_front = [330.0, float(height_at(TERRAIN, 330.0, 0.0)) + 100.0, 0.0]
     behind = [980.0, float(height_at(TERRAIN, 980.0, 0.0)) - 180.0, 0.0]
     # the whole of the hidden puff (every particle's top) is out of sight behind the hill
     assert all(line_of_sight_blocked(p[:3] + [0.0, p[3], 0.0]) for p in puff(behind).particles)
     assert not line_of_sight_blocked(in_front)
-    images = {name: renderer.render(scene_with(*clouds))[0] for name, clouds in
+    settings = request.param
+    images = {name: renderer.render(scene_with(*clouds), settings=settings)[0] for name, clouds in
               {"none": (), "in_front": (puff(in_front),), "behind": (puff(behind),)}.items()}
-    images["behind_without_hill"] = renderer.render(scene_with(puff(behind), terrain=None))[0]
-    images["none_without_hill"] = renderer.render(scene_with(terrain=None))[0]
+    images["behind_without_hill"] = renderer.render(scene_with(puff(behind), terrain=None), settings=settings)[0]
+    images["none_without_hill"] = renderer.render(scene_with(terrain=None), settings=settings)[0]
     return images
 
 

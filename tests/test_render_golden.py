@@ -21,6 +21,7 @@ from cloudcore.lighting import sun_direction
 from cloudcore.paths import sample
 from cloudcore.scene import Camera, Scene
 from cloudcore.scenefile import load_scene
+from cloudcore.settings import FULL_3D
 from conftest import VALLEY
 
 GOLDEN = Path(__file__).parent / "golden"
@@ -60,7 +61,7 @@ VIEWS = {
 @pytest.mark.parametrize("name", VIEWS)
 def test_render_matches_golden(name, renderer, valley, request):
     scene, hours, camera = VIEWS[name](valley)
-    image, _ = renderer.render(scene, time_of_day=hours, camera=camera)
+    image, _ = renderer.render(scene, time_of_day=hours, camera=camera, settings=FULL_3D)
     golden_path = GOLDEN / f"{name}.png"
     if request.config.getoption("--regenerate-goldens"):
         GOLDEN.mkdir(exist_ok=True)
@@ -81,7 +82,7 @@ def test_render_matches_golden(name, renderer, valley, request):
 
 
 def test_comparison_catches_a_planted_defect(valley, renderer):
-    image, _ = renderer.render(valley)
+    image, _ = renderer.render(valley, settings=FULL_3D)
     damaged = image.copy()
     damaged[50:60, 70:80] = 255 - damaged[50:60, 70:80]
     difference = compare(image, damaged)

@@ -10,6 +10,7 @@ import pytest
 
 from cloudcore.scene import Camera
 from cloudcore.scenefile import load_scene
+from cloudcore.settings import FULL_3D
 from conftest import RENDER_HEIGHT as HEIGHT, RENDER_WIDTH as WIDTH, VALLEY
 
 STATS_KEYS = {"frame_ms", "world_ms", "cloud_ms", "particles_drawn", "clouds_drawn", "clouds_culled"}
@@ -22,7 +23,7 @@ def valley():
 
 @pytest.fixture(scope="module")
 def afternoon(renderer, valley):
-    return renderer.render(valley, time_of_day=15.5)
+    return renderer.render(valley, time_of_day=15.5, settings=FULL_3D)
 
 
 def luminance(rgb):
@@ -45,13 +46,13 @@ def test_sky_at_the_top_is_blue(afternoon):
 
 
 def test_clouds_are_brighter_than_the_sky_behind_them(renderer, valley, afternoon):
-    clear, _ = renderer.render(dataclasses.replace(valley, clouds=()), time_of_day=15.5)
+    clear, _ = renderer.render(dataclasses.replace(valley, clouds=()), time_of_day=15.5, settings=FULL_3D)
     added = luminance(afternoon[0]) - luminance(clear)
     assert (added > 20).mean() > 0.01
 
 
 def test_midnight_is_dark_blue_not_black_holes(renderer, valley):
-    rgb, _ = renderer.render(valley, time_of_day=0.0)
+    rgb, _ = renderer.render(valley, time_of_day=0.0, settings=FULL_3D)
     mean = rgb.reshape(-1, 3).mean(axis=0)
     assert mean[2] > mean[0] and mean.max() < 80
     assert rgb.max(axis=2).min() > 0  # no pixel lost to NaN or black

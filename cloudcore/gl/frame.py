@@ -1,9 +1,17 @@
-"""A whole frame: world pass, cloud pass, read-back to 8-bit sRGB, with timings.
+"""A whole frame: plan, world pass, impostor updates, cloud pass, read-back to 8-bit sRGB, with timings.
 
 Everything is composed in linear light in a float target; the one transfer to
 sRGB happens on read-back.  `FrameRenderer` keeps its context, GL objects,
-terrain and precomputed cloud illumination between frames and rebuilds the
-latter two only when the scene or lighting they came from changes.
+terrain, precomputed cloud illumination, impostor cache and ring between
+frames and rebuilds each only when what it came from changes.  Each frame it
+asks `cloudcore.frameplan.plan_frame` what to do and executes exactly that:
+
+1. the world (terrain depth and colour over the sky);
+2. the impostors and ring segment the plan regenerates;
+3. the ring panels, then the clouds far to near: runs of full-3D clouds
+   as one sorted splat batch, impostors as quads, crossfading clouds as their
+   full-3D image (in a screen layer) mixed with their impostor, the cloud
+   the eye is inside as a reduced-resolution screen impostor.
 """
 
 from __future__ import annotations
@@ -15,15 +23,20 @@ import numpy as np
 from OpenGL import GL
 
 from cloudcore.camera import NEAR_PLANE_M, projection_matrix, view_matrix
-from cloudcore.gl.context import HeadlessContext
-from cloudcore.eye_scattering import ParticleShading
-from cloudcore.gl.splats import SplatPass
 from cloudcore.colour import linear_to_srgb8
-from cloudcore.gl.targets import TextureTarget
+from cloudcore.eye_scattering import ParticleShading
+from cloudcore.frameplan import FramePlan, plan_frame
+from cloudcore.gl.context import HeadlessContext
+from cloudcore.gl.impostor_store import ImpostorStore
+from cloudcore.gl.quads import SCREEN_CORNERS, QuadPass
+from cloudcore.gl.splats import SplatPass, splat_batch
+from cloudcore.gl.targets import TextureTarget, blit_depth, depth_renderbuffer
 from cloudcore.gl.world import WorldPass
 from cloudcore.lighting import scene_lights, sky_colors
 from cloudcore.overdraw import analytic_overdraw, overdraw_statistics
+from cloudcore.ring import SEGMENTS, RingState, panel_corners
 from cloudcore.scene import Camera, Lighting, Scene
+from cloudcore.settings import FULL_3D, RenderSettings
 
 #: the sky needs an hour even when explicit lights replace the sun.
 _DEFAULT_SKY_HOURS = Lighting().time_of_day
@@ -36,20 +49,68 @@ class FrameRenderer:
         self.context = HeadlessContext(width, height)
         self.context.make_current()
         self._splats = SplatPass()
+        self._quads = QuadPass()
+        self._impostors = ImpostorStore(self._splats)
         self._world, self._world_source = None, None
         self._particles, self._particles_source = None, None
+        #: changes whenever the particles' colours may have: every impostor made before is stale
+        self._lighting_key = 0
+        self._records, self._ring_state = {}, RingState()
+        self._layer = None  # screen-sized, sharing the frame's depth: crossfading clouds' full-3D image
+        self._inside = None  # (target, its depth renderbuffer) of the screen impostor
         self._overdraw_target = None
-        self._last_view_projection = None
+        self._replay = []  # the last frame's draws into the screen, for the overdraw counter
+        self.last_plan: FramePlan | None = None
+
+    @property
+    def size(self) -> tuple[int, int]:
+        return self.context.width, self.context.height
 
     def render(self, scene: Scene, *, time_of_day: float | None = None, camera: Camera | None = None,
-               illumination_method: str = "exact") -> tuple[np.ndarray, dict]:
+               illumination_method: str = "exact",
+               settings: RenderSettings = RenderSettings()) -> tuple[np.ndarray, dict]:
         """(sRGB uint8 (height, width, 3), stats); `time_of_day` and `camera` override the scene's."""
         lighting = scene.lighting if time_of_day is None else dataclasses.replace(
             scene.lighting, time_of_day=time_of_day)
         camera = scene.camera if camera is None else camera
-        lights, ambient = scene_lights(lighting)
-        stats = {"illumination_ms": 0.0}
+        stats = {"illumination_ms": self._prepare(scene, lighting, illumination_method)}
+        particles = self._particles
+        plan = plan_frame(particles.bounding_centres, particles.bounding_radii, camera, self.size, settings,
+                          self._records, self._ring_state, self._lighting_key)
+        self._records, self._ring_state, self.last_plan = plan.records, plan.ring_state, plan
 
+        view = view_matrix(camera)
+        projection = projection_matrix(camera.fov_y_deg, self.context.width / self.context.height)
+        start = time.perf_counter()
+        self._world.draw(self.context, camera, projection @ view)
+        GL.glFinish()
+        world_done = time.perf_counter()
+        rendered = self._impostors.update(plan, particles, self.size, camera.fov_y_deg, settings)
+        GL.glFinish()
+        updates_done = time.perf_counter()
+        self.context.bind_target()
+        drawn = self._draw_clouds(plan, particles, camera, view, projection, settings)
+        GL.glFinish()
+        done = time.perf_counter()
+        stats |= plan.stats() | {
+            "frame_ms": 1e3 * (done - start), "world_ms": 1e3 * (world_done - start),
+            "impostor_update_ms": 1e3 * (updates_done - world_done), "cloud_ms": 1e3 * (done - updates_done),
+            "particles_drawn": drawn, "particles_to_impostors": rendered,
+            "clouds_drawn": len(plan.draw_order), "clouds_culled": len(plan.of_kind("culled")),
+            "texture_bytes": self.texture_bytes}
+        return linear_to_srgb8(self.context.read_linear_rgb()), stats
+
+    @property
+    def texture_bytes(self) -> int:
+        """GPU memory of every impostor, ring, layer and screen-impostor texture held."""
+        held = self._impostors.pool.bytes_total
+        for target in (self._layer, self._inside[0] if self._inside else None):
+            held += target.nbytes if target is not None else 0
+        return held
+
+    def _prepare(self, scene: Scene, lighting: Lighting, illumination_method: str) -> float:
+        """Rebuild the world pass and the particle illumination where their inputs changed; ms spent shading."""
+        lights, ambient = scene_lights(lighting)
         world_source = (scene.terrain, lighting)
         if world_source != self._world_source:
             self.context.make_current()
@@ -59,55 +120,128 @@ class FrameRenderer:
             self._world = WorldPass(scene.terrain, lights, ambient, *sky_colors(hours))
             self._world_source = world_source
         particles_source = (scene.clouds, scene.shading, lighting, illumination_method)
-        if particles_source != self._particles_source:
-            start = time.perf_counter()
-            self._particles = ParticleShading(scene.clouds, scene.shading, lights, ambient, illumination_method)
-            self._particles_source = particles_source
-            stats["illumination_ms"] = 1e3 * (time.perf_counter() - start)
-
-        view = view_matrix(camera)
-        projection = projection_matrix(camera.fov_y_deg, self.context.width / self.context.height)
-        self._last_view_projection = view, projection
+        if particles_source == self._particles_source:
+            return 0.0
         start = time.perf_counter()
-        self._world.draw(self.context, camera, projection @ view)
-        GL.glFinish()
-        world_done = time.perf_counter()
-        stats |= self._splats.draw(self._particles, camera.position, view, projection)
-        GL.glFinish()
-        done = time.perf_counter()
-        stats |= {"frame_ms": 1e3 * (done - start), "world_ms": 1e3 * (world_done - start),
-                  "cloud_ms": 1e3 * (done - world_done)}
-        return linear_to_srgb8(self.context.read_linear_rgb()), stats
+        self._particles = ParticleShading(scene.clouds, scene.shading, lights, ambient, illumination_method)
+        self._particles_source = particles_source
+        self._lighting_key += 1
+        return 1e3 * (time.perf_counter() - start)
+
+    def _draw_clouds(self, plan: FramePlan, particles: ParticleShading, camera: Camera, view, projection,
+                     settings: RenderSettings) -> int:
+        """Execute the plan's cloud drawing into the frame target; returns the particles drawn."""
+        eye = camera.position
+        view_projection = projection @ view
+        self._replay = []
+        drawn = 0
+
+        def draw_splats(clouds) -> int:
+            batch = splat_batch(particles, clouds, eye)
+            self._splats.draw(batch, view, projection)
+            self._replay.append(("splats", batch, view, projection))
+            return len(batch)
+
+        def draw_quad(corners, texture, weight, **options) -> None:
+            self._quads.draw(corners, view_projection if options.get("depth_test", True) else np.eye(4),
+                             texture, weight, **options)
+            self._replay.append(("quad", corners, view_projection, options.get("depth_test", True)))
+
+        if plan.ring is not None:
+            for generation, weight in plan.ring.draws:
+                for segment in range(SEGMENTS):
+                    draw_quad(panel_corners(generation, segment, settings.ring_elevation_deg),
+                              self._impostors.ring_panel(generation, segment).texture, weight)
+
+        full_run = []
+        for index in plan.draw_order:
+            cloud = plan.clouds[index]
+            if cloud.kind == "full":
+                full_run.append(index)  # neighbours in depth order are sorted together: they interpenetrate
+                continue
+            if full_run:
+                drawn += draw_splats(full_run)
+                full_run = []
+            if cloud.kind == "impostor":
+                target, impostor = self._impostors.cloud_impostor(index)
+                draw_quad(impostor.corners, target.texture, cloud.impostor_weight)
+            elif cloud.kind == "crossfade":
+                target, impostor = self._impostors.cloud_impostor(index)
+                layer = self._screen_layer()
+                layer.bind_cleared()
+                drawn += draw_splats([index])
+                self.context.bind_target()
+                draw_quad(impostor.corners, target.texture, cloud.impostor_weight,
+                          layer_texture=layer.texture, layer_weight=cloud.full_weight)
+            elif cloud.kind == "inside":
+                target = self._inside_target(plan.inside_size)
+                target.bind_cleared()
+                batch = splat_batch(particles, [index], eye)
+                self._splats.draw(batch, view, projection)
+                drawn += len(batch)
+                self.context.bind_target()
+                draw_quad(SCREEN_CORNERS, target.texture, cloud.full_weight, depth_test=False)
+        if full_run:
+            drawn += draw_splats(full_run)
+        return drawn
+
+    def _screen_layer(self) -> TextureTarget:
+        if self._layer is None:
+            self._layer = TextureTarget(*self.size, depth_renderbuffer=self.context.depth_renderbuffer)
+        return self._layer
+
+    def _inside_target(self, size) -> TextureTarget:
+        """The screen impostor's target, with the frame's depth scaled into its own depth buffer."""
+        if self._inside is None or (self._inside[0].width, self._inside[0].height) != tuple(size):
+            self._close_inside()
+            depth = depth_renderbuffer(*size)
+            self._inside = (TextureTarget(*size, depth_renderbuffer=depth), depth)
+        target = self._inside[0]
+        blit_depth(self.context.framebuffer, self.size, target.framebuffer, size)
+        return target
+
+    def _close_inside(self) -> None:
+        if self._inside is not None:
+            self._inside[0].close()
+            GL.glDeleteRenderbuffers(1, [self._inside[1]])
+            self._inside = None
 
     def measure_overdraw(self) -> tuple[np.ndarray, dict]:
         """(fragments per pixel (height, width) float32, statistics) of the last rendered frame's clouds.
 
-        Replays the cloud pass into a float counter that shares the frame's
-        depth, so fragments hidden by terrain are not counted; the analytic
-        estimate of the same frame is reported beside the measurement.
+        Replays the last frame's screen-resolution cloud draws (splats, and one
+        fragment per pixel for each impostor quad) into a float counter that
+        shares the frame's depth, so fragments hidden by terrain are not
+        counted.  The analytic estimate beside it sums the splats' disc areas.
         """
-        if self._last_view_projection is None:
+        if self.last_plan is None:
             raise RuntimeError("render a frame before measuring its overdraw")
-        view, projection = self._last_view_projection
         self.context.make_current()
         if self._overdraw_target is None:
-            self._overdraw_target = TextureTarget(self.context.width, self.context.height, GL.GL_R32F,
+            self._overdraw_target = TextureTarget(*self.size, GL.GL_R32F,
                                                   depth_renderbuffer=self.context.depth_renderbuffer)
         self._overdraw_target.bind_cleared()
-        self._splats.count_fragments(view, projection)
+        analytic = 0.0
+        for kind, geometry, matrix, extra in self._replay:
+            if kind == "splats":
+                self._splats.draw(geometry, matrix, extra, counting=True)
+                analytic += analytic_overdraw(geometry.centres, geometry.radii, matrix, extra, NEAR_PLANE_M)
+            else:
+                self._quads.draw(geometry, matrix if extra else np.eye(4), 0, 1.0, depth_test=extra, counting=True)
         counts = self._overdraw_target.read()
         self.context.bind_target()
-        stats = overdraw_statistics(counts)
-        stats["overdraw_analytic"] = analytic_overdraw(self._splats.drawn_centres, self._splats.drawn_radii,
-                                                       view, projection, NEAR_PLANE_M)
-        return counts, stats
+        return counts, overdraw_statistics(counts) | {"overdraw_analytic": analytic}
 
     def close(self) -> None:
         if self.context.renderer is None:
             return
         self.context.make_current()
-        if self._overdraw_target is not None:
-            self._overdraw_target.close()
+        for target in (self._overdraw_target, self._layer):
+            if target is not None:
+                target.close()
+        self._close_inside()
+        self._impostors.close()
+        self._quads.close()
         self._splats.close()
         if self._world is not None:
             self._world.close()
@@ -122,7 +256,7 @@ class FrameRenderer:
 
 def render_full(scene: Scene, width: int, height: int, *, time_of_day: float | None = None,
                 camera: Camera | None = None, illumination_method: str = "exact") -> tuple[np.ndarray, dict]:
-    """Render one frame of `scene` in a context of its own; see `FrameRenderer.render`."""
+    """Render one full-3D frame of `scene` in a context of its own; see `FrameRenderer.render`."""
     with FrameRenderer(width, height) as renderer:
         return renderer.render(scene, time_of_day=time_of_day, camera=camera,
-                               illumination_method=illumination_method)
+                               illumination_method=illumination_method, settings=FULL_3D)

@@ -1,22 +1,22 @@
-"""The cloud pass: every particle as an instanced camera-facing billboard, blended back to front.
+"""Splats: particles as instanced camera-facing billboards, blended back to front.
 
-Per frame: clouds whose bounding sphere misses the view frustum are dropped,
-the remaining particles (of all clouds together, since clouds interpenetrate
-in depth) are sorted far to near from the eye, coloured for this eye
-(`ParticleShading.seen_from`) and drawn in one instanced call; particles the
-near fade has made fully transparent are left out.  The depth test hides
-splats behind terrain; splats do not write depth.  `count_fragments` replays
-the last draw with a shader that writes 1 per fragment, for overdraw.
+`splat_batch` gathers the particles of some clouds (several together, since
+clouds interpenetrate in depth), sorts them far to near from the eye, colours
+them for that eye (`ParticleShading.seen_from`) and leaves out those the near
+fade has made fully transparent; `SplatPass.draw` draws a batch in one
+instanced call.  With the depth test on, terrain hides splats; splats never
+write depth.  Drawn with `counting=True`, every fragment adds 1 instead
+(overdraw).
 """
 
 from __future__ import annotations
 
 import ctypes
+from dataclasses import dataclass
 
 import numpy as np
 from OpenGL import GL
 
-from cloudcore.camera import frustum_planes, spheres_in_frustum
 from cloudcore.eye_scattering import ParticleShading
 from cloudcore.gl.programs import build_program, set_matrix
 from cloudcore.kernel import SPLAT_SHARPNESS
@@ -26,13 +26,38 @@ _QUAD_CORNERS = np.array([[-1, -1], [1, -1], [-1, 1], [1, 1]], dtype=np.float32)
 _INSTANCE_FLOATS = 8
 
 
+@dataclass(frozen=True)
+class SplatBatch:
+    instances: np.ndarray  # (n, 8) float32, far to near
+    centres: np.ndarray  # (n, 3) float64 world centres, for the analytic overdraw estimate
+    radii: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.instances)
+
+
+def splat_batch(particles: ParticleShading, clouds, eye) -> SplatBatch:
+    """The visible particles of `clouds` (indices), sorted far to near from `eye` and coloured for it."""
+    starts = particles.cloud_starts
+    ranges = [np.arange(starts[c], starts[c + 1]) for c in clouds]
+    indices = np.concatenate(ranges) if ranges else np.zeros(0, dtype=np.int64)
+    eye = np.asarray(eye, dtype=np.float64)
+    far_to_near = indices[np.argsort(-np.linalg.norm(particles.centres[indices] - eye, axis=1), kind="stable")]
+    colour, alpha = particles.seen_from(eye, far_to_near)
+    seen = alpha > 0.0
+    drawn = far_to_near[seen]
+    instances = np.empty((len(drawn), _INSTANCE_FLOATS), dtype=np.float32)
+    instances[:, :3] = particles.centres[drawn]
+    instances[:, 3] = particles.radii[drawn]
+    instances[:, 4:7] = colour[seen]
+    instances[:, 7] = alpha[seen]
+    return SplatBatch(instances, particles.centres[drawn], particles.radii[drawn])
+
+
 class SplatPass:
     def __init__(self):
         self._program = build_program("splat", {"SPLAT_SHARPNESS": SPLAT_SHARPNESS})
         self._counting_program = build_program("splat", {"SPLAT_SHARPNESS": SPLAT_SHARPNESS, "COUNT_FRAGMENTS": 1})
-        self._instance_count = 0
-        #: the last draw's particles (world centres, radii), for the analytic overdraw estimate
-        self.drawn_centres, self.drawn_radii = np.zeros((0, 3)), np.zeros(0)
         self._vertex_array = GL.glGenVertexArrays(1)
         self._corner_buffer, self._instance_buffer = GL.glGenBuffers(2)
         GL.glBindVertexArray(self._vertex_array)
@@ -48,50 +73,25 @@ class SplatPass:
             GL.glVertexAttribDivisor(location, 1)
         GL.glBindVertexArray(0)
 
-    def draw(self, particles: ParticleShading, eye, view: np.ndarray, projection: np.ndarray) -> dict:
-        """Draw the visible clouds into the bound target; returns the culling counts."""
-        view_projection = projection @ view
-        visible = spheres_in_frustum(frustum_planes(view_projection),
-                                     particles.bounding_centres, particles.bounding_radii)
-        starts = particles.cloud_starts
-        ranges = [np.arange(starts[c], starts[c + 1]) for c in np.flatnonzero(visible)]
-        indices = np.concatenate(ranges) if ranges else np.zeros(0, dtype=np.int64)
-        eye = np.asarray(eye, dtype=np.float64)
-        far_to_near = indices[np.argsort(-np.linalg.norm(particles.centres[indices] - eye, axis=1))]
-        colour, alpha = particles.seen_from(eye, far_to_near)
-        seen = alpha > 0.0
-        drawn = far_to_near[seen]
-        instances = np.empty((len(drawn), _INSTANCE_FLOATS), dtype=np.float32)
-        instances[:, :3] = particles.centres[drawn]
-        instances[:, 3] = particles.radii[drawn]
-        instances[:, 4:7] = colour[seen]
-        instances[:, 7] = alpha[seen]
-        self._instance_count = len(instances)
-        self.drawn_centres, self.drawn_radii = particles.centres[drawn], particles.radii[drawn]
-        if len(instances):
-            GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self._instance_buffer)
-            GL.glBufferData(GL.GL_ARRAY_BUFFER, instances.nbytes, instances, GL.GL_STREAM_DRAW)
-            self._draw_instances(self._program, view, projection)
-        return {"particles_drawn": len(instances), "clouds_drawn": int(visible.sum()),
-                "clouds_culled": int((~visible).sum())}
-
-    def count_fragments(self, view: np.ndarray, projection: np.ndarray) -> None:
-        """Redraw the last frame's splats adding 1 per fragment into the bound (float) target."""
-        if self._instance_count:
-            self._draw_instances(self._counting_program, view, projection, additive=True)
-
-    def _draw_instances(self, program: int, view: np.ndarray, projection: np.ndarray, additive=False) -> None:
+    def draw(self, batch: SplatBatch, view: np.ndarray, projection: np.ndarray, *, depth_test: bool = True,
+             counting: bool = False) -> None:
+        """Blend the batch over the bound target (premultiplied), or add 1 per fragment when counting."""
+        if not len(batch):
+            return
+        program = self._counting_program if counting else self._program
         GL.glUseProgram(program)
         set_matrix(program, "view", view)
         set_matrix(program, "projection", projection)
-        GL.glEnable(GL.GL_DEPTH_TEST)
+        GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self._instance_buffer)
+        GL.glBufferData(GL.GL_ARRAY_BUFFER, batch.instances.nbytes, batch.instances, GL.GL_STREAM_DRAW)
+        (GL.glEnable if depth_test else GL.glDisable)(GL.GL_DEPTH_TEST)
         GL.glDepthFunc(GL.GL_LESS)
         GL.glDepthMask(GL.GL_FALSE)
         GL.glDisable(GL.GL_CULL_FACE)
         GL.glEnable(GL.GL_BLEND)
-        GL.glBlendFunc(GL.GL_ONE, GL.GL_ONE if additive else GL.GL_ONE_MINUS_SRC_ALPHA)
+        GL.glBlendFunc(GL.GL_ONE, GL.GL_ONE if counting else GL.GL_ONE_MINUS_SRC_ALPHA)
         GL.glBindVertexArray(self._vertex_array)
-        GL.glDrawArraysInstanced(GL.GL_TRIANGLE_STRIP, 0, 4, self._instance_count)
+        GL.glDrawArraysInstanced(GL.GL_TRIANGLE_STRIP, 0, 4, len(batch))
         GL.glBindVertexArray(0)
         GL.glDisable(GL.GL_BLEND)
         GL.glDepthMask(GL.GL_TRUE)

@@ -60,3 +60,18 @@ class TextureTarget:
     def close(self) -> None:
         GL.glDeleteFramebuffers(1, [self.framebuffer])
         GL.glDeleteTextures([self.texture])
+
+
+def depth_renderbuffer(width: int, height: int) -> int:
+    """A 24-bit depth renderbuffer, the format pyrender's depth is blitted from."""
+    renderbuffer = GL.glGenRenderbuffers(1)
+    GL.glBindRenderbuffer(GL.GL_RENDERBUFFER, renderbuffer)
+    GL.glRenderbufferStorage(GL.GL_RENDERBUFFER, GL.GL_DEPTH_COMPONENT24, width, height)
+    return renderbuffer
+
+
+def blit_depth(source_framebuffer: int, source_size, target_framebuffer: int, target_size) -> None:
+    """Copy (and rescale, nearest texel) the depth of one framebuffer into another."""
+    GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, source_framebuffer)
+    GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, target_framebuffer)
+    GL.glBlitFramebuffer(0, 0, *source_size, 0, 0, *target_size, GL.GL_DEPTH_BUFFER_BIT, GL.GL_NEAREST)

@@ -1,0 +1,99 @@
+"""The GL side of impostors: renders what the frame plan says to regenerate and keeps the textures.
+
+Per-cloud impostors are rendered from the eye recorded in the plan's impostor
+cache, through the tight frustum of `cloudcore.impostors.impostor_view`; ring
+segments from their generation's eye (`cloudcore.ring`).  Textures come from
+one `TexturePool`; those of clouds or ring generations the plan no longer
+holds go back to it.
+"""
+
+from __future__ import annotations
+
+import math
+
+from cloudcore.eye_scattering import ParticleShading
+from cloudcore.frameplan import FramePlan
+from cloudcore.gl.splats import SplatPass, splat_batch
+from cloudcore.gl.targets import TextureTarget
+from cloudcore.gl.texture_pool import TexturePool
+from cloudcore.impostors import ImpostorView, impostor_view, required_size
+from cloudcore.ring import SEGMENT_DEG, RingGeneration, segment_camera
+from cloudcore.settings import RenderSettings
+
+
+class ImpostorStore:
+    def __init__(self, splats: SplatPass):
+        self._splats = splats
+        self.pool = TexturePool()
+        self._clouds: dict[int, tuple[TextureTarget, ImpostorView]] = {}
+        self._ring: dict[tuple[RingGeneration, int], TextureTarget] = {}
+        self._ring_sizes: dict[RingGeneration, tuple[int, int]] = {}
+
+    def update(self, plan: FramePlan, particles: ParticleShading, viewport, fov_y_deg: float,
+               settings: RenderSettings) -> int:
+        """Render this frame's regenerations and ring segment; returns the particles rendered."""
+        rendered = 0
+        for cloud in plan.clouds:
+            if cloud.regenerate is None:
+                continue
+            eye = plan.records[cloud.index].eye
+            view = impostor_view(particles.bounding_centres[cloud.index], particles.bounding_radii[cloud.index], eye)
+            target = self._cloud_target(cloud.index, cloud.texture_size)
+            self._clouds[cloud.index] = (target, view)
+            rendered += self._render(target, particles, [cloud.index], eye, view.view, view.projection)
+        for index in set(self._clouds) - set(plan.records):
+            self.pool.release(self._clouds.pop(index)[0])
+
+        ring = plan.ring
+        if ring is not None and ring.build_segment is not None:
+            generation, segment = ring.state.pending, ring.build_segment
+            size = self._ring_sizes.setdefault(generation, _ring_texture_size(viewport, fov_y_deg, settings))
+            target = self._ring[generation, segment] = self.pool.acquire(*size)
+            view, projection = segment_camera(generation, segment, settings.ring_elevation_deg)
+            rendered += self._render(target, particles, generation.segment_members[segment], generation.eye,
+                                     view, projection)
+        live = {plan.ring_state.current, plan.ring_state.pending}
+        for key in [key for key in self._ring if key[0] not in live]:
+            self.pool.release(self._ring.pop(key))
+        for generation in set(self._ring_sizes) - live:
+            del self._ring_sizes[generation]
+        return rendered
+
+    def cloud_impostor(self, index: int) -> tuple[TextureTarget, ImpostorView]:
+        return self._clouds[index]
+
+    def ring_panel(self, generation: RingGeneration, segment: int) -> TextureTarget:
+        return self._ring[generation, segment]
+
+    def _cloud_target(self, index: int, size: int) -> TextureTarget:
+        held = self._clouds.pop(index, None)
+        if held is not None and held[0].width == size:
+            return held[0]
+        if held is not None:
+            self.pool.release(held[0])
+        return self.pool.acquire(size, size)
+
+    def _render(self, target: TextureTarget, particles, clouds, eye, view, projection) -> int:
+        """The clouds alone, no depth test: the texture holds their premultiplied colour and opacity."""
+        batch = splat_batch(particles, clouds, eye)
+        target.bind_cleared()
+        self._splats.draw(batch, view, projection, depth_test=False)
+        return len(batch)
+
+    def close(self) -> None:
+        for target, _ in self._clouds.values():
+            target.close()
+        for target in self._ring.values():
+            target.close()
+        self._clouds.clear()
+        self._ring.clear()
+        self.pool.close()
+
+
+def _ring_texture_size(viewport, fov_y_deg: float, settings: RenderSettings) -> tuple[int, int]:
+    """(width, height) of a ring segment texture: the screen's pixel density over 45 x 2 elevation degrees."""
+    pixels_per_tangent = viewport[1] / (2.0 * math.tan(math.radians(fov_y_deg) / 2.0))
+    width = 2.0 * math.tan(math.radians(SEGMENT_DEG / 2.0)) * pixels_per_tangent
+    height = 2.0 * math.tan(math.radians(settings.ring_elevation_deg)) * pixels_per_tangent
+    return (required_size(width, settings.impostor_min_size, settings.impostor_max_size),
+            required_size(height, settings.impostor_min_size, settings.impostor_max_size))

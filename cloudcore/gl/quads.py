@@ -1,0 +1,58 @@
+"""Textured quads: impostors, ring panels and screen impostors, blended premultiplied."""
+
+from __future__ import annotations
+
+import numpy as np
+from OpenGL import GL
+
+from cloudcore.gl.programs import build_program, set_matrix
+
+#: clip-space corners of the whole screen, for screen impostors
+SCREEN_CORNERS = np.array([[-1, -1, 0], [1, -1, 0], [-1, 1, 0], [1, 1, 0]], dtype=np.float64)
+
+
+class QuadPass:
+    def __init__(self):
+        self._program = build_program("quad")
+        self._counting_program = build_program("quad", {"COUNT_FRAGMENTS": 1})
+        for program in (self._program, self._counting_program):
+            GL.glUseProgram(program)
+            GL.glUniform1i(GL.glGetUniformLocation(program, "impostor"), 0)
+            GL.glUniform1i(GL.glGetUniformLocation(program, "layer"), 1)
+        # core profile draws nothing without a vertex array, even one with no attributes
+        self._vertex_array = GL.glGenVertexArrays(1)
+
+    def draw(self, corners: np.ndarray, view_projection: np.ndarray, texture: int, impostor_weight: float,
+             *, layer_texture: int | None = None, layer_weight: float = 0.0, depth_test: bool = True,
+             counting: bool = False) -> None:
+        """Blend `texture` (premultiplied) over the bound target on the quad `corners` (4, 3)."""
+        program = self._counting_program if counting else self._program
+        GL.glUseProgram(program)
+        GL.glUniform3fv(GL.glGetUniformLocation(program, "corners"), 4,
+                        np.ascontiguousarray(corners, dtype=np.float32))
+        set_matrix(program, "view_projection", view_projection)
+        GL.glUniform1f(GL.glGetUniformLocation(program, "impostor_weight"), float(impostor_weight))
+        GL.glUniform1f(GL.glGetUniformLocation(program, "layer_weight"),
+                       float(layer_weight) if layer_texture is not None else 0.0)
+        GL.glActiveTexture(GL.GL_TEXTURE0)
+        GL.glBindTexture(GL.GL_TEXTURE_2D, texture)
+        if layer_texture is not None:
+            GL.glActiveTexture(GL.GL_TEXTURE1)
+            GL.glBindTexture(GL.GL_TEXTURE_2D, layer_texture)
+            GL.glActiveTexture(GL.GL_TEXTURE0)
+        (GL.glEnable if depth_test else GL.glDisable)(GL.GL_DEPTH_TEST)
+        GL.glDepthFunc(GL.GL_LESS)
+        GL.glDepthMask(GL.GL_FALSE)
+        GL.glDisable(GL.GL_CULL_FACE)
+        GL.glEnable(GL.GL_BLEND)
+        GL.glBlendFunc(GL.GL_ONE, GL.GL_ONE if counting else GL.GL_ONE_MINUS_SRC_ALPHA)
+        GL.glBindVertexArray(self._vertex_array)
+        GL.glDrawArrays(GL.GL_TRIANGLE_STRIP, 0, 4)
+        GL.glBindVertexArray(0)
+        GL.glDisable(GL.GL_BLEND)
+        GL.glDepthMask(GL.GL_TRUE)
+
+    def close(self) -> None:
+        GL.glDeleteProgram(self._program)
+        GL.glDeleteProgram(self._counting_program)
+        GL.glDeleteVertexArrays(1, [self._vertex_array])

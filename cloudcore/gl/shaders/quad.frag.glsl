@@ -1,0 +1,26 @@
+#version 330 core
+// Premultiplied colour from an impostor texture, scaled by its share of the
+// cloud's opacity, plus (in a crossfade) the full-3D image of the same cloud
+// from a screen-sized layer scaled by the rest: a linear mix of two
+// premultiplied images is itself a correct premultiplied image, so the
+// crossfade neither brightens nor darkens.  COUNT_FRAGMENTS writes 1 instead.
+
+uniform sampler2D impostor;
+uniform sampler2D layer;
+uniform float impostor_weight;
+uniform float layer_weight;
+
+in vec2 uv;
+out vec4 frag_colour;
+
+void main()
+{
+#ifdef COUNT_FRAGMENTS
+    frag_colour = vec4(1.0);
+#else
+    vec4 colour = impostor_weight * texture(impostor, uv);
+    if (layer_weight > 0.0)
+        colour += layer_weight * texelFetch(layer, ivec2(gl_FragCoord.xy), 0);
+    frag_colour = colour;
+#endif
+}

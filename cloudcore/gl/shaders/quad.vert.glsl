@@ -1,0 +1,16 @@
+#version 330 core
+// A textured quad from four corners given as uniforms (no vertex buffer):
+// impostors and ring panels in world space, screen impostors in clip space
+// (with an identity view_projection).  Triangle-strip order: lower left,
+// lower right, upper left, upper right, so uv = (id & 1, id >> 1).
+
+uniform vec3 corners[4];
+uniform mat4 view_projection;
+
+out vec2 uv;
+
+void main()
+{
+    uv = vec2(gl_VertexID & 1, gl_VertexID >> 1);
+    gl_Position = view_projection * vec4(corners[gl_VertexID], 1.0);
+}

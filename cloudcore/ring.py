@@ -1,0 +1,144 @@
+"""Wang's ring of impostors (section 6.2): far clouds on eight panels around the eye.
+
+Clouds wholly beyond the ring radius (horizontally) and within the ring's
+elevation band are rendered, from the eye at which the ring was made, into
+eight textures of 45 degrees each; the panels form an octagon at the ring
+radius.  The ring is remade when the eye has moved more than a fraction of
+the radius (15% horizontally, 2% vertically, as in the paper) or the lights
+changed: one segment a frame, then the new ring crossfades in over a few
+frames while the old one fades out.  Pure numpy; the GL side renders what
+`RingPlan` says.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+from typing import Hashable
+
+import numpy as np
+
+from cloudcore.camera import camera_pose, frustum_planes, projection_matrix, spheres_in_frustum, view_matrix
+from cloudcore.scene import Camera
+from cloudcore.settings import RenderSettings
+
+SEGMENTS = 8
+SEGMENT_DEG = 360.0 / SEGMENTS
+#: metres: the panels never come nearer than this, so a zero ring radius still has a drawable octagon
+MIN_PANEL_DISTANCE = 10.0
+
+
+@dataclass(frozen=True)
+class RingGeneration:
+    """One ring: where and for which lights it was made, which clouds it holds, per segment."""
+
+    eye: tuple[float, float, float]
+    radius: float
+    lighting_key: Hashable
+    members: frozenset
+    segment_members: tuple  # SEGMENTS tuples of cloud indices
+
+
+@dataclass(frozen=True)
+class RingState:
+    """Carried from frame to frame: the ring shown, and the one being built or faded in."""
+
+    current: RingGeneration | None = None
+    pending: RingGeneration | None = None
+    built: int = 0
+    fade_step: int = 0
+
+
+@dataclass(frozen=True)
+class RingPlan:
+    """This frame's ring work: the segment to build (of `pending`), and the generations to draw with weights."""
+
+    build_segment: int | None
+    draws: tuple = field(default_factory=tuple)  # ((generation, weight), ...)
+    state: RingState = RingState()
+
+    def weight_of(self, cloud: int) -> float:
+        """The share of a cloud's opacity the ring shows this frame."""
+        return sum(weight for generation, weight in self.draws if cloud in generation.members)
+
+
+def segment_direction(segment: int) -> np.ndarray:
+    """Horizontal unit vector through the middle of a segment; segment 0 starts at -z, turning toward +x."""
+    azimuth = math.radians((segment + 0.5) * SEGMENT_DEG)
+    return np.array([math.sin(azimuth), 0.0, -math.cos(azimuth)])
+
+
+def segment_camera(generation: RingGeneration, segment: int, elevation_deg: float) -> tuple[np.ndarray, np.ndarray]:
+    """(view, projection) rendering one 45-degree segment of the ring from its eye."""
+    eye = np.asarray(generation.eye, dtype=np.float64)
+    camera = Camera(tuple(eye), tuple(eye + segment_direction(segment)), 2.0 * elevation_deg)
+    aspect = math.tan(math.radians(SEGMENT_DEG / 2.0)) / math.tan(math.radians(elevation_deg))
+    return view_matrix(camera), projection_matrix(camera.fov_y_deg, aspect)
+
+
+def panel_corners(generation: RingGeneration, segment: int, elevation_deg: float) -> np.ndarray:
+    """(4, 3) world corners of a segment's panel (lower left, lower right, upper left, upper right)."""
+    eye = np.asarray(generation.eye, dtype=np.float64)
+    distance = max(generation.radius, MIN_PANEL_DISTANCE)
+    pose = camera_pose(Camera(tuple(eye), tuple(eye + segment_direction(segment)), 60.0))
+    right = pose[:3, 0] * distance * math.tan(math.radians(SEGMENT_DEG / 2.0))
+    up = pose[:3, 1] * distance * math.tan(math.radians(elevation_deg))
+    middle = eye + segment_direction(segment) * distance
+    return np.array([middle - right - up, middle + right - up, middle - right + up, middle + right + up])
+
+
+def ring_members(centres: np.ndarray, radii: np.ndarray, eye, settings: RenderSettings) -> np.ndarray:
+    """Boolean (N,): clouds wholly beyond the ring radius and wholly inside its elevation band, seen from `eye`."""
+    offset = centres - np.asarray(eye, dtype=np.float64)
+    horizontal = np.hypot(offset[:, 0], offset[:, 2])
+    distance = np.linalg.norm(offset, axis=1)
+    elevation = np.degrees(np.arctan2(np.abs(offset[:, 1]), horizontal))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        angular_radius = np.degrees(np.arcsin(np.clip(radii / distance, 0.0, 1.0)))
+    return (radii > 0) & (horizontal - radii > settings.ring_radius) & (
+        elevation + np.nan_to_num(angular_radius, nan=90.0) <= settings.ring_elevation_deg)
+
+
+def new_generation(centres, radii, eye, settings: RenderSettings, lighting_key: Hashable) -> RingGeneration:
+    members = ring_members(centres, radii, eye, settings)
+    generation = RingGeneration(tuple(float(v) for v in eye), float(settings.ring_radius), lighting_key,
+                                frozenset(np.flatnonzero(members).tolist()), ())
+    per_segment = []
+    for segment in range(SEGMENTS):
+        view, projection = segment_camera(generation, segment, settings.ring_elevation_deg)
+        seen = spheres_in_frustum(frustum_planes(projection @ view), centres, radii) & members
+        per_segment.append(tuple(np.flatnonzero(seen).tolist()))
+    return replace(generation, segment_members=tuple(per_segment))
+
+
+def _needs_rebuild(generation: RingGeneration, eye, settings: RenderSettings, lighting_key: Hashable) -> bool:
+    moved = np.asarray(eye, dtype=np.float64) - np.asarray(generation.eye)
+    return (generation.lighting_key != lighting_key or generation.radius != settings.ring_radius
+            or math.hypot(moved[0], moved[2]) > settings.ring_rebuild_horizontal * settings.ring_radius
+            or abs(moved[1]) > settings.ring_rebuild_vertical * settings.ring_radius)
+
+
+def plan_ring(state: RingState, centres, radii, eye, settings: RenderSettings, lighting_key: Hashable) -> RingPlan | None:
+    """Advance the ring by one frame: start a rebuild if needed, build one segment or step the fade."""
+    if not settings.uses_ring:
+        return None
+    current, pending, built, fade_step = state.current, state.pending, state.built, state.fade_step
+    if pending is not None and (pending.lighting_key != lighting_key or pending.radius != settings.ring_radius):
+        pending = None  # what it was being built for is gone: start again
+    if pending is None and (current is None or _needs_rebuild(current, eye, settings, lighting_key)):
+        pending, built, fade_step = new_generation(centres, radii, eye, settings, lighting_key), 0, 0
+    build_segment = None
+    if pending is not None:
+        if built < SEGMENTS:
+            build_segment, built = built, built + 1
+        else:
+            fade_step += 1
+    draws = ()
+    if pending is not None and fade_step >= settings.ring_fade_frames:
+        current, pending, built, fade_step = pending, None, 0, 0
+    if pending is not None and fade_step > 0:
+        weight = fade_step / settings.ring_fade_frames
+        draws = ((pending, weight),) + (((current, 1.0 - weight),) if current is not None else ())
+    elif current is not None:
+        draws = ((current, 1.0),)
+    return RingPlan(build_segment, draws, RingState(current, pending, built, fade_step))
