@@ -1,0 +1,205 @@
+"""The frame plan without GL: impostor regeneration, fade weights, the ring, and degenerate cameras."""
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from cloudcore.frameplan import plan_frame
+from cloudcore.impostors import impostor_view, translation_error_deg
+from cloudcore.ring import SEGMENTS, RingState
+from cloudcore.scene import Camera
+from cloudcore.settings import RenderSettings
+
+RADIUS = 100.0
+NO_RING = RenderSettings(ring_radius=math.inf)
+VIEWPORT = (640, 480)
+
+
+def camera_at(position, look_at=(0.0, 0.0, 0.0)) -> Camera:
+    return Camera(tuple(float(v) for v in position), tuple(float(v) for v in look_at), 60.0)
+
+
+def orbit(distance: float, degrees: float) -> Camera:
+    """An eye on a horizontal circle around the origin, looking at it."""
+    angle = math.radians(degrees)
+    return camera_at((distance * math.sin(angle), 0.0, distance * math.cos(angle)))
+
+
+def plan(camera, settings=NO_RING, records=None, ring=RingState(), centres=((0.0, 0.0, 0.0),), radii=(RADIUS,),
+         lighting=1):
+    return plan_frame(np.array(centres, dtype=float), np.array(radii, dtype=float), camera, VIEWPORT, settings,
+                      records or {}, ring, lighting)
+
+
+def test_first_sight_of_a_far_cloud_makes_its_impostor():
+    first = plan(orbit(2000.0, 0.0))
+    (cloud,) = first.clouds
+    assert (cloud.kind, cloud.regenerate, cloud.impostor_weight) == ("impostor", "new", 1.0)
+    assert first.records[0].eye == (0.0, 0.0, 2000.0)
+
+
+@pytest.mark.parametrize("tolerance, regenerates", [(0.15, False), (0.05, True)])
+def test_turning_a_tenth_of_a_degree_around_a_cloud(tolerance, regenerates):
+    settings = dataclasses.replace(NO_RING, tolerance_deg=tolerance)
+    first = plan(orbit(2000.0, 0.0), settings)
+    turned = plan(orbit(2000.0, 0.1), settings, first.records)
+    assert turned.clouds[0].regenerate == ("translation" if regenerates else None)
+    assert translation_error_deg((0, 0, 0), first.records[0].eye, orbit(2000.0, 0.1).position) == pytest.approx(0.1)
+
+
+def test_moving_straight_at_a_cloud_is_no_translation_error_but_raises_the_resolution():
+    first = plan(orbit(8000.0, 0.0))
+    closer = plan(orbit(1200.0, 0.0), records=first.records)
+    assert closer.clouds[0].regenerate == "resolution"
+    assert closer.clouds[0].texture_size > first.clouds[0].texture_size
+    # a little closer still, within the same power of two: the impostor stays
+    assert plan(orbit(1150.0, 0.0), records=closer.records).clouds[0].regenerate is None
+
+
+def test_changed_lights_remake_every_impostor():
+    first = plan(orbit(2000.0, 0.0))
+    assert plan(orbit(2000.0, 0.0), records=first.records, lighting=2).clouds[0].regenerate == "lights"
+
+
+def test_texture_sizes_stay_within_the_limits():
+    settings = dataclasses.replace(NO_RING, impostor_min_size=32, impostor_max_size=256)
+    impostors = dataclasses.replace(settings, mode="impostor")
+    for distance in (1e2 * 1.06, 1e3, 5e4, 9e4):
+        size = plan(orbit(distance, 0.0), impostors).clouds[0].texture_size
+        assert 32 <= size <= 256 and size & (size - 1) == 0
+    assert plan(orbit(1e7, 0.0), impostors).clouds[0].kind == "culled"  # beyond the far plane
+
+
+def test_fade_weights_between_two_and_four_radii():
+    weights = []
+    for distance in np.linspace(1.2, 5.0, 60) * RADIUS:
+        cloud = plan(orbit(distance, 0.0)).clouds[0]
+        expected = "full" if distance <= 2 * RADIUS else "impostor" if distance >= 4 * RADIUS else "crossfade"
+        assert cloud.kind == expected
+        assert cloud.full_weight + cloud.impostor_weight == pytest.approx(1.0)
+        weights.append(cloud.full_weight)
+    assert np.all(np.diff(weights) <= 0.0)  # fades out monotonically with distance
+    assert plan(orbit(3 * RADIUS, 0.0)).clouds[0].full_weight == pytest.approx(0.5)
+
+
+def test_the_modes_override_the_distance_choice():
+    near = orbit(1.5 * RADIUS, 0.0)
+    assert plan(near, dataclasses.replace(NO_RING, mode="impostor")).clouds[0].kind == "impostor"
+    assert plan(orbit(1e5, 0.0), dataclasses.replace(NO_RING, mode="full")).clouds[0].kind == "full"
+
+
+def test_a_cloud_out_of_view_costs_nothing():
+    behind = plan(camera_at((0.0, 0.0, 2000.0), look_at=(0.0, 0.0, 4000.0)))
+    assert behind.clouds[0].kind == "culled" and behind.clouds[0].regenerate is None
+    assert behind.draw_order == () and behind.stats()["impostors_regenerated"] == 0
+
+
+@pytest.mark.parametrize("position", [(0.0, 0.0, 0.0), (30.0, 0.0, 0.0), (0.0, 0.0, 104.0)])
+def test_the_eye_inside_a_cloud_gets_the_screen_impostor(position):
+    cloud_plan = plan(camera_at(position, look_at=(0.0, 0.0, -500.0)))
+    assert cloud_plan.clouds[0].kind == "inside" and cloud_plan.clouds[0].full_weight == 1.0
+    assert cloud_plan.inside_size == (160, 120)
+    assert cloud_plan.clouds[0].regenerate is None  # a screen impostor is redrawn every frame, not cached
+
+
+def test_a_cloud_without_particles_is_planned_as_empty():
+    empty = plan(orbit(500.0, 0.0), centres=((0.0, 0.0, 0.0),), radii=(0.0,))
+    assert empty.clouds[0].kind == "empty" and empty.draw_order == ()
+
+
+def test_the_eye_back_at_an_impostor_s_creation_point():
+    first = plan(orbit(2000.0, 0.0))
+    away = plan(orbit(2000.0, 0.1), dataclasses.replace(NO_RING, tolerance_deg=1.0), first.records)
+    back = plan(orbit(2000.0, 0.0), records=away.records)
+    assert back.clouds[0].regenerate is None and back.clouds[0].impostor_weight == 1.0
+    view = impostor_view((0.0, 0.0, 0.0), RADIUS, first.records[0].eye)
+    assert all(np.isfinite(m).all() for m in (view.view, view.projection, view.corners))
+
+
+def test_impostor_views_stay_finite_at_extreme_scales():
+    for radius, distance in [(1e-6, 1e7), (1e6, 1.06e6), (1.0, 1.0 + 1e-9)]:
+        view = impostor_view((0.0, 0.0, 0.0), radius, (0.0, 0.0, distance))
+        assert all(np.isfinite(m).all() for m in (view.view, view.projection, view.corners))
+    with pytest.raises(ValueError, match="outside the cloud"):
+        impostor_view((0.0, 0.0, 0.0), 1.0, (0.0, 0.0, 0.5))
+
+
+def test_draw_order_is_far_to_near():
+    centres = [(0.0, 0.0, -3000.0), (0.0, 0.0, -1000.0), (50.0, 0.0, -2000.0)]
+    ordered = plan(camera_at((0.0, 0.0, 0.0), look_at=(0.0, 0.0, -1.0)), centres=centres, radii=(RADIUS,) * 3)
+    assert ordered.draw_order == (0, 2, 1)
+
+
+# --- Wang's ring -------------------------------------------------------------------------------------------
+
+RING = RenderSettings(ring_radius=1000.0, ring_fade_frames=4)
+FAR_CLOUDS = [(3000.0 * math.sin(a), 100.0, -3000.0 * math.cos(a)) for a in np.radians(np.arange(0, 360, 30))]
+
+
+def run_ring(eye, frames, state=RingState(), settings=RING, lighting=1):
+    plans = []
+    for _ in range(frames):
+        plans.append(plan(camera_at(eye, look_at=(0.0, 100.0, -1.0)), settings, ring=state,
+                          centres=FAR_CLOUDS, radii=(RADIUS,) * len(FAR_CLOUDS), lighting=lighting))
+        state = plans[-1].ring_state
+    return plans, state
+
+
+def test_the_ring_builds_one_segment_a_frame_then_fades_in():
+    plans, state = run_ring((0.0, 100.0, 0.0), SEGMENTS + RING.ring_fade_frames + 1)
+    assert [p.ring.build_segment for p in plans[:SEGMENTS]] == list(range(SEGMENTS))
+    # while the ring is built, its clouds are drawn one by one
+    assert all(p.stats()["clouds_ring"] == 0 for p in plans[:SEGMENTS])
+    fading = plans[SEGMENTS:SEGMENTS + RING.ring_fade_frames - 1]
+    weights = [p.ring.draws[0][1] for p in fading]
+    assert weights == sorted(weights) and 0 < weights[0] < 1
+    for p in fading:  # the individual impostor and the ring share each cloud's opacity
+        in_view = [cloud for cloud in p.clouds if cloud.kind != "culled"]
+        assert in_view and all(c.impostor_weight + p.ring.weight_of(c.index) == pytest.approx(1.0) for c in in_view)
+    assert state.current is not None and state.pending is None
+    assert plans[-1].stats()["clouds_ring"] == len(FAR_CLOUDS) and plans[-1].draw_order == ()
+    # every cloud is rendered into the segments it reaches, and into no others
+    assert set().union(*map(set, state.current.segment_members)) == set(range(len(FAR_CLOUDS)))
+
+
+@pytest.mark.parametrize("move, rebuilds", [
+    ((149.0, 0.0, 0.0), False), ((151.0, 0.0, 0.0), True),  # 15% of 1000 m horizontally
+    ((0.0, 19.0, 0.0), False), ((0.0, 21.0, 0.0), True),  # 2% vertically
+])
+def test_the_ring_is_rebuilt_after_15_percent_across_or_2_percent_up(move, rebuilds):
+    _, state = run_ring((0.0, 100.0, 0.0), SEGMENTS + RING.ring_fade_frames + 1)
+    moved, _ = run_ring(np.array([0.0, 100.0, 0.0]) + move, 1, state)
+    assert (moved[0].ring.build_segment == 0) is rebuilds
+
+
+def test_a_sun_change_rebuilds_the_ring():
+    _, state = run_ring((0.0, 100.0, 0.0), SEGMENTS + RING.ring_fade_frames + 1)
+    relit, _ = run_ring((0.0, 100.0, 0.0), 1, state, lighting=2)
+    assert relit[0].ring.build_segment == 0
+
+
+def test_clouds_far_above_or_within_the_radius_stay_out_of_the_ring():
+    centres = [(0.0, 100.0, -3000.0), (0.0, 2700.0, -3000.0), (0.0, 100.0, -600.0)]
+    state = RingState()
+    for _ in range(SEGMENTS + RING.ring_fade_frames + 1):
+        p = plan(camera_at((0.0, 100.0, 0.0), look_at=(0.0, 1200.0, -3000.0)), RING, ring=state, centres=centres,
+                 radii=(RADIUS,) * 3)
+        state = p.ring_state
+    assert [c.kind for c in p.clouds] == ["ring", "impostor", "impostor"]
+
+
+def test_full_mode_and_an_infinite_radius_have_no_ring():
+    assert plan(orbit(2000.0, 0.0), dataclasses.replace(RING, mode="full")).ring is None
+    assert plan(orbit(2000.0, 0.0), NO_RING).ring is None
+
+
+def test_settings_refuse_out_of_domain_values():
+    with pytest.raises(ValueError, match="tolerance_deg"):
+        RenderSettings(tolerance_deg=-1.0)
+    with pytest.raises(ValueError, match="power of two"):
+        RenderSettings(impostor_max_size=300)
+    with pytest.raises(ValueError, match="mode"):
+        RenderSettings(mode="sideways")
+    assert RenderSettings(tolerance_deg=0.0, ring_radius=0.0).uses_ring
