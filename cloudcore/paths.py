@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from cloudcore.scene import Camera
+
 
 def sample(keys: np.ndarray, t: float) -> np.ndarray:
     """Values at time `t` of rows (t, v...), keys sorted by strictly increasing time."""
@@ -28,3 +30,16 @@ def sample(keys: np.ndarray, t: float) -> np.ndarray:
     s2, s3 = s * s, s * s * s
     return ((2 * s3 - 3 * s2 + 1) * p1 + (s3 - 2 * s2 + s) * m1
             + (-2 * s3 + 3 * s2) * p2 + (s3 - s2) * m2)
+
+
+def camera_on_path(path, t: float, fov_y_deg: float) -> Camera:
+    """The `Camera` a `CameraPath` gives at time `t` (seconds from the path's start time)."""
+    at = sample(path.keys, path.keys[0, 0] + t)
+    return Camera(tuple(float(v) for v in at[:3]), tuple(float(v) for v in at[3:]), fov_y_deg)
+
+
+def frame_times(path, frames: int) -> np.ndarray:
+    """`frames` times (seconds from the path's start) spread evenly over the path, ends included."""
+    if frames < 1:
+        raise ValueError(f"frames must be >= 1, got {frames}")
+    return np.linspace(0.0, path.duration, frames) if frames > 1 else np.zeros(1)

@@ -2,14 +2,14 @@
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import os
 from pathlib import Path
 
+from cloudcore.cli.settings_args import add_settings_arguments, settings_from
 from cloudcore.errors import SceneError
 from cloudcore.overdraw import heat_map
-from cloudcore.paths import sample
+from cloudcore.paths import camera_on_path
 from cloudcore.scene import Camera
 from cloudcore.scenefile import load_scene
 
@@ -20,12 +20,13 @@ def add_parser(commands) -> None:
     parser.add_argument("--out", required=True, type=Path, help="PNG to write")
     parser.add_argument("--width", type=pixel_count, default=640)
     parser.add_argument("--height", type=pixel_count, default=480)
-    parser.add_argument("--mode", choices=("full",), default="full", help="cloud drawing mode")
     parser.add_argument("--time", type=float, help="time of day in hours, overriding the scene's")
     parser.add_argument("--camera-path", help="take the camera from this path of the scene")
     parser.add_argument("--t", type=float, default=0.0, help="seconds along --camera-path")
     parser.add_argument("--overdraw", type=Path, help="write the overdraw heat map here (PNG)")
     parser.add_argument("--stats", type=Path, help="write frame statistics, overdraw included, here (JSON)")
+    # one frame: the reference picture unless asked otherwise (impostors pay off over many frames)
+    add_settings_arguments(parser, default_mode="full")
     parser.set_defaults(run=run)
 
 
@@ -41,14 +42,14 @@ def run(args) -> int:
     scene = load_scene(args.scene)
     if args.time is not None and not 0.0 <= args.time <= 24.0:
         raise SceneError("--time", "time_of_day", f"must be within [0, 24] hours, got {args.time}")
+    settings = settings_from(args)
     camera = scene.camera
     if args.camera_path is not None:
         try:
-            keys = scene.camera_path(args.camera_path).keys
+            path = scene.camera_path(args.camera_path)
         except KeyError as error:
             raise SceneError(args.scene, "camera_paths", error.args[0]) from None
-        at = sample(keys, args.t)
-        camera = dataclasses.replace(camera, position=tuple(at[:3]), look_at=tuple(at[3:]))
+        camera = camera_on_path(path, args.t, camera.fov_y_deg)
     # headless: EGL must be chosen before OpenGL is first imported
     os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
     import imageio.v3 as iio
@@ -56,7 +57,7 @@ def run(args) -> int:
     from cloudcore.gl import FrameRenderer
 
     with FrameRenderer(args.width, args.height) as renderer:
-        image, stats = renderer.render(scene, time_of_day=args.time, camera=camera)
+        image, stats = renderer.render(scene, time_of_day=args.time, camera=camera, settings=settings)
         if args.overdraw or args.stats:
             counts, overdraw = renderer.measure_overdraw()
             stats |= overdraw

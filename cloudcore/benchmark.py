@@ -1,0 +1,111 @@
+"""Error against run time: a camera path rendered in full 3D and in each setting, side by side in one run.
+
+`bench_path` takes any renderer with `render(scene, camera=, settings=) ->
+(sRGB image, stats)` (in practice `cloudcore.gl.FrameRenderer`), so this module
+stays free of OpenGL.  The full-3D reference is rendered first, in the same
+process and context, and every setting's frames are compared with it frame
+by frame.  PSNR of identical frames is reported as `PSNR_CAP_DB` (JSON has no
+infinity).  The report keys are a contract (issue 7): extend, do not rename.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+
+import numpy as np
+
+from cloudcore.illumination import illuminate_clouds
+from cloudcore.imagecompare import compare
+from cloudcore.lighting import active_lights, scene_lights
+from cloudcore.paths import camera_on_path, frame_times
+from cloudcore.scene import Scene
+from cloudcore.settings import FULL_3D, RenderSettings
+
+PSNR_CAP_DB = 100.0
+
+
+def path_cameras(scene: Scene, path_name: str, frames: int) -> list:
+    path = scene.camera_path(path_name)
+    return [camera_on_path(path, t, scene.camera.fov_y_deg) for t in frame_times(path, frames)]
+
+
+def _run(renderer, scene: Scene, cameras, settings: RenderSettings, reference=None, progress=None):
+    images, rows = [], []
+    for frame, camera in enumerate(cameras):
+        image, stats = renderer.render(scene, camera=camera, settings=settings)
+        row = {"frame": frame, **{k: v for k, v in stats.items() if isinstance(v, (int, float))}}
+        if reference is not None:
+            difference = compare(image, reference[frame])
+            row |= {"psnr_db": min(difference.psnr_db, PSNR_CAP_DB), "mad": difference.mean_abs}
+        else:
+            images.append(image)
+        rows.append(row)
+        if progress is not None:
+            progress()
+    return images, rows
+
+
+def _summary(rows) -> dict:
+    times = np.array([r["frame_ms"] for r in rows])
+    return {"frame_ms_mean": float(times.mean()), "frame_ms_p95": float(np.percentile(times, 95)),
+            "cloud_ms_mean": float(np.mean([r["cloud_ms"] + r.get("impostor_update_ms", 0.0) for r in rows])),
+            "world_ms_mean": float(np.mean([r["world_ms"] for r in rows]))}
+
+
+def bench_path(renderer, scene: Scene, path_name: str, frames: int, settings_list, size, progress=None) -> dict:
+    """The report: reference (full 3D) and one run per settings object, errors per frame and overall."""
+    cameras = path_cameras(scene, path_name, frames)
+    renderer.render(scene, camera=cameras[0], settings=FULL_3D)  # shading precompute, shader compiles
+    reference_images, reference_rows = _run(renderer, scene, cameras, FULL_3D, progress=progress)
+    reference = {"mode": "full", **_summary(reference_rows), "per_frame": reference_rows}
+    runs = []
+    for settings in settings_list:
+        _, rows = _run(renderer, scene, cameras, settings, reference_images, progress)
+        psnr = np.array([r["psnr_db"] for r in rows])
+        summary = _summary(rows)
+        runs.append({
+            "settings": dataclasses.asdict(settings), **summary,
+            "speedup_vs_full": reference["frame_ms_mean"] / summary["frame_ms_mean"],
+            "cloud_speedup_vs_full": reference["cloud_ms_mean"] / summary["cloud_ms_mean"],
+            "psnr_mean": float(psnr.mean()), "psnr_min": float(psnr.min()),
+            "mad_mean": float(np.mean([r["mad"] for r in rows])),
+            "regenerations": int(sum(r.get("impostors_regenerated", 0) for r in rows)),
+            "texture_bytes_max": int(max(r.get("texture_bytes", 0) for r in rows)),
+            "per_frame": rows})
+    return {"scene": scene.description or "", "path": path_name, "width": size[0], "height": size[1],
+            "frames": frames, "reference": reference, "runs": runs}
+
+
+def shading_comparison(scene: Scene, resolutions=(32, 48, 96), repeat: int = 1) -> list[dict]:
+    """Seconds and error of raster shading against exact, per active light (best of `repeat`)."""
+    lights, _ = scene_lights(scene.lighting)
+    rows = []
+    for index, light in enumerate(active_lights(lights)):
+        exact_s, exact = _timed_shading(scene, light, "exact", repeat)
+        rows.append({"light": index, "method": "exact", "seconds": exact_s, "particles": len(exact),
+                     "max_abs_error_vs_exact": 0.0, "mean_abs_error_vs_exact": 0.0})
+        for resolution in resolutions:
+            seconds, raster = _timed_shading(scene, light, "raster", repeat, resolution)
+            error = np.abs(raster - exact)
+            rows.append({"light": index, "method": f"raster-{resolution}", "seconds": seconds,
+                         "particles": len(raster), "max_abs_error_vs_exact": float(error.max(initial=0.0)),
+                         "mean_abs_error_vs_exact": float(error.mean()) if error.size else 0.0})
+    return rows
+
+
+def _timed_shading(scene: Scene, light, method: str, repeat: int, resolution: int | None = None):
+    best, result = np.inf, None
+    options = {} if resolution is None else {"resolution": resolution}
+    for _ in range(max(repeat, 1)):
+        start = time.perf_counter()
+        result = illuminate_clouds(scene.clouds, scene.shading, (light,), method, **options)
+        best = min(best, time.perf_counter() - start)
+    return best, (np.concatenate(result)[:, 0] if result else np.zeros(0))
+
+
+def pareto_front(seconds, errors) -> list[int]:
+    """Indices of the points no other point beats in both time and error (lower is better in both)."""
+    points = list(zip(seconds, errors))
+    return [i for i, (t, e) in enumerate(points)
+            if not any((t2 <= t and e2 <= e) and (t2 < t or e2 < e) for t2, e2 in points)]

@@ -1,0 +1,109 @@
+"""`cloudview bench SCENE --path NAME --json OUT.json`: error against run time along a camera path, headless.
+
+Each setting of the sweeps is rendered along the path beside the full-3D
+reference in the same run; the report is `cloudcore.benchmark.bench_path`'s,
+plus the shading precompute (exact against raster).  With no --sweep, the
+default settings are run.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import json
+import os
+from pathlib import Path
+
+from cloudcore.benchmark import bench_path, pareto_front, shading_comparison
+from cloudcore.cli.render import pixel_count
+from cloudcore.cli.settings_args import add_settings_arguments, parse_sweep, settings_from
+from cloudcore.errors import SceneError
+from cloudcore.scenefile import load_scene
+
+
+def add_parser(commands) -> None:
+    parser = commands.add_parser("bench", help="frame time and image error of settings against full 3D")
+    parser.add_argument("scene", help="scene file (.toml)")
+    parser.add_argument("--path", required=True, help="camera path of the scene to fly")
+    parser.add_argument("--json", required=True, type=Path, help="report to write")
+    parser.add_argument("--sweep", action="append", type=parse_sweep, default=[],
+                        help="NAME=V1,V2,... with NAME one of tolerance, ring_radius, impostor_max_size, mode; "
+                             "several --sweep options combine")
+    parser.add_argument("--frames", type=int, default=60, help="frames spread along the path (default 60)")
+    parser.add_argument("--width", type=pixel_count, default=640)
+    parser.add_argument("--height", type=pixel_count, default=480)
+    parser.add_argument("--plot", type=Path, help="write the error-against-time plot here (PNG)")
+    parser.add_argument("--no-shading", action="store_true", help="skip the shading precompute comparison")
+    add_settings_arguments(parser)
+    parser.set_defaults(run=run)
+
+
+def run(args) -> int:
+    scene = load_scene(args.scene)
+    try:
+        scene.camera_path(args.path)
+    except KeyError as error:
+        raise SceneError(args.scene, "camera_paths", error.args[0]) from None
+    if args.frames < 1:
+        raise SceneError("--frames", "frames", f"must be >= 1, got {args.frames}")
+    base = settings_from(args)
+    fields = [field for field, _ in args.sweep]
+    settings_list = [settings_from(args, **dict(zip(fields, values)))
+                     for values in itertools.product(*(values for _, values in args.sweep))] or [base]
+
+    os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
+    from tqdm import tqdm
+
+    from cloudcore.gl import FrameRenderer
+
+    with FrameRenderer(args.width, args.height) as renderer, \
+            tqdm(total=args.frames * (1 + len(settings_list)), unit="frame", desc="bench") as bar:
+        report = bench_path(renderer, scene, args.path, args.frames, settings_list, (args.width, args.height),
+                            progress=bar.update)
+    report["scene"] = str(args.scene)
+    report["shading"] = [] if args.no_shading else shading_comparison(scene)
+    args.json.parent.mkdir(parents=True, exist_ok=True)
+    args.json.write_text(json.dumps(report, indent=2) + "\n")
+    reference = report["reference"]
+    print(f"full 3D: {reference['frame_ms_mean']:.1f} ms mean, {reference['frame_ms_p95']:.1f} ms p95")
+    for run_ in report["runs"]:
+        changed = {k: v for k, v in run_["settings"].items() if v != dataclasses.asdict(base)[k]}
+        print(f"{changed or run_['settings']['mode']}: {run_['frame_ms_mean']:.1f} ms "
+              f"(x{run_['speedup_vs_full']:.2f} frame, x{run_['cloud_speedup_vs_full']:.2f} clouds), "
+              f"PSNR mean {run_['psnr_mean']:.2f} dB, min {run_['psnr_min']:.2f} dB, "
+              f"{run_['regenerations']} regenerations")
+    if args.plot:
+        plot_error_against_time(report, args.plot)
+    print(f"wrote {args.json}" + (f" and {args.plot}" if args.plot else ""))
+    return 0
+
+
+def plot_error_against_time(report: dict, path: Path) -> None:
+    """One point per setting (frame time, mean absolute difference), the Pareto front joined, full 3D marked."""
+    import matplotlib
+
+    matplotlib.use("Agg")  # headless: no display, no GUI toolkit
+    import matplotlib.pyplot as plt
+
+    runs = report["runs"]
+    seconds = [r["frame_ms_mean"] for r in runs]
+    errors = [r["mad_mean"] for r in runs]
+    front = sorted(pareto_front(seconds, errors), key=lambda i: seconds[i])
+    figure, axes = plt.subplots(figsize=(6.4, 4.2), dpi=120)
+    axes.scatter(seconds, errors, color="tab:blue", zorder=3, label="settings")
+    axes.plot([seconds[i] for i in front], [errors[i] for i in front], color="tab:orange", zorder=2,
+              label="Pareto front")
+    for run_, x, y in zip(runs, seconds, errors):
+        settings = run_["settings"]
+        axes.annotate(f"{settings['mode']} tol {settings['tolerance_deg']:g}\nring {settings['ring_radius']:g}"
+                      f" max {settings['impostor_max_size']}", (x, y), fontsize=6, textcoords="offset points",
+                      xytext=(4, 4))
+    axes.axvline(report["reference"]["frame_ms_mean"], color="grey", linestyle="--", label="full 3D (error 0)")
+    axes.set_xlabel("mean frame time (ms)")
+    axes.set_ylabel("mean |difference| from full 3D (8-bit levels)")
+    axes.set_title(f"{Path(report['scene']).name}, path {report['path']}, {report['width']}x{report['height']}")
+    axes.legend(fontsize=7)
+    figure.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    figure.savefig(path)
+    plt.close(figure)

@@ -1,0 +1,40 @@
+"""The `RenderSettings` options shared by `render`, `bench` and `record`."""
+
+from __future__ import annotations
+
+from cloudcore.errors import SceneError
+from cloudcore.settings import MODES, RenderSettings
+
+#: --sweep NAME=... -> (settings field, value parser)
+SWEEPABLE = {"tolerance": ("tolerance_deg", float), "ring_radius": ("ring_radius", float),
+             "impostor_max_size": ("impostor_max_size", int), "mode": ("mode", str)}
+
+
+def add_settings_arguments(parser, default_mode: str = "auto") -> None:
+    defaults = RenderSettings()
+    parser.add_argument("--mode", choices=MODES, default=default_mode, help="how clouds are drawn")
+    parser.add_argument("--tolerance", type=float, default=defaults.tolerance_deg,
+                        help="impostor tolerance, degrees (default %(default)s)")
+    parser.add_argument("--ring-radius", type=float, default=defaults.ring_radius,
+                        help="metres beyond which clouds join the impostor ring; inf for none (default %(default)s)")
+    parser.add_argument("--impostor-max-size", type=int, default=defaults.impostor_max_size,
+                        help="largest impostor texture side, a power of two (default %(default)s)")
+
+
+def settings_from(args, **overrides) -> RenderSettings:
+    """The settings the arguments name; out-of-domain values are a one-line error."""
+    values = dict(mode=args.mode, tolerance_deg=args.tolerance, ring_radius=args.ring_radius,
+                  impostor_max_size=args.impostor_max_size) | overrides
+    try:
+        return RenderSettings(**values)
+    except (TypeError, ValueError) as error:
+        raise SceneError("settings", ",".join(overrides) or "options", str(error)) from None
+
+
+def parse_sweep(text: str) -> tuple[str, list]:
+    """`tolerance=0.05,0.15` -> ("tolerance_deg", [0.05, 0.15]); argparse names this function on refusal."""
+    name, _, values = text.partition("=")
+    if name not in SWEEPABLE or not values:
+        raise ValueError(text)
+    field, parse = SWEEPABLE[name]
+    return field, [parse(value) for value in values.split(",")]

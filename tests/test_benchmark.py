@@ -1,0 +1,76 @@
+"""`cloudview bench` and its engine: the report contract, the Pareto front, errors against the reference."""
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from cloudcore.benchmark import bench_path, pareto_front
+from cloudcore.scenefile import load_scene
+from cloudcore.settings import FULL_3D, RenderSettings
+from conftest import VALLEY
+
+CONTRACT_RUN_KEYS = {"settings", "frame_ms_mean", "frame_ms_p95", "speedup_vs_full", "psnr_mean", "psnr_min",
+                     "mad_mean", "regenerations", "texture_bytes_max"}
+
+
+def test_pareto_front_keeps_the_points_nothing_beats():
+    seconds = [10.0, 20.0, 15.0, 30.0, 15.0]
+    errors = [5.0, 1.0, 6.0, 0.5, 2.0]
+    assert pareto_front(seconds, errors) == [0, 1, 3, 4]
+
+
+class FakeRenderer:
+    """Full 3D is grey 100; every other mode adds `offset` levels: the bench must see exactly that error."""
+
+    def __init__(self, offset):
+        self.offset = offset
+
+    def render(self, scene, camera=None, settings=None):
+        level = 100 if settings == FULL_3D else 100 + self.offset
+        stats = {"frame_ms": 40.0 if settings == FULL_3D else 10.0, "world_ms": 5.0, "cloud_ms": 30.0,
+                 "impostors_regenerated": 1, "texture_bytes": 1024}
+        return np.full((4, 4, 3), level, dtype=np.uint8), stats
+
+
+def test_bench_path_reports_the_error_and_speedup_it_measured():
+    scene = load_scene(VALLEY)
+    report = bench_path(FakeRenderer(offset=5), scene, "flythrough", 3, [RenderSettings()], (4, 4))
+    (run,) = report["runs"]
+    assert CONTRACT_RUN_KEYS <= set(run)
+    assert run["psnr_mean"] == pytest.approx(10 * np.log10(255**2 / 25))
+    assert run["mad_mean"] == 5.0 and run["speedup_vs_full"] == 4.0 and run["regenerations"] == 3
+    assert report["reference"]["mode"] == "full" and report["frames"] == 3
+    identical = bench_path(FakeRenderer(offset=0), scene, "flythrough", 2, [RenderSettings()], (4, 4))
+    assert identical["runs"][0]["psnr_min"] == 100.0  # identical frames: the cap, JSON has no infinity
+
+
+def test_bench_cli_writes_the_contract(tmp_path):
+    out = tmp_path / "bench.json"
+    result = subprocess.run([sys.executable, "-m", "cloudcore.cli", "bench", str(VALLEY), "--path", "flythrough",
+                             "--frames", "2", "--width", "48", "--height", "32", "--sweep", "tolerance=0.15,2",
+                             "--json", str(out), "--plot", str(tmp_path / "plot.png"), "--no-shading"],
+                            capture_output=True, text=True)
+    if result.returncode != 0 and "EGL" in result.stderr:
+        pytest.skip("no headless OpenGL (EGL) context")
+    assert result.returncode == 0, result.stderr
+    report = json.loads(out.read_text())
+    assert {"scene", "path", "width", "height", "frames", "reference", "runs", "shading"} <= set(report)
+    assert [r["settings"]["tolerance_deg"] for r in report["runs"]] == [0.15, 2.0]
+    assert all(CONTRACT_RUN_KEYS <= set(r) and len(r["per_frame"]) == 2 for r in report["runs"])
+    assert (tmp_path / "plot.png").stat().st_size > 0
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--path", "nowhere"], "no camera path named 'nowhere'"),
+    (["--path", "flythrough", "--sweep", "colour=1,2"], "--sweep"),
+    (["--path", "flythrough", "--sweep", "impostor_max_size=300"], "power of two"),
+])
+def test_bad_bench_arguments_exit_2_in_one_line(tmp_path, args, message):
+    result = subprocess.run([sys.executable, "-m", "cloudcore.cli", "bench", str(VALLEY), "--json",
+                             str(tmp_path / "b.json"), *args], capture_output=True, text=True)
+    assert result.returncode == 2
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and message in lines[0], result.stderr
