@@ -27,19 +27,27 @@ TERRAIN_KINDS = ("heightfield", "mesh")
 INLINE_PARTICLE_LIMIT = 64
 
 
+def _error(source, field: str, problem: str) -> SceneError:
+    """A SceneError kept to one line: line breaks and other control characters (from keys,
+    file names or library messages) are escaped."""
+    def one_line(text) -> str:
+        return "".join(ch if ch.isprintable() else ascii(ch)[1:-1] for ch in str(text))
+    return SceneError(one_line(source), one_line(field), one_line(problem))
+
+
 class _Table:
     """Typed access to one TOML table; remembers which keys were read."""
 
     def __init__(self, source: str, field: str, data):
         if not isinstance(data, dict):
-            raise SceneError(source, field, f"expected a table, got {type(data).__name__}")
+            raise _error(source, field, f"expected a table, got {type(data).__name__}")
         self.source, self.field, self.data = source, field, data
 
     def path(self, key: str) -> str:
         return f"{self.field}.{key}" if self.field else key
 
     def fail(self, key: str, problem: str):
-        raise SceneError(self.source, self.path(key), problem)
+        raise _error(self.source, self.path(key), problem)
 
     def reject_unknown(self, known: tuple[str, ...]):
         for key in self.data:
@@ -60,7 +68,10 @@ class _Table:
         value = self.data[key]
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             self.fail(key, f"expected a number, got {value!r}")
-        value = float(value)
+        try:
+            value = float(value)
+        except OverflowError:
+            self.fail(key, "must be finite, got an integer too large for a float")
         if not math.isfinite(value):
             self.fail(key, f"must be finite, got {value}")
         if value < low or (low_open and value == low) or value > high:
@@ -103,10 +114,12 @@ class _Table:
         if np.any(row < low) or np.any(row > high):
             self.fail(key, f"components must be within [{low}, {high}], got {row.tolist()}")
         if unit:
-            length = float(np.linalg.norm(row))
-            if not length > 0:
+            largest = float(np.abs(row).max())
+            if not largest > 0:
                 self.fail(key, "direction must not be the zero vector")
-            row = row / length
+            if not 1e-150 < largest < 1e150:  # the norm would overflow to inf or underflow to 0
+                row = row / largest
+            row = row / np.linalg.norm(row)
         return tuple(float(x) for x in row)
 
     def tables(self, key) -> list["_Table"]:
@@ -119,15 +132,19 @@ class _Table:
 def _checked_matrix(value, columns, source, field, allow_empty) -> np.ndarray:
     try:
         array = np.array(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise SceneError(source, field, f"expected rows of {columns} numbers") from None
+        # numpy would take the strings "1.5" and booleans as numbers: TOML input must hold numbers
+        if not isinstance(value, np.ndarray) and not all(
+                isinstance(x, (int, float)) and not isinstance(x, bool) for x in np.array(value, dtype=object).flat):
+            raise TypeError
+    except (TypeError, ValueError, OverflowError):  # OverflowError: an integer too large for a float
+        raise _error(source, field, f"expected rows of {columns} numbers") from None
     if array.size == 0 and allow_empty:
         return np.zeros((0, columns))
     if array.ndim != 2 or array.shape[1] != columns:
-        raise SceneError(source, field, f"expected rows of {columns} numbers, got shape {array.shape}")
+        raise _error(source, field, f"expected rows of {columns} numbers, got shape {array.shape}")
     bad = np.flatnonzero(~np.isfinite(array).all(axis=1))
     if bad.size:
-        raise SceneError(source, field, f"row {bad[0]} is not finite: {array[bad[0]].tolist()}")
+        raise _error(source, field, f"row {bad[0]} is not finite: {array[bad[0]].tolist()}")
     return array
 
 
@@ -141,11 +158,13 @@ def load_scene(path) -> Scene:
     try:
         data = tomllib.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
-        raise SceneError(source, "(file)", "no such file") from None
+        raise _error(source, "(file)", "no such file") from None
     except (OSError, UnicodeDecodeError) as error:
-        raise SceneError(source, "(file)", f"cannot read: {error}") from None
-    except tomllib.TOMLDecodeError as error:
-        raise SceneError(source, "(toml)", str(error)) from None
+        raise _error(source, "(file)", f"cannot read: {error}") from None
+    except RecursionError:
+        raise _error(source, "(toml)", "arrays or tables nested too deeply") from None
+    except ValueError as error:  # TOMLDecodeError, or tomllib's ValueError for an integer of over 4300 digits
+        raise _error(source, "(toml)", str(error)) from None
     return scene_from_dict(data, source, path.parent)
 
 
@@ -175,7 +194,7 @@ def _unique_names(root: _Table, key: str, items) -> None:
     seen = set()
     for i, item in enumerate(items):
         if item.name in seen:
-            raise SceneError(root.source, f"{key}[{i}].name", f"duplicate name {item.name!r}")
+            raise _error(root.source, f"{key}[{i}].name", f"duplicate name {item.name!r}")
         seen.add(item.name)
 
 
@@ -242,10 +261,12 @@ def _cloud(t: _Table, base_dir: Path) -> Cloud:
 
 def _read_particles(t: _Table, file: Path) -> np.ndarray:
     try:
-        array = np.load(file, allow_pickle=False)
+        # mmap_mode: a header that claims more data than the file holds fails here instead of
+        # allocating it; _checked_matrix copies the data out of the map
+        array = np.load(file, mmap_mode="r", allow_pickle=False)
     except FileNotFoundError:
         t.fail("particles_file", f"{file}: no such file")
-    except (OSError, ValueError, EOFError) as error:
+    except Exception as error:  # a forged header raises ValueError, OverflowError, TokenError, BadZipFile...
         t.fail("particles_file", f"{file}: not a readable .npy ({error})")
     if not isinstance(array, np.ndarray) or array.dtype.kind not in "fiu":
         t.fail("particles_file", f"{file}: expected a numeric array")
