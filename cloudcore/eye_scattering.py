@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cloudcore.illumination import cloud_optics, illuminate_clouds
+from cloudcore.illumination import IlluminationCache, cloud_optics, illuminate_clouds
 from cloudcore.lighting import active_lights
 from cloudcore.phase import phase_function
 from cloudcore.ramps import smoothstep
@@ -34,7 +34,9 @@ FADE_END_RADII = 1.5
 class ParticleShading:
     """All particles of a scene's clouds, concatenated, with their illumination precomputed."""
 
-    def __init__(self, clouds, shading: Shading, lights, ambient, method: str = "exact"):
+    def __init__(self, clouds, shading: Shading, lights, ambient, method: str = "exact",
+                 cache: IlluminationCache | None = None):
+        """`cache` keeps the illumination of unchanged clouds between instances (the editor)."""
         clouds = tuple(clouds)
         self._phase, self._g = shading.phase, shading.g
         lights = active_lights(lights)
@@ -53,7 +55,9 @@ class ParticleShading:
         self._alpha = -np.expm1(-tau)
         self._scattering = scattering_coefficient(tau, albedo, shading.phase, shading.g)
         self._tint = np.repeat(np.array([c.color for c in clouds], dtype=np.float64).reshape(-1, 3), counts, axis=0)
-        self._incident = _concatenated(illuminate_clouds(clouds, shading, lights, method), (0, len(lights)))
+        incident = (cache.incident(clouds, shading, lights, method) if cache is not None
+                    else illuminate_clouds(clouds, shading, lights, method))
+        self._incident = _concatenated(incident, (0, len(lights)))
 
         spheres = [c.bounding_sphere() for c in clouds]
         self.bounding_centres = np.array([s[0] for s in spheres], dtype=np.float64).reshape(-1, 3)

@@ -85,15 +85,21 @@ class FramePlan:
 def plan_frame(centres: np.ndarray, radii: np.ndarray, camera: Camera, viewport: tuple[int, int],
                settings: RenderSettings, records: Mapping[int, ImpostorRecord], ring_state: RingState,
                lighting_key: Hashable) -> FramePlan:
-    """Plan one frame; `centres` (N, 3) and `radii` (N,) are the clouds' bounding spheres."""
+    """Plan one frame; `centres` (N, 3) and `radii` (N,) are the clouds' bounding spheres.
+
+    `lighting_key` identifies what the particles' colours were computed from: one key for
+    all clouds, or a tuple with one per cloud (the editor changes one cloud at a time, and
+    only that cloud's impostor is stale).
+    """
     centres, radii = np.asarray(centres, dtype=np.float64).reshape(-1, 3), np.asarray(radii, dtype=np.float64)
     width, height = viewport
     eye = np.asarray(camera.position, dtype=np.float64)
     view_projection = projection_matrix(camera.fov_y_deg, width / height) @ view_matrix(camera)
     visible = spheres_in_frustum(frustum_planes(view_projection), centres, radii)
     distances = np.linalg.norm(centres - eye, axis=1)
-    ring = plan_ring(ring_state, centres, radii, eye, settings, lighting_key)
-    next_records = dict(records)
+    keys = list(lighting_key) if isinstance(lighting_key, tuple) else [lighting_key] * len(radii)
+    ring = plan_ring(ring_state, centres, radii, eye, settings, tuple(keys))
+    next_records = {index: record for index, record in records.items() if index < len(radii)}
 
     clouds = []
     for index, (centre, radius, distance) in enumerate(zip(centres, radii, distances)):
@@ -121,9 +127,9 @@ def plan_frame(centres: np.ndarray, radii: np.ndarray, camera: Camera, viewport:
             pixels = screen_size_px(radius, distance, height, camera.fov_y_deg)
             size = required_size(pixels, settings.impostor_min_size, settings.impostor_max_size)
             record = records.get(index)
-            reason = regeneration_reason(record, centre, eye, size, lighting_key, settings.tolerance_deg)
+            reason = regeneration_reason(record, centre, eye, size, keys[index], settings.tolerance_deg)
             if reason is not None:
-                record = ImpostorRecord(tuple(float(v) for v in eye), size, lighting_key)
+                record = ImpostorRecord(tuple(float(v) for v in eye), size, keys[index])
                 next_records[index] = record
             kind = "crossfade" if full > 0.0 else "impostor"
             clouds.append(CloudPlan(index, kind, distance, full_weight=full * individual,

@@ -48,3 +48,27 @@ def illuminate_clouds(clouds, shading: Shading, lights, method: str = "exact", *
     ]
     incident = np.stack(columns, axis=1) if columns else np.zeros((len(positions), 0))
     return np.split(incident, np.cumsum(counts)[:-1])
+
+
+class IlluminationCache:
+    """`illuminate_clouds` that recomputes only clouds it has not seen under the same shading and lights.
+
+    The editor changes one cloud at a time; recomputing the other 33 clouds of
+    the default scene would freeze it for seconds.  Clouds are immutable, so a
+    cloud object seen before (by identity) has the same particles; entries for
+    clouds no longer asked for are dropped.
+    """
+
+    def __init__(self):
+        self._entries: dict[int, tuple[Cloud, object, np.ndarray]] = {}
+        self.last_recomputed = 0  # clouds shaded by the last call
+
+    def incident(self, clouds, shading: Shading, lights, method: str = "exact") -> list[np.ndarray]:
+        clouds = list(clouds)
+        key = (shading, tuple(active_lights(lights)), method)
+        stale = [c for c in clouds if (hit := self._entries.get(id(c))) is None or hit[0] is not c or hit[1] != key]
+        for cloud, incident in zip(stale, illuminate_clouds(stale, shading, lights, method)):
+            self._entries[id(cloud)] = (cloud, key, incident)
+        self._entries = {id(c): self._entries[id(c)] for c in clouds}
+        self.last_recomputed = len(stale)
+        return [self._entries[id(c)][2] for c in clouds]

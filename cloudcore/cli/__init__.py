@@ -7,12 +7,10 @@ exit status 2.
 from __future__ import annotations
 
 import argparse
+import os
 import sys
-from pathlib import Path
 
 from cloudcore.errors import SceneError
-
-DEFAULT_SCENE = Path(__file__).resolve().parents[2] / "resources" / "scenes" / "valley.toml"
 
 
 class _OneLineParser(argparse.ArgumentParser):
@@ -35,12 +33,9 @@ def build_parser() -> tuple[argparse.ArgumentParser, argparse._SubParsersAction]
 def main(argv=None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     parser, commands = build_parser()
-    if not argv or (argv[0] not in commands.choices and not argv[0].startswith("-")):
-        argv = _main_job(argv)
+    if not argv or (argv[0] not in commands.choices and argv[0] not in ("-h", "--help")):
+        return _editor(argv)
     args = parser.parse_args(argv)
-    if args.command is None:
-        parser.print_help()
-        return 0
     try:
         return int(args.run(args) or 0)
     except SceneError as error:
@@ -51,10 +46,13 @@ def main(argv=None) -> int:
         return 130
 
 
-def _main_job(argv: list[str]) -> list[str]:
-    """`cloudview [SCENE]`: the editor once it exists; until then the most complete headless job."""
-    scene = Path(argv[0] if argv else DEFAULT_SCENE)
-    out = Path("out") / f"{scene.stem}.png"
-    print(f"cloudview: the editor is not built yet; rendering {scene} headless to {out} instead.",
-          file=sys.stderr)
-    return ["render", str(scene), "--out", str(out), *argv[1:]]
+def _editor(argv: list[str]) -> int:
+    """`cloudview [SCENE]`: the editor window (imported only here: headless commands never load the GUI)."""
+    if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+        print("cloudview: error: the editor needs a display (none is set); on a headless machine try "
+              "`xvfb-run -a cloudview`, or the headless commands: cloudview render|record|bench|compare --help",
+              file=sys.stderr)
+        return 2
+    from app.main import main as editor_main
+
+    return editor_main(argv)

@@ -1,14 +1,18 @@
-"""The headless OpenGL context (pyrender's EGL OffscreenRenderer) and our render targets.
+"""Where frames are drawn: our render targets inside either a headless EGL context or the GUI's window.
 
-pyrender owns the context; we borrow it for raw GL.  Its `render()` leaves the
-context un-current when it returns, so every raw-GL entry point here calls
-`make_current()` first.
+The frame is composed in linear light in an RGBA16F colour texture with a
+24-bit depth buffer (`RenderTargets`).  pyrender draws the world's colour
+(8 bits, sRGB-encoded) into `world_texture` and its depth into that same depth
+buffer, which the cloud passes then test against.  How pyrender gets there
+differs:
 
-The frame is composed in linear light in an RGBA16F colour buffer with a 24-bit
-depth buffer.  pyrender's output (8 bits per channel) is copied beside it with
-glBlitFramebuffer: its depth straight into our depth buffer (the formats must
-match, hence DEPTH_COMPONENT24), its colour into `world_texture` for the world
-pass to decode and composite over the sky.
+- `HeadlessContext` (tools, tests): pyrender's EGL `OffscreenRenderer` owns
+  the context and renders into its own framebuffer; we blit colour and depth
+  across (the depth formats must match, hence DEPTH_COMPONENT24).  Its
+  `render()` leaves the context un-current, so every raw-GL entry point calls
+  `make_current()` first.
+- `WindowContext` (the editor): the window's context is current already; a
+  `pyrender.Renderer` draws straight into our world framebuffer.
 """
 
 from __future__ import annotations
@@ -19,37 +23,68 @@ from OpenGL import GL
 from cloudcore.gl.pyrender_compat import pyrender
 
 
-class HeadlessContext:
-    """An EGL context of a fixed size with a linear-colour + depth target and pyrender's colour."""
+class RenderTargets:
+    """The linear colour + depth target of one frame size and the world's colour beside it."""
 
     def __init__(self, width: int, height: int):
         if width < 1 or height < 1:
             raise ValueError(f"framebuffer size must be positive, got {width}x{height}")
         self.width, self.height = int(width), int(height)
-        self.renderer = pyrender.OffscreenRenderer(self.width, self.height)
-        self.make_current()
-        self._colour, self.depth_renderbuffer = GL.glGenRenderbuffers(2)
-        GL.glBindRenderbuffer(GL.GL_RENDERBUFFER, self._colour)
-        GL.glRenderbufferStorage(GL.GL_RENDERBUFFER, GL.GL_RGBA16F, self.width, self.height)
+        self.depth_renderbuffer = GL.glGenRenderbuffers(1)
         GL.glBindRenderbuffer(GL.GL_RENDERBUFFER, self.depth_renderbuffer)
         GL.glRenderbufferStorage(GL.GL_RENDERBUFFER, GL.GL_DEPTH_COMPONENT24, self.width, self.height)
-        self.framebuffer = _framebuffer(colour_renderbuffer=self._colour, depth_renderbuffer=self.depth_renderbuffer)
-
-        self.world_texture = GL.glGenTextures(1)
-        GL.glBindTexture(GL.GL_TEXTURE_2D, self.world_texture)
-        GL.glTexStorage2D(GL.GL_TEXTURE_2D, 1, GL.GL_RGBA8, self.width, self.height)
-        GL.glTexParameteri(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_MIN_FILTER, GL.GL_NEAREST)
-        GL.glTexParameteri(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_MAG_FILTER, GL.GL_NEAREST)
-        self._world_framebuffer = _framebuffer(colour_texture=self.world_texture)
+        self.colour_texture = _texture(self.width, self.height, GL.GL_RGBA16F)
+        self.framebuffer = _framebuffer(self.colour_texture, self.depth_renderbuffer)
+        self.world_texture = _texture(self.width, self.height, GL.GL_RGBA8)
+        self.world_framebuffer = _framebuffer(self.world_texture, self.depth_renderbuffer)
 
     def make_current(self) -> None:
-        self.renderer._platform.make_current()
+        """Make the GL context current (a no-op where the owner keeps it current)."""
 
     def bind_target(self) -> None:
         """Make the context current and direct drawing into the linear render target."""
         self.make_current()
         GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, self.framebuffer)
         GL.glViewport(0, 0, self.width, self.height)
+
+    def clear_world(self) -> None:
+        """The state pyrender leaves for an empty scene: nothing in the world colour, far depth."""
+        self.make_current()
+        GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, self.world_framebuffer)
+        GL.glViewport(0, 0, self.width, self.height)
+        GL.glDepthMask(GL.GL_TRUE)
+        GL.glClearColor(0.0, 0.0, 0.0, 0.0)
+        GL.glClearDepth(1.0)
+        GL.glClear(GL.GL_COLOR_BUFFER_BIT | GL.GL_DEPTH_BUFFER_BIT)
+        self.bind_target()
+
+    def read_linear_rgb(self) -> np.ndarray:
+        """The render target as float32 (height, width, 3), top row first."""
+        self.make_current()
+        GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, self.framebuffer)
+        GL.glPixelStorei(GL.GL_PACK_ALIGNMENT, 1)
+        data = GL.glReadPixels(0, 0, self.width, self.height, GL.GL_RGB, GL.GL_FLOAT)
+        pixels = np.frombuffer(data, dtype=np.float32).reshape(self.height, self.width, 3)
+        return pixels[::-1].copy()
+
+    def close_targets(self) -> None:
+        GL.glDeleteFramebuffers(2, [self.framebuffer, self.world_framebuffer])
+        GL.glDeleteRenderbuffers(1, [self.depth_renderbuffer])
+        GL.glDeleteTextures([self.colour_texture, self.world_texture])
+
+
+class HeadlessContext(RenderTargets):
+    """An EGL context of a fixed size (PYOPENGL_PLATFORM=egl) with our targets."""
+
+    def __init__(self, width: int, height: int):
+        if width < 1 or height < 1:
+            raise ValueError(f"framebuffer size must be positive, got {width}x{height}")
+        self.renderer = pyrender.OffscreenRenderer(int(width), int(height))
+        self.make_current()
+        super().__init__(width, height)
+
+    def make_current(self) -> None:
+        self.renderer._platform.make_current()
 
     def render_pyrender_scene(self, scene, flags) -> None:
         """Render a pyrender scene: its depth into the target's depth, its colour into `world_texture`.
@@ -61,56 +96,73 @@ class HeadlessContext:
         self.renderer.render(scene, flags=flags)
         self.make_current()
         GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, self.renderer._renderer._main_fb)
+        GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, self.world_framebuffer)
         w, h = self.width, self.height
-        GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, self.framebuffer)
-        GL.glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL.GL_DEPTH_BUFFER_BIT, GL.GL_NEAREST)
-        GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, self._world_framebuffer)
-        GL.glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL.GL_COLOR_BUFFER_BIT, GL.GL_NEAREST)
+        GL.glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL.GL_COLOR_BUFFER_BIT | GL.GL_DEPTH_BUFFER_BIT, GL.GL_NEAREST)
         self.bind_target()
 
-    def clear_world(self) -> None:
-        """The state `render_pyrender_scene` leaves for an empty scene: nothing in colour or depth."""
-        self.make_current()
-        GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, self._world_framebuffer)
-        GL.glClearColor(0.0, 0.0, 0.0, 0.0)
-        GL.glClear(GL.GL_COLOR_BUFFER_BIT)
-        self.bind_target()
-        GL.glDepthMask(GL.GL_TRUE)
-        GL.glClearDepth(1.0)
-        GL.glClear(GL.GL_DEPTH_BUFFER_BIT)
-
-    def read_linear_rgb(self) -> np.ndarray:
-        """The render target as float32 (height, width, 3), top row first."""
-        self.make_current()
-        GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, self.framebuffer)
-        GL.glPixelStorei(GL.GL_PACK_ALIGNMENT, 1)
-        data = GL.glReadPixels(0, 0, self.width, self.height, GL.GL_RGB, GL.GL_FLOAT)
-        pixels = np.frombuffer(data, dtype=np.float32).reshape(self.height, self.width, 3)
-        return pixels[::-1].copy()
+    @property
+    def closed(self) -> bool:
+        return self.renderer is None
 
     def close(self) -> None:
         """Free the GL objects and the EGL context; the object is unusable afterwards."""
         if self.renderer is None:
             return
         self.make_current()
-        GL.glDeleteFramebuffers(2, [self.framebuffer, self._world_framebuffer])
-        GL.glDeleteRenderbuffers(2, [self._colour, self.depth_renderbuffer])
-        GL.glDeleteTextures([self.world_texture])
+        self.close_targets()
         self.renderer.delete()
         self.renderer = None
 
 
-def _framebuffer(*, colour_renderbuffer=None, depth_renderbuffer=None, colour_texture=None) -> int:
+class _RendererIntoFramebuffer(pyrender.Renderer):
+    """pyrender's on-screen renderer, pointed at a framebuffer of ours instead of the window's."""
+
+    target_framebuffer = 0
+
+    def _configure_forward_pass_viewport(self, flags):
+        super()._configure_forward_pass_viewport(flags)
+        GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, self.target_framebuffer)
+
+
+class WindowContext(RenderTargets):
+    """Our targets inside a context someone else made current (the editor's window)."""
+
+    def __init__(self, width: int, height: int):
+        super().__init__(width, height)
+        self._renderer = _RendererIntoFramebuffer(self.width, self.height)
+        self._renderer.target_framebuffer = self.world_framebuffer
+
+    def render_pyrender_scene(self, scene, flags) -> None:
+        self._renderer.render(scene, flags)
+        self.bind_target()
+
+    @property
+    def closed(self) -> bool:
+        return self._renderer is None
+
+    def close(self) -> None:
+        if self._renderer is None:
+            return
+        self.close_targets()
+        self._renderer.delete()
+        self._renderer = None
+
+
+def _texture(width: int, height: int, internal_format) -> int:
+    texture = GL.glGenTextures(1)
+    GL.glBindTexture(GL.GL_TEXTURE_2D, texture)
+    GL.glTexStorage2D(GL.GL_TEXTURE_2D, 1, internal_format, width, height)
+    GL.glTexParameteri(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_MIN_FILTER, GL.GL_NEAREST)
+    GL.glTexParameteri(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_MAG_FILTER, GL.GL_NEAREST)
+    return texture
+
+
+def _framebuffer(colour_texture: int, depth_renderbuffer: int) -> int:
     framebuffer = GL.glGenFramebuffers(1)
     GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, framebuffer)
-    if colour_renderbuffer is not None:
-        GL.glFramebufferRenderbuffer(GL.GL_FRAMEBUFFER, GL.GL_COLOR_ATTACHMENT0, GL.GL_RENDERBUFFER,
-                                     colour_renderbuffer)
-    if colour_texture is not None:
-        GL.glFramebufferTexture2D(GL.GL_FRAMEBUFFER, GL.GL_COLOR_ATTACHMENT0, GL.GL_TEXTURE_2D, colour_texture, 0)
-    if depth_renderbuffer is not None:
-        GL.glFramebufferRenderbuffer(GL.GL_FRAMEBUFFER, GL.GL_DEPTH_ATTACHMENT, GL.GL_RENDERBUFFER,
-                                     depth_renderbuffer)
+    GL.glFramebufferTexture2D(GL.GL_FRAMEBUFFER, GL.GL_COLOR_ATTACHMENT0, GL.GL_TEXTURE_2D, colour_texture, 0)
+    GL.glFramebufferRenderbuffer(GL.GL_FRAMEBUFFER, GL.GL_DEPTH_ATTACHMENT, GL.GL_RENDERBUFFER, depth_renderbuffer)
     status = GL.glCheckFramebufferStatus(GL.GL_FRAMEBUFFER)
     if status != GL.GL_FRAMEBUFFER_COMPLETE:
         raise RuntimeError(f"framebuffer incomplete (status 0x{int(status):x})")

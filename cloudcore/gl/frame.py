@@ -25,9 +25,11 @@ from OpenGL import GL
 from cloudcore.camera import NEAR_PLANE_M, projection_matrix, view_matrix
 from cloudcore.colour import linear_to_srgb8
 from cloudcore.eye_scattering import ParticleShading
+from cloudcore.illumination import IlluminationCache
 from cloudcore.frameplan import FramePlan, plan_frame
-from cloudcore.gl.context import HeadlessContext
+from cloudcore.gl.context import HeadlessContext, WindowContext
 from cloudcore.gl.impostor_store import ImpostorStore
+from cloudcore.gl.programs import build_program
 from cloudcore.gl.quads import SCREEN_CORNERS, QuadPass
 from cloudcore.gl.splats import SplatPass, splat_batch
 from cloudcore.gl.targets import TextureTarget, blit_depth, depth_renderbuffer
@@ -45,20 +47,24 @@ _DEFAULT_SKY_HOURS = Lighting().time_of_day
 class FrameRenderer:
     """Renders scenes headlessly at a fixed size; use as a context manager or call close()."""
 
-    def __init__(self, width: int, height: int):
-        self.context = HeadlessContext(width, height)
+    def __init__(self, width: int, height: int, context=None):
+        """A headless renderer, or with `context` (a `WindowContext`) one inside the current window."""
+        self.context = context if context is not None else HeadlessContext(width, height)
         self.context.make_current()
         self._splats = SplatPass()
         self._quads = QuadPass()
         self._impostors = ImpostorStore(self._splats)
         self._world, self._world_source = None, None
         self._particles, self._particles_source = None, None
-        #: changes whenever the particles' colours may have: every impostor made before is stale
-        self._lighting_key = 0
+        self._illumination = IlluminationCache()
+        #: per cloud, changes whenever that cloud's particle colours may have: its impostor is stale
+        self._lighting_keys: tuple = ()
+        self._key_serial = 0
         self._records, self._ring_state = {}, RingState()
         self._layer = None  # screen-sized, sharing the frame's depth: crossfading clouds' full-3D image
         self._inside = None  # (target, its depth renderbuffer) of the screen impostor
         self._overdraw_target = None
+        self._display = None  # (RGBA8 target, program): the frame in sRGB for the editor
         self._replay = []  # the last frame's draws into the screen, for the overdraw counter
         self.last_plan: FramePlan | None = None
 
@@ -67,20 +73,26 @@ class FrameRenderer:
         return self.context.width, self.context.height
 
     def render(self, scene: Scene, *, time_of_day: float | None = None, camera: Camera | None = None,
-               illumination_method: str = "exact",
-               settings: RenderSettings = RenderSettings()) -> tuple[np.ndarray, dict]:
-        """(sRGB uint8 (height, width, 3), stats); `time_of_day` and `camera` override the scene's."""
+               illumination_method: str = "exact", settings: RenderSettings = RenderSettings(),
+               read_back: bool = True) -> tuple[np.ndarray | None, dict]:
+        """(sRGB uint8 (height, width, 3), stats); `time_of_day` and `camera` override the scene's.
+
+        With `read_back=False` the image stays on the GPU (None is returned in its place): the
+        editor shows it through `display_texture`.
+        """
         lighting = scene.lighting if time_of_day is None else dataclasses.replace(
             scene.lighting, time_of_day=time_of_day)
         camera = scene.camera if camera is None else camera
         stats = {"illumination_ms": self._prepare(scene, lighting, illumination_method)}
         particles = self._particles
         plan = plan_frame(particles.bounding_centres, particles.bounding_radii, camera, self.size, settings,
-                          self._records, self._ring_state, self._lighting_key)
+                          self._records, self._ring_state, self._lighting_keys)
         self._records, self._ring_state, self.last_plan = plan.records, plan.ring_state, plan
 
         view = view_matrix(camera)
         projection = projection_matrix(camera.fov_y_deg, self.context.width / self.context.height)
+        # in the editor's context the GUI leaves its scissor rectangle on, which would clip our targets
+        GL.glDisable(GL.GL_SCISSOR_TEST)
         start = time.perf_counter()
         self._world.draw(self.context, camera, projection @ view)
         GL.glFinish()
@@ -98,7 +110,33 @@ class FrameRenderer:
             "particles_drawn": drawn, "particles_to_impostors": rendered,
             "clouds_drawn": len(plan.draw_order), "clouds_culled": len(plan.of_kind("culled")),
             "texture_bytes": self.texture_bytes}
-        return linear_to_srgb8(self.context.read_linear_rgb()), stats
+        return (linear_to_srgb8(self.context.read_linear_rgb()) if read_back else None), stats
+
+    def display_texture(self) -> int:
+        """An RGBA8 texture holding the last frame in sRGB (rows bottom first, as GL stores them)."""
+        if self._display is None:
+            self._display = (TextureTarget(*self.size, GL.GL_RGBA8), build_program("present", vertex="world"))
+        target, program = self._display
+        target.bind_cleared()
+        GL.glUseProgram(program)
+        GL.glActiveTexture(GL.GL_TEXTURE0)
+        GL.glBindTexture(GL.GL_TEXTURE_2D, self.context.colour_texture)
+        GL.glDisable(GL.GL_BLEND)
+        GL.glDisable(GL.GL_DEPTH_TEST)
+        GL.glBindVertexArray(self._quads.vertex_array)
+        GL.glDrawArrays(GL.GL_TRIANGLES, 0, 3)
+        GL.glBindVertexArray(0)
+        return target.texture
+
+    def resize(self, width: int, height: int) -> None:
+        """New frame size for a window renderer; cached shading and impostors are kept."""
+        if (width, height) == self.size:
+            return
+        if not isinstance(self.context, WindowContext):
+            raise TypeError("a headless renderer has a fixed size; make a new one")
+        self._close_screen_targets()
+        self.context.close()
+        self.context = WindowContext(width, height)
 
     @property
     def texture_bytes(self) -> int:
@@ -123,10 +161,20 @@ class FrameRenderer:
         if particles_source == self._particles_source:
             return 0.0
         start = time.perf_counter()
-        self._particles = ParticleShading(scene.clouds, scene.shading, lights, ambient, illumination_method)
+        self._particles = ParticleShading(scene.clouds, scene.shading, lights, ambient, illumination_method,
+                                          self._illumination)
+        old_clouds, old_lighting = ((), None) if self._particles_source is None else (
+            self._particles_source[0], self._particles_source[1:])
+        same_lighting = old_lighting == particles_source[1:]
+        self._lighting_keys = tuple(
+            self._lighting_keys[i] if same_lighting and i < len(old_clouds) and old_clouds[i] is cloud
+            else self._next_key() for i, cloud in enumerate(scene.clouds))
         self._particles_source = particles_source
-        self._lighting_key += 1
         return 1e3 * (time.perf_counter() - start)
+
+    def _next_key(self) -> int:
+        self._key_serial += 1
+        return self._key_serial
 
     def _draw_clouds(self, plan: FramePlan, particles: ParticleShading, camera: Camera, view, projection,
                      settings: RenderSettings) -> int:
@@ -232,14 +280,21 @@ class FrameRenderer:
         self.context.bind_target()
         return counts, overdraw_statistics(counts) | {"overdraw_analytic": analytic}
 
-    def close(self) -> None:
-        if self.context.renderer is None:
-            return
-        self.context.make_current()
-        for target in (self._overdraw_target, self._layer):
+    def _close_screen_targets(self) -> None:
+        """Free the targets whose size is the frame's."""
+        for target in (self._overdraw_target, self._layer, self._display[0] if self._display else None):
             if target is not None:
                 target.close()
+        if self._display is not None:
+            GL.glDeleteProgram(self._display[1])
+        self._overdraw_target = self._layer = self._display = None
         self._close_inside()
+
+    def close(self) -> None:
+        if self.context.closed:
+            return
+        self.context.make_current()
+        self._close_screen_targets()
         self._impostors.close()
         self._quads.close()
         self._splats.close()

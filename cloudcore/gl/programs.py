@@ -19,9 +19,9 @@ class ShaderError(RuntimeError):
     """A shader failed to compile or a program failed to link."""
 
 
-def build_program(name: str, defines: dict[str, float] | None = None) -> int:
-    """Compile shaders/NAME.vert.glsl and NAME.frag.glsl and link them; returns the program id."""
-    stages = [(GL.GL_VERTEX_SHADER, f"{name}.vert.glsl"), (GL.GL_FRAGMENT_SHADER, f"{name}.frag.glsl")]
+def build_program(name: str, defines: dict[str, float] | None = None, vertex: str | None = None) -> int:
+    """Compile shaders/VERTEX.vert.glsl (VERTEX defaults to NAME) and NAME.frag.glsl, link; returns the id."""
+    stages = [(GL.GL_VERTEX_SHADER, f"{vertex or name}.vert.glsl"), (GL.GL_FRAGMENT_SHADER, f"{name}.frag.glsl")]
     shaders = [_compile(kind, file, defines or {}) for kind, file in stages]
     program = GL.glCreateProgram()
     for shader in shaders:

@@ -19,8 +19,9 @@ class QuadPass:
             GL.glUseProgram(program)
             GL.glUniform1i(GL.glGetUniformLocation(program, "impostor"), 0)
             GL.glUniform1i(GL.glGetUniformLocation(program, "layer"), 1)
-        # core profile draws nothing without a vertex array, even one with no attributes
-        self._vertex_array = GL.glGenVertexArrays(1)
+        #: core profile draws nothing without a vertex array, even one with no attributes; shared
+        #: with the other attribute-less passes
+        self.vertex_array = GL.glGenVertexArrays(1)
 
     def draw(self, corners: np.ndarray, view_projection: np.ndarray, texture: int, impostor_weight: float,
              *, layer_texture: int | None = None, layer_weight: float = 0.0, depth_test: bool = True,
@@ -46,7 +47,7 @@ class QuadPass:
         GL.glDisable(GL.GL_CULL_FACE)
         GL.glEnable(GL.GL_BLEND)
         GL.glBlendFunc(GL.GL_ONE, GL.GL_ONE if counting else GL.GL_ONE_MINUS_SRC_ALPHA)
-        GL.glBindVertexArray(self._vertex_array)
+        GL.glBindVertexArray(self.vertex_array)
         GL.glDrawArrays(GL.GL_TRIANGLE_STRIP, 0, 4)
         GL.glBindVertexArray(0)
         GL.glDisable(GL.GL_BLEND)
@@ -55,4 +56,4 @@ class QuadPass:
     def close(self) -> None:
         GL.glDeleteProgram(self._program)
         GL.glDeleteProgram(self._counting_program)
-        GL.glDeleteVertexArrays(1, [self._vertex_array])
+        GL.glDeleteVertexArrays(1, [self.vertex_array])

@@ -2,7 +2,7 @@
 
 Used for the overdraw counter (R32F, sharing the frame's depth so hidden
 fragments are not counted), impostor textures and screen layers (RGBA16F,
-premultiplied linear colour).
+premultiplied linear colour) and the editor's display image (RGBA8, sRGB).
 """
 
 from __future__ import annotations
@@ -11,8 +11,8 @@ import numpy as np
 from OpenGL import GL
 
 #: bytes per texel of the formats used here, for texture-memory statistics
-_TEXEL_BYTES = {GL.GL_RGBA16F: 8, GL.GL_R32F: 4}
-_READ_FORMAT = {GL.GL_RGBA16F: (GL.GL_RGBA, 4), GL.GL_R32F: (GL.GL_RED, 1)}
+_TEXEL_BYTES = {GL.GL_RGBA16F: 8, GL.GL_R32F: 4, GL.GL_RGBA8: 4}
+_READ_FORMAT = {GL.GL_RGBA16F: (GL.GL_RGBA, 4), GL.GL_R32F: (GL.GL_RED, 1), GL.GL_RGBA8: (GL.GL_RGBA, 4)}
 
 
 class TextureTarget:

@@ -1,0 +1,122 @@
+"""The editor's window: hello_imgui with a docking layout, the viewport and the panels.
+
+    python -m app [SCENE] [--self-test RESULTS.json]
+    python -m app [SCENE] --frames N [--screenshot PNG] [--frame-stats JSON]
+
+The docking layout is remembered between runs (hello_imgui's settings file in
+the user's config folder).  With --self-test the Dear ImGui Test Engine drives
+the real widgets (`app.gui_tests`), writes its results and exits 0 when every
+test passed, 1 otherwise.  With --frames the editor quits after N frames,
+optionally leaving a screenshot of the window and the per-frame statistics
+(the GUI benchmark).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+from pathlib import Path
+
+# the window's GLX context needs PyOpenGL's default platform, not the headless EGL one
+if os.environ.get("PYOPENGL_PLATFORM") == "egl":
+    del os.environ["PYOPENGL_PLATFORM"]
+
+from imgui_bundle import hello_imgui, imgui, immapp  # noqa: E402
+
+from app.editor import Editor  # noqa: E402
+from app.panels import Panels  # noqa: E402
+from app.viewport import Viewport  # noqa: E402
+from cloudcore.errors import SceneError  # noqa: E402
+
+DEFAULT_SCENE = Path(__file__).resolve().parents[1] / "resources" / "scenes" / "valley.toml"
+
+
+def runner_params(editor: Editor, viewport: Viewport, panels: Panels, testing: bool) -> hello_imgui.RunnerParams:
+    params = hello_imgui.RunnerParams()
+    params.app_window_params.window_title = "cloudview"
+    params.app_window_params.window_geometry.size = (1280, 800)
+    params.imgui_window_params.default_imgui_window_type = (
+        hello_imgui.DefaultImGuiWindowType.provide_full_screen_dock_space)
+    params.imgui_window_params.show_menu_bar = False
+    # a CPU rasteriser pays for every multisample; the splats are smooth already
+    options = hello_imgui.OpenGlOptions()
+    options.anti_aliasing_samples = 0
+    params.renderer_backend_options.open_gl_options = options
+    params.fps_idling.enable_idling = False
+    params.ini_folder_type = hello_imgui.IniFolderType.app_user_config_folder
+    params.ini_filename = "cloudview/layout.ini"
+    params.ini_disable = testing  # tests start from the code's layout and leave no file behind
+
+    left = hello_imgui.DockingSplit("MainDockSpace", "Left", imgui.Dir.left, 0.3)
+    bottom = hello_imgui.DockingSplit("Left", "LeftBottom", imgui.Dir.down, 0.45)
+    params.docking_params.docking_splits = [left, bottom]
+    windows = []
+    for label, dock, function in (("Viewport", "MainDockSpace", viewport.gui), ("Scene", "Left", panels.scene),
+                                  ("Clouds", "Left", panels.clouds), ("Lighting", "Left", panels.lighting),
+                                  ("LOD", "Left", panels.lod), ("Camera", "Left", panels.camera),
+                                  ("Statistics", "LeftBottom", panels.statistics)):
+        window = hello_imgui.DockableWindow(label, dock, function)
+        windows.append(window)
+    params.docking_params.dockable_windows = windows
+
+    def every_frame():
+        io = imgui.get_io()
+        if io.key_ctrl and imgui.is_key_pressed(imgui.Key.s):
+            editor.save()
+        if io.key_ctrl and imgui.is_key_pressed(imgui.Key.z):
+            editor.redo() if io.key_shift else editor.undo()
+        if io.key_ctrl and imgui.is_key_pressed(imgui.Key.y):
+            editor.redo()
+        editor.autosave()
+
+    params.callbacks.pre_new_frame = every_frame
+    params.callbacks.before_exit = viewport.close
+    return params
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(prog="cloudview", description="the cloudview editor")
+    parser.add_argument("scene", nargs="?", type=Path, default=DEFAULT_SCENE)
+    parser.add_argument("--self-test", type=Path, metavar="RESULTS.json",
+                        help="run the GUI tests with the Dear ImGui Test Engine, write results, exit")
+    parser.add_argument("--frames", type=int, help="quit after this many frames")
+    parser.add_argument("--screenshot", type=Path, help="with --frames: save the window here (PNG) at the end")
+    parser.add_argument("--frame-stats", type=Path, help="with --frames: write every frame's statistics (JSON)")
+    args = parser.parse_args(argv)
+    try:
+        editor = Editor.open(args.scene)
+    except SceneError as error:
+        print(f"cloudview: error: {error}", file=sys.stderr)
+        return 2
+    viewport = Viewport(editor)
+    panels = Panels(editor, viewport)
+    params = runner_params(editor, viewport, panels, testing=args.self_test is not None)
+    outcome = {}
+    if args.self_test is not None:
+        from app.gui_tests import install
+
+        install(params, editor, viewport, panels, args.self_test, outcome)
+    if args.frames is not None:
+        _quit_after(params, args.frames, editor, outcome)
+    immapp.run(params, immapp.AddOnsParams(with_implot=True))
+    if args.screenshot is not None:
+        import imageio.v3 as iio
+
+        iio.imwrite(args.screenshot, hello_imgui.final_app_window_screenshot())
+    if args.frame_stats is not None:
+        args.frame_stats.write_text(json.dumps(outcome.get("frames", []), indent=1) + "\n")
+    return outcome.get("exit_code", 0)
+
+
+def _quit_after(params, frames: int, editor: Editor, outcome: dict) -> None:
+    recorded = outcome.setdefault("frames", [])
+
+    def count():
+        if editor.last_stats and (not recorded or recorded[-1] is not editor.last_stats):
+            recorded.append(editor.last_stats)
+        if len(recorded) >= frames:
+            hello_imgui.get_runner_params().app_shall_exit = True
+
+    params.callbacks.before_imgui_render = count
