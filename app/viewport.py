@@ -11,7 +11,6 @@ import time
 
 import numpy as np
 from imgui_bundle import imgui
-from OpenGL import GL
 
 from app.editor import Editor
 from cloudcore.editing import add_particle, pick_ray, point_at_altitude
@@ -47,8 +46,7 @@ class Viewport:
             stats |= self.renderer.measure_overdraw()[1]
         texture = self.renderer.display_texture()
         if self.capture_next:
-            self.captured, self.capture_next = _read_texture(texture, width, height), False
-        GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, 0)
+            self.captured, self.capture_next = self.renderer.read_display(), False
         stats["viewport_ms"] = 1e3 * (time.perf_counter() - start)
         self.regenerations_total += stats.get("impostors_regenerated", 0)
         editor.record_frame(stats)
@@ -100,10 +98,3 @@ class Viewport:
             self.renderer.close()
             self.renderer = None
 
-
-def _read_texture(texture: int, width: int, height: int) -> np.ndarray:
-    """The displayed frame as 8-bit RGB, top row first (for GUI tests)."""
-    GL.glBindTexture(GL.GL_TEXTURE_2D, texture)
-    GL.glPixelStorei(GL.GL_PACK_ALIGNMENT, 1)
-    data = GL.glGetTexImage(GL.GL_TEXTURE_2D, 0, GL.GL_RGB, GL.GL_UNSIGNED_BYTE)
-    return np.frombuffer(data, dtype=np.uint8).reshape(height, width, 3)[::-1].copy()

@@ -12,7 +12,6 @@ glFinish, read-back excluded) and measured and analytic overdraw.
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import json
 import os
 import platform
@@ -23,8 +22,9 @@ import numpy as np
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 
 from cloudcore.gl import FrameRenderer  # noqa: E402  (needs the platform chosen above)
-from cloudcore.paths import sample  # noqa: E402
+from cloudcore.paths import camera_on_path, frame_times  # noqa: E402
 from cloudcore.scenefile import load_scene  # noqa: E402
+from cloudcore.settings import FULL_3D  # noqa: E402
 
 DEFAULT_SCENE = Path(__file__).resolve().parents[1] / "resources" / "scenes" / "valley.toml"
 _TIMES = ("frame_ms", "world_ms", "cloud_ms")
@@ -33,18 +33,17 @@ _TIMES = ("frame_ms", "world_ms", "cloud_ms")
 def cameras(scene, path_name: str | None, frames: int):
     yield scene.camera
     if path_name:
-        keys = scene.camera_path(path_name).keys
-        for t in np.linspace(keys[0, 0], keys[-1, 0], frames):
-            at = sample(keys, t)
-            yield dataclasses.replace(scene.camera, position=tuple(at[:3]), look_at=tuple(at[3:]))
+        path = scene.camera_path(path_name)
+        for t in frame_times(path, frames):
+            yield camera_on_path(path, t, scene.camera.fov_y_deg)
 
 
 def bench_size(scene, width: int, height: int, views) -> dict:
     samples = []
     with FrameRenderer(width, height) as renderer:
-        renderer.render(scene, camera=views[0])  # pays the shading precompute and shader compiles
+        renderer.render(scene, camera=views[0], settings=FULL_3D)  # shading precompute, shader compiles
         for camera in views:
-            _, stats = renderer.render(scene, camera=camera)
+            _, stats = renderer.render(scene, camera=camera, settings=FULL_3D)
             stats |= renderer.measure_overdraw()[1]
             samples.append(stats)
     summary = {"width": width, "height": height, "frames": len(samples),

@@ -113,7 +113,10 @@ class FrameRenderer:
         return (linear_to_srgb8(self.context.read_linear_rgb()) if read_back else None), stats
 
     def display_texture(self) -> int:
-        """An RGBA8 texture holding the last frame in sRGB (rows bottom first, as GL stores them)."""
+        """An RGBA8 texture holding the last frame in sRGB (rows bottom first, as GL stores them).
+
+        Leaves the window's framebuffer bound.
+        """
         if self._display is None:
             self._display = (TextureTarget(*self.size, GL.GL_RGBA8), build_program("present", vertex="world"))
         target, program = self._display
@@ -126,7 +129,14 @@ class FrameRenderer:
         GL.glBindVertexArray(self._quads.vertex_array)
         GL.glDrawArrays(GL.GL_TRIANGLES, 0, 3)
         GL.glBindVertexArray(0)
+        GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, 0)  # the window's own framebuffer, for the GUI to draw on
         return target.texture
+
+    def read_display(self) -> np.ndarray:
+        """The last `display_texture` as 8-bit RGB, top row first (what the editor showed)."""
+        pixels = self._display[0].read()
+        GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, 0)
+        return np.rint(pixels[..., :3] * 255.0).astype(np.uint8)
 
     def resize(self, width: int, height: int) -> None:
         """New frame size for a window renderer; cached shading and impostors are kept."""
