@@ -31,21 +31,21 @@ def _yaw_pitch(vector) -> tuple[float, float]:
     return math.atan2(x, -z), math.atan2(y, math.hypot(x, z))
 
 
-def turned(camera: Camera, yaw_deg: float, pitch_deg: float) -> Camera:
-    """The camera turned in place: yaw to the right about the vertical, pitch up."""
-    offset = np.subtract(camera.look_at, camera.position)
+def _rotated(offset, yaw_deg: float, pitch_deg: float) -> np.ndarray:
+    """`offset` turned by yaw about the vertical and pitch toward it, length kept, pitch clamped."""
     yaw, pitch = _yaw_pitch(offset)
     limit = math.radians(_PITCH_LIMIT_DEG)
     pitch = min(max(pitch + math.radians(pitch_deg), -limit), limit)
-    look_at = np.add(camera.position, np.linalg.norm(offset) * _direction(yaw + math.radians(yaw_deg), pitch))
-    return dataclasses.replace(camera, look_at=tuple(look_at))
+    return np.linalg.norm(offset) * _direction(yaw + math.radians(yaw_deg), pitch)
+
+
+def turned(camera: Camera, yaw_deg: float, pitch_deg: float) -> Camera:
+    """The camera turned in place: yaw to the right about the vertical, pitch up."""
+    offset = _rotated(np.subtract(camera.look_at, camera.position), yaw_deg, pitch_deg)
+    return dataclasses.replace(camera, look_at=tuple(np.add(camera.position, offset)))
 
 
 def orbited(camera: Camera, yaw_deg: float, pitch_deg: float = 0.0) -> Camera:
     """The camera moved around its look-at point, still looking at it."""
-    offset = np.subtract(camera.position, camera.look_at)
-    yaw, pitch = _yaw_pitch(offset)
-    limit = math.radians(_PITCH_LIMIT_DEG)
-    pitch = min(max(pitch + math.radians(pitch_deg), -limit), limit)
-    position = np.add(camera.look_at, np.linalg.norm(offset) * _direction(yaw + math.radians(yaw_deg), pitch))
-    return dataclasses.replace(camera, position=tuple(position))
+    offset = _rotated(np.subtract(camera.position, camera.look_at), yaw_deg, pitch_deg)
+    return dataclasses.replace(camera, position=tuple(np.add(camera.look_at, offset)))

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 from OpenGL import GL
 
+from cloudcore.gl.blending import cloud_blending
 from cloudcore.gl.programs import build_program, set_matrix
 
 #: clip-space corners of the whole screen, for screen impostors
@@ -41,17 +42,10 @@ class QuadPass:
             GL.glActiveTexture(GL.GL_TEXTURE1)
             GL.glBindTexture(GL.GL_TEXTURE_2D, layer_texture)
             GL.glActiveTexture(GL.GL_TEXTURE0)
-        (GL.glEnable if depth_test else GL.glDisable)(GL.GL_DEPTH_TEST)
-        GL.glDepthFunc(GL.GL_LESS)
-        GL.glDepthMask(GL.GL_FALSE)
-        GL.glDisable(GL.GL_CULL_FACE)
-        GL.glEnable(GL.GL_BLEND)
-        GL.glBlendFunc(GL.GL_ONE, GL.GL_ONE if counting else GL.GL_ONE_MINUS_SRC_ALPHA)
-        GL.glBindVertexArray(self.vertex_array)
-        GL.glDrawArrays(GL.GL_TRIANGLE_STRIP, 0, 4)
-        GL.glBindVertexArray(0)
-        GL.glDisable(GL.GL_BLEND)
-        GL.glDepthMask(GL.GL_TRUE)
+        with cloud_blending(depth_test, counting):
+            GL.glBindVertexArray(self.vertex_array)
+            GL.glDrawArrays(GL.GL_TRIANGLE_STRIP, 0, 4)
+            GL.glBindVertexArray(0)
 
     def close(self) -> None:
         GL.glDeleteProgram(self._program)

@@ -18,6 +18,7 @@ import numpy as np
 from OpenGL import GL
 
 from cloudcore.eye_scattering import ParticleShading
+from cloudcore.gl.blending import cloud_blending
 from cloudcore.gl.programs import build_program, set_matrix
 from cloudcore.kernel import SPLAT_SHARPNESS
 
@@ -84,17 +85,10 @@ class SplatPass:
         set_matrix(program, "projection", projection)
         GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self._instance_buffer)
         GL.glBufferData(GL.GL_ARRAY_BUFFER, batch.instances.nbytes, batch.instances, GL.GL_STREAM_DRAW)
-        (GL.glEnable if depth_test else GL.glDisable)(GL.GL_DEPTH_TEST)
-        GL.glDepthFunc(GL.GL_LESS)
-        GL.glDepthMask(GL.GL_FALSE)
-        GL.glDisable(GL.GL_CULL_FACE)
-        GL.glEnable(GL.GL_BLEND)
-        GL.glBlendFunc(GL.GL_ONE, GL.GL_ONE if counting else GL.GL_ONE_MINUS_SRC_ALPHA)
-        GL.glBindVertexArray(self._vertex_array)
-        GL.glDrawArraysInstanced(GL.GL_TRIANGLE_STRIP, 0, 4, len(batch))
-        GL.glBindVertexArray(0)
-        GL.glDisable(GL.GL_BLEND)
-        GL.glDepthMask(GL.GL_TRUE)
+        with cloud_blending(depth_test, counting):
+            GL.glBindVertexArray(self._vertex_array)
+            GL.glDrawArraysInstanced(GL.GL_TRIANGLE_STRIP, 0, 4, len(batch))
+            GL.glBindVertexArray(0)
 
     def close(self) -> None:
         """Free the GL objects (the context must be current)."""
