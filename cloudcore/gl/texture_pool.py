@@ -20,7 +20,6 @@ class TexturePool:
         self._idle: OrderedDict[int, TextureTarget] = OrderedDict()  # keyed by id(), oldest first
         self.idle_limit_bytes = idle_limit_bytes
         self.bytes_in_use = 0
-        self.created = 0
 
     @property
     def bytes_idle(self) -> int:
@@ -37,7 +36,6 @@ class TexturePool:
                 break
         else:
             target = TextureTarget(width, height)
-            self.created += 1
         self.bytes_in_use += target.nbytes
         return target
 
