@@ -21,21 +21,13 @@ import numpy as np
 
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 
-from cloudcore.gl import FrameRenderer  # noqa: E402  (needs the platform chosen above)
-from cloudcore.paths import camera_on_path, frame_times  # noqa: E402
+from cloudcore.benchmark import path_cameras  # noqa: E402  (the GL imports need the platform above)
+from cloudcore.gl import FrameRenderer  # noqa: E402
 from cloudcore.scenefile import load_scene  # noqa: E402
 from cloudcore.settings import FULL_3D  # noqa: E402
 
 DEFAULT_SCENE = Path(__file__).resolve().parents[1] / "resources" / "scenes" / "valley.toml"
 _TIMES = ("frame_ms", "world_ms", "cloud_ms")
-
-
-def cameras(scene, path_name: str | None, frames: int):
-    yield scene.camera
-    if path_name:
-        path = scene.camera_path(path_name)
-        for t in frame_times(path, frames):
-            yield camera_on_path(path, t, scene.camera.fov_y_deg)
 
 
 def bench_size(scene, width: int, height: int, views) -> dict:
@@ -68,7 +60,7 @@ def main() -> None:
     args = parser.parse_args()
 
     scene = load_scene(args.scene)
-    views = list(cameras(scene, args.path, args.frames))
+    views = [scene.camera] + (path_cameras(scene, args.path, args.frames) if args.path else [])
     sizes = [tuple(int(v) for v in size.split("x")) for size in args.sizes.split(",")]
     result = {"scene": str(args.scene), "path": args.path, "machine": platform.processor() or platform.machine(),
               "runs": [bench_size(scene, w, h, views) for w, h in sizes]}

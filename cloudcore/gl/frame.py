@@ -65,7 +65,8 @@ class FrameRenderer:
         self._inside = None  # (target, its depth renderbuffer) of the screen impostor
         self._overdraw_target = None
         self._display = None  # (RGBA8 target, program): the frame in sRGB for the editor
-        self._replay = []  # the last frame's draws into the screen, for the overdraw counter
+        # the last frame's draws into the screen, replayable as fragment counts, and its splat batches
+        self._replay, self._screen_batches, self._last_matrices = [], [], None
         self.last_plan: FramePlan | None = None
 
     @property
@@ -91,6 +92,7 @@ class FrameRenderer:
 
         view = view_matrix(camera)
         projection = projection_matrix(camera.fov_y_deg, self.context.width / self.context.height)
+        self._last_matrices = view, projection
         # in the editor's context the GUI leaves its scissor rectangle on, which would clip our targets
         GL.glDisable(GL.GL_SCISSOR_TEST)
         start = time.perf_counter()
@@ -191,19 +193,22 @@ class FrameRenderer:
         """Execute the plan's cloud drawing into the frame target; returns the particles drawn."""
         eye = camera.position
         view_projection = projection @ view
-        self._replay = []
+        self._replay, self._screen_batches = [], []
         drawn = 0
 
         def draw_splats(clouds) -> int:
             batch = splat_batch(particles, clouds, eye)
             self._splats.draw(batch, view, projection)
-            self._replay.append(("splats", batch, view, projection))
+            self._replay.append(lambda: self._splats.draw(batch, view, projection, counting=True))
+            self._screen_batches.append(batch)
             return len(batch)
 
-        def draw_quad(corners, texture, weight, **options) -> None:
-            self._quads.draw(corners, view_projection if options.get("depth_test", True) else np.eye(4),
-                             texture, weight, **options)
-            self._replay.append(("quad", corners, view_projection, options.get("depth_test", True)))
+        def draw_quad(corners, texture, weight, *, screen: bool = False, **layer) -> None:
+            """A world-space quad, depth-tested; or with `screen`, clip-space corners over everything."""
+            matrix, depth_test = (np.eye(4), False) if screen else (view_projection, True)
+            self._quads.draw(corners, matrix, texture, weight, depth_test=depth_test, **layer)
+            self._replay.append(lambda: self._quads.draw(corners, matrix, 0, 1.0, depth_test=depth_test,
+                                                         counting=True))
 
         if plan.ring is not None:
             for generation, weight in plan.ring.draws:
@@ -238,7 +243,7 @@ class FrameRenderer:
                 self._splats.draw(batch, view, projection)
                 drawn += len(batch)
                 self.context.bind_target()
-                draw_quad(SCREEN_CORNERS, target.texture, cloud.full_weight, depth_test=False)
+                draw_quad(SCREEN_CORNERS, target.texture, cloud.full_weight, screen=True)
         if full_run:
             drawn += draw_splats(full_run)
         return drawn
@@ -279,13 +284,11 @@ class FrameRenderer:
             self._overdraw_target = TextureTarget(*self.size, GL.GL_R32F,
                                                   depth_renderbuffer=self.context.depth_renderbuffer)
         self._overdraw_target.bind_cleared()
-        analytic = 0.0
-        for kind, geometry, matrix, extra in self._replay:
-            if kind == "splats":
-                self._splats.draw(geometry, matrix, extra, counting=True)
-                analytic += analytic_overdraw(geometry.centres, geometry.radii, matrix, extra, NEAR_PLANE_M)
-            else:
-                self._quads.draw(geometry, matrix if extra else np.eye(4), 0, 1.0, depth_test=extra, counting=True)
+        for count_fragments in self._replay:
+            count_fragments()
+        view, projection = self._last_matrices
+        analytic = sum(analytic_overdraw(batch.centres, batch.radii, view, projection, NEAR_PLANE_M)
+                       for batch in self._screen_batches)
         counts = self._overdraw_target.read()
         self.context.bind_target()
         return counts, overdraw_statistics(counts) | {"overdraw_analytic": analytic}
