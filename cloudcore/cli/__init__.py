@@ -19,7 +19,7 @@ class _OneLineParser(argparse.ArgumentParser):
 
 
 def build_parser() -> tuple[argparse.ArgumentParser, argparse._SubParsersAction]:
-    from cloudcore.cli import bench, compare, render, shade
+    from cloudcore.cli import bench, compare, record, render, shade
 
     parser = _OneLineParser(prog="cloudview", description="Real-time volumetric particle clouds.")
     commands = parser.add_subparsers(dest="command", parser_class=_OneLineParser, metavar="COMMAND")
@@ -27,6 +27,7 @@ def build_parser() -> tuple[argparse.ArgumentParser, argparse._SubParsersAction]
     render.add_parser(commands)
     compare.add_parser(commands)
     bench.add_parser(commands)
+    record.add_parser(commands)
     return parser, commands
 
 

@@ -1,0 +1,165 @@
+"""`cloudview record SCENE --path NAME --out FILE.mp4`: every frame of a camera path, headless, to H.264 and/or PNGs.
+
+Frame i shows the path at i / fps seconds; --stats writes one CSV row per
+frame (`cloudcore.recording.COLUMNS`).  Ctrl-C stops after the frame being
+drawn: the video is finished properly, so it plays with the frames so far,
+and the exit status is 130.  The same arguments give the same frames.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import os
+import signal
+import sys
+from contextlib import ExitStack, contextmanager
+from pathlib import Path
+from types import SimpleNamespace
+
+from cloudcore.cli.render import pixel_count
+from cloudcore.cli.settings_args import add_settings_arguments, settings_from
+from cloudcore.errors import SceneError
+from cloudcore.paths import camera_on_path
+from cloudcore.recording import COLUMNS, frame_row, frame_times
+from cloudcore.scenefile import load_scene
+
+
+def add_parser(commands) -> None:
+    parser = commands.add_parser("record", help="render every frame of a camera path to a video and/or PNGs")
+    parser.add_argument("scene", help="scene file (.toml)")
+    parser.add_argument("--path", required=True, help="camera path of the scene to fly")
+    parser.add_argument("--out", type=Path, help="H.264 video to write (.mp4); needs an even width and height")
+    parser.add_argument("--frames-dir", type=Path, help="folder to write frame_00000.png, frame_00001.png, ... into")
+    parser.add_argument("--stats", type=Path, help="one row of frame statistics per frame (CSV)")
+    parser.add_argument("--fps", type=frame_rate, default=30.0, help="frames per second (default 30)")
+    parser.add_argument("--frames", type=frame_count, help="record only the first N frames")
+    parser.add_argument("--width", type=pixel_count, default=640)
+    parser.add_argument("--height", type=pixel_count, default=480)
+    parser.add_argument("--no-overdraw", action="store_true",
+                        help="leave the overdraw columns empty (measuring replays each frame's cloud draws)")
+    # many frames: impostors pay off
+    add_settings_arguments(parser, default_mode="auto")
+    parser.set_defaults(run=run)
+
+
+def frame_rate(text: str) -> float:
+    """Frames per second, finite and > 0; argparse names this function in its refusal."""
+    value = float(text)
+    if not (math.isfinite(value) and value > 0):
+        raise ValueError(text)
+    return value
+
+
+def frame_count(text: str) -> int:
+    """A number of frames, >= 1; argparse names this function in its refusal."""
+    value = int(text)
+    if value < 1:
+        raise ValueError(text)
+    return value
+
+
+def run(args) -> int:
+    if args.out is None and args.frames_dir is None:
+        raise SceneError("record", "output", "give --out FILE.mp4, --frames-dir DIR, or both")
+    if args.out is not None and (args.width % 2 or args.height % 2):
+        raise SceneError(str(args.out), "size", f"H.264 (yuv420p) needs an even width and height, "
+                                                f"got {args.width}x{args.height}")
+    scene = load_scene(args.scene)
+    try:
+        path = scene.camera_path(args.path)
+    except KeyError as error:
+        raise SceneError(args.scene, "camera_paths", error.args[0]) from None
+    settings = settings_from(args)
+    times = frame_times(path.duration, args.fps, args.frames)
+
+    # headless: EGL must be chosen before OpenGL is first imported
+    os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
+    import imageio.v3 as iio
+    from tqdm import tqdm
+
+    from cloudcore.gl import FrameRenderer
+
+    frame_ms = []
+    with _stop_on_interrupt() as stop, ExitStack() as outputs:
+        # every output is made before the renderer starts, so an unwritable one fails at once
+        if args.out:
+            _output(args.out, lambda p: p.open("wb").close())
+        if args.frames_dir:
+            _output(args.frames_dir, lambda folder: folder.mkdir(exist_ok=True))
+        table = outputs.enter_context(_output(args.stats, lambda p: p.open("w", newline=""))) if args.stats else None
+        rows = csv.DictWriter(table, COLUMNS) if table is not None else None
+        if rows is not None:
+            rows.writeheader()
+        renderer = outputs.enter_context(FrameRenderer(args.width, args.height))
+        video = outputs.enter_context(_video(args.out, (args.width, args.height), args.fps)) if args.out else None
+        bar = outputs.enter_context(tqdm(total=len(times), unit="frame", desc="record"))
+        for index, t in enumerate(times):
+            camera = camera_on_path(path, t, scene.camera.fov_y_deg)
+            image, stats = renderer.render(scene, camera=camera, settings=settings, time_s=path.keys[0, 0] + t)
+            if not args.no_overdraw:
+                stats |= renderer.measure_overdraw()[1]
+            if video is not None:
+                video.send(image)
+            if args.frames_dir:
+                iio.imwrite(args.frames_dir / f"frame_{index:05d}.png", image)
+            if rows is not None:
+                rows.writerow(frame_row(index, t, stats))
+                table.flush()  # a run cut short, even by a kill, keeps its rows
+            frame_ms.append(stats["frame_ms"])
+            bar.update()
+            if stop.requested:
+                break
+    written = ", ".join(str(p) for p in (args.out, args.frames_dir, args.stats) if p)
+    summary = (f"{len(frame_ms)} frames ({len(frame_ms) / args.fps:.2f} s at {args.fps:g} fps, "
+               f"{args.width}x{args.height}) to {written}; frame {sum(frame_ms) / len(frame_ms):.1f} ms mean")
+    if stop.requested:
+        print(f"cloudview: interrupted: wrote {summary}", file=sys.stderr)
+        return 130
+    print(f"wrote {summary}")
+    return 0
+
+
+@contextmanager
+def _stop_on_interrupt():
+    """Ctrl-C sets `requested` instead of raising, so the frame being drawn and written finishes whole.
+
+    (A KeyboardInterrupt inside the write to ffmpeg would cut a frame short and
+    make imageio-ffmpeg kill the encoder, leaving an unplayable file.)  A second
+    Ctrl-C raises as usual.
+    """
+    stop = SimpleNamespace(requested=False)
+
+    def request(signum, frame):
+        stop.requested = True
+        signal.signal(signal.SIGINT, previous)
+
+    previous = signal.signal(signal.SIGINT, request)
+    try:
+        yield stop
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+@contextmanager
+def _video(path: Path, size: tuple[int, int], fps: float):
+    """An imageio-ffmpeg H.264 writer taking (height, width, 3) uint8 frames; closed, the file is complete."""
+    import imageio_ffmpeg
+
+    # macro_block_size 2: sizes are even, so imageio-ffmpeg never rescales the frames
+    writer = imageio_ffmpeg.write_frames(str(path), size, fps=fps, codec="libx264", pix_fmt_out="yuv420p",
+                                         macro_block_size=2)
+    writer.send(None)  # starts ffmpeg
+    try:
+        yield writer
+    finally:
+        writer.close()  # ffmpeg encodes what it holds and writes the index
+
+
+def _output(path: Path, create):
+    """Create the parent folder, then `create(path)`; an unwritable path is a one-line error."""
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        return create(path)
+    except OSError as error:
+        raise SceneError(str(path), "output", error.strerror or str(error)) from None
