@@ -1,6 +1,6 @@
 """Error against run time: a camera path rendered in full 3D and in each setting, side by side in one run.
 
-`bench_path` takes any renderer with `render(scene, camera=, settings=) ->
+`bench_path` takes any renderer with `render(scene, camera=, settings=, time_s=) ->
 (sRGB image, stats)` (in practice `cloudcore.gl.FrameRenderer`), so this module
 stays free of OpenGL.  The full-3D reference is rendered first, in the same
 process and context, and every setting's frames are compared with it frame
@@ -26,14 +26,15 @@ PSNR_CAP_DB = 100.0
 
 
 def path_cameras(scene: Scene, path_name: str, frames: int) -> list:
+    """(scene clock in seconds, camera) of `frames` frames spread along the path."""
     path = scene.camera_path(path_name)
-    return [camera_on_path(path, t, scene.camera.fov_y_deg) for t in frame_times(path, frames)]
+    return [(path.keys[0, 0] + t, camera_on_path(path, t, scene.camera.fov_y_deg)) for t in frame_times(path, frames)]
 
 
-def _run(renderer, scene: Scene, cameras, settings: RenderSettings, reference=None, progress=None):
+def _run(renderer, scene: Scene, views, settings: RenderSettings, reference=None, progress=None):
     images, rows = [], []
-    for frame, camera in enumerate(cameras):
-        image, stats = renderer.render(scene, camera=camera, settings=settings)
+    for frame, (time_s, camera) in enumerate(views):
+        image, stats = renderer.render(scene, camera=camera, settings=settings, time_s=time_s)
         row = {"frame": frame, **{k: v for k, v in stats.items() if isinstance(v, (int, float))}}
         if reference is not None:
             difference = compare(image, reference[frame])
@@ -56,7 +57,7 @@ def _summary(rows) -> dict:
 def bench_path(renderer, scene: Scene, path_name: str, frames: int, settings_list, size, progress=None) -> dict:
     """The report: reference (full 3D) and one run per settings object, errors per frame and overall."""
     cameras = path_cameras(scene, path_name, frames)
-    renderer.render(scene, camera=cameras[0], settings=FULL_3D)  # shading precompute, shader compiles
+    renderer.render(scene, camera=cameras[0][1], settings=FULL_3D)  # shading precompute, shader compiles
     reference_images, reference_rows = _run(renderer, scene, cameras, FULL_3D, progress=progress)
     reference = {"mode": "full", **_summary(reference_rows), "per_frame": reference_rows}
     runs = []

@@ -4,7 +4,9 @@ Harris eq. 5: a particle scatters toward the eye the light that reached it
 (precomputed per light by `cloudcore.illumination`) times its scattering
 coefficient times the phase function at the angle between the light and the
 view ray, plus ambient light in proportion to its opacity, all tinted by the
-cloud's colour (white by default).  `light.direction`
+cloud's colour (white by default).  A cloud that forms or dissipates has
+both scaled by its opacity factor (Wang section 4 multiplies it into the
+sprite's alpha; the colour here is premultiplied).  `light.direction`
 points from the scene toward the light, so a view ray pointing at the light
 (omega = particle - eye parallel to light.direction) sees light scattered
 straight on: cos_theta = +1, the forward lobe that makes silver linings.
@@ -18,6 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from cloudcore.formation import core_distances, opacity_factor
 from cloudcore.illumination import IlluminationCache, cloud_optics, illuminate_clouds
 from cloudcore.lighting import active_lights
 from cloudcore.phase import phase_function
@@ -62,9 +65,17 @@ class ParticleShading:
         spheres = [c.bounding_sphere() for c in clouds]
         self.bounding_centres = np.array([s[0] for s in spheres], dtype=np.float64).reshape(-1, 3)
         self.bounding_radii = np.array([s[1] for s in spheres], dtype=np.float64)
+        # only clouds that form or dissipate: (first particle, end, formation, core distances)
+        self._forming = [(start, stop, c.formation, core_distances(c.centres))
+                         for c, start, stop in zip(clouds, self.cloud_starts[:-1], self.cloud_starts[1:])
+                         if c.formation is not None]
 
-    def seen_from(self, eye, indices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(linear RGB (n, 3), opacity (n,)) of particles `indices` seen from `eye`, near fade applied."""
+    def seen_from(self, eye, indices: np.ndarray, *, time_s: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """(linear RGB (n, 3), opacity (n,)) of particles `indices` seen from `eye`, near fade applied.
+
+        Given `time_s` (the scene clock), clouds that form or dissipate are
+        scaled by their opacity factor at that time (`cloudcore.formation`).
+        """
         offset = self.centres[indices] - np.asarray(eye, dtype=np.float64)
         distance = np.linalg.norm(offset, axis=1)
         # a particle centred on the eye is faded to nothing below, so its direction does not matter
@@ -77,7 +88,16 @@ class ParticleShading:
         colour = (scattered * self._scattering[indices, None] + self._ambient * alpha[:, None]) * self._tint[indices]
         radii = self.radii[indices]
         fade = smoothstep(FADE_START_RADII * radii, FADE_END_RADII * radii, distance)
+        if time_s is not None and self._forming:
+            fade = fade * self._formation_factors(time_s)[indices]
         return colour * fade[:, None], alpha * fade
+
+    def _formation_factors(self, time_s: float) -> np.ndarray:
+        """Every particle's formation opacity factor at `time_s`: 1 in clouds without a formation."""
+        factors = np.ones(len(self.radii))
+        for start, stop, formation, distances in self._forming:
+            factors[start:stop] = opacity_factor(formation, distances, time_s)
+        return factors
 
 
 def _concatenated(parts, empty_shape) -> np.ndarray:

@@ -17,6 +17,11 @@ one of
 
 with the impostor cache and ring state to carry into the next frame.  The GL
 side executes plans and nothing else; statistics come from the plan.
+
+Objects inside a drawn cloud's bounds split it into layers
+(`cloudcore.splitting`); `draw_items` is then the frame's cloud pass far to
+near: cloud layers, and the objects between them.  Without objects in clouds
+no particle is looked at.
 """
 
 from __future__ import annotations
@@ -34,6 +39,7 @@ from cloudcore.ramps import smoothstep
 from cloudcore.ring import RingPlan, RingState, plan_ring
 from cloudcore.scene import Camera
 from cloudcore.settings import RenderSettings
+from cloudcore.splitting import layer_bounds, layer_counts, layer_sort_key, objects_inside
 
 KINDS = ("empty", "culled", "ring", "full", "crossfade", "impostor", "inside")
 #: kinds that draw from an impostor texture kept in the cache
@@ -49,6 +55,25 @@ class CloudPlan:
     impostor_weight: float = 0.0  # share drawn from the cached impostor
     regenerate: str | None = None  # why the impostor is remade this frame
     texture_size: int = 0  # side of the impostor texture used
+    split_objects: tuple = ()  # indices of the objects inside it, far to near
+    splits: tuple = ()  # their distances from the eye: the layers' boundaries
+    layer_counts: tuple = ()  # particles per layer, far to near (of the impostor's layers when textured)
+
+    @property
+    def layers(self) -> int:
+        return len(self.splits) + 1
+
+
+@dataclass(frozen=True)
+class DrawItem:
+    """One step of the cloud pass: a layer of a cloud, or an object drawn between layers."""
+
+    kind: str  # "cloud" or "object"
+    index: int
+    depth: float  # distance from the eye the pass is sorted by, far to near
+    layer: int = 0  # of the cloud, 0 the farthest
+    near: float = -math.inf  # the layer holds the particles with near < distance from the eye <= far
+    far: float = math.inf
 
 
 @dataclass(frozen=True)
@@ -58,6 +83,8 @@ class FramePlan:
     ring: RingPlan | None
     records: Mapping = field(default_factory=dict)  # the impostor cache after this frame
     inside_size: tuple = (0, 0)  # the screen impostor's texture size (width, height)
+    draw_items: tuple = ()  # the cloud pass, far to near (DrawItem)
+    objects_with_world: tuple = ()  # visible objects outside split clouds: drawn before the cloud pass
 
     @property
     def ring_state(self) -> RingState:
@@ -79,27 +106,52 @@ class FramePlan:
             "regeneration_reasons": reasons,
             "ring_segments_built": int(self.ring is not None and self.ring.build_segment is not None),
             "ring_panels_drawn": 8 * len(self.ring.draws) if self.ring is not None else 0,
+            "objects_in_clouds": len(self.objects_between_layers),
+            "layers_drawn": sum(c.layers for c in self.clouds if c.splits),
+            "layers_rebuilt": sum(c.layers for c in self.clouds if c.splits and c.regenerate),
         }
+
+    @property
+    def objects_between_layers(self) -> tuple:
+        """Objects drawn inside the cloud pass; the rest are drawn with the world."""
+        return tuple(item.index for item in self.draw_items if item.kind == "object")
 
 
 def plan_frame(centres: np.ndarray, radii: np.ndarray, camera: Camera, viewport: tuple[int, int],
                settings: RenderSettings, records: Mapping[int, ImpostorRecord], ring_state: RingState,
-               lighting_key: Hashable) -> FramePlan:
+               lighting_key: Hashable, objects=(), cloud_particles=None) -> FramePlan:
     """Plan one frame; `centres` (N, 3) and `radii` (N,) are the clouds' bounding spheres.
 
     `lighting_key` identifies what the particles' colours were computed from: one key for
     all clouds, or a tuple with one per cloud (the editor changes one cloud at a time, and
-    only that cloud's impostor is stale).
+    only that cloud's impostor is stale).  `objects` are the opaque objects' bounding
+    spheres this frame (`cloudcore.objects.ObjectPose`); `cloud_particles(i)` gives cloud i's
+    particle centres, asked only for clouds with objects inside.
     """
     centres, radii = np.asarray(centres, dtype=np.float64).reshape(-1, 3), np.asarray(radii, dtype=np.float64)
     width, height = viewport
     eye = np.asarray(camera.position, dtype=np.float64)
     view_projection = projection_matrix(camera.fov_y_deg, width / height) @ view_matrix(camera)
-    visible = spheres_in_frustum(frustum_planes(view_projection), centres, radii)
+    planes = frustum_planes(view_projection)
+    visible = spheres_in_frustum(planes, centres, radii)
     distances = np.linalg.norm(centres - eye, axis=1)
     keys = list(lighting_key) if isinstance(lighting_key, tuple) else [lighting_key] * len(radii)
     ring = plan_ring(ring_state, centres, radii, eye, settings, tuple(keys))
     next_records = {index: record for index, record in records.items() if index < len(radii)}
+    object_centres = np.array([o.centre for o in objects], dtype=np.float64).reshape(-1, 3)
+    object_radii = np.array([o.radius for o in objects], dtype=np.float64)
+    objects_visible = spheres_in_frustum(planes, object_centres, object_radii)
+
+    def splitting(index: int, from_eye) -> tuple[np.ndarray, tuple, tuple]:
+        """(objects inside the cloud far to near from `from_eye`, their distances, layer counts)."""
+        inside = objects_inside(centres[index], radii[index], object_centres, object_radii) if (
+            settings.split_objects) else np.zeros(0, dtype=np.int64)
+        if not inside.size:
+            return inside, (), (0,)
+        gaps = np.linalg.norm(object_centres[inside] - np.asarray(from_eye, dtype=np.float64), axis=1)
+        order = np.argsort(-gaps, kind="stable")
+        splits = tuple(float(g) for g in gaps[order])
+        return inside[order], splits, layer_counts(cloud_particles(index), from_eye, splits)
 
     clouds = []
     for index, (centre, radius, distance) in enumerate(zip(centres, radii, distances)):
@@ -111,31 +163,59 @@ def plan_frame(centres: np.ndarray, radii: np.ndarray, camera: Camera, viewport:
             clouds.append(CloudPlan(index, "ring", distance))
         elif not visible[index]:
             clouds.append(CloudPlan(index, "culled", distance))
-        elif settings.mode == "full":
-            clouds.append(CloudPlan(index, "full", distance, full_weight=1.0))
-        elif distance < INSIDE_RADII * radius:
-            clouds.append(CloudPlan(index, "inside", distance, full_weight=individual))
+        elif settings.mode == "full" or distance < INSIDE_RADII * radius:
+            kind = "full" if settings.mode == "full" else "inside"
+            inside, splits, counts = splitting(index, eye)
+            clouds.append(CloudPlan(index, kind, distance, full_weight=1.0 if kind == "full" else individual,
+                                    split_objects=tuple(int(i) for i in inside), splits=splits,
+                                    layer_counts=counts))
         else:
             # a cloud fading into or out of the ring is drawn as an impostor: one layer scales exactly
             full = 1.0 if settings.mode == "auto" and individual == 1.0 else 0.0
             if full:
                 full = 1.0 - smoothstep(settings.fade_start_radii * radius, settings.fade_end_radii * radius,
                                         distance)
+            inside, splits, counts = splitting(index, eye)
             if full == 1.0:
-                clouds.append(CloudPlan(index, "full", distance, full_weight=1.0))
+                clouds.append(CloudPlan(index, "full", distance, full_weight=1.0, split_objects=tuple(
+                    int(i) for i in inside), splits=splits, layer_counts=counts))
                 continue
             pixels = screen_size_px(radius, distance, height, camera.fov_y_deg)
             size = required_size(pixels, settings.impostor_min_size, settings.impostor_max_size)
             record = records.get(index)
-            reason = regeneration_reason(record, centre, eye, size, keys[index], settings.tolerance_deg)
+            # the layers the impostor's textures would hold now: split where the objects are, seen from its eye
+            held_counts = splitting(index, record.eye)[2] if record is not None and inside.size else None
+            reason = regeneration_reason(record, centre, eye, size, keys[index], settings.tolerance_deg,
+                                         held_counts)
             if reason is not None:
-                record = ImpostorRecord(tuple(float(v) for v in eye), size, keys[index])
+                record = ImpostorRecord(tuple(float(v) for v in eye), size, keys[index], splits, counts)
                 next_records[index] = record
             kind = "crossfade" if full > 0.0 else "impostor"
             clouds.append(CloudPlan(index, kind, distance, full_weight=full * individual,
                                     impostor_weight=(1.0 - full) * individual, regenerate=reason,
-                                    texture_size=record.size))
+                                    texture_size=record.size, split_objects=tuple(int(i) for i in inside),
+                                    splits=splits, layer_counts=record.layer_counts if splits else (0,)))
     drawn = [c.index for c in clouds if c.kind in ("full", "crossfade", "impostor", "inside")]
     draw_order = tuple(sorted(drawn, key=lambda i: -distances[i]))
     inside_size = tuple(max(1, math.ceil(side * settings.inside_resolution_scale)) for side in viewport)
-    return FramePlan(tuple(clouds), draw_order, ring, next_records, inside_size)
+    items = _draw_items([clouds[i] for i in draw_order], radii, object_centres, objects_visible, eye)
+    between = {item.index for item in items if item.kind == "object"}
+    with_world = tuple(i for i in range(len(object_radii)) if objects_visible[i] and i not in between)
+    return FramePlan(tuple(clouds), draw_order, ring, next_records, inside_size, items, with_world)
+
+
+def _draw_items(drawn, radii, object_centres, objects_visible, eye) -> tuple:
+    """The cloud pass far to near: each drawn cloud's layers, and each split object once between them."""
+    items, objects = [], set()
+    for cloud in drawn:
+        for layer in range(cloud.layers):
+            near, far = layer_bounds(cloud.splits, layer)
+            depth = layer_sort_key(near, far, cloud.distance, radii[cloud.index]) if cloud.splits else cloud.distance
+            items.append(DrawItem("cloud", cloud.index, depth, layer, near, far))
+        objects.update(cloud.split_objects)
+    for index in sorted(i for i in objects if objects_visible[i]):
+        distance = float(np.linalg.norm(object_centres[index] - eye))
+        items.append(DrawItem("object", index, distance, near=distance, far=distance))
+    # far to near; at equal depth the layer reaching farther first, then objects before layers
+    items.sort(key=lambda item: (-item.depth, -item.far, item.kind != "object"))
+    return tuple(items)

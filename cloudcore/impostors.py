@@ -29,11 +29,18 @@ INSIDE_RADII = 1.05
 
 @dataclass(frozen=True)
 class ImpostorRecord:
-    """What an impostor texture was made from: the eye, the texture side, the lighting."""
+    """What an impostor texture was made from: the eye, the texture side, the lighting, the layers.
+
+    A cloud split around objects (`cloudcore.splitting`) has one texture per layer: `splits`
+    are the objects' distances from `eye` when it was made and `layer_counts` its layers'
+    particle counts.
+    """
 
     eye: tuple[float, float, float]
     size: int
     lighting_key: Hashable
+    splits: tuple[float, ...] = ()
+    layer_counts: tuple[int, ...] = (0,)
 
 
 @dataclass(frozen=True)
@@ -84,8 +91,14 @@ def translation_error_deg(centre, eye_then, eye_now) -> float:
 
 
 def regeneration_reason(record: ImpostorRecord | None, centre, eye, size: int, lighting_key: Hashable,
-                        tolerance_deg: float) -> str | None:
-    """Why the impostor must be remade this frame ("new", "lights", "resolution", "translation"), or None."""
+                        tolerance_deg: float, layer_counts=None) -> str | None:
+    """Why the impostor must be remade this frame ("new", "lights", "resolution", "translation",
+    "layers"), or None.
+
+    `layer_counts` are the layers' particle counts the objects inside the cloud now give, seen
+    from the record's eye (None: the cloud is not split); a change moves particles between
+    layer textures, so they are remade.
+    """
     if record is None:
         return "new"
     if record.lighting_key != lighting_key:
@@ -94,4 +107,6 @@ def regeneration_reason(record: ImpostorRecord | None, centre, eye, size: int, l
         return "resolution"
     if translation_error_deg(centre, record.eye, eye) > tolerance_deg:
         return "translation"
+    if (layer_counts or (0,)) != (record.layer_counts if record.splits else (0,)):
+        return "layers"
     return None

@@ -12,6 +12,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from cloudcore.formation import Formation
+
 Vec3 = tuple[float, float, float]
 
 
@@ -75,7 +77,7 @@ class Shading:
 
 @dataclass(frozen=True, eq=False)
 class Cloud(_Record):
-    """Particles as rows (x, y, z, radius); optional per-cloud shading overrides."""
+    """Particles as rows (x, y, z, radius); optional per-cloud shading overrides and formation."""
 
     name: str
     particles: np.ndarray = field(default_factory=lambda: _frozen_array((), 4))
@@ -83,6 +85,7 @@ class Cloud(_Record):
     optical_depth: float | None = None
     albedo: float | None = None
     color: Vec3 = (1.0, 1.0, 1.0)
+    formation: Formation | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "particles", _frozen_array(self.particles, 4))
@@ -130,10 +133,18 @@ class SceneObject(_Record):
     position: Vec3 = (0.0, 0.0, 0.0)
     path: np.ndarray | None = None  # rows (t, x, y, z)
     color: Vec3 = (0.75, 0.75, 0.78)
+    #: the mesh file's triangles, read by the loader (None for primitives)
+    vertices: np.ndarray | None = None
+    faces: np.ndarray | None = None
 
     def __post_init__(self):
         if self.path is not None:
             object.__setattr__(self, "path", _frozen_array(self.path, 4))
+        if self.vertices is not None:
+            object.__setattr__(self, "vertices", _frozen_array(self.vertices, 3))
+            faces = np.array(self.faces, dtype=np.int64).reshape(-1, 3)
+            faces.flags.writeable = False
+            object.__setattr__(self, "faces", faces)
 
 
 @dataclass(frozen=True, eq=False)

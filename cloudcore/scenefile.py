@@ -8,6 +8,7 @@ valid ones listed, so a typo never passes silently.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import tempfile
@@ -18,6 +19,7 @@ import numpy as np
 import tomlkit
 
 from cloudcore.errors import SceneError
+from cloudcore.formation import FORMATION_KINDS, Formation
 from cloudcore.phase import MAX_ABS_G, PHASE_NAMES
 from cloudcore.scene import Camera, CameraPath, Cloud, Light, Lighting, Scene, SceneObject, Shading, Terrain
 
@@ -174,7 +176,7 @@ def scene_from_dict(data: dict, source: str = "<scene>", base_dir=Path(".")) -> 
                          "camera_paths"))
     clouds = tuple(_cloud(t, Path(base_dir)) for t in root.tables("clouds"))
     _unique_names(root, "clouds", clouds)
-    objects = tuple(_object(t) for t in root.tables("objects"))
+    objects = tuple(_object(t, Path(base_dir)) for t in root.tables("objects"))
     _unique_names(root, "objects", objects)
     paths = tuple(_camera_path(t) for t in root.tables("camera_paths"))
     _unique_names(root, "camera_paths", paths)
@@ -236,7 +238,7 @@ def _shading(t: _Table) -> Shading:
 
 
 def _cloud(t: _Table, base_dir: Path) -> Cloud:
-    t.reject_unknown(("name", "particles", "particles_file", "optical_depth", "albedo", "color"))
+    t.reject_unknown(("name", "particles", "particles_file", "optical_depth", "albedo", "color", "formation"))
     name = t.string("name")
     if t.has("particles") == t.has("particles_file"):
         t.fail("particles", "give exactly one of particles (inline) or particles_file (.npy)")
@@ -256,6 +258,17 @@ def _cloud(t: _Table, base_dir: Path) -> Cloud:
         optical_depth=t.number("optical_depth", None, low=0.0) if t.has("optical_depth") else None,
         albedo=t.number("albedo", None, low=0.0, high=1.0) if t.has("albedo") else None,
         color=t.vector("color", (1.0, 1.0, 1.0), low=0.0),
+        formation=_formation(_Table(t.source, t.path("formation"), t.raw("formation")))
+        if t.has("formation") else None,
+    )
+
+
+def _formation(t: _Table) -> Formation:
+    t.reject_unknown(("kind", "start_s", "duration_s"))
+    return Formation(
+        kind=t.string("kind", choices=FORMATION_KINDS),
+        start_s=t.number("start_s", 0.0),
+        duration_s=t.number("duration_s", low=0.0),
     )
 
 
@@ -292,7 +305,7 @@ def _terrain(t: _Table) -> Terrain:
     )
 
 
-def _object(t: _Table) -> SceneObject:
+def _object(t: _Table, base_dir: Path) -> SceneObject:
     t.reject_unknown(("name", "mesh", "primitive", "scale", "position", "path", "color"))
     if t.has("mesh") == t.has("primitive"):
         t.fail("mesh", "give exactly one of mesh (a file) or primitive")
@@ -300,15 +313,37 @@ def _object(t: _Table) -> SceneObject:
     if t.has("path"):
         path = t.matrix("path", 4)
         _check_times(t, "path", path[:, 0])
+    mesh = t.string("mesh") if t.has("mesh") else None
+    vertices, faces = _read_mesh(t, base_dir / mesh) if mesh is not None else (None, None)
     return SceneObject(
         name=t.string("name"),
-        mesh=t.string("mesh") if t.has("mesh") else None,
+        mesh=mesh,
+        vertices=vertices,
+        faces=faces,
         primitive=t.string("primitive", choices=PRIMITIVES) if t.has("primitive") else None,
         scale=t.number("scale", 1.0, low=0.0, low_open=True),
         position=t.vector("position", (0.0, 0.0, 0.0)),
         path=path,
         color=t.vector("color", SceneObject("").color, low=0.0, high=1.0),
     )
+
+
+def _read_mesh(t: _Table, file: Path) -> tuple[np.ndarray, np.ndarray]:
+    """The triangles of a mesh file trimesh reads (all its geometry merged), checked finite."""
+    import trimesh
+
+    if not file.is_file():
+        t.fail("mesh", f"{file}: no such file")
+    try:
+        mesh = trimesh.load(file, force="mesh")
+    except Exception as error:  # trimesh raises many kinds on a file it cannot parse
+        t.fail("mesh", f"{file}: not a mesh trimesh can read ({error})")
+    vertices, faces = np.asarray(mesh.vertices, dtype=np.float64), np.asarray(mesh.faces, dtype=np.int64)
+    if len(faces) == 0:
+        t.fail("mesh", f"{file}: no triangles")
+    if not np.all(np.isfinite(vertices)):
+        t.fail("mesh", f"{file}: vertices must be finite")
+    return vertices, faces
 
 
 def _camera_path(t: _Table) -> CameraPath:
@@ -370,6 +405,9 @@ def _cloud_dict(cloud: Cloud) -> dict:
         if getattr(cloud, key) is not None:
             out[key] = getattr(cloud, key)
     out["color"] = list(cloud.color)
+    if cloud.formation is not None:
+        f = cloud.formation
+        out["formation"] = {"kind": f.kind, "start_s": f.start_s, "duration_s": f.duration_s}
     return out
 
 
@@ -413,7 +451,7 @@ def save_scene(scene: Scene, path) -> Scene:
             target = path.parent / relative
             target.parent.mkdir(parents=True, exist_ok=True)
             _atomic_write(target, lambda f, p=cloud.particles: np.save(f, np.asarray(p, dtype=np.float64)))
-            cloud = Cloud(cloud.name, cloud.particles, relative, cloud.optical_depth, cloud.albedo, cloud.color)
+            cloud = dataclasses.replace(cloud, particles_file=relative)
         saved_clouds.append(cloud)
     saved = Scene(scene.camera, scene.lighting, scene.shading, tuple(saved_clouds), scene.terrain,
                   scene.objects, scene.camera_paths, scene.description)

@@ -37,6 +37,9 @@ class RenderSettings:
     ring_elevation_deg: float = 30.0
     #: frames over which a rebuilt ring crossfades in
     ring_fade_frames: int = 8
+    #: split clouds into layers around the objects inside them (Harris 3.1.1); off, objects are drawn
+    #: with the world and clouds are depth-tested against them (the naive picture, for comparison)
+    split_objects: bool = True
 
     def __post_init__(self):
         problems = []
@@ -63,6 +66,8 @@ class RenderSettings:
             problems.append(f"ring_elevation_deg must be within (0, 90), got {self.ring_elevation_deg}")
         if not (isinstance(self.ring_fade_frames, int) and self.ring_fade_frames >= 1):
             problems.append(f"ring_fade_frames must be an integer >= 1, got {self.ring_fade_frames!r}")
+        if not isinstance(self.split_objects, bool):
+            problems.append(f"split_objects must be true or false, got {self.split_objects!r}")
         if problems:
             raise ValueError("; ".join(problems))
 

@@ -28,7 +28,7 @@ class FakeRenderer:
     def __init__(self, offset):
         self.offset = offset
 
-    def render(self, scene, camera=None, settings=None):
+    def render(self, scene, camera=None, settings=None, time_s=0.0):
         level = 100 if settings == FULL_3D else 100 + self.offset
         stats = {"frame_ms": 40.0 if settings == FULL_3D else 10.0, "world_ms": 5.0, "cloud_ms": 30.0,
                  "impostors_regenerated": 1, "texture_bytes": 1024}

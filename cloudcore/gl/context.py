@@ -86,9 +86,10 @@ class HeadlessContext(RenderTargets):
     def make_current(self) -> None:
         self.renderer._platform.make_current()
 
-    def render_pyrender_scene(self, scene, flags) -> None:
+    def render_pyrender_scene(self, scene, flags, framebuffer: int | None = None) -> None:
         """Render a pyrender scene: its depth into the target's depth, its colour into `world_texture`.
 
+        Or both into `framebuffer` (colour RGBA8, depth DEPTH_COMPONENT24), the objects' target.
         `OffscreenRenderer.render` always reads its result back to numpy; we copy
         from the resolved framebuffer it leaves behind (pyrender 0.1.45 keeps it
         in `Renderer._main_fb`), so colour and depth stay on the GPU.
@@ -96,7 +97,7 @@ class HeadlessContext(RenderTargets):
         self.renderer.render(scene, flags=flags)
         self.make_current()
         GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, self.renderer._renderer._main_fb)
-        GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, self.world_framebuffer)
+        GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, self.world_framebuffer if framebuffer is None else framebuffer)
         w, h = self.width, self.height
         GL.glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL.GL_COLOR_BUFFER_BIT | GL.GL_DEPTH_BUFFER_BIT, GL.GL_NEAREST)
         self.bind_target()
@@ -131,9 +132,9 @@ class WindowContext(RenderTargets):
     def __init__(self, width: int, height: int):
         super().__init__(width, height)
         self._renderer = _RendererIntoFramebuffer(self.width, self.height)
-        self._renderer.target_framebuffer = self.world_framebuffer
 
-    def render_pyrender_scene(self, scene, flags) -> None:
+    def render_pyrender_scene(self, scene, flags, framebuffer: int | None = None) -> None:
+        self._renderer.target_framebuffer = self.world_framebuffer if framebuffer is None else framebuffer
         self._renderer.render(scene, flags)
         self.bind_target()
 

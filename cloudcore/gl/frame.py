@@ -6,12 +6,15 @@ terrain, precomputed cloud illumination, impostor cache and ring between
 frames and rebuilds each only when what it came from changes.  Each frame it
 asks `cloudcore.frameplan.plan_frame` what to do and executes exactly that:
 
-1. the world (terrain depth and colour over the sky);
+1. the world (terrain depth and colour over the sky), and the objects
+   that are not inside a drawn cloud;
 2. the impostors and ring segment the plan regenerates;
-3. the ring panels, then the clouds far to near: runs of full-3D clouds
-   as one sorted splat batch, impostors as quads, crossfading clouds as their
-   full-3D image (in a screen layer) mixed with their impostor, the cloud
-   the eye is inside as a reduced-resolution screen impostor.
+3. the ring panels, then the plan's draw items far to near: runs of full-3D
+   clouds (or of their layers) as one sorted splat batch, impostors as
+   quads, crossfading clouds as their full-3D image (in a screen layer)
+   mixed with their impostor, the cloud the eye is inside as a
+   reduced-resolution screen impostor, and the objects inside clouds
+   between the layers they split.
 """
 
 from __future__ import annotations
@@ -29,6 +32,7 @@ from cloudcore.illumination import IlluminationCache
 from cloudcore.frameplan import FramePlan, plan_frame
 from cloudcore.gl.context import HeadlessContext, WindowContext
 from cloudcore.gl.impostor_store import ImpostorStore
+from cloudcore.gl.objects import ObjectPass
 from cloudcore.gl.programs import build_program
 from cloudcore.gl.quads import SCREEN_CORNERS, QuadPass
 from cloudcore.gl.splats import SplatPass, splat_batch
@@ -55,6 +59,7 @@ class FrameRenderer:
         self._quads = QuadPass()
         self._impostors = ImpostorStore(self._splats)
         self._world, self._world_source = None, None
+        self._objects, self._objects_source = None, None
         self._particles, self._particles_source = None, None
         self._illumination = IlluminationCache()
         #: per cloud, changes whenever that cloud's particle colours may have: its impostor is stale
@@ -75,8 +80,10 @@ class FrameRenderer:
 
     def render(self, scene: Scene, *, time_of_day: float | None = None, camera: Camera | None = None,
                illumination_method: str = "exact", settings: RenderSettings = RenderSettings(),
-               read_back: bool = True) -> tuple[np.ndarray | None, dict]:
+               time_s: float = 0.0, read_back: bool = True) -> tuple[np.ndarray | None, dict]:
         """(sRGB uint8 (height, width, 3), stats); `time_of_day` and `camera` override the scene's.
+
+        `time_s` is the scene clock, in the time of the objects' path keys.
 
         With `read_back=False` the image stays on the GPU (None is returned in its place): the
         editor shows it through `display_texture`.
@@ -86,8 +93,11 @@ class FrameRenderer:
         camera = scene.camera if camera is None else camera
         stats = {"illumination_ms": self._prepare(scene, lighting, illumination_method)}
         particles = self._particles
+        poses = self._objects.poses(time_s) if self._objects is not None else ()
+        starts = particles.cloud_starts
         plan = plan_frame(particles.bounding_centres, particles.bounding_radii, camera, self.size, settings,
-                          self._records, self._ring_state, self._lighting_keys)
+                          self._records, self._ring_state, self._lighting_keys, poses,
+                          lambda cloud: particles.centres[starts[cloud]:starts[cloud + 1]])
         self._records, self._ring_state, self.last_plan = plan.records, plan.ring_state, plan
 
         view = view_matrix(camera)
@@ -97,13 +107,15 @@ class FrameRenderer:
         GL.glDisable(GL.GL_SCISSOR_TEST)
         start = time.perf_counter()
         self._world.draw(self.context, camera, projection @ view)
+        if plan.objects_with_world:
+            self._objects.draw(self.context, camera, poses, plan.objects_with_world, write_depth=True)
         GL.glFinish()
         world_done = time.perf_counter()
         rendered = self._impostors.update(plan, particles, self.size, camera.fov_y_deg, settings)
         GL.glFinish()
         updates_done = time.perf_counter()
         self.context.bind_target()
-        drawn = self._draw_clouds(plan, particles, camera, view, projection, settings)
+        drawn = self._draw_clouds(plan, particles, camera, view, projection, settings, poses)
         GL.glFinish()
         done = time.perf_counter()
         stats |= plan.stats() | {
@@ -169,6 +181,13 @@ class FrameRenderer:
             hours = _DEFAULT_SKY_HOURS if lighting.time_of_day is None else lighting.time_of_day
             self._world = WorldPass(scene.terrain, lights, ambient, *sky_colors(hours))
             self._world_source = world_source
+        objects_source = (scene.objects, lights, tuple(ambient), self.size)
+        if objects_source != self._objects_source:
+            self.context.make_current()
+            if self._objects is not None:
+                self._objects.close()
+            self._objects = ObjectPass(scene.objects, lights, ambient, self.size) if scene.objects else None
+            self._objects_source = objects_source
         particles_source = (scene.clouds, scene.shading, lighting, illumination_method)
         if particles_source == self._particles_source:
             return 0.0
@@ -189,15 +208,15 @@ class FrameRenderer:
         return self._key_serial
 
     def _draw_clouds(self, plan: FramePlan, particles: ParticleShading, camera: Camera, view, projection,
-                     settings: RenderSettings) -> int:
-        """Execute the plan's cloud drawing into the frame target; returns the particles drawn."""
+                     settings: RenderSettings, poses) -> int:
+        """Execute the plan's cloud pass into the frame target; returns the particles drawn."""
         eye = camera.position
         view_projection = projection @ view
         self._replay, self._screen_batches = [], []
         drawn = 0
 
-        def draw_splats(clouds) -> int:
-            batch = splat_batch(particles, clouds, eye)
+        def draw_splats(clouds, depth_ranges) -> int:
+            batch = splat_batch(particles, clouds, eye, depth_ranges)
             self._splats.draw(batch, view, projection)
             self._replay.append(lambda: self._splats.draw(batch, view, projection, counting=True))
             self._screen_batches.append(batch)
@@ -216,36 +235,38 @@ class FrameRenderer:
                     draw_quad(panel_corners(generation, segment, settings.ring_elevation_deg),
                               self._impostors.ring_panel(generation, segment).texture, weight)
 
-        full_run = []
-        for index in plan.draw_order:
-            cloud = plan.clouds[index]
-            if cloud.kind == "full":
-                full_run.append(index)  # neighbours in depth order are sorted together: they interpenetrate
+        full_run = []  # (cloud, (near, far)) of consecutive full-3D layers: they interpenetrate, sorted together
+        for item in plan.draw_items:
+            cloud = plan.clouds[item.index] if item.kind == "cloud" else None
+            if cloud is not None and cloud.kind == "full":
+                full_run.append((item.index, (item.near, item.far)))
                 continue
             if full_run:
-                drawn += draw_splats(full_run)
+                drawn += draw_splats(*zip(*full_run))
                 full_run = []
-            if cloud.kind == "impostor":
-                target, impostor = self._impostors.cloud_impostor(index)
+            if cloud is None:
+                self._objects.draw(self.context, camera, poses, [item.index], write_depth=False)
+            elif cloud.kind == "impostor":
+                target, impostor = self._impostors.cloud_impostor(item.index, item.layer)
                 draw_quad(impostor.corners, target.texture, cloud.impostor_weight)
             elif cloud.kind == "crossfade":
-                target, impostor = self._impostors.cloud_impostor(index)
+                target, impostor = self._impostors.cloud_impostor(item.index, item.layer)
                 layer = self._screen_layer()
                 layer.bind_cleared()
-                drawn += draw_splats([index])
+                drawn += draw_splats([item.index], [(item.near, item.far)])
                 self.context.bind_target()
                 draw_quad(impostor.corners, target.texture, cloud.impostor_weight,
                           layer_texture=layer.texture, layer_weight=cloud.full_weight)
             elif cloud.kind == "inside":
                 target = self._inside_target(plan.inside_size)
                 target.bind_cleared()
-                batch = splat_batch(particles, [index], eye)
+                batch = splat_batch(particles, [item.index], eye, [(item.near, item.far)])
                 self._splats.draw(batch, view, projection)
                 drawn += len(batch)
                 self.context.bind_target()
                 draw_quad(SCREEN_CORNERS, target.texture, cloud.full_weight, screen=True)
         if full_run:
-            drawn += draw_splats(full_run)
+            drawn += draw_splats(*zip(*full_run))
         return drawn
 
     def _screen_layer(self) -> TextureTarget:
@@ -313,6 +334,8 @@ class FrameRenderer:
         self._splats.close()
         if self._world is not None:
             self._world.close()
+        if self._objects is not None:
+            self._objects.close()
         self.context.close()
 
     def __enter__(self):

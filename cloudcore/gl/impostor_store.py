@@ -4,7 +4,9 @@ Per-cloud impostors are rendered from the eye recorded in the plan's impostor
 cache, through the tight frustum of `cloudcore.impostors.impostor_view`; ring
 segments from their generation's eye (`cloudcore.ring`).  Textures come from
 one `TexturePool`; those of clouds or ring generations the plan no longer
-holds go back to it.
+holds go back to it.  A cloud split around objects has one texture per
+layer, each holding the particles of its depth range seen from the
+impostor's eye.
 """
 
 from __future__ import annotations
@@ -19,13 +21,14 @@ from cloudcore.gl.texture_pool import TexturePool
 from cloudcore.impostors import ImpostorView, impostor_view, required_size
 from cloudcore.ring import SEGMENT_DEG, RingGeneration, segment_camera
 from cloudcore.settings import RenderSettings
+from cloudcore.splitting import layer_bounds
 
 
 class ImpostorStore:
     def __init__(self, splats: SplatPass):
         self._splats = splats
         self.pool = TexturePool()
-        self._clouds: dict[int, tuple[TextureTarget, ImpostorView]] = {}
+        self._clouds: dict[int, tuple[list[TextureTarget], ImpostorView]] = {}  # layers far to near
         self._ring: dict[tuple[RingGeneration, int], TextureTarget] = {}
         self._ring_sizes: dict[RingGeneration, tuple[int, int]] = {}
 
@@ -36,13 +39,17 @@ class ImpostorStore:
         for cloud in plan.clouds:
             if cloud.regenerate is None:
                 continue
-            eye = plan.records[cloud.index].eye
-            view = impostor_view(particles.bounding_centres[cloud.index], particles.bounding_radii[cloud.index], eye)
-            target = self._cloud_target(cloud.index, cloud.texture_size)
-            self._clouds[cloud.index] = (target, view)
-            rendered += self._render(target, particles, [cloud.index], eye, view.view, view.projection)
+            record = plan.records[cloud.index]
+            view = impostor_view(particles.bounding_centres[cloud.index], particles.bounding_radii[cloud.index],
+                                 record.eye)
+            targets = self._cloud_targets(cloud.index, cloud.texture_size, len(record.splits) + 1)
+            self._clouds[cloud.index] = (targets, view)
+            for layer, target in enumerate(targets):
+                depth_range = layer_bounds(record.splits, layer)
+                rendered += self._render(target, particles, [cloud.index], record.eye, view.view, view.projection,
+                                         [depth_range])
         for index in set(self._clouds) - set(plan.records):
-            self.pool.release(self._clouds.pop(index)[0])
+            self._release(self._clouds.pop(index)[0])
 
         ring = plan.ring
         if ring is not None and ring.build_segment is not None:
@@ -59,30 +66,35 @@ class ImpostorStore:
             del self._ring_sizes[generation]
         return rendered
 
-    def cloud_impostor(self, index: int) -> tuple[TextureTarget, ImpostorView]:
-        return self._clouds[index]
+    def cloud_impostor(self, index: int, layer: int = 0) -> tuple[TextureTarget, ImpostorView]:
+        targets, view = self._clouds[index]
+        return targets[layer], view
 
     def ring_panel(self, generation: RingGeneration, segment: int) -> TextureTarget:
         return self._ring[generation, segment]
 
-    def _cloud_target(self, index: int, size: int) -> TextureTarget:
-        held = self._clouds.pop(index, None)
-        if held is not None and held[0].width == size:
-            return held[0]
-        if held is not None:
-            self.pool.release(held[0])
-        return self.pool.acquire(size, size)
+    def _cloud_targets(self, index: int, size: int, layers: int) -> list[TextureTarget]:
+        """`layers` textures of side `size`, reusing the cloud's where they fit."""
+        held = self._clouds.pop(index, ([], None))[0]
+        kept = [target for target in held if target.width == size][:layers]
+        self._release([target for target in held if target not in kept])
+        return kept + [self.pool.acquire(size, size) for _ in range(layers - len(kept))]
 
-    def _render(self, target: TextureTarget, particles, clouds, eye, view, projection) -> int:
+    def _release(self, targets) -> None:
+        for target in targets:
+            self.pool.release(target)
+
+    def _render(self, target: TextureTarget, particles, clouds, eye, view, projection, depth_ranges=None) -> int:
         """The clouds alone, no depth test: the texture holds their premultiplied colour and opacity."""
-        batch = splat_batch(particles, clouds, eye)
+        batch = splat_batch(particles, clouds, eye, depth_ranges)
         target.bind_cleared()
         self._splats.draw(batch, view, projection, depth_test=False)
         return len(batch)
 
     def close(self) -> None:
-        for target, _ in self._clouds.values():
-            target.close()
+        for targets, _ in self._clouds.values():
+            for target in targets:
+                target.close()
         for target in self._ring.values():
             target.close()
         self._clouds.clear()

@@ -37,13 +37,23 @@ class SplatBatch:
         return len(self.instances)
 
 
-def splat_batch(particles: ParticleShading, clouds, eye) -> SplatBatch:
-    """The visible particles of `clouds` (indices), sorted far to near from `eye` and coloured for it."""
+def splat_batch(particles: ParticleShading, clouds, eye, depth_ranges=None) -> SplatBatch:
+    """The visible particles of `clouds` (indices), sorted far to near from `eye` and coloured for it.
+
+    `depth_ranges`, one (near, far) per cloud, keeps only the particles with
+    near < distance from `eye` <= far: one layer of a cloud split around objects.
+    """
     starts = particles.cloud_starts
     ranges = [np.arange(starts[c], starts[c + 1]) for c in clouds]
     indices = np.concatenate(ranges) if ranges else np.zeros(0, dtype=np.int64)
     eye = np.asarray(eye, dtype=np.float64)
-    far_to_near = indices[np.argsort(-np.linalg.norm(particles.centres[indices] - eye, axis=1), kind="stable")]
+    distances = np.linalg.norm(particles.centres[indices] - eye, axis=1)
+    if depth_ranges is not None:
+        near = np.repeat([r[0] for r in depth_ranges], [len(r) for r in ranges])
+        far = np.repeat([r[1] for r in depth_ranges], [len(r) for r in ranges])
+        kept = (distances > near) & (distances <= far)
+        indices, distances = indices[kept], distances[kept]
+    far_to_near = indices[np.argsort(-distances, kind="stable")]
     colour, alpha = particles.seen_from(eye, far_to_near)
     seen = alpha > 0.0
     drawn = far_to_near[seen]

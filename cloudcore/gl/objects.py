@@ -1,0 +1,115 @@
+"""The scene's opaque objects: drawn by pyrender, lit by the scene's lights, composited into the frame.
+
+pyrender draws the objects asked for into a target of our own (RGBA8 colour
+and a depth texture); one full-screen pass then blends them into the linear
+frame at their own depth, tested against the frame's depth so terrain stays
+in front.  Objects outside clouds are composited once after the world with
+their depth written, so the clouds behind them are hidden; an object inside
+a split cloud is composited between its layers without writing depth, so
+the layers in front of it cover it whole and no billboard cuts through it
+(`cloudcore.splitting`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from OpenGL import GL
+
+from cloudcore.camera import FAR_PLANE_M, NEAR_PLANE_M, camera_pose
+from cloudcore.gl.programs import build_program
+from cloudcore.gl.pyrender_compat import pyrender
+from cloudcore.lighting import active_lights
+from cloudcore.objects import object_mesh, object_poses
+from cloudcore.scene import Camera
+
+_UP = np.array([0.0, 1.0, 0.0])
+
+
+class ObjectPass:
+    """Objects of one scene under one lighting; rebuild it when either changes."""
+
+    def __init__(self, objects, lights, ambient, size: tuple[int, int]):
+        """`size`: the frame's, which the objects' colour and depth targets match."""
+        self.objects = tuple(objects)
+        self.meshes = [object_mesh(obj) for obj in self.objects]
+        self._scene = pyrender.Scene(bg_color=(0.0, 0.0, 0.0, 0.0), ambient_light=np.asarray(ambient))
+        for light in active_lights(lights):
+            # pyrender's diffuse term is albedo / pi: pi * intensity gives the terrain's Lambert shading
+            node = pyrender.DirectionalLight(color=np.asarray(light.color), intensity=math.pi * light.intensity)
+            self._scene.add(node, pose=_light_pose(np.asarray(light.direction, dtype=np.float64)))
+        self._nodes = []
+        for obj, mesh in zip(self.objects, self.meshes):
+            material = pyrender.MetallicRoughnessMaterial(baseColorFactor=(*obj.color, 1.0), metallicFactor=0.0,
+                                                          roughnessFactor=1.0)
+            self._nodes.append(self._scene.add(pyrender.Mesh.from_trimesh(mesh, material=material, smooth=False)))
+        self._camera_node = self._scene.add(
+            pyrender.PerspectiveCamera(yfov=1.0, znear=NEAR_PLANE_M, zfar=FAR_PLANE_M))
+        self._program = build_program("objects", vertex="world")
+        self._vertex_array = GL.glGenVertexArrays(1)
+        self._colour, self._depth, self._framebuffer = _colour_and_depth_target(*size)
+
+    def poses(self, time_s: float):
+        return object_poses(self.objects, time_s, self.meshes)
+
+    def draw(self, context, camera: Camera, poses, which, *, write_depth: bool) -> None:
+        """Composite the objects `which` (indices) at `poses` into the bound frame target."""
+        which = set(which)
+        for index, (node, pose) in enumerate(zip(self._nodes, poses)):
+            node.mesh.is_visible = index in which
+            self._scene.set_pose(node, pose.model)
+        self._camera_node.camera.yfov = math.radians(camera.fov_y_deg)
+        self._scene.set_pose(self._camera_node, camera_pose(camera))
+        context.render_pyrender_scene(self._scene, pyrender.RenderFlags.NONE, self._framebuffer)
+        GL.glUseProgram(self._program)
+        for unit, (texture, name) in enumerate(((self._colour, "object_colour"), (self._depth, "object_depth"))):
+            GL.glActiveTexture(GL.GL_TEXTURE0 + unit)
+            GL.glBindTexture(GL.GL_TEXTURE_2D, texture)
+            GL.glUniform1i(GL.glGetUniformLocation(self._program, name), unit)
+        GL.glActiveTexture(GL.GL_TEXTURE0)
+        GL.glEnable(GL.GL_DEPTH_TEST)
+        GL.glDepthFunc(GL.GL_LESS)
+        GL.glDepthMask(GL.GL_TRUE if write_depth else GL.GL_FALSE)
+        GL.glEnable(GL.GL_BLEND)
+        GL.glBlendFunc(GL.GL_ONE, GL.GL_ONE_MINUS_SRC_ALPHA)
+        GL.glBindVertexArray(self._vertex_array)
+        GL.glDrawArrays(GL.GL_TRIANGLES, 0, 3)
+        GL.glBindVertexArray(0)
+        GL.glDepthMask(GL.GL_TRUE)
+        GL.glDisable(GL.GL_BLEND)
+
+    def close(self) -> None:
+        """Free our GL objects (the context must be current); pyrender frees the meshes with its context."""
+        GL.glDeleteProgram(self._program)
+        GL.glDeleteVertexArrays(1, [self._vertex_array])
+        GL.glDeleteFramebuffers(1, [self._framebuffer])
+        GL.glDeleteTextures([self._colour, self._depth])
+
+
+def _light_pose(direction: np.ndarray) -> np.ndarray:
+    """A pose whose -z axis points along the light's travel (from the light, -direction)."""
+    back = direction / np.linalg.norm(direction)
+    side = np.cross(_UP, back)
+    side = side / np.linalg.norm(side) if np.linalg.norm(side) > 1e-9 else np.array([1.0, 0.0, 0.0])
+    pose = np.eye(4)
+    pose[:3, 0], pose[:3, 1], pose[:3, 2] = side, np.cross(back, side), back
+    return pose
+
+
+def _colour_and_depth_target(width: int, height: int) -> tuple[int, int, int]:
+    """(RGBA8 colour texture, DEPTH_COMPONENT24 texture, framebuffer): pyrender's formats, sampleable."""
+    textures = GL.glGenTextures(2)
+    for texture, internal_format in zip(textures, (GL.GL_RGBA8, GL.GL_DEPTH_COMPONENT24)):
+        GL.glBindTexture(GL.GL_TEXTURE_2D, texture)
+        GL.glTexStorage2D(GL.GL_TEXTURE_2D, 1, internal_format, width, height)
+        GL.glTexParameteri(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_MIN_FILTER, GL.GL_NEAREST)
+        GL.glTexParameteri(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_MAG_FILTER, GL.GL_NEAREST)
+    framebuffer = GL.glGenFramebuffers(1)
+    GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, framebuffer)
+    GL.glFramebufferTexture2D(GL.GL_FRAMEBUFFER, GL.GL_COLOR_ATTACHMENT0, GL.GL_TEXTURE_2D, textures[0], 0)
+    GL.glFramebufferTexture2D(GL.GL_FRAMEBUFFER, GL.GL_DEPTH_ATTACHMENT, GL.GL_TEXTURE_2D, textures[1], 0)
+    status = GL.glCheckFramebufferStatus(GL.GL_FRAMEBUFFER)
+    if status != GL.GL_FRAMEBUFFER_COMPLETE:
+        raise RuntimeError(f"objects framebuffer incomplete (status 0x{int(status):x})")
+    return int(textures[0]), int(textures[1]), framebuffer

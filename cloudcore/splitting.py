@@ -1,0 +1,62 @@
+"""Splitting clouds around the objects inside them (Harris 3.1.1), so no billboard cuts through a mesh.
+
+A cloud with n objects inside its bounds is drawn as n+1 layers: its
+particles are partitioned by their distance from the eye at each object's
+distance (the same distance the back-to-front sort uses), and the layers and
+objects are drawn far to near: layer, object, layer, ...  A particle belongs
+to layer k (0 = farthest) when exactly k of the split distances are >= its
+distance.
+
+Layers of different clouds sharing an object are ordered by a sort key
+inside their depth range, so every layer behind an object is drawn before it
+and every layer in front after it, whichever cloud they belong to.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+def objects_inside(cloud_centre, cloud_radius: float, object_centres: np.ndarray,
+                   object_radii: np.ndarray) -> np.ndarray:
+    """Indices of the objects whose bounding spheres reach into the cloud's bounding sphere."""
+    if cloud_radius <= 0.0 or len(object_radii) == 0:
+        return np.zeros(0, dtype=np.int64)
+    gaps = np.linalg.norm(object_centres - np.asarray(cloud_centre, dtype=np.float64), axis=1)
+    return np.flatnonzero(gaps < cloud_radius + object_radii)
+
+
+def layer_of(distances: np.ndarray, splits) -> np.ndarray:
+    """The layer (0 = farthest) of each particle at `distances` from the eye; `splits` far to near."""
+    splits = np.asarray(splits, dtype=np.float64)
+    if splits.size == 0:
+        return np.zeros(len(distances), dtype=np.int64)
+    return np.count_nonzero(np.asarray(distances)[:, None] <= splits[None, :], axis=1)
+
+
+def layer_counts(centres: np.ndarray, eye, splits) -> tuple[int, ...]:
+    """Particles in each of the len(splits)+1 layers, seen from `eye`."""
+    distances = np.linalg.norm(centres - np.asarray(eye, dtype=np.float64), axis=1)
+    return tuple(int(c) for c in np.bincount(layer_of(distances, splits), minlength=len(splits) + 1))
+
+
+def layer_bounds(splits, layer: int) -> tuple[float, float]:
+    """(near, far): the layer holds particles with near < distance <= far."""
+    far = math.inf if layer == 0 else splits[layer - 1]
+    near = -math.inf if layer == len(splits) else splits[layer]
+    return near, far
+
+
+def layer_sort_key(near: float, far: float, cloud_distance: float, cloud_radius: float) -> float:
+    """Where a layer sits among the frame's draws: the middle of its depth range within the cloud.
+
+    Always within [near, far], so it sorts behind the objects in front of the layer and in
+    front of those behind it (ties are broken by `far`, see `cloudcore.frameplan`).
+    """
+    low = max(near, cloud_distance - cloud_radius)
+    high = min(far, cloud_distance + cloud_radius)
+    if low <= high:
+        return 0.5 * (low + high)
+    return min(max(cloud_distance, near), far)
