@@ -34,6 +34,8 @@ class Editor:
         self.saved_scene = scene
         self.settings = RenderSettings()
         self.camera: Camera = scene.camera
+        #: the scene clock the objects move by (seconds, in their path keys' time)
+        self.scene_time_s = 0.0
         self.selected_cloud = 0 if scene.clouds else None
         self.placement_altitude = 1000.0
         self.particle_radius = 60.0
@@ -42,6 +44,11 @@ class Editor:
         self.frame_times: deque[dict] = deque(maxlen=240)
         self.last_stats: dict = {}
         self._last_recovery = time.monotonic()
+
+    @property
+    def scene_duration_s(self) -> float:
+        """The last key time of any object path (0 for a scene with static objects only)."""
+        return max((float(o.path[-1, 0]) for o in self.scene.objects if o.path is not None), default=0.0)
 
     @classmethod
     def open(cls, path: Path) -> "Editor":

@@ -152,6 +152,9 @@ class Panels:
             editor.camera = orbited(editor.camera, self.orbit_step_deg)
         if imgui.button("Reset to the scene's camera"):
             editor.camera = editor.scene.camera
+        if editor.scene_duration_s > 0.0:
+            _, editor.scene_time_s = imgui.slider_float("Scene time (s)", editor.scene_time_s, 0.0,
+                                                        editor.scene_duration_s)
 
     # --- Statistics -----------------------------------------------------------------------------------------
     def statistics(self) -> None:
@@ -168,6 +171,8 @@ class Panels:
         imgui.text(f"clouds: full {stats['clouds_full']}, crossfade {stats['clouds_crossfade']}, impostor "
                    f"{stats['clouds_impostor']}, inside {stats['clouds_inside']}, ring {stats['clouds_ring']}, "
                    f"culled {stats['clouds_culled']}")
+        imgui.text(f"objects in clouds {stats['objects_in_clouds']}: layers drawn {stats['layers_drawn']}, "
+                   f"rebuilt {stats['layers_rebuilt']}")
         imgui.text(f"texture memory {stats['texture_bytes'] / 2**20:.1f} MiB")
         _, self.viewport.measure_overdraw = imgui.checkbox("Measure overdraw", self.viewport.measure_overdraw)
         if "overdraw_mean" in stats:

@@ -41,7 +41,7 @@ class Viewport:
         self.renderer.resize(width, height)
         start = time.perf_counter()
         _, stats = self.renderer.render(editor.scene, camera=editor.camera, settings=editor.settings,
-                                        read_back=False)
+                                        time_s=editor.scene_time_s, read_back=False)
         if self.measure_overdraw:
             stats |= self.renderer.measure_overdraw()[1]
         texture = self.renderer.display_texture()

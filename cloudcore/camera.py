@@ -73,3 +73,27 @@ def spheres_in_frustum(planes: np.ndarray, centres: np.ndarray, radii: np.ndarra
     """Boolean (N,): which spheres are at least partly inside the frustum (conservative)."""
     distances = centres @ planes[:, :3].T + planes[:, 3]
     return np.all(distances >= -radii[:, None], axis=1)
+
+
+def screen_box(centre, radius: float, camera: Camera, viewport: tuple[int, int]) -> tuple[slice, slice] | None:
+    """(rows, columns) of the image, top row first, covering a sphere's image; None when it is behind the eye.
+
+    The box is that of the sphere's tangent cone's image, bounded by the
+    distance to its centre (conservative, and exact enough to crop around an
+    object's silhouette).
+    """
+    width, height = viewport
+    eye_space = view_matrix(camera) @ np.append(np.asarray(centre, dtype=np.float64), 1.0)
+    depth = -eye_space[2]
+    if depth <= radius:
+        return None
+    projection = projection_matrix(camera.fov_y_deg, width / height)
+    focal_x, focal_y = projection[0, 0], projection[1, 1]
+    spread = radius / np.sqrt(depth * depth - radius * radius)
+    x = (eye_space[0] / depth * focal_x + np.array([-1.0, 1.0]) * spread * focal_x + 1.0) * 0.5 * width
+    y = (1.0 - (eye_space[1] / depth * focal_y + np.array([1.0, -1.0]) * spread * focal_y)) * 0.5 * height
+    columns = np.clip(np.floor(x).astype(int) + [0, 1], 0, width)
+    rows = np.clip(np.floor(y).astype(int) + [0, 1], 0, height)
+    if columns[0] >= columns[1] or rows[0] >= rows[1]:
+        return None
+    return slice(*rows), slice(*columns)

@@ -34,7 +34,7 @@ class RingGeneration:
 
     eye: tuple[float, float, float]
     radius: float
-    lighting_key: Hashable
+    lighting_key: Hashable  # its members' lighting keys when it was made
     members: frozenset
     segment_members: tuple  # SEGMENTS tuples of cloud indices
 
@@ -99,34 +99,46 @@ def ring_members(centres: np.ndarray, radii: np.ndarray, eye, settings: RenderSe
         elevation + np.nan_to_num(angular_radius, nan=90.0) <= settings.ring_elevation_deg)
 
 
-def new_generation(centres, radii, eye, settings: RenderSettings, lighting_key: Hashable) -> RingGeneration:
-    members = ring_members(centres, radii, eye, settings)
-    generation = RingGeneration(tuple(float(v) for v in eye), float(settings.ring_radius), lighting_key,
-                                frozenset(np.flatnonzero(members).tolist()), ())
+def new_generation(centres, radii, eye, settings: RenderSettings, lighting_keys: tuple) -> RingGeneration:
+    members = frozenset(np.flatnonzero(ring_members(centres, radii, eye, settings)).tolist())
+    generation = RingGeneration(tuple(float(v) for v in eye), float(settings.ring_radius),
+                                _members_key(members, lighting_keys), members, ())
     per_segment = []
     for segment in range(SEGMENTS):
         view, projection = segment_camera(generation, segment, settings.ring_elevation_deg)
-        seen = spheres_in_frustum(frustum_planes(projection @ view), centres, radii) & members
+        seen = spheres_in_frustum(frustum_planes(projection @ view), centres, radii)
+        seen &= np.isin(np.arange(len(radii)), list(members))
         per_segment.append(tuple(np.flatnonzero(seen).tolist()))
     return replace(generation, segment_members=tuple(per_segment))
 
 
-def _needs_rebuild(generation: RingGeneration, eye, settings: RenderSettings, lighting_key: Hashable) -> bool:
+def _members_key(members: frozenset, lighting_keys: tuple) -> tuple:
+    """What the members' colours were computed from: a change to a cloud outside the ring leaves it be."""
+    return tuple(lighting_keys[i] if i < len(lighting_keys) else None for i in sorted(members))
+
+
+def _needs_rebuild(generation: RingGeneration, eye, settings: RenderSettings, lighting_keys: tuple) -> bool:
     moved = np.asarray(eye, dtype=np.float64) - np.asarray(generation.eye)
-    return (generation.lighting_key != lighting_key or generation.radius != settings.ring_radius
+    return (generation.lighting_key != _members_key(generation.members, lighting_keys)
+            or generation.radius != settings.ring_radius
             or math.hypot(moved[0], moved[2]) > settings.ring_rebuild_horizontal * settings.ring_radius
             or abs(moved[1]) > settings.ring_rebuild_vertical * settings.ring_radius)
 
 
-def plan_ring(state: RingState, centres, radii, eye, settings: RenderSettings, lighting_key: Hashable) -> RingPlan | None:
-    """Advance the ring by one frame: start a rebuild if needed, build one segment or step the fade."""
+def plan_ring(state: RingState, centres, radii, eye, settings: RenderSettings, lighting_keys: tuple) -> RingPlan | None:
+    """Advance the ring by one frame: start a rebuild if needed, build one segment or step the fade.
+
+    `lighting_keys` has one key per cloud.  A ring being built when its members' keys change
+    is finished first and rebuilt after: a cloud forming in the ring, whose key changes every
+    frame, would otherwise keep the ring from ever completing.
+    """
     if not settings.uses_ring:
         return None
     current, pending, built, fade_step = state.current, state.pending, state.built, state.fade_step
-    if pending is not None and (pending.lighting_key != lighting_key or pending.radius != settings.ring_radius):
-        pending = None  # what it was being built for is gone: start again
-    if pending is None and (current is None or _needs_rebuild(current, eye, settings, lighting_key)):
-        pending, built, fade_step = new_generation(centres, radii, eye, settings, lighting_key), 0, 0
+    if pending is not None and pending.radius != settings.ring_radius:
+        pending = None  # the ring it was being built for is gone: start again
+    if pending is None and (current is None or _needs_rebuild(current, eye, settings, lighting_keys)):
+        pending, built, fade_step = new_generation(centres, radii, eye, settings, lighting_keys), 0, 0
     build_segment = None
     if pending is not None:
         if built < SEGMENTS:

@@ -4,7 +4,7 @@
 
 34 cumulus clouds (about 90,000 particles) hang low over a procedural valley
 of 59,858 triangles, lit by an afternoon sun; a 30 s camera path `flythrough`
-passes through two clouds and an aircraft crosses a third.  Everything follows
+passes through two clouds, the first while an aircraft crosses it.  Everything follows
 from SEED; the particles are shipped as .npy beside the scene so the golden
 images never depend on numpy's random streams.
 """
@@ -66,10 +66,13 @@ def build() -> Scene:
             ahead = position + (position - stations[i - 1][1])
         keys.append([t, *position, *ahead])
 
-    # The aircraft crosses a third cloud, seen from the start of the flythrough.
-    crossed = heart(by_distance[2])
-    aircraft_path = np.array([[t, *(crossed + [x, 30.0 * np.sin(t / 6.0), 0.0])]
-                              for t, x in zip(np.linspace(0, 30, 7), np.linspace(-900, 900, 7))])
+    # The aircraft crosses the first cloud, right to left across the camera's view, at its heart at t = 6 s,
+    # while the camera closes in (so the split layers show along the flythrough).
+    across = np.cross(first - start, [0.0, 1.0, 0.0])
+    across[1] = 0.0
+    across /= np.linalg.norm(across)
+    aircraft_path = np.array([[t, *(first + across * 70.0 * (t - 6.0) + [0.0, 30.0 * np.sin(t / 6.0), 0.0])]
+                              for t in np.linspace(0, 30, 7)])
     return Scene(
         # an establishing view up the valley; the flythrough has its own keys
         camera=Camera((450.0, 330.0, 2900.0), (-250.0, 850.0, -600.0), 60.0),

@@ -180,6 +180,18 @@ def test_a_sun_change_rebuilds_the_ring():
     assert relit[0].ring.build_segment == 0
 
 
+def test_a_ring_cloud_changing_every_frame_still_lets_the_ring_complete():
+    """A forming cloud's key changes each frame: the ring keeps being finished and remade, one segment a frame."""
+    eye, state, built = (0.0, 100.0, 0.0), RingState(), []
+    for frame in range(3 * (SEGMENTS + RING.ring_fade_frames)):
+        keys = (frame,) + (1,) * (len(FAR_CLOUDS) - 1)  # cloud 0 forms
+        (p,) = run_ring(eye, 1, state, lighting=keys)[0]
+        state = p.ring_state
+        built.append(p.ring.build_segment)
+    assert state.current is not None, "a ring was completed"
+    assert built[:SEGMENTS] == list(range(SEGMENTS)) and built.count(SEGMENTS - 1) >= 2
+
+
 def test_clouds_far_above_or_within_the_radius_stay_out_of_the_ring():
     centres = [(0.0, 100.0, -3000.0), (0.0, 2700.0, -3000.0), (0.0, 100.0, -600.0)]
     state = RingState()

@@ -28,6 +28,7 @@ from OpenGL import GL
 from cloudcore.camera import NEAR_PLANE_M, projection_matrix, view_matrix
 from cloudcore.colour import linear_to_srgb8
 from cloudcore.eye_scattering import ParticleShading
+from cloudcore.formation import formation_state
 from cloudcore.illumination import IlluminationCache
 from cloudcore.frameplan import FramePlan, plan_frame
 from cloudcore.gl.context import HeadlessContext, WindowContext
@@ -83,7 +84,7 @@ class FrameRenderer:
                time_s: float = 0.0, read_back: bool = True) -> tuple[np.ndarray | None, dict]:
         """(sRGB uint8 (height, width, 3), stats); `time_of_day` and `camera` override the scene's.
 
-        `time_s` is the scene clock, in the time of the objects' path keys.
+        `time_s` is the scene clock, in the time of the objects' path keys and of the clouds' formations.
 
         With `read_back=False` the image stays on the GPU (None is returned in its place): the
         editor shows it through `display_texture`.
@@ -95,8 +96,11 @@ class FrameRenderer:
         particles = self._particles
         poses = self._objects.poses(time_s) if self._objects is not None else ()
         starts = particles.cloud_starts
+        # a forming or dissipating cloud's colours change with the clock too: its impostor is stale meanwhile
+        cloud_keys = tuple((key, formation_state(cloud.formation, time_s))
+                           for key, cloud in zip(self._lighting_keys, scene.clouds))
         plan = plan_frame(particles.bounding_centres, particles.bounding_radii, camera, self.size, settings,
-                          self._records, self._ring_state, self._lighting_keys, poses,
+                          self._records, self._ring_state, cloud_keys, poses,
                           lambda cloud: particles.centres[starts[cloud]:starts[cloud + 1]])
         self._records, self._ring_state, self.last_plan = plan.records, plan.ring_state, plan
 
@@ -111,11 +115,11 @@ class FrameRenderer:
             self._objects.draw(self.context, camera, poses, plan.objects_with_world, write_depth=True)
         GL.glFinish()
         world_done = time.perf_counter()
-        rendered = self._impostors.update(plan, particles, self.size, camera.fov_y_deg, settings)
+        rendered = self._impostors.update(plan, particles, self.size, camera.fov_y_deg, settings, time_s)
         GL.glFinish()
         updates_done = time.perf_counter()
         self.context.bind_target()
-        drawn = self._draw_clouds(plan, particles, camera, view, projection, settings, poses)
+        drawn = self._draw_clouds(plan, particles, camera, view, projection, settings, poses, time_s)
         GL.glFinish()
         done = time.perf_counter()
         stats |= plan.stats() | {
@@ -208,15 +212,15 @@ class FrameRenderer:
         return self._key_serial
 
     def _draw_clouds(self, plan: FramePlan, particles: ParticleShading, camera: Camera, view, projection,
-                     settings: RenderSettings, poses) -> int:
-        """Execute the plan's cloud pass into the frame target; returns the particles drawn."""
+                     settings: RenderSettings, poses, time_s: float) -> int:
+        """Execute the plan's cloud pass into the frame target at scene time `time_s`; returns the particles drawn."""
         eye = camera.position
         view_projection = projection @ view
         self._replay, self._screen_batches = [], []
         drawn = 0
 
         def draw_splats(clouds, depth_ranges) -> int:
-            batch = splat_batch(particles, clouds, eye, depth_ranges)
+            batch = splat_batch(particles, clouds, eye, depth_ranges, time_s)
             self._splats.draw(batch, view, projection)
             self._replay.append(lambda: self._splats.draw(batch, view, projection, counting=True))
             self._screen_batches.append(batch)
@@ -260,7 +264,7 @@ class FrameRenderer:
             elif cloud.kind == "inside":
                 target = self._inside_target(plan.inside_size)
                 target.bind_cleared()
-                batch = splat_batch(particles, [item.index], eye, [(item.near, item.far)])
+                batch = splat_batch(particles, [item.index], eye, [(item.near, item.far)], time_s)
                 self._splats.draw(batch, view, projection)
                 drawn += len(batch)
                 self.context.bind_target()

@@ -33,8 +33,8 @@ class ImpostorStore:
         self._ring_sizes: dict[RingGeneration, tuple[int, int]] = {}
 
     def update(self, plan: FramePlan, particles: ParticleShading, viewport, fov_y_deg: float,
-               settings: RenderSettings) -> int:
-        """Render this frame's regenerations and ring segment; returns the particles rendered."""
+               settings: RenderSettings, time_s: float) -> int:
+        """Render this frame's regenerations and ring segment at scene time `time_s`; returns the particles rendered."""
         rendered = 0
         for cloud in plan.clouds:
             if cloud.regenerate is None:
@@ -47,7 +47,7 @@ class ImpostorStore:
             for layer, target in enumerate(targets):
                 depth_range = layer_bounds(record.splits, layer)
                 rendered += self._render(target, particles, [cloud.index], record.eye, view.view, view.projection,
-                                         [depth_range])
+                                         time_s, [depth_range])
         for index in set(self._clouds) - set(plan.records):
             self._release(self._clouds.pop(index)[0])
 
@@ -58,7 +58,7 @@ class ImpostorStore:
             target = self._ring[generation, segment] = self.pool.acquire(*size)
             view, projection = segment_camera(generation, segment, settings.ring_elevation_deg)
             rendered += self._render(target, particles, generation.segment_members[segment], generation.eye,
-                                     view, projection)
+                                     view, projection, time_s)
         live = {plan.ring_state.current, plan.ring_state.pending}
         for key in [key for key in self._ring if key[0] not in live]:
             self.pool.release(self._ring.pop(key))
@@ -84,9 +84,10 @@ class ImpostorStore:
         for target in targets:
             self.pool.release(target)
 
-    def _render(self, target: TextureTarget, particles, clouds, eye, view, projection, depth_ranges=None) -> int:
+    def _render(self, target: TextureTarget, particles, clouds, eye, view, projection, time_s: float,
+                depth_ranges=None) -> int:
         """The clouds alone, no depth test: the texture holds their premultiplied colour and opacity."""
-        batch = splat_batch(particles, clouds, eye, depth_ranges)
+        batch = splat_batch(particles, clouds, eye, depth_ranges, time_s)
         target.bind_cleared()
         self._splats.draw(batch, view, projection, depth_test=False)
         return len(batch)

@@ -37,11 +37,12 @@ class SplatBatch:
         return len(self.instances)
 
 
-def splat_batch(particles: ParticleShading, clouds, eye, depth_ranges=None) -> SplatBatch:
+def splat_batch(particles: ParticleShading, clouds, eye, depth_ranges=None, time_s: float | None = None) -> SplatBatch:
     """The visible particles of `clouds` (indices), sorted far to near from `eye` and coloured for it.
 
     `depth_ranges`, one (near, far) per cloud, keeps only the particles with
     near < distance from `eye` <= far: one layer of a cloud split around objects.
+    `time_s`, the scene clock, fades forming and dissipating clouds (`ParticleShading.seen_from`).
     """
     starts = particles.cloud_starts
     ranges = [np.arange(starts[c], starts[c + 1]) for c in clouds]
@@ -54,7 +55,7 @@ def splat_batch(particles: ParticleShading, clouds, eye, depth_ranges=None) -> S
         kept = (distances > near) & (distances <= far)
         indices, distances = indices[kept], distances[kept]
     far_to_near = indices[np.argsort(-distances, kind="stable")]
-    colour, alpha = particles.seen_from(eye, far_to_near)
+    colour, alpha = particles.seen_from(eye, far_to_near, time_s=time_s)
     seen = alpha > 0.0
     drawn = far_to_near[seen]
     instances = np.empty((len(drawn), _INSTANCE_FLOATS), dtype=np.float32)
