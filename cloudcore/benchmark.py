@@ -25,7 +25,7 @@ from cloudcore.settings import FULL_3D, RenderSettings
 PSNR_CAP_DB = 100.0
 
 
-def path_cameras(scene: Scene, path_name: str, frames: int) -> list:
+def path_views(scene: Scene, path_name: str, frames: int) -> list:
     """(scene clock in seconds, camera) of `frames` frames spread along the path."""
     path = scene.camera_path(path_name)
     return [(path.keys[0, 0] + t, camera_on_path(path, t, scene.camera.fov_y_deg)) for t in frame_times(path, frames)]
@@ -56,13 +56,13 @@ def _summary(rows) -> dict:
 
 def bench_path(renderer, scene: Scene, path_name: str, frames: int, settings_list, size, progress=None) -> dict:
     """The report: reference (full 3D) and one run per settings object, errors per frame and overall."""
-    cameras = path_cameras(scene, path_name, frames)
-    renderer.render(scene, camera=cameras[0][1], settings=FULL_3D)  # shading precompute, shader compiles
-    reference_images, reference_rows = _run(renderer, scene, cameras, FULL_3D, progress=progress)
+    views = path_views(scene, path_name, frames)
+    renderer.render(scene, camera=views[0][1], settings=FULL_3D)  # shading precompute, shader compiles
+    reference_images, reference_rows = _run(renderer, scene, views, FULL_3D, progress=progress)
     reference = {"mode": "full", **_summary(reference_rows), "per_frame": reference_rows}
     runs = []
     for settings in settings_list:
-        _, rows = _run(renderer, scene, cameras, settings, reference_images, progress)
+        _, rows = _run(renderer, scene, views, settings, reference_images, progress)
         psnr = np.array([r["psnr_db"] for r in rows])
         summary = _summary(rows)
         runs.append({

@@ -142,59 +142,57 @@ def plan_frame(centres: np.ndarray, radii: np.ndarray, camera: Camera, viewport:
     object_radii = np.array([o.radius for o in objects], dtype=np.float64)
     objects_visible = spheres_in_frustum(planes, object_centres, object_radii)
 
-    def splitting(index: int, from_eye) -> tuple[np.ndarray, tuple, tuple]:
-        """(objects inside the cloud far to near from `from_eye`, their distances, layer counts)."""
+    def split_at(index: int, from_eye) -> tuple[tuple, tuple]:
+        """(objects inside the cloud far to near from `from_eye`, their distances: the layers' boundaries)."""
         inside = objects_inside(centres[index], radii[index], object_centres, object_radii) if (
-            settings.split_objects) else np.zeros(0, dtype=np.int64)
-        if not inside.size:
-            return inside, (), (0,)
+            settings.split_objects) else ()
+        if not len(inside):
+            return (), ()
         gaps = np.linalg.norm(object_centres[inside] - np.asarray(from_eye, dtype=np.float64), axis=1)
         order = np.argsort(-gaps, kind="stable")
-        splits = tuple(float(g) for g in gaps[order])
-        return inside[order], splits, layer_counts(cloud_particles(index), from_eye, splits)
+        return tuple(int(i) for i in inside[order]), tuple(float(g) for g in gaps[order])
+
+    def counts(index: int, from_eye, splits) -> tuple:
+        """Particles per layer seen from `from_eye`; the particles are looked at only when there are splits."""
+        return layer_counts(cloud_particles(index), from_eye, splits) if splits else (0,)
 
     clouds = []
     for index, (centre, radius, distance) in enumerate(zip(centres, radii, distances)):
         distance = float(distance)
         individual = 1.0 - (ring.weight_of(index) if ring is not None else 0.0)
-        if radius <= 0.0:
-            clouds.append(CloudPlan(index, "empty", distance))
-        elif individual <= 0.0:
-            clouds.append(CloudPlan(index, "ring", distance))
-        elif not visible[index]:
-            clouds.append(CloudPlan(index, "culled", distance))
-        elif settings.mode == "full" or distance < INSIDE_RADII * radius:
-            kind = "full" if settings.mode == "full" else "inside"
-            inside, splits, counts = splitting(index, eye)
-            clouds.append(CloudPlan(index, kind, distance, full_weight=1.0 if kind == "full" else individual,
-                                    split_objects=tuple(int(i) for i in inside), splits=splits,
-                                    layer_counts=counts))
-        else:
-            # a cloud fading into or out of the ring is drawn as an impostor: one layer scales exactly
-            full = 1.0 if settings.mode == "auto" and individual == 1.0 else 0.0
-            if full:
-                full = 1.0 - smoothstep(settings.fade_start_radii * radius, settings.fade_end_radii * radius,
-                                        distance)
-            inside, splits, counts = splitting(index, eye)
-            if full == 1.0:
-                clouds.append(CloudPlan(index, "full", distance, full_weight=1.0, split_objects=tuple(
-                    int(i) for i in inside), splits=splits, layer_counts=counts))
-                continue
-            pixels = screen_size_px(radius, distance, height, camera.fov_y_deg)
-            size = required_size(pixels, settings.impostor_min_size, settings.impostor_max_size)
-            record = records.get(index)
-            # the layers the impostor's textures would hold now: split where the objects are, seen from its eye
-            held_counts = splitting(index, record.eye)[2] if record is not None and inside.size else None
-            reason = regeneration_reason(record, centre, eye, size, keys[index], settings.tolerance_deg,
-                                         held_counts)
-            if reason is not None:
-                record = ImpostorRecord(tuple(float(v) for v in eye), size, keys[index], splits, counts)
-                next_records[index] = record
-            kind = "crossfade" if full > 0.0 else "impostor"
-            clouds.append(CloudPlan(index, kind, distance, full_weight=full * individual,
-                                    impostor_weight=(1.0 - full) * individual, regenerate=reason,
-                                    texture_size=record.size, split_objects=tuple(int(i) for i in inside),
-                                    splits=splits, layer_counts=record.layer_counts if splits else (0,)))
+        if radius <= 0.0 or individual <= 0.0 or not visible[index]:
+            clouds.append(CloudPlan(index, "empty" if radius <= 0.0 else "ring" if individual <= 0.0 else "culled",
+                                    distance))
+            continue
+        inside, splits = split_at(index, eye)
+        # a cloud fading into or out of the ring is drawn as an impostor: one layer scales exactly
+        full = 1.0 if settings.mode == "full" or (settings.mode == "auto" and individual == 1.0) else 0.0
+        if settings.mode != "full" and distance < INSIDE_RADII * radius:
+            clouds.append(CloudPlan(index, "inside", distance, full_weight=individual, split_objects=inside,
+                                    splits=splits, layer_counts=counts(index, eye, splits)))
+            continue
+        if full and settings.mode == "auto":
+            full = 1.0 - smoothstep(settings.fade_start_radii * radius, settings.fade_end_radii * radius, distance)
+        if full == 1.0:
+            clouds.append(CloudPlan(index, "full", distance, full_weight=1.0, split_objects=inside, splits=splits,
+                                    layer_counts=counts(index, eye, splits)))
+            continue
+        pixels = screen_size_px(radius, distance, height, camera.fov_y_deg)
+        size = required_size(pixels, settings.impostor_min_size, settings.impostor_max_size)
+        record = records.get(index)
+        # the layers the impostor's textures would hold now: split where the objects are, seen from its eye
+        held_counts = counts(index, record.eye, split_at(index, record.eye)[1]) if (
+            record is not None and splits) else None
+        reason = regeneration_reason(record, centre, eye, size, keys[index], settings.tolerance_deg, held_counts)
+        if reason is not None:
+            record = ImpostorRecord(tuple(float(v) for v in eye), size, keys[index], splits,
+                                    counts(index, eye, splits))
+            next_records[index] = record
+        kind = "crossfade" if full > 0.0 else "impostor"
+        clouds.append(CloudPlan(index, kind, distance, full_weight=full * individual,
+                                impostor_weight=(1.0 - full) * individual, regenerate=reason,
+                                texture_size=record.size, split_objects=inside, splits=splits,
+                                layer_counts=record.layer_counts if splits else (0,)))
     drawn = [c.index for c in clouds if c.kind in ("full", "crossfade", "impostor", "inside")]
     draw_order = tuple(sorted(drawn, key=lambda i: -distances[i]))
     inside_size = tuple(max(1, math.ceil(side * settings.inside_resolution_scale)) for side in viewport)

@@ -30,7 +30,6 @@ _HEADING_INTERVAL_S = 0.05
 class ObjectPose:
     """Where one object is: its 4x4 model matrix and its bounding sphere in world space."""
 
-    name: str
     model: np.ndarray  # model-to-world, scale included
     centre: np.ndarray  # (3,) bounding sphere centre, world
     radius: float
@@ -67,20 +66,26 @@ def _aircraft() -> trimesh.Trimesh:
     return trimesh.util.concatenate([fuselage, wings, tailplane, fin])
 
 
-def object_pose(obj: SceneObject, time_s: float, mesh: trimesh.Trimesh | None = None) -> ObjectPose:
-    """The object at `time_s` seconds on the scene clock (the clock its path keys are in)."""
-    mesh = object_mesh(obj) if mesh is None else mesh
+def mesh_sphere(mesh: trimesh.Trimesh) -> tuple[np.ndarray, float]:
+    """(centre, radius) of a sphere around the mesh in its own frame, about its box centre."""
+    if not len(mesh.vertices):
+        return np.zeros(3), 0.0
+    low, high = mesh.bounds
+    centre = 0.5 * (low + high)
+    return centre, float(np.max(np.linalg.norm(mesh.vertices - centre, axis=1)))
+
+
+def object_pose(obj: SceneObject, time_s: float, sphere: tuple[np.ndarray, float] | None = None) -> ObjectPose:
+    """The object at `time_s` seconds on the scene clock (the clock its path keys are in).
+
+    `sphere` is `mesh_sphere` of its mesh, when the caller keeps it between frames.
+    """
+    local_centre, local_radius = mesh_sphere(object_mesh(obj)) if sphere is None else sphere
     position, heading = _placement(obj, time_s)
     model = np.eye(4)
     model[:3, :3] = _heading_rotation(heading) * obj.scale
     model[:3, 3] = position
-    # the mesh's bounding sphere about its box centre, carried into the world
-    low, high = mesh.bounds
-    local_centre = 0.5 * (low + high)
-    radius = float(np.max(np.linalg.norm(mesh.vertices - local_centre, axis=1))) * obj.scale if len(
-        mesh.vertices) else 0.0
-    centre = model[:3, :3] @ local_centre + position
-    return ObjectPose(obj.name, model, centre, radius)
+    return ObjectPose(model, model[:3, :3] @ local_centre + position, local_radius * obj.scale)
 
 
 def _placement(obj: SceneObject, time_s: float) -> tuple[np.ndarray, np.ndarray | None]:
@@ -111,7 +116,7 @@ def _heading_rotation(heading: np.ndarray | None) -> np.ndarray:
     return np.column_stack([heading, up, side])
 
 
-def object_poses(objects, time_s: float, meshes=None) -> tuple[ObjectPose, ...]:
-    """Every object's pose at `time_s`; `meshes` (one per object) saves rebuilding them."""
-    meshes = [None] * len(objects) if meshes is None else meshes
-    return tuple(object_pose(obj, time_s, mesh) for obj, mesh in zip(objects, meshes))
+def object_poses(objects, time_s: float, spheres=None) -> tuple[ObjectPose, ...]:
+    """Every object's pose at `time_s`; `spheres` (`mesh_sphere`, one per object) saves remaking them."""
+    spheres = [None] * len(objects) if spheres is None else spheres
+    return tuple(object_pose(obj, time_s, sphere) for obj, sphere in zip(objects, spheres))

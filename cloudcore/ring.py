@@ -100,21 +100,21 @@ def ring_members(centres: np.ndarray, radii: np.ndarray, eye, settings: RenderSe
 
 
 def new_generation(centres, radii, eye, settings: RenderSettings, lighting_keys: tuple) -> RingGeneration:
-    members = frozenset(np.flatnonzero(ring_members(centres, radii, eye, settings)).tolist())
+    in_ring = ring_members(centres, radii, eye, settings)
+    members = frozenset(np.flatnonzero(in_ring).tolist())
     generation = RingGeneration(tuple(float(v) for v in eye), float(settings.ring_radius),
                                 _members_key(members, lighting_keys), members, ())
     per_segment = []
     for segment in range(SEGMENTS):
         view, projection = segment_camera(generation, segment, settings.ring_elevation_deg)
-        seen = spheres_in_frustum(frustum_planes(projection @ view), centres, radii)
-        seen &= np.isin(np.arange(len(radii)), list(members))
+        seen = spheres_in_frustum(frustum_planes(projection @ view), centres, radii) & in_ring
         per_segment.append(tuple(np.flatnonzero(seen).tolist()))
     return replace(generation, segment_members=tuple(per_segment))
 
 
 def _members_key(members: frozenset, lighting_keys: tuple) -> tuple:
     """What the members' colours were computed from: a change to a cloud outside the ring leaves it be."""
-    return tuple(lighting_keys[i] if i < len(lighting_keys) else None for i in sorted(members))
+    return tuple(lighting_keys[i] for i in sorted(members))
 
 
 def _needs_rebuild(generation: RingGeneration, eye, settings: RenderSettings, lighting_keys: tuple) -> bool:

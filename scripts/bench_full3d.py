@@ -21,7 +21,7 @@ import numpy as np
 
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 
-from cloudcore.benchmark import path_cameras  # noqa: E402  (the GL imports need the platform above)
+from cloudcore.benchmark import path_views  # noqa: E402  (the GL imports need the platform above)
 from cloudcore.gl import FrameRenderer  # noqa: E402
 from cloudcore.scenefile import load_scene  # noqa: E402
 from cloudcore.settings import FULL_3D  # noqa: E402
@@ -60,7 +60,7 @@ def main() -> None:
     args = parser.parse_args()
 
     scene = load_scene(args.scene)
-    views = [scene.camera] + ([camera for _, camera in path_cameras(scene, args.path, args.frames)] if args.path else [])
+    views = [scene.camera] + ([camera for _, camera in path_views(scene, args.path, args.frames)] if args.path else [])
     sizes = [tuple(int(v) for v in size.split("x")) for size in args.sizes.split(",")]
     result = {"scene": str(args.scene), "path": args.path, "machine": platform.processor() or platform.machine(),
               "runs": [bench_size(scene, w, h, views) for w, h in sizes]}

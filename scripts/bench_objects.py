@@ -25,7 +25,7 @@ import numpy as np
 
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 
-from cloudcore.benchmark import path_cameras  # noqa: E402  (the GL imports need the platform above)
+from cloudcore.benchmark import path_views  # noqa: E402  (the GL imports need the platform above)
 from cloudcore.camera import screen_box  # noqa: E402
 from cloudcore.gl import FrameRenderer  # noqa: E402
 from cloudcore.imagecompare import compare  # noqa: E402
@@ -61,7 +61,7 @@ def split_against_naive(size) -> tuple[list[dict], list]:
 
 def flythrough_cost(frames: int, size) -> dict:
     scene = load_scene(SCENES / "valley.toml")
-    views = path_cameras(scene, "flythrough", frames)
+    views = path_views(scene, "flythrough", frames)
     variants = {"with aircraft": scene, "without objects": dataclasses.replace(scene, objects=())}
     stats = {}
     for label, variant in variants.items():

@@ -22,10 +22,10 @@ PARTICLES = PARTICLES[np.linalg.norm(PARTICLES, axis=1) < 90.0]
 CENTRE, RADIUS = np.zeros((1, 3)), np.array([100.0])
 
 
-def pose(position, radius=5.0, name="object") -> ObjectPose:
+def pose(position, radius=5.0) -> ObjectPose:
     model = np.eye(4)
     model[:3, 3] = position
-    return ObjectPose(name, model, np.asarray(position, dtype=np.float64), radius)
+    return ObjectPose(model, np.asarray(position, dtype=np.float64), radius)
 
 
 def plan(camera, objects, settings=RenderSettings(mode="full"), records=None, particles=lambda _: PARTICLES):
@@ -62,7 +62,7 @@ def layer_order_errors(frame_plan, object_centres, eye, cloud_particles) -> list
 def test_two_objects_in_one_cloud_give_three_layers_in_order_from_any_side(azimuth_deg, mode):
     a = math.radians(azimuth_deg)
     eye = np.array([600.0 * math.sin(a), 150.0, 600.0 * math.cos(a)])
-    objects = (pose((-35.0, 0.0, 10.0), name="west"), pose((35.0, 0.0, -10.0), name="east"))
+    objects = (pose((-35.0, 0.0, 10.0)), pose((35.0, 0.0, -10.0)))
     frame = plan(Camera(tuple(eye), (0.0, 0.0, 0.0), 50.0), objects, RenderSettings(mode=mode))
     (cloud,) = frame.clouds
     assert cloud.kind == mode and cloud.layers == 3

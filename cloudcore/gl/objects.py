@@ -21,7 +21,7 @@ from cloudcore.camera import FAR_PLANE_M, NEAR_PLANE_M, camera_pose
 from cloudcore.gl.programs import build_program
 from cloudcore.gl.pyrender_compat import pyrender
 from cloudcore.lighting import active_lights
-from cloudcore.objects import object_mesh, object_poses
+from cloudcore.objects import mesh_sphere, object_mesh, object_poses
 from cloudcore.scene import Camera
 
 _UP = np.array([0.0, 1.0, 0.0])
@@ -33,14 +33,15 @@ class ObjectPass:
     def __init__(self, objects, lights, ambient, size: tuple[int, int]):
         """`size`: the frame's, which the objects' colour and depth targets match."""
         self.objects = tuple(objects)
-        self.meshes = [object_mesh(obj) for obj in self.objects]
+        meshes = [object_mesh(obj) for obj in self.objects]
+        self._spheres = [mesh_sphere(mesh) for mesh in meshes]
         self._scene = pyrender.Scene(bg_color=(0.0, 0.0, 0.0, 0.0), ambient_light=np.asarray(ambient))
         for light in active_lights(lights):
             # pyrender's diffuse term is albedo / pi: pi * intensity gives the terrain's Lambert shading
             node = pyrender.DirectionalLight(color=np.asarray(light.color), intensity=math.pi * light.intensity)
             self._scene.add(node, pose=_light_pose(np.asarray(light.direction, dtype=np.float64)))
         self._nodes = []
-        for obj, mesh in zip(self.objects, self.meshes):
+        for obj, mesh in zip(self.objects, meshes):
             material = pyrender.MetallicRoughnessMaterial(baseColorFactor=(*obj.color, 1.0), metallicFactor=0.0,
                                                           roughnessFactor=1.0)
             self._nodes.append(self._scene.add(pyrender.Mesh.from_trimesh(mesh, material=material, smooth=False)))
@@ -51,7 +52,7 @@ class ObjectPass:
         self._colour, self._depth, self._framebuffer = _colour_and_depth_target(*size)
 
     def poses(self, time_s: float):
-        return object_poses(self.objects, time_s, self.meshes)
+        return object_poses(self.objects, time_s, self._spheres)
 
     def draw(self, context, camera: Camera, poses, which, *, write_depth: bool) -> None:
         """Composite the objects `which` (indices) at `poses` into the bound frame target."""
