@@ -8,8 +8,10 @@ Wang (2004, section 3.1) lets artists build a cloud from boxes that a tool
 fills with randomly placed sprites, then drops every sprite closer than a cull
 distance to one already kept (`box_fill`, `cull_close`); a cull distance of a
 third of the sprite size suits typical clouds, a fifth to a sixth dense ones.
-`PRESETS` are cloud types built that way, with the per-type colour and
-transparency of his section 5.1 (`preset_cloud`).
+`PRESETS` are cloud types built that way (`preset_cloud`), each with the
+per-type colour and transparency of his section 5.1 twice over: as Harris
+shading overrides and as an artist shading model (`cloudcore.artist_shading`),
+and with the atlas sprites it draws (`cloudcore.sprites`, section 3.2).
 
 Same seed, same cloud (the shipped scenes also store the particles, so
 goldens never depend on numpy's generator streams).
@@ -17,13 +19,16 @@ goldens never depend on numpy's generator streams).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.spatial import cKDTree
 
+from cloudcore.artist_shading import ArtistShading
 from cloudcore.scene import Cloud, Vec3
+from cloudcore.sprites import FOGGY, PUFFY, WISPY, SpriteStyle
 
 #: Wang's cull distance for typical clouds, as a fraction of the sprite size (its diameter)
 TYPICAL_CULL_FRACTION = 1.0 / 3.0
@@ -130,7 +135,7 @@ def _check_positive(name: str, value: float) -> None:
 
 @dataclass(frozen=True)
 class CloudPreset:
-    """A cloud type as an artist builds it: boxes filled with sprites, plus its shading (Wang 2004).
+    """A cloud type as an artist builds it: boxes filled with sprites, its sprites and its shading (Wang 2004).
 
     Lengths are metres at scale 1.  Each box is (low corner, high corner) in
     fractions of `size`: x and z from -0.5 to 0.5 about the cloud's centre, y
@@ -146,44 +151,88 @@ class CloudPreset:
     optical_depth: float
     albedo: float
     color: Vec3
+    sprite: SpriteStyle  # its seed is replaced by preset_cloud's
+    artist: ArtistShading
 
 
 _WHOLE = ((-0.5, 0.0, -0.5), (0.5, 1.0, 0.5))
 
-#: cloud types by name.  Wang's artists tint stratus light grey and make it more transparent,
-#: leave cumulus humilis nearly white and give cumulonimbus a dark look (section 5.1).
+
+def _levels(bottom: Vec3, top: Vec3, alpha: tuple[float, ...] = (1.0,) * 5) -> tuple:
+    """Five colour levels at heights 0, 0.2, 0.45, 0.75, 1 from `bottom` to `top`, lightening fastest
+    low down, where Wang's artists darken the bases; one alpha per level."""
+    heights = (0.0, 0.2, 0.45, 0.75, 1.0)
+    weights = (0.0, 0.4, 0.7, 0.9, 1.0)
+    # rounded so that scene files show the numbers an artist would type
+    return tuple((h, *(round(b + w * (t - b), 3) for b, t in zip(bottom, top)), a)
+                 for h, w, a in zip(heights, weights, alpha))
+
+
+#: camera-facing puffs and wisps, any rotation, flat-bottom sprites along the base
+_CUMULUS_SPRITES = SpriteStyle(rows=(PUFFY, PUFFY, WISPY), flat_bottom_fraction=0.12)
+
+#: cloud types by name.  Colour levels after Wang section 5.1: stratus light grey and more transparent,
+#: cumulus humilis nearly uniformly white, cumulonimbus dark from top to bottom; the others between,
+#: darker at the base.  Directional ranges: more contrast for towering clouds, little for layers.
+#: Sprites after section 3.2: foggy textures for stratus, puffy ones with flat bottoms for cumulus,
+#: wisps everywhere; cirrus as flat textured quads (section 7.1).
 PRESETS: dict[str, CloudPreset] = {
     "cumulus_humilis": CloudPreset(
         size=(900.0, 450.0, 800.0),
         boxes=(((-0.5, 0.0, -0.5), (0.5, 0.45, 0.5)), ((-0.3, 0.3, -0.3), (0.3, 1.0, 0.3))),
         particle_radius=75.0, count=160, cull_fraction=TYPICAL_CULL_FRACTION,
-        optical_depth=6.0, albedo=0.9, color=(1.0, 1.0, 1.0)),
+        optical_depth=6.0, albedo=0.9, color=(1.0, 1.0, 1.0),
+        sprite=_CUMULUS_SPRITES,
+        artist=ArtistShading(levels=_levels((0.62, 0.64, 0.68), (0.82, 0.82, 0.84)))),
     "cumulus_congestus": CloudPreset(
         size=(1800.0, 3000.0, 1600.0),
         boxes=(((-0.5, 0.0, -0.5), (0.5, 0.3, 0.5)), ((-0.35, 0.2, -0.35), (0.35, 0.8, 0.35)),
                ((-0.2, 0.7, -0.2), (0.25, 1.0, 0.2))),
         particle_radius=170.0, count=700, cull_fraction=TYPICAL_CULL_FRACTION,
-        optical_depth=10.0, albedo=0.9, color=(0.96, 0.96, 0.98)),
+        optical_depth=10.0, albedo=0.9, color=(0.96, 0.96, 0.98),
+        sprite=dataclasses.replace(_CUMULUS_SPRITES, flat_bottom_fraction=0.06),
+        artist=ArtistShading(levels=_levels((0.36, 0.38, 0.43), (0.80, 0.80, 0.82)),
+                             directional_range=(0.1, 0.6, 1.0))),
     "stratus": CloudPreset(
         size=(9000.0, 300.0, 7000.0), boxes=(_WHOLE,),
         particle_radius=220.0, count=1000, cull_fraction=TYPICAL_CULL_FRACTION,
-        optical_depth=3.0, albedo=0.85, color=(0.80, 0.82, 0.86)),
+        optical_depth=3.0, albedo=0.85, color=(0.80, 0.82, 0.86),
+        sprite=SpriteStyle(rows=(FOGGY, FOGGY, FOGGY, WISPY)),
+        artist=ArtistShading(levels=_levels((0.50, 0.52, 0.56), (0.62, 0.63, 0.66), (0.5, 0.55, 0.55, 0.5, 0.4)),
+                             directional_range=(0.4, 0.75, 1.0))),
     "stratocumulus": CloudPreset(
         size=(4500.0, 600.0, 4000.0),
         boxes=(((-0.5, 0.0, -0.5), (0.5, 0.55, 0.5)), ((-0.4, 0.3, -0.35), (-0.05, 1.0, 0.05)),
                ((0.05, 0.3, -0.1), (0.4, 0.9, 0.4)), ((-0.3, 0.3, 0.15), (0.1, 0.85, 0.45))),
         particle_radius=200.0, count=800, cull_fraction=TYPICAL_CULL_FRACTION,
-        optical_depth=5.0, albedo=0.88, color=(0.86, 0.87, 0.90)),
+        optical_depth=5.0, albedo=0.88, color=(0.86, 0.87, 0.90),
+        sprite=SpriteStyle(rows=(FOGGY, PUFFY, PUFFY, WISPY), flat_bottom_fraction=0.1),
+        artist=ArtistShading(levels=_levels((0.40, 0.42, 0.46), (0.66, 0.67, 0.70), (0.9, 0.95, 1.0, 1.0, 0.95)),
+                             directional_range=(0.2, 0.65, 1.0))),
     "cumulonimbus": CloudPreset(
         size=(6000.0, 11000.0, 6000.0),
         boxes=(((-0.45, 0.0, -0.45), (0.45, 0.25, 0.45)), ((-0.3, 0.15, -0.3), (0.3, 0.85, 0.3)),
                ((-0.5, 0.82, -0.5), (0.5, 1.0, 0.5))),
         particle_radius=600.0, count=1400, cull_fraction=DENSE_CULL_FRACTION,
-        optical_depth=16.0, albedo=0.95, color=(0.62, 0.64, 0.68)),
+        optical_depth=16.0, albedo=0.95, color=(0.62, 0.64, 0.68),
+        sprite=SpriteStyle(rows=(PUFFY, PUFFY, FOGGY, WISPY), flat_bottom_fraction=0.05),
+        artist=ArtistShading(levels=_levels((0.12, 0.13, 0.16), (0.42, 0.43, 0.46)),
+                             directional_range=(0.05, 0.5, 1.0))),
     "altocumulus": CloudPreset(
         size=(3000.0, 250.0, 3000.0), boxes=(_WHOLE,),
         particle_radius=70.0, count=600, cull_fraction=TYPICAL_CULL_FRACTION,
-        optical_depth=4.0, albedo=0.9, color=(0.95, 0.95, 0.97)),
+        optical_depth=4.0, albedo=0.9, color=(0.95, 0.95, 0.97),
+        sprite=SpriteStyle(rows=(PUFFY, PUFFY, WISPY)),
+        artist=ArtistShading(levels=_levels((0.58, 0.60, 0.64), (0.76, 0.77, 0.79), (0.8, 0.85, 0.9, 0.9, 0.85)),
+                             directional_range=(0.25, 0.7, 1.0))),
+    # few large wisps lying flat, all within 20 degrees of one heading, as high winds comb cirrus
+    "cirrus": CloudPreset(
+        size=(7000.0, 300.0, 5000.0), boxes=(_WHOLE,),
+        particle_radius=500.0, count=120, cull_fraction=TYPICAL_CULL_FRACTION,
+        optical_depth=1.5, albedo=0.9, color=(0.97, 0.97, 1.0),
+        sprite=SpriteStyle(rows=(WISPY,), rotation_deg=(-20.0, 20.0), facing="horizontal"),
+        artist=ArtistShading(levels=_levels((0.74, 0.76, 0.80), (0.80, 0.82, 0.86), (0.45, 0.5, 0.5, 0.5, 0.45)),
+                             directional_range=(0.5, 0.8, 1.0))),
 }
 
 
@@ -191,7 +240,9 @@ def preset_cloud(preset: str, name: str, base_centre, scale: float = 1.0, seed: 
     """A `Cloud` of type `preset` (a key of PRESETS) whose base is centred on `base_centre`.
 
     `scale` multiplies every length of the preset (boxes and sprites), so the
-    same seed gives the same cloud shape at any scale.
+    same seed gives the same cloud shape at any scale.  The cloud carries the
+    preset's sprite style (with `seed`, an integer in [0, 2^31 - 1]) and artist
+    shading model; its shading groups take the default size.
     """
     if preset not in PRESETS:
         raise ValueError(f"unknown cloud preset {preset!r}; presets: {', '.join(PRESETS)}")
@@ -212,4 +263,5 @@ def preset_cloud(preset: str, name: str, base_centre, scale: float = 1.0, seed: 
     centres = np.concatenate([rng.uniform(low, high, (n, 3)) for (low, high), n in zip(corners, per_box)])
     kept = centres[cull_close(centres, p.cull_fraction * 2.0 * radius)]
     return Cloud(name, np.column_stack([kept, np.full(len(kept), radius)]),
-                 optical_depth=p.optical_depth, albedo=p.albedo, color=p.color)
+                 optical_depth=p.optical_depth, albedo=p.albedo, color=p.color,
+                 sprite=dataclasses.replace(p.sprite, seed=seed), artist=p.artist)

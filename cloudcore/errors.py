@@ -14,3 +14,16 @@ class SceneError(ValueError):
         self.field = field
         self.problem = problem
         super().__init__(f"{self.source}: {field}: {problem}")
+
+
+class FieldError(ValueError):
+    """A value that breaks a record's own rule, naming the field (`levels`, `rotation_deg`...).
+
+    Records check their rules once, in `__post_init__`; the scene loader turns
+    this into a SceneError under the field's full path.
+    """
+
+    def __init__(self, field: str, problem: str):
+        self.field = field
+        self.problem = problem
+        super().__init__(f"{field}: {problem}")

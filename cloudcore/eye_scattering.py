@@ -14,6 +14,12 @@ straight on: cos_theta = +1, the forward lobe that makes silver linings.
 The colour is the light the particle adds, so it is already premultiplied;
 the splat shader scales colour and opacity by the kernel and the blend is
 dst = src + (1 - src_alpha) dst.
+
+`seen_from` is the reference: the splat compute shader (`cloudcore/gl/shaders/
+splat_shade.comp.glsl`) evaluates the same sum per particle from the arrays
+kept here, so the CPU only sorts, and tests hold the two together.  Clouds
+shaded by Wang's artist model instead (`styles`) have their reference in
+`cloudcore.artist_shading.artist_colours`.
 """
 
 from __future__ import annotations
@@ -23,9 +29,10 @@ import numpy as np
 from cloudcore.formation import core_distances, opacity_factor
 from cloudcore.illumination import IlluminationCache, cloud_optics, illuminate_clouds
 from cloudcore.lighting import active_lights
+from cloudcore.particle_styles import ParticleStyles, particle_styles
 from cloudcore.phase import phase_function
 from cloudcore.ramps import smoothstep
-from cloudcore.scene import Shading
+from cloudcore.scene import Lighting, Shading
 from cloudcore.shading import scattering_coefficient
 
 #: a particle fades out between these distances from the eye, in radii, so the
@@ -38,15 +45,18 @@ class ParticleShading:
     """All particles of a scene's clouds, concatenated, with their illumination precomputed."""
 
     def __init__(self, clouds, shading: Shading, lights, ambient, method: str = "exact",
-                 cache: IlluminationCache | None = None):
-        """`cache` keeps the illumination of unchanged clouds between instances (the editor)."""
+                 cache: IlluminationCache | None = None, styles: ParticleStyles | None = None):
+        """`cache` keeps the illumination of unchanged clouds between instances (the editor);
+        `styles` (`cloudcore.particle_styles`, by default at the default hour) say which clouds
+        are sprites or artist-shaded."""
         clouds = tuple(clouds)
-        self._phase, self._g = shading.phase, shading.g
+        self.styles = styles if styles is not None else particle_styles(clouds, Lighting())
+        self.phase, self.g = shading.phase, shading.g
         lights = active_lights(lights)
-        self._light_directions = np.array([l.direction for l in lights], dtype=np.float64).reshape(-1, 3)
-        self._light_radiance = np.array([np.asarray(l.color) * l.intensity for l in lights],
-                                        dtype=np.float64).reshape(-1, 3)
-        self._ambient = np.asarray(ambient, dtype=np.float64)
+        self.light_directions = np.array([l.direction for l in lights], dtype=np.float64).reshape(-1, 3)
+        self.light_radiance = np.array([np.asarray(l.color) * l.intensity for l in lights],
+                                       dtype=np.float64).reshape(-1, 3)
+        self.ambient = np.asarray(ambient, dtype=np.float64)
 
         counts = np.array([len(c.particles) for c in clouds], dtype=np.int64)
         self.cloud_starts = np.concatenate([[0], np.cumsum(counts)])
@@ -55,12 +65,15 @@ class ParticleShading:
         optics = [cloud_optics(c, shading) for c in clouds]
         tau = _concatenated([o[0] for o in optics], (0,))
         albedo = _concatenated([o[1] for o in optics], (0,))
-        self._alpha = -np.expm1(-tau)
-        self._scattering = scattering_coefficient(tau, albedo, shading.phase, shading.g)
-        self._tint = np.repeat(np.array([c.color for c in clouds], dtype=np.float64).reshape(-1, 3), counts, axis=0)
+        self.alpha = -np.expm1(-tau)
+        artist = np.array([c.artist is not None for c in clouds], dtype=bool)
+        self._opaque = (self.alpha > 0.0) | np.repeat(artist, counts)
+        self.scattering = scattering_coefficient(tau, albedo, shading.phase, shading.g)
+        self.tint = np.repeat(np.array([c.color for c in clouds], dtype=np.float64).reshape(-1, 3), counts, axis=0)
         incident = (cache.incident(clouds, shading, lights, method) if cache is not None
                     else illuminate_clouds(clouds, shading, lights, method))
-        self._incident = _concatenated(incident, (0, len(lights)))
+        #: (n, lights): light that reached each particle, per light (Harris's light pass)
+        self.incident = _concatenated(incident, (0, len(lights)))
 
         spheres = [c.bounding_sphere() for c in clouds]
         self.bounding_centres = np.array([s[0] for s in spheres], dtype=np.float64).reshape(-1, 3)
@@ -69,6 +82,7 @@ class ParticleShading:
         self._forming = [(start, stop, c.formation, core_distances(c.centres))
                          for c, start, stop in zip(clouds, self.cloud_starts[:-1], self.cloud_starts[1:])
                          if c.formation is not None]
+        self._formation_memo: tuple[float, np.ndarray] | None = None
 
     def seen_from(self, eye, indices: np.ndarray, *, time_s: float | None = None) -> tuple[np.ndarray, np.ndarray]:
         """(linear RGB (n, 3), opacity (n,)) of particles `indices` seen from `eye`, near fade applied.
@@ -81,23 +95,40 @@ class ParticleShading:
         # a particle centred on the eye is faded to nothing below, so its direction does not matter
         view = offset / np.maximum(distance, np.finfo(np.float64).tiny)[:, None]
         scattered = np.zeros((len(indices), 3))
-        for light, (direction, radiance) in enumerate(zip(self._light_directions, self._light_radiance)):
-            phase = phase_function(view @ direction, self._phase, self._g)
-            scattered += (self._incident[indices, light] * phase)[:, None] * radiance
-        alpha = self._alpha[indices]
-        colour = (scattered * self._scattering[indices, None] + self._ambient * alpha[:, None]) * self._tint[indices]
+        for light, (direction, radiance) in enumerate(zip(self.light_directions, self.light_radiance)):
+            phase = phase_function(view @ direction, self.phase, self.g)
+            scattered += (self.incident[indices, light] * phase)[:, None] * radiance
+        alpha = self.alpha[indices]
+        colour = (scattered * self.scattering[indices, None] + self.ambient * alpha[:, None]) * self.tint[indices]
         radii = self.radii[indices]
         fade = smoothstep(FADE_START_RADII * radii, FADE_END_RADII * radii, distance)
-        if time_s is not None and self._forming:
-            fade = fade * self._formation_factors(time_s)[indices]
+        factors = self.formation_factors(time_s)
+        if factors is not None:
+            fade = fade * factors[indices]
         return colour * fade[:, None], alpha * fade
 
-    def _formation_factors(self, time_s: float) -> np.ndarray:
-        """Every particle's formation opacity factor at `time_s`: 1 in clouds without a formation."""
-        factors = np.ones(len(self.radii))
-        for start, stop, formation, distances in self._forming:
-            factors[start:stop] = opacity_factor(formation, distances, time_s)
-        return factors
+    def drawn(self, indices: np.ndarray, distances: np.ndarray, time_s: float | None = None) -> np.ndarray:
+        """Which of `indices`, at `distances` from the eye, have any opacity: the rest need no draw.
+
+        Splats vanish next to the eye (the near fade); sprites lock there instead and stay.
+        Harris's opacity is the particle's own, the artist model's its colour level's.
+        """
+        near_faded = self.styles.near_faded[indices]
+        kept = ((distances > FADE_START_RADII * self.radii[indices]) | ~near_faded) & self._opaque[indices]
+        factors = self.formation_factors(time_s)
+        return kept if factors is None else kept & (factors[indices] > 0.0)
+
+    def formation_factors(self, time_s: float | None) -> np.ndarray | None:
+        """Every particle's formation opacity factor at `time_s` (1 in clouds without a formation), or
+        None when nothing forms or dissipates (or no time is given): then every factor is 1."""
+        if time_s is None or not self._forming:
+            return None
+        if self._formation_memo is None or self._formation_memo[0] != time_s:
+            factors = np.ones(len(self.radii))
+            for start, stop, formation, distances in self._forming:
+                factors[start:stop] = opacity_factor(formation, distances, time_s)
+            self._formation_memo = (time_s, factors)
+        return self._formation_memo[1]
 
 
 def _concatenated(parts, empty_shape) -> np.ndarray:

@@ -95,13 +95,18 @@ def daylight(hours: float) -> tuple[tuple[Light, ...], np.ndarray]:
     return lights, ambient
 
 
+def scene_hour(lighting: Lighting) -> float:
+    """The hour a scene's sky (and artist-shaded clouds) follow: its time of day, or the default one
+    where explicit lights replace the sun."""
+    return Lighting().time_of_day if lighting.time_of_day is None else lighting.time_of_day
+
+
 def scene_lights(lighting: Lighting) -> tuple[tuple[Light, ...], np.ndarray]:
     """The lights and ambient a scene's lighting section stands for."""
     if lighting.lights:
         ambient = NIGHT_AMBIENT if lighting.ambient is None else np.asarray(lighting.ambient, float)
         return lighting.lights, ambient
-    hours = Lighting().time_of_day if lighting.time_of_day is None else lighting.time_of_day
-    lights, ambient = daylight(hours)
+    lights, ambient = daylight(scene_hour(lighting))
     return lights, (ambient if lighting.ambient is None else np.asarray(lighting.ambient, float))
 
 

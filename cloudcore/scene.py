@@ -12,7 +12,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from cloudcore.artist_shading import ArtistShading
 from cloudcore.formation import Formation
+from cloudcore.sprites import SpriteStyle
 
 Vec3 = tuple[float, float, float]
 
@@ -77,7 +79,13 @@ class Shading:
 
 @dataclass(frozen=True, eq=False)
 class Cloud(_Record):
-    """Particles as rows (x, y, z, radius); optional per-cloud shading overrides and formation."""
+    """Particles as rows (x, y, z, radius); optional per-cloud shading overrides and formation.
+
+    `sprite` draws the particles as textured sprites from the atlas instead of
+    Gaussian splats (Wang 2004, section 3.2); `artist` shades them with Wang's
+    artist model instead of Harris's (section 5), in shading groups of
+    `shading_group_size` metres (None: `artist_shading.default_group_size`).
+    """
 
     name: str
     particles: np.ndarray = field(default_factory=lambda: _frozen_array((), 4))
@@ -86,9 +94,14 @@ class Cloud(_Record):
     albedo: float | None = None
     color: Vec3 = (1.0, 1.0, 1.0)
     formation: Formation | None = None
+    sprite: SpriteStyle | None = None
+    artist: ArtistShading | None = None
+    shading_group_size: float | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "particles", _frozen_array(self.particles, 4))
+        if self.shading_group_size is not None:
+            object.__setattr__(self, "shading_group_size", float(self.shading_group_size))
 
     @property
     def centres(self) -> np.ndarray:

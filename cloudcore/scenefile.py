@@ -9,6 +9,7 @@ valid ones listed, so a typo never passes silently.
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import math
 import os
 import tempfile
@@ -18,10 +19,12 @@ from pathlib import Path
 import numpy as np
 import tomlkit
 
-from cloudcore.errors import SceneError
+from cloudcore.artist_shading import ArtistShading
+from cloudcore.errors import FieldError, SceneError
 from cloudcore.formation import FORMATION_KINDS, Formation
 from cloudcore.phase import MAX_ABS_G, PHASE_NAMES
 from cloudcore.scene import Camera, CameraPath, Cloud, Light, Lighting, Scene, SceneObject, Shading, Terrain
+from cloudcore.sprites import FACINGS, MAX_SEED, SpriteStyle
 
 PRIMITIVES = ("box", "sphere", "aircraft")
 TERRAIN_KINDS = ("heightfield", "mesh")
@@ -107,12 +110,28 @@ class _Table:
             self.fail(key, "required array is missing")
         return _checked_matrix(value, columns, self.source, self.path(key), allow_empty)
 
+    def row(self, key, length: int, default=None) -> tuple[float, ...]:
+        """A flat array of `length` finite numbers."""
+        if key not in self.data:
+            if default is None:
+                self.fail(key, f"required array of {length} numbers is missing")
+            return default
+        return tuple(float(x) for x in _checked_matrix([self.data[key]], length, self.source, self.path(key), False)[0])
+
+    def integers(self, key, default) -> tuple[int, ...]:
+        """A flat array of integers (their range is the record's to check)."""
+        value = self.data.get(key, default)
+        if not isinstance(value, (list, tuple)) or not all(isinstance(x, int) and not isinstance(x, bool)
+                                                           for x in value):
+            self.fail(key, f"expected an array of integers, got {value!r}")
+        return tuple(value)
+
     def vector(self, key, default=None, *, low=-math.inf, high=math.inf, unit=False):
         if key not in self.data:
             if default is None:
                 self.fail(key, "required 3-vector is missing")
             return default
-        row = _checked_matrix([self.data[key]], 3, self.source, self.path(key), False)[0]
+        row = np.array(self.row(key, 3))
         if np.any(row < low) or np.any(row > high):
             self.fail(key, f"components must be within [{low}, {high}], got {row.tolist()}")
         if unit:
@@ -123,6 +142,17 @@ class _Table:
                 row = row / largest
             row = row / np.linalg.norm(row)
         return tuple(float(x) for x in row)
+
+    def table(self, key, parse):
+        """`parse` of the sub-table `key`, or None where there is none."""
+        return parse(_Table(self.source, self.path(key), self.data[key])) if key in self.data else None
+
+    def record(self, kind, **values):
+        """`kind(**values)`, with a rule the record itself refuses (a FieldError) reported at its field."""
+        try:
+            return kind(**values)
+        except FieldError as error:
+            self.fail(error.field, error.problem)
 
     def tables(self, key) -> list["_Table"]:
         value = self.data.get(key, [])
@@ -238,7 +268,8 @@ def _shading(t: _Table) -> Shading:
 
 
 def _cloud(t: _Table, base_dir: Path) -> Cloud:
-    t.reject_unknown(("name", "particles", "particles_file", "optical_depth", "albedo", "color", "formation"))
+    t.reject_unknown(("name", "particles", "particles_file", "optical_depth", "albedo", "color", "formation",
+                      "sprite", "artist", "shading_group_size"))
     name = t.string("name")
     if t.has("particles") == t.has("particles_file"):
         t.fail("particles", "give exactly one of particles (inline) or particles_file (.npy)")
@@ -258,8 +289,11 @@ def _cloud(t: _Table, base_dir: Path) -> Cloud:
         optical_depth=t.number("optical_depth", None, low=0.0) if t.has("optical_depth") else None,
         albedo=t.number("albedo", None, low=0.0, high=1.0) if t.has("albedo") else None,
         color=t.vector("color", (1.0, 1.0, 1.0), low=0.0),
-        formation=_formation(_Table(t.source, t.path("formation"), t.raw("formation")))
-        if t.has("formation") else None,
+        formation=t.table("formation", _formation),
+        sprite=t.table("sprite", _sprite),
+        artist=t.table("artist", _artist),
+        shading_group_size=t.number("shading_group_size", None, low=0.0, low_open=True)
+        if t.has("shading_group_size") else None,
     )
 
 
@@ -269,6 +303,36 @@ def _formation(t: _Table) -> Formation:
         kind=t.string("kind", choices=FORMATION_KINDS),
         start_s=t.number("start_s", 0.0),
         duration_s=t.number("duration_s", low=0.0),
+    )
+
+
+def _sprite(t: _Table) -> SpriteStyle:
+    t.reject_unknown(tuple(f.name for f in dataclasses.fields(SpriteStyle)))
+    d = SpriteStyle()
+    return t.record(
+        SpriteStyle,
+        rows=t.integers("rows", d.rows),
+        rotation_deg=t.row("rotation_deg", 2, d.rotation_deg),
+        facing=t.string("facing", d.facing, choices=FACINGS),
+        seed=t.integer("seed", d.seed, low=0, high=MAX_SEED),
+        flat_bottom_fraction=t.number("flat_bottom_fraction", d.flat_bottom_fraction),
+        flat_bottom_rotation_deg=t.row("flat_bottom_rotation_deg", 2, d.flat_bottom_rotation_deg),
+    )
+
+
+def _artist(t: _Table) -> ArtistShading:
+    t.reject_unknown(tuple(f.name for f in dataclasses.fields(ArtistShading)))
+    d = ArtistShading()
+
+    def keys(key: str, columns: int):
+        return t.matrix(key, columns) if t.has(key) else getattr(d, key)
+
+    return t.record(
+        ArtistShading,
+        levels=keys("levels", 5),
+        level_percent_by_hour=keys("level_percent_by_hour", 2),
+        directional_colour_by_hour=keys("directional_colour_by_hour", 4),
+        directional_range=t.row("directional_range", 3, d.directional_range),
     )
 
 
@@ -405,9 +469,24 @@ def _cloud_dict(cloud: Cloud) -> dict:
         if getattr(cloud, key) is not None:
             out[key] = getattr(cloud, key)
     out["color"] = list(cloud.color)
-    if cloud.formation is not None:
-        f = cloud.formation
-        out["formation"] = {"kind": f.kind, "start_s": f.start_s, "duration_s": f.duration_s}
+    if cloud.shading_group_size is not None:
+        out["shading_group_size"] = cloud.shading_group_size
+    for key in ("formation", "sprite", "artist"):
+        if getattr(cloud, key) is not None:
+            out[key] = _record_dict(getattr(cloud, key))
+    return out
+
+
+def _record_dict(record) -> dict:
+    """A frozen record's fields as a TOML table: tables of rows one row per line, tuples as arrays."""
+    out = {}
+    for f in dataclasses.fields(record):
+        value = getattr(record, f.name)
+        if isinstance(value, tuple) and value and isinstance(value[0], tuple):
+            value = _rows(np.array(value))
+        elif isinstance(value, tuple):
+            value = list(value)
+        out[f.name] = value
     return out
 
 
@@ -428,36 +507,84 @@ def _rows(matrix: np.ndarray):
 
 
 def particles_file_for(scene_path, cloud_name: str) -> str:
-    """Where `save_scene` puts a large cloud's particles, relative to the scene file."""
+    """Where `save_scene` puts a large cloud's particles, relative to the scene file (when that file is free)."""
     safe = "".join(ch if ch.isalnum() or ch in "-_" else "_" for ch in cloud_name)
-    return f"{Path(scene_path).stem}.particles/{safe}.npy"
+    return f"{particles_folder(scene_path)}/{safe}.npy"
+
+
+def particles_folder(scene_path) -> str:
+    """The folder beside a scene that belongs to it: its saves write and delete particle files there only."""
+    return f"{Path(scene_path).stem}.particles"
 
 
 def save_scene(scene: Scene, path) -> Scene:
-    """Write `scene` to `path` atomically; return the scene as saved.
+    """Write `scene` to `path` atomically, particle files included; return the scene as saved.
 
-    Clouds with more than INLINE_PARTICLE_LIMIT particles and no particles_file
-    get one beside the scene.  Particle files are written first, each by
-    write-then-rename, so the TOML never names a missing or partial file; the
-    TOML itself is replaced last, in one rename.
+    Clouds with more than INLINE_PARTICLE_LIMIT particles or with a particles_file
+    are stored as .npy (`_store_particles`).  No existing particle file is ever
+    overwritten with other particles, so until the TOML is replaced, in one rename
+    that commits the save, the previous TOML and every file it names are intact: a
+    crash at any moment leaves the old scene or the new one, never a mix.  After
+    the commit, particle files in the scene's own folder the new TOML does not
+    name are deleted.
     """
     path = Path(path)
-    saved_clouds = []
-    for cloud in scene.clouds:
-        relative = cloud.particles_file
-        if relative is None and len(cloud.particles) > INLINE_PARTICLE_LIMIT:
-            relative = particles_file_for(path, cloud.name)
-        if relative is not None:
-            target = path.parent / relative
-            target.parent.mkdir(parents=True, exist_ok=True)
-            _atomic_write(target, lambda f, p=cloud.particles: np.save(f, np.asarray(p, dtype=np.float64)))
-            cloud = dataclasses.replace(cloud, particles_file=relative)
-        saved_clouds.append(cloud)
-    saved = Scene(scene.camera, scene.lighting, scene.shading, tuple(saved_clouds), scene.terrain,
+    saved_clouds = tuple(
+        dataclasses.replace(cloud, particles_file=_store_particles(cloud, path))
+        if cloud.particles_file is not None or len(cloud.particles) > INLINE_PARTICLE_LIMIT else cloud
+        for cloud in scene.clouds)
+    saved = Scene(scene.camera, scene.lighting, scene.shading, saved_clouds, scene.terrain,
                   scene.objects, scene.camera_paths, scene.description)
     document = tomlkit.dumps(scene_to_dict(saved)).encode("utf-8")
     _atomic_write(path, lambda f: f.write(document))
+    _remove_unnamed_particle_files(path, {c.particles_file for c in saved_clouds if c.particles_file is not None})
     return saved
+
+
+def _store_particles(cloud: Cloud, path: Path) -> str:
+    """The particles_file, relative to the scene at `path`, that holds `cloud`'s particles, written if need be.
+
+    The cloud's own particles_file is kept when it holds exactly these particles,
+    unless it lies in another scene's folder (that scene's saves may change or
+    delete it: a scene saved under a new name, or a recovery copy, gets copies of
+    its own).  Otherwise the particles go into this scene's folder, under the
+    cloud's name or, where that file holds other particles the current TOML may
+    still name, under a name with their digest.
+    """
+    particles = np.ascontiguousarray(cloud.particles, dtype=np.float64)
+    own_folder, default = particles_folder(path), particles_file_for(path, cloud.name)
+    digest = hashlib.sha256(particles.tobytes()).hexdigest()[:16]
+    by_digest = f"{own_folder}/{Path(default).stem}-{digest}.npy"
+    candidates = [default, by_digest]
+    if cloud.particles_file is not None:
+        parts = Path(cloud.particles_file).parts
+        if not parts or parts[0] == own_folder or not parts[0].endswith(".particles"):
+            candidates.insert(0, cloud.particles_file)
+    for relative in candidates:
+        if _holds(path.parent / relative, particles):
+            return relative
+    relative = by_digest if (path.parent / default).exists() else default
+    _atomic_write(path.parent / relative, lambda f: np.save(f, particles))
+    return relative
+
+
+def _holds(file: Path, particles: np.ndarray) -> bool:
+    """Whether `file` is a .npy of exactly `particles` (float64, bit for bit)."""
+    try:
+        stored = np.load(file, mmap_mode="r", allow_pickle=False)
+    except Exception:  # missing, unreadable or corrupt (np.load raises many kinds): it does not hold them
+        return False
+    return stored.dtype == np.float64 and stored.shape == particles.shape and np.array_equal(stored, particles)
+
+
+def _remove_unnamed_particle_files(path: Path, named: set) -> None:
+    """After a save's commit: delete the .npy files in the scene's own folder its TOML no longer names, and
+    the temporary files that saves of this scene killed mid-write left (`_atomic_write` names them)."""
+    folder = path.parent / particles_folder(path)
+    named_files = {(path.parent / relative).resolve() for relative in named}
+    for file in [*folder.glob("*.npy"), *folder.glob(".*.tmp"), *path.parent.glob(f".{path.name}.*.tmp")]:
+        if file.resolve() not in named_files:
+            file.unlink(missing_ok=True)
 
 
 def _atomic_write(path: Path, write) -> None:

@@ -1,41 +1,17 @@
 """Procedural heightfield terrain: a valley with noisy ridges, deterministic from a seed.
 
-Noise comes from an integer hash, not a random generator, so the same
-parameters give the same heights on every numpy version and platform.
+Noise comes from an integer hash (`cloudcore.noise`), not a random generator,
+so the same parameters give the same heights on every numpy version and platform.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from cloudcore.noise import value_noise
 from cloudcore.scene import Terrain
 
 _OCTAVES = 6
-
-
-def _hash01(ix: np.ndarray, iz: np.ndarray, seed: int) -> np.ndarray:
-    """A value in [0, 1) per integer lattice point (splitmix-style integer mixing)."""
-    h = (ix.astype(np.uint64) * np.uint64(0x9E3779B97F4A7C15)
-         ^ iz.astype(np.uint64) * np.uint64(0xC2B2AE3D27D4EB4F)
-         ^ np.uint64(seed) * np.uint64(0x165667B19E3779F9))
-    h ^= h >> np.uint64(31)
-    h *= np.uint64(0xBF58476D1CE4E5B9)
-    h ^= h >> np.uint64(29)
-    return (h >> np.uint64(11)).astype(np.float64) / float(1 << 53)
-
-
-def _value_noise(x: np.ndarray, z: np.ndarray, seed: int) -> np.ndarray:
-    """Smoothly interpolated lattice noise in [-1, 1]."""
-    x0, z0 = np.floor(x), np.floor(z)
-    fx, fz = x - x0, z - z0
-    sx, sz = fx * fx * (3 - 2 * fx), fz * fz * (3 - 2 * fz)
-    ix, iz = x0.astype(np.int64), z0.astype(np.int64)
-    with np.errstate(over="ignore"):
-        c00, c10 = _hash01(ix, iz, seed), _hash01(ix + 1, iz, seed)
-        c01, c11 = _hash01(ix, iz + 1, seed), _hash01(ix + 1, iz + 1, seed)
-    top = c00 + (c10 - c00) * sx
-    bottom = c01 + (c11 - c01) * sx
-    return 2.0 * (top + (bottom - top) * sz) - 1.0
 
 
 def height_at(terrain: Terrain, x, z) -> np.ndarray:
@@ -48,7 +24,7 @@ def height_at(terrain: Terrain, x, z) -> np.ndarray:
     noise = np.zeros(np.broadcast(x, z).shape)
     amplitude, total = 1.0, 0.0
     for octave in range(_OCTAVES):
-        noise += amplitude * _value_noise(x / wavelength, z / wavelength, terrain.seed + 101 * octave)
+        noise += amplitude * value_noise(x / wavelength, z / wavelength, terrain.seed + 101 * octave)
         total += amplitude
         amplitude *= 0.5
         wavelength *= 0.5

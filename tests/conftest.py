@@ -4,7 +4,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from cloudcore.artist_shading import ArtistShading
 from cloudcore.scene import Camera, CameraPath, Cloud, Light, Lighting, Scene, SceneObject, Shading, Terrain
+from cloudcore.sprites import SpriteStyle
 
 ROOT = Path(__file__).resolve().parents[1]
 VALLEY = ROOT / "resources" / "scenes" / "valley.toml"
@@ -29,7 +31,8 @@ def renderer():
 
 @pytest.fixture
 def small_scene() -> Scene:
-    """A scene that touches every field: inline and file particles, explicit lights, objects, paths."""
+    """A scene that touches every field: inline and file particles, sprites and artist shading, explicit
+    lights, objects, paths."""
     rng = np.random.default_rng(4)
     small = np.column_stack([rng.normal(size=(12, 3)) * 50 + [0, 800, 0], rng.uniform(10, 20, 12)])
     large = np.column_stack([rng.normal(size=(200, 3)) * 80 + [400, 900, 0], rng.uniform(15, 30, 200)])
@@ -39,7 +42,11 @@ def small_scene() -> Scene:
                           lights=(Light((0.0, 1.0, 0.0), (1.0, 0.9, 0.8), 1.0),
                                   Light((0.6, 0.8, 0.0), (0.5, 0.6, 1.0), 0.3))),
         shading=Shading(albedo=0.8, optical_depth=6.5, phase="henyey-greenstein", g=0.7),
-        clouds=(Cloud("small", small, optical_depth=3.0, color=(1.0, 0.95, 0.9)), Cloud("large", large, albedo=0.95)),
+        clouds=(Cloud("small", small, optical_depth=3.0, color=(1.0, 0.95, 0.9),
+                      sprite=SpriteStyle(rows=(0, 2, 2), rotation_deg=(-30.0, 200.0), seed=11,
+                                         flat_bottom_fraction=0.2),
+                      artist=ArtistShading(directional_range=(0.1, 0.55, 0.9)), shading_group_size=40.0),
+                Cloud("large", large, albedo=0.95)),
         terrain=Terrain(size=(2000.0, 3000.0), resolution=33, height=300.0, seed=3),
         objects=(SceneObject("crate", primitive="box", scale=12.5, position=(10.0, 700.0, 5.0)),
                  SceneObject("plane", primitive="aircraft", path=np.array([[0, 0, 900, 0], [10, 500, 900, 0]]))),

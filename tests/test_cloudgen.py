@@ -1,13 +1,16 @@
 """Generated clouds: Wang's box fill with a cull distance, and the named cloud types built from it."""
 
+import dataclasses
 import time
 
 import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
+from cloudcore.artist_shading import height_fractions
 from cloudcore.cloudgen import PRESETS, box_fill, cull_close, preset_cloud
 from cloudcore.scene import Cloud
+from cloudcore.sprites import ATLAS_GRID, FLAT_BOTTOM, FOGGY, WISPY, particle_sprites
 
 LOW, HIGH = np.array([-500.0, 1000.0, -300.0]), np.array([700.0, 1400.0, 500.0])
 
@@ -110,7 +113,7 @@ def clouds() -> dict[str, Cloud]:
 
 def test_presets_cover_wangs_cloud_types():
     assert set(PRESETS) == {"cumulus_humilis", "cumulus_congestus", "stratus", "stratocumulus", "cumulonimbus",
-                            "altocumulus"}
+                            "altocumulus", "cirrus"}
 
 
 def test_each_preset_is_a_sensible_cloud_in_its_boxes(clouds):
@@ -135,7 +138,9 @@ def test_presets_differ_the_way_the_cloud_types_do(clouds):
     assert height["cumulus_congestus"] > width["cumulus_congestus"] > width["cumulus_humilis"]
     assert width["stratus"] == max(width.values())
     assert clouds["altocumulus"].radii.max() == min(c.radii.max() for c in clouds.values())  # small puffs
-    assert clouds["stratus"].optical_depth == min(c.optical_depth for c in clouds.values())  # most transparent
+    depth = {n: c.optical_depth for n, c in clouds.items()}
+    assert min(depth, key=depth.get) == "cirrus"  # thin veils
+    assert clouds["stratus"].optical_depth == min(d for n, d in depth.items() if n != "cirrus")  # most transparent
     assert clouds["cumulonimbus"].optical_depth == max(c.optical_depth for c in clouds.values())
     brightness = {n: sum(c.color) for n, c in clouds.items()}
     assert min(brightness, key=brightness.get) == "cumulonimbus"  # dark
@@ -158,7 +163,7 @@ def test_presets_are_deterministic_for_a_seed():
 
 
 @pytest.mark.parametrize("call, message", [
-    (lambda: preset_cloud("cirrus", "c", (0.0, 0.0, 0.0)), "stratus"),
+    (lambda: preset_cloud("nimbostratus", "c", (0.0, 0.0, 0.0)), "stratus"),
     (lambda: preset_cloud("stratus", "c", (0.0, 0.0, 0.0), scale=0.0), "scale"),
     (lambda: preset_cloud("stratus", "c", (0.0, 0.0, 0.0), scale=1e306), "finite"),
     (lambda: preset_cloud("stratus", "c", (0.0, np.nan, 0.0)), "base_centre"),
@@ -166,3 +171,56 @@ def test_presets_are_deterministic_for_a_seed():
 def test_bad_preset_input_is_refused(call, message):
     with pytest.raises(ValueError, match=message):
         call()
+
+
+# ---------------------------------------------------------------- presets: sprites and artist shading
+
+
+def test_each_preset_cloud_carries_its_sprites_and_artist_model(clouds):
+    for name, cloud in clouds.items():
+        assert cloud.sprite == dataclasses.replace(PRESETS[name].sprite, seed=4), name
+        assert cloud.artist == PRESETS[name].artist, name
+    assert preset_cloud("stratus", "s", (0.0, 0.0, 0.0), seed=9).sprite.seed == 9
+
+
+def test_cumulus_presets_have_flat_bottoms_turned_only_a_little(clouds):
+    """Wang 3.2: flat-bottomed textures make cumulus bases, within a few degrees of upright; other sprites
+    turn the full circle."""
+    for name in ("cumulus_humilis", "cumulus_congestus", "stratocumulus", "cumulonimbus"):
+        cloud = clouds[name]
+        indices, rotations = particle_sprites(cloud.sprite, cloud.centres)
+        y = cloud.centres[:, 1]
+        base = height_fractions(y, y.min(), y.max()) <= cloud.sprite.flat_bottom_fraction
+        assert base.any() and (~base).any(), name
+        assert np.all(indices[base] // ATLAS_GRID == FLAT_BOTTOM), name
+        assert np.all(indices[~base] // ATLAS_GRID != FLAT_BOTTOM), name
+        assert np.all(np.abs(np.degrees(rotations[base])) <= 5.0), name
+        assert np.ptp(np.degrees(rotations[~base])) > 300.0, name
+
+
+def test_stratus_is_mostly_foggy_and_cirrus_is_flat_wisps(clouds):
+    stratus = clouds["stratus"]
+    rows = particle_sprites(stratus.sprite, stratus.centres)[0] // ATLAS_GRID
+    assert np.mean(rows == FOGGY) > 0.6
+    cirrus = clouds["cirrus"]
+    indices, rotations = particle_sprites(cirrus.sprite, cirrus.centres)
+    assert cirrus.sprite.facing == "horizontal"
+    assert np.all(indices // ATLAS_GRID == WISPY)
+    assert np.all(np.abs(np.degrees(rotations)) <= 20.0)  # combed one way by the wind
+    assert all(c.sprite.facing == "camera" for n, c in clouds.items() if n != "cirrus")
+
+
+def test_preset_colour_levels_follow_wang(clouds):
+    """Wang 5.1: humilis nearly uniformly white, cumulonimbus dark from top to bottom, stratus light grey and
+    more transparent; every type darker at the base."""
+    levels = {n: np.array(c.artist.levels) for n, c in clouds.items()}
+    grey = {n: level[:, 1:4].mean(axis=1) for n, level in levels.items()}  # (5,) bottom to top
+    alpha = {n: level[:, 4].mean() for n, level in levels.items()}
+    assert grey["cumulus_humilis"].min() > 0.6 and np.ptp(grey["cumulus_humilis"]) < 0.25
+    for name, g in grey.items():
+        assert np.all(np.diff(g) >= 0.0), name
+        if name != "cumulonimbus":
+            assert np.all(grey["cumulonimbus"] < g), name
+    assert grey["cumulus_congestus"][-1] - grey["cumulus_congestus"][0] > 0.3  # grey base, white top
+    assert 0.4 < grey["stratus"].mean() < 0.7 and alpha["stratus"] < 0.6
+    assert alpha["stratus"] < min(alpha[n] for n in levels if n not in ("stratus", "cirrus"))

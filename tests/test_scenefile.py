@@ -87,6 +87,40 @@ MALFORMED = [
     ("[camera]", "colour = 3\n[camera]", "colour", "unknown key"),
     ("[[camera_paths]]", "[[clouds]]\nname = \"a\"\nparticles = []\n[[camera_paths]]", "clouds[1].name", "duplicate"),
     ("[lighting]", "[lighting", "(toml)", "line"),
+    # sprites and artist shading (Wang 2004, sections 3.2 and 5)
+    ('name = "a"', 'name = "a"\nsprite = { rows = [4] }', "clouds[0].sprite.rows", "0..3"),
+    ('name = "a"', 'name = "a"\nsprite = { rows = [] }', "clouds[0].sprite.rows", "one or more"),
+    ('name = "a"', 'name = "a"\nsprite = { rows = [1.0] }', "clouds[0].sprite.rows", "integers"),
+    ('name = "a"', 'name = "a"\nsprite = { rotation_deg = [10.0, 0.0] }', "clouds[0].sprite.rotation_deg",
+     "low <= high"),
+    ('name = "a"', 'name = "a"\nsprite = { rotation_deg = [0.0, 400.0] }', "clouds[0].sprite.rotation_deg",
+     "low + 360"),
+    ('name = "a"', 'name = "a"\nsprite = { rotation_deg = [0.0] }', "clouds[0].sprite.rotation_deg", "rows of 2"),
+    ('name = "a"', 'name = "a"\nsprite = { facing = "up" }', "clouds[0].sprite.facing", "horizontal"),
+    ('name = "a"', 'name = "a"\nsprite = { seed = -1 }', "clouds[0].sprite.seed", "within"),
+    ('name = "a"', 'name = "a"\nsprite = { flat_bottom_fraction = 1.5 }', "clouds[0].sprite.flat_bottom_fraction",
+     "within [0, 1]"),
+    ('name = "a"', 'name = "a"\nsprite = { colour = 1 }', "clouds[0].sprite.colour", "unknown key"),
+    ('name = "a"', 'name = "a"\nsprite = 3', "clouds[0].sprite", "expected a table"),
+    ('name = "a"', 'name = "a"\nartist = { levels = [[0, 1, 1, 1, 1], [1, 1, 1, 1, 1]] }', "clouds[0].artist.levels",
+     "expected 5 levels"),
+    ('name = "a"', 'name = "a"\nartist = { levels = [[0, 1, 1, 1, 1]' + ", [0.5, 1, 1, 1, 1]" * 3 + ", [1, 1, 1, 1, 1]] }",
+     "clouds[0].artist.levels", "increase strictly"),
+    ('name = "a"', 'name = "a"\nartist = { levels = [[0, 2, 1, 1, 1], [0.25, 1, 1, 1, 1], [0.5, 1, 1, 1, 1], '
+                   '[0.75, 1, 1, 1, 1], [1, 1, 1, 1, 1]] }', "clouds[0].artist.levels", "within [0, 1]"),
+    ('name = "a"', 'name = "a"\nartist = { levels = [[0, 1, 1, 1]] }', "clouds[0].artist.levels", "rows of 5"),
+    ('name = "a"', 'name = "a"\nartist = { level_percent_by_hour = [[24.0, 50.0]] }',
+     "clouds[0].artist.level_percent_by_hour", "[0, 24)"),
+    ('name = "a"', 'name = "a"\nartist = { level_percent_by_hour = [[12.0, -5.0]] }',
+     "clouds[0].artist.level_percent_by_hour", ">= 0"),
+    ('name = "a"', 'name = "a"\nartist = { directional_colour_by_hour = [[12.0, 1.0, "x", 1.0]] }',
+     "clouds[0].artist.directional_colour_by_hour", "rows of 4"),
+    ('name = "a"', 'name = "a"\nartist = { directional_range = [0.8, 0.5, 1.0] }', "clouds[0].artist.directional_range",
+     "min <= median"),
+    ('name = "a"', 'name = "a"\nartist = { directional_range = [0.1, nan, 1.0] }',
+     "clouds[0].artist.directional_range", "not finite"),
+    ('name = "a"', 'name = "a"\nartist = { ambient = 1 }', "clouds[0].artist.ambient", "unknown key"),
+    ('name = "a"', 'name = "a"\nshading_group_size = 0.0', "clouds[0].shading_group_size", "within"),
 ]
 
 
@@ -163,3 +197,41 @@ def test_cli_refuses_a_malformed_scene_in_one_line_with_status_2(tmp_path):
     assert result.stderr.strip().splitlines() == [
         f"cloudview: error: {path}: clouds[0].particles: radius must be > 0 (row 0 has -20.0)"]
     assert "Traceback" not in result.stderr
+
+
+def test_sprites_and_artist_shading_round_trip(tmp_path):
+    """Every preset's sprite style and artist model, and a shading group size, survive a save and load exactly."""
+    from dataclasses import replace
+
+    from cloudcore.cloudgen import PRESETS, preset_cloud
+    from cloudcore.scene import Scene
+
+    clouds = tuple(preset_cloud(name, name, (3000.0 * i, 1000.0, 0.0), seed=i) for i, name in enumerate(PRESETS))
+    clouds = (replace(clouds[0], shading_group_size=123.25),) + clouds[1:]
+    saved = save_scene(Scene(clouds=clouds), tmp_path / "p.toml")
+    loaded = load_scene(tmp_path / "p.toml")
+    assert loaded == saved
+    for cloud, again in zip(clouds, loaded.clouds):
+        assert (again.sprite, again.artist, again.shading_group_size) == (cloud.sprite, cloud.artist,
+                                                                          cloud.shading_group_size)
+    save_scene(loaded, tmp_path / "p.toml")
+    assert load_scene(tmp_path / "p.toml") == loaded
+    data = tomllib.loads((tmp_path / "p.toml").read_text())
+    assert data["clouds"][0]["sprite"]["rows"] == [2, 2, 3]
+    assert len(data["clouds"][0]["artist"]["levels"]) == 5
+
+
+def test_a_cloud_without_sprite_or_artist_keeps_splats_and_harris(tmp_path):
+    (tmp_path / "ok.toml").write_text(BASE)
+    cloud = load_scene(tmp_path / "ok.toml").clouds[0]
+    assert (cloud.sprite, cloud.artist, cloud.shading_group_size) == (None, None, None)
+    assert set(scene_to_dict(load_scene(tmp_path / "ok.toml"))["clouds"][0]) == {"name", "particles", "color"}
+
+
+def test_sprite_and_artist_tables_take_their_defaults(tmp_path):
+    from cloudcore.artist_shading import ArtistShading
+    from cloudcore.sprites import SpriteStyle
+
+    (tmp_path / "d.toml").write_text(BASE.replace('name = "a"', 'name = "a"\nsprite = {}\nartist = {}', 1))
+    cloud = load_scene(tmp_path / "d.toml").clouds[0]
+    assert cloud.sprite == SpriteStyle() and cloud.artist == ArtistShading()

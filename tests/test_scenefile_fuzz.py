@@ -85,6 +85,15 @@ def check_invariants(scene: Scene):
         p = cloud.particles
         assert p.dtype == np.float64 and p.ndim == 2 and p.shape[1] == 4
         assert np.all(np.isfinite(p)) and np.all(p[:, 3] > 0)
+        if cloud.sprite is not None:
+            assert cloud.sprite.rows and all(0 <= r < 4 for r in cloud.sprite.rows)
+            low, high = cloud.sprite.rotation_deg
+            assert low <= high <= low + 360 and 0 <= cloud.sprite.flat_bottom_fraction <= 1
+        if cloud.artist is not None:
+            levels = np.array(cloud.artist.levels)
+            assert levels.shape == (5, 5) and np.all(np.diff(levels[:, 0]) > 0) and np.all(levels >= 0)
+            assert np.all(levels <= 1) and 0 <= min(cloud.artist.directional_range)
+        assert cloud.shading_group_size is None or 0 < cloud.shading_group_size < math.inf
     for item in scene.objects + scene.camera_paths:
         assert isinstance(item.name, str)
 
@@ -104,6 +113,8 @@ char_edits = st.tuples(st.sampled_from(["insert", "delete", "replace"]), st.inte
 LINE_KEYS = ["name", "particles", "particles_file", "position", "look_at", "fov_y_deg", "direction", "color",
              "intensity", "time_of_day", "ambient", "albedo", "optical_depth", "phase", "g", "kind", "size",
              "resolution", "height", "seed", "mesh", "primitive", "scale", "path", "keys", "description",
+             "rows", "rotation_deg", "facing", "flat_bottom_fraction", "levels", "level_percent_by_hour",
+             "directional_colour_by_hour", "directional_range", "shading_group_size",
              r'"a\nb"', '""', '"x.y"', "x.y", r'"\u001b[31m"']
 LINE_VALUES = ["1", "-1", "0", "-0.0", "nan", "-inf", "1e308", "1e-320", "9" * 30, "1" + "0" * 400, "9" * 5000,
                "true", '"x"', '"1.0"', '""', r'"a\nb"', '"s.particles/large.npy"', '"."', "[]", "[[]]", "[1, 2]",
@@ -112,7 +123,8 @@ LINE_VALUES = ["1", "-1", "0", "-0.0", "nan", "-inf", "1e308", "1e-320", "9" * 3
                "[[1, 2, 3]]", "[[0, 0, 0, 0, 0, 0, 0], [0, 0, 0, 0, 0, 0, 0]]", "{}", "{ x = 1 }", "[{}]",
                "[" * 3000 + "]" * 3000, "1979-05-27", "07:32:00"]
 LINE_TABLES = ["[camera]", "[lighting]", "[shading]", "[terrain]", "[[clouds]]", "[[objects]]", "[[camera_paths]]",
-               "[[lighting.lights]]", "[lighting.lights]", "[[camera]]", "[clouds.x]", "[x]"]
+               "[[lighting.lights]]", "[lighting.lights]", "[[camera]]", "[clouds.x]", "[x]", "[clouds.sprite]",
+               "[clouds.artist]", "[[clouds.artist]]"]
 line_edits = st.tuples(st.just("line"), st.integers(0, 10**6),
                        st.sampled_from(["value", "value", "set", "table", "delete", "repeat"]),
                        st.tuples(st.sampled_from(LINE_KEYS), st.sampled_from(LINE_VALUES)), st.sampled_from(LINE_TABLES))

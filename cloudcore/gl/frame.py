@@ -28,6 +28,7 @@ from OpenGL import GL
 from cloudcore.camera import NEAR_PLANE_M, projection_matrix, view_matrix
 from cloudcore.colour import linear_to_srgb8
 from cloudcore.eye_scattering import ParticleShading
+from cloudcore.facing import CloudFacings
 from cloudcore.formation import formation_state
 from cloudcore.illumination import IlluminationCache
 from cloudcore.frameplan import FramePlan, plan_frame
@@ -39,14 +40,12 @@ from cloudcore.gl.quads import SCREEN_CORNERS, QuadPass
 from cloudcore.gl.splats import SplatPass, splat_batch
 from cloudcore.gl.targets import TextureTarget, blit_depth, depth_renderbuffer
 from cloudcore.gl.world import WorldPass
-from cloudcore.lighting import scene_lights, sky_colors
+from cloudcore.lighting import scene_hour, scene_lights, sky_colors
 from cloudcore.overdraw import analytic_overdraw, overdraw_statistics
+from cloudcore.particle_styles import particle_styles
 from cloudcore.ring import SEGMENTS, RingState, panel_corners
 from cloudcore.scene import Camera, Lighting, Scene
 from cloudcore.settings import FULL_3D, RenderSettings
-
-#: the sky needs an hour even when explicit lights replace the sun.
-_DEFAULT_SKY_HOURS = Lighting().time_of_day
 
 
 class FrameRenderer:
@@ -62,6 +61,7 @@ class FrameRenderer:
         self._world, self._world_source = None, None
         self._objects, self._objects_source = None, None
         self._particles, self._particles_source = None, None
+        self._facings: CloudFacings | None = None
         self._illumination = IlluminationCache()
         #: per cloud, changes whenever that cloud's particle colours may have: its impostor is stale
         self._lighting_keys: tuple = ()
@@ -109,6 +109,8 @@ class FrameRenderer:
         self._last_matrices = view, projection
         # in the editor's context the GUI leaves its scissor rectangle on, which would clip our targets
         GL.glDisable(GL.GL_SCISSOR_TEST)
+        for start, facing in self._facings.update(camera.position):
+            self._splats.update_facing(particles, start, facing)
         start = time.perf_counter()
         self._world.draw(self.context, camera, projection @ view)
         if plan.objects_with_world:
@@ -182,8 +184,7 @@ class FrameRenderer:
             self.context.make_current()
             if self._world is not None:
                 self._world.close()
-            hours = _DEFAULT_SKY_HOURS if lighting.time_of_day is None else lighting.time_of_day
-            self._world = WorldPass(scene.terrain, lights, ambient, *sky_colors(hours))
+            self._world = WorldPass(scene.terrain, lights, ambient, *sky_colors(scene_hour(lighting)))
             self._world_source = world_source
         objects_source = (scene.objects, lights, tuple(ambient), self.size)
         if objects_source != self._objects_source:
@@ -197,7 +198,8 @@ class FrameRenderer:
             return 0.0
         start = time.perf_counter()
         self._particles = ParticleShading(scene.clouds, scene.shading, lights, ambient, illumination_method,
-                                          self._illumination)
+                                          self._illumination, particle_styles(scene.clouds, lighting))
+        self._facings = CloudFacings(self._particles)
         old_clouds, old_lighting = ((), None) if self._particles_source is None else (
             self._particles_source[0], self._particles_source[1:])
         same_lighting = old_lighting == particles_source[1:]

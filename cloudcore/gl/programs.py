@@ -19,10 +19,18 @@ class ShaderError(RuntimeError):
     """A shader failed to compile or a program failed to link."""
 
 
-def build_program(name: str, defines: dict[str, float] | None = None, vertex: str | None = None) -> int:
+def build_program(name: str, defines: dict[str, int | float] | None = None, vertex: str | None = None) -> int:
     """Compile shaders/VERTEX.vert.glsl (VERTEX defaults to NAME) and NAME.frag.glsl, link; returns the id."""
     stages = [(GL.GL_VERTEX_SHADER, f"{vertex or name}.vert.glsl"), (GL.GL_FRAGMENT_SHADER, f"{name}.frag.glsl")]
-    shaders = [_compile(kind, file, defines or {}) for kind, file in stages]
+    return _link(name, [_compile(kind, file, defines or {}) for kind, file in stages])
+
+
+def build_compute_program(name: str, defines: dict[str, int | float] | None = None) -> int:
+    """Compile shaders/NAME.comp.glsl and link it alone; returns the program id."""
+    return _link(name, [_compile(GL.GL_COMPUTE_SHADER, f"{name}.comp.glsl", defines or {})])
+
+
+def _link(name: str, shaders: list[int]) -> int:
     program = GL.glCreateProgram()
     for shader in shaders:
         GL.glAttachShader(program, shader)
@@ -37,12 +45,14 @@ def build_program(name: str, defines: dict[str, float] | None = None, vertex: st
     return program
 
 
-def _compile(kind: int, file: str, defines: dict[str, float]) -> int:
+def _compile(kind: int, file: str, defines: dict[str, int | float]) -> int:
     source = (SHADER_DIR / file).read_text()
     version, _, body = source.partition("\n")
     if not version.startswith("#version"):
         raise ShaderError(f"{file}: the first line must be the #version directive")
-    lines = [version] + [f"#define {key} {float(value)!r}" for key, value in defines.items()]
+    # integers stay integers (array sizes); everything else is written as a float literal
+    lines = [version] + [f"#define {key} {value if isinstance(value, int) else float(value)!r}"
+                         for key, value in defines.items()]
     # keep the driver's line numbers pointing into the file
     lines.append("#line 2")
     shader = GL.glCreateShader(kind)

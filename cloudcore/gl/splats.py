@@ -1,12 +1,16 @@
 """Splats: particles as instanced camera-facing billboards, blended back to front.
 
+The particles stay on the GPU: `SplatPass` uploads a `ParticleShading`'s
+per-particle terms (centre, radius, scattering, ambient, incident light per
+light) once, into a storage buffer, and a compute shader colours each
+particle of a draw for the eye (Harris eq. 5) into the instance attributes
+the splats are drawn from.  Per draw the CPU only orders:
 `splat_batch` gathers the particles of some clouds (several together, since
-clouds interpenetrate in depth), sorts them far to near from the eye, colours
-them for that eye (`ParticleShading.seen_from`) and leaves out those the near
-fade has made fully transparent; `SplatPass.draw` draws a batch in one
-instanced call.  With the depth test on, terrain hides splats; splats never
-write depth.  Drawn with `counting=True`, every fragment adds 1 instead
-(overdraw).
+clouds interpenetrate in depth), leaves out those the near fade or a
+formation makes fully transparent, and sorts the rest far to near from the
+eye; the batch uploads just those indices (4 bytes a particle).  With the
+depth test on, terrain hides splats; splats never write depth.  Drawn with
+`counting=True`, every fragment adds 1 instead (overdraw).
 """
 
 from __future__ import annotations
@@ -17,28 +21,57 @@ from dataclasses import dataclass
 import numpy as np
 from OpenGL import GL
 
-from cloudcore.eye_scattering import ParticleShading
+from cloudcore.depth_order import far_to_near
+from cloudcore.eye_scattering import FADE_END_RADII, FADE_START_RADII, ParticleShading
+from cloudcore.facing import FacingState
 from cloudcore.gl.blending import cloud_blending
-from cloudcore.gl.programs import build_program, set_matrix
+from cloudcore.gl.programs import build_compute_program, build_program, set_matrix, set_vec3
 from cloudcore.kernel import SPLAT_SHARPNESS
+from cloudcore.particle_styles import ParticleStyles
+from cloudcore.phase import PHASE_NAMES
+from cloudcore.sprites import ATLAS_GRID, ATLAS_MAX_MIP_LEVEL, load_atlas
 
-_QUAD_CORNERS = np.array([[-1, -1], [1, -1], [-1, 1], [1, 1]], dtype=np.float32)
-#: per instance: centre xyz, radius, premultiplied colour rgb, opacity
-_INSTANCE_FLOATS = 8
+#: two triangles over a particle's four corners (lower left, lower right, upper left, upper right)
+_QUAD_TRIANGLES = np.array([0, 1, 2, 2, 1, 3], dtype=np.uint32)
+#: lights the shader sums over; more would only add light too faint to matter (skylights share the sky)
+MAX_LIGHTS = 8
+#: the shader's `Particle` in std430 layout: five vec4 then MAX_LIGHTS floats
+_PARTICLE_FLOATS = 20 + MAX_LIGHTS
+#: the shader's `CloudStyle`: ten vec4
+_CLOUD_FLOATS = 40
+#: per particle, written by the compute shader: four corners and four colours (vec4 each)
+_INSTANCE_BYTES = 8 * 16
+_UNLOCKED = (0.0, 0.0, 0.0, -1.0)
+(_PARTICLES_BINDING, _FORMATION_BINDING, _ORDER_BINDING, _INSTANCES_BINDING, _CLOUDS_BINDING,
+ _FACING_BINDING) = range(6)
+#: the compute shader's local_size_x
+_SHADE_GROUP = 64
 
 
 @dataclass(frozen=True)
 class SplatBatch:
-    instances: np.ndarray  # (n, 8) float32, far to near
-    centres: np.ndarray  # (n, 3) float64 world centres, for the analytic overdraw estimate
-    radii: np.ndarray
+    """Particles of one draw, far to near from `eye`, as indices into `particles`."""
+
+    particles: ParticleShading
+    order: np.ndarray  # (n,) uint32
+    eye: np.ndarray
+    time_s: float | None
 
     def __len__(self) -> int:
-        return len(self.instances)
+        return len(self.order)
+
+    @property
+    def centres(self) -> np.ndarray:
+        """(n, 3) world centres, for the analytic overdraw estimate."""
+        return self.particles.centres[self.order]
+
+    @property
+    def radii(self) -> np.ndarray:
+        return self.particles.radii[self.order]
 
 
 def splat_batch(particles: ParticleShading, clouds, eye, depth_ranges=None, time_s: float | None = None) -> SplatBatch:
-    """The visible particles of `clouds` (indices), sorted far to near from `eye` and coloured for it.
+    """The visible particles of `clouds` (indices), sorted far to near from `eye`.
 
     `depth_ranges`, one (near, far) per cloud, keeps only the particles with
     near < distance from `eye` <= far: one layer of a cloud split around objects.
@@ -48,62 +81,196 @@ def splat_batch(particles: ParticleShading, clouds, eye, depth_ranges=None, time
     ranges = [np.arange(starts[c], starts[c + 1]) for c in clouds]
     indices = np.concatenate(ranges) if ranges else np.zeros(0, dtype=np.int64)
     eye = np.asarray(eye, dtype=np.float64)
-    distances = np.linalg.norm(particles.centres[indices] - eye, axis=1)
+    offsets = particles.centres[indices] - eye
+    distances = np.sqrt(np.einsum("ij,ij->i", offsets, offsets))
+    kept = particles.drawn(indices, distances, time_s)
     if depth_ranges is not None:
         near = np.repeat([r[0] for r in depth_ranges], [len(r) for r in ranges])
         far = np.repeat([r[1] for r in depth_ranges], [len(r) for r in ranges])
-        kept = (distances > near) & (distances <= far)
-        indices, distances = indices[kept], distances[kept]
-    far_to_near = indices[np.argsort(-distances, kind="stable")]
-    colour, alpha = particles.seen_from(eye, far_to_near, time_s=time_s)
-    seen = alpha > 0.0
-    drawn = far_to_near[seen]
-    instances = np.empty((len(drawn), _INSTANCE_FLOATS), dtype=np.float32)
-    instances[:, :3] = particles.centres[drawn]
-    instances[:, 3] = particles.radii[drawn]
-    instances[:, 4:7] = colour[seen]
-    instances[:, 7] = alpha[seen]
-    return SplatBatch(instances, particles.centres[drawn], particles.radii[drawn])
+        kept &= (distances > near) & (distances <= far)
+    indices, distances = indices[kept], distances[kept]
+    return SplatBatch(particles, indices[far_to_near(distances)].astype(np.uint32), eye, time_s)
 
 
 class SplatPass:
     def __init__(self):
-        self._program = build_program("splat", {"SPLAT_SHARPNESS": SPLAT_SHARPNESS})
-        self._counting_program = build_program("splat", {"SPLAT_SHARPNESS": SPLAT_SHARPNESS, "COUNT_FRAGMENTS": 1})
+        defines = {"SPLAT_SHARPNESS": SPLAT_SHARPNESS, "ATLAS_GRID": ATLAS_GRID}
+        self._program = build_program("splat", defines)
+        self._counting_program = build_program("splat", defines | {"COUNT_FRAGMENTS": 1})
+        self._shade_program = build_compute_program("splat_shade", {
+            "MAX_LIGHTS": MAX_LIGHTS, "FADE_START_RADII": FADE_START_RADII, "FADE_END_RADII": FADE_END_RADII})
         self._vertex_array = GL.glGenVertexArrays(1)
-        self._corner_buffer, self._instance_buffer = GL.glGenBuffers(2)
-        GL.glBindVertexArray(self._vertex_array)
-        GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self._corner_buffer)
-        GL.glBufferData(GL.GL_ARRAY_BUFFER, _QUAD_CORNERS.nbytes, _QUAD_CORNERS, GL.GL_STATIC_DRAW)
-        GL.glEnableVertexAttribArray(0)
-        GL.glVertexAttribPointer(0, 2, GL.GL_FLOAT, GL.GL_FALSE, 0, ctypes.c_void_p(0))
-        GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self._instance_buffer)
-        stride = _INSTANCE_FLOATS * 4
-        for location, offset in ((1, 0), (2, 16)):
-            GL.glEnableVertexAttribArray(location)
-            GL.glVertexAttribPointer(location, 4, GL.GL_FLOAT, GL.GL_FALSE, stride, ctypes.c_void_p(offset))
-            GL.glVertexAttribDivisor(location, 1)
-        GL.glBindVertexArray(0)
+        (self._corner_index_buffer, self._order_buffer, self._instance_buffer, self._particle_buffer,
+         self._formation_buffer, self._cloud_buffer, self._facing_buffer) = self._buffers = GL.glGenBuffers(7)
+        self._atlas: int | None = None  # the sprite atlas texture, made when a cloud first needs it
+        self._quads_indexed = 0
+        self._instance_capacity = 0
+        self._resident: ParticleShading | None = None
+        self._formation_time: float | None = None
 
     def draw(self, batch: SplatBatch, view: np.ndarray, projection: np.ndarray, *, depth_test: bool = True,
              counting: bool = False) -> None:
         """Blend the batch over the bound target (premultiplied), or add 1 per fragment when counting."""
         if not len(batch):
             return
+        self._shade(batch, view)
         program = self._counting_program if counting else self._program
         GL.glUseProgram(program)
-        set_matrix(program, "view", view)
+        view_rotation = np.array(view, dtype=np.float64)
+        view_rotation[:3, 3] = 0.0  # corners come relative to the batch's eye, the view's own
+        set_matrix(program, "view_rotation", view_rotation)
         set_matrix(program, "projection", projection)
-        GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self._instance_buffer)
-        GL.glBufferData(GL.GL_ARRAY_BUFFER, batch.instances.nbytes, batch.instances, GL.GL_STREAM_DRAW)
+        if self._atlas is not None:
+            GL.glActiveTexture(GL.GL_TEXTURE0)
+            GL.glBindTexture(GL.GL_TEXTURE_2D, self._atlas)
+        GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _INSTANCES_BINDING, self._instance_buffer)
+        GL.glBindVertexArray(self._vertex_array)
+        self._index_quads(len(batch))
         with cloud_blending(depth_test, counting):
-            GL.glBindVertexArray(self._vertex_array)
-            GL.glDrawArraysInstanced(GL.GL_TRIANGLE_STRIP, 0, 4, len(batch))
-            GL.glBindVertexArray(0)
+            GL.glDrawElements(GL.GL_TRIANGLES, 6 * len(batch), GL.GL_UNSIGNED_INT, ctypes.c_void_p(0))
+        GL.glBindVertexArray(0)
+
+    def _index_quads(self, count: int) -> None:
+        """Grow the (bound vertex array's) element buffer to hold the triangles of `count` particles."""
+        if count <= self._quads_indexed:
+            return
+        count = max(count, 2 * self._quads_indexed)  # grow geometrically: few reallocations on a long path
+        indices = (_QUAD_TRIANGLES[None, :] + 4 * np.arange(count, dtype=np.uint32)[:, None]).ravel()
+        GL.glBindBuffer(GL.GL_ELEMENT_ARRAY_BUFFER, self._corner_index_buffer)
+        GL.glBufferData(GL.GL_ELEMENT_ARRAY_BUFFER, indices.nbytes, indices, GL.GL_STATIC_DRAW)
+        self._quads_indexed = count
+
+    def update_facing(self, particles: ParticleShading, start: int, state: FacingState) -> None:
+        """The facing lock of particles `start`, `start + 1`, ... (one cloud's) for the next draws."""
+        self._make_resident(particles, None)
+        records = np.empty((len(state.fade), 4), dtype=np.float32)
+        records[:, :3] = state.normals
+        records[:, 3] = np.where(state.locked, state.fade, _UNLOCKED[3])
+        GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, self._facing_buffer)
+        GL.glBufferSubData(GL.GL_SHADER_STORAGE_BUFFER, start * records.itemsize * 4, records.nbytes, records)
+        GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, 0)
+
+    def _shade(self, batch: SplatBatch, view: np.ndarray) -> None:
+        """Run the compute shader: the batch's quads and colours for its eye, in its order."""
+        self._make_resident(batch.particles, batch.time_s)
+        _store(self._order_buffer, batch.order, GL.GL_STREAM_DRAW)
+        needed = len(batch) * _INSTANCE_BYTES
+        if needed > self._instance_capacity:
+            GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, self._instance_buffer)
+            GL.glBufferData(GL.GL_SHADER_STORAGE_BUFFER, needed, None, GL.GL_DYNAMIC_COPY)
+            self._instance_capacity = needed
+        for binding, buffer in ((_PARTICLES_BINDING, self._particle_buffer),
+                                (_FORMATION_BINDING, self._formation_buffer),
+                                (_ORDER_BINDING, self._order_buffer), (_INSTANCES_BINDING, self._instance_buffer),
+                                (_CLOUDS_BINDING, self._cloud_buffer), (_FACING_BINDING, self._facing_buffer)):
+            GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, binding, buffer)
+        GL.glUseProgram(self._shade_program)
+        GL.glUniform1ui(GL.glGetUniformLocation(self._shade_program, "count"), len(batch))
+        set_vec3(self._shade_program, "eye", batch.eye)
+        set_vec3(self._shade_program, "view_right", view[0, :3])
+        set_vec3(self._shade_program, "view_up", view[1, :3])
+        GL.glDispatchCompute(-(-len(batch) // _SHADE_GROUP), 1, 1)
+        GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT)
+
+    def _make_resident(self, particles: ParticleShading, time_s: float | None) -> None:
+        """Upload the particles' shading terms when they change, and their formation factors when those do."""
+        if particles is not self._resident:
+            _store(self._particle_buffer, _particle_records(particles))
+            _store(self._cloud_buffer, _cloud_records(particles.styles))
+            _store(self._facing_buffer, np.tile(np.array(_UNLOCKED, dtype=np.float32),
+                                                (max(len(particles.radii), 1), 1)), GL.GL_DYNAMIC_DRAW)
+            if self._atlas is None and np.any(particles.styles.sprite_index >= 0):
+                self._atlas = _atlas_texture()
+            _store(self._formation_buffer, np.ones(max(len(particles.radii), 1), dtype=np.float32))
+            _set_light_uniforms(self._shade_program, particles)
+            self._resident, self._formation_time = particles, None
+        factors = particles.formation_factors(time_s)
+        held = None if factors is None else time_s  # the time the buffer's factors are for; None: all 1
+        if held != self._formation_time:
+            _store(self._formation_buffer, (np.ones(max(len(particles.radii), 1)) if factors is None
+                                            else factors).astype(np.float32))
+            self._formation_time = held
 
     def close(self) -> None:
         """Free the GL objects (the context must be current)."""
-        GL.glDeleteProgram(self._program)
-        GL.glDeleteProgram(self._counting_program)
-        GL.glDeleteBuffers(2, [self._corner_buffer, self._instance_buffer])
+        for program in (self._program, self._counting_program, self._shade_program):
+            GL.glDeleteProgram(program)
+        if self._atlas is not None:
+            GL.glDeleteTextures([self._atlas])
+        GL.glDeleteBuffers(len(self._buffers), list(self._buffers))
         GL.glDeleteVertexArrays(1, [self._vertex_array])
+        self._resident = None
+
+
+def _particle_records(particles: ParticleShading) -> np.ndarray:
+    """The shader's `Particle` array (n, _PARTICLE_FLOATS) float32: the view-independent terms of `seen_from`."""
+    lights = len(particles.light_directions)
+    if lights > MAX_LIGHTS:
+        raise ValueError(f"at most {MAX_LIGHTS} lights can shine on clouds at once, the scene has {lights}")
+    records = np.zeros((max(len(particles.radii), 1), _PARTICLE_FLOATS), dtype=np.float32)
+    n = len(particles.radii)
+    records[:n, 0:3] = particles.centres
+    records[:n, 3] = particles.radii
+    records[:n, 4:7] = particles.scattering[:, None] * particles.tint
+    records[:n, 7] = particles.alpha
+    records[:n, 8:11] = particles.ambient * particles.alpha[:, None] * particles.tint
+    styles = particles.styles
+    records[:n, 12:15] = styles.group_centres
+    records[:n, 15] = styles.cloud_index
+    records[:n, 16] = styles.sprite_index
+    records[:n, 17] = styles.rotation
+    records[:n, 20:20 + lights] = particles.incident
+    return records
+
+
+def _cloud_records(styles: ParticleStyles) -> np.ndarray:
+    """The shader's `CloudStyle` array (clouds, _CLOUD_FLOATS) float32."""
+    records = np.zeros((max(len(styles.clouds), 1), _CLOUD_FLOATS), dtype=np.float32)
+    for record, style in zip(records, styles.clouds):
+        record[25:27] = style.bottom_y, style.top_y
+        record[31] = style.facing
+        if style.artist is not None:
+            heights = style.artist["level_heights"]
+            record[0:20] = style.artist["level_colours"].ravel()
+            record[20:25] = heights
+            record[27] = 1.0
+            record[28:31] = style.artist["directional_colour"]
+            record[32:35] = style.artist["directional_range"]
+            record[36:39] = style.artist["sun_direction"]
+    return records
+
+
+def _atlas_texture() -> int:
+    """The sprite atlas, mipmapped down to the level its cells' empty margins keep apart."""
+    pixels = np.ascontiguousarray(load_atlas())
+    texture = GL.glGenTextures(1)
+    GL.glBindTexture(GL.GL_TEXTURE_2D, texture)
+    GL.glTexParameteri(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_MAX_LEVEL, ATLAS_MAX_MIP_LEVEL)
+    GL.glTexStorage2D(GL.GL_TEXTURE_2D, ATLAS_MAX_MIP_LEVEL + 1, GL.GL_RGBA8, pixels.shape[1], pixels.shape[0])
+    GL.glTexSubImage2D(GL.GL_TEXTURE_2D, 0, 0, 0, pixels.shape[1], pixels.shape[0], GL.GL_RGBA, GL.GL_FLOAT, pixels)
+    GL.glGenerateMipmap(GL.GL_TEXTURE_2D)
+    GL.glTexParameteri(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_MIN_FILTER, GL.GL_LINEAR_MIPMAP_LINEAR)
+    GL.glTexParameteri(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_MAG_FILTER, GL.GL_LINEAR)
+    GL.glTexParameteri(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_WRAP_S, GL.GL_CLAMP_TO_EDGE)
+    GL.glTexParameteri(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_WRAP_T, GL.GL_CLAMP_TO_EDGE)
+    GL.glBindTexture(GL.GL_TEXTURE_2D, 0)
+    return texture
+
+
+def _set_light_uniforms(program: int, particles: ParticleShading) -> None:
+    GL.glUseProgram(program)
+    lights = len(particles.light_directions)
+    GL.glUniform1i(GL.glGetUniformLocation(program, "light_count"), lights)
+    if lights:
+        GL.glUniform3fv(GL.glGetUniformLocation(program, "light_direction"), lights,
+                        np.ascontiguousarray(particles.light_directions, dtype=np.float32))
+        GL.glUniform3fv(GL.glGetUniformLocation(program, "light_radiance"), lights,
+                        np.ascontiguousarray(particles.light_radiance, dtype=np.float32))
+    GL.glUniform1i(GL.glGetUniformLocation(program, "phase_kind"), PHASE_NAMES.index(particles.phase))
+    GL.glUniform1f(GL.glGetUniformLocation(program, "g"), float(particles.g))
+
+
+def _store(buffer: int, data: np.ndarray, usage=GL.GL_STATIC_DRAW) -> None:
+    GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, buffer)
+    GL.glBufferData(GL.GL_SHADER_STORAGE_BUFFER, data.nbytes, np.ascontiguousarray(data), usage)
+    GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, 0)

@@ -1,24 +1,39 @@
-#version 330 core
-// The splat kernel of cloudcore.kernel: K(d) = (exp(-s d^2) - exp(-s)) / (1 - exp(-s))
-// for d < 1, else 0; SPLAT_SHARPNESS (s) is injected from Python.  Output is
-// premultiplied (colour K, alpha K) for glBlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA).
-// With COUNT_FRAGMENTS defined every fragment the kernel keeps writes 1, for
-// additive blending into the overdraw counter.
+#version 430 core
+// A Gaussian splat: the kernel of cloudcore.kernel, K(d) = (exp(-s d^2) - exp(-s)) / (1 - exp(-s))
+// for d < 1, else 0, SPLAT_SHARPNESS (s) injected from Python.  Or an atlas sprite
+// (cloudcore.sprites): its cell's texture, alpha the sprite's opacity and rgb a
+// brightness that multiplies the colour.  Output is premultiplied for
+// glBlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA).  With COUNT_FRAGMENTS defined every
+// fragment kept writes 1, for additive blending into the overdraw counter.
 
 in vec2 splat_position;
-flat in vec4 particle;
+in vec4 colour;
+flat in int sprite;
 out vec4 frag_colour;
+
+uniform sampler2D atlas;
 
 void main()
 {
-    float d2 = dot(splat_position, splat_position);
-    if (d2 >= 1.0)
-        discard;
+    vec4 shade;
+    if (sprite < 0) {
+        float d2 = dot(splat_position, splat_position);
+        if (d2 >= 1.0)
+            discard;
+        float floor_value = exp(-SPLAT_SHARPNESS);
+        shade = vec4(max((exp(-SPLAT_SHARPNESS * d2) - floor_value) / (1.0 - floor_value), 0.0));
+    } else {
+        // cells are ATLAS_GRID wide, row 0 at the top (v = 0); the sprite's bottom edge is its cell's
+        vec2 cell = vec2(sprite % ATLAS_GRID, sprite / ATLAS_GRID);
+        vec2 uv = (cell + vec2(0.5 + 0.5 * splat_position.x, 0.5 - 0.5 * splat_position.y)) / float(ATLAS_GRID);
+        vec4 texel = texture(atlas, uv);
+        if (texel.a <= 0.0)
+            discard;
+        shade = vec4(texel.rgb * texel.a, texel.a);
+    }
 #ifdef COUNT_FRAGMENTS
     frag_colour = vec4(1.0);
 #else
-    float floor_value = exp(-SPLAT_SHARPNESS);
-    float kernel = (exp(-SPLAT_SHARPNESS * d2) - floor_value) / (1.0 - floor_value);
-    frag_colour = particle * max(kernel, 0.0);
+    frag_colour = colour * shade;
 #endif
 }

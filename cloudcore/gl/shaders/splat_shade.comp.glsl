@@ -1,0 +1,150 @@
+#version 430 core
+// Builds one batch of particles for the eye, one invocation per particle:
+// the quad's four corners and their premultiplied colours, in the batch's
+// far-to-near order, for splat.vert.glsl to draw.  Once per particle here
+// rather than at each corner in the vertex shader: on a software rasteriser
+// vertex work is the cost.
+//
+// Colour, Harris (reference cloudcore.eye_scattering.ParticleShading.seen_from):
+// per light, the incident light of the light pass times the phase function at
+// the angle between the view ray and the light, times the scattering
+// coefficient, plus ambient.  Colour, Wang's artist model (reference
+// cloudcore.artist_shading.artist_colours): the cloud's five vertical colour
+// levels at each corner's height plus the directional term of its shading
+// group, per corner.  Opacity: splats fade out next to the eye; sprites lock
+// their facing there (cloudcore.facing) and fade by its angle; forming
+// clouds scale both (cloudcore.formation).
+//
+// Orientation (cloudcore.particle_styles): splats lie in the image plane;
+// sprites face the eye (or their locked facing) with world up projected
+// into their plane (cloudcore.facing.sprite_axes), or lie flat; both turned
+// by their rotation.  Corners are written relative to the eye, so float32
+// keeps tiny particles far from the origin their size.
+
+layout(local_size_x = 64) in;
+
+struct Particle {
+    vec4 centre_radius;       // world xyz, radius
+    vec4 scattering_opacity;  // scattering coefficient x tint (rgb), opacity
+    vec4 ambient;             // ambient x opacity x tint (rgb), unused
+    vec4 group_cloud;         // shading group centre xyz, cloud index
+    vec4 sprite;              // atlas cell (-1: Gaussian splat), rotation (radians), unused, unused
+    float incident[MAX_LIGHTS];
+};
+struct CloudStyle {
+    vec4 level_colours[5];       // RGBA, RGB times the hour's percentage
+    vec4 level_heights;          // the first four level heights (fractions of the cloud's height)
+    vec4 last_height_extent;     // fifth level height, lowest and highest particle centre y, artist (0 or 1)
+    vec4 directional_colour;     // rgb, facing (FACING_* of cloudcore.particle_styles)
+    vec4 directional_range;      // min, median, max, unused
+    vec4 sun;                    // toward the sun, unused
+};
+struct Instance {
+    vec4 corners[4];  // relative to the eye; w: atlas cell (-1: Gaussian splat)
+    vec4 colours[4];  // premultiplied linear rgb, opacity
+};
+layout(std430, binding = 0) readonly buffer Particles { Particle particles[]; };
+layout(std430, binding = 1) readonly buffer Formation { float formation[]; };
+layout(std430, binding = 2) readonly buffer Order { uint order[]; };
+layout(std430, binding = 3) writeonly buffer Instances { Instance instances[]; };
+layout(std430, binding = 4) readonly buffer Clouds { CloudStyle clouds[]; };
+layout(std430, binding = 5) readonly buffer Facing { vec4 facing[]; };  // locked normal, fade (< 0: unlocked)
+
+uniform uint count;
+uniform vec3 eye;
+uniform vec3 view_right;  // the image plane's axes in the world, for splats
+uniform vec3 view_up;
+uniform int light_count;
+uniform vec3 light_direction[MAX_LIGHTS];  // toward the light
+uniform vec3 light_radiance[MAX_LIGHTS];
+uniform int phase_kind;  // cloudcore.phase.PHASE_NAMES order
+uniform float g;
+
+const int FACING_SPLAT = 0;
+const int FACING_HORIZONTAL = 2;
+const vec2 CORNERS[4] = vec2[](vec2(-1.0, -1.0), vec2(1.0, -1.0), vec2(-1.0, 1.0), vec2(1.0, 1.0));
+
+float phase(float mu)
+{
+    mu = clamp(mu, -1.0, 1.0);
+    float rayleigh = 0.75 * (1.0 + mu * mu);
+    if (phase_kind == 0)
+        return rayleigh;
+    float lobe = (1.0 - g * g) / pow(1.0 + g * g - 2.0 * g * mu, 1.5);
+    return phase_kind == 1 ? lobe : 2.0 * rayleigh / (2.0 + g * g) * lobe;
+}
+
+// cloudcore.ramps.smoothstep; GLSL's own is undefined for a zero-width ramp
+float ramp(float edge0, float edge1, float x)
+{
+    float t = clamp((x - edge0) / max(edge1 - edge0, 1e-30), 0.0, 1.0);
+    return t * t * (3.0 - 2.0 * t);
+}
+
+vec4 harris_colour(Particle p, vec3 view_ray)
+{
+    vec3 scattered = vec3(0.0);
+    for (int light = 0; light < light_count; ++light)
+        scattered += p.incident[light] * phase(dot(view_ray, light_direction[light])) * light_radiance[light];
+    return vec4(scattered * p.scattering_opacity.rgb + p.ambient.rgb, p.scattering_opacity.a);
+}
+
+// cloudcore.artist_shading.artist_colours at one vertex, premultiplied
+vec4 artist_colour(CloudStyle style, vec3 vertex, vec3 group_centre)
+{
+    float bottom = style.last_height_extent.y, top = style.last_height_extent.z;
+    float f = top > bottom ? clamp((vertex.y - bottom) / (top - bottom), 0.0, 1.0) : 0.5;
+    float heights[5] = float[](style.level_heights.x, style.level_heights.y, style.level_heights.z,
+                               style.level_heights.w, style.last_height_extent.x);
+    vec4 ambient = style.level_colours[0];
+    for (int level = 1; level < 5; ++level)
+        if (f > heights[level - 1])
+            ambient = mix(style.level_colours[level - 1], style.level_colours[level],
+                          clamp((f - heights[level - 1]) / (heights[level] - heights[level - 1]), 0.0, 1.0));
+    vec3 v = vertex - group_centre;
+    float d = length(v) > 0.0 ? dot(v / length(v), style.sun.xyz) : 0.0;
+    vec3 range = style.directional_range.xyz;
+    float t = d < 0.0 ? range.y + d * (range.y - range.x) : range.y + d * (range.z - range.y);
+    vec4 colour = clamp(ambient + vec4(style.directional_colour.rgb * t, 0.0), 0.0, 1.0);
+    return vec4(colour.rgb * colour.a, colour.a);
+}
+
+void main()
+{
+    uint slot = gl_GlobalInvocationID.x;
+    if (slot >= count)
+        return;
+    uint index = order[slot];
+    Particle p = particles[index];
+    CloudStyle style = clouds[int(p.group_cloud.w)];
+    int facing_kind = int(style.directional_colour.w);
+    vec3 offset = p.centre_radius.xyz - eye;
+    float distance = length(offset);
+    vec3 view_ray = offset / max(distance, 1e-30);
+    float radius = p.centre_radius.w;
+
+    vec3 right = view_right, up = view_up;
+    float fade = ramp(FADE_START_RADII * radius, FADE_END_RADII * radius, distance);
+    if (facing_kind != FACING_SPLAT) {
+        vec4 lock = facing[index];
+        vec3 normal = facing_kind == FACING_HORIZONTAL ? vec3(0.0, 1.0, 0.0)
+                    : lock.w >= 0.0 ? lock.xyz : (distance > 0.0 ? -view_ray : vec3(0.0, 0.0, 1.0));
+        fade = facing_kind == FACING_HORIZONTAL || lock.w < 0.0 ? 1.0 : lock.w;
+        vec3 reference = length(normal.xz) < 1e-6 ? vec3(0.0, 0.0, -1.0) : vec3(0.0, 1.0, 0.0);
+        vec3 axis = normalize(cross(reference, normal));
+        up = cross(normal, axis);
+        float c = cos(p.sprite.y), s = sin(p.sprite.y);
+        right = c * axis + s * up;
+        up = cross(normal, right);
+    }
+    fade *= formation[index];
+
+    bool artist = style.last_height_extent.w > 0.5;
+    vec4 colour = artist ? vec4(0.0) : harris_colour(p, view_ray) * fade;
+    for (int k = 0; k < 4; ++k) {
+        vec3 corner = offset + radius * (CORNERS[k].x * right + CORNERS[k].y * up);
+        instances[slot].corners[k] = vec4(corner, p.sprite.x);
+        instances[slot].colours[k] = artist ? artist_colour(style, corner + eye, p.group_cloud.xyz) * fade
+                                            : colour;
+    }
+}
