@@ -1,30 +1,43 @@
-"""What the editor holds between frames: the scene and its history, the file, settings, messages (no GL, no GUI).
+"""What the editor holds between frames: the scene and its history, the file, settings, the tools, the
+camera path playing, messages (no GL, no GUI).
 
 The panels read and change an `Editor`; the viewport asks the engine to draw
 `editor.scene` with `editor.settings`.  Saves are atomic (`save_scene`); a
 recovery copy is written beside the scene at most a minute after an unsaved
-edit, so a crash loses at most a minute of work.
+edit, so a crash loses at most a minute of work: the next `open` says the copy
+is there and `recover` loads it.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import shutil
 import time
 from collections import deque
 from pathlib import Path
 
-from cloudcore.editing import History
+from cloudcore.editing import History, delete_cloud, delete_particles
 from cloudcore.errors import SceneError
+from cloudcore.paths import camera_on_path
 from cloudcore.scene import Camera, Scene
-from cloudcore.scenefile import load_scene, save_scene
+from cloudcore.scenefile import load_scene, particles_folder, save_scene
 from cloudcore.settings import RenderSettings
 
 AUTOSAVE_SECONDS = 60.0
 RECENT_LIMIT = 8
+#: what a left press in the viewport does, by name: (key, label)
+TOOLS = (("place", "Place"), ("brush", "Brush"), ("move_cloud", "Move cloud"), ("move_particle", "Move particle"))
 
 
 def recovery_path(path: Path) -> Path:
     return path.with_name(f"{path.stem}.recovery.toml")
+
+
+def discard_recovery(path: Path) -> None:
+    """Delete the recovery copy of the scene at `path`, with the particle files it owns."""
+    recovery = recovery_path(path)
+    recovery.unlink(missing_ok=True)
+    shutil.rmtree(recovery.with_name(particles_folder(recovery)), ignore_errors=True)
 
 
 class Editor:
@@ -37,13 +50,25 @@ class Editor:
         #: the scene clock the objects move by (seconds, in their path keys' time)
         self.scene_time_s = 0.0
         self.selected_cloud = 0 if scene.clouds else None
+        self.tool = "place"
+        #: where Place and Brush put particles: on the selected cloud's particles, or on the altitude plane
+        self.on_cloud_surface = False
         self.placement_altitude = 1000.0
         self.particle_radius = 60.0
+        self.brush_radius = 250.0
+        self.brush_rate = 40.0  # particles per second held
+        self.brush_erases = False
+        self._strokes = 0
+        self._picked: tuple[int, int, Scene] | None = None  # (cloud, particle, the scene they index)
+        self.camera_path_name: str | None = scene.camera_paths[0].name if scene.camera_paths else None
+        self.path_time_s = 0.0
+        self.playing = False
         self.messages: deque[str] = deque(maxlen=6)
         self.recent: list[Path] = [path] if path else []
         self.frame_times: deque[dict] = deque(maxlen=240)
         self.last_stats: dict = {}
         self._last_recovery = time.monotonic()
+        self._recovered_scene: Scene | None = None  # the scene the recovery copy last written holds
 
     @property
     def scene_duration_s(self) -> float:
@@ -54,8 +79,29 @@ class Editor:
     def open(cls, path: Path) -> "Editor":
         editor = cls(load_scene(path), path)
         if recovery_path(path).exists():
-            editor.messages.append(f"a recovery file from an unsaved session exists: {recovery_path(path)}")
+            editor.messages.append(f"a recovery file from an unsaved session exists: {recovery_path(path)} "
+                                   "(Scene panel: Recover unsaved edits)")
         return editor
+
+    def recover(self) -> bool:
+        """Load the recovery copy of the open scene as one undoable edit.
+
+        The scene keeps its path, so Save writes the recovered edits over the last
+        save (and discards the copy); undo returns to the scene as last saved.
+        """
+        recovery = recovery_path(self.path) if self.path is not None else None
+        if recovery is None or not recovery.exists():
+            self.messages.append("there is no recovery file to load")
+            return False
+        try:
+            scene = load_scene(recovery)
+        except SceneError as error:
+            self.messages.append(f"could not recover: {error}")
+            return False
+        self.edit(scene)
+        self.camera = scene.camera
+        self.messages.append(f"recovered the unsaved edits in {recovery}; save to keep them")
+        return True
 
     @property
     def scene(self) -> Scene:
@@ -74,6 +120,67 @@ class Editor:
         self.history.apply(scene)
         if self.selected_cloud is not None and self.selected_cloud >= len(scene.clouds):
             self.selected_cloud = len(scene.clouds) - 1 if scene.clouds else None
+
+    def begin_gesture(self) -> None:
+        """Edits until `end_gesture` (a brush stroke, a drag) undo as one."""
+        self.history.begin_gesture()
+
+    def end_gesture(self) -> None:
+        self.history.end_gesture()
+
+    def next_stroke_seed(self) -> int:
+        """A new seed for each brush stroke: strokes differ, and a session replays the same."""
+        self._strokes += 1
+        return self._strokes
+
+    def pick(self, cloud: int, particle: int) -> None:
+        """Make a particle the one Delete removes (until the scene changes otherwise)."""
+        self._picked = (cloud, particle, self.scene)
+
+    @property
+    def picked_particle(self) -> tuple[int, int] | None:
+        """(cloud, particle) picked in the scene shown now; any other edit, undo included, forgets it."""
+        if self._picked is None or self._picked[2] is not self.scene:
+            return None
+        return self._picked[:2]
+
+    def delete_selection(self) -> None:
+        """Delete the picked particle, or else the selected cloud (undoable)."""
+        picked = self.picked_particle
+        if picked is not None:
+            self.edit(delete_particles(self.scene, picked[0], [picked[1]]))
+            self.messages.append(f"deleted particle {picked[1]} of {self.scene.clouds[picked[0]].name}")
+        elif self.selected_cloud is not None:
+            name = self.scene.clouds[self.selected_cloud].name
+            self.edit(delete_cloud(self.scene, self.selected_cloud))
+            self.messages.append(f"deleted cloud {name}")
+        else:
+            self.messages.append("nothing to delete: pick a particle (Move particle) or select a cloud")
+
+    def show_path_time(self, seconds: float) -> None:
+        """Put the camera (and the scene clock) where the chosen camera path is `seconds` from its start."""
+        path = self.scene.camera_path(self.camera_path_name)
+        self.path_time_s = min(max(float(seconds), 0.0), path.duration)
+        self.camera = camera_on_path(path, self.path_time_s, self.camera.fov_y_deg)
+        self.scene_time_s = float(path.keys[0, 0]) + self.path_time_s
+
+    def play(self) -> None:
+        if self.camera_path_name is None:
+            self.messages.append("the scene has no camera path to play")
+            return
+        if self.path_time_s >= self.scene.camera_path(self.camera_path_name).duration:
+            self.path_time_s = 0.0  # played to the end: play again from the start
+        self.playing = True
+
+    def advance_playback(self, seconds: float) -> None:
+        """Move along the playing path by `seconds` of wall time; it stops at the path's end."""
+        if not self.playing:
+            return
+        if self.camera_path_name not in {p.name for p in self.scene.camera_paths}:
+            self.playing = False  # the scene changed under it (opened, undone)
+            return
+        self.show_path_time(self.path_time_s + seconds)
+        self.playing = self.path_time_s < self.scene.camera_path(self.camera_path_name).duration
 
     def set_time_of_day(self, hours: float) -> None:
         self.edit(dataclasses.replace(self.scene, lighting=dataclasses.replace(self.scene.lighting,
@@ -97,6 +204,8 @@ class Editor:
         self.history.reset(scene)
         self.saved_scene, self.path, self.camera = scene, Path(path), scene.camera
         self.selected_cloud = 0 if scene.clouds else None
+        self.camera_path_name = scene.camera_paths[0].name if scene.camera_paths else None
+        self.path_time_s, self.playing = 0.0, False
         self._remember(Path(path))
         self.messages.append(f"opened {path}")
         return True
@@ -106,30 +215,36 @@ class Editor:
         if target is None:
             self.messages.append("choose a file name to save to (Save as)")
             return False
-        scene = dataclasses.replace(self.scene, camera=self.camera)
         try:
-            save_scene(scene, target)
+            scene = save_scene(dataclasses.replace(self.scene, camera=self.camera), target)
         except (OSError, SceneError, ValueError) as error:
             self.messages.append(f"could not save {target}: {error}")
             return False
-        self.history.current = scene  # the saved camera is part of the scene now, not an edit
+        # the scene as saved (its camera, the particle files it names) is the current one, not an edit
+        self.history.current = scene
         self.saved_scene, self.path = scene, target
-        recovery_path(target).unlink(missing_ok=True)
+        discard_recovery(target)
         self._remember(target)
         self.messages.append(f"saved {target}")
         return True
 
     def autosave(self, now: float | None = None) -> bool:
-        """Write the recovery copy when there are unsaved edits and a minute has passed."""
+        """Write the recovery copy when there are unsaved edits it lacks and a minute has passed since the last.
+
+        `now` is `time.monotonic()`'s clock.  The copy is a scene of its own, with its
+        own particle files (`save_scene`), so writing it never touches the last save.
+        """
         now = time.monotonic() if now is None else now
-        if not self.dirty or self.path is None or now - self._last_recovery < AUTOSAVE_SECONDS:
+        if (not self.dirty or self.path is None or self.scene is self._recovered_scene
+                or now - self._last_recovery < AUTOSAVE_SECONDS):
             return False
         self._last_recovery = now
         try:
-            save_scene(self.scene, recovery_path(self.path))
+            save_scene(dataclasses.replace(self.scene, camera=self.camera), recovery_path(self.path))
         except (OSError, SceneError, ValueError) as error:
             self.messages.append(f"could not write the recovery file: {error}")
             return False
+        self._recovered_scene = self.scene
         return True
 
     def record_frame(self, stats: dict) -> None:

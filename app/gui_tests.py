@@ -8,12 +8,19 @@ editor under Xvfb and checks the results file.
 from __future__ import annotations
 
 import json
+import time
 from pathlib import Path
 
 import numpy as np
 from imgui_bundle import hello_imgui, imgui
 from imgui_bundle.imgui import test_engine as te
 from imgui_bundle.imgui.test_engine_checks import CHECK
+
+from app.editor import discard_recovery, recovery_path
+from cloudcore.editing import add_cloud
+from cloudcore.overlays import to_pixels
+from cloudcore.paths import camera_on_path
+from cloudcore.scenefile import save_scene
 
 #: frames to let the renderer catch up after an edit (illumination runs on the next frame)
 SETTLE = 4
@@ -34,12 +41,31 @@ def install(params, editor, viewport, panels, results_path: Path, outcome: dict)
         ctx.yield_(2)
         ctx.set_ref(name)
 
+    def viewport_rect(ctx):
+        return ctx.item_info("//Viewport/canvas").rect_full
+
+    def to_viewport(ctx, x: float, y: float) -> imgui.ImVec2:
+        """The screen position of the viewport point (x, y) in [0, 1]^2."""
+        rect = viewport_rect(ctx)
+        return imgui.ImVec2(rect.min.x + x * (rect.max.x - rect.min.x), rect.min.y + y * (rect.max.y - rect.min.y))
+
+    def where_on_screen(ctx, point) -> imgui.ImVec2:
+        """The screen position at which the viewport shows the world point."""
+        rect = viewport_rect(ctx)
+        size = (rect.max.x - rect.min.x, rect.max.y - rect.min.y)
+        pixels, _ = to_pixels(point, editor.camera, size)
+        x, y = pixels[0]
+        return imgui.ImVec2(rect.min.x + x, rect.min.y + y)
+
     def click_viewport(ctx, x: float, y: float) -> None:
-        rect = ctx.item_info("//Viewport/canvas").rect_full
-        ctx.mouse_move_to_pos(imgui.ImVec2(rect.min.x + x * (rect.max.x - rect.min.x),
-                                           rect.min.y + y * (rect.max.y - rect.min.y)))
+        ctx.mouse_move_to_pos(to_viewport(ctx, x, y))
         ctx.mouse_click(0)
         ctx.yield_(SETTLE)
+
+    def undo(ctx) -> None:
+        use_window(ctx, "Scene")
+        ctx.item_click("Undo")
+        ctx.yield_()
 
     def place_particles_by_clicking(ctx):
         use_window(ctx, "Clouds")
@@ -115,8 +141,187 @@ def install(params, editor, viewport, panels, results_path: Path, outcome: dict)
         CHECK(editor.scene is current)
         CHECK(any("could not open" in m and "malformed.toml" in m for m in editor.messages))
 
+    def recovery_is_offered_and_restores_the_edits(ctx):
+        """A recovery copy beside the scene (what a crashed session leaves) is offered and loads as one edit."""
+        before = editor.scene
+        save_scene(add_cloud(before, "recovered"), recovery_path(editor.path))
+        use_window(ctx, "Scene")
+        ctx.item_click("Recover unsaved edits")
+        CHECK([c.name for c in editor.scene.clouds] == [c.name for c in before.clouds] + ["recovered"])
+        ctx.item_click("Undo")
+        CHECK(editor.scene is before)
+        discard_recovery(editor.path)
+
+    def place_on_the_cloud_surface(ctx):
+        use_window(ctx, "Clouds")
+        ctx.item_click("Place")
+        ctx.item_click("On the cloud's surface")
+        cloud = editor.selected_cloud
+        before = editor.scene.clouds[cloud].particles
+        ctx.mouse_move_to_pos(where_on_screen(ctx, before[0, :3]))  # over a particle: the ray meets the cloud
+        ctx.mouse_click(0)
+        ctx.yield_(SETTLE)
+        after = editor.scene.clouds[cloud].particles
+        CHECK(len(after) == len(before) + 1)
+        gaps = np.linalg.norm(before[:, :3] - after[-1, :3], axis=1) - before[:, 3]
+        outcome["surface_gap_m"] = float(np.abs(gaps).min())
+        CHECK(bool(np.abs(gaps).min() < 1e-6) and bool(gaps.min() > -1e-6))  # on one sphere, inside none
+        undo(ctx)
+        use_window(ctx, "Clouds")
+        ctx.item_click("On the altitude plane")
+
+    def brush_stroke_is_one_undo_step(ctx):
+        use_window(ctx, "Clouds")
+        ctx.item_click("Brush")
+        ctx.item_click("Brush adds")
+        ctx.item_input_value("Altitude (m)", 900.0)
+        ctx.item_input_value("Brush radius (m)", 200.0)
+        ctx.item_input_value("Brush rate (per s)", 100.0)
+        before = editor.scene.particle_count
+        ctx.mouse_move_to_pos(to_viewport(ctx, 0.45, 0.35))
+        ctx.mouse_down(0)
+        for step in range(8):
+            ctx.mouse_move_to_pos(to_viewport(ctx, 0.45 + 0.01 * step, 0.35))
+            ctx.yield_(2)
+        ctx.mouse_up(0)
+        ctx.yield_(SETTLE)
+        added = editor.scene.particle_count - before
+        outcome["brush_stroke_added"] = added
+        CHECK(added >= 5)
+        undo(ctx)
+        CHECK(editor.scene.particle_count == before)
+        ctx.item_click("Redo")
+        CHECK(editor.scene.particle_count == before + added)
+        ctx.item_click("Undo")
+        use_window(ctx, "Clouds")
+        ctx.item_click("Place")
+
+    def box_fill_adds_sprites(ctx):
+        use_window(ctx, "Build")
+        ctx.item_input_value("Sprites", 150)
+        ctx.item_input_value("Sprite radius (m)", 40.0)
+        before = editor.scene.particle_count
+        ctx.item_click("Fill the selected cloud")
+        added = editor.scene.particle_count - before
+        outcome["box_fill_added"] = added
+        CHECK(0 < added <= 150)
+        undo(ctx)
+        CHECK(editor.scene.particle_count == before)
+
+    def move_cloud_by_dragging(ctx):
+        use_window(ctx, "Clouds")
+        ctx.item_click("Move cloud")
+        scene = editor.scene
+        centre, _ = scene.clouds[editor.selected_cloud].bounding_sphere()
+        start = where_on_screen(ctx, centre)
+        ctx.mouse_move_to_pos(start)
+        ctx.mouse_down(0)
+        ctx.mouse_move_to_pos(imgui.ImVec2(start.x + 80.0, start.y))
+        ctx.yield_(2)
+        ctx.mouse_up(0)
+        ctx.yield_(SETTLE)
+        moved = [i for i, (a, b) in enumerate(zip(scene.clouds, editor.scene.clouds)) if a is not b]
+        CHECK(len(moved) == 1)
+        if len(moved) == 1:
+            offsets = editor.scene.clouds[moved[0]].centres - scene.clouds[moved[0]].centres
+            outcome["drag_offset_m"] = offsets[0].tolist()
+            # the whole cloud moves rigidly, sideways on a horizontal plane
+            CHECK(bool(np.allclose(offsets, offsets[0]) and abs(offsets[0, 1]) < 1e-6 and offsets[0, 0] > 1.0))
+        undo(ctx)
+        CHECK(editor.scene == scene)
+        use_window(ctx, "Clouds")
+        ctx.item_click("Place")
+
+    def delete_key_and_statistics_toggle(ctx):
+        use_window(ctx, "Clouds")
+        ctx.item_click("Move particle")
+        cloud = editor.selected_cloud
+        before = editor.scene.clouds[cloud].particles
+        ctx.mouse_move_to_pos(where_on_screen(ctx, before[3, :3]))
+        ctx.mouse_click(0)  # a click picks without moving
+        ctx.yield_(SETTLE)
+        CHECK(editor.picked_particle is not None and editor.scene.clouds[cloud].particles is before)
+        ctx.key_press(imgui.Key.delete)
+        ctx.yield_(2)
+        CHECK(len(editor.scene.clouds[cloud].particles) == len(before) - 1)
+        undo(ctx)
+        CHECK(editor.scene.clouds[cloud].particles is before)
+        statistics = hello_imgui.get_runner_params().docking_params.dockable_window_of_name("Statistics")
+        ctx.key_press(imgui.Key.f3)
+        ctx.yield_(2)
+        CHECK(not statistics.is_visible)
+        ctx.key_press(imgui.Key.f3)
+        ctx.yield_(2)
+        CHECK(statistics.is_visible)
+        use_window(ctx, "Clouds")
+        ctx.item_click("Place")
+
+    def heat_map_changes_the_picture(ctx):
+        use_window(ctx, "Statistics")
+        ctx.yield_(SETTLE)
+        frame = capture(ctx)
+        ctx.item_check("Overdraw heat map")
+        ctx.yield_(SETTLE)
+        heat = capture(ctx)
+        ctx.item_uncheck("Overdraw heat map")
+        changed = (np.abs(frame.astype(int) - heat.astype(int)).max(axis=2) > 20).mean()
+        outcome["heat_map_changed_fraction"] = float(changed)
+        CHECK(bool(changed > 0.5))  # the sky has no overdraw: black where it was blue
+        CHECK(len(np.unique(heat.reshape(-1, 3), axis=0)) > 3)  # and the clouds show as a ramp
+
+    def overlays_outline_impostors_and_the_ring(ctx):
+        use_window(ctx, "LOD")
+        ctx.item_check("Impostor outlines")
+        ctx.item_check("Ring segments")
+        ctx.yield_(SETTLE)
+        plan = viewport.renderer.last_plan
+        kinds = [outline.kind for outline in viewport.outlines_drawn]
+        outcome["outlines"] = {kind: kinds.count(kind) for kind in set(kinds)}
+        textured = len(plan.of_kind("impostor", "crossfade"))
+        CHECK(textured > 0 and kinds.count("impostor") + kinds.count("crossfade") == textured)
+        CHECK(plan.ring is not None and 0 < kinds.count("ring") <= 8)
+        ctx.item_uncheck("Impostor outlines")
+        ctx.item_uncheck("Ring segments")
+        ctx.yield_()
+        CHECK(viewport.outlines_drawn == [])
+
+    def playing_a_camera_path_moves_the_camera(ctx):
+        use_window(ctx, "Camera")
+        path = editor.scene.camera_path(editor.camera_path_name)
+        start = editor.camera
+        ctx.item_click("Play")
+        ctx.yield_(6)
+        CHECK(editor.playing and editor.path_time_s > 0.0 and editor.camera != start)
+        ctx.item_click("Pause")
+        paused_at = editor.path_time_s
+        ctx.yield_(3)
+        CHECK(editor.path_time_s == paused_at)
+        CHECK(editor.camera == camera_on_path(path, paused_at, start.fov_y_deg))
+        ctx.item_input_value("Path time (s)", float(path.duration))
+        CHECK(bool(np.allclose(editor.camera.position, path.keys[-1, 1:4])))
+        ctx.item_click("Reset to the scene's camera")
+
+    def recording_runs_in_the_background(ctx):
+        use_window(ctx, "Camera")
+        video = results_path.with_name("pan.mp4")
+        ctx.item_input_value("Video", str(video))
+        ctx.item_input_value("Size (px)/$$0", 32)
+        ctx.item_input_value("Size (px)/$$1", 24)
+        ctx.item_input_value("Frames per second", 1.0)  # the 2 s path: 3 frames
+        ctx.item_click("Record the path to video")
+        started, deadline = imgui.get_frame_count(), time.monotonic() + 120.0
+        while panels.record_job is not None and time.monotonic() < deadline:
+            ctx.yield_()
+        outcome["frames_drawn_while_recording"] = imgui.get_frame_count() - started
+        CHECK(panels.record_job is None and any(m.startswith("recorded: wrote 3 frames") for m in editor.messages))
+        CHECK(video.exists() and imgui.get_frame_count() - started > 10)  # the editor kept drawing meanwhile
+
     tests = [place_particles_by_clicking, time_of_day_changes_the_picture, tolerance_drives_regeneration,
-             save_and_reopen, malformed_scene_keeps_the_current_one]
+             save_and_reopen, malformed_scene_keeps_the_current_one, recovery_is_offered_and_restores_the_edits,
+             place_on_the_cloud_surface,
+             brush_stroke_is_one_undo_step, box_fill_adds_sprites, move_cloud_by_dragging,
+             delete_key_and_statistics_toggle, heat_map_changes_the_picture, overlays_outline_impostors_and_the_ring,
+             playing_a_camera_path_moves_the_camera, recording_runs_in_the_background]
 
     def register():
         engine = hello_imgui.get_imgui_test_engine()

@@ -1,6 +1,6 @@
 """The editor's window: hello_imgui with a docking layout, the viewport and the panels.
 
-    python -m app [SCENE] [--self-test RESULTS.json]
+    python -m app [SCENE] [--window-size WIDTHxHEIGHT] [--self-test RESULTS.json]
     python -m app [SCENE] --frames N [--screenshot PNG] [--frame-stats JSON]
 
 The docking layout is remembered between runs (hello_imgui's settings file in
@@ -8,7 +8,11 @@ the user's config folder).  With --self-test the Dear ImGui Test Engine drives
 the real widgets (`app.gui_tests`), writes its results and exits 0 when every
 test passed, 1 otherwise.  With --frames the editor quits after N frames,
 optionally leaving a screenshot of the window and the per-frame statistics
-(the GUI benchmark).
+with the time between window frames (`scripts/bench_editor.py` summarises them).
+
+Keys: Ctrl+S saves, Ctrl+Z / Ctrl+Y (or Ctrl+Shift+Z) undo and redo, Delete
+removes the picked particle or else the selected cloud, F3 (or Ctrl+T) shows
+or hides the statistics.
 """
 
 from __future__ import annotations
@@ -17,6 +21,7 @@ import argparse
 import json
 import os
 import sys
+import time
 from pathlib import Path
 
 # the window's GLX context needs PyOpenGL's default platform, not the headless EGL one
@@ -33,10 +38,11 @@ from cloudcore.errors import SceneError  # noqa: E402
 DEFAULT_SCENE = Path(__file__).resolve().parents[1] / "resources" / "scenes" / "valley.toml"
 
 
-def runner_params(editor: Editor, viewport: Viewport, panels: Panels, testing: bool) -> hello_imgui.RunnerParams:
+def runner_params(editor: Editor, viewport: Viewport, panels: Panels, testing: bool,
+                  window_size: tuple[int, int] = (1280, 800)) -> hello_imgui.RunnerParams:
     params = hello_imgui.RunnerParams()
     params.app_window_params.window_title = "cloudview"
-    params.app_window_params.window_geometry.size = (1280, 800)
+    params.app_window_params.window_geometry.size = window_size
     params.imgui_window_params.default_imgui_window_type = (
         hello_imgui.DefaultImGuiWindowType.provide_full_screen_dock_space)
     params.imgui_window_params.show_menu_bar = False
@@ -54,7 +60,8 @@ def runner_params(editor: Editor, viewport: Viewport, panels: Panels, testing: b
     params.docking_params.docking_splits = [left, bottom]
     windows = []
     for label, dock, function in (("Viewport", "MainDockSpace", viewport.gui), ("Scene", "Left", panels.scene),
-                                  ("Clouds", "Left", panels.clouds), ("Lighting", "Left", panels.lighting),
+                                  ("Clouds", "Left", panels.clouds), ("Build", "Left", panels.build),
+                                  ("Lighting", "Left", panels.lighting),
                                   ("LOD", "Left", panels.lod), ("Camera", "Left", panels.camera),
                                   ("Statistics", "LeftBottom", panels.statistics)):
         window = hello_imgui.DockableWindow(label, dock, function)
@@ -62,23 +69,41 @@ def runner_params(editor: Editor, viewport: Viewport, panels: Panels, testing: b
     params.docking_params.dockable_windows = windows
 
     def every_frame():
-        io = imgui.get_io()
-        if io.key_ctrl and imgui.is_key_pressed(imgui.Key.s):
-            editor.save()
-        if io.key_ctrl and imgui.is_key_pressed(imgui.Key.z):
-            editor.redo() if io.key_shift else editor.undo()
-        if io.key_ctrl and imgui.is_key_pressed(imgui.Key.y):
-            editor.redo()
+        shortcuts(editor)
+        panels.poll_recording()
         editor.autosave()
 
+    def before_exit():
+        panels.close()
+        viewport.close()
+
     params.callbacks.pre_new_frame = every_frame
-    params.callbacks.before_exit = viewport.close
+    params.callbacks.before_exit = before_exit
     return params
+
+
+def shortcuts(editor: Editor) -> None:
+    io = imgui.get_io()
+    if io.key_ctrl and imgui.is_key_pressed(imgui.Key.s):
+        editor.save()
+    if io.key_ctrl and imgui.is_key_pressed(imgui.Key.z):
+        editor.redo() if io.key_shift else editor.undo()
+    if io.key_ctrl and imgui.is_key_pressed(imgui.Key.y):
+        editor.redo()
+    # Delete in a text field edits the text; held down it must not delete one thing after another
+    if not io.want_text_input and imgui.is_key_pressed(imgui.Key.delete, repeat=False):
+        editor.delete_selection()
+    if imgui.is_key_pressed(imgui.Key.f3, repeat=False) or (
+            io.key_ctrl and imgui.is_key_pressed(imgui.Key.t, repeat=False)):
+        statistics = hello_imgui.get_runner_params().docking_params.dockable_window_of_name("Statistics")
+        statistics.is_visible = not statistics.is_visible
 
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="cloudview", description="the cloudview editor")
     parser.add_argument("scene", nargs="?", type=Path, default=DEFAULT_SCENE)
+    parser.add_argument("--window-size", type=window_size, default=(1280, 800), metavar="WIDTHxHEIGHT",
+                        help="the window's size in pixels (default 1280x800)")
     parser.add_argument("--self-test", type=Path, metavar="RESULTS.json",
                         help="run the GUI tests with the Dear ImGui Test Engine, write results, exit")
     parser.add_argument("--frames", type=int, help="quit after this many frames")
@@ -92,7 +117,8 @@ def main(argv=None) -> int:
         return 2
     viewport = Viewport(editor)
     panels = Panels(editor, viewport)
-    params = runner_params(editor, viewport, panels, testing=args.self_test is not None)
+    params = runner_params(editor, viewport, panels, testing=args.self_test is not None,
+                           window_size=args.window_size)
     outcome = {}
     if args.self_test is not None:
         from app.gui_tests import install
@@ -110,12 +136,24 @@ def main(argv=None) -> int:
     return outcome.get("exit_code", 0)
 
 
+def window_size(text: str) -> tuple[int, int]:
+    """WIDTHxHEIGHT, both >= 1; argparse names this function in its refusal."""
+    width, height = (int(side) for side in text.lower().split("x"))
+    if width < 1 or height < 1:
+        raise ValueError(text)
+    return width, height
+
+
 def _quit_after(params, frames: int, editor: Editor, outcome: dict) -> None:
+    """Quit after `frames` viewport frames, each recorded with the time since the window's previous frame."""
     recorded = outcome.setdefault("frames", [])
+    previous = {"stats": None, "time": time.perf_counter()}
 
     def count():
-        if editor.last_stats and (not recorded or recorded[-1] is not editor.last_stats):
-            recorded.append(editor.last_stats)
+        now = time.perf_counter()
+        if editor.last_stats and editor.last_stats is not previous["stats"]:
+            recorded.append(editor.last_stats | {"window_frame_ms": 1e3 * (now - previous["time"])})
+        previous.update(stats=editor.last_stats, time=now)
         if len(recorded) >= frames:
             hello_imgui.get_runner_params().app_shall_exit = True
 

@@ -9,9 +9,13 @@ from pathlib import Path
 import numpy as np
 from imgui_bundle import imgui, implot
 
-from app.editor import Editor
+from app.editor import TOOLS, Editor, recovery_path
+from app.record_job import RecordJob
 from app.viewport import Viewport
-from cloudcore.editing import add_cloud, delete_cloud, replace_cloud
+from cloudcore.cloudgen import PRESETS, TYPICAL_CULL_FRACTION
+from cloudcore.editing import (add_cloud, add_preset_cloud, delete_cloud, fill_box, pick_ray, point_at_altitude,
+                               replace_cloud, with_mean_radius)
+from cloudcore.errors import SceneError
 from cloudcore.navigation import orbited
 from cloudcore.phase import PHASE_NAMES
 from cloudcore.settings import MODES
@@ -23,6 +27,21 @@ class Panels:
         self.file_field = str(editor.path or "")
         self.orbit_step_deg = 1.0
         self._dragging: dict[str, float] = {}
+        # box fill (Wang): the artist's box, its sprites, and the preset a new cloud is made from
+        self.box_centre = [float(v) for v in editor.camera.look_at]
+        self.box_size = [800.0, 400.0, 800.0]
+        self.box_particle_radius = 60.0
+        self.box_count = 300
+        self.box_default_cull = True  # Wang's third of the sprite size
+        self.box_cull_distance = TYPICAL_CULL_FRACTION * 2.0 * self.box_particle_radius
+        self.box_seed = 0
+        self.preset = 0
+        self.preset_scale = 1.0
+        # recording the chosen camera path
+        self.record_out = ""
+        self.record_size = [640, 480]
+        self.record_fps = 30.0
+        self.record_job: RecordJob | None = None
 
     def _slider_on_release(self, label: str, value: float, low: float, high: float, fmt: str = "%.3f"):
         """A slider whose new value counts once, on release: dragging does not re-shade every frame
@@ -56,6 +75,10 @@ class Panels:
         imgui.same_line()
         if imgui.button("Redo"):
             editor.redo()
+        if editor.path is not None and recovery_path(editor.path).exists():
+            if imgui.button("Recover unsaved edits"):
+                editor.recover()
+            imgui.set_item_tooltip(f"load {recovery_path(editor.path)}, written before the last session ended")
         for path in editor.recent[1:]:
             if imgui.small_button(f"recent: {path}"):
                 self.file_field = str(path)
@@ -64,7 +87,7 @@ class Panels:
         for message in reversed(editor.messages):
             imgui.text_wrapped(message)
 
-    # --- Clouds and particle placement -----------------------------------------------------------------
+    # --- Clouds, the viewport's tools, particle placement ---------------------------------------------------
     def clouds(self) -> None:
         editor = self.editor
         scene = editor.scene
@@ -79,10 +102,6 @@ class Panels:
             imgui.same_line()
             if imgui.button("Delete cloud"):
                 editor.edit(delete_cloud(scene, editor.selected_cloud))
-        imgui.separator()
-        imgui.text("Click in the viewport to place a particle")
-        _, editor.placement_altitude = imgui.slider_float("Altitude (m)", editor.placement_altitude, 0.0, 5000.0)
-        _, editor.particle_radius = imgui.slider_float("Particle radius (m)", editor.particle_radius, 1.0, 500.0)
         if editor.selected_cloud is not None:
             cloud = editor.scene.clouds[editor.selected_cloud]
             tau = scene.shading.optical_depth if cloud.optical_depth is None else cloud.optical_depth
@@ -90,6 +109,95 @@ class Panels:
             if tau is not None:
                 editor.edit(replace_cloud(scene, editor.selected_cloud,
                                           dataclasses.replace(cloud, optical_depth=float(tau))))
+            if len(cloud.particles):
+                radius = self._slider_on_release("Mean particle radius", float(cloud.radii.mean()), 1.0, 1000.0,
+                                                 "%.1f m")
+                if radius is not None:
+                    editor.edit(with_mean_radius(scene, editor.selected_cloud, radius))
+        imgui.separator_text("Viewport tool (left mouse)")
+        for number, (key, label) in enumerate(TOOLS):
+            if number % 2:
+                imgui.same_line()
+            if imgui.radio_button(label, editor.tool == key):
+                editor.tool = key
+        if imgui.radio_button("On the altitude plane", not editor.on_cloud_surface):
+            editor.on_cloud_surface = False
+        imgui.same_line()
+        if imgui.radio_button("On the cloud's surface", editor.on_cloud_surface):
+            editor.on_cloud_surface = True
+        _, editor.placement_altitude = imgui.slider_float("Altitude (m)", editor.placement_altitude, 0.0, 5000.0)
+        _, editor.particle_radius = imgui.slider_float("Particle radius (m)", editor.particle_radius, 1.0, 500.0)
+        if imgui.radio_button("Brush adds", not editor.brush_erases):
+            editor.brush_erases = False
+        imgui.same_line()
+        if imgui.radio_button("Brush erases", editor.brush_erases):
+            editor.brush_erases = True
+        _, editor.brush_radius = imgui.slider_float("Brush radius (m)", editor.brush_radius, 10.0, 3000.0, "%.0f")
+        _, editor.brush_rate = imgui.slider_float("Brush rate (per s)", editor.brush_rate, 1.0, 500.0, "%.0f")
+        imgui.text_wrapped("Move: drag in the viewport (Shift: in the screen's plane). Delete removes the picked "
+                           "particle, or else the selected cloud.")
+
+    # --- Build: Wang's box fill and cloud presets ---------------------------------------------------------
+    def build(self) -> None:
+        editor = self.editor
+        _, self.box_centre = imgui.input_float3("Box centre (m)", self.box_centre, "%.0f")
+        if imgui.button("Centre on the view"):
+            self._centre_box_on_view()
+        _, self.box_size = imgui.input_float3("Box size (m)", self.box_size, "%.0f")
+        _, self.box_particle_radius = imgui.input_float("Sprite radius (m)", self.box_particle_radius)
+        _, self.box_count = imgui.input_int("Sprites", self.box_count, 10, 100)
+        _, self.box_default_cull = imgui.checkbox("Cull at a third of the sprite size", self.box_default_cull)
+        if self.box_default_cull:
+            self.box_cull_distance = TYPICAL_CULL_FRACTION * 2.0 * self.box_particle_radius
+        imgui.begin_disabled(self.box_default_cull)
+        _, self.box_cull_distance = imgui.input_float("Cull distance (m)", self.box_cull_distance)
+        imgui.end_disabled()
+        _, self.box_seed = imgui.input_int("Seed", self.box_seed)
+        if editor.selected_cloud is not None:
+            if imgui.button("Fill the selected cloud"):
+                self._fill(editor.selected_cloud)
+            imgui.same_line()
+        if imgui.button("Fill a new cloud"):
+            self._fill(None)
+        imgui.separator_text("Cloud presets")
+        names = list(PRESETS)
+        _, self.preset = imgui.combo("Preset", self.preset, names)
+        _, self.preset_scale = imgui.slider_float("Scale", self.preset_scale, 0.1, 3.0)
+        if imgui.button("New cloud from preset"):
+            try:
+                editor.edit(add_preset_cloud(editor.scene, names[self.preset], self.box_centre, self.preset_scale,
+                                             self.box_seed))
+            except ValueError as error:
+                editor.messages.append(f"could not make a {names[self.preset]}: {error}")
+                return
+            editor.selected_cloud = len(editor.scene.clouds) - 1
+            editor.messages.append(f"added {editor.scene.clouds[-1].name}, base at the box centre")
+            self.box_seed += 1
+
+    def _fill(self, cloud_index: int | None) -> None:
+        editor = self.editor
+        try:
+            scene, filled = fill_box(editor.scene, cloud_index, self.box_centre, self.box_size,
+                                     self.box_particle_radius, self.box_count, self.box_cull_distance, self.box_seed)
+        except ValueError as error:
+            editor.messages.append(f"could not fill the box: {error}")
+            return
+        had = len(editor.scene.clouds[cloud_index].particles) if cloud_index is not None else 0
+        added = len(scene.clouds[filled].particles) - had
+        editor.edit(scene)
+        editor.selected_cloud = filled
+        editor.messages.append(f"box fill: {added} of {self.box_count} sprites kept in {scene.clouds[filled].name}")
+        self.box_seed += 1  # the next fill scatters differently
+
+    def _centre_box_on_view(self) -> None:
+        """The box centre where the middle of the view meets the placement altitude."""
+        editor = self.editor
+        # the ray through the middle of the view is the same at any aspect ratio
+        point = point_at_altitude(*pick_ray(editor.camera, 1.0, 0.5, 0.5), editor.placement_altitude)
+        if point is None:
+            editor.messages.append("the middle of the view never reaches the placement altitude")
+            return
+        self.box_centre = [float(v) for v in point]
 
     # --- Lighting -------------------------------------------------------------------------------------------
     def lighting(self) -> None:
@@ -134,6 +242,11 @@ class Panels:
                     impostor_min_size=2 ** min(sizes), impostor_max_size=2 ** max(sizes))
             except ValueError as error:
                 editor.messages.append(str(error))
+        imgui.separator_text("Overlays")
+        _, self.viewport.show_impostor_outlines = imgui.checkbox("Impostor outlines",
+                                                                 self.viewport.show_impostor_outlines)
+        imgui.same_line()
+        _, self.viewport.show_ring_segments = imgui.checkbox("Ring segments", self.viewport.show_ring_segments)
 
     # --- Camera ---------------------------------------------------------------------------------------------
     def camera(self) -> None:
@@ -155,6 +268,72 @@ class Panels:
         if editor.scene_duration_s > 0.0:
             _, editor.scene_time_s = imgui.slider_float("Scene time (s)", editor.scene_time_s, 0.0,
                                                         editor.scene_duration_s)
+        self._camera_paths()
+
+    def _camera_paths(self) -> None:
+        editor = self.editor
+        imgui.separator_text("Camera path")
+        names = [p.name for p in editor.scene.camera_paths]
+        if not names:
+            imgui.text("the scene has no camera paths")
+            return
+        current = names.index(editor.camera_path_name) if editor.camera_path_name in names else 0
+        changed, current = imgui.combo("Path", current, names)
+        if changed or editor.camera_path_name not in names:
+            editor.camera_path_name, editor.path_time_s, editor.playing = names[current], 0.0, False
+        if imgui.button("Play"):
+            editor.play()
+        imgui.same_line()
+        if imgui.button("Pause"):
+            editor.playing = False
+        duration = editor.scene.camera_path(editor.camera_path_name).duration
+        changed, seconds = imgui.slider_float("Path time (s)", editor.path_time_s, 0.0, duration, "%.2f")
+        if changed:
+            editor.playing = False
+            editor.show_path_time(seconds)
+        self._recording(editor.camera_path_name)
+
+    def _recording(self, path_name: str) -> None:
+        editor = self.editor
+        if not self.record_out:
+            stem = editor.path.stem if editor.path else "scene"
+            self.record_out = f"{stem}-{path_name}.mp4"
+        _, self.record_out = imgui.input_text("Video", self.record_out)
+        _, self.record_size = imgui.input_int2("Size (px)", self.record_size)
+        _, self.record_fps = imgui.input_float("Frames per second", self.record_fps)
+        job = self.record_job
+        if job is None:
+            if imgui.button("Record the path to video"):
+                self._start_recording(path_name)
+            return
+        imgui.text_wrapped(job.progress)
+        if imgui.button("Stop recording"):
+            job.stop()
+
+    def poll_recording(self) -> None:
+        """Every frame, whichever panel shows: say how a finished recording ended."""
+        job = self.record_job
+        status = job.poll() if job is not None else None
+        if status is not None:
+            self.record_job = None
+            outcome = "recorded" if status == 0 else "recording stopped" if status == 130 else "recording failed"
+            self.editor.messages.append(f"{outcome}: {job.progress}")
+
+    def _start_recording(self, path_name: str) -> None:
+        editor = self.editor
+        folder = editor.path.parent if editor.path else Path.cwd()
+        try:
+            self.record_job = RecordJob(dataclasses.replace(editor.scene, camera=editor.camera), folder, path_name,
+                                        Path(self.record_out), *self.record_size, self.record_fps)
+        except (OSError, SceneError, ValueError) as error:
+            editor.messages.append(f"could not start recording: {error}")
+            return
+        editor.messages.append(f"recording {path_name} to {self.record_out} (in the background)")
+
+    def close(self) -> None:
+        """Stop a recording still running: the frames so far stay a playable video."""
+        if self.record_job is not None:
+            self.record_job.stop()
 
     # --- Statistics -----------------------------------------------------------------------------------------
     def statistics(self) -> None:
@@ -175,6 +354,8 @@ class Panels:
                    f"rebuilt {stats['layers_rebuilt']}")
         imgui.text(f"texture memory {stats['texture_bytes'] / 2**20:.1f} MiB")
         _, self.viewport.measure_overdraw = imgui.checkbox("Measure overdraw", self.viewport.measure_overdraw)
+        imgui.same_line()
+        _, self.viewport.heat_map = imgui.checkbox("Overdraw heat map", self.viewport.heat_map)
         if "overdraw_mean" in stats:
             imgui.text(f"overdraw mean {stats['overdraw_mean']:.1f}, max {stats['overdraw_max']:.0f}, "
                        f"analytic {stats['overdraw_analytic']:.1f}")

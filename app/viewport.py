@@ -1,8 +1,15 @@
-"""The 3D viewport: the engine draws the editor's scene into the window's GL context; clicks place particles.
+"""The 3D viewport: the engine draws the editor's scene into the window's GL context; the mouse edits it.
 
-Mouse: left click places a particle in the selected cloud (on the plane at the
-placement altitude), right drag turns the camera, middle drag or wheel flies.
-Keys while the viewport is hovered: W/S forward/back, A/D sideways, Q/E down/up.
+Mouse: the left button uses the editor's tool (`app.tools`): Place puts a
+particle in the selected cloud on a click, Brush adds (or erases) particles
+while held, Move cloud / Move particle drag what they grab parallel to the
+placement plane (with Shift held at the press, in the screen's plane).  Right
+drag turns the camera, the wheel flies forward.  Keys while the viewport is
+hovered: W/S forward/back, A/D sideways, Q/E down/up.
+
+Over the picture it outlines the impostors and ring segments of the frame plan
+(`cloudcore.overlays`) when asked, and shows the overdraw heat map
+(`cloudcore.heatmap`) in place of the frame when that is on.
 """
 
 from __future__ import annotations
@@ -13,27 +20,46 @@ import numpy as np
 from imgui_bundle import imgui
 
 from app.editor import Editor
-from cloudcore.editing import add_particle, pick_ray, point_at_altitude
+from app.tools import ViewportTools
+from cloudcore.editing import pick_ray
 from cloudcore.gl.context import WindowContext
 from cloudcore.gl.frame import FrameRenderer
+from cloudcore.gl.image_texture import ImageTexture
+from cloudcore.heatmap import heat_image, ramp_colours
 from cloudcore.navigation import moved, turned
+from cloudcore.overlays import impostor_outlines, ring_outlines, to_pixels
 
 TURN_DEG_PER_PIXEL = 0.2
+#: outline colours (RGBA): impostors yellow, crossfading clouds orange, ring panels cyan, the picked particle red
+_OUTLINE_COLOURS = {"impostor": (255, 220, 0, 220), "crossfade": (255, 140, 0, 220), "ring": (0, 220, 255, 200)}
+_PICKED_COLOUR = (255, 60, 60, 255)
+_LEGEND_STEPS = 32
 
 
 class Viewport:
     def __init__(self, editor: Editor):
         self.editor = editor
+        self.tools = ViewportTools(editor)
         self.renderer: FrameRenderer | None = None
         self.fly_speed = 300.0  # metres per second
         self.measure_overdraw = False
-        self.capture_next = False  # a GUI test asks for the next frame's pixels
+        self.heat_map = False  # show the overdraw counts instead of the frame
+        self.show_impostor_outlines = False
+        self.show_ring_segments = False
+        self.capture_next = False  # a GUI test asks for the next frame's pixels (as shown)
         self.captured: np.ndarray | None = None
+        self.outlines_drawn: list = []  # this frame's overlay outlines (`cloudcore.overlays.Outline`)
         self.regenerations_total = 0
+        self._heat_texture: ImageTexture | None = None
+        self._bounds: tuple | None = None  # (clouds, centres, radii): the bounding spheres the plan used
         self._last_time = time.perf_counter()
 
     def gui(self) -> None:
         editor = self.editor
+        now = time.perf_counter()
+        # one clock for flying, brushing and playing paths; a stall (re-shading) is not a leap
+        seconds, self._last_time = min(now - self._last_time, 0.25), now
+        editor.advance_playback(seconds)
         available = imgui.get_content_region_avail()
         width, height = max(1, int(available.x)), max(1, int(available.y))
         if self.renderer is None:
@@ -42,42 +68,96 @@ class Viewport:
         start = time.perf_counter()
         _, stats = self.renderer.render(editor.scene, camera=editor.camera, settings=editor.settings,
                                         time_s=editor.scene_time_s, read_back=False)
-        if self.measure_overdraw:
-            stats |= self.renderer.measure_overdraw()[1]
+        heat = None
+        if self.measure_overdraw or self.heat_map:
+            counts, overdraw = self.renderer.measure_overdraw()
+            stats |= overdraw
+            heat = heat_image(counts) if self.heat_map else None
         texture = self.renderer.display_texture()
+        # texture coordinates of the image's top left and bottom right corners: the frame's rows are bottom
+        # first as GL keeps them (flip v), the heat map's top first
+        uv_top_left, uv_bottom_right = imgui.ImVec2(0, 1), imgui.ImVec2(1, 0)
+        if heat is not None:
+            if self._heat_texture is None:
+                self._heat_texture = ImageTexture()
+            texture = self._heat_texture.upload(heat[0])
+            uv_top_left, uv_bottom_right = imgui.ImVec2(0, 0), imgui.ImVec2(1, 1)
         if self.capture_next:
-            self.captured, self.capture_next = self.renderer.read_display(), False
-        stats["viewport_ms"] = 1e3 * (time.perf_counter() - start)
+            self.captured = heat[0][..., :3] if heat is not None else self.renderer.read_display()
+            self.capture_next = False
+        stats |= {"viewport_ms": 1e3 * (time.perf_counter() - start), "viewport_width": width,
+                  "viewport_height": height}
         self.regenerations_total += stats.get("impostors_regenerated", 0)
         editor.record_frame(stats)
 
         origin = imgui.get_cursor_screen_pos()
-        # GL keeps rows bottom first: flip v
-        imgui.image(imgui.ImTextureRef(texture), imgui.ImVec2(width, height), imgui.ImVec2(0, 1), imgui.ImVec2(1, 0))
+        imgui.image(imgui.ImTextureRef(texture), imgui.ImVec2(width, height), uv_top_left, uv_bottom_right)
+        self._draw_overlays(origin, (width, height), heat[1] if heat is not None else None)
         imgui.set_cursor_screen_pos(origin)
         clicked = imgui.invisible_button("canvas", imgui.ImVec2(width, height),
                                          imgui.ButtonFlags_.mouse_button_left | imgui.ButtonFlags_.mouse_button_right)
         hovered = imgui.is_item_hovered()
-        mouse = imgui.get_mouse_pos()
-        if clicked and imgui.is_mouse_released(imgui.MouseButton_.left):
-            self._place_particle((mouse.x - origin.x) / width, (mouse.y - origin.y) / height, width / height)
-        self._navigate(hovered)
+        self._use_tool(origin, (width, height), clicked, seconds)
+        self._navigate(hovered, seconds)
 
-    def _place_particle(self, x: float, y: float, aspect: float) -> None:
-        editor = self.editor
-        if editor.selected_cloud is None:
-            editor.messages.append("select or add a cloud before placing particles")
-            return
-        origin, direction = pick_ray(editor.camera, aspect, x, y)
-        point = point_at_altitude(origin, direction, editor.placement_altitude)
-        if point is None:
-            editor.messages.append(f"that ray never reaches the placement altitude ({editor.placement_altitude:g} m)")
-            return
-        editor.edit(add_particle(editor.scene, editor.selected_cloud, point, editor.particle_radius))
+    def _use_tool(self, origin, size, clicked: bool, seconds: float) -> None:
+        mouse, (width, height) = imgui.get_mouse_pos(), size
+        ray = pick_ray(self.editor.camera, width / height, (mouse.x - origin.x) / width, (mouse.y - origin.y) / height)
+        left = imgui.MouseButton_.left
+        if imgui.is_item_activated() and imgui.is_mouse_clicked(left):
+            self.tools.press(ray, screen_plane=imgui.get_io().key_shift)
+        elif self.tools.busy and imgui.is_mouse_down(left):
+            self.tools.hold(ray, seconds)
+        elif imgui.is_mouse_released(left):
+            self.tools.release(ray, clicked)
 
-    def _navigate(self, hovered: bool) -> None:
-        now = time.perf_counter()
-        seconds, self._last_time = min(now - self._last_time, 0.25), now
+    def _draw_overlays(self, origin, size, heat_top: float | None) -> None:
+        editor, plan = self.editor, self.renderer.last_plan
+        draw = imgui.get_window_draw_list()
+        outlines = []
+        if plan is not None and self.show_impostor_outlines:
+            outlines += impostor_outlines(plan, *self._bounding_spheres(), editor.camera, size)
+        if plan is not None and self.show_ring_segments:
+            outlines += ring_outlines(plan, editor.camera, size, editor.settings.ring_elevation_deg)
+        for outline in outlines:
+            points = [imgui.ImVec2(origin.x + x, origin.y + y) for x, y in outline.points]
+            draw.add_polyline(points, imgui.IM_COL32(*_OUTLINE_COLOURS[outline.kind]), 1.5,
+                              imgui.ImDrawFlags_.closed.value)
+        self.outlines_drawn = outlines
+        picked = editor.picked_particle
+        if picked is not None:
+            pixels, in_front = to_pixels(editor.scene.clouds[picked[0]].centres[picked[1]], editor.camera, size)
+            if in_front[0]:
+                x, y = pixels[0]
+                draw.add_circle(imgui.ImVec2(origin.x + x, origin.y + y), 6.0, imgui.IM_COL32(*_PICKED_COLOUR),
+                                thickness=2.0)
+        if heat_top is not None:
+            self._draw_legend(draw, origin, size, heat_top)
+
+    def _draw_legend(self, draw, origin, size, top: float) -> None:
+        """The heat map's ramp from 0 to `top` fragments per pixel, in the viewport's lower left corner."""
+        step_width, bar_height = 5.0, 12.0
+        left, bottom = origin.x + 10.0, origin.y + size[1] - 10.0
+        for step, colour in enumerate(ramp_colours(np.linspace(0.0, 1.0, _LEGEND_STEPS))):
+            x = left + step * step_width
+            draw.add_rect_filled(imgui.ImVec2(x, bottom - bar_height), imgui.ImVec2(x + step_width, bottom),
+                                 imgui.IM_COL32(*(int(c) for c in colour), 255))
+        white = imgui.IM_COL32(255, 255, 255, 255)
+        label_y = bottom - bar_height - imgui.get_text_line_height() - 2.0
+        draw.add_text(imgui.ImVec2(left, label_y), white, "0")
+        draw.add_text(imgui.ImVec2(left + _LEGEND_STEPS * step_width + 6.0, bottom - imgui.get_text_line_height()),
+                      white, f"{top:g} fragments per pixel")
+
+    def _bounding_spheres(self) -> tuple[np.ndarray, np.ndarray]:
+        """The clouds' bounding spheres, as the renderer plans with them; remade when the clouds change."""
+        clouds = self.editor.scene.clouds
+        if self._bounds is None or self._bounds[0] is not clouds:
+            spheres = [cloud.bounding_sphere() for cloud in clouds]
+            self._bounds = (clouds, np.array([s[0] for s in spheres]).reshape(-1, 3),
+                            np.array([s[1] for s in spheres], dtype=np.float64))
+        return self._bounds[1], self._bounds[2]
+
+    def _navigate(self, hovered: bool, seconds: float) -> None:
         editor, io = self.editor, imgui.get_io()
         if imgui.is_item_active() and imgui.is_mouse_dragging(imgui.MouseButton_.right):
             delta = io.mouse_delta
@@ -94,7 +174,9 @@ class Viewport:
             editor.camera = moved(editor.camera, forward=io.mouse_wheel * self.fly_speed * 0.5)
 
     def close(self) -> None:
+        if self._heat_texture is not None:
+            self._heat_texture.close()
+            self._heat_texture = None
         if self.renderer is not None:
             self.renderer.close()
             self.renderer = None
-

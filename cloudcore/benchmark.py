@@ -25,6 +25,15 @@ from cloudcore.settings import FULL_3D, RenderSettings
 PSNR_CAP_DB = 100.0
 
 
+def resident_memory_bytes() -> int:
+    """This process's resident memory now, from /proc (Linux): on llvmpipe "GPU" memory is process memory too."""
+    with open("/proc/self/status", encoding="ascii") as status:
+        for line in status:
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1]) * 1024
+    raise RuntimeError("no VmRSS line in /proc/self/status")
+
+
 def path_views(scene: Scene, path_name: str, frames: int) -> list:
     """(scene clock in seconds, camera) of `frames` frames spread along the path."""
     path = scene.camera_path(path_name)

@@ -1,8 +1,8 @@
 """Overdraw: how many splat fragments land on each pixel, measured and estimated (numpy).
 
 The GL side counts blended fragments per pixel (`FrameRenderer.measure_overdraw`);
-this module turns those counts into the reported numbers and a heat map, and
-gives the analytic estimate Harris and Wang reason with: the summed screen area
+this module turns those counts into the reported numbers (their heat map is
+`cloudcore.heatmap`) and gives the analytic estimate Harris and Wang reason with: the summed screen area
 of the splats over the screen area.  The estimate clips each disc to the
 screen by its bounding square but ignores terrain in front, so it exceeds the
 measured mean where hills hide clouds.
@@ -16,26 +16,12 @@ from __future__ import annotations
 
 import numpy as np
 
-#: colour stops of the heat map, from no fragment (black) to the maximum (white)
-_HEAT_STOPS = np.array([[0, 0, 0], [0, 0, 160], [190, 0, 120], [255, 110, 0], [255, 230, 60], [255, 255, 255]],
-                       dtype=np.float64)
-
-
 def overdraw_statistics(counts: np.ndarray) -> dict:
     """Mean over the screen, mean over covered pixels, and maximum of a per-pixel fragment count."""
     covered = counts > 0
     return {"overdraw_mean": float(counts.mean()) if counts.size else 0.0,
             "overdraw_mean_covered": float(counts[covered].mean()) if covered.any() else 0.0,
             "overdraw_max": float(counts.max()) if counts.size else 0.0}
-
-
-def heat_map(counts: np.ndarray, scale_max: float | None = None) -> np.ndarray:
-    """8-bit RGB: fragment counts mapped through the heat stops, 0 black, `scale_max` (default the max) white."""
-    top = float(counts.max()) if scale_max is None and counts.size else float(scale_max or 0.0)
-    level = np.clip(counts / top, 0.0, 1.0) if top > 0 else np.zeros_like(counts, dtype=np.float64)
-    positions = np.linspace(0.0, 1.0, len(_HEAT_STOPS))
-    rgb = np.stack([np.interp(level, positions, _HEAT_STOPS[:, c]) for c in range(3)], axis=-1)
-    return np.round(rgb).astype(np.uint8)
 
 
 def analytic_overdraw(centres: np.ndarray, radii: np.ndarray, view: np.ndarray, projection: np.ndarray,
@@ -91,3 +77,9 @@ def cloud_block_overdraw_statistics(overdraw: np.ndarray) -> dict:
     return {"block_overdraw_max": float(overdraw.max()) if overdraw.size else 0.0,
             "block_overdraw_mean": float(overdraw.mean()) if overdraw.size else 0.0,
             "blocks": int(overdraw.size)}
+
+
+def scene_block_overdraw_statistics(clouds, block_size: float = WANG_BLOCK_SIZE_M) -> dict:
+    """`cloud_block_overdraw_statistics` over every particle of `clouds`."""
+    particles = np.concatenate([c.particles for c in clouds]) if clouds else np.zeros((0, 4))
+    return cloud_block_overdraw_statistics(cloud_block_overdraw(particles[:, :3], particles[:, 3], block_size)[1])

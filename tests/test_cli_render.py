@@ -33,7 +33,7 @@ def test_render_writes_the_png_and_the_stats(rendered):
     assert image.shape == (64, 96, 3) and image.dtype == np.uint8
     stats = json.loads((out / "v.json").read_text())
     assert {"frame_ms", "world_ms", "cloud_ms", "particles_drawn", "clouds_drawn", "clouds_culled",
-            "overdraw_mean", "overdraw_max", "overdraw_analytic"} <= set(stats)
+            "overdraw_mean", "overdraw_max", "overdraw_analytic", "block_overdraw_mean", "blocks"} <= set(stats)
     assert stats["overdraw_max"] >= stats["overdraw_mean"] > 0
     assert iio.imread(out / "heat.png").shape == (64, 96, 3)
     assert stats["clouds_drawn"] + stats["clouds_culled"] == 34

@@ -14,15 +14,18 @@ import numpy as np
 import pytest
 
 from cloudcore.cloudgen import cumulus
-from cloudcore.scene import Camera, Cloud, Lighting, Scene, Terrain
+from cloudcore.scene import Camera, CameraPath, Cloud, Lighting, Scene, Terrain
 from cloudcore.scenefile import save_scene
 
 
 def small_editor_scene() -> Scene:
     clouds = tuple(Cloud(f"c{i}", cumulus((x, 900.0, z), (700.0, 350.0, 500.0), 250, 60.0, seed=i))
                    for i, (x, z) in enumerate([(-600.0, -2000.0), (500.0, -2600.0), (0.0, -6000.0)]))
+    pan = CameraPath("pan", [[0.0, 0.0, 400.0, 0.0, 0.0, 900.0, -2000.0],
+                             [2.0, 600.0, 500.0, 300.0, 0.0, 900.0, -2000.0]])
     return Scene(camera=Camera((0.0, 400.0, 0.0), (0.0, 900.0, -2000.0), 60.0), lighting=Lighting(15.5),
-                 clouds=clouds, terrain=Terrain(size=(8000.0, 8000.0), resolution=33, height=300.0, seed=2))
+                 clouds=clouds, terrain=Terrain(size=(8000.0, 8000.0), resolution=33, height=300.0, seed=2),
+                 camera_paths=(pan,))
 
 
 @pytest.fixture(scope="module")
@@ -43,7 +46,12 @@ def gui_results(tmp_path_factory):
 
 @pytest.mark.parametrize("name", ["place_particles_by_clicking", "time_of_day_changes_the_picture",
                                   "tolerance_drives_regeneration", "save_and_reopen",
-                                  "malformed_scene_keeps_the_current_one"])
+                                  "malformed_scene_keeps_the_current_one", "recovery_is_offered_and_restores_the_edits",
+                                  "place_on_the_cloud_surface",
+                                  "brush_stroke_is_one_undo_step", "box_fill_adds_sprites", "move_cloud_by_dragging",
+                                  "delete_key_and_statistics_toggle", "heat_map_changes_the_picture",
+                                  "overlays_outline_impostors_and_the_ring", "playing_a_camera_path_moves_the_camera",
+                                  "recording_runs_in_the_background"])
 def test_gui(gui_results, name):
     result, report = gui_results
     assert report["tests"][name] == "success", report["logs"].get(name, "") + result.stdout[-2000:]

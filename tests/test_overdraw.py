@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from cloudcore.camera import NEAR_PLANE_M, projection_matrix, view_matrix
-from cloudcore.overdraw import analytic_overdraw, heat_map, overdraw_statistics
+from cloudcore.overdraw import analytic_overdraw, overdraw_statistics
 from cloudcore.scene import Camera, Cloud, Scene
 from cloudcore.settings import FULL_3D
 
@@ -29,12 +29,9 @@ def test_splats_behind_the_near_plane_are_not_estimated():
     assert analytic_overdraw(behind, np.array([10.0]), view, projection, NEAR_PLANE_M) == 0.0
 
 
-def test_statistics_and_heat_map_of_known_counts():
+def test_statistics_of_known_counts():
     counts = np.array([[0.0, 2.0], [4.0, 0.0]], dtype=np.float32)
     assert overdraw_statistics(counts) == {"overdraw_mean": 1.5, "overdraw_mean_covered": 3.0, "overdraw_max": 4.0}
-    heat = heat_map(counts)
-    assert heat.dtype == np.uint8 and (heat[0, 0] == 0).all() and (heat[1, 0] == 255).all()
-    assert (heat_map(np.zeros((2, 2))) == 0).all()
 
 
 def test_counted_fragments_match_the_disc_and_stack(renderer):

@@ -1,11 +1,17 @@
-"""Property-based checks (hypothesis) of the scene round trip and the shading contract."""
+"""Property-based checks (hypothesis) of the scene round trip, the loader's refusals and the shading contract."""
+
+import math
 
 import numpy as np
+import pytest
+import tomlkit
 from hypothesis import given, settings, strategies as st
 from hypothesis.extra.numpy import arrays
 
+from cloudcore.errors import SceneError
+from cloudcore.phase import MAX_ABS_G, PHASE_NAMES
 from cloudcore.scene import Camera, Cloud, Lighting, Scene, Shading
-from cloudcore.scenefile import load_scene, save_scene
+from cloudcore.scenefile import load_scene, save_scene, scene_to_dict
 from cloudcore.shading import incident_light
 
 finite = st.floats(-1e6, 1e6, allow_nan=False)
@@ -45,6 +51,62 @@ def test_random_valid_scenes_save_and_reload_identically(tmp_path_factory, scene
     assert load_scene(path) == saved
     for original, again in zip(scene.clouds, saved.clouds):
         np.testing.assert_array_equal(original.particles, again.particles)
+
+
+def outside(low: float, high: float):
+    """Floats out of [low, high], NaN and the infinities included."""
+    return st.floats().filter(lambda value: not low <= value <= high)
+
+
+not_finite = st.sampled_from([math.nan, math.inf, -math.inf])
+
+
+@st.composite
+def bad_rows(draw, rows: list):
+    """Particle rows with one radius <= 0 or one coordinate not finite."""
+    rows = [list(row) for row in rows]
+    row, column = draw(st.integers(0, len(rows) - 1)), draw(st.integers(0, 3))
+    rows[row][column] = draw(not_finite | st.floats(max_value=0.0)) if column == 3 else draw(not_finite)
+    return rows
+
+
+@st.composite
+def invalid_documents(draw):
+    """(a random valid scene's TOML document with one value made invalid, the field that value is at)."""
+    document = scene_to_dict(draw(scenes()))
+    mistakes = [
+        (("camera", "fov_y_deg"), outside(1.0, 170.0)),
+        (("camera", "position"), st.lists(finite, max_size=5).filter(lambda v: len(v) != 3)
+         | st.tuples(finite, not_finite, finite).map(list)),
+        (("lighting", "time_of_day"), outside(0.0, 24.0)),
+        (("shading", "albedo"), outside(0.0, 1.0)),
+        (("shading", "optical_depth"), st.floats(max_value=-1e-300) | not_finite),
+        (("shading", "phase"), st.text(max_size=20).filter(lambda name: name not in PHASE_NAMES)),
+        (("shading", "g"), outside(-MAX_ABS_G, MAX_ABS_G)),
+    ]
+    for index, cloud in enumerate(document.get("clouds", [])):
+        mistakes.append((("clouds", index, "albedo"), outside(0.0, 1.0)))
+        if cloud["particles"]:
+            mistakes.append((("clouds", index, "particles"), bad_rows(cloud["particles"])))
+    path, values = draw(st.sampled_from(mistakes))
+    table = document
+    for step in path[:-1]:
+        table = table[step]
+    table[path[-1]] = draw(values)
+    return document, "".join(f"[{step}]" if isinstance(step, int) else f".{step}" for step in path).lstrip(".")
+
+
+@settings(max_examples=80, deadline=None)
+@given(invalid=invalid_documents())
+def test_random_invalid_scenes_are_refused_naming_the_field(tmp_path_factory, invalid):
+    document, field = invalid
+    path = tmp_path_factory.mktemp("invalid") / "scene.toml"
+    path.write_text(tomlkit.dumps(document), encoding="utf-8")
+    with pytest.raises(SceneError) as refused:
+        load_scene(path)
+    message = str(refused.value)
+    assert refused.value.field == field, message
+    assert message.startswith(f"{path}: {field}: ") and len(message.splitlines()) == 1
 
 
 @settings(max_examples=60, deadline=None)

@@ -8,7 +8,8 @@ from pathlib import Path
 
 from cloudcore.cli.settings_args import add_settings_arguments, settings_from
 from cloudcore.errors import SceneError
-from cloudcore.overdraw import heat_map
+from cloudcore.heatmap import heat_image
+from cloudcore.overdraw import scene_block_overdraw_statistics
 from cloudcore.paths import camera_on_path
 from cloudcore.scene import Camera
 from cloudcore.scenefile import load_scene
@@ -61,9 +62,10 @@ def run(args) -> int:
         if args.overdraw or args.stats:
             counts, overdraw = renderer.measure_overdraw()
             stats |= overdraw
+            stats |= scene_block_overdraw_statistics(scene.clouds)  # Wang's view-independent counterpart
     _write(args.out, lambda path: iio.imwrite(path, image))
     if args.overdraw:
-        _write(args.overdraw, lambda path: iio.imwrite(path, heat_map(counts)))
+        _write(args.overdraw, lambda path: iio.imwrite(path, heat_image(counts)[0][..., :3]))
     if args.stats:
         _write(args.stats, lambda path: path.write_text(json.dumps(stats, indent=2) + "\n"))
     print(f"wrote {args.out} ({args.width}x{args.height}): frame {stats['frame_ms']:.1f} ms "
@@ -72,7 +74,8 @@ def run(args) -> int:
           f"{stats['clouds_culled']} culled")
     if "overdraw_mean" in stats:
         print(f"overdraw: mean {stats['overdraw_mean']:.2f}, max {stats['overdraw_max']:.0f} "
-              f"(analytic estimate {stats['overdraw_analytic']:.2f})")
+              f"(analytic estimate {stats['overdraw_analytic']:.2f}); cloud blocks: mean "
+              f"{stats['block_overdraw_mean']:.2f}, max {stats['block_overdraw_max']:.2f} over {stats['blocks']}")
     return 0
 
 

@@ -23,12 +23,17 @@ from OpenGL import GL
 from cloudcore.gl.pyrender_compat import pyrender
 
 
+def check_frame_size(width: int, height: int) -> None:
+    """Refuse a frame without pixels (a minimised window asks for 0x0)."""
+    if width < 1 or height < 1:
+        raise ValueError(f"framebuffer size must be positive, got {width}x{height}")
+
+
 class RenderTargets:
     """The linear colour + depth target of one frame size and the world's colour beside it."""
 
     def __init__(self, width: int, height: int):
-        if width < 1 or height < 1:
-            raise ValueError(f"framebuffer size must be positive, got {width}x{height}")
+        check_frame_size(width, height)
         self.width, self.height = int(width), int(height)
         self.depth_renderbuffer = GL.glGenRenderbuffers(1)
         GL.glBindRenderbuffer(GL.GL_RENDERBUFFER, self.depth_renderbuffer)
@@ -77,8 +82,7 @@ class HeadlessContext(RenderTargets):
     """An EGL context of a fixed size (PYOPENGL_PLATFORM=egl) with our targets."""
 
     def __init__(self, width: int, height: int):
-        if width < 1 or height < 1:
-            raise ValueError(f"framebuffer size must be positive, got {width}x{height}")
+        check_frame_size(width, height)
         self.renderer = pyrender.OffscreenRenderer(int(width), int(height))
         self.make_current()
         super().__init__(width, height)

@@ -32,7 +32,7 @@ from cloudcore.facing import CloudFacings
 from cloudcore.formation import formation_state
 from cloudcore.illumination import IlluminationCache
 from cloudcore.frameplan import FramePlan, plan_frame
-from cloudcore.gl.context import HeadlessContext, WindowContext
+from cloudcore.gl.context import HeadlessContext, WindowContext, check_frame_size
 from cloudcore.gl.impostor_store import ImpostorStore
 from cloudcore.gl.objects import ObjectPass
 from cloudcore.gl.programs import build_program
@@ -164,6 +164,7 @@ class FrameRenderer:
             return
         if not isinstance(self.context, WindowContext):
             raise TypeError("a headless renderer has a fixed size; make a new one")
+        check_frame_size(width, height)  # before anything is closed: a refused size leaves the renderer as it was
         self._close_screen_targets()
         self.context.close()
         self.context = WindowContext(width, height)

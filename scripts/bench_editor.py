@@ -1,0 +1,83 @@
+"""The editor's frame times: the window at a size (default 1280x720) on a scene, auto mode, camera still. JSON out.
+
+    python scripts/bench_editor.py [resources/scenes/valley.toml] [--size 1280x720] [--frames 150]
+                                   [--warm-up 10] [--json out/bench_editor.json]
+
+Runs the real editor (`python -m app SCENE --frames N --frame-stats ...`), under
+`xvfb-run` when there is no display, and summarises its per-frame statistics
+after the warm-up frames (the first shades every cloud): the time between
+window frames (what the user feels: render, GUI and swap), the viewport's share
+(the engine's frame and its display copy) and the engine's passes, each as
+mean, median and 95th percentile in milliseconds.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import shutil
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+DEFAULT_SCENE = ROOT / "resources" / "scenes" / "valley.toml"
+_TIMES = ("window_frame_ms", "viewport_ms", "frame_ms", "cloud_ms", "world_ms", "impostor_update_ms")
+
+
+def run_editor(scene: Path, size: str, frames: int, stats_file: Path, home: Path) -> None:
+    command = [sys.executable, "-m", "app", str(scene), "--window-size", size, "--frames", str(frames),
+               "--frame-stats", str(stats_file)]
+    if not os.environ.get("DISPLAY"):
+        if shutil.which("xvfb-run") is None:
+            sys.exit("bench_editor: no display and no xvfb-run (install xvfb)")
+        width, height = (int(side) for side in size.split("x"))
+        command = ["xvfb-run", "-a", "-s", f"-screen 0 {width + 64}x{height + 64}x24"] + command
+    # a private HOME: the benchmark neither reads nor rewrites the user's panel layout
+    env = {k: v for k, v in os.environ.items() if k != "PYOPENGL_PLATFORM"} | {"HOME": str(home)}
+    subprocess.run(command, check=True, cwd=ROOT, env=env)
+
+
+def summarise(frames: list[dict], warm_up: int) -> dict:
+    measured = frames[warm_up:]
+    if not measured:
+        raise SystemExit(f"bench_editor: only {len(frames)} frames recorded, none after {warm_up} warm-up frames")
+    summary = {"frames": len(measured),
+               "viewport": [measured[-1]["viewport_width"], measured[-1]["viewport_height"]],
+               "particles_drawn_mean": float(np.mean([f["particles_drawn"] for f in measured]))}
+    for key in _TIMES:
+        values = np.array([f[key] for f in measured], dtype=np.float64)
+        summary[key] = {"mean": float(values.mean()), "median": float(np.median(values)),
+                        "p95": float(np.percentile(values, 95))}
+    summary["fps_mean"] = 1e3 / summary["window_frame_ms"]["mean"]
+    return summary
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("scene", nargs="?", type=Path, default=DEFAULT_SCENE)
+    parser.add_argument("--size", default="1280x720", help="the window, WIDTHxHEIGHT (default 1280x720)")
+    parser.add_argument("--frames", type=int, default=150)
+    parser.add_argument("--warm-up", type=int, default=10, help="first frames left out (default 10)")
+    parser.add_argument("--json", type=Path, help="write the results here as well as to stdout")
+    args = parser.parse_args()
+    with tempfile.TemporaryDirectory(prefix="bench-editor-") as folder:
+        stats_file = Path(folder) / "frames.json"
+        run_editor(args.scene.resolve(), args.size, args.frames, stats_file, Path(folder))
+        frames = json.loads(stats_file.read_text())
+    report = {"scene": str(args.scene), "window": args.size, "mode": "auto", "machine": platform.platform(),
+              "cpus": os.cpu_count(), **summarise(frames, args.warm_up)}
+    text = json.dumps(report, indent=2)
+    print(text)
+    if args.json:
+        args.json.parent.mkdir(parents=True, exist_ok=True)
+        args.json.write_text(text + "\n")
+
+
+if __name__ == "__main__":
+    main()
