@@ -11,7 +11,10 @@ infinity).  The report keys are a contract (issue 7): extend, do not rename.
 from __future__ import annotations
 
 import dataclasses
+import json
+import platform
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -119,3 +122,16 @@ def pareto_front(seconds, errors) -> list[int]:
     points = list(zip(seconds, errors))
     return [i for i, (t, e) in enumerate(points)
             if not any((t2 <= t and e2 <= e) and (t2 < t or e2 < e) for t2, e2 in points)]
+
+
+def machine() -> str:
+    """The processor the numbers were measured on, for a report."""
+    return platform.processor() or platform.machine()
+
+
+def write_report(report: dict, path: Path | None, summary=None) -> None:
+    """Print `summary` (by default the report) as JSON and write the whole report to `path` (if given)."""
+    if path is not None:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(json.dumps(report, indent=2) + "\n")
+    print(json.dumps(report if summary is None else summary, indent=2))

@@ -16,7 +16,6 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import platform
 import shutil
 import subprocess
 import sys
@@ -24,6 +23,8 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
+
+from cloudcore.benchmark import machine, write_report
 
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_SCENE = ROOT / "resources" / "scenes" / "valley.toml"
@@ -70,13 +71,9 @@ def main() -> None:
         stats_file = Path(folder) / "frames.json"
         run_editor(args.scene.resolve(), args.size, args.frames, stats_file, Path(folder))
         frames = json.loads(stats_file.read_text())
-    report = {"scene": str(args.scene), "window": args.size, "mode": "auto", "machine": platform.platform(),
+    report = {"scene": str(args.scene), "window": args.size, "mode": "auto", "machine": machine(),
               "cpus": os.cpu_count(), **summarise(frames, args.warm_up)}
-    text = json.dumps(report, indent=2)
-    print(text)
-    if args.json:
-        args.json.parent.mkdir(parents=True, exist_ok=True)
-        args.json.write_text(text + "\n")
+    write_report(report, args.json)
 
 
 if __name__ == "__main__":

@@ -12,16 +12,14 @@ glFinish, read-back excluded) and measured and analytic overdraw.
 from __future__ import annotations
 
 import argparse
-import json
 import os
-import platform
 from pathlib import Path
 
 import numpy as np
 
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 
-from cloudcore.benchmark import path_views  # noqa: E402  (the GL imports need the platform above)
+from cloudcore.benchmark import machine, path_views, write_report  # noqa: E402  (the GL imports need the platform above)
 from cloudcore.gl import FrameRenderer  # noqa: E402
 from cloudcore.scenefile import load_scene  # noqa: E402
 from cloudcore.settings import FULL_3D  # noqa: E402
@@ -62,13 +60,9 @@ def main() -> None:
     scene = load_scene(args.scene)
     views = [scene.camera] + ([camera for _, camera in path_views(scene, args.path, args.frames)] if args.path else [])
     sizes = [tuple(int(v) for v in size.split("x")) for size in args.sizes.split(",")]
-    result = {"scene": str(args.scene), "path": args.path, "machine": platform.processor() or platform.machine(),
+    result = {"scene": str(args.scene), "path": args.path, "machine": machine(),
               "runs": [bench_size(scene, w, h, views) for w, h in sizes]}
-    text = json.dumps(result, indent=2)
-    if args.json:
-        args.json.parent.mkdir(parents=True, exist_ok=True)
-        args.json.write_text(text + "\n")
-    print(json.dumps([{k: v for k, v in run.items() if k != "per_frame"} for run in result["runs"]], indent=2))
+    write_report(result, args.json, [{k: v for k, v in run.items() if k != "per_frame"} for run in result["runs"]])
 
 
 if __name__ == "__main__":

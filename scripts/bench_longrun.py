@@ -17,9 +17,7 @@ from __future__ import annotations
 
 import argparse
 import itertools
-import json
 import os
-import platform
 import time
 from pathlib import Path
 
@@ -27,7 +25,7 @@ import numpy as np
 
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 
-from cloudcore.benchmark import path_views, resident_memory_bytes  # noqa: E402  (the GL imports need the platform)
+from cloudcore.benchmark import machine, path_views, resident_memory_bytes, write_report  # noqa: E402  (the GL imports need the platform)
 from cloudcore.gl import FrameRenderer  # noqa: E402
 from cloudcore.scenefile import load_scene  # noqa: E402
 from cloudcore.settings import MODES, RenderSettings  # noqa: E402
@@ -96,14 +94,10 @@ def main() -> None:
     views = path_views(scene, args.path, max(2, round(path.duration * args.fps) + 1))
     result = {"scene": str(args.scene), "path": args.path, "mode": args.mode, "width": args.width,
               "height": args.height, "minutes": args.minutes, "path_frames": len(views),
-              "machine": platform.processor() or platform.machine(), "date": time.strftime("%Y-%m-%d"),
+              "machine": machine(), "date": time.strftime("%Y-%m-%d"),
               **long_run(scene, views, RenderSettings(mode=args.mode), (args.width, args.height),
                          60.0 * args.minutes, args.sample_seconds)}
-    text = json.dumps(result, indent=2)
-    if args.json:
-        args.json.parent.mkdir(parents=True, exist_ok=True)
-        args.json.write_text(text + "\n")
-    print(json.dumps({k: v for k, v in result.items() if k != "samples"}, indent=2))
+    write_report(result, args.json, {k: v for k, v in result.items() if k != "samples"})
 
 
 if __name__ == "__main__":

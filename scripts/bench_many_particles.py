@@ -18,10 +18,8 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import json
 import math
 import os
-import platform
 import time
 from pathlib import Path
 
@@ -29,7 +27,7 @@ import numpy as np
 
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 
-from cloudcore.benchmark import resident_memory_bytes  # noqa: E402  (the GL imports need the platform)
+from cloudcore.benchmark import machine, resident_memory_bytes, write_report  # noqa: E402  (the GL imports need the platform)
 from cloudcore.cloudgen import cumulus  # noqa: E402
 from cloudcore.gl import FrameRenderer  # noqa: E402
 from cloudcore.scene import Cloud, Scene  # noqa: E402
@@ -101,7 +99,7 @@ def main() -> None:
     generated_s = time.perf_counter() - start
     result = {"particles": scene.particle_count, "clouds": len(scene.clouds), "width": args.width,
               "height": args.height, "illumination": args.illumination, "generation_s": generated_s,
-              "machine": platform.processor() or platform.machine(), "date": time.strftime("%Y-%m-%d"),
+              "machine": machine(), "date": time.strftime("%Y-%m-%d"),
               "resident_bytes_before": resident_memory_bytes()}
     with FrameRenderer(args.width, args.height) as renderer:
         _, first = renderer.render(scene, illumination_method=args.illumination, settings=RenderSettings(mode="full"),
@@ -109,11 +107,7 @@ def main() -> None:
         result["illumination_ms"] = first["illumination_ms"]
         result["runs"] = [bench_mode(renderer, scene, mode, args.frames, args.illumination)
                           for mode in args.modes.split(",")]
-    text = json.dumps(result, indent=2)
-    if args.json:
-        args.json.parent.mkdir(parents=True, exist_ok=True)
-        args.json.write_text(text + "\n")
-    print(text)
+    write_report(result, args.json)
 
 
 if __name__ == "__main__":

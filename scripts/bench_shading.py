@@ -11,11 +11,10 @@ and reports seconds, particles per second and the raster error against exact
 from __future__ import annotations
 
 import argparse
-import json
 import platform
 from pathlib import Path
 
-from cloudcore.benchmark import shading_comparison
+from cloudcore.benchmark import machine, shading_comparison, write_report
 from cloudcore.scenefile import load_scene
 from cloudcore.shading import DEFAULT_RASTER_RESOLUTION
 
@@ -34,14 +33,10 @@ def main() -> None:
     rows = shading_comparison(scene, tuple(int(r) for r in args.resolutions.split(",")), args.repeat)
     for row in rows:
         row["particles_per_second"] = row["particles"] / row["seconds"]
-    report = {"scene": args.scene, "machine": f"{platform.machine()} {platform.processor() or ''}".strip(),
+    report = {"scene": args.scene, "machine": machine(),
               "python": platform.python_version(), "clouds": len(scene.clouds),
               "particles": scene.particle_count, "shading": rows}
-    text = json.dumps(report, indent=2)
-    print(text)
-    if args.json:
-        args.json.parent.mkdir(parents=True, exist_ok=True)
-        args.json.write_text(text + "\n")
+    write_report(report, args.json)
 
 
 if __name__ == "__main__":
