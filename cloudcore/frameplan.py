@@ -104,8 +104,10 @@ class FramePlan:
             "impostors_drawn": len(self.of_kind(*TEXTURED)) + len(self.of_kind("inside")),
             "impostors_regenerated": sum(reasons.values()),
             "regeneration_reasons": reasons,
-            "ring_segments_built": int(self.ring is not None and self.ring.build_segment is not None),
-            "ring_panels_drawn": 8 * len(self.ring.draws) if self.ring is not None else 0,
+            "ring_segments_built": int(self.ring is not None and self.ring.state.pending is not None
+                                       and self.ring.build_segment in self.ring.state.pending.occupied_segments),
+            "ring_panels_drawn": (sum(len(g.occupied_segments) for g, _ in self.ring.draws)
+                                  if self.ring is not None else 0),
             "objects_in_clouds": len(self.objects_between_layers),
             "layers_drawn": sum(c.layers for c in self.clouds if c.splits),
             "layers_rebuilt": sum(c.layers for c in self.clouds if c.splits and c.regenerate),

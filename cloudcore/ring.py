@@ -38,6 +38,11 @@ class RingGeneration:
     members: frozenset
     segment_members: tuple  # SEGMENTS tuples of cloud indices
 
+    @property
+    def occupied_segments(self) -> tuple[int, ...]:
+        """The segments holding a cloud: only they are rendered and drawn."""
+        return tuple(segment for segment, clouds in enumerate(self.segment_members) if clouds)
+
 
 @dataclass(frozen=True)
 class RingState:

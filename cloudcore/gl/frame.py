@@ -43,7 +43,7 @@ from cloudcore.gl.world import WorldPass
 from cloudcore.lighting import scene_hour, scene_lights, sky_colors
 from cloudcore.overdraw import analytic_overdraw, overdraw_statistics
 from cloudcore.particle_styles import particle_styles
-from cloudcore.ring import SEGMENTS, RingState, panel_corners
+from cloudcore.ring import RingState, panel_corners
 from cloudcore.scene import Camera, Lighting, Scene
 from cloudcore.settings import FULL_3D, RenderSettings
 
@@ -238,7 +238,7 @@ class FrameRenderer:
 
         if plan.ring is not None:
             for generation, weight in plan.ring.draws:
-                for segment in range(SEGMENTS):
+                for segment in generation.occupied_segments:
                     draw_quad(panel_corners(generation, segment, settings.ring_elevation_deg),
                               self._impostors.ring_panel(generation, segment).texture, weight)
 

@@ -52,7 +52,7 @@ class ImpostorStore:
             self._release(self._clouds.pop(index)[0])
 
         ring = plan.ring
-        if ring is not None and ring.build_segment is not None:
+        if ring is not None and ring.build_segment in (ring.state.pending.occupied_segments if ring.state.pending else ()):
             generation, segment = ring.state.pending, ring.build_segment
             size = self._ring_sizes.setdefault(generation, _ring_texture_size(viewport, fov_y_deg, settings))
             target = self._ring[generation, segment] = self.pool.acquire(*size)
