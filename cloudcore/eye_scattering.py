@@ -68,6 +68,7 @@ class ParticleShading:
         self.alpha = -np.expm1(-tau)
         artist = np.array([c.artist is not None for c in clouds], dtype=bool)
         self._opaque = (self.alpha > 0.0) | np.repeat(artist, counts)
+        self._near_faded = self.styles.near_faded
         self.scattering = scattering_coefficient(tau, albedo, shading.phase, shading.g)
         self.tint = np.repeat(np.array([c.color for c in clouds], dtype=np.float64).reshape(-1, 3), counts, axis=0)
         incident = (cache.incident(clouds, shading, lights, method) if cache is not None
@@ -113,8 +114,7 @@ class ParticleShading:
         Splats vanish next to the eye (the near fade); sprites lock there instead and stay.
         Harris's opacity is the particle's own, the artist model's its colour level's.
         """
-        near_faded = self.styles.near_faded[indices]
-        kept = ((distances > FADE_START_RADII * self.radii[indices]) | ~near_faded) & self._opaque[indices]
+        kept = ((distances > FADE_START_RADII * self.radii[indices]) | ~self._near_faded[indices]) & self._opaque[indices]
         factors = self.formation_factors(time_s)
         return kept if factors is None else kept & (factors[indices] > 0.0)
 

@@ -142,7 +142,7 @@ class SplatPass:
 
     def update_facing(self, particles: ParticleShading, start: int, state: FacingState) -> None:
         """The facing lock of particles `start`, `start + 1`, ... (one cloud's) for the next draws."""
-        self._make_resident(particles, None)
+        self._make_resident(particles)
         records = np.empty((len(state.fade), 4), dtype=np.float32)
         records[:, :3] = state.normals
         records[:, 3] = np.where(state.locked, state.fade, _UNLOCKED[3])
@@ -152,7 +152,8 @@ class SplatPass:
 
     def _shade(self, batch: SplatBatch, view: np.ndarray) -> None:
         """Run the compute shader: the batch's quads and colours for its eye, in its order."""
-        self._make_resident(batch.particles, batch.time_s)
+        self._make_resident(batch.particles)
+        self._hold_formation(batch.particles, batch.time_s)
         _store(self._order_buffer, batch.order, GL.GL_STREAM_DRAW)
         needed = len(batch) * _INSTANCE_BYTES
         if needed > self._instance_capacity:
@@ -172,8 +173,8 @@ class SplatPass:
         GL.glDispatchCompute(-(-len(batch) // _SHADE_GROUP), 1, 1)
         GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT)
 
-    def _make_resident(self, particles: ParticleShading, time_s: float | None) -> None:
-        """Upload the particles' shading terms when they change, and their formation factors when those do."""
+    def _make_resident(self, particles: ParticleShading) -> None:
+        """Upload the particles' shading terms, styles and unlocked facings when the particles change."""
         if particles is not self._resident:
             _store(self._particle_buffer, _particle_records(particles))
             _store(self._cloud_buffer, _cloud_records(particles.styles))
@@ -184,6 +185,9 @@ class SplatPass:
             _store(self._formation_buffer, np.ones(max(len(particles.radii), 1), dtype=np.float32))
             _set_light_uniforms(self._shade_program, particles)
             self._resident, self._formation_time = particles, None
+
+    def _hold_formation(self, particles: ParticleShading, time_s: float | None) -> None:
+        """Upload the formation factors at `time_s` when they differ from those held."""
         factors = particles.formation_factors(time_s)
         held = None if factors is None else time_s  # the time the buffer's factors are for; None: all 1
         if held != self._formation_time:
