@@ -51,7 +51,6 @@ class Viewport:
         self.outlines_drawn: list = []  # this frame's overlay outlines (`cloudcore.overlays.Outline`)
         self.regenerations_total = 0
         self._heat_texture: ImageTexture | None = None
-        self._bounds: tuple | None = None  # (clouds, centres, radii): the bounding spheres the plan used
         self._last_time = time.perf_counter()
 
     def gui(self) -> None:
@@ -116,7 +115,7 @@ class Viewport:
         draw = imgui.get_window_draw_list()
         outlines = []
         if plan is not None and self.show_impostor_outlines:
-            outlines += impostor_outlines(plan, *self._bounding_spheres(), editor.camera, size)
+            outlines += impostor_outlines(plan, *self.renderer.cloud_bounds, editor.camera, size)
         if plan is not None and self.show_ring_segments:
             outlines += ring_outlines(plan, editor.camera, size, editor.settings.ring_elevation_deg)
         for outline in outlines:
@@ -147,15 +146,6 @@ class Viewport:
         draw.add_text(imgui.ImVec2(left, label_y), white, "0")
         draw.add_text(imgui.ImVec2(left + _LEGEND_STEPS * step_width + 6.0, bottom - imgui.get_text_line_height()),
                       white, f"{top:g} fragments per pixel")
-
-    def _bounding_spheres(self) -> tuple[np.ndarray, np.ndarray]:
-        """The clouds' bounding spheres, as the renderer plans with them; remade when the clouds change."""
-        clouds = self.editor.scene.clouds
-        if self._bounds is None or self._bounds[0] is not clouds:
-            spheres = [cloud.bounding_sphere() for cloud in clouds]
-            self._bounds = (clouds, np.array([s[0] for s in spheres]).reshape(-1, 3),
-                            np.array([s[1] for s in spheres], dtype=np.float64))
-        return self._bounds[1], self._bounds[2]
 
     def _navigate(self, hovered: bool, seconds: float) -> None:
         editor, io = self.editor, imgui.get_io()

@@ -11,7 +11,6 @@ from cloudcore.errors import SceneError
 from cloudcore.heatmap import heat_image
 from cloudcore.overdraw import scene_block_overdraw_statistics
 from cloudcore.paths import camera_on_path
-from cloudcore.scene import Camera
 from cloudcore.scenefile import load_scene
 
 

@@ -76,6 +76,11 @@ class FrameRenderer:
         self.last_plan: FramePlan | None = None
 
     @property
+    def cloud_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """(centres (clouds, 3), radii (clouds,)) of the bounding spheres the last frame was planned with."""
+        return self._particles.bounding_centres, self._particles.bounding_radii
+
+    @property
     def size(self) -> tuple[int, int]:
         return self.context.width, self.context.height
 
