@@ -113,8 +113,27 @@ def install(params, editor, viewport, panels, results_path: Path, outcome: dict)
         ctx.item_click("Orbit left")
         ctx.yield_(SETTLE)
         strict = viewport.regenerations_total - before
-        outcome["regenerations"] = {"tolerance 5": lenient, "tolerance 0.1": strict}
+        # a budget of one spreads the same regenerations over frames, one a frame
+        use_window(ctx, "LOD")
+        ctx.item_input_value("Regeneration budget", 1)
+        CHECK(editor.settings.regeneration_budget == 1)
+        ctx.yield_(SETTLE)
+        before, marker = viewport.regenerations_total, editor.last_stats
+        use_window(ctx, "Camera")
+        ctx.item_click("Orbit left")
+        ctx.yield_(SETTLE)
+        history = list(editor.frame_times)
+        budgeted = history[next(i for i, s in enumerate(history) if s is marker) + 1:]
+        per_frame = [s.get("impostors_regenerated", 0) for s in budgeted]
+        postponed = sum(s.get("regenerations_postponed", 0) for s in budgeted)
+        use_window(ctx, "LOD")
+        ctx.item_input_value("Regeneration budget", 0)
+        outcome["regenerations"] = {"tolerance 5": lenient, "tolerance 0.1": strict,
+                                    "budget 1, most in a frame": max(per_frame, default=0),
+                                    "budget 1, postponed": postponed}
         CHECK(lenient == 0 and strict > 0)
+        CHECK(max(per_frame, default=0) <= 1 and viewport.regenerations_total > before)
+        CHECK(postponed > 0)  # the orbit moves both clouds past the tolerance
 
     def save_and_reopen(ctx):
         target = results_path.with_name("saved_by_gui.toml")

@@ -233,13 +233,23 @@ class Panels:
                                                                     settings.fade_end_radii], 1.0, 10.0)
         sizes = [int(math.log2(settings.impostor_min_size)), int(math.log2(settings.impostor_max_size))]
         changed_sizes, sizes = imgui.slider_int2("Impostor size (log2)", sizes, 3, 12)
-        if changed_mode or changed_tol or changed_ring_on or changed_radius or changed_fade or changed_sizes:
+        changed_detail, detail = imgui.slider_float("Detail (texels per particle)", settings.impostor_detail_texels,
+                                                    0.0, 8.0, "%.1f")
+        imgui.set_item_tooltip("An impostor texture is never finer than this many texels across the radius of "
+                               "the cloud's smallest particle; 0: the screen's resolution alone decides.")
+        changed_budget, budget = imgui.slider_int("Regeneration budget", settings.regeneration_budget, 0, 32,
+                                                  "%d" if settings.regeneration_budget else "no limit")
+        imgui.set_item_tooltip("Impostors remade per frame at most, those farthest past the tolerance first; "
+                               "0: no limit.")
+        if (changed_mode or changed_tol or changed_ring_on or changed_radius or changed_fade or changed_sizes
+                or changed_detail or changed_budget):
             try:
                 editor.settings = dataclasses.replace(
                     settings, mode=MODES[mode], tolerance_deg=tolerance,
                     ring_radius=radius if ring_on else math.inf,
                     fade_start_radii=min(fades), fade_end_radii=max(fades),
-                    impostor_min_size=2 ** min(sizes), impostor_max_size=2 ** max(sizes))
+                    impostor_min_size=2 ** min(sizes), impostor_max_size=2 ** max(sizes),
+                    impostor_detail_texels=detail, regeneration_budget=budget)
             except ValueError as error:
                 editor.messages.append(str(error))
         imgui.separator_text("Overlays")
@@ -346,7 +356,8 @@ class Panels:
         imgui.text(f"particles drawn {stats['particles_drawn']}, rendered to impostors "
                    f"{stats['particles_to_impostors']}")
         imgui.text(f"impostors drawn {stats['impostors_drawn']}, regenerated {stats['impostors_regenerated']} "
-                   f"(total {self.viewport.regenerations_total}), ring segments built {stats['ring_segments_built']}")
+                   f"(total {self.viewport.regenerations_total}), postponed {stats['regenerations_postponed']}, "
+                   f"ring segments built {stats['ring_segments_built']}")
         imgui.text(f"clouds: full {stats['clouds_full']}, crossfade {stats['clouds_crossfade']}, impostor "
                    f"{stats['clouds_impostor']}, inside {stats['clouds_inside']}, ring {stats['clouds_ring']}, "
                    f"culled {stats['clouds_culled']}")

@@ -34,6 +34,7 @@ from cloudcore.phase import phase_function
 from cloudcore.ramps import smoothstep
 from cloudcore.scene import Lighting, Shading
 from cloudcore.shading import scattering_coefficient
+from cloudcore.sprites import CELL_PIXELS
 
 #: a particle fades out between these distances from the eye, in radii, so the
 #: camera inside one never gets a screen-filling quad.
@@ -76,6 +77,12 @@ class ParticleShading:
         #: (n, lights): light that reached each particle, per light (Harris's light pass)
         self.incident = _concatenated(incident, (0, len(lights)))
 
+        # a sprite's detail is its texture's texel, a splat's the splat itself (a smooth Gaussian)
+        detail = np.where(self.styles.sprite_index >= 0, self.radii * (2.0 / CELL_PIXELS), self.radii)
+        #: (clouds,) metres: the finest detail in each cloud (0 for an empty one), which bounds how
+        #: fine an impostor texture needs to be (`cloudcore.impostors.detail_size_px`)
+        self.finest_radii = np.array([detail[start:stop].min() if stop > start else 0.0
+                                      for start, stop in zip(self.cloud_starts[:-1], self.cloud_starts[1:])])
         spheres = [c.bounding_sphere() for c in clouds]
         self.bounding_centres = np.array([s[0] for s in spheres], dtype=np.float64).reshape(-1, 3)
         self.bounding_radii = np.array([s[1] for s in spheres], dtype=np.float64)

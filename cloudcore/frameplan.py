@@ -26,6 +26,7 @@ no particle is looked at.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 from typing import Hashable, Mapping
@@ -33,8 +34,9 @@ from typing import Hashable, Mapping
 import numpy as np
 
 from cloudcore.camera import frustum_planes, projection_matrix, spheres_in_frustum, view_matrix
-from cloudcore.impostors import (INSIDE_RADII, ImpostorRecord, regeneration_reason, required_size,
-                                 screen_size_px)
+from cloudcore.impostors import (INSIDE_RADII, ImpostorRecord, budgeted_regenerations, detail_size_px,
+                                 regeneration_priority, regeneration_reason, required_size, screen_size_px,
+                                 translation_error_deg)
 from cloudcore.ramps import smoothstep
 from cloudcore.ring import RingPlan, RingState, plan_ring
 from cloudcore.scene import Camera
@@ -54,6 +56,7 @@ class CloudPlan:
     full_weight: float = 0.0  # share of opacity drawn from particles (full, crossfade, inside)
     impostor_weight: float = 0.0  # share drawn from the cached impostor
     regenerate: str | None = None  # why the impostor is remade this frame
+    postponed: str | None = None  # why it would be, had the regeneration budget allowed it
     texture_size: int = 0  # side of the impostor texture used
     split_objects: tuple = ()  # indices of the objects inside it, far to near
     splits: tuple = ()  # their distances from the eye: the layers' boundaries
@@ -104,6 +107,7 @@ class FramePlan:
             "impostors_drawn": len(self.of_kind(*TEXTURED)) + len(self.of_kind("inside")),
             "impostors_regenerated": sum(reasons.values()),
             "regeneration_reasons": reasons,
+            "regenerations_postponed": sum(1 for c in self.clouds if c.postponed),
             "ring_segments_built": int(self.ring is not None and self.ring.state.pending is not None
                                        and self.ring.build_segment in self.ring.state.pending.occupied_segments),
             "ring_panels_drawn": (sum(len(g.occupied_segments) for g, _ in self.ring.draws)
@@ -121,14 +125,16 @@ class FramePlan:
 
 def plan_frame(centres: np.ndarray, radii: np.ndarray, camera: Camera, viewport: tuple[int, int],
                settings: RenderSettings, records: Mapping[int, ImpostorRecord], ring_state: RingState,
-               lighting_key: Hashable, objects=(), cloud_particles=None) -> FramePlan:
+               lighting_key: Hashable, objects=(), cloud_particles=None, finest_radii=None) -> FramePlan:
     """Plan one frame; `centres` (N, 3) and `radii` (N,) are the clouds' bounding spheres.
 
     `lighting_key` identifies what the particles' colours were computed from: one key for
     all clouds, or a tuple with one per cloud (the editor changes one cloud at a time, and
     only that cloud's impostor is stale).  `objects` are the opaque objects' bounding
     spheres this frame (`cloudcore.objects.ObjectPose`); `cloud_particles(i)` gives cloud i's
-    particle centres, asked only for clouds with objects inside.
+    particle centres, asked only for clouds with objects inside.  `finest_radii` (N,) are the
+    clouds' finest detail in metres (`ParticleShading.finest_radii`), which bounds the impostor
+    texture size (`settings.impostor_detail_texels`); None bounds nothing.
     """
     centres, radii = np.asarray(centres, dtype=np.float64).reshape(-1, 3), np.asarray(radii, dtype=np.float64)
     width, height = viewport
@@ -158,7 +164,8 @@ def plan_frame(centres: np.ndarray, radii: np.ndarray, camera: Camera, viewport:
         """Particles per layer seen from `from_eye`; the particles are looked at only when there are splits."""
         return layer_counts(cloud_particles(index), from_eye, splits) if splits else (0,)
 
-    clouds = []
+    finest = np.zeros(len(radii)) if finest_radii is None else np.asarray(finest_radii, dtype=np.float64)
+    clouds, wanted = [], []  # wanted: (index, priority) of the impostors past their tolerance
     for index, (centre, radius, distance) in enumerate(zip(centres, radii, distances)):
         distance = float(distance)
         individual = 1.0 - (ring.weight_of(index) if ring is not None else 0.0)
@@ -179,22 +186,35 @@ def plan_frame(centres: np.ndarray, radii: np.ndarray, camera: Camera, viewport:
             clouds.append(CloudPlan(index, "full", distance, full_weight=1.0, split_objects=inside, splits=splits,
                                     layer_counts=counts(index, eye, splits)))
             continue
-        pixels = screen_size_px(radius, distance, height, camera.fov_y_deg)
+        pixels = min(screen_size_px(radius, distance, height, camera.fov_y_deg),
+                     detail_size_px(radius, distance, finest[index], settings.impostor_detail_texels))
         size = required_size(pixels, settings.impostor_min_size, settings.impostor_max_size)
         record = records.get(index)
         # the layers the impostor's textures would hold now: split where the objects are, seen from its eye
         held_counts = counts(index, record.eye, split_at(index, record.eye)[1]) if (
             record is not None and splits) else None
         reason = regeneration_reason(record, centre, eye, size, keys[index], settings.tolerance_deg, held_counts)
-        if reason is not None:
-            record = ImpostorRecord(tuple(float(v) for v in eye), size, keys[index], splits,
-                                    counts(index, eye, splits))
-            next_records[index] = record
         kind = "crossfade" if full > 0.0 else "impostor"
         clouds.append(CloudPlan(index, kind, distance, full_weight=full * individual,
                                 impostor_weight=(1.0 - full) * individual, regenerate=reason,
-                                texture_size=record.size, split_objects=inside, splits=splits,
-                                layer_counts=record.layer_counts if splits else (0,)))
+                                texture_size=size, split_objects=inside, splits=splits))
+        if reason is not None:
+            ratio = (translation_error_deg(centre, record.eye, eye) / max(settings.tolerance_deg, 1e-300)
+                     if record is not None else math.inf)
+            wanted.append((index, regeneration_priority(reason, ratio, bool(splits))))
+    served = budgeted_regenerations(wanted, settings.regeneration_budget)
+    for index, cloud in enumerate(clouds):
+        if cloud.kind not in TEXTURED:
+            continue
+        record = records.get(index)
+        if index in served:
+            record = next_records[index] = ImpostorRecord(
+                tuple(float(v) for v in eye), cloud.texture_size, keys[index], cloud.splits,
+                counts(index, eye, cloud.splits))
+        regenerate, postponed = (cloud.regenerate, None) if index in served else (None, cloud.regenerate)
+        clouds[index] = dataclasses.replace(cloud, regenerate=regenerate, postponed=postponed,
+                                            texture_size=record.size,
+                                            layer_counts=record.layer_counts if cloud.splits else (0,))
     drawn = [c.index for c in clouds if c.kind in ("full", "crossfade", "impostor", "inside")]
     draw_order = tuple(sorted(drawn, key=lambda i: -distances[i]))
     inside_size = tuple(max(1, math.ceil(side * settings.inside_resolution_scale)) for side in viewport)

@@ -68,10 +68,27 @@ def impostor_view(centre, radius: float, eye) -> ImpostorView:
     return ImpostorView(view_matrix(camera), projection, corners)
 
 
+def _tangent(radius: float, distance: float) -> float:
+    """Half side of the impostor quad of a sphere seen from `distance` (> radius), over that distance."""
+    return radius / math.sqrt(max((distance - radius) * (distance + radius), np.finfo(float).tiny))
+
+
 def screen_size_px(radius: float, distance: float, viewport_height: int, fov_y_deg: float) -> float:
     """Side in pixels of the impostor quad of a sphere seen from `distance` (> radius)."""
-    tangent = radius / math.sqrt(max((distance - radius) * (distance + radius), np.finfo(float).tiny))
-    return viewport_height * tangent / math.tan(math.radians(fov_y_deg) / 2.0)
+    return viewport_height * _tangent(radius, distance) / math.tan(math.radians(fov_y_deg) / 2.0)
+
+
+def detail_size_px(radius: float, distance: float, finest_radius: float, texels: float) -> float:
+    """Texture side that gives a particle of `finest_radius` `texels` texels of radius on the quad.
+
+    A cloud of Gaussian splats holds no detail finer than its smallest splat, so a
+    texture finer than this only resamples smooth curves (Nyquist: about 3 texels per
+    radius keep the kernel's spectrum above 8-bit noise).  Inf when there is no limit
+    (`texels` 0, or a zero `finest_radius`).
+    """
+    if not (texels > 0.0 and finest_radius > 0.0):
+        return math.inf
+    return 2.0 * texels * _tangent(radius, distance) * distance / finest_radius
 
 
 def required_size(pixels: float, smallest: int, largest: int) -> int:
@@ -88,6 +105,30 @@ def translation_error_deg(centre, eye_then, eye_now) -> float:
     b = np.asarray(eye_now, dtype=np.float64) - centre
     # atan2 of |a x b| and a.b stays accurate for tiny angles, where acos of the dot product does not
     return math.degrees(math.atan2(float(np.linalg.norm(np.cross(a, b))), float(a @ b)))
+
+
+#: the order in which a regeneration budget serves reasons; rank 0 is never postponed: there is
+#: no texture to show, or its layers would cut through an object
+_REASON_RANK = {"new": 0, "layers": 0, "lights": 1, "resolution": 2, "translation": 3}
+
+
+def regeneration_priority(reason: str, translation_ratio: float, split: bool) -> tuple[int, float]:
+    """Sort key of a wanted regeneration, most urgent first; `translation_ratio` is the translation
+    error over the tolerance.  A cloud split around objects is never postponed."""
+    return (0 if split else _REASON_RANK[reason], -translation_ratio)
+
+
+def budgeted_regenerations(wanted, budget: int) -> set:
+    """The indices to regenerate now out of `wanted` (index, `regeneration_priority`).
+
+    At most `budget` (0: no limit), yet every one of rank 0; most urgent first, so a
+    postponed impostor rises in the queue (its error grows) until it is served.
+    """
+    if not budget:
+        return {index for index, _ in wanted}
+    ranked = sorted(wanted, key=lambda w: w[1])
+    must = sum(1 for _, priority in ranked if priority[0] == 0)
+    return {index for index, _ in ranked[:max(budget, must)]}
 
 
 def regeneration_reason(record: ImpostorRecord | None, centre, eye, size: int, lighting_key: Hashable,

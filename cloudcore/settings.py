@@ -25,6 +25,12 @@ class RenderSettings:
     #: impostor texture sides, powers of two
     impostor_min_size: int = 16
     impostor_max_size: int = 512
+    #: texels across the radius of a cloud's finest particle that an impostor texture must give; a finer
+    #: texture only resamples smooth Gaussians, so none is made (0: the screen's resolution alone decides)
+    impostor_detail_texels: float = 3.0
+    #: impostors remade per frame at most; those past their tolerance wait, the farthest past it first
+    #: (0: no limit, every impostor past its tolerance is remade at once)
+    regeneration_budget: int = 0
     #: cloud radii: full 3D below `fade_start_radii`, impostor beyond `fade_end_radii`, crossfade between
     fade_start_radii: float = 2.0
     fade_end_radii: float = 4.0
@@ -53,6 +59,10 @@ class RenderSettings:
             size = getattr(self, name)
             if not (isinstance(size, int) and 1 <= size <= 8192 and size & (size - 1) == 0):
                 problems.append(f"{name} must be a power of two within [1, 8192], got {size!r}")
+        if not 0.0 <= self.impostor_detail_texels < math.inf:
+            problems.append(f"impostor_detail_texels must be >= 0 and finite, got {self.impostor_detail_texels}")
+        if not (isinstance(self.regeneration_budget, int) and self.regeneration_budget >= 0):
+            problems.append(f"regeneration_budget must be an integer >= 0 (0: no limit), got {self.regeneration_budget!r}")
         if self.impostor_min_size > self.impostor_max_size:
             problems.append("impostor_min_size must not exceed impostor_max_size")
         if not 0.0 <= self.fade_start_radii <= self.fade_end_radii < math.inf:

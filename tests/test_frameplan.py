@@ -28,9 +28,9 @@ def orbit(distance: float, degrees: float) -> Camera:
 
 
 def plan(camera, settings=NO_RING, records=None, ring=RingState(), centres=((0.0, 0.0, 0.0),), radii=(RADIUS,),
-         lighting=1):
+         lighting=1, finest_radii=None):
     return plan_frame(np.array(centres, dtype=float), np.array(radii, dtype=float), camera, VIEWPORT, settings,
-                      records or {}, ring, lighting)
+                      records or {}, ring, lighting, finest_radii=finest_radii)
 
 
 def test_first_sight_of_a_far_cloud_makes_its_impostor():
@@ -70,6 +70,75 @@ def test_texture_sizes_stay_within_the_limits():
         size = plan(orbit(distance, 0.0), impostors).clouds[0].texture_size
         assert 32 <= size <= 256 and size & (size - 1) == 0
     assert plan(orbit(1e7, 0.0), impostors).clouds[0].kind == "culled"  # beyond the far plane
+
+
+def test_a_texture_is_never_finer_than_the_cloud_s_finest_splat_needs():
+    impostors = dataclasses.replace(NO_RING, mode="impostor", impostor_max_size=4096)
+    # 32 finest radii across the cloud, 3 texels each: 96 texels on a far quad (128), more as the quad
+    # widens (half side R d / sqrt(d^2 - R^2)); the screen asks for 42, 215 and 743 pixels
+    finest = (RADIUS / 16.0,)
+    sizes = [plan(orbit(d, 0.0), impostors, finest_radii=finest).clouds[0].texture_size for d in (2000.0, 400.0, 150.0)]
+    unbounded = [plan(orbit(d, 0.0), impostors).clouds[0].texture_size for d in (2000.0, 400.0, 150.0)]
+    assert sizes == [64, 128, 256] and unbounded == [64, 256, 1024]
+    # the quad widens as the eye nears the sphere, and the texture with it, detail for detail
+    assert plan(orbit(1.06 * RADIUS, 0.0), impostors, finest_radii=finest).clouds[0].texture_size == 512
+    # off, the screen alone decides; a cloud whose detail is unknown (0) is not bounded
+    off = dataclasses.replace(impostors, impostor_detail_texels=0.0)
+    assert plan(orbit(150.0, 0.0), off, finest_radii=finest).clouds[0].texture_size == 1024
+    assert plan(orbit(150.0, 0.0), impostors, finest_radii=(0.0,)).clouds[0].texture_size == 1024
+
+
+def test_approaching_past_the_detail_bound_remakes_nothing():
+    impostors = dataclasses.replace(NO_RING, mode="impostor")
+    first = plan(orbit(400.0, 0.0), impostors, finest_radii=(RADIUS / 16.0,))
+    nearer = plan(orbit(200.0, 0.0), impostors, first.records, finest_radii=(RADIUS / 16.0,))
+    assert nearer.clouds[0].regenerate is None and nearer.clouds[0].texture_size == 128
+    # the screen alone asks for 256 at 400 m and 512 at 200 m, so it remakes the impostor
+    unbounded = plan(orbit(200.0, 0.0), impostors, plan(orbit(400.0, 0.0), impostors).records)
+    assert (unbounded.clouds[0].regenerate, unbounded.clouds[0].texture_size) == ("resolution", 512)
+
+
+RING_OF_CLOUDS = tuple((600.0 * math.sin(a), 0.0, -600.0 * math.cos(a)) for a in np.radians([-20, -10, 0, 10, 20]))
+
+
+def test_a_regeneration_budget_serves_the_impostors_farthest_past_their_tolerance():
+    budget = dataclasses.replace(NO_RING, mode="impostor", regeneration_budget=2)
+    start = camera_at((0.0, 0.0, 0.0), (0.0, 0.0, -1.0))
+    first = plan(start, budget, centres=RING_OF_CLOUDS, radii=(RADIUS,) * 5)
+    # new impostors are never postponed: there is nothing else to show
+    assert [c.regenerate for c in first.clouds] == ["new"] * 5 and first.stats()["regenerations_postponed"] == 0
+    moved = camera_at((40.0, 0.0, 0.0), (40.0, 0.0, -1.0))  # the outer clouds turn farthest
+    second = plan(moved, budget, first.records, centres=RING_OF_CLOUDS, radii=(RADIUS,) * 5)
+    errors = [translation_error_deg(c, first.records[i].eye, moved.position) for i, c in enumerate(RING_OF_CLOUDS)]
+    served = [c.index for c in second.clouds if c.regenerate]
+    assert sorted(served) == sorted(np.argsort(errors)[-2:].tolist())
+    assert all(c.postponed == "translation" for c in second.clouds if c.index not in served)
+    assert second.stats()["regenerations_postponed"] == 3
+    # a postponed impostor keeps its texture and its record, and is served on a later frame
+    for cloud in second.clouds:
+        if cloud.index not in served:
+            assert second.records[cloud.index] == first.records[cloud.index]
+            assert cloud.texture_size == first.records[cloud.index].size
+    records, served_once = second.records, set(served)
+    for _ in range(3):
+        later = plan(moved, budget, records, centres=RING_OF_CLOUDS, radii=(RADIUS,) * 5)
+        served_once |= {c.index for c in later.clouds if c.regenerate}
+        records = later.records
+    assert served_once == set(range(5))
+    # without a budget every impostor past its tolerance is remade at once
+    unlimited = plan(moved, dataclasses.replace(budget, regeneration_budget=0), first.records,
+                     centres=RING_OF_CLOUDS, radii=(RADIUS,) * 5)
+    assert sum(1 for c in unlimited.clouds if c.regenerate) == 5
+
+
+def test_a_budget_serves_changed_lights_before_translation():
+    budget = dataclasses.replace(NO_RING, mode="impostor", regeneration_budget=1)
+    start = camera_at((0.0, 0.0, 0.0), (0.0, 0.0, -1.0))
+    first = plan(start, budget, centres=RING_OF_CLOUDS[:2], radii=(RADIUS,) * 2, lighting=(1, 1))
+    moved = camera_at((40.0, 0.0, 0.0), (40.0, 0.0, -1.0))
+    second = plan(moved, budget, first.records, centres=RING_OF_CLOUDS[:2], radii=(RADIUS,) * 2, lighting=(1, 2))
+    assert [c.regenerate for c in second.clouds] == [None, "lights"]
+    assert second.clouds[0].postponed == "translation"
 
 
 def test_fade_weights_between_two_and_four_radii():
@@ -214,4 +283,12 @@ def test_settings_refuse_out_of_domain_values():
         RenderSettings(impostor_max_size=300)
     with pytest.raises(ValueError, match="mode"):
         RenderSettings(mode="sideways")
+    with pytest.raises(ValueError, match="regeneration_budget"):
+        RenderSettings(regeneration_budget=-1)
+    with pytest.raises(ValueError, match="regeneration_budget"):
+        RenderSettings(regeneration_budget=1.5)
+    with pytest.raises(ValueError, match="impostor_detail_texels"):
+        RenderSettings(impostor_detail_texels=math.inf)
+    with pytest.raises(ValueError, match="impostor_detail_texels"):
+        RenderSettings(impostor_detail_texels=math.nan)
     assert RenderSettings(tolerance_deg=0.0, ring_radius=0.0).uses_ring

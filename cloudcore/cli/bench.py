@@ -16,7 +16,7 @@ from pathlib import Path
 
 from cloudcore.benchmark import bench_path, pareto_front, shading_comparison
 from cloudcore.cli.render import pixel_count
-from cloudcore.cli.settings_args import add_settings_arguments, parse_sweep, settings_from
+from cloudcore.cli.settings_args import SWEEPABLE, add_settings_arguments, parse_sweep, settings_from
 from cloudcore.errors import SceneError
 from cloudcore.scenefile import load_scene
 
@@ -27,19 +27,23 @@ def add_parser(commands) -> None:
     parser.add_argument("--path", required=True, help="camera path of the scene to fly")
     parser.add_argument("--json", required=True, type=Path, help="report to write")
     parser.add_argument("--sweep", action="append", type=parse_sweep, default=[],
-                        help="NAME=V1,V2,... with NAME one of tolerance, ring_radius, impostor_max_size, mode; "
+                        help=f"NAME=V1,V2,... with NAME one of {', '.join(SWEEPABLE)}; "
                              "several --sweep options combine")
     parser.add_argument("--frames", type=int, default=60, help="frames spread along the path (default 60)")
     parser.add_argument("--width", type=pixel_count, default=640)
     parser.add_argument("--height", type=pixel_count, default=480)
     parser.add_argument("--plot", type=Path, help="write the error-against-time plot here (PNG)")
     parser.add_argument("--no-shading", action="store_true", help="skip the shading precompute comparison")
+    parser.add_argument("--without-terrain", action="store_true",
+                        help="fly the scene without its terrain: the whole frame is then the sky and the clouds")
     add_settings_arguments(parser)
     parser.set_defaults(run=run)
 
 
 def run(args) -> int:
     scene = load_scene(args.scene)
+    if args.without_terrain:
+        scene = dataclasses.replace(scene, terrain=None)
     try:
         scene.camera_path(args.path)
     except KeyError as error:
@@ -61,6 +65,7 @@ def run(args) -> int:
         report = bench_path(renderer, scene, args.path, args.frames, settings_list, (args.width, args.height),
                             progress=bar.update)
     report["scene"] = str(args.scene)
+    report["without_terrain"] = args.without_terrain
     report["shading"] = [] if args.no_shading else shading_comparison(scene)
     args.json.parent.mkdir(parents=True, exist_ok=True)
     args.json.write_text(json.dumps(report, indent=2) + "\n")
@@ -95,8 +100,9 @@ def plot_error_against_time(report: dict, path: Path) -> None:
               label="Pareto front")
     for run_, x, y in zip(runs, seconds, errors):
         settings = run_["settings"]
-        axes.annotate(f"{settings['mode']} tol {settings['tolerance_deg']:g}\nring {settings['ring_radius']:g}"
-                      f" max {settings['impostor_max_size']}", (x, y), fontsize=6, textcoords="offset points",
+        axes.annotate(f"{settings['mode']} tol {settings['tolerance_deg']:g} budget {settings['regeneration_budget']}"
+                      f"\nring {settings['ring_radius']:g} max {settings['impostor_max_size']}"
+                      f" detail {settings['impostor_detail_texels']:g}", (x, y), fontsize=6, textcoords="offset points",
                       xytext=(4, 4))
     axes.axvline(report["reference"]["frame_ms_mean"], color="grey", linestyle="--", label="full 3D (error 0)")
     axes.set_xlabel("mean frame time (ms)")

@@ -7,7 +7,8 @@ from cloudcore.settings import MODES, RenderSettings
 
 #: --sweep NAME=... -> (settings field, value parser)
 SWEEPABLE = {"tolerance": ("tolerance_deg", float), "ring_radius": ("ring_radius", float),
-             "impostor_max_size": ("impostor_max_size", int), "mode": ("mode", str)}
+             "impostor_max_size": ("impostor_max_size", int), "detail_texels": ("impostor_detail_texels", float),
+             "regeneration_budget": ("regeneration_budget", int), "mode": ("mode", str)}
 
 
 def add_settings_arguments(parser, default_mode: str = "auto") -> None:
@@ -19,12 +20,19 @@ def add_settings_arguments(parser, default_mode: str = "auto") -> None:
                         help="metres beyond which clouds join the impostor ring; inf for none (default %(default)s)")
     parser.add_argument("--impostor-max-size", type=int, default=defaults.impostor_max_size,
                         help="largest impostor texture side, a power of two (default %(default)s)")
+    parser.add_argument("--detail-texels", type=float, default=defaults.impostor_detail_texels,
+                        help="texels across a cloud's finest particle radius an impostor needs; 0: screen resolution "
+                             "only (default %(default)s)")
+    parser.add_argument("--regeneration-budget", type=int, default=defaults.regeneration_budget,
+                        help="impostors remade per frame at most, the farthest past the tolerance first; 0: no limit "
+                             "(default %(default)s)")
 
 
 def settings_from(args, **overrides) -> RenderSettings:
     """The settings the arguments name; out-of-domain values are a one-line error."""
     values = dict(mode=args.mode, tolerance_deg=args.tolerance, ring_radius=args.ring_radius,
-                  impostor_max_size=args.impostor_max_size) | overrides
+                  impostor_max_size=args.impostor_max_size, impostor_detail_texels=args.detail_texels,
+                  regeneration_budget=args.regeneration_budget) | overrides
     try:
         return RenderSettings(**values)
     except (TypeError, ValueError) as error:

@@ -106,7 +106,7 @@ class FrameRenderer:
                            for key, cloud in zip(self._lighting_keys, scene.clouds))
         plan = plan_frame(particles.bounding_centres, particles.bounding_radii, camera, self.size, settings,
                           self._records, self._ring_state, cloud_keys, poses,
-                          lambda cloud: particles.centres[starts[cloud]:starts[cloud + 1]])
+                          lambda cloud: particles.centres[starts[cloud]:starts[cloud + 1]], particles.finest_radii)
         self._records, self._ring_state, self.last_plan = plan.records, plan.ring_state, plan
 
         view = view_matrix(camera)
