@@ -82,9 +82,9 @@ def detail_size_px(radius: float, distance: float, finest_radius: float, texels:
     """Texture side that gives a particle of `finest_radius` `texels` texels of radius on the quad.
 
     A cloud of Gaussian splats holds no detail finer than its smallest splat, so a
-    texture finer than this only resamples smooth curves (Nyquist: about 3 texels per
-    radius keep the kernel's spectrum above 8-bit noise).  Inf when there is no limit
-    (`texels` 0, or a zero `finest_radius`).
+    texture finer than this only resamples smooth curves (Nyquist: 3 texels per radius
+    sample the kernel's spectrum down to 8-bit quantisation; docs/lod.md).  Inf when
+    there is no limit (`texels` 0, or a zero `finest_radius`).
     """
     if not (texels > 0.0 and finest_radius > 0.0):
         return math.inf

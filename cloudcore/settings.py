@@ -62,7 +62,8 @@ class RenderSettings:
         if not 0.0 <= self.impostor_detail_texels < math.inf:
             problems.append(f"impostor_detail_texels must be >= 0 and finite, got {self.impostor_detail_texels}")
         if not (isinstance(self.regeneration_budget, int) and self.regeneration_budget >= 0):
-            problems.append(f"regeneration_budget must be an integer >= 0 (0: no limit), got {self.regeneration_budget!r}")
+            problems.append("regeneration_budget must be an integer >= 0 (0: no limit), "
+                            f"got {self.regeneration_budget!r}")
         if self.impostor_min_size > self.impostor_max_size:
             problems.append("impostor_min_size must not exceed impostor_max_size")
         if not 0.0 <= self.fade_start_radii <= self.fade_end_radii < math.inf:

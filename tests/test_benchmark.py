@@ -51,6 +51,7 @@ def test_bench_cli_writes_the_contract(tmp_path):
     out = tmp_path / "bench.json"
     result = subprocess.run([sys.executable, "-m", "cloudcore.cli", "bench", str(VALLEY), "--path", "flythrough",
                              "--frames", "2", "--width", "48", "--height", "32", "--sweep", "tolerance=0.15,2",
+                             "--sweep", "regeneration_budget=0,1", "--without-terrain",
                              "--json", str(out), "--plot", str(tmp_path / "plot.png"), "--no-shading"],
                             capture_output=True, text=True)
     if result.returncode != 0 and "EGL" in result.stderr:
@@ -58,8 +59,10 @@ def test_bench_cli_writes_the_contract(tmp_path):
     assert result.returncode == 0, result.stderr
     report = json.loads(out.read_text())
     assert {"scene", "path", "width", "height", "frames", "reference", "runs", "shading"} <= set(report)
-    assert [r["settings"]["tolerance_deg"] for r in report["runs"]] == [0.15, 2.0]
+    assert [(r["settings"]["tolerance_deg"], r["settings"]["regeneration_budget"]) for r in report["runs"]] == [
+        (0.15, 0), (0.15, 1), (2.0, 0), (2.0, 1)]
     assert all(CONTRACT_RUN_KEYS <= set(r) and len(r["per_frame"]) == 2 for r in report["runs"])
+    assert report["without_terrain"] is True
     assert (tmp_path / "plot.png").stat().st_size > 0
 
 
@@ -67,6 +70,7 @@ def test_bench_cli_writes_the_contract(tmp_path):
     (["--path", "nowhere"], "no camera path named 'nowhere'"),
     (["--path", "flythrough", "--sweep", "colour=1,2"], "--sweep"),
     (["--path", "flythrough", "--sweep", "impostor_max_size=300"], "power of two"),
+    (["--path", "flythrough", "--regeneration-budget", "-1"], "regeneration_budget"),
 ])
 def test_bad_bench_arguments_exit_2_in_one_line(tmp_path, args, message):
     result = subprocess.run([sys.executable, "-m", "cloudcore.cli", "bench", str(VALLEY), "--json",

@@ -100,7 +100,8 @@ def plot_error_against_time(report: dict, path: Path) -> None:
               label="Pareto front")
     for run_, x, y in zip(runs, seconds, errors):
         settings = run_["settings"]
-        axes.annotate(f"{settings['mode']} tol {settings['tolerance_deg']:g} budget {settings['regeneration_budget']}"
+        budget = settings["regeneration_budget"] or "none"
+        axes.annotate(f"{settings['mode']} tol {settings['tolerance_deg']:g} budget {budget}"
                       f"\nring {settings['ring_radius']:g} max {settings['impostor_max_size']}"
                       f" detail {settings['impostor_detail_texels']:g}", (x, y), fontsize=6, textcoords="offset points",
                       xytext=(4, 4))
