@@ -163,15 +163,12 @@ def _level_colours(model: ArtistShading, hour: float) -> np.ndarray:
     return colours
 
 
-def _interpolate_levels(level_heights: np.ndarray, level_colours: np.ndarray, fractions: np.ndarray) -> np.ndarray:
-    """Colours (n, 4) at height fractions (n,): linear between levels, the end colours beyond (equation 1)."""
-    return np.stack([np.interp(fractions, level_heights, channel) for channel in level_colours.T], axis=-1)
-
-
 def vertical_colour(model: ArtistShading, heights_fraction, hour: float) -> np.ndarray:
-    """Wang's ambient colour (n, 4) RGBA at height fractions (n,) and `hour` (section 5.1, equation 1)."""
+    """Wang's ambient colour (n, 4) RGBA at height fractions (n,) and `hour` (section 5.1, equation 1):
+    linear between levels, the end colours beyond."""
     fractions = np.clip(np.asarray(heights_fraction, dtype=np.float64).reshape(-1), 0.0, 1.0)
-    return _interpolate_levels(np.array(model.levels)[:, 0], _level_colours(model, hour), fractions)
+    heights, colours = np.array(model.levels)[:, 0], _level_colours(model, hour)
+    return np.stack([np.interp(fractions, heights, channel) for channel in colours.T], axis=-1)
 
 
 def directional_factor(vertex_positions, group_centres_per_vertex, sun_direction, model: ArtistShading) -> np.ndarray:
@@ -255,7 +252,7 @@ def artist_colours(model: ArtistShading, vertex_positions, cloud_bottom_y: float
     uniforms = artist_uniforms(model, hour, sun_direction)
     vertices = _finite_points("vertex_positions", vertex_positions)
     fractions = height_fractions(vertices[:, 1], cloud_bottom_y, cloud_top_y)
-    ambient = _interpolate_levels(uniforms["level_heights"], uniforms["level_colours"], fractions)
+    ambient = vertical_colour(model, fractions, hour)
     factor = directional_factor(vertices, group_centres_per_vertex, sun_direction, model)
     directional = np.column_stack([factor[:, None] * uniforms["directional_colour"], np.zeros(len(factor))])
     return np.clip(ambient + directional, 0.0, 1.0)
