@@ -34,8 +34,8 @@ from app.editor import Editor  # noqa: E402
 from app.panels import Panels  # noqa: E402
 from app.viewport import Viewport  # noqa: E402
 from cloudcore.errors import SceneError  # noqa: E402
+from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
 
-DEFAULT_SCENE = Path(__file__).resolve().parents[1] / "resources" / "scenes" / "valley.toml"
 
 
 def runner_params(editor: Editor, viewport: Viewport, panels: Panels, testing: bool,

@@ -4,7 +4,7 @@ Wang's artists painted 16 textures "with interesting features that resemble
 eddies and wisps" so that few sprites make a detailed cloud.  These are drawn
 from hashed value noise (`cloudcore.noise`), four variants per kind, so the
 sheet is the same on every machine and `scripts/make_sprite_atlas.py`
-regenerates `resources/sprites/atlas.png` exactly.
+regenerates `cloudcore/resources/sprites/atlas.png` exactly.
 
 Each cell holds one sprite, upright: its top toward the top of the image.
 Alpha is the sprite's opacity; RGB its brightness (grey, except the foggy

@@ -3,7 +3,7 @@
 Wang mixes 16 textures on one sheet to make a dozen cloud types: a
 flat-bottomed one for cumulus bases, foggy ones "used heavily in stratus",
 puffy ones for cumulus and wispy ones "used across all cloud types".  Here the
-sheet is `resources/sprites/atlas.png`, ATLAS_GRID x ATLAS_GRID cells of
+sheet is `cloudcore/resources/sprites/atlas.png`, ATLAS_GRID x ATLAS_GRID cells of
 CELL_PIXELS, one kind per row (`ROWS`, top row first), four variants across;
 `scripts/make_sprite_atlas.py` draws it (`cloudcore.sprite_art`).
 
@@ -26,15 +26,15 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
 from cloudcore.artist_shading import height_fractions
 from cloudcore.errors import FieldError
 from cloudcore.noise import hash01
+from cloudcore.resources import ATLAS
 
-ATLAS_PATH = Path(__file__).resolve().parents[1] / "resources" / "sprites" / "atlas.png"
+ATLAS_PATH = ATLAS
 ATLAS_GRID = 4
 CELL_PIXELS = 256
 #: empty border of each cell, in pixels at mip level 0

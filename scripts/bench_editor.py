@@ -1,6 +1,6 @@
 """The editor's frame times: the window at a size (default 1280x720) on a scene, auto mode, camera still. JSON out.
 
-    python scripts/bench_editor.py [resources/scenes/valley.toml] [--size 1280x720] [--frames 150]
+    python scripts/bench_editor.py [cloudcore/resources/scenes/valley.toml] [--size 1280x720] [--frames 150]
                                    [--warm-up 10] [--json out/bench_editor.json]
 
 Runs the real editor (`python -m app SCENE --frames N --frame-stats ...`), under
@@ -25,9 +25,9 @@ from pathlib import Path
 import numpy as np
 
 from cloudcore.benchmark import machine, write_report
+from cloudcore.resources import DEFAULT_SCENE
 
 ROOT = Path(__file__).resolve().parents[1]
-DEFAULT_SCENE = ROOT / "resources" / "scenes" / "valley.toml"
 _TIMES = ("window_frame_ms", "viewport_ms", "frame_ms", "cloud_ms", "world_ms", "impostor_update_ms")
 
 

@@ -1,6 +1,6 @@
 """Full-3D frame time and overdraw of a scene at several sizes: the record impostors must beat. JSON out.
 
-    python scripts/bench_full3d.py [resources/scenes/valley.toml] [--sizes 640x480,1600x1200]
+    python scripts/bench_full3d.py [cloudcore/resources/scenes/valley.toml] [--sizes 640x480,1600x1200]
                                    [--path flythrough --frames 8] [--json out/bench_full3d.json]
 
 For each size renders the scene's camera view, then --frames views spread along
@@ -21,10 +21,10 @@ os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 
 from cloudcore.benchmark import machine, path_views, write_report  # noqa: E402  (the GL imports need the platform above)
 from cloudcore.gl import FrameRenderer  # noqa: E402
+from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
 from cloudcore.scenefile import load_scene  # noqa: E402
 from cloudcore.settings import FULL_3D  # noqa: E402
 
-DEFAULT_SCENE = Path(__file__).resolve().parents[1] / "resources" / "scenes" / "valley.toml"
 _TIMES = ("frame_ms", "world_ms", "cloud_ms")
 
 

@@ -1,6 +1,6 @@
 """Long run: a camera path looped headless for minutes; texture and process memory must stay flat. JSON out.
 
-    python scripts/bench_longrun.py [resources/scenes/valley.toml] [--path flythrough] [--minutes 10]
+    python scripts/bench_longrun.py [cloudcore/resources/scenes/valley.toml] [--path flythrough] [--minutes 10]
                                     [--width 640 --height 480] [--mode auto] [--json out/longrun.json]
 
 Renders the path's frames (--fps per second of path time) over and over, as
@@ -27,10 +27,10 @@ os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 
 from cloudcore.benchmark import machine, path_views, resident_memory_bytes, write_report  # noqa: E402  (the GL imports need the platform)
 from cloudcore.gl import FrameRenderer  # noqa: E402
+from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
 from cloudcore.scenefile import load_scene  # noqa: E402
 from cloudcore.settings import MODES, RenderSettings  # noqa: E402
 
-DEFAULT_SCENE = Path(__file__).resolve().parents[1] / "resources" / "scenes" / "valley.toml"
 
 
 def sample(renderer: FrameRenderer, started: float, frames: int, frame_ms: list[float]) -> dict:

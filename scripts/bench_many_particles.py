@@ -30,11 +30,11 @@ os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 from cloudcore.benchmark import machine, resident_memory_bytes, write_report  # noqa: E402  (the GL imports need the platform)
 from cloudcore.cloudgen import cumulus  # noqa: E402
 from cloudcore.gl import FrameRenderer  # noqa: E402
+from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
 from cloudcore.scene import Cloud, Scene  # noqa: E402
 from cloudcore.scenefile import load_scene  # noqa: E402
 from cloudcore.settings import RenderSettings  # noqa: E402
 
-DEFAULT_SCENE = Path(__file__).resolve().parents[1] / "resources" / "scenes" / "valley.toml"
 #: metres between neighbouring clouds of the field (the valley's clouds are 380 to 760 m across)
 SPACING_M = 900.0
 #: the last frames of a mode, averaged as its steady state: by then the ring (8 segments, 8 fade frames) is built

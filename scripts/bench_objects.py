@@ -3,7 +3,7 @@
     python scripts/bench_objects.py [--frames 301] [--json out/bench_objects.json]
                                     [--figure docs/images/split_layers.png]
 
-1. resources/scenes/aircraft_in_cloud.toml at 640x480 at three instants of the
+1. cloudcore/resources/scenes/aircraft_in_cloud.toml at 640x480 at three instants of the
    aircraft's crossing: full 3D split (the reference), full 3D naive (splats
    depth-tested against the mesh), impostor split, impostor naive (the mesh
    depth-tested against one quad); PSNR over the frame and over the aircraft's
@@ -30,10 +30,11 @@ from cloudcore.camera import screen_box  # noqa: E402
 from cloudcore.gl import FrameRenderer  # noqa: E402
 from cloudcore.imagecompare import compare  # noqa: E402
 from cloudcore.objects import object_poses  # noqa: E402
+from cloudcore.resources import resource_path  # noqa: E402
 from cloudcore.scenefile import load_scene  # noqa: E402
 from cloudcore.settings import FULL_3D, RenderSettings  # noqa: E402
 
-SCENES = Path(__file__).resolve().parents[1] / "resources" / "scenes"
+SCENES = resource_path("scenes")
 VARIANTS = {"full 3D, split": FULL_3D, "full 3D, naive": RenderSettings(mode="full", split_objects=False),
             "impostor, split": RenderSettings(mode="impostor"),
             "impostor, naive": RenderSettings(mode="impostor", split_objects=False)}

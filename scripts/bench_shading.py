@@ -1,6 +1,6 @@
 """Shading throughput and accuracy: exact against raster on a scene, JSON out.
 
-    python scripts/bench_shading.py [resources/scenes/valley.toml] [--json out/bench_shading.json]
+    python scripts/bench_shading.py [cloudcore/resources/scenes/valley.toml] [--json out/bench_shading.json]
 
 For each active light of the scene, shades every cloud with the exact method
 and with the raster method at several resolutions (best of --repeat runs),
@@ -15,10 +15,10 @@ import platform
 from pathlib import Path
 
 from cloudcore.benchmark import machine, shading_comparison, write_report
+from cloudcore.resources import DEFAULT_SCENE
 from cloudcore.scenefile import load_scene
 from cloudcore.shading import DEFAULT_RASTER_RESOLUTION
 
-DEFAULT_SCENE = Path(__file__).resolve().parents[1] / "resources" / "scenes" / "valley.toml"
 
 
 def main() -> None:

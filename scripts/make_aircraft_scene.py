@@ -1,6 +1,6 @@
-"""Regenerate resources/scenes/aircraft_in_cloud.toml: one cumulus, an aircraft flying through it.
+"""Regenerate cloudcore/resources/scenes/aircraft_in_cloud.toml: one cumulus, an aircraft flying through it.
 
-    python scripts/make_aircraft_scene.py [--out resources/scenes/aircraft_in_cloud.toml]
+    python scripts/make_aircraft_scene.py [--out cloudcore/resources/scenes/aircraft_in_cloud.toml]
 
 The scene of the split-layer tests and docs (Harris 3.1.1): the aircraft
 crosses the cloud at 45 degrees to the fixed camera's view, so an impostor
@@ -50,7 +50,7 @@ def build() -> Scene:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", type=Path, default=Path("resources/scenes/aircraft_in_cloud.toml"))
+    parser.add_argument("--out", type=Path, default=Path("cloudcore/resources/scenes/aircraft_in_cloud.toml"))
     out = parser.parse_args().out
     save_scene(build(), out)
     print(f"wrote {out}")

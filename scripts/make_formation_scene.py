@@ -1,7 +1,7 @@
-"""Regenerate resources/scenes/formation.toml: one cloud forming, one dissipating, one steady between them.
+"""Regenerate cloudcore/resources/scenes/formation.toml: one cloud forming, one dissipating, one steady between them.
 
-    python scripts/make_formation_scene.py [--out resources/scenes/formation.toml]
-    cloudview record resources/scenes/formation.toml --path watch --out formation.mp4
+    python scripts/make_formation_scene.py [--out cloudcore/resources/scenes/formation.toml]
+    cloudview record cloudcore/resources/scenes/formation.toml --path watch --out formation.mp4
 
 The demo of Wang's formation and dissipation (2004, section 4 and Listing 1):
 over the 10 s camera path `watch` the left cloud grows from its core outward
@@ -60,7 +60,7 @@ def build() -> Scene:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", type=Path, default=Path("resources/scenes/formation.toml"))
+    parser.add_argument("--out", type=Path, default=Path("cloudcore/resources/scenes/formation.toml"))
     out = parser.parse_args().out
     save_scene(build(), out)
     print(f"wrote {out}")

@@ -1,6 +1,6 @@
-"""Regenerate the cloud sprite atlas resources/sprites/atlas.png (Wang 2004, section 3.2, figure 6).
+"""Regenerate the cloud sprite atlas cloudcore/resources/sprites/atlas.png (Wang 2004, section 3.2, figure 6).
 
-    python scripts/make_sprite_atlas.py [--out resources/sprites/atlas.png] [--seed 2004]
+    python scripts/make_sprite_atlas.py [--out cloudcore/resources/sprites/atlas.png] [--seed 2004]
 
 A 4x4 sheet of 256 px cells, one kind per row from the top: flat-bottom,
 foggy, puffy, wispy (`cloudcore.sprites.ROWS`), four variants each, drawn

@@ -1,6 +1,6 @@
-"""Regenerate the default scene resources/scenes/valley.toml (after Harris 2002, figure 3).
+"""Regenerate the default scene cloudcore/resources/scenes/valley.toml (after Harris 2002, figure 3).
 
-    python scripts/make_valley.py [--out resources/scenes/valley.toml]
+    python scripts/make_valley.py [--out cloudcore/resources/scenes/valley.toml]
 
 34 cumulus clouds (about 90,000 particles) hang low over a procedural valley
 of 59,858 triangles, lit by an afternoon sun; a 30 s camera path `flythrough`
@@ -89,7 +89,7 @@ def build() -> Scene:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", type=Path, default=Path("resources/scenes/valley.toml"))
+    parser.add_argument("--out", type=Path, default=Path("cloudcore/resources/scenes/valley.toml"))
     out = parser.parse_args().out
     scene = save_scene(build(), out)
     print(f"wrote {out}: {len(scene.clouds)} clouds, {scene.particle_count} particles")

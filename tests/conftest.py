@@ -5,11 +5,12 @@ import numpy as np
 import pytest
 
 from cloudcore.artist_shading import ArtistShading
+from cloudcore.resources import DEFAULT_SCENE
 from cloudcore.scene import Camera, CameraPath, Cloud, Light, Lighting, Scene, SceneObject, Shading, Terrain
 from cloudcore.sprites import SpriteStyle
 
 ROOT = Path(__file__).resolve().parents[1]
-VALLEY = ROOT / "resources" / "scenes" / "valley.toml"
+VALLEY = DEFAULT_SCENE
 RENDER_WIDTH, RENDER_HEIGHT = 160, 120
 
 # PyOpenGL picks its platform on first import: the tests render headless through EGL.

@@ -1,4 +1,4 @@
-"""The default scene: what issue 2 promises about resources/scenes/valley.toml."""
+"""The default scene: what issue 2 promises about cloudcore/resources/scenes/valley.toml."""
 
 import numpy as np
 import pytest

@@ -1,6 +1,6 @@
 """Objects inside clouds (issue 5), rendered: split layers against the naive single impostor.
 
-The scene (resources/scenes/aircraft_in_cloud.toml) flies a 70 m aircraft
+The scene (cloudcore/resources/scenes/aircraft_in_cloud.toml) flies a 70 m aircraft
 through one cumulus, 45 degrees across the view.  The reference is full 3D
 split at the aircraft; tolerances: the split impostor within 45 dB of it over
 the frame and 50 dB over the aircraft's screen box (measured about 54 and
@@ -16,11 +16,11 @@ import pytest
 from cloudcore.camera import screen_box
 from cloudcore.imagecompare import compare
 from cloudcore.objects import object_poses
+from cloudcore.resources import resource_path
 from cloudcore.scenefile import load_scene
 from cloudcore.settings import FULL_3D, RenderSettings
-from conftest import ROOT
 
-AIRCRAFT_IN_CLOUD = ROOT / "resources" / "scenes" / "aircraft_in_cloud.toml"
+AIRCRAFT_IN_CLOUD = resource_path("scenes", "aircraft_in_cloud.toml")
 SPLIT_IMPOSTOR = RenderSettings(mode="impostor")
 NAIVE_IMPOSTOR = RenderSettings(mode="impostor", split_objects=False)
 

@@ -17,7 +17,7 @@ from contextlib import ExitStack, contextmanager
 from pathlib import Path
 from types import SimpleNamespace
 
-from cloudcore.cli.render import pixel_count
+from cloudcore.cli.render import add_scene_argument, pixel_count
 from cloudcore.cli.settings_args import add_settings_arguments, settings_from
 from cloudcore.errors import SceneError
 from cloudcore.paths import camera_on_path
@@ -27,7 +27,7 @@ from cloudcore.scenefile import load_scene
 
 def add_parser(commands) -> None:
     parser = commands.add_parser("record", help="render every frame of a camera path to a video and/or PNGs")
-    parser.add_argument("scene", help="scene file (.toml)")
+    add_scene_argument(parser)
     parser.add_argument("--path", required=True, help="camera path of the scene to fly")
     parser.add_argument("--out", type=Path, help="H.264 video to write (.mp4); needs an even width and height")
     parser.add_argument("--frames-dir", type=Path, help="folder to write frame_00000.png, frame_00001.png, ... into")

@@ -11,12 +11,13 @@ from cloudcore.errors import SceneError
 from cloudcore.heatmap import heat_image
 from cloudcore.overdraw import scene_block_overdraw_statistics
 from cloudcore.paths import camera_on_path
+from cloudcore.resources import DEFAULT_SCENE
 from cloudcore.scenefile import load_scene
 
 
 def add_parser(commands) -> None:
     parser = commands.add_parser("render", help="render one frame to a PNG, headless")
-    parser.add_argument("scene", help="scene file (.toml)")
+    add_scene_argument(parser)
     parser.add_argument("--out", required=True, type=Path, help="PNG to write")
     parser.add_argument("--width", type=pixel_count, default=640)
     parser.add_argument("--height", type=pixel_count, default=480)
@@ -28,6 +29,12 @@ def add_parser(commands) -> None:
     # one frame: the reference picture unless asked otherwise (impostors pay off over many frames)
     add_settings_arguments(parser, default_mode="full")
     parser.set_defaults(run=run)
+
+
+def add_scene_argument(parser) -> None:
+    """The optional SCENE argument: without it, the built-in default scene (shipped in the package)."""
+    parser.add_argument("scene", nargs="?", default=str(DEFAULT_SCENE),
+                        help="scene file (.toml); default: the built-in valley scene")
 
 
 def pixel_count(text: str) -> int:

@@ -7,6 +7,7 @@ import time
 import numpy as np
 from tqdm import tqdm
 
+from cloudcore.cli.render import add_scene_argument
 from cloudcore.illumination import illuminate_clouds
 from cloudcore.lighting import active_lights, scene_lights
 from cloudcore.scenefile import load_scene
@@ -15,7 +16,7 @@ from cloudcore.shading import METHODS
 
 def add_parser(commands) -> None:
     parser = commands.add_parser("shade", help="precompute cloud illumination and print statistics")
-    parser.add_argument("scene", help="scene file (.toml)")
+    add_scene_argument(parser)
     parser.add_argument("--method", choices=METHODS, default="exact")
     parser.set_defaults(run=run)
 

@@ -4,7 +4,7 @@ Set PYOPENGL_PLATFORM=egl before importing this package to render without a
 display (PyOpenGL picks its platform on first import).
 
     from cloudcore.gl import render_full
-    rgb, stats = render_full(load_scene("resources/scenes/valley.toml"), 640, 480)
+    rgb, stats = render_full(load_scene("cloudcore/resources/scenes/valley.toml"), 640, 480)
 """
 
 from cloudcore.gl.frame import FrameRenderer, render_full

@@ -7,12 +7,13 @@ and link errors raise with the driver's log and the file name.
 
 from __future__ import annotations
 
-from pathlib import Path
+from importlib.resources import files
 
 import numpy as np
 from OpenGL import GL
 
-SHADER_DIR = Path(__file__).with_name("shaders")
+#: the .glsl files, package data (found in an installed wheel as in a checkout)
+SHADER_DIR = files("cloudcore.gl").joinpath("shaders")
 
 
 class ShaderError(RuntimeError):
@@ -46,7 +47,7 @@ def _link(name: str, shaders: list[int]) -> int:
 
 
 def _compile(kind: int, file: str, defines: dict[str, int | float]) -> int:
-    source = (SHADER_DIR / file).read_text()
+    source = SHADER_DIR.joinpath(file).read_text(encoding="utf-8")
     version, _, body = source.partition("\n")
     if not version.startswith("#version"):
         raise ShaderError(f"{file}: the first line must be the #version directive")
