@@ -8,7 +8,9 @@ from __future__ import annotations
 
 import argparse
 import os
+import platform
 import sys
+from importlib import metadata
 
 from cloudcore.errors import SceneError
 
@@ -18,10 +20,25 @@ class _OneLineParser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message} (see --help)\n")
 
 
+def version_line() -> str:
+    """`cloudview --version`: ours, then the Python and the libraries that decide whether it runs."""
+    def installed(name: str) -> str:
+        try:
+            return metadata.version(name)
+        except metadata.PackageNotFoundError:
+            return "not installed"
+    libraries = ", ".join(f"{name} {installed(name)}" for name in ("pyrender-maintained", "PyOpenGL", "numpy",
+                                                                    "imgui-bundle"))
+    return f"cloudview {installed('cloudview')} (Python {platform.python_version()}; {libraries})"
+
+
 def build_parser() -> tuple[argparse.ArgumentParser, argparse._SubParsersAction]:
     from cloudcore.cli import bench, compare, record, render, shade
 
-    parser = _OneLineParser(prog="cloudview", description="Real-time volumetric particle clouds.")
+    # raw text: the version stays one line however narrow the terminal
+    parser = _OneLineParser(prog="cloudview", description="Real-time volumetric particle clouds.",
+                            formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--version", action="version", version=version_line())
     commands = parser.add_subparsers(dest="command", parser_class=_OneLineParser, metavar="COMMAND")
     shade.add_parser(commands)
     render.add_parser(commands)
@@ -34,7 +51,7 @@ def build_parser() -> tuple[argparse.ArgumentParser, argparse._SubParsersAction]
 def main(argv=None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     parser, commands = build_parser()
-    if not argv or (argv[0] not in commands.choices and argv[0] not in ("-h", "--help")):
+    if not argv or (argv[0] not in commands.choices and argv[0] not in ("-h", "--help", "--version")):
         return _editor(argv)
     args = parser.parse_args(argv)
     try:
