@@ -188,7 +188,8 @@ def load_scene(path) -> Scene:
     path = Path(path)
     source = str(path)
     try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
+        # utf-8-sig: a byte-order mark (Windows editors write one) is not part of the TOML
+        data = tomllib.loads(path.read_text(encoding="utf-8-sig"))
     except FileNotFoundError:
         raise _error(source, "(file)", "no such file") from None
     except (OSError, UnicodeDecodeError) as error:

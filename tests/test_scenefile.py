@@ -142,6 +142,19 @@ def test_base_scene_is_valid(tmp_path):
     assert len(load_scene(tmp_path / "ok.toml").clouds) == 1
 
 
+def test_a_byte_order_mark_from_a_windows_editor_is_accepted(tmp_path):
+    (tmp_path / "bom.toml").write_bytes(b"\xef\xbb\xbf" + BASE.replace("\n", "\r\n").encode("utf-8"))
+    (tmp_path / "plain.toml").write_text(BASE)
+    assert load_scene(tmp_path / "bom.toml") == load_scene(tmp_path / "plain.toml")
+
+
+def test_a_byte_order_mark_anywhere_but_the_start_is_still_refused(tmp_path):
+    (tmp_path / "bad.toml").write_bytes(BASE.encode("utf-8") + b"\xef\xbb\xbf")
+    with pytest.raises(SceneError) as caught:
+        load_scene(tmp_path / "bad.toml")
+    assert caught.value.field == "(toml)"
+
+
 @pytest.mark.parametrize("content, problem", [
     (None, "no such file"),
     (b"\x93NUMPY\x01\x00", "not a readable .npy"),
