@@ -14,10 +14,12 @@ import dataclasses
 import shutil
 import time
 from collections import deque
+from collections.abc import Callable
 from pathlib import Path
 
 from cloudcore.editing import History, delete_cloud, delete_particles
 from cloudcore.errors import SceneError
+from cloudcore.limits import scene_limit_problems
 from cloudcore.paths import camera_on_path
 from cloudcore.scene import Camera, Scene
 from cloudcore.scenefile import load_scene, particles_folder, save_scene
@@ -115,11 +117,27 @@ class Editor:
     def time_of_day(self) -> float | None:
         return self.scene.lighting.time_of_day
 
-    def edit(self, scene: Scene) -> None:
-        """Apply an edit (undoable)."""
+    def edit(self, scene: Scene) -> bool:
+        """Apply an edit (undoable).  One the renderer could not draw (`cloudcore.limits`, the
+        limits the scene loader checks too) is refused with a message; the scene stays as it was."""
+        problems = scene_limit_problems(scene, unchanged=self.scene)
+        if problems:
+            self.messages.append("not applied: {}: {}".format(*problems[0]))
+            return False
         self.history.apply(scene)
         if self.selected_cloud is not None and self.selected_cloud >= len(scene.clouds):
             self.selected_cloud = len(scene.clouds) - 1 if scene.clouds else None
+        return True
+
+    def change(self, make: Callable[[], Scene]) -> bool:
+        """Build an edit of the current scene with `make` and apply it; an edit the editing
+        functions refuse (ValueError: a radius of 0, a non-finite point) becomes a message."""
+        try:
+            scene = make()
+        except ValueError as error:
+            self.messages.append(f"not applied: {error}")
+            return False
+        return self.edit(scene)
 
     def begin_gesture(self) -> None:
         """Edits until `end_gesture` (a brush stroke, a drag) undo as one."""

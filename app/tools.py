@@ -46,7 +46,7 @@ class ViewportTools:
             start, cloud, particle, grabbed, normal = self._drag
             offset = drag_offset(*ray, grabbed, normal)
             if offset is not None:  # beyond the plane's horizon the thing stays where it last was
-                self.editor.edit(translated(start, cloud, offset, particle))
+                self.editor.change(lambda: translated(start, cloud, offset, particle))
 
     def release(self, ray, clicked: bool) -> None:
         """The left button came up; `clicked`: without leaving the viewport (a click, for Place)."""
@@ -85,7 +85,7 @@ class ViewportTools:
         if point is None:
             editor.messages.append(self._why_missed())
             return
-        editor.edit(add_particle(editor.scene, editor.selected_cloud, point, editor.particle_radius))
+        editor.change(lambda: add_particle(editor.scene, editor.selected_cloud, point, editor.particle_radius))
 
     def _start_stroke(self, ray) -> None:
         editor = self.editor
@@ -112,7 +112,7 @@ class ViewportTools:
             editor.edit(delete_particles(editor.scene, cloud, erased))
         else:
             centres = self._stroke.dab(point, editor.brush_radius, count)
-            editor.edit(add_particles(editor.scene, cloud, centres, editor.particle_radius))
+            editor.change(lambda: add_particles(editor.scene, cloud, centres, editor.particle_radius))
 
     def _start_drag(self, ray, one_particle: bool, screen_plane: bool) -> None:
         editor = self.editor

@@ -272,15 +272,30 @@ def shading_groups(centres, group_size_m: float) -> tuple[np.ndarray, np.ndarray
         raise ValueError(f"group_size_m must be finite and > 0, got {group_size_m}")
     if len(centres) == 0:
         return np.zeros(0, dtype=np.int64), np.zeros((0, 3))
-    with np.errstate(over="ignore"):
-        cells = np.floor((centres - centres.min(axis=0)) / group_size_m)
-    if not np.all(cells < 2.0 ** 53):  # beyond this the cell numbers stop being exact integers
+    cells = _grid_cells(centres, group_size_m)
+    if not _cells_exact(cells):
         raise ValueError(f"group_size_m {group_size_m} is too small for a cloud this large")
     _, group_index = np.unique(cells.astype(np.int64), axis=0, return_inverse=True)
     group_index = group_index.reshape(-1)
     counts = np.bincount(group_index)
     sums = np.stack([np.bincount(group_index, weights=centres[:, axis]) for axis in range(3)], axis=1)
     return group_index.astype(np.int64), sums / counts[:, None]
+
+
+def shading_grid_fits(centres, group_size_m: float) -> bool:
+    """Whether `shading_groups` can number this cloud's groups (cloudcore.limits checks scenes with it)."""
+    centres = np.asarray(centres, dtype=np.float64).reshape(-1, 3)
+    return len(centres) == 0 or _cells_exact(_grid_cells(centres, group_size_m))
+
+
+def _grid_cells(centres: np.ndarray, group_size_m: float) -> np.ndarray:
+    with np.errstate(over="ignore"):
+        return np.floor((centres - centres.min(axis=0)) / group_size_m)
+
+
+def _cells_exact(cells: np.ndarray) -> bool:
+    """Beyond 2**53 the cell numbers stop being exact integers (an infinite extent is beyond too)."""
+    return bool(np.all(cells < 2.0 ** 53))
 
 
 def default_group_size(radii) -> float:

@@ -22,6 +22,7 @@ import tomlkit
 from cloudcore.artist_shading import ArtistShading
 from cloudcore.errors import FieldError, SceneError
 from cloudcore.formation import FORMATION_KINDS, Formation
+from cloudcore.limits import scene_limit_problems
 from cloudcore.phase import MAX_ABS_G, PHASE_NAMES
 from cloudcore.scene import Camera, CameraPath, Cloud, Light, Lighting, Scene, SceneObject, Shading, Terrain
 from cloudcore.sprites import FACINGS, MAX_SEED, SpriteStyle
@@ -211,7 +212,7 @@ def scene_from_dict(data: dict, source: str = "<scene>", base_dir=Path(".")) -> 
     _unique_names(root, "objects", objects)
     paths = tuple(_camera_path(t) for t in root.tables("camera_paths"))
     _unique_names(root, "camera_paths", paths)
-    return Scene(
+    scene = Scene(
         camera=_camera(_Table(source, "camera", root.raw("camera", {}))),
         lighting=_lighting(_Table(source, "lighting", root.raw("lighting", {}))),
         shading=_shading(_Table(source, "shading", root.raw("shading", {}))),
@@ -221,6 +222,11 @@ def scene_from_dict(data: dict, source: str = "<scene>", base_dir=Path(".")) -> 
         camera_paths=paths,
         description=root.string("description", ""),
     )
+    # what every field allows, the renderer may still not draw: refuse that here, not in the GL code
+    problems = scene_limit_problems(scene)
+    if problems:
+        raise _error(source, *problems[0])
+    return scene
 
 
 def _unique_names(root: _Table, key: str, items) -> None:

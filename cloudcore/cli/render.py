@@ -9,6 +9,7 @@ from pathlib import Path
 from cloudcore.cli.settings_args import add_settings_arguments, settings_from
 from cloudcore.errors import SceneError
 from cloudcore.heatmap import heat_image
+from cloudcore.limits import MAX_FRAME_SIDE
 from cloudcore.overdraw import scene_block_overdraw_statistics
 from cloudcore.paths import camera_on_path
 from cloudcore.resources import DEFAULT_SCENE
@@ -40,7 +41,7 @@ def add_scene_argument(parser) -> None:
 def pixel_count(text: str) -> int:
     """An image side in pixels; argparse names this function in its refusal."""
     value = int(text)
-    if not 1 <= value <= 16384:
+    if not 1 <= value <= MAX_FRAME_SIDE:
         raise ValueError(text)
     return value
 

@@ -27,6 +27,7 @@ from cloudcore.facing import FacingState
 from cloudcore.gl.blending import cloud_blending
 from cloudcore.gl.programs import build_compute_program, build_program, set_matrix, set_vec3
 from cloudcore.kernel import SPLAT_SHARPNESS
+from cloudcore.limits import MAX_LIGHTS
 from cloudcore.particle_styles import ParticleStyles
 from cloudcore.phase import PHASE_NAMES
 from cloudcore.sprites import ATLAS_GRID, ATLAS_MAX_MIP_LEVEL, load_atlas
@@ -34,7 +35,6 @@ from cloudcore.sprites import ATLAS_GRID, ATLAS_MAX_MIP_LEVEL, load_atlas
 #: two triangles over a particle's four corners (lower left, lower right, upper left, upper right)
 _QUAD_TRIANGLES = np.array([0, 1, 2, 2, 1, 3], dtype=np.uint32)
 #: lights the shader sums over; more would only add light too faint to matter (skylights share the sky)
-MAX_LIGHTS = 8
 #: the shader's `Particle` in std430 layout: five vec4 then MAX_LIGHTS floats
 _PARTICLE_FLOATS = 20 + MAX_LIGHTS
 #: the shader's `CloudStyle`: ten vec4
@@ -209,7 +209,7 @@ class SplatPass:
 def _particle_records(particles: ParticleShading) -> np.ndarray:
     """The shader's `Particle` array (n, _PARTICLE_FLOATS) float32: the view-independent terms of `seen_from`."""
     lights = len(particles.light_directions)
-    if lights > MAX_LIGHTS:
+    if lights > MAX_LIGHTS:  # the scene loader and the editor refuse these first (cloudcore.limits)
         raise ValueError(f"at most {MAX_LIGHTS} lights can shine on clouds at once, the scene has {lights}")
     records = np.zeros((max(len(particles.radii), 1), _PARTICLE_FLOATS), dtype=np.float32)
     n = len(particles.radii)

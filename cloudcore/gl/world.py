@@ -19,6 +19,7 @@ from cloudcore.gl.programs import build_program, set_matrix, set_vec3
 from cloudcore.gl.pyrender_compat import pyrender
 from cloudcore.colour import srgb_encode
 from cloudcore.lighting import active_lights
+from cloudcore.limits import DRAWN_TERRAIN_KINDS
 from cloudcore.scene import Camera, Terrain
 from cloudcore.terrain import heightfield_mesh
 
@@ -48,7 +49,7 @@ class WorldPass:
 
     @staticmethod
     def _terrain_scene(terrain: Terrain, lights, ambient):
-        if terrain.kind != "heightfield":
+        if terrain.kind not in DRAWN_TERRAIN_KINDS:  # the scene loader refuses these first (cloudcore.limits)
             raise ValueError(f"the GL prototype draws heightfield terrain only, not {terrain.kind!r}")
         vertices, faces = heightfield_mesh(terrain)
         colours = terrain_vertex_colours(vertices, faces, terrain.color, lights, ambient)
