@@ -276,6 +276,10 @@ def install(params, editor, viewport, panels, results_path: Path, outcome: dict)
         ctx.item_click("Place")
 
     def heat_map_changes_the_picture(ctx):
+        # in full 3D, where every splat counts: auto draws this still view from impostors, one a pixel
+        use_window(ctx, "LOD")
+        ctx.combo_click("Mode/full")
+        CHECK(editor.settings.mode == "full")
         use_window(ctx, "Statistics")
         ctx.yield_(SETTLE)
         frame = capture(ctx)
@@ -283,6 +287,8 @@ def install(params, editor, viewport, panels, results_path: Path, outcome: dict)
         ctx.yield_(SETTLE)
         heat = capture(ctx)
         ctx.item_uncheck("Overdraw heat map")
+        use_window(ctx, "LOD")
+        ctx.combo_click("Mode/auto")
         changed = (np.abs(frame.astype(int) - heat.astype(int)).max(axis=2) > 20).mean()
         outcome["heat_map_changed_fraction"] = float(changed)
         CHECK(bool(changed > 0.5))  # the sky has no overdraw: black where it was blue

@@ -18,7 +18,7 @@ from cloudcore.editing import (add_cloud, add_preset_cloud, delete_cloud, fill_b
 from cloudcore.errors import SceneError
 from cloudcore.navigation import orbited
 from cloudcore.phase import PHASE_NAMES
-from cloudcore.settings import MODES
+from cloudcore.settings import MODES, TRANSLATION_METRICS
 
 
 class Panels:
@@ -225,12 +225,17 @@ class Panels:
         settings = editor.settings
         changed_mode, mode = imgui.combo("Mode", MODES.index(settings.mode), list(MODES))
         changed_tol, tolerance = imgui.slider_float("Tolerance (deg)", settings.tolerance_deg, 0.0, 5.0, "%.3f")
+        imgui.set_item_tooltip("An impostor is remade once its translation error passes this; by default the "
+                               "parallax between its near and far points (Harris), 0.125 about one pixel.")
+        metrics = list(TRANSLATION_METRICS)
+        changed_metric, metric = imgui.combo("Translation error", metrics.index(settings.translation_metric), metrics)
         ring_on = math.isfinite(settings.ring_radius)
         changed_ring_on, ring_on = imgui.checkbox("Impostor ring", ring_on)
         radius = settings.ring_radius if math.isfinite(settings.ring_radius) else 4000.0
         changed_radius, radius = imgui.slider_float("Ring radius (m)", radius, 0.0, 20000.0, "%.0f")
-        changed_fade, fades = imgui.slider_float2("Fade (radii)", [settings.fade_start_radii,
-                                                                    settings.fade_end_radii], 1.0, 10.0)
+        changed_fade, transition = imgui.slider_int("Transition (frames)", settings.transition_frames, 1, 60)
+        imgui.set_item_tooltip("Frames of crossfade when auto mode moves a cloud between full 3D and its impostor.")
+        changed_group, group = imgui.checkbox("Group interpenetrating clouds", settings.group_clouds)
         sizes = [int(math.log2(settings.impostor_min_size)), int(math.log2(settings.impostor_max_size))]
         changed_sizes, sizes = imgui.slider_int2("Impostor size (log2)", sizes, 3, 12)
         changed_detail, detail = imgui.slider_float("Detail (texels per particle)", settings.impostor_detail_texels,
@@ -241,15 +246,21 @@ class Panels:
                                                   "%d" if settings.regeneration_budget else "no limit")
         imgui.set_item_tooltip("Impostors remade per frame at most, those farthest past the tolerance first; "
                                "0: no limit.")
-        if (changed_mode or changed_tol or changed_ring_on or changed_radius or changed_fade or changed_sizes
-                or changed_detail or changed_budget):
+        changed_frame_budget, frame_budget = imgui.slider_float(
+            "Frame budget (ms)", settings.frame_budget_ms, 0.0, 200.0,
+            "%.0f ms" if settings.frame_budget_ms else "none")
+        imgui.set_item_tooltip("Time for impostor updates and the cloud pass together, as the measured costs "
+                               "predict it; over it, regenerations wait and the error drawn grows past the "
+                               "tolerance (Statistics shows by how much). 0: none.")
+        if (changed_mode or changed_tol or changed_metric or changed_ring_on or changed_radius or changed_fade
+                or changed_group or changed_sizes or changed_detail or changed_budget or changed_frame_budget):
             try:
                 editor.settings = dataclasses.replace(
                     settings, mode=MODES[mode], tolerance_deg=tolerance,
                     ring_radius=radius if ring_on else math.inf,
-                    fade_start_radii=min(fades), fade_end_radii=max(fades),
+                    translation_metric=metrics[metric], transition_frames=transition, group_clouds=group,
                     impostor_min_size=2 ** min(sizes), impostor_max_size=2 ** max(sizes),
-                    impostor_detail_texels=detail, regeneration_budget=budget)
+                    impostor_detail_texels=detail, regeneration_budget=budget, frame_budget_ms=frame_budget)
             except ValueError as error:
                 editor.messages.append(str(error))
         imgui.separator_text("Overlays")
@@ -361,6 +372,10 @@ class Panels:
         imgui.text(f"clouds: full {stats['clouds_full']}, crossfade {stats['clouds_crossfade']}, impostor "
                    f"{stats['clouds_impostor']}, inside {stats['clouds_inside']}, ring {stats['clouds_ring']}, "
                    f"culled {stats['clouds_culled']}")
+        imgui.text(f"units {stats['units']} ({stats['units_grouped']} of interpenetrating clouds); predicted "
+                   f"{stats['predicted_ms']:.1f} ms against {stats['impostor_update_ms'] + stats['cloud_ms']:.1f} "
+                   f"measured; largest error drawn {stats['accepted_error_tolerances']:.2f} x the tolerance "
+                   f"({stats['tolerance_deg']:.3f} deg)")
         imgui.text(f"objects in clouds {stats['objects_in_clouds']}: layers drawn {stats['layers_drawn']}, "
                    f"rebuilt {stats['layers_rebuilt']}")
         imgui.text(f"texture memory {stats['texture_bytes'] / 2**20:.1f} MiB")

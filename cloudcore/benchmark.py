@@ -21,6 +21,7 @@ import numpy as np
 from cloudcore.illumination import illuminate_clouds
 from cloudcore.imagecompare import compare
 from cloudcore.lighting import active_lights, scene_lights
+from cloudcore.navigation import orbited
 from cloudcore.paths import camera_on_path, frame_times
 from cloudcore.scene import Scene
 from cloudcore.settings import FULL_3D, RenderSettings
@@ -43,8 +44,26 @@ def path_views(scene: Scene, path_name: str, frames: int) -> list:
     return [(path.keys[0, 0] + t, camera_on_path(path, t, scene.camera.fov_y_deg)) for t in frame_times(path, frames)]
 
 
-def _run(renderer, scene: Scene, views, settings: RenderSettings, reference=None, progress=None):
+def still_views(scene: Scene, frames: int) -> list:
+    """The scene's own camera, `frames` times: what a still camera costs once the caches are warm."""
+    return [(0.0, scene.camera)] * frames
+
+
+def orbit_views(scene: Scene, frames: int, degrees_per_frame: float) -> list:
+    """The scene's camera orbiting its look-at point by `degrees_per_frame` a frame (a slow pan round)."""
+    views, camera = [], scene.camera
+    for _ in range(frames):
+        views.append((0.0, camera))
+        camera = orbited(camera, degrees_per_frame)
+    return views
+
+
+def _run(renderer, scene: Scene, views, settings: RenderSettings, reference=None, progress=None, warmup: int = 0):
     images, rows = [], []
+    for _ in range(warmup):  # unmeasured frames at the first view: caches built, the ring faded in
+        renderer.render(scene, camera=views[0][1], settings=settings, time_s=views[0][0])
+        if progress is not None:
+            progress()
     for frame, (time_s, camera) in enumerate(views):
         image, stats = renderer.render(scene, camera=camera, settings=settings, time_s=time_s)
         row = {"frame": frame, **{k: v for k, v in stats.items() if isinstance(v, (int, float))}}
@@ -66,15 +85,20 @@ def _summary(rows) -> dict:
             "world_ms_mean": float(np.mean([r["world_ms"] for r in rows]))}
 
 
-def bench_path(renderer, scene: Scene, path_name: str, frames: int, settings_list, size, progress=None) -> dict:
-    """The report: reference (full 3D) and one run per settings object, errors per frame and overall."""
-    views = path_views(scene, path_name, frames)
+def bench_path(renderer, scene: Scene, path_name: str, frames: int, settings_list, size, progress=None,
+               views=None, warmup: int = 0) -> dict:
+    """The report: reference (full 3D) and one run per settings object, errors per frame and overall.
+
+    The frames are `views` ((scene clock, camera) pairs) when given, else `frames` along the path;
+    each run first renders `warmup` unmeasured frames of the first view.
+    """
+    views = path_views(scene, path_name, frames) if views is None else views
     renderer.render(scene, camera=views[0][1], settings=FULL_3D)  # shading precompute, shader compiles
-    reference_images, reference_rows = _run(renderer, scene, views, FULL_3D, progress=progress)
+    reference_images, reference_rows = _run(renderer, scene, views, FULL_3D, progress=progress, warmup=warmup)
     reference = {"mode": "full", **_summary(reference_rows), "per_frame": reference_rows}
     runs = []
     for settings in settings_list:
-        _, rows = _run(renderer, scene, views, settings, reference_images, progress)
+        _, rows = _run(renderer, scene, views, settings, reference_images, progress, warmup)
         psnr = np.array([r["psnr_db"] for r in rows])
         summary = _summary(rows)
         runs.append({
@@ -84,6 +108,9 @@ def bench_path(renderer, scene: Scene, path_name: str, frames: int, settings_lis
             "psnr_mean": float(psnr.mean()), "psnr_min": float(psnr.min()),
             "mad_mean": float(np.mean([r["mad"] for r in rows])),
             "regenerations": int(sum(r.get("impostors_regenerated", 0) for r in rows)),
+            "regenerations_per_frame": float(np.mean([r.get("impostors_regenerated", 0) for r in rows])),
+            "predicted_ms_mean": float(np.mean([r.get("predicted_ms", 0.0) for r in rows])),
+            "frames_below_30_db": int(np.sum(psnr < 30.0)),
             "texture_bytes_max": int(max(r.get("texture_bytes", 0) for r in rows)),
             "per_frame": rows})
     return {"scene": scene.description or "", "path": path_name, "width": size[0], "height": size[1],

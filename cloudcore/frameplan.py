@@ -1,26 +1,34 @@
 """The frame plan: what each cloud costs this frame, decided before any GL call (pure numpy).
 
-`plan_frame` turns (cloud bounding spheres, camera, viewport, settings, the
-impostor cache, the ring state, the lighting) into a `FramePlan`: per cloud
-one of
+`plan_frame` turns (the LOD units, camera, viewport, settings, the state
+carried from the last frame, the lighting, measured costs) into a
+`FramePlan`.  A unit (`cloudcore.lod_units`) is a cloud, or a group of clouds
+whose particles interpenetrate, drawn as one; per unit one of
 
 - ``empty``: no particles, nothing to draw;
 - ``culled``: its bounding sphere misses the view frustum: no work at all;
 - ``ring``: shown by Wang's ring of impostors only;
-- ``full``: every particle drawn (near clouds, and every cloud in full mode);
-- ``crossfade``: between `fade_start_radii` and `fade_end_radii` both the full
-  cloud and its impostor, weights summing to one (the GL side mixes the two
-  premultiplied images linearly, so the opacity is right throughout);
+- ``full``: every particle drawn;
 - ``impostor``: a textured quad, remade when `regenerate` names a reason;
+- ``crossfade``: both, weights summing to one, while auto mode moves the
+  unit from one representation to the other over `transition_frames` (the
+  GL side mixes the two premultiplied images linearly, so the opacity is
+  right throughout);
 - ``inside``: the eye is in the cloud: a screen-sized impostor at reduced
   resolution, redrawn every frame (Harris 3.1),
 
-with the impostor cache and ring state to carry into the next frame.  The GL
-side executes plans and nothing else; statistics come from the plan.
+and the `LodState` to carry into the next frame.  In auto mode the choice
+between full 3D and an impostor is by predicted cost within the tolerance:
+an impostor's error is bounded by the tolerance (it is remade past it) and
+full 3D is the reference, so both are admissible, and the plan prices each
+with the measured `CostModel` (`cloudcore.lod_costs`): full 3D its particles
+and fragments, the impostor its quad plus its regeneration spread over the
+frames it is predicted to last at the eye's current speed.  The GL side
+executes plans and nothing else; statistics come from the plan.
 
-Objects inside a drawn cloud's bounds split it into layers
+Objects inside a drawn unit's bounds split it into layers
 (`cloudcore.splitting`); `draw_items` is then the frame's cloud pass far to
-near: cloud layers, and the objects between them.  Without objects in clouds
+near: unit layers, and the objects between them.  Without objects in clouds
 no particle is looked at.
 """
 
@@ -33,11 +41,13 @@ from typing import Hashable, Mapping
 
 import numpy as np
 
-from cloudcore.camera import frustum_planes, projection_matrix, spheres_in_frustum, view_matrix
-from cloudcore.impostors import (INSIDE_RADII, ImpostorRecord, budgeted_regenerations, detail_size_px,
-                                 regeneration_priority, regeneration_reason, required_size, screen_size_px,
-                                 translation_error_deg)
-from cloudcore.ramps import smoothstep
+from cloudcore.camera import NEAR_PLANE_M, frustum_planes, projection_matrix, spheres_in_frustum, view_matrix
+from cloudcore.impostors import (INSIDE_RADII, TRANSLATION_METRICS, ImpostorRecord, budgeted_regenerations,
+                                 detail_size_px, quad_half_side, regeneration_priority, regeneration_reason,
+                                 required_size, screen_size_px, tolerance_deg_for)
+from cloudcore.lod_costs import CostEstimator, CostModel, Work, full_work, quad_work, regeneration_work
+from cloudcore.lod_units import LodUnits
+from cloudcore.overdraw import analytic_overdraw
 from cloudcore.ring import RingPlan, RingState, plan_ring
 from cloudcore.scene import Camera
 from cloudcore.settings import RenderSettings
@@ -46,11 +56,24 @@ from cloudcore.splitting import layer_bounds, layer_counts, layer_sort_key, obje
 KINDS = ("empty", "culled", "ring", "full", "crossfade", "impostor", "inside")
 #: kinds that draw from an impostor texture kept in the cache
 TEXTURED = ("crossfade", "impostor")
+#: an impostor predicted to last longer than this many frames is priced as if it lasted this long
+#: (a still eye would otherwise make any regeneration free)
+LONGEST_LIFETIME_FRAMES = 120.0
+#: auto mode switches a unit's representation only when the other is cheaper by this fraction
+#: (costs measured frame to frame wobble; without it a unit near the break-even point would flicker
+#: between the two, paying for a crossfade each time)
+SWITCH_MARGIN = 0.25
+#: bounding radii: a unit nearer than this has its full-3D fragments counted splat by splat, clipped to the
+#: screen (`cloudcore.overdraw.analytic_overdraw`); a ball of discs overestimates a near cloud tenfold, the
+#: parts of it beside and behind the eye costing nothing
+NEAR_EXACT_RADII = 3.0
+#: a ring panel in view covers about this share of the screen (45 of ~75 degrees across, all the way up)
+RING_PANEL_SCREEN_SHARE = 0.6
 
 
 @dataclass(frozen=True)
 class CloudPlan:
-    index: int
+    index: int  # the unit's
     kind: str
     distance: float
     full_weight: float = 0.0  # share of opacity drawn from particles (full, crossfade, inside)
@@ -61,6 +84,9 @@ class CloudPlan:
     split_objects: tuple = ()  # indices of the objects inside it, far to near
     splits: tuple = ()  # their distances from the eye: the layers' boundaries
     layer_counts: tuple = ()  # particles per layer, far to near (of the impostor's layers when textured)
+    members: tuple = ()  # the clouds of the unit
+    full_ms: float = 0.0  # auto mode: predicted cost of full 3D this frame
+    impostor_ms: float = 0.0  # auto mode: predicted cost of the impostor per frame, its regeneration amortised
 
     @property
     def layers(self) -> int:
@@ -69,29 +95,65 @@ class CloudPlan:
 
 @dataclass(frozen=True)
 class DrawItem:
-    """One step of the cloud pass: a layer of a cloud, or an object drawn between layers."""
+    """One step of the cloud pass: a layer of a unit, or an object drawn between layers."""
 
     kind: str  # "cloud" or "object"
     index: int
     depth: float  # distance from the eye the pass is sorted by, far to near
-    layer: int = 0  # of the cloud, 0 the farthest
+    layer: int = 0  # of the unit, 0 the farthest
     near: float = -math.inf  # the layer holds the particles with near < distance from the eye <= far
     far: float = math.inf
 
 
 @dataclass(frozen=True)
+class Representation:
+    """Auto mode's choice for a unit: where it is heading and how far it has come (1 = all full 3D)."""
+
+    target: str  # "full" or "impostor"
+    full_weight: float
+
+
+@dataclass(frozen=True)
+class LodState:
+    """What the level of detail carries from one frame to the next (pure; the renderer holds one)."""
+
+    records: Mapping = field(default_factory=dict)  # unit members -> ImpostorRecord: the impostor cache
+    ring: RingState = RingState()
+    representations: Mapping = field(default_factory=dict)  # unit members -> Representation (auto mode)
+    eye: tuple | None = None  # last frame's eye: the speed that predicts an impostor's lifetime
+    costs: CostEstimator = CostEstimator()
+
+    def measured(self, measurements) -> "LodState":
+        """The state with this frame's (predicted work, measured ms) pairs folded into the cost fit."""
+        return dataclasses.replace(self, costs=self.costs.observe(measurements))
+
+
+@dataclass(frozen=True)
 class FramePlan:
-    clouds: tuple
-    draw_order: tuple  # indices of the clouds drawn individually, far to near
+    clouds: tuple  # one CloudPlan per unit
+    draw_order: tuple  # indices of the units drawn individually, far to near
     ring: RingPlan | None
-    records: Mapping = field(default_factory=dict)  # the impostor cache after this frame
+    state: LodState = LodState()  # to carry into the next frame
     inside_size: tuple = (0, 0)  # the screen impostor's texture size (width, height)
     draw_items: tuple = ()  # the cloud pass, far to near (DrawItem)
     objects_with_world: tuple = ()  # visible objects outside split clouds: drawn before the cloud pass
+    update_work: Work = Work()  # predicted work of the impostor updates (regenerations, ring segment)
+    cloud_work: Work = Work()  # predicted work of the cloud pass
+    costs: CostModel = CostModel()  # the model the plan priced its choices with
+    tolerance_deg: float = 0.0  # the translation tolerance in force
+    accepted_error: float = 0.0  # the largest translation error drawn, in tolerances (> 1: a budget postponed it)
+
+    @property
+    def records(self) -> Mapping:
+        return self.state.records
 
     @property
     def ring_state(self) -> RingState:
-        return self.ring.state if self.ring is not None else RingState()
+        return self.state.ring
+
+    @property
+    def predicted_ms(self) -> float:
+        return self.costs.ms(self.update_work + self.cloud_work)
 
     def of_kind(self, *kinds: str) -> list:
         return [c for c in self.clouds if c.kind in kinds]
@@ -99,11 +161,13 @@ class FramePlan:
     def stats(self) -> dict:
         counts = {f"clouds_{kind}": 0 for kind in KINDS}
         reasons: dict = {}
-        for cloud in self.clouds:
-            counts[f"clouds_{cloud.kind}"] += 1
-            if cloud.regenerate:
-                reasons[cloud.regenerate] = reasons.get(cloud.regenerate, 0) + 1
+        for unit in self.clouds:
+            counts[f"clouds_{unit.kind}"] += len(unit.members)
+            if unit.regenerate:
+                reasons[unit.regenerate] = reasons.get(unit.regenerate, 0) + 1
         return counts | {
+            "units": len(self.clouds),
+            "units_grouped": sum(1 for unit in self.clouds if len(unit.members) > 1),
             "impostors_drawn": len(self.of_kind(*TEXTURED)) + len(self.of_kind("inside")),
             "impostors_regenerated": sum(reasons.values()),
             "regeneration_reasons": reasons,
@@ -115,6 +179,10 @@ class FramePlan:
             "objects_in_clouds": len(self.objects_between_layers),
             "layers_drawn": sum(c.layers for c in self.clouds if c.splits),
             "layers_rebuilt": sum(c.layers for c in self.clouds if c.splits and c.regenerate),
+            "predicted_ms": self.predicted_ms,
+            "tolerance_deg": self.tolerance_deg,
+            "accepted_error_tolerances": self.accepted_error,
+            **{f"cost_{name}_ms": value for name, value in dataclasses.asdict(self.costs).items()},
         }
 
     @property
@@ -123,35 +191,50 @@ class FramePlan:
         return tuple(item.index for item in self.draw_items if item.kind == "object")
 
 
-def plan_frame(centres: np.ndarray, radii: np.ndarray, camera: Camera, viewport: tuple[int, int],
-               settings: RenderSettings, records: Mapping[int, ImpostorRecord], ring_state: RingState,
-               lighting_key: Hashable, objects=(), cloud_particles=None, finest_radii=None) -> FramePlan:
-    """Plan one frame; `centres` (N, 3) and `radii` (N,) are the clouds' bounding spheres.
+def plan_frame(units: LodUnits, camera: Camera, viewport: tuple[int, int], settings: RenderSettings,
+               state: LodState, lighting_key: Hashable, objects=(), cloud_particles=None,
+               costs: CostModel | None = None, cloud_splats=None) -> FramePlan:
+    """Plan one frame of `units` (`cloudcore.lod_units.LodUnits`) seen by `camera`.
 
     `lighting_key` identifies what the particles' colours were computed from: one key for
     all clouds, or a tuple with one per cloud (the editor changes one cloud at a time, and
-    only that cloud's impostor is stale).  `objects` are the opaque objects' bounding
-    spheres this frame (`cloudcore.objects.ObjectPose`); `cloud_particles(i)` gives cloud i's
-    particle centres, asked only for clouds with objects inside.  `finest_radii` (N,) are the
-    clouds' finest detail in metres (`ParticleShading.finest_radii`), which bounds the impostor
-    texture size (`settings.impostor_detail_texels`); None bounds nothing.
+    only its unit's impostor is stale).  `objects` are the opaque objects' bounding spheres
+    this frame (`cloudcore.objects.ObjectPose`); `cloud_particles(i)` gives cloud i's particle
+    centres, asked only for units with objects inside.  `costs` prices auto mode's choices;
+    by default the model `state.costs` has fitted to the frames so far.  `cloud_splats(i)` gives
+    cloud i's (particle centres, radii), asked for units near the eye to count their fragments.
     """
-    centres, radii = np.asarray(centres, dtype=np.float64).reshape(-1, 3), np.asarray(radii, dtype=np.float64)
+    centres, radii = units.centres, units.radii
     width, height = viewport
     eye = np.asarray(camera.position, dtype=np.float64)
-    view_projection = projection_matrix(camera.fov_y_deg, width / height) @ view_matrix(camera)
+    view, projection = view_matrix(camera), projection_matrix(camera.fov_y_deg, width / height)
+    view_projection = projection @ view
     planes = frustum_planes(view_projection)
     visible = spheres_in_frustum(planes, centres, radii)
     distances = np.linalg.norm(centres - eye, axis=1)
-    keys = list(lighting_key) if isinstance(lighting_key, tuple) else [lighting_key] * len(radii)
-    ring = plan_ring(ring_state, centres, radii, eye, settings, tuple(keys))
-    next_records = {index: record for index, record in records.items() if index < len(radii)}
+    cloud_keys = lighting_key if isinstance(lighting_key, tuple) else (lighting_key,) * sum(map(len, units.members))
+    keys = tuple(tuple(cloud_keys[c] for c in members) for members in units.members)
+    ring = plan_ring(state.ring, centres, radii, eye, settings, keys, units.members)
+    records = state.records
+    next_records = {members: record for members, record in records.items() if members in set(units.members)}
     object_centres = np.array([o.centre for o in objects], dtype=np.float64).reshape(-1, 3)
     object_radii = np.array([o.radius for o in objects], dtype=np.float64)
     objects_visible = spheres_in_frustum(planes, object_centres, object_radii)
+    costs = state.costs.model() if costs is None else costs
+    tolerance = tolerance_deg_for(settings, camera.fov_y_deg, height)
+    translation_error = TRANSLATION_METRICS[settings.translation_metric]
+    focal_px = 0.5 * height / math.tan(math.radians(camera.fov_y_deg) / 2.0)
+    screen_pixels = float(width * height)
+    last_eye = None if state.eye is None else np.asarray(state.eye, dtype=np.float64)
+
+    def particles_of(index: int) -> np.ndarray:
+        members = units.members[index]
+        if len(members) == 1:
+            return cloud_particles(members[0])
+        return np.concatenate([cloud_particles(c) for c in members])
 
     def split_at(index: int, from_eye) -> tuple[tuple, tuple]:
-        """(objects inside the cloud far to near from `from_eye`, their distances: the layers' boundaries)."""
+        """(objects inside the unit far to near from `from_eye`, their distances: the layers' boundaries)."""
         inside = objects_inside(centres[index], radii[index], object_centres, object_radii) if (
             settings.split_objects) else ()
         if not len(inside):
@@ -162,66 +245,172 @@ def plan_frame(centres: np.ndarray, radii: np.ndarray, camera: Camera, viewport:
 
     def counts(index: int, from_eye, splits) -> tuple:
         """Particles per layer seen from `from_eye`; the particles are looked at only when there are splits."""
-        return layer_counts(cloud_particles(index), from_eye, splits) if splits else (0,)
+        return layer_counts(particles_of(index), from_eye, splits) if splits else (0,)
 
-    finest = np.zeros(len(radii)) if finest_radii is None else np.asarray(finest_radii, dtype=np.float64)
-    clouds, wanted = [], []  # wanted: (index, priority) of the impostors past their tolerance
+    representations = {}
+    update_work, cloud_work = Work(), Work()
+    clouds, wanted = [], []  # wanted: (index, priority, work) of the impostors past their tolerance
     for index, (centre, radius, distance) in enumerate(zip(centres, radii, distances)):
-        distance = float(distance)
-        individual = 1.0 - (ring.weight_of(index) if ring is not None else 0.0)
+        distance, members = float(distance), units.members[index]
+        individual = 1.0 - (ring.weight_of(members) if ring is not None else 0.0)
         if radius <= 0.0 or individual <= 0.0 or not visible[index]:
             clouds.append(CloudPlan(index, "empty" if radius <= 0.0 else "ring" if individual <= 0.0 else "culled",
-                                    distance))
+                                    distance, members=members))
             continue
         inside, splits = split_at(index, eye)
-        # a cloud fading into or out of the ring is drawn as an impostor: one layer scales exactly
-        full = 1.0 if settings.mode == "full" or (settings.mode == "auto" and individual == 1.0) else 0.0
+        if cloud_splats is not None and distance < NEAR_EXACT_RADII * radius:
+            splats = [cloud_splats(c) for c in members]
+            fragments = screen_pixels * analytic_overdraw(np.concatenate([c for c, _ in splats]),
+                                                          np.concatenate([r for _, r in splats]), view,
+                                                          projection, NEAR_PLANE_M)
+            full = Work(particles=units.particle_counts[index], fragments=fragments)
+        else:
+            full = full_work(units.particle_counts[index], units.radius_squares[index], radius, distance, focal_px,
+                             screen_pixels)
         if settings.mode != "full" and distance < INSIDE_RADII * radius:
             clouds.append(CloudPlan(index, "inside", distance, full_weight=individual, split_objects=inside,
-                                    splits=splits, layer_counts=counts(index, eye, splits)))
+                                    splits=splits, layer_counts=counts(index, eye, splits), members=members))
+            cloud_work += full.scaled(settings.inside_resolution_scale ** 2) + Work(quad_pixels=screen_pixels)
             continue
-        if full and settings.mode == "auto":
-            full = 1.0 - smoothstep(settings.fade_start_radii * radius, settings.fade_end_radii * radius, distance)
-        if full == 1.0:
+        if settings.mode == "full":
             clouds.append(CloudPlan(index, "full", distance, full_weight=1.0, split_objects=inside, splits=splits,
-                                    layer_counts=counts(index, eye, splits)))
+                                    layer_counts=counts(index, eye, splits), members=members))
+            cloud_work += full
             continue
-        pixels = min(screen_size_px(radius, distance, height, camera.fov_y_deg),
-                     detail_size_px(radius, distance, finest[index], settings.impostor_detail_texels))
-        size = required_size(pixels, settings.impostor_min_size, settings.impostor_max_size)
-        record = records.get(index)
+        pixels = screen_size_px(radius, distance, height, camera.fov_y_deg)
+        size = required_size(min(pixels, detail_size_px(radius, distance, units.finest_radii[index],
+                                                        settings.impostor_detail_texels)),
+                             settings.impostor_min_size, settings.impostor_max_size)
+        quad = quad_work(pixels, screen_pixels)
+        remake = regeneration_work(units.particle_counts[index], units.radius_squares[index], radius, distance,
+                                   quad_half_side(radius, distance), size)
+        # a unit fading into or out of the ring is drawn as an impostor: one layer scales exactly
+        weight, full_ms, impostor_ms = 0.0, costs.ms(full), math.inf
+        if settings.mode == "auto" and individual == 1.0:
+            rate = translation_error(centre, radius, last_eye, eye) if last_eye is not None else 0.0
+            lifetime = min(tolerance / rate, LONGEST_LIFETIME_FRAMES) if rate > 0.0 else LONGEST_LIFETIME_FRAMES
+            impostor_ms = costs.ms(quad) + costs.ms(remake) / max(lifetime, 1.0)
+            held = records.get(members)
+            error = translation_error(centre, radius, held.eye, eye) if held is not None else math.inf
+            budgeted = bool(settings.regeneration_budget or settings.frame_budget_ms)
+            # an impostor within half its tolerance of the picture full 3D gives, or one remade from this very
+            # eye, differs from it by less than a regeneration's own step: the switch needs no crossfade
+            close = {"impostor": error <= 0.5 * tolerance or (error > tolerance and not budgeted),
+                     "full": error <= 0.5 * tolerance}
+            representation = _represent(state.representations.get(members), full_ms, impostor_ms,
+                                        settings.transition_frames, close)
+            representations[members] = representation
+            weight = representation.full_weight
+        if weight == 1.0:
+            clouds.append(CloudPlan(index, "full", distance, full_weight=1.0, split_objects=inside, splits=splits,
+                                    layer_counts=counts(index, eye, splits), members=members, full_ms=full_ms,
+                                    impostor_ms=impostor_ms))
+            cloud_work += full
+            continue
+        record = records.get(members)
         # the layers the impostor's textures would hold now: split where the objects are, seen from its eye
         held_counts = counts(index, record.eye, split_at(index, record.eye)[1]) if (
             record is not None and splits) else None
-        reason = regeneration_reason(record, centre, eye, size, keys[index], settings.tolerance_deg, held_counts)
-        kind = "crossfade" if full > 0.0 else "impostor"
-        clouds.append(CloudPlan(index, kind, distance, full_weight=full * individual,
-                                impostor_weight=(1.0 - full) * individual, regenerate=reason,
-                                texture_size=size, split_objects=inside, splits=splits))
+        reason = regeneration_reason(record, centre, radius, eye, size, keys[index], tolerance, held_counts,
+                                     settings.translation_metric)
+        kind = "crossfade" if weight > 0.0 else "impostor"
+        clouds.append(CloudPlan(index, kind, distance, full_weight=weight * individual,
+                                impostor_weight=(1.0 - weight) * individual, regenerate=reason,
+                                texture_size=size, split_objects=inside, splits=splits, members=members,
+                                full_ms=full_ms, impostor_ms=impostor_ms))
+        cloud_work += quad + (full + Work(quad_pixels=screen_pixels) if weight > 0.0 else Work())  # the layer
         if reason is not None:
-            ratio = (translation_error_deg(centre, record.eye, eye) / max(settings.tolerance_deg, 1e-300)
+            ratio = (translation_error(centre, radius, record.eye, eye) / max(tolerance, 1e-300)
                      if record is not None else math.inf)
-            wanted.append((index, regeneration_priority(reason, ratio, bool(splits))))
-    served = budgeted_regenerations(wanted, settings.regeneration_budget)
+            wanted.append((index, regeneration_priority(reason, ratio, bool(splits)), remake.scaled(len(splits) + 1)))
+    served = budgeted_regenerations([(index, priority) for index, priority, _ in wanted],
+                                    settings.regeneration_budget)
+    if settings.frame_budget_ms > 0.0:
+        served &= _within_frame_budget(wanted, settings.frame_budget_ms - costs.ms(cloud_work), costs)
+    for index, _, remake in wanted:
+        if index in served:
+            update_work += remake
+    accepted = 0.0  # the largest translation error drawn, over the tolerance
     for index, cloud in enumerate(clouds):
         if cloud.kind not in TEXTURED:
             continue
-        record = records.get(index)
+        record = records.get(cloud.members)
+        if index not in served and record is not None:
+            accepted = max(accepted, translation_error(centres[index], radii[index], record.eye, eye)
+                           / max(tolerance, 1e-300))
         if index in served:
-            record = next_records[index] = ImpostorRecord(
+            record = next_records[cloud.members] = ImpostorRecord(
                 tuple(float(v) for v in eye), cloud.texture_size, keys[index], cloud.splits,
                 counts(index, eye, cloud.splits))
         regenerate, postponed = (cloud.regenerate, None) if index in served else (None, cloud.regenerate)
         clouds[index] = dataclasses.replace(cloud, regenerate=regenerate, postponed=postponed,
                                             texture_size=record.size,
                                             layer_counts=record.layer_counts if cloud.splits else (0,))
+    if ring is not None:
+        cloud_work += Work(quad_pixels=RING_PANEL_SCREEN_SHARE * screen_pixels * sum(
+            len(generation.occupied_segments) for generation, _ in ring.draws) / 2.0)
+        if ring.build_segment is not None and ring.state.pending is not None:
+            segment = ring.state.pending.segment_members[ring.build_segment]
+            index_of = {members: index for index, members in enumerate(units.members)}
+            update_work += Work(particles=float(sum(units.particle_counts[index_of[u]] for u in segment)),
+                                regenerations=float(bool(segment)))
     drawn = [c.index for c in clouds if c.kind in ("full", "crossfade", "impostor", "inside")]
     draw_order = tuple(sorted(drawn, key=lambda i: -distances[i]))
+    cloud_work += Work(batches=float(_full_runs([clouds[i].kind for i in draw_order])))
     inside_size = tuple(max(1, math.ceil(side * settings.inside_resolution_scale)) for side in viewport)
     items = _draw_items([clouds[i] for i in draw_order], radii, object_centres, objects_visible, eye)
     between = {item.index for item in items if item.kind == "object"}
     with_world = tuple(i for i in range(len(object_radii)) if objects_visible[i] and i not in between)
-    return FramePlan(tuple(clouds), draw_order, ring, next_records, inside_size, items, with_world)
+    next_state = LodState(next_records, ring.state if ring is not None else RingState(), representations,
+                          tuple(float(v) for v in eye), state.costs)
+    return FramePlan(tuple(clouds), draw_order, ring, next_state, inside_size, items, with_world, update_work,
+                     cloud_work, costs, tolerance, accepted)
+
+
+def _within_frame_budget(wanted, available_ms: float, costs: CostModel) -> set:
+    """The wanted regenerations (index, priority, work) that fit in `available_ms`, most urgent first;
+    those that must be made (rank 0: nothing to show, or layers that would cut an object) always."""
+    served, spent = set(), 0.0
+    for index, priority, work in sorted(wanted, key=lambda w: w[1]):
+        ms = costs.ms(work)
+        if priority[0] == 0 or spent + ms <= available_ms:
+            served.add(index)
+            spent += ms
+    return served
+
+
+def _represent(previous: Representation | None, full_ms: float, impostor_ms: float, transition_frames: int,
+               close: dict) -> Representation:
+    """Auto mode's next step for a unit: aim at the cheaper representation (by `SWITCH_MARGIN` against the
+    one aimed at already), and move the full-3D weight one transition step toward it.
+
+    A unit seen for the first time starts at its target: there is nothing on screen to pop from; nor
+    does a switch to a representation that `close` says shows the same picture within half the
+    tolerance: it is made at once, and only a switch that would show a step crossfades.
+    """
+    cheaper = "full" if full_ms <= impostor_ms else "impostor"
+    if previous is None:
+        return Representation(cheaper, 1.0 if cheaper == "full" else 0.0)
+    target = previous.target
+    held, other = (full_ms, impostor_ms) if target == "full" else (impostor_ms, full_ms)
+    if other < (1.0 - SWITCH_MARGIN) * held:
+        target = "impostor" if target == "full" else "full"
+        if close[target] and previous.full_weight in (0.0, 1.0):
+            return Representation(target, 1.0 if target == "full" else 0.0)
+    step = 1.0 / transition_frames
+    weight = (min(1.0, previous.full_weight + step) if target == "full"
+              else max(0.0, previous.full_weight - step))
+    return Representation(target, weight)
+
+
+def _full_runs(kinds) -> int:
+    """Splat draws of the cloud pass: each run of consecutive full units is one, every other splatting kind one."""
+    runs, previous = 0, None
+    for kind in kinds:
+        if kind in ("crossfade", "inside") or (kind == "full" and previous != "full"):
+            runs += 1
+        previous = kind
+    return runs
 
 
 def _draw_items(drawn, radii, object_centres, objects_visible, eye) -> tuple:

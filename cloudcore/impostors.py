@@ -3,9 +3,16 @@
 An impostor of a cloud is the cloud rendered alone through a frustum fitted to
 its bounding sphere from an eye, drawn afterwards as a quad through the
 sphere's centre facing that eye.  It is good while the eye stays close to that
-eye: the *translation error* is the angle, seen from the cloud's centre,
-between the eye's direction at creation and now; the *resolution error* is a
-texture coarser than the cloud's current size on screen asks for.
+eye.  The *translation error* is, by default, Harris's own (SkyWorks,
+`SkyRenderableInstanceCloud::IsImpostorValid`): the impostor stores the
+nearest and farthest points of the bounding sphere along its view axis, and
+the error is the angle between the rays from the current eye to those two
+points, the parallax that a flat quad cannot show.  It is about 2R/D times
+the angle the eye has turned around the centre, so a distant cloud tolerates
+proportionally more motion (`parallax_error_deg`).  The stricter angle seen
+from the centre is kept as the "centre" metric for comparison.  The
+*resolution error* is a texture coarser than the cloud's current size on
+screen asks for.
 """
 
 from __future__ import annotations
@@ -68,9 +75,50 @@ def impostor_view(centre, radius: float, eye) -> ImpostorView:
     return ImpostorView(view_matrix(camera), projection, corners)
 
 
+#: texels of margin around the particles' extent (bilinear filtering reads one beyond the edge)
+CROP_MARGIN_TEXELS = 2.0
+
+
+def particle_extent(view: np.ndarray, projection: np.ndarray, centres: np.ndarray, radii: np.ndarray,
+                    size: tuple[int, int]) -> tuple[float, float, float, float]:
+    """(u0, v0, u1, v1) in [0, 1]: the part of a texture rendered through (view, projection) that the
+    splats at `centres` (n, 3) with `radii` can cover, plus `CROP_MARGIN_TEXELS`.
+
+    Cumulus are flatter than their bounding spheres, so drawing only this part of an impostor
+    quad leaves out fragments that would all be transparent.  The whole texture when a splat
+    reaches behind the eye (its projection is unbounded).
+    """
+    if len(radii) == 0:
+        return (0.0, 0.0, 0.0, 0.0)
+    eye_space = centres @ view[:3, :3].T + view[:3, 3]
+    depth = -eye_space[:, 2]
+    if not np.all(depth - radii > 0.0):
+        return (0.0, 0.0, 1.0, 1.0)
+    # a sphere's projection along each axis lies within (x +- r) / (depth - r)
+    low = (eye_space[:, :2] - radii[:, None]) / (depth - radii)[:, None]
+    high = (eye_space[:, :2] + radii[:, None]) / (depth - radii)[:, None]
+    scale = np.array([projection[0, 0], projection[1, 1]])
+    margin = 2.0 * CROP_MARGIN_TEXELS / np.asarray(size, dtype=np.float64)
+    lower = np.clip(0.5 * (np.minimum(low * scale, high * scale).min(axis=0) + 1.0) - margin / 2, 0.0, 1.0)
+    upper = np.clip(0.5 * (np.maximum(low * scale, high * scale).max(axis=0) + 1.0) + margin / 2, 0.0, 1.0)
+    return (float(lower[0]), float(lower[1]), float(upper[0]), float(upper[1]))
+
+
+def cropped_corners(corners: np.ndarray, extent) -> np.ndarray:
+    """The quad `corners` (lower left, lower right, upper left, upper right) cut to `extent` (u0, v0, u1, v1)."""
+    u0, v0, u1, v1 = extent
+    right, up = corners[1] - corners[0], corners[2] - corners[0]
+    return np.array([corners[0] + u * right + v * up for u, v in ((u0, v0), (u1, v0), (u0, v1), (u1, v1))])
+
+
 def _tangent(radius: float, distance: float) -> float:
     """Half side of the impostor quad of a sphere seen from `distance` (> radius), over that distance."""
     return radius / math.sqrt(max((distance - radius) * (distance + radius), np.finfo(float).tiny))
+
+
+def quad_half_side(radius: float, distance: float) -> float:
+    """Half side in metres of the impostor quad through the centre of a sphere seen from `distance` (> radius)."""
+    return _tangent(radius, distance) * distance
 
 
 def screen_size_px(radius: float, distance: float, viewport_height: int, fov_y_deg: float) -> float:
@@ -88,23 +136,76 @@ def detail_size_px(radius: float, distance: float, finest_radius: float, texels:
     """
     if not (texels > 0.0 and finest_radius > 0.0):
         return math.inf
-    return 2.0 * texels * _tangent(radius, distance) * distance / finest_radius
+    return 2.0 * texels * quad_half_side(radius, distance) / finest_radius
+
+
+#: texture sides come in this many geometric steps per doubling: rounding up to the next power of two
+#: would fill up to 4 times the texels asked for (a regeneration's cost on a CPU rasteriser is its fill),
+#: quarter octaves at most 1.41 times, while a steady distance still maps to one size
+SIZE_STEPS_PER_OCTAVE = 4
 
 
 def required_size(pixels: float, smallest: int, largest: int) -> int:
-    """The smallest power of two >= `pixels`, within [smallest, largest]."""
-    if not pixels > 1.0:
+    """The smallest texture side >= `pixels` of the form `smallest` * 2^(k / SIZE_STEPS_PER_OCTAVE) (rounded
+    up to a multiple of 4 texels), within [smallest, largest]."""
+    if not pixels > smallest:
         return smallest
-    return int(min(max(2 ** math.ceil(math.log2(min(pixels, 2.0**30))), smallest), largest))
+    steps = math.ceil(SIZE_STEPS_PER_OCTAVE * math.log2(min(pixels, 2.0**30) / smallest) - 1e-9)
+    side = smallest * 2.0 ** (steps / SIZE_STEPS_PER_OCTAVE)
+    return int(min(4 * math.ceil(side / 4 - 1e-9), largest))
+
+
+def _angle_deg(a: np.ndarray, b: np.ndarray) -> float:
+    """Angle between two vectors; atan2 of |a x b| and a.b stays accurate for tiny angles, where acos does not."""
+    return math.degrees(math.atan2(float(np.linalg.norm(np.cross(a, b))), float(a @ b)))
 
 
 def translation_error_deg(centre, eye_then, eye_now) -> float:
     """Angle at `centre` between the directions to the two eyes (0 when either coincides with it)."""
     centre = np.asarray(centre, dtype=np.float64)
-    a = np.asarray(eye_then, dtype=np.float64) - centre
-    b = np.asarray(eye_now, dtype=np.float64) - centre
-    # atan2 of |a x b| and a.b stays accurate for tiny angles, where acos of the dot product does not
-    return math.degrees(math.atan2(float(np.linalg.norm(np.cross(a, b))), float(a @ b)))
+    return _angle_deg(np.asarray(eye_then, dtype=np.float64) - centre, np.asarray(eye_now, dtype=np.float64) - centre)
+
+
+def parallax_error_deg(centre, radius: float, eye_then, eye_now) -> float:
+    """Harris's translation error: the angle at `eye_now` between the sphere's near and far points as seen
+    from `eye_then` (SkyWorks' `_vecNearPoint`, `_vecFarPoint`), 0 at `eye_then`.
+
+    Inf once the far point has come nearer than the near point (SkyWorks' "backwards impostor"):
+    the eye has passed the cloud's side and the quad shows it from behind.
+    """
+    centre, then = np.asarray(centre, dtype=np.float64), np.asarray(eye_then, dtype=np.float64)
+    now = np.asarray(eye_now, dtype=np.float64)
+    if np.array_equal(now, then):  # exactly 0 (rounding in the rays below would not give it), as SkyWorks
+        return 0.0
+    axis = centre - then
+    distance = float(np.linalg.norm(axis))
+    if not distance > radius:
+        return math.inf
+    axis /= distance
+    to_near, to_far = then + axis * (distance - radius) - now, then + axis * (distance + radius) - now
+    if to_near @ to_near > to_far @ to_far:
+        return math.inf
+    return _angle_deg(to_near, to_far)
+
+
+#: translation metrics by name (`RenderSettings.translation_metric`): (centre, radius, eye then, eye now) -> degrees
+TRANSLATION_METRICS = {
+    "parallax": parallax_error_deg,
+    "centre": lambda centre, radius, eye_then, eye_now: translation_error_deg(centre, eye_then, eye_now),
+}
+
+
+def tolerance_deg_for(settings, fov_y_deg: float, viewport_height: int) -> float:
+    """The translation tolerance in degrees: `tolerance_px` pixels at the screen's centre when set,
+    else `tolerance_deg`."""
+    if settings.tolerance_px > 0.0:
+        return settings.tolerance_px * pixel_angle_deg(fov_y_deg, viewport_height)
+    return settings.tolerance_deg
+
+
+def pixel_angle_deg(fov_y_deg: float, viewport_height: int) -> float:
+    """Degrees one pixel spans at the screen's centre."""
+    return math.degrees(2.0 * math.atan(math.tan(math.radians(fov_y_deg) / 2.0) / max(viewport_height, 1)))
 
 
 #: the order in which a regeneration budget serves reasons; rank 0 is never postponed: there is
@@ -131,14 +232,16 @@ def budgeted_regenerations(wanted, budget: int) -> set:
     return {index for index, _ in ranked[:max(budget, must)]}
 
 
-def regeneration_reason(record: ImpostorRecord | None, centre, eye, size: int, lighting_key: Hashable,
-                        tolerance_deg: float, layer_counts=None) -> str | None:
+def regeneration_reason(record: ImpostorRecord | None, centre, radius: float, eye, size: int,
+                        lighting_key: Hashable, tolerance_deg: float, layer_counts=None,
+                        metric: str = "parallax") -> str | None:
     """Why the impostor must be remade this frame ("new", "lights", "resolution", "translation",
     "layers"), or None.
 
     `layer_counts` are the layers' particle counts the objects inside the cloud now give, seen
     from the record's eye (None: the cloud is not split); a change moves particles between
-    layer textures, so they are remade.
+    layer textures, so they are remade.  `metric` names the translation error
+    (`TRANSLATION_METRICS`).
     """
     if record is None:
         return "new"
@@ -146,7 +249,7 @@ def regeneration_reason(record: ImpostorRecord | None, centre, eye, size: int, l
         return "lights"
     if record.size < size or record.size >= SHRINK_FACTOR * size:
         return "resolution"
-    if translation_error_deg(centre, record.eye, eye) > tolerance_deg:
+    if TRANSLATION_METRICS[metric](centre, radius, record.eye, eye) > tolerance_deg:
         return "translation"
     if (layer_counts or (0,)) != (record.layer_counts if record.splits else (0,)):
         return "layers"

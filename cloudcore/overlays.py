@@ -63,13 +63,13 @@ def clip_to_near(polygon: np.ndarray, near: float) -> np.ndarray | None:
     return np.array(kept) if len(kept) >= 3 else None
 
 
-def impostor_outlines(plan: FramePlan, centres, radii, camera: Camera, viewport: tuple[int, int]) -> list[Outline]:
-    """The quads of the clouds the plan draws from impostor textures; `centres` (N, 3) and `radii` (N,)
-    are the clouds' bounding spheres the plan was made with."""
+def impostor_outlines(plan: FramePlan, units, camera: Camera, viewport: tuple[int, int]) -> list[Outline]:
+    """The quads of the units the plan draws from impostor textures; `units` (`cloudcore.lod_units.LodUnits`)
+    are those the plan was made with."""
     outlines = []
     for cloud in plan.of_kind(*TEXTURED):
-        record = plan.records[cloud.index]
-        corners = impostor_view(centres[cloud.index], radii[cloud.index], record.eye).corners[_AROUND]
+        record = plan.records[cloud.members]
+        corners = impostor_view(units.centres[cloud.index], units.radii[cloud.index], record.eye).corners[_AROUND]
         polygon = screen_polygon(corners, camera, viewport)
         if polygon is not None:
             outlines.append(Outline(cloud.kind, cloud.index, polygon))

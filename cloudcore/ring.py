@@ -35,8 +35,8 @@ class RingGeneration:
     eye: tuple[float, float, float]
     radius: float
     lighting_key: Hashable  # its members' lighting keys when it was made
-    members: frozenset
-    segment_members: tuple  # SEGMENTS tuples of cloud indices
+    members: frozenset  # the ids of the clouds (or units) it holds (`plan_ring`'s `ids`)
+    segment_members: tuple  # SEGMENTS tuples of member ids
 
     @property
     def occupied_segments(self) -> tuple[int, ...]:
@@ -62,8 +62,8 @@ class RingPlan:
     draws: tuple = field(default_factory=tuple)  # ((generation, weight), ...)
     state: RingState = RingState()
 
-    def weight_of(self, cloud: int) -> float:
-        """The share of a cloud's opacity the ring shows this frame."""
+    def weight_of(self, cloud: Hashable) -> float:
+        """The share of the opacity of the cloud (or unit) of id `cloud` the ring shows this frame."""
         return sum(weight for generation, weight in self.draws if cloud in generation.members)
 
 
@@ -104,36 +104,40 @@ def ring_members(centres: np.ndarray, radii: np.ndarray, eye, settings: RenderSe
         elevation + np.nan_to_num(angular_radius, nan=90.0) <= settings.ring_elevation_deg)
 
 
-def new_generation(centres, radii, eye, settings: RenderSettings, lighting_keys: tuple) -> RingGeneration:
+def new_generation(centres, radii, eye, settings: RenderSettings, keys: dict, ids: tuple) -> RingGeneration:
     in_ring = ring_members(centres, radii, eye, settings)
-    members = frozenset(np.flatnonzero(in_ring).tolist())
+    members = frozenset(ids[i] for i in np.flatnonzero(in_ring))
     generation = RingGeneration(tuple(float(v) for v in eye), float(settings.ring_radius),
-                                _members_key(members, lighting_keys), members, ())
+                                _members_key(members, keys), members, ())
     per_segment = []
     for segment in range(SEGMENTS):
         view, projection = segment_camera(generation, segment, settings.ring_elevation_deg)
         seen = spheres_in_frustum(frustum_planes(projection @ view), centres, radii) & in_ring
-        per_segment.append(tuple(np.flatnonzero(seen).tolist()))
+        per_segment.append(tuple(ids[i] for i in np.flatnonzero(seen)))
     return replace(generation, segment_members=tuple(per_segment))
 
 
-def _members_key(members: frozenset, lighting_keys: tuple) -> tuple:
-    """What the members' colours were computed from: a change to a cloud outside the ring leaves it be."""
-    return tuple(lighting_keys[i] for i in sorted(members))
+def _members_key(members: frozenset, keys: dict) -> tuple:
+    """What the members' colours were computed from: a change to a cloud outside the ring leaves it be;
+    a member gone (its cloud removed, or regrouped) changes it."""
+    return tuple((member, keys.get(member)) for member in sorted(members))
 
 
-def _needs_rebuild(generation: RingGeneration, eye, settings: RenderSettings, lighting_keys: tuple) -> bool:
+def _needs_rebuild(generation: RingGeneration, eye, settings: RenderSettings, keys: dict) -> bool:
     moved = np.asarray(eye, dtype=np.float64) - np.asarray(generation.eye)
-    return (generation.lighting_key != _members_key(generation.members, lighting_keys)
+    return (generation.lighting_key != _members_key(generation.members, keys)
             or generation.radius != settings.ring_radius
             or math.hypot(moved[0], moved[2]) > settings.ring_rebuild_horizontal * settings.ring_radius
             or abs(moved[1]) > settings.ring_rebuild_vertical * settings.ring_radius)
 
 
-def plan_ring(state: RingState, centres, radii, eye, settings: RenderSettings, lighting_keys: tuple) -> RingPlan | None:
+def plan_ring(state: RingState, centres, radii, eye, settings: RenderSettings, lighting_keys: tuple,
+              ids: tuple | None = None) -> RingPlan | None:
     """Advance the ring by one frame: start a rebuild if needed, build one segment or step the fade.
 
-    `lighting_keys` has one key per cloud.  A ring being built when its members' keys change
+    `lighting_keys` has one key per sphere, `ids` one identity (by default its index): the ring
+    holds ids, so a scene whose spheres are renumbered (clouds regrouped, one removed) does not
+    mistake one cloud for another.  A ring being built when its members' keys change
     is finished first and rebuilt after: a cloud forming in the ring, whose key changes every
     frame, would otherwise keep the ring from ever completing.
     """
@@ -142,8 +146,10 @@ def plan_ring(state: RingState, centres, radii, eye, settings: RenderSettings, l
     current, pending, built, fade_step = state.current, state.pending, state.built, state.fade_step
     if pending is not None and pending.radius != settings.ring_radius:
         pending = None  # the ring it was being built for is gone: start again
-    if pending is None and (current is None or _needs_rebuild(current, eye, settings, lighting_keys)):
-        pending, built, fade_step = new_generation(centres, radii, eye, settings, lighting_keys), 0, 0
+    ids = tuple(range(len(radii))) if ids is None else ids
+    keys = dict(zip(ids, lighting_keys))
+    if pending is None and (current is None or _needs_rebuild(current, eye, settings, keys)):
+        pending, built, fade_step = new_generation(centres, radii, eye, settings, keys, ids), 0, 0
     build_segment = None
     if pending is not None:
         if built < SEGMENTS:

@@ -2,9 +2,10 @@
 
 `mode` picks the representation: "full" draws every particle every frame (the
 reference picture), "impostor" draws every cloud from a cached texture, "auto"
-chooses per cloud by distance (full near, crossfade, impostor far, the ring
-beyond `ring_radius`).  Distances for the fade are in units of the cloud's
-bounding radius, as in the gamedev.net article (full below 2r, impostor above 4r).
+chooses per cloud, each frame, the representation predicted cheapest within
+the tolerance (`cloudcore.frameplan`, with the measured `cloudcore.lod_costs`),
+crossfading over `transition_frames` when it changes, and the ring beyond
+`ring_radius`.
 """
 
 from __future__ import annotations
@@ -13,13 +14,22 @@ import math
 from dataclasses import dataclass
 
 MODES = ("auto", "full", "impostor")
+#: the names of `cloudcore.impostors.TRANSLATION_METRICS` (kept here so settings import no geometry)
+TRANSLATION_METRICS = ("parallax", "centre")
 
 
 @dataclass(frozen=True)
 class RenderSettings:
     mode: str = "auto"
-    #: degrees: an impostor is regenerated once the eye has turned this far around its cloud's centre
-    tolerance_deg: float = 0.15
+    #: degrees of translation error past which an impostor is regenerated; see `translation_metric`.
+    #: SkyWorks' default is 0.125 (0.9 of a pixel at 480 lines and 60 degrees); measured along the default
+    #: flythrough, 0.5 costs a third less time for 0.4 dB of mean PSNR (docs/performance.md)
+    tolerance_deg: float = 0.5
+    #: "parallax": the angle between the rays to the impostor's near and far points (Harris, SkyWorks);
+    #: "centre": the angle the eye has turned around the cloud's centre (stricter by about D / 2R)
+    translation_metric: str = "parallax"
+    #: pixels: when > 0, the tolerance is this many pixels at the screen's centre instead of tolerance_deg
+    tolerance_px: float = 0.0
     #: metres: clouds wholly beyond this horizontal distance join Wang's ring of 8 impostors; inf: no ring
     ring_radius: float = 4000.0
     #: impostor texture sides, powers of two
@@ -27,13 +37,19 @@ class RenderSettings:
     impostor_max_size: int = 512
     #: texels across the radius of a cloud's finest particle that an impostor texture must give; a finer
     #: texture only resamples smooth Gaussians, so none is made (0: the screen's resolution alone decides)
-    impostor_detail_texels: float = 3.0
+    impostor_detail_texels: float = 2.0
     #: impostors remade per frame at most; those past their tolerance wait, the farthest past it first
     #: (0: no limit, every impostor past its tolerance is remade at once)
     regeneration_budget: int = 0
-    #: cloud radii: full 3D below `fade_start_radii`, impostor beyond `fade_end_radii`, crossfade between
-    fade_start_radii: float = 2.0
-    fade_end_radii: float = 4.0
+    #: milliseconds the impostor updates and the cloud pass may take together, as the measured cost model
+    #: predicts them; over it, regenerations wait (most urgent first) and the error drawn exceeds the
+    #: tolerance by what the statistics report (0: no budget)
+    frame_budget_ms: float = 0.0
+    #: frames over which a cloud crossfades when auto mode changes its representation (no pop)
+    transition_frames: int = 6
+    #: draw interpenetrating clouds as one unit (one impostor, one sort: `cloudcore.lod_units`); off, each
+    #: cloud's impostor is sorted as a whole, Harris's approximation
+    group_clouds: bool = True
     #: per axis: the screen impostor of a cloud the eye is inside has this fraction of the screen's pixels
     inside_resolution_scale: float = 0.25
     #: the ring is rebuilt when the eye has moved this fraction of ring_radius horizontally / vertically
@@ -53,6 +69,11 @@ class RenderSettings:
             problems.append(f"mode must be one of {', '.join(MODES)}, got {self.mode!r}")
         if not 0.0 <= self.tolerance_deg <= 180.0:
             problems.append(f"tolerance_deg must be within [0, 180], got {self.tolerance_deg}")
+        if self.translation_metric not in TRANSLATION_METRICS:
+            problems.append(f"translation_metric must be one of {', '.join(TRANSLATION_METRICS)}, "
+                            f"got {self.translation_metric!r}")
+        if not 0.0 <= self.tolerance_px < math.inf:
+            problems.append(f"tolerance_px must be >= 0 and finite (0: use tolerance_deg), got {self.tolerance_px}")
         if not (self.ring_radius >= 0.0):
             problems.append(f"ring_radius must be >= 0 metres (inf for no ring), got {self.ring_radius}")
         for name in ("impostor_min_size", "impostor_max_size"):
@@ -64,11 +85,12 @@ class RenderSettings:
         if not (isinstance(self.regeneration_budget, int) and self.regeneration_budget >= 0):
             problems.append("regeneration_budget must be an integer >= 0 (0: no limit), "
                             f"got {self.regeneration_budget!r}")
+        if not 0.0 <= self.frame_budget_ms < math.inf:
+            problems.append(f"frame_budget_ms must be >= 0 and finite (0: no budget), got {self.frame_budget_ms}")
         if self.impostor_min_size > self.impostor_max_size:
             problems.append("impostor_min_size must not exceed impostor_max_size")
-        if not 0.0 <= self.fade_start_radii <= self.fade_end_radii < math.inf:
-            problems.append("fade distances must satisfy 0 <= fade_start_radii <= fade_end_radii < inf, "
-                            f"got {self.fade_start_radii} and {self.fade_end_radii}")
+        if not (isinstance(self.transition_frames, int) and self.transition_frames >= 1):
+            problems.append(f"transition_frames must be an integer >= 1, got {self.transition_frames!r}")
         if not 0.0 < self.inside_resolution_scale <= 1.0:
             problems.append(f"inside_resolution_scale must be within (0, 1], got {self.inside_resolution_scale}")
         if not (self.ring_rebuild_horizontal > 0.0 and self.ring_rebuild_vertical > 0.0):
@@ -77,8 +99,9 @@ class RenderSettings:
             problems.append(f"ring_elevation_deg must be within (0, 90), got {self.ring_elevation_deg}")
         if not (isinstance(self.ring_fade_frames, int) and self.ring_fade_frames >= 1):
             problems.append(f"ring_fade_frames must be an integer >= 1, got {self.ring_fade_frames!r}")
-        if not isinstance(self.split_objects, bool):
-            problems.append(f"split_objects must be true or false, got {self.split_objects!r}")
+        for name in ("split_objects", "group_clouds"):
+            if not isinstance(getattr(self, name), bool):
+                problems.append(f"{name} must be true or false, got {getattr(self, name)!r}")
         if problems:
             raise ValueError("; ".join(problems))
 

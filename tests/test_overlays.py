@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 from cloudcore.editing import pick_ray
-from cloudcore.frameplan import plan_frame
+from cloudcore.frameplan import LodState, plan_frame
+from cloudcore.lod_units import LodUnits
 from cloudcore.impostors import screen_size_px
 from cloudcore.overlays import clip_to_near, impostor_outlines, ring_outlines, screen_polygon, to_pixels
-from cloudcore.ring import RingState
 from cloudcore.scene import Camera
 from cloudcore.settings import RenderSettings
 
@@ -43,9 +43,11 @@ def test_a_polygon_is_cut_at_the_near_plane():
 def test_an_impostor_outline_is_its_quad_on_screen():
     distance, radius = 3000.0, 200.0
     centres, radii = np.array([[0.0, 0.0, -distance], [0.0, 0.0, -15.0]]), np.array([radius, 10.0])
-    plan = plan_frame(centres, radii, CAMERA, VIEWPORT, RenderSettings(ring_radius=math.inf), {}, RingState(), 1)
+    # the far cloud's splats fill more than its quad, the near one has none to draw: impostor, full
+    units = LodUnits.of_spheres(centres, radii, particle_counts=[3000, 0], radius_squares=[3000 * 40.0 ** 2, 0.0])
+    plan = plan_frame(units, CAMERA, VIEWPORT, RenderSettings(ring_radius=math.inf), LodState(), 1)
     assert [c.kind for c in plan.clouds] == ["impostor", "full"]
-    (outline,) = impostor_outlines(plan, centres, radii, CAMERA, VIEWPORT)  # the full cloud has none
+    (outline,) = impostor_outlines(plan, units, CAMERA, VIEWPORT)  # the full cloud has none
     assert (outline.kind, outline.index) == ("impostor", 0)
     side = screen_size_px(radius, distance, VIEWPORT[1], CAMERA.fov_y_deg)
     np.testing.assert_allclose(np.ptp(outline.points, axis=0), [side, side], rtol=1e-9)
@@ -57,10 +59,11 @@ def test_the_ring_outlines_are_the_panels_in_front_of_the_eye():
     angles = np.radians(np.arange(0.0, 360.0, 30.0))
     centres = np.column_stack([3000.0 * np.sin(angles), np.zeros(len(angles)), -3000.0 * np.cos(angles)])
     radii = np.full(len(angles), 100.0)
-    state, plan = RingState(), None
+    units = LodUnits.of_spheres(centres, radii)
+    state, plan = LodState(), None
     for _ in range(8 + settings.ring_fade_frames):  # one segment a frame, then the fade in
-        plan = plan_frame(centres, radii, CAMERA, VIEWPORT, settings, {}, state, 1)
-        state = plan.ring_state
+        plan = plan_frame(units, CAMERA, VIEWPORT, settings, state, 1)
+        state = plan.state
     assert plan.ring.draws and all(c.kind == "ring" for c in plan.clouds)
     outlines = ring_outlines(plan, CAMERA, VIEWPORT, settings.ring_elevation_deg)
     # looking along a panel boundary (-z) with a 60-degree field: two panels ahead, and the two beside
@@ -73,5 +76,5 @@ def test_the_ring_outlines_are_the_panels_in_front_of_the_eye():
         ys = outline.points[:, 1]
         assert ys.min() + ys.max() == pytest.approx(VIEWPORT[1], abs=1e-6)
         assert ys.min() <= 0.0
-    assert ring_outlines(plan_frame(centres, radii, CAMERA, VIEWPORT, RenderSettings(ring_radius=math.inf), {},
-                                    RingState(), 1), CAMERA, VIEWPORT, 30.0) == []
+    assert ring_outlines(plan_frame(units, CAMERA, VIEWPORT, RenderSettings(ring_radius=math.inf), LodState(), 1),
+                         CAMERA, VIEWPORT, 30.0) == []

@@ -1,9 +1,9 @@
 """Impostors, the crossfade and the ring against the full-3D reference, rendered at 160x120.
 
 Thresholds (PSNR against full 3D, after the ring has been built and faded in):
-default view >= 34 dB (measured 36.1: impostors of interpenetrating clouds are
-sorted as wholes, the one error Harris accepts), into the sun >= 45 dB, inside
-a cloud >= 50 dB.
+default view >= 38 dB (measured 40.5 in impostor mode and 44.6 in auto at this
+size; 36.1 before interpenetrating clouds were grouped into one impostor),
+into the sun >= 45 dB, inside a cloud >= 50 dB.
 """
 
 import dataclasses
@@ -12,11 +12,16 @@ import numpy as np
 import pytest
 
 from cloudcore.imagecompare import compare
+from cloudcore.navigation import orbited
 from cloudcore.ring import SEGMENTS
 from cloudcore.scene import Camera
 from cloudcore.scenefile import load_scene
 from cloudcore.settings import FULL_3D, RenderSettings
 from conftest import VALLEY
+from test_frameplan import FILL_BOUND, UPKEEP_BOUND
+
+#: full 3D all but free, an impostor's quad dear: auto moves every unit to full 3D
+FULL_CHEAP = dataclasses.replace(UPKEEP_BOUND, quad_pixels=1.0)
 from test_render_golden import inside_a_cloud, into_the_sun
 
 #: enough frames to build all ring segments and fade the ring in
@@ -34,7 +39,7 @@ def settled(renderer, scene, camera, settings):
     return image, stats
 
 
-@pytest.mark.parametrize("view, min_psnr_db", [("default", 34.0), ("into_the_sun", 45.0), ("inside_a_cloud", 50.0)])
+@pytest.mark.parametrize("view, min_psnr_db", [("default", 38.0), ("into_the_sun", 45.0), ("inside_a_cloud", 50.0)])
 @pytest.mark.parametrize("mode", ["auto", "impostor"])
 def test_impostor_renders_agree_with_full_3d(renderer, valley, view, min_psnr_db, mode):
     camera = {"default": None, "into_the_sun": into_the_sun(valley), "inside_a_cloud": inside_a_cloud(valley)}[view]
@@ -46,37 +51,47 @@ def test_impostor_renders_agree_with_full_3d(renderer, valley, view, min_psnr_db
     fewer = stats["particles_drawn"] < full_stats["particles_drawn"]
     assert fewer if mode == "impostor" else stats["particles_drawn"] <= full_stats["particles_drawn"]
     if view == "inside_a_cloud":
-        assert stats["clouds_inside"] == 1
+        assert len(renderer.last_plan.of_kind("inside")) == 1
 
 
-def test_the_default_view_uses_every_representation(renderer, valley):
+def test_the_default_view_still_is_drawn_from_impostors_and_the_ring(renderer, valley):
+    """A still eye: every impostor lasts, so auto draws every unit from one (none is cheaper in full 3D)."""
     _, stats = settled(renderer, valley, None, RenderSettings())
-    assert all(stats[f"clouds_{kind}"] > 0 for kind in ("ring", "crossfade", "impostor"))
+    assert stats["clouds_ring"] > 0 and stats["clouds_impostor"] > 0 and stats["clouds_full"] == 0
+    assert stats["units_grouped"] > 0  # the default scene has interpenetrating clouds
     _, again = renderer.render(valley, settings=RenderSettings())
     assert again["impostors_regenerated"] == 0 and again["ring_segments_built"] == 0  # nothing moved
 
 
 def test_the_crossfade_mixes_full_3d_and_impostor_linearly(renderer, valley):
-    """Sweeping the distance through 2r..4r, the frame's mean is the plan's weighted mean of the two ends.
+    """When the measured costs turn, the unit crossfades from its impostor to full 3D; at every step the
+    frame's mean is the plan's weighted mean of the two ends.
 
     A blend that brightened or darkened mid-fade (the seam) would leave this line.
     """
     cloud = valley.clouds[5]
     centre, radius = cloud.bounding_sphere()
     scene = dataclasses.replace(valley, clouds=(cloud,), terrain=None)
-    no_ring = dataclasses.replace(RenderSettings(), ring_radius=np.inf)
+    # the impostor is made from one eye and seen from another, three quarters of the tolerance round:
+    # kept, but far enough from full 3D that switching to it calls for the crossfade
+    auto = dataclasses.replace(RenderSettings(), ring_radius=np.inf, transition_frames=5, translation_metric="centre",
+                               tolerance_deg=1.0)
+    made_from = Camera(tuple(centre + [0.0, 0.0, 3.0 * radius]), tuple(centre), 60.0)
+    camera = orbited(made_from, 0.75)
+    renderer.render(scene, camera=made_from, settings=dataclasses.replace(auto, mode="impostor"))
+    ends = [renderer.render(scene, camera=camera, settings=s)[0].astype(float).mean()
+            for s in (FULL_3D, dataclasses.replace(auto, mode="impostor"))]
+    assert renderer.last_plan.clouds[0].regenerate is None
     means, weights = [], []
-    for radii in np.linspace(1.5, 5.0, 15):
-        camera = Camera(tuple(centre + [0.0, 0.0, radii * radius]), tuple(centre), 60.0)
-        ends = [renderer.render(scene, camera=camera, settings=s)[0].astype(float).mean()
-                for s in (FULL_3D, dataclasses.replace(no_ring, mode="impostor"))]
-        blended = renderer.render(scene, camera=camera, settings=no_ring)[0].astype(float).mean()
+    for frame in range(8):
+        costs = FILL_BOUND if frame == 0 else FULL_CHEAP
+        blended = renderer.render(scene, camera=camera, settings=auto, costs=costs)[0].astype(float).mean()
         weight = renderer.last_plan.clouds[0].full_weight
         assert blended == pytest.approx(weight * ends[0] + (1 - weight) * ends[1], abs=0.01)
         means.append(blended)
         weights.append(weight)
-    assert weights[0] == 1.0 and weights[-1] == 0.0 and 0.0 < weights[6] < 1.0
-    assert np.max(np.abs(np.diff(means))) < 1.0  # smooth: under one 8-bit level between sweep steps
+    assert weights == pytest.approx([0.0, 0.2, 0.4, 0.6, 0.8, 1.0, 1.0, 1.0])
+    assert np.max(np.abs(np.diff(means))) < 1.0  # smooth: under one 8-bit level a frame
 
 
 def test_textures_of_a_dropped_ring_are_reused_not_added(renderer, valley):

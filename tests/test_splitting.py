@@ -5,9 +5,9 @@ import math
 import numpy as np
 import pytest
 
-from cloudcore.frameplan import plan_frame
+from cloudcore.frameplan import LodState, plan_frame
+from cloudcore.lod_units import LodUnits
 from cloudcore.objects import ObjectPose, object_poses
-from cloudcore.ring import RingState
 from cloudcore.scene import Camera
 from cloudcore.scenefile import load_scene
 from cloudcore.settings import RenderSettings
@@ -29,8 +29,9 @@ def pose(position, radius=5.0) -> ObjectPose:
 
 
 def plan(camera, objects, settings=RenderSettings(mode="full"), records=None, particles=lambda _: PARTICLES):
-    return plan_frame(CENTRE, RADIUS, camera, VIEWPORT, settings, records or {}, RingState(), 1,
-                      objects, particles)
+    units = LodUnits.of_spheres(CENTRE, RADIUS, particle_counts=[len(PARTICLES)],
+                                radius_squares=[len(PARTICLES) * 25.0])
+    return plan_frame(units, camera, VIEWPORT, settings, LodState(records or {}), 1, objects, particles)
 
 
 def layer_order_errors(frame_plan, object_centres, eye, cloud_particles) -> list[str]:
@@ -126,8 +127,8 @@ def test_an_object_behind_the_camera_is_not_drawn_but_still_splits():
 
 def test_objects_in_an_empty_or_zero_radius_cloud_are_finite():
     camera = Camera((0.0, 0.0, 700.0), (0.0, 0.0, 0.0), 50.0)
-    frame = plan_frame(np.zeros((1, 3)), np.zeros(1), camera, VIEWPORT, RenderSettings(), {}, RingState(), 1,
-                       (pose((0.0, 0.0, 0.0), radius=0.0),), lambda _: np.zeros((0, 3)))
+    frame = plan_frame(LodUnits.of_spheres(np.zeros((1, 3)), np.zeros(1)), camera, VIEWPORT, RenderSettings(),
+                       LodState(), 1, (pose((0.0, 0.0, 0.0), radius=0.0),), lambda _: np.zeros((0, 3)))
     assert frame.clouds[0].kind == "empty" and frame.objects_with_world == (0,)
 
 
@@ -139,15 +140,16 @@ def test_no_frame_of_the_default_flythrough_has_a_layer_order_error():
     path = scene.camera_path("flythrough")
     from cloudcore.paths import camera_on_path
 
-    records, ring, split_frames, errors = {}, RingState(), 0, []
+    units = LodUnits.of_spheres(centres, radii, particle_counts=[len(c.particles) for c in scene.clouds],
+                                radius_squares=[float(np.sum(c.radii ** 2)) for c in scene.clouds])
+    state, split_frames, errors = LodState(), 0, []
     settings = RenderSettings()
     for frame_index in range(int(path.duration * 30) + 1):
         t = frame_index / 30.0
         camera = camera_on_path(path, t, scene.camera.fov_y_deg)
         poses = object_poses(scene.objects, path.keys[0, 0] + t)
-        frame = plan_frame(centres, radii, camera, VIEWPORT, settings, records, ring, 1, poses,
-                           lambda i: scene.clouds[i].centres)
-        records, ring = frame.records, frame.ring_state
+        frame = plan_frame(units, camera, VIEWPORT, settings, state, 1, poses, lambda i: scene.clouds[i].centres)
+        state = frame.state
         split_frames += bool(frame.objects_between_layers)
         errors += [f"t={t:.2f}: {e}" for e in layer_order_errors(
             frame, np.array([p.centre for p in poses]), np.asarray(camera.position), lambda i: scene.clouds[i].centres)]

@@ -14,7 +14,7 @@ import json
 import os
 from pathlib import Path
 
-from cloudcore.benchmark import bench_path, pareto_front, shading_comparison
+from cloudcore.benchmark import bench_path, orbit_views, pareto_front, shading_comparison, still_views
 from cloudcore.cli.render import pixel_count
 from cloudcore.cli.settings_args import SWEEPABLE, add_settings_arguments, parse_sweep, settings_from
 from cloudcore.errors import SceneError
@@ -24,12 +24,19 @@ from cloudcore.scenefile import load_scene
 def add_parser(commands) -> None:
     parser = commands.add_parser("bench", help="frame time and image error of settings against full 3D")
     parser.add_argument("scene", help="scene file (.toml)")
-    parser.add_argument("--path", required=True, help="camera path of the scene to fly")
+    views = parser.add_mutually_exclusive_group(required=True)
+    views.add_argument("--path", help="camera path of the scene to fly")
+    views.add_argument("--still", action="store_true", help="the scene's camera, still, for --frames frames")
+    views.add_argument("--orbit", type=float, metavar="DEG",
+                       help="the scene's camera orbiting its look-at point DEG degrees a frame")
     parser.add_argument("--json", required=True, type=Path, help="report to write")
     parser.add_argument("--sweep", action="append", type=parse_sweep, default=[],
                         help=f"NAME=V1,V2,... with NAME one of {', '.join(SWEEPABLE)}; "
                              "several --sweep options combine")
     parser.add_argument("--frames", type=int, default=60, help="frames spread along the path (default 60)")
+    parser.add_argument("--warmup", type=int, default=0,
+                        help="unmeasured frames of the first view before each run: 20 build a still view's "
+                             "impostors and ring (default %(default)s)")
     parser.add_argument("--width", type=pixel_count, default=640)
     parser.add_argument("--height", type=pixel_count, default=480)
     parser.add_argument("--plot", type=Path, help="write the error-against-time plot here (PNG)")
@@ -44,12 +51,20 @@ def run(args) -> int:
     scene = load_scene(args.scene)
     if args.without_terrain:
         scene = dataclasses.replace(scene, terrain=None)
-    try:
-        scene.camera_path(args.path)
-    except KeyError as error:
-        raise SceneError(args.scene, "camera_paths", error.args[0]) from None
+    if args.path is not None:
+        try:
+            scene.camera_path(args.path)
+        except KeyError as error:
+            raise SceneError(args.scene, "camera_paths", error.args[0]) from None
     if args.frames < 1:
         raise SceneError("--frames", "frames", f"must be >= 1, got {args.frames}")
+    if args.warmup < 0:
+        raise SceneError("--warmup", "warmup", f"must be >= 0, got {args.warmup}")
+    if args.orbit is not None and not abs(args.orbit) < 360.0:
+        raise SceneError("--orbit", "orbit", f"must be within (-360, 360) degrees a frame, got {args.orbit}")
+    views = (still_views(scene, args.frames) if args.still else orbit_views(scene, args.frames, args.orbit)
+             if args.orbit is not None else None)
+    motion = "still" if args.still else f"orbit {args.orbit:g} deg/frame" if args.orbit is not None else args.path
     base = settings_from(args)
     fields = [field for field, _ in args.sweep]
     settings_list = [settings_from(args, **dict(zip(fields, values)))
@@ -61,9 +76,10 @@ def run(args) -> int:
     from cloudcore.gl import FrameRenderer
 
     with FrameRenderer(args.width, args.height) as renderer, \
-            tqdm(total=args.frames * (1 + len(settings_list)), unit="frame", desc="bench") as bar:
+            tqdm(total=(args.frames + args.warmup) * (1 + len(settings_list)), unit="frame", desc="bench") as bar:
         report = bench_path(renderer, scene, args.path, args.frames, settings_list, (args.width, args.height),
-                            progress=bar.update)
+                            progress=bar.update, views=views, warmup=args.warmup)
+    report["path"] = motion
     report["scene"] = str(args.scene)
     report["without_terrain"] = args.without_terrain
     report["shading"] = [] if args.no_shading else shading_comparison(scene)
@@ -76,7 +92,7 @@ def run(args) -> int:
         print(f"{changed or run_['settings']['mode']}: {run_['frame_ms_mean']:.1f} ms "
               f"(x{run_['speedup_vs_full']:.2f} frame, x{run_['cloud_speedup_vs_full']:.2f} clouds), "
               f"PSNR mean {run_['psnr_mean']:.2f} dB, min {run_['psnr_min']:.2f} dB, "
-              f"{run_['regenerations']} regenerations")
+              f"{run_['regenerations_per_frame']:.2f} regenerations a frame")
     if args.plot:
         plot_error_against_time(report, args.plot)
     print(f"wrote {args.json}" + (f" and {args.plot}" if args.plot else ""))

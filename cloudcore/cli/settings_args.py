@@ -3,19 +3,44 @@
 from __future__ import annotations
 
 from cloudcore.errors import SceneError
-from cloudcore.settings import MODES, RenderSettings
+from cloudcore.settings import MODES, TRANSLATION_METRICS, RenderSettings
+
+
+def _boolean(text: str) -> bool:
+    """`true` or `false`, as a sweep value; argparse names this function on refusal."""
+    if text not in ("true", "false"):
+        raise ValueError(text)
+    return text == "true"
+
 
 #: --sweep NAME=... -> (settings field, value parser)
 SWEEPABLE = {"tolerance": ("tolerance_deg", float), "ring_radius": ("ring_radius", float),
              "impostor_max_size": ("impostor_max_size", int), "detail_texels": ("impostor_detail_texels", float),
-             "regeneration_budget": ("regeneration_budget", int), "mode": ("mode", str)}
+             "regeneration_budget": ("regeneration_budget", int), "mode": ("mode", str),
+             "metric": ("translation_metric", str), "tolerance_px": ("tolerance_px", float),
+             "transition_frames": ("transition_frames", int), "frame_budget": ("frame_budget_ms", float),
+             "group_clouds": ("group_clouds", _boolean)}
 
 
 def add_settings_arguments(parser, default_mode: str = "auto") -> None:
     defaults = RenderSettings()
     parser.add_argument("--mode", choices=MODES, default=default_mode, help="how clouds are drawn")
     parser.add_argument("--tolerance", type=float, default=defaults.tolerance_deg,
-                        help="impostor tolerance, degrees (default %(default)s)")
+                        help="impostor tolerance, degrees of translation error (default %(default)s)")
+    parser.add_argument("--translation-metric", choices=TRANSLATION_METRICS, default=defaults.translation_metric,
+                        help="parallax: the angle between the rays to the impostor's near and far points (Harris); "
+                             "centre: the angle turned around the cloud's centre (default %(default)s)")
+    parser.add_argument("--tolerance-px", type=float, default=defaults.tolerance_px,
+                        help="impostor tolerance in pixels at the screen's centre; 0: use --tolerance "
+                             "(default %(default)s)")
+    parser.add_argument("--transition-frames", type=int, default=defaults.transition_frames,
+                        help="frames of crossfade when auto mode changes a cloud's representation "
+                             "(default %(default)s)")
+    parser.add_argument("--frame-budget", type=float, default=defaults.frame_budget_ms,
+                        help="milliseconds for impostor updates and the cloud pass together; over it, regenerations "
+                             "wait, most urgent first; 0: none (default %(default)s)")
+    parser.add_argument("--no-group-clouds", dest="group_clouds", action="store_false",
+                        help="sort each cloud's impostor as a whole even where clouds interpenetrate")
     parser.add_argument("--ring-radius", type=float, default=defaults.ring_radius,
                         help="metres beyond which clouds join the impostor ring; inf for none (default %(default)s)")
     parser.add_argument("--impostor-max-size", type=int, default=defaults.impostor_max_size,
@@ -32,7 +57,9 @@ def settings_from(args, **overrides) -> RenderSettings:
     """The settings the arguments name; out-of-domain values are a one-line error."""
     values = dict(mode=args.mode, tolerance_deg=args.tolerance, ring_radius=args.ring_radius,
                   impostor_max_size=args.impostor_max_size, impostor_detail_texels=args.detail_texels,
-                  regeneration_budget=args.regeneration_budget) | overrides
+                  regeneration_budget=args.regeneration_budget, translation_metric=args.translation_metric,
+                  tolerance_px=args.tolerance_px, transition_frames=args.transition_frames,
+                  group_clouds=args.group_clouds, frame_budget_ms=args.frame_budget) | overrides
     try:
         return RenderSettings(**values)
     except (TypeError, ValueError) as error:

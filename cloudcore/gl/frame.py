@@ -2,19 +2,22 @@
 
 Everything is composed in linear light in a float target; the one transfer to
 sRGB happens on read-back.  `FrameRenderer` keeps its context, GL objects,
-terrain, precomputed cloud illumination, impostor cache and ring between
-frames and rebuilds each only when what it came from changes.  Each frame it
-asks `cloudcore.frameplan.plan_frame` what to do and executes exactly that:
+terrain and precomputed cloud illumination between frames and rebuilds each
+only when what it came from changes; what the level of detail carries from
+frame to frame (impostor cache, ring, representations, the fitted costs) is
+the pure `cloudcore.frameplan.LodState` it holds.  Each frame it asks
+`cloudcore.frameplan.plan_frame` what to do, executes exactly that, and
+folds the two timed passes into the state's cost fit:
 
 1. the world (terrain depth and colour over the sky), and the objects
    that are not inside a drawn cloud;
 2. the impostors and ring segment the plan regenerates;
 3. the ring panels, then the plan's draw items far to near: runs of full-3D
-   clouds (or of their layers) as one sorted splat batch, impostors as
-   quads, crossfading clouds as their full-3D image (in a screen layer)
-   mixed with their impostor, the cloud the eye is inside as a
-   reduced-resolution screen impostor, and the objects inside clouds
-   between the layers they split.
+   units (clouds, or groups of interpenetrating clouds, or their layers) as
+   one sorted splat batch, impostors as quads, crossfading units as their
+   full-3D image (in a screen layer) mixed with their impostor, the unit the
+   eye is inside as a reduced-resolution screen impostor, and the objects
+   inside clouds between the layers they split.
 """
 
 from __future__ import annotations
@@ -31,7 +34,7 @@ from cloudcore.eye_scattering import ParticleShading
 from cloudcore.facing import CloudFacings
 from cloudcore.formation import formation_state
 from cloudcore.illumination import IlluminationCache
-from cloudcore.frameplan import FramePlan, plan_frame
+from cloudcore.frameplan import FramePlan, LodState, plan_frame
 from cloudcore.gl.context import HeadlessContext, WindowContext, check_frame_size
 from cloudcore.gl.impostor_store import ImpostorStore
 from cloudcore.gl.objects import ObjectPass
@@ -41,9 +44,10 @@ from cloudcore.gl.splats import SplatPass, splat_batch
 from cloudcore.gl.targets import TextureTarget, blit_depth, depth_renderbuffer
 from cloudcore.gl.world import WorldPass
 from cloudcore.lighting import scene_hour, scene_lights, sky_colors
+from cloudcore.lod_costs import CostModel
+from cloudcore.lod_units import LodUnits, lod_units
 from cloudcore.overdraw import analytic_overdraw, overdraw_statistics
 from cloudcore.particle_styles import particle_styles
-from cloudcore.ring import RingState, panel_corners
 from cloudcore.scene import Camera, Lighting, Scene
 from cloudcore.settings import FULL_3D, RenderSettings
 
@@ -66,7 +70,10 @@ class FrameRenderer:
         #: per cloud, changes whenever that cloud's particle colours may have: its impostor is stale
         self._lighting_keys: tuple = ()
         self._key_serial = 0
-        self._records, self._ring_state = {}, RingState()
+        #: the level of detail's state between frames (impostor cache, ring, representations, costs)
+        self.lod_state = LodState()
+        self._units: LodUnits | None = None
+        self._units_source = None
         self._layer = None  # screen-sized, sharing the frame's depth: crossfading clouds' full-3D image
         self._inside = None  # (target, its depth renderbuffer) of the screen impostor
         self._overdraw_target = None
@@ -76,9 +83,9 @@ class FrameRenderer:
         self.last_plan: FramePlan | None = None
 
     @property
-    def cloud_bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        """(centres (clouds, 3), radii (clouds,)) of the bounding spheres the last frame was planned with."""
-        return self._particles.bounding_centres, self._particles.bounding_radii
+    def units(self) -> LodUnits:
+        """The units (clouds, or groups of interpenetrating clouds) the last frame was planned with."""
+        return self._units
 
     @property
     def size(self) -> tuple[int, int]:
@@ -86,8 +93,12 @@ class FrameRenderer:
 
     def render(self, scene: Scene, *, time_of_day: float | None = None, camera: Camera | None = None,
                illumination_method: str = "exact", settings: RenderSettings = RenderSettings(),
-               time_s: float = 0.0, read_back: bool = True) -> tuple[np.ndarray | None, dict]:
+               time_s: float = 0.0, read_back: bool = True,
+               costs: CostModel | None = None) -> tuple[np.ndarray | None, dict]:
         """(sRGB uint8 (height, width, 3), stats); `time_of_day` and `camera` override the scene's.
+
+        Auto mode prices its choices with the cost model fitted to the frames rendered so far, or
+        with `costs` when given (a pinned model: tests, comparisons across machines).
 
         `time_s` is the scene clock, in the time of the objects' path keys and of the clouds' formations.
 
@@ -104,10 +115,14 @@ class FrameRenderer:
         # a forming or dissipating cloud's colours change with the clock too: its impostor is stale meanwhile
         cloud_keys = tuple((key, formation_state(cloud.formation, time_s))
                            for key, cloud in zip(self._lighting_keys, scene.clouds))
-        plan = plan_frame(particles.bounding_centres, particles.bounding_radii, camera, self.size, settings,
-                          self._records, self._ring_state, cloud_keys, poses,
-                          lambda cloud: particles.centres[starts[cloud]:starts[cloud + 1]], particles.finest_radii)
-        self._records, self._ring_state, self.last_plan = plan.records, plan.ring_state, plan
+        if (particles, settings.group_clouds) != self._units_source:
+            self._units, self._units_source = lod_units(particles, settings.group_clouds), (particles,
+                                                                                             settings.group_clouds)
+        plan = plan_frame(self._units, camera, self.size, settings, self.lod_state, cloud_keys, poses,
+                          lambda cloud: particles.centres[starts[cloud]:starts[cloud + 1]], costs,
+                          lambda cloud: (particles.centres[starts[cloud]:starts[cloud + 1]],
+                                         particles.radii[starts[cloud]:starts[cloud + 1]]))
+        self.last_plan = plan
 
         view = view_matrix(camera)
         projection = projection_matrix(camera.fov_y_deg, self.context.width / self.context.height)
@@ -122,18 +137,22 @@ class FrameRenderer:
             self._objects.draw(self.context, camera, poses, plan.objects_with_world, write_depth=True)
         GL.glFinish()
         world_done = time.perf_counter()
-        rendered = self._impostors.update(plan, particles, self.size, camera.fov_y_deg, settings, time_s)
+        rendered = self._impostors.update(plan, self._units, particles, self.size, camera.fov_y_deg, settings,
+                                          time_s)
         GL.glFinish()
         updates_done = time.perf_counter()
         self.context.bind_target()
         drawn = self._draw_clouds(plan, particles, camera, view, projection, settings, poses, time_s)
         GL.glFinish()
         done = time.perf_counter()
+        self.lod_state = plan.state.measured([(plan.update_work, 1e3 * (updates_done - world_done)),
+                                              (plan.cloud_work, 1e3 * (done - updates_done))])
         stats |= plan.stats() | {
             "frame_ms": 1e3 * (done - start), "world_ms": 1e3 * (world_done - start),
             "impostor_update_ms": 1e3 * (updates_done - world_done), "cloud_ms": 1e3 * (done - updates_done),
             "particles_drawn": drawn, "particles_to_impostors": rendered,
-            "clouds_drawn": len(plan.draw_order), "clouds_culled": len(plan.of_kind("culled")),
+            "clouds_drawn": sum(len(plan.clouds[i].members) for i in plan.draw_order),
+            "clouds_culled": sum(len(c.members) for c in plan.of_kind("culled")),
             "texture_bytes": self.texture_bytes}
         return (linear_to_srgb8(self.context.read_linear_rgb()) if read_back else None), stats
 
@@ -234,24 +253,26 @@ class FrameRenderer:
             self._screen_batches.append(batch)
             return len(batch)
 
-        def draw_quad(corners, texture, weight, *, screen: bool = False, **layer) -> None:
+        def draw_quad(corners, texture, weight, *, screen: bool = False, uv_rect=(0.0, 0.0, 1.0, 1.0),
+                      **layer) -> None:
             """A world-space quad, depth-tested; or with `screen`, clip-space corners over everything."""
             matrix, depth_test = (np.eye(4), False) if screen else (view_projection, True)
-            self._quads.draw(corners, matrix, texture, weight, depth_test=depth_test, **layer)
+            self._quads.draw(corners, matrix, texture, weight, depth_test=depth_test, uv_rect=uv_rect, **layer)
             self._replay.append(lambda: self._quads.draw(corners, matrix, 0, 1.0, depth_test=depth_test,
-                                                         counting=True))
+                                                         counting=True, uv_rect=uv_rect))
 
         if plan.ring is not None:
             for generation, weight in plan.ring.draws:
                 for segment in generation.occupied_segments:
-                    draw_quad(panel_corners(generation, segment, settings.ring_elevation_deg),
-                              self._impostors.ring_panel(generation, segment).texture, weight)
+                    target, corners, extent = self._impostors.ring_panel(generation, segment,
+                                                                         settings.ring_elevation_deg)
+                    draw_quad(corners, target.texture, weight, uv_rect=extent)
 
         full_run = []  # (cloud, (near, far)) of consecutive full-3D layers: they interpenetrate, sorted together
         for item in plan.draw_items:
             cloud = plan.clouds[item.index] if item.kind == "cloud" else None
             if cloud is not None and cloud.kind == "full":
-                full_run.append((item.index, (item.near, item.far)))
+                full_run += [(member, (item.near, item.far)) for member in cloud.members]
                 continue
             if full_run:
                 drawn += draw_splats(*zip(*full_run))
@@ -259,20 +280,21 @@ class FrameRenderer:
             if cloud is None:
                 self._objects.draw(self.context, camera, poses, [item.index], write_depth=False)
             elif cloud.kind == "impostor":
-                target, impostor = self._impostors.cloud_impostor(item.index, item.layer)
-                draw_quad(impostor.corners, target.texture, cloud.impostor_weight)
+                target, corners, extent = self._impostors.cloud_impostor(cloud.members, item.layer)
+                draw_quad(corners, target.texture, cloud.impostor_weight, uv_rect=extent)
             elif cloud.kind == "crossfade":
-                target, impostor = self._impostors.cloud_impostor(item.index, item.layer)
+                target, corners, extent = self._impostors.cloud_impostor(cloud.members, item.layer)
                 layer = self._screen_layer()
                 layer.bind_cleared()
-                drawn += draw_splats([item.index], [(item.near, item.far)])
+                drawn += draw_splats(cloud.members, [(item.near, item.far)] * len(cloud.members))
                 self.context.bind_target()
-                draw_quad(impostor.corners, target.texture, cloud.impostor_weight,
+                draw_quad(corners, target.texture, cloud.impostor_weight, uv_rect=extent,
                           layer_texture=layer.texture, layer_weight=cloud.full_weight)
             elif cloud.kind == "inside":
                 target = self._inside_target(plan.inside_size)
                 target.bind_cleared()
-                batch = splat_batch(particles, [item.index], eye, [(item.near, item.far)], time_s)
+                batch = splat_batch(particles, cloud.members, eye, [(item.near, item.far)] * len(cloud.members),
+                                    time_s)
                 self._splats.draw(batch, view, projection)
                 drawn += len(batch)
                 self.context.bind_target()

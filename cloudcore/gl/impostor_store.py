@@ -1,25 +1,29 @@
 """The GL side of impostors: renders what the frame plan says to regenerate and keeps the textures.
 
-Per-cloud impostors are rendered from the eye recorded in the plan's impostor
-cache, through the tight frustum of `cloudcore.impostors.impostor_view`; ring
-segments from their generation's eye (`cloudcore.ring`).  Textures come from
-one `TexturePool`; those of clouds or ring generations the plan no longer
-holds go back to it.  A cloud split around objects has one texture per
-layer, each holding the particles of its depth range seen from the
-impostor's eye.
+A unit's impostor (one cloud, or a group of interpenetrating clouds sorted
+together: `cloudcore.lod_units`) is rendered from the eye recorded in the
+plan's impostor cache, through the tight frustum of
+`cloudcore.impostors.impostor_view`; ring segments from their generation's
+eye (`cloudcore.ring`).  Textures come from one `TexturePool`; those of units
+or ring generations the plan no longer holds go back to it.  A unit split
+around objects has one texture per layer, each holding the particles of its
+depth range seen from the impostor's eye.
 """
 
 from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from cloudcore.eye_scattering import ParticleShading
 from cloudcore.frameplan import FramePlan
 from cloudcore.gl.splats import SplatPass, splat_batch
 from cloudcore.gl.targets import TextureTarget
 from cloudcore.gl.texture_pool import TexturePool
-from cloudcore.impostors import ImpostorView, impostor_view, required_size
-from cloudcore.ring import SEGMENT_DEG, RingGeneration, segment_camera
+from cloudcore.impostors import ImpostorView, cropped_corners, impostor_view, particle_extent, required_size
+from cloudcore.lod_units import LodUnits
+from cloudcore.ring import SEGMENT_DEG, RingGeneration, panel_corners, segment_camera
 from cloudcore.settings import RenderSettings
 from cloudcore.splitting import layer_bounds
 
@@ -28,26 +32,28 @@ class ImpostorStore:
     def __init__(self, splats: SplatPass):
         self._splats = splats
         self.pool = TexturePool()
-        self._clouds: dict[int, tuple[list[TextureTarget], ImpostorView]] = {}  # layers far to near
-        self._ring: dict[tuple[RingGeneration, int], TextureTarget] = {}
+        #: unit members -> (textures of its layers far to near, the view they were made with, the part of
+        #: the textures its particles can cover: only that part of the quad is drawn)
+        self._clouds: dict[tuple, tuple[list[TextureTarget], ImpostorView, tuple]] = {}
+        self._ring: dict[tuple[RingGeneration, int], tuple[TextureTarget, tuple]] = {}  # (texture, extent)
         self._ring_sizes: dict[RingGeneration, tuple[int, int]] = {}
 
-    def update(self, plan: FramePlan, particles: ParticleShading, viewport, fov_y_deg: float,
+    def update(self, plan: FramePlan, units: LodUnits, particles: ParticleShading, viewport, fov_y_deg: float,
                settings: RenderSettings, time_s: float) -> int:
         """Render this frame's regenerations and ring segment at scene time `time_s`; returns the particles rendered."""
         rendered = 0
         for cloud in plan.clouds:
             if cloud.regenerate is None:
                 continue
-            record = plan.records[cloud.index]
-            view = impostor_view(particles.bounding_centres[cloud.index], particles.bounding_radii[cloud.index],
-                                 record.eye)
-            targets = self._cloud_targets(cloud.index, cloud.texture_size, len(record.splits) + 1)
-            self._clouds[cloud.index] = (targets, view)
+            record = plan.records[cloud.members]
+            view = impostor_view(units.centres[cloud.index], units.radii[cloud.index], record.eye)
+            targets = self._cloud_targets(cloud.members, cloud.texture_size, len(record.splits) + 1)
+            self._clouds[cloud.members] = (targets, view, _extent(particles, cloud.members, view.view,
+                                                                  view.projection, (cloud.texture_size,) * 2))
             for layer, target in enumerate(targets):
                 depth_range = layer_bounds(record.splits, layer)
-                rendered += self._render(target, particles, [cloud.index], record.eye, view.view, view.projection,
-                                         time_s, [depth_range])
+                rendered += self._render(target, particles, cloud.members, record.eye, view.view, view.projection,
+                                         time_s, [depth_range] * len(cloud.members))
         for index in set(self._clouds) - set(plan.records):
             self._release(self._clouds.pop(index)[0])
 
@@ -55,27 +61,33 @@ class ImpostorStore:
         if ring is not None and ring.build_segment in (ring.state.pending.occupied_segments if ring.state.pending else ()):
             generation, segment = ring.state.pending, ring.build_segment
             size = self._ring_sizes.setdefault(generation, _ring_texture_size(viewport, fov_y_deg, settings))
-            target = self._ring[generation, segment] = self.pool.acquire(*size)
+            target = self.pool.acquire(*size)
             view, projection = segment_camera(generation, segment, settings.ring_elevation_deg)
-            rendered += self._render(target, particles, generation.segment_members[segment], generation.eye,
-                                     view, projection, time_s)
+            clouds = [cloud for unit in generation.segment_members[segment] for cloud in unit]
+            self._ring[generation, segment] = (target, _extent(particles, clouds, view, projection, size))
+            rendered += self._render(target, particles, clouds, generation.eye, view, projection, time_s)
         live = {plan.ring_state.current, plan.ring_state.pending}
         for key in [key for key in self._ring if key[0] not in live]:
-            self.pool.release(self._ring.pop(key))
+            self.pool.release(self._ring.pop(key)[0])
         for generation in set(self._ring_sizes) - live:
             del self._ring_sizes[generation]
         return rendered
 
-    def cloud_impostor(self, index: int, layer: int = 0) -> tuple[TextureTarget, ImpostorView]:
-        targets, view = self._clouds[index]
-        return targets[layer], view
+    def cloud_impostor(self, members: tuple, layer: int = 0) -> tuple[TextureTarget, np.ndarray, tuple]:
+        """(texture of layer `layer` of the unit of clouds `members`, the world corners of the part of its
+        quad that can show particles, the part of the texture they cover (u0, v0, u1, v1))."""
+        targets, view, extent = self._clouds[members]
+        return targets[layer], cropped_corners(view.corners, extent), extent
 
-    def ring_panel(self, generation: RingGeneration, segment: int) -> TextureTarget:
-        return self._ring[generation, segment]
+    def ring_panel(self, generation: RingGeneration, segment: int,
+                   elevation_deg: float) -> tuple[TextureTarget, np.ndarray, tuple]:
+        """(texture, cropped world corners, extent) of a ring segment's panel, as `cloud_impostor`."""
+        target, extent = self._ring[generation, segment]
+        return target, cropped_corners(panel_corners(generation, segment, elevation_deg), extent), extent
 
-    def _cloud_targets(self, index: int, size: int, layers: int) -> list[TextureTarget]:
-        """`layers` textures of side `size`, reusing the cloud's where they fit."""
-        held = self._clouds.pop(index, ([], None))[0]
+    def _cloud_targets(self, members: tuple, size: int, layers: int) -> list[TextureTarget]:
+        """`layers` textures of side `size`, reusing the unit's where they fit."""
+        held = self._clouds.pop(members, ([], None))[0]
         kept = [target for target in held if target.width == size][:layers]
         self._release([target for target in held if target not in kept])
         return kept + [self.pool.acquire(size, size) for _ in range(layers - len(kept))]
@@ -93,14 +105,21 @@ class ImpostorStore:
         return len(batch)
 
     def close(self) -> None:
-        for targets, _ in self._clouds.values():
+        for targets, _, _ in self._clouds.values():
             for target in targets:
                 target.close()
-        for target in self._ring.values():
+        for target, _ in self._ring.values():
             target.close()
         self._clouds.clear()
         self._ring.clear()
         self.pool.close()
+
+
+def _extent(particles: ParticleShading, clouds, view, projection, size) -> tuple:
+    """The part of a texture rendered through (view, projection) that the particles of `clouds` can cover."""
+    starts = particles.cloud_starts
+    indices = np.concatenate([np.arange(starts[c], starts[c + 1]) for c in clouds]) if len(clouds) else []
+    return particle_extent(view, projection, particles.centres[indices], particles.radii[indices], size)
 
 
 def _ring_texture_size(viewport, fov_y_deg: float, settings: RenderSettings) -> tuple[int, int]:

@@ -1,0 +1,172 @@
+"""What a representation costs: a linear model of the cloud passes, its coefficients measured as the frames run.
+
+The frame plan predicts the work of each unit's representation in machine-
+independent quantities (`Work`: particles splatted, splat fragments blended
+on the screen and into textures, impostor-quad pixels, regenerations, splat
+draws) and prices it with a
+`CostModel`, milliseconds per unit of work.  The coefficients are not
+constants of the code: `CostEstimator` fits them to the passes' measured
+times (the renderer times its impostor updates and its cloud pass to
+`glFinish`) by exponentially forgetting least squares, anchored to a prior.
+On llvmpipe fragments dominate, so impostors win; on a GPU where a
+regeneration's fixed cost dominates, full 3D does; the same plan code picks
+each, from numbers measured on the machine it runs on.  The fragment counts
+are estimates (a unit's splats as a ball of discs); screen and texture
+fragments have coefficients of their own, so the fit also absorbs each
+estimate's bias, which differs between the two (a near unit's off-screen
+splats cost nothing on the screen; in its impostor texture, all of them
+count).  Pure numpy: plan tests pass fixed models.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Work:
+    """Counts of work, additive: one representation's, one pass's or a whole frame's."""
+
+    particles: float = 0.0  # splats shaded, sorted and set up (screen or impostor texture)
+    fragments: float = 0.0  # splat fragments blended on the screen (estimated: `splat_fragments`)
+    texture_fragments: float = 0.0  # splat fragments blended into impostor textures (estimated likewise)
+    quad_pixels: float = 0.0  # pixels of impostor quads, ring panels and crossfade layers drawn
+    regenerations: float = 0.0  # impostor textures (or ring segments) remade: target switch, clear, draw call
+    batches: float = 0.0  # splat draws of the cloud pass: an upload of the order, a dispatch, a draw call
+
+    def __add__(self, other: "Work") -> "Work":
+        return Work(*(a + b for a, b in zip(self.vector(), other.vector())))
+
+    def scaled(self, factor: float) -> "Work":
+        return Work(*(factor * v for v in self.vector()))
+
+    def vector(self) -> np.ndarray:
+        return np.array([getattr(self, f.name) for f in fields(self)], dtype=np.float64)
+
+
+@dataclass(frozen=True)
+class CostModel:
+    """Milliseconds per unit of `Work`, field by field (the defaults: llvmpipe, `LLVMPIPE_COSTS`)."""
+
+    particles: float = 8.5e-4
+    fragments: float = 8.0e-6
+    texture_fragments: float = 8.0e-6
+    quad_pixels: float = 1.5e-5
+    regenerations: float = 0.5
+    batches: float = 0.3
+
+    def vector(self) -> np.ndarray:
+        return np.array([getattr(self, f.name) for f in fields(self)], dtype=np.float64)
+
+    def ms(self, work: Work) -> float:
+        return float(self.vector() @ work.vector())
+
+
+#: the prior: coefficients measured on llvmpipe, 2 cores (docs/performance.md, "The cost model"): a
+#: particle's shading, vertices and sort 0.85 us; a splat fragment 8 ns on the screen or in a texture
+#: (RGBA16F, blended); a regeneration's target switch, clear and draw 0.5 ms
+LLVMPIPE_COSTS = CostModel()
+
+
+def inverse_square_depth(radius: float, distance: float) -> float:
+    """E[1 / z^2] over a ball of `radius` whose centre is `distance` (> radius) from the eye, z the depth.
+
+    A splat's area on screen (and in an impostor texture) goes as 1 / z^2, and a near cloud's near
+    side looms: at 1.05 radii its splats cover 3.1 times what the centre's distance says.  With the
+    ball's slices weighted by their area, 3 (d ln((d + R) / (d - R)) - 2R) / (2 R^3); far away the
+    logarithm cancels to rounding, so the series 1 / d^2 (1 + 3/5 t^2 + 3/7 t^4 + 3/9 t^6), t = R / d.
+    """
+    if radius <= 0.0:
+        return 1.0 / max(distance * distance, 1e-18)
+    if not distance > radius:
+        distance = radius * (1.0 + 1e-6)
+    t = radius / distance
+    if t < 0.2:
+        return (1.0 + 0.6 * t * t + 3.0 / 7.0 * t ** 4 + t ** 6 / 3.0) / (distance * distance)
+    return 3.0 * (distance * math.log1p(2.0 * radius / (distance - radius)) - 2.0 * radius) / (2.0 * radius ** 3)
+
+
+def splat_fragments(radius_squares: float, radius: float, distance: float, focal_px: float, particles: float,
+                    screen_pixels: float) -> float:
+    """Fragments of a unit's splats seen from `distance`: their disc areas pi (f r / z)^2 summed, z spread
+    over the unit's bounding ball (`inverse_square_depth`); each disc at most the screen."""
+    area = math.pi * focal_px * focal_px * radius_squares * inverse_square_depth(radius, distance)
+    return min(area, particles * screen_pixels)
+
+
+def full_work(particles: float, radius_squares: float, radius: float, distance: float, focal_px: float,
+              screen_pixels: float) -> Work:
+    """A unit drawn in full 3D: every particle splatted to the screen."""
+    return Work(particles=particles, fragments=splat_fragments(radius_squares, radius, distance, focal_px,
+                                                               particles, screen_pixels))
+
+
+def regeneration_work(particles: float, radius_squares: float, radius: float, distance: float,
+                      quad_half_side: float, texture_size: int) -> Work:
+    """Remaking a unit's impostor: its particles splatted into a texture whose side spans the quad
+    (`quad_half_side` at the centre's `distance`)."""
+    focal_texels = texture_size * distance / (2.0 * max(quad_half_side, np.finfo(float).tiny))
+    texels = float(texture_size) ** 2
+    return Work(particles=particles, texture_fragments=splat_fragments(radius_squares, radius, distance,
+                                                                       focal_texels, particles, texels),
+                regenerations=1.0)
+
+
+def quad_work(side_px: float, screen_pixels: float) -> Work:
+    """An impostor quad of `side_px` on screen (at most the screen)."""
+    return Work(quad_pixels=min(side_px * side_px, screen_pixels))
+
+
+#: how much the fitted coefficients remember of each frame: 0.97 is about the last 30 frames
+FORGETTING = 0.97
+#: weight of the prior, in squared milliseconds of evidence: a term worth 10 ms a frame outweighs it within
+#: a frame, so a machine unlike the prior's (a GPU) moves the fit in a few frames, while the small terms
+#: (a regeneration's fixed cost) and the split between terms that grow together (particles and their
+#: fragments) stay near the prior through the noise of frame times
+PRIOR_WEIGHT = 100.0
+#: the fitted coefficients stay within this factor of the prior either way (a pass timed during a
+#: stall, or work the model does not see, must not make a representation look free or prohibitive)
+RATIO_LIMIT = 30.0
+
+
+@dataclass(frozen=True, eq=False)
+class CostEstimator:
+    """Fits a `CostModel` to measured pass times: y_ms = model . work, least squares with forgetting.
+
+    Solved in units of the prior (v_i = coefficient_i / prior_i, so every unknown is near 1) with
+    a ridge term pulling v toward 1; immutable: `observe` returns the next estimator.
+    """
+
+    prior: CostModel = LLVMPIPE_COSTS
+    normal: np.ndarray = None  # sum of forgotten g g^T, g = work * prior (the prior's ms per field)
+    right: np.ndarray = None  # sum of forgotten g y
+    frames: int = 0
+
+    def __post_init__(self):
+        size = len(fields(CostModel))
+        if self.normal is None:
+            object.__setattr__(self, "normal", np.zeros((size, size)))
+        if self.right is None:
+            object.__setattr__(self, "right", np.zeros(size))
+
+    def observe(self, measurements) -> "CostEstimator":
+        """Add this frame's (work, measured ms) pairs, one per timed pass."""
+        normal, right = FORGETTING * self.normal, FORGETTING * self.right
+        prior = self.prior.vector()
+        for work, ms in measurements:
+            if not (math.isfinite(ms) and ms >= 0.0):
+                continue
+            g = work.vector() * prior
+            normal = normal + np.outer(g, g)
+            right = right + g * ms
+        return CostEstimator(self.prior, normal, right, self.frames + 1)
+
+    def model(self) -> CostModel:
+        """The coefficients the measurements so far support (the prior before any)."""
+        size = len(self.right)
+        ratios = np.linalg.solve(self.normal + PRIOR_WEIGHT * np.eye(size), self.right + PRIOR_WEIGHT)
+        ratios = np.clip(np.nan_to_num(ratios, nan=1.0), 1.0 / RATIO_LIMIT, RATIO_LIMIT)
+        return CostModel(*(ratios * self.prior.vector()))
