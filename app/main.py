@@ -1,14 +1,16 @@
 """The editor's window: hello_imgui with a docking layout, the viewport and the panels.
 
     python -m app [SCENE] [--window-size WIDTHxHEIGHT] [--self-test RESULTS.json]
-    python -m app [SCENE] --frames N [--screenshot PNG] [--frame-stats JSON]
+    python -m app [SCENE] --frames N [--screenshot PNG] [--window-screenshot PNG] [--frame-stats JSON]
 
 The docking layout is remembered between runs (hello_imgui's settings file in
 the user's config folder).  With --self-test the Dear ImGui Test Engine drives
 the real widgets (`app.gui_tests`), writes its results and exits 0 when every
 test passed, 1 otherwise.  With --frames the editor quits after N frames,
-optionally leaving a screenshot of the window and the per-frame statistics
-with the time between window frames (`scripts/bench_editor.py` summarises them).
+optionally leaving the viewport's last picture at its own size (what
+`cloudview render` of the same view gives: `tests/test_editor_matches_render.py`),
+a screenshot of the whole window, and the per-frame statistics with the time
+between window frames (`scripts/bench_editor.py` summarises them).
 
 Keys: Ctrl+S saves, Ctrl+Z / Ctrl+Y (or Ctrl+Shift+Z) undo and redo, Delete
 removes the picked particle or else the selected cloud, F3 (or Ctrl+T) shows
@@ -107,7 +109,10 @@ def main(argv=None) -> int:
     parser.add_argument("--self-test", type=Path, metavar="RESULTS.json",
                         help="run the GUI tests with the Dear ImGui Test Engine, write results, exit")
     parser.add_argument("--frames", type=int, help="quit after this many frames")
-    parser.add_argument("--screenshot", type=Path, help="with --frames: save the window here (PNG) at the end")
+    parser.add_argument("--screenshot", type=Path,
+                        help="with --frames: save the viewport's last picture here (PNG, the viewport's size)")
+    parser.add_argument("--window-screenshot", type=Path,
+                        help="with --frames: save the whole window here (PNG) at the end")
     parser.add_argument("--frame-stats", type=Path, help="with --frames: write every frame's statistics (JSON)")
     args = parser.parse_args(argv)
     try:
@@ -125,12 +130,15 @@ def main(argv=None) -> int:
 
         install(params, editor, viewport, panels, args.self_test, outcome)
     if args.frames is not None:
-        _quit_after(params, args.frames, editor, outcome)
+        _quit_after(params, args.frames, editor, viewport, outcome)
     immapp.run(params, immapp.AddOnsParams(with_implot=True))
-    if args.screenshot is not None:
+    if args.screenshot is not None or args.window_screenshot is not None:
         import imageio.v3 as iio
 
-        iio.imwrite(args.screenshot, hello_imgui.final_app_window_screenshot())
+        if args.screenshot is not None and viewport.captured is not None:
+            iio.imwrite(args.screenshot, viewport.captured)
+        if args.window_screenshot is not None:
+            iio.imwrite(args.window_screenshot, hello_imgui.final_app_window_screenshot())
     if args.frame_stats is not None:
         args.frame_stats.write_text(json.dumps(outcome.get("frames", []), indent=1) + "\n")
     return outcome.get("exit_code", 0)
@@ -144,8 +152,9 @@ def window_size(text: str) -> tuple[int, int]:
     return width, height
 
 
-def _quit_after(params, frames: int, editor: Editor, outcome: dict) -> None:
-    """Quit after `frames` viewport frames, each recorded with the time since the window's previous frame."""
+def _quit_after(params, frames: int, editor: Editor, viewport: Viewport, outcome: dict) -> None:
+    """Quit after `frames` viewport frames, each recorded with the time since the window's previous frame;
+    the last one's picture is kept (`Viewport.captured`)."""
     recorded = outcome.setdefault("frames", [])
     previous = {"stats": None, "time": time.perf_counter()}
 
@@ -154,6 +163,8 @@ def _quit_after(params, frames: int, editor: Editor, outcome: dict) -> None:
         if editor.last_stats and editor.last_stats is not previous["stats"]:
             recorded.append(editor.last_stats | {"window_frame_ms": 1e3 * (now - previous["time"])})
         previous.update(stats=editor.last_stats, time=now)
+        if len(recorded) == frames - 1:
+            viewport.capture_next = True
         if len(recorded) >= frames:
             hello_imgui.get_runner_params().app_shall_exit = True
 

@@ -48,7 +48,7 @@ from cloudcore.impostors import (INSIDE_RADII, TRANSLATION_METRICS, ImpostorReco
 from cloudcore.lod_costs import CostEstimator, CostModel, Work, full_work, quad_work, regeneration_work
 from cloudcore.lod_units import LodUnits
 from cloudcore.overdraw import analytic_overdraw
-from cloudcore.ring import RingPlan, RingState, plan_ring
+from cloudcore.ring import RingPlan, RingState, plan_ring, segment_texture_size
 from cloudcore.scene import Camera
 from cloudcore.settings import RenderSettings
 from cloudcore.splitting import layer_bounds, layer_counts, layer_sort_key, objects_inside
@@ -214,7 +214,8 @@ def plan_frame(units: LodUnits, camera: Camera, viewport: tuple[int, int], setti
     distances = np.linalg.norm(centres - eye, axis=1)
     cloud_keys = lighting_key if isinstance(lighting_key, tuple) else (lighting_key,) * sum(map(len, units.members))
     keys = tuple(tuple(cloud_keys[c] for c in members) for members in units.members)
-    ring = plan_ring(state.ring, centres, radii, eye, settings, keys, units.members)
+    ring = plan_ring(state.ring, centres, radii, eye, settings, keys, units.members,
+                     segment_texture_size(height, camera.fov_y_deg, settings))
     records = state.records
     next_records = {members: record for members, record in records.items() if members in set(units.members)}
     object_centres = np.array([o.centre for o in objects], dtype=np.float64).reshape(-1, 3)

@@ -4,8 +4,9 @@ Clouds wholly beyond the ring radius (horizontally) and within the ring's
 elevation band are rendered, from the eye at which the ring was made, into
 eight textures of 45 degrees each; the panels form an octagon at the ring
 radius.  The ring is remade when the eye has moved more than a fraction of
-the radius (15% horizontally, 2% vertically, as in the paper) or the lights
-changed: one segment a frame, then the new ring crossfades in over a few
+the radius (15% horizontally, 2% vertically, as in the paper), the lights
+changed, or the screen now asks for finer (or far coarser) segment textures
+than the ring was made with (a window grown from its first, tiny frame): one segment a frame, then the new ring crossfades in over a few
 frames while the old one fades out.  Pure numpy; the GL side renders what
 `RingPlan` says.
 """
@@ -19,6 +20,7 @@ from typing import Hashable
 import numpy as np
 
 from cloudcore.camera import camera_pose, frustum_planes, projection_matrix, spheres_in_frustum, view_matrix
+from cloudcore.impostors import SHRINK_FACTOR, required_size
 from cloudcore.scene import Camera
 from cloudcore.settings import RenderSettings
 
@@ -37,6 +39,7 @@ class RingGeneration:
     lighting_key: Hashable  # its members' lighting keys when it was made
     members: frozenset  # the ids of the clouds (or units) it holds (`plan_ring`'s `ids`)
     segment_members: tuple  # SEGMENTS tuples of member ids
+    texture_size: tuple = (0, 0)  # (width, height) of its segment textures
 
     @property
     def occupied_segments(self) -> tuple[int, ...]:
@@ -104,11 +107,21 @@ def ring_members(centres: np.ndarray, radii: np.ndarray, eye, settings: RenderSe
         elevation + np.nan_to_num(angular_radius, nan=90.0) <= settings.ring_elevation_deg)
 
 
-def new_generation(centres, radii, eye, settings: RenderSettings, keys: dict, ids: tuple) -> RingGeneration:
+def segment_texture_size(viewport_height: int, fov_y_deg: float, settings: RenderSettings) -> tuple[int, int]:
+    """(width, height) of a ring segment texture: the screen's pixel density over 45 x 2 elevation degrees."""
+    pixels_per_tangent = viewport_height / (2.0 * math.tan(math.radians(fov_y_deg) / 2.0))
+    width = 2.0 * math.tan(math.radians(SEGMENT_DEG / 2.0)) * pixels_per_tangent
+    height = 2.0 * math.tan(math.radians(settings.ring_elevation_deg)) * pixels_per_tangent
+    return (required_size(width, settings.impostor_min_size, settings.impostor_max_size),
+            required_size(height, settings.impostor_min_size, settings.impostor_max_size))
+
+
+def new_generation(centres, radii, eye, settings: RenderSettings, keys: dict, ids: tuple,
+                   texture_size: tuple = (0, 0)) -> RingGeneration:
     in_ring = ring_members(centres, radii, eye, settings)
     members = frozenset(ids[i] for i in np.flatnonzero(in_ring))
     generation = RingGeneration(tuple(float(v) for v in eye), float(settings.ring_radius),
-                                _members_key(members, keys), members, ())
+                                _members_key(members, keys), members, (), tuple(texture_size))
     per_segment = []
     for segment in range(SEGMENTS):
         view, projection = segment_camera(generation, segment, settings.ring_elevation_deg)
@@ -123,33 +136,42 @@ def _members_key(members: frozenset, keys: dict) -> tuple:
     return tuple((member, keys.get(member)) for member in sorted(members))
 
 
-def _needs_rebuild(generation: RingGeneration, eye, settings: RenderSettings, keys: dict) -> bool:
+def _wrong_size(generation: RingGeneration, texture_size: tuple) -> bool:
+    """The screen asks for finer segment textures than the generation has, or for far coarser ones."""
+    return any(held < wanted or held >= SHRINK_FACTOR * wanted
+               for held, wanted in zip(generation.texture_size, texture_size))
+
+
+def _needs_rebuild(generation: RingGeneration, eye, settings: RenderSettings, keys: dict,
+                   texture_size: tuple) -> bool:
     moved = np.asarray(eye, dtype=np.float64) - np.asarray(generation.eye)
     return (generation.lighting_key != _members_key(generation.members, keys)
+            or _wrong_size(generation, texture_size)
             or generation.radius != settings.ring_radius
             or math.hypot(moved[0], moved[2]) > settings.ring_rebuild_horizontal * settings.ring_radius
             or abs(moved[1]) > settings.ring_rebuild_vertical * settings.ring_radius)
 
 
 def plan_ring(state: RingState, centres, radii, eye, settings: RenderSettings, lighting_keys: tuple,
-              ids: tuple | None = None) -> RingPlan | None:
+              ids: tuple | None = None, texture_size: tuple = (0, 0)) -> RingPlan | None:
     """Advance the ring by one frame: start a rebuild if needed, build one segment or step the fade.
 
     `lighting_keys` has one key per sphere, `ids` one identity (by default its index): the ring
     holds ids, so a scene whose spheres are renumbered (clouds regrouped, one removed) does not
-    mistake one cloud for another.  A ring being built when its members' keys change
+    mistake one cloud for another.  `texture_size` is the segment texture size the screen asks for
+    (`segment_texture_size`).  A ring being built when its members' keys change
     is finished first and rebuilt after: a cloud forming in the ring, whose key changes every
     frame, would otherwise keep the ring from ever completing.
     """
     if not settings.uses_ring:
         return None
     current, pending, built, fade_step = state.current, state.pending, state.built, state.fade_step
-    if pending is not None and pending.radius != settings.ring_radius:
+    if pending is not None and (pending.radius != settings.ring_radius or _wrong_size(pending, texture_size)):
         pending = None  # the ring it was being built for is gone: start again
     ids = tuple(range(len(radii))) if ids is None else ids
     keys = dict(zip(ids, lighting_keys))
-    if pending is None and (current is None or _needs_rebuild(current, eye, settings, keys)):
-        pending, built, fade_step = new_generation(centres, radii, eye, settings, keys, ids), 0, 0
+    if pending is None and (current is None or _needs_rebuild(current, eye, settings, keys, texture_size)):
+        pending, built, fade_step = new_generation(centres, radii, eye, settings, keys, ids, texture_size), 0, 0
     build_segment = None
     if pending is not None:
         if built < SEGMENTS:

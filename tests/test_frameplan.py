@@ -384,6 +384,23 @@ def test_the_ring_is_rebuilt_after_15_percent_across_or_2_percent_up(move, rebui
     assert (moved[0].ring.build_segment == 0) is rebuilds
 
 
+def test_a_window_grown_from_a_tiny_first_frame_rebuilds_the_ring_at_the_new_resolution():
+    """The editor's first frame has a tiny viewport: a ring built then has 16-texel panels, and must not
+    stay so once the window has its size (issue 17's blurred smudges and seam)."""
+    units = units_of(FAR_CLOUDS, (RADIUS,) * len(FAR_CLOUDS))
+    camera = camera_at((0.0, 100.0, 0.0), look_at=(0.0, 100.0, -1.0))
+    state = LodState()
+    for _ in range(SEGMENTS + RING.ring_fade_frames + 1):
+        state = plan_frame(units, camera, (32, 24), RING, state, 1).state
+    assert state.ring.current.texture_size == (20, 28)
+    grown = plan_frame(units, camera, VIEWPORT, RING, state, 1)
+    assert grown.ring.build_segment == 0 and grown.ring_state.pending.texture_size == (364, 512)
+    # a steady size, once built, keeps its ring
+    for _ in range(SEGMENTS + RING.ring_fade_frames + 1):
+        grown = plan_frame(units, camera, VIEWPORT, RING, grown.state, 1)
+    assert grown.ring.build_segment is None and grown.ring_state.current.texture_size == (364, 512)
+
+
 def test_a_sun_change_rebuilds_the_ring():
     _, state = run_ring((0.0, 100.0, 0.0), SEGMENTS + RING.ring_fade_frames + 1)
     relit, _ = run_ring((0.0, 100.0, 0.0), 1, state, lighting=2)

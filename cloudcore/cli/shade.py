@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import time
 
-import numpy as np
 from tqdm import tqdm
 
 from cloudcore.cli.render import add_scene_argument

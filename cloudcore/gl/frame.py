@@ -137,8 +137,7 @@ class FrameRenderer:
             self._objects.draw(self.context, camera, poses, plan.objects_with_world, write_depth=True)
         GL.glFinish()
         world_done = time.perf_counter()
-        rendered = self._impostors.update(plan, self._units, particles, self.size, camera.fov_y_deg, settings,
-                                          time_s)
+        rendered = self._impostors.update(plan, self._units, particles, settings, time_s)
         GL.glFinish()
         updates_done = time.perf_counter()
         self.context.bind_target()

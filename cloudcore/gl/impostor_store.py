@@ -12,8 +12,6 @@ depth range seen from the impostor's eye.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from cloudcore.eye_scattering import ParticleShading
@@ -21,9 +19,9 @@ from cloudcore.frameplan import FramePlan
 from cloudcore.gl.splats import SplatPass, splat_batch
 from cloudcore.gl.targets import TextureTarget
 from cloudcore.gl.texture_pool import TexturePool
-from cloudcore.impostors import ImpostorView, cropped_corners, impostor_view, particle_extent, required_size
+from cloudcore.impostors import ImpostorView, cropped_corners, impostor_view, particle_extent
 from cloudcore.lod_units import LodUnits
-from cloudcore.ring import SEGMENT_DEG, RingGeneration, panel_corners, segment_camera
+from cloudcore.ring import RingGeneration, panel_corners, segment_camera
 from cloudcore.settings import RenderSettings
 from cloudcore.splitting import layer_bounds
 
@@ -36,10 +34,9 @@ class ImpostorStore:
         #: the textures its particles can cover: only that part of the quad is drawn)
         self._clouds: dict[tuple, tuple[list[TextureTarget], ImpostorView, tuple]] = {}
         self._ring: dict[tuple[RingGeneration, int], tuple[TextureTarget, tuple]] = {}  # (texture, extent)
-        self._ring_sizes: dict[RingGeneration, tuple[int, int]] = {}
 
-    def update(self, plan: FramePlan, units: LodUnits, particles: ParticleShading, viewport, fov_y_deg: float,
-               settings: RenderSettings, time_s: float) -> int:
+    def update(self, plan: FramePlan, units: LodUnits, particles: ParticleShading, settings: RenderSettings,
+               time_s: float) -> int:
         """Render this frame's regenerations and ring segment at scene time `time_s`; returns the particles rendered."""
         rendered = 0
         for cloud in plan.clouds:
@@ -60,7 +57,7 @@ class ImpostorStore:
         ring = plan.ring
         if ring is not None and ring.build_segment in (ring.state.pending.occupied_segments if ring.state.pending else ()):
             generation, segment = ring.state.pending, ring.build_segment
-            size = self._ring_sizes.setdefault(generation, _ring_texture_size(viewport, fov_y_deg, settings))
+            size = generation.texture_size
             target = self.pool.acquire(*size)
             view, projection = segment_camera(generation, segment, settings.ring_elevation_deg)
             clouds = [cloud for unit in generation.segment_members[segment] for cloud in unit]
@@ -69,8 +66,6 @@ class ImpostorStore:
         live = {plan.ring_state.current, plan.ring_state.pending}
         for key in [key for key in self._ring if key[0] not in live]:
             self.pool.release(self._ring.pop(key)[0])
-        for generation in set(self._ring_sizes) - live:
-            del self._ring_sizes[generation]
         return rendered
 
     def cloud_impostor(self, members: tuple, layer: int = 0) -> tuple[TextureTarget, np.ndarray, tuple]:
@@ -120,12 +115,3 @@ def _extent(particles: ParticleShading, clouds, view, projection, size) -> tuple
     starts = particles.cloud_starts
     indices = np.concatenate([np.arange(starts[c], starts[c + 1]) for c in clouds]) if len(clouds) else []
     return particle_extent(view, projection, particles.centres[indices], particles.radii[indices], size)
-
-
-def _ring_texture_size(viewport, fov_y_deg: float, settings: RenderSettings) -> tuple[int, int]:
-    """(width, height) of a ring segment texture: the screen's pixel density over 45 x 2 elevation degrees."""
-    pixels_per_tangent = viewport[1] / (2.0 * math.tan(math.radians(fov_y_deg) / 2.0))
-    width = 2.0 * math.tan(math.radians(SEGMENT_DEG / 2.0)) * pixels_per_tangent
-    height = 2.0 * math.tan(math.radians(settings.ring_elevation_deg)) * pixels_per_tangent
-    return (required_size(width, settings.impostor_min_size, settings.impostor_max_size),
-            required_size(height, settings.impostor_min_size, settings.impostor_max_size))
