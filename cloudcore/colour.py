@@ -14,6 +14,27 @@ def srgb_encode(linear) -> np.ndarray:
     return np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1.0 / 2.4) - 0.055)
 
 
+#: the 4x4 ordered-dither (Bayer) matrix: each pixel's rounding threshold is (entry + 0.5) / 16
+BAYER_4 = np.array([[0, 8, 2, 10], [12, 4, 14, 6], [3, 11, 1, 9], [15, 7, 13, 5]], dtype=np.float64)
+
+
+def dither_thresholds(height: int, width: int) -> np.ndarray:
+    """(height, width) rounding thresholds in (0, 1), indexed as GL's gl_FragCoord is: row 0 of the
+    image (its top) is the frame's last row, so the editor's shader and this agree pixel for pixel."""
+    rows = (height - 1 - np.arange(height)) % 4
+    return (BAYER_4[rows][:, np.arange(width) % 4] + 0.5) / 16.0
+
+
 def linear_to_srgb8(linear) -> np.ndarray:
-    """Linear colour to 8-bit sRGB, after clamping to [0, 1]."""
-    return np.rint(srgb_encode(linear) * 255.0).astype(np.uint8)
+    """Linear colour (height, width, channels; top row first) to 8-bit sRGB, after clamping to [0, 1].
+
+    Dithered once, here at the 8-bit output (ordered, 4x4): a dark sky or a slow gradient spans
+    only a few sRGB levels, and rounding every pixel the same way bands it; a per-pixel threshold
+    keeps each 4x4 block's mean on the true value (within 1/32 of a level) for one level of noise.
+    Values on a level stay exactly on it.  shaders/present.frag.glsl does the same for the editor.
+    """
+    encoded = srgb_encode(linear) * 255.0
+    thresholds = dither_thresholds(*encoded.shape[:2])
+    if encoded.ndim == 3:
+        thresholds = thresholds[:, :, None]
+    return np.clip(np.floor(encoded + thresholds), 0.0, 255.0).astype(np.uint8)
