@@ -56,6 +56,14 @@ def small_scene() -> Scene:
     )
 
 
+def pytest_collection_modifyitems(items):
+    """Every test that asks for the shared renderer renders: marked `gl` (modules that render otherwise
+    say so themselves with `pytestmark`)."""
+    for item in items:
+        if "renderer" in getattr(item, "fixturenames", ()):
+            item.add_marker(pytest.mark.gl)
+
+
 def pytest_addoption(parser):
     parser.addoption("--regenerate-goldens", action="store_true",
                      help="rewrite tests/golden/*.png from the current renderer instead of comparing")

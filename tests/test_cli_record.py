@@ -13,6 +13,8 @@ import pytest
 from cloudcore.recording import COLUMNS
 from conftest import VALLEY
 
+pytestmark = pytest.mark.gl
+
 SIZE = ["--width", "64", "--height", "48"]
 
 

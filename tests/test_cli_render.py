@@ -10,6 +10,8 @@ import pytest
 
 from conftest import VALLEY
 
+pytestmark = pytest.mark.gl
+
 
 def run_cli(*args):
     return subprocess.run([sys.executable, "-m", "cloudcore.cli", *args], capture_output=True, text=True)

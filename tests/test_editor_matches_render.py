@@ -17,6 +17,8 @@ import pytest
 from cloudcore.imagecompare import compare
 from conftest import VALLEY
 
+pytestmark = pytest.mark.gui
+
 #: enough frames to build the ring of impostors (8 segments) and fade it in (8 more)
 FRAMES = 24
 #: the picture may differ only by the sRGB encoding's rounding (on the GPU in the editor, on the CPU

@@ -16,6 +16,8 @@ from cloudcore.cloudgen import cumulus
 from cloudcore.scene import Camera, CameraPath, Cloud, Lighting, Scene, Terrain
 from cloudcore.scenefile import save_scene
 
+pytestmark = pytest.mark.gui
+
 
 def small_editor_scene() -> Scene:
     clouds = tuple(Cloud(f"c{i}", cumulus((x, 900.0, z), (700.0, 350.0, 500.0), 250, 60.0, seed=i))

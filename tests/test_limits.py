@@ -22,6 +22,8 @@ from cloudcore.limits import DRAWN_TERRAIN_KINDS, MAX_FRAME_SIDE, MAX_LIGHTS, sc
 from cloudcore.scene import Cloud, Light, Lighting, Scene, Terrain
 from cloudcore.scenefile import load_scene
 
+pytestmark = pytest.mark.gl
+
 CLOUD = '[[clouds]]\nname = "c"\nparticles = [[0, 800, 0, 50], [100, 850, 0, 60]]\n'
 ARTIST_CLOUD = ('[[clouds]]\nname = "c"\nparticles = [[0, 800, 0, 50], [1e5, 850, 0, 60]]\n'
                 'shading_group_size = {size}\nartist = {{}}\n')

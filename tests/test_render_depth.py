@@ -10,6 +10,8 @@ from cloudcore.scene import Camera, Cloud, Lighting, Scene, Terrain
 from cloudcore.settings import FULL_3D, RenderSettings
 from cloudcore.terrain import height_at
 
+pytestmark = pytest.mark.gl
+
 TERRAIN = Terrain(size=(2000.0, 2000.0), resolution=65, height=600.0, seed=3)
 EYE = np.array([0.0, 120.0, 0.0])
 
