@@ -18,6 +18,7 @@ from imgui_bundle.imgui.test_engine_checks import CHECK
 
 from app.editor import discard_recovery, recovery_path
 from cloudcore.editing import add_cloud
+from cloudcore.navigation import orbited
 from cloudcore.overlays import to_pixels
 from cloudcore.paths import camera_on_path
 from cloudcore.scenefile import save_scene
@@ -341,12 +342,57 @@ def install(params, editor, viewport, panels, results_path: Path, outcome: dict)
         CHECK(panels.record_job is None and any(m.startswith("recorded: wrote 3 frames") for m in editor.messages))
         CHECK(video.exists() and imgui.get_frame_count() - started > 10)  # the editor kept drawing meanwhile
 
+    def a_click_within_one_frame_is_not_lost(ctx):
+        """At a low frame rate a press and its release reach Dear ImGui in one frame: raw mouse events, a whole
+        click on the Camera tab (behind Lighting, in the same tab bar) and then one on "Orbit left", are all
+        queued before a single new frame.  Dear ImGui's input queue trickling (io.config_input_trickle_event_queue,
+        on by default; the editor never turns it off) spreads them over frames, so the tab and the button each
+        see their click; without it the frame would see the button up again at the end and no click at all."""
+        io = imgui.get_io()
+        CHECK(io.config_input_trickle_event_queue)
+        use_window(ctx, "Camera")
+        button = ctx.item_info("Orbit left").rect_full
+        use_window(ctx, "Lighting")
+        camera_window = imgui.internal.find_window_by_name("Camera")
+        tab_bar = camera_window.dock_node.tab_bar
+        tab = ctx.item_info(te.TestRef(camera_window.tab_id)).rect_full
+        CHECK(tab_bar.selected_tab_id != camera_window.tab_id)
+        start = editor.camera
+        raw = int(te.TestRunFlags_.enable_raw_inputs)
+        ctx.run_flags = int(ctx.run_flags) | raw  # the test engine submits none of its simulated input meanwhile
+        ctx.yield_()
+        centre = {id(r): ((r.min.x + r.max.x) / 2, (r.min.y + r.max.y) / 2) for r in (tab, button)}
+        # the pointer rests on the tab first, as a real one does (a tab, like any item that allows overlap,
+        # takes a press only once it was hovered the frame before); then both whole clicks come in one frame
+        io.add_mouse_pos_event(*centre[id(tab)])
+        ctx.yield_()
+        for rect in (tab, button):
+            io.add_mouse_pos_event(*centre[id(rect)])
+            io.add_mouse_button_event(0, True)
+            io.add_mouse_button_event(0, False)
+        selected_after = moved_after = None
+        for frame in range(1, 11):
+            ctx.yield_()
+            if selected_after is None and tab_bar.selected_tab_id == camera_window.tab_id:
+                selected_after = frame
+            if moved_after is None and editor.camera != start:
+                moved_after = frame
+        ctx.run_flags = int(ctx.run_flags) & ~raw
+        ctx.yield_(SETTLE)
+        outcome["click_within_one_frame"] = {"tab selected after frames": selected_after,
+                                             "camera orbited after frames": moved_after}
+        CHECK(selected_after is not None and camera_window.active)  # the Camera panel is the one drawn
+        CHECK(editor.camera == orbited(start, -panels.orbit_step_deg))  # one orbit, not none and not two
+        use_window(ctx, "Camera")
+        ctx.item_click("Reset to the scene's camera")
+
     tests = [place_particles_by_clicking, time_of_day_changes_the_picture, tolerance_drives_regeneration,
              save_and_reopen, malformed_scene_keeps_the_current_one, recovery_is_offered_and_restores_the_edits,
              place_on_the_cloud_surface,
              brush_stroke_is_one_undo_step, box_fill_adds_sprites, move_cloud_by_dragging,
              delete_key_and_statistics_toggle, heat_map_changes_the_picture, overlays_outline_impostors_and_the_ring,
-             playing_a_camera_path_moves_the_camera, recording_runs_in_the_background]
+             playing_a_camera_path_moves_the_camera, recording_runs_in_the_background,
+             a_click_within_one_frame_is_not_lost]
 
     def register():
         engine = hello_imgui.get_imgui_test_engine()

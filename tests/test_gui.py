@@ -52,7 +52,7 @@ def gui_results(tmp_path_factory):
                                   "brush_stroke_is_one_undo_step", "box_fill_adds_sprites", "move_cloud_by_dragging",
                                   "delete_key_and_statistics_toggle", "heat_map_changes_the_picture",
                                   "overlays_outline_impostors_and_the_ring", "playing_a_camera_path_moves_the_camera",
-                                  "recording_runs_in_the_background"])
+                                  "recording_runs_in_the_background", "a_click_within_one_frame_is_not_lost"])
 def test_gui(gui_results, name):
     result, report = gui_results
     assert report["tests"][name] == "success", report["logs"].get(name, "") + result.stdout[-2000:]
