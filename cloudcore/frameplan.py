@@ -85,7 +85,7 @@ class CloudPlan:
     splits: tuple = ()  # their distances from the eye: the layers' boundaries
     layer_counts: tuple = ()  # particles per layer, far to near (of the impostor's layers when textured)
     members: tuple = ()  # the clouds of the unit
-    full_ms: float = 0.0  # auto mode: predicted cost of full 3D this frame
+    full_ms: float = 0.0  # predicted cost of full 3D this frame (0 in impostor mode, which never draws it)
     impostor_ms: float = 0.0  # auto mode: predicted cost of the impostor per frame, its regeneration amortised
 
     @property
@@ -248,6 +248,17 @@ def plan_frame(units: LodUnits, camera: Camera, viewport: tuple[int, int], setti
         """Particles per layer seen from `from_eye`; the particles are looked at only when there are splits."""
         return layer_counts(particles_of(index), from_eye, splits) if splits else (0,)
 
+    def full_3d(index: int, radius: float, distance: float) -> Work:
+        """The unit drawn in full 3D: a ball of discs far off, splat by splat (clipped to the screen) near."""
+        if cloud_splats is None or distance >= NEAR_EXACT_RADII * radius:
+            return full_work(units.particle_counts[index], units.radius_squares[index], radius, distance, focal_px,
+                             screen_pixels)
+        splats = [cloud_splats(c) for c in units.members[index]]
+        fragments = screen_pixels * analytic_overdraw(np.concatenate([c for c, _ in splats]),
+                                                      np.concatenate([r for _, r in splats]), view, projection,
+                                                      NEAR_PLANE_M)
+        return Work(particles=units.particle_counts[index], fragments=fragments)
+
     representations = {}
     update_work, cloud_work = Work(), Work()
     clouds, wanted = [], []  # wanted: (index, priority, work) of the impostors past their tolerance
@@ -259,16 +270,10 @@ def plan_frame(units: LodUnits, camera: Camera, viewport: tuple[int, int], setti
                                     distance, members=members))
             continue
         inside, splits = split_at(index, eye)
-        if cloud_splats is not None and distance < NEAR_EXACT_RADII * radius:
-            splats = [cloud_splats(c) for c in members]
-            fragments = screen_pixels * analytic_overdraw(np.concatenate([c for c, _ in splats]),
-                                                          np.concatenate([r for _, r in splats]), view,
-                                                          projection, NEAR_PLANE_M)
-            full = Work(particles=units.particle_counts[index], fragments=fragments)
-        else:
-            full = full_work(units.particle_counts[index], units.radius_squares[index], radius, distance, focal_px,
-                             screen_pixels)
-        if settings.mode != "full" and distance < INSIDE_RADII * radius:
+        eye_inside = settings.mode != "full" and distance < INSIDE_RADII * radius
+        # impostor mode draws no unit in full 3D but the one the eye is in: nothing else to price
+        full = full_3d(index, radius, distance) if settings.mode != "impostor" or eye_inside else Work()
+        if eye_inside:
             clouds.append(CloudPlan(index, "inside", distance, full_weight=individual, split_objects=inside,
                                     splits=splits, layer_counts=counts(index, eye, splits), members=members))
             cloud_work += full.scaled(settings.inside_resolution_scale ** 2) + Work(quad_pixels=screen_pixels)

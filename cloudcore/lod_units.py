@@ -27,6 +27,8 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
+from cloudcore.scene import splats_bounding_sphere
+
 #: two splats interpenetrate when their centres are closer than this times the sum of their radii
 TOUCH_RADII = 0.5
 
@@ -42,9 +44,6 @@ class LodUnits:
     radius_squares: np.ndarray  # (units,) sum of the particles' squared radii, m^2: their splats' area
     finest_radii: np.ndarray  # (units,) metres: the finest detail in the unit (0: unknown)
 
-    def __len__(self) -> int:
-        return len(self.radii)
-
     @staticmethod
     def of_spheres(centres, radii, finest_radii=None, particle_counts=None, radius_squares=None) -> "LodUnits":
         """One unit per sphere (tests, and scenes planned without particles)."""
@@ -57,12 +56,6 @@ class LodUnits:
                         zeros if radius_squares is None else np.asarray(radius_squares, dtype=np.float64),
                         zeros if finest_radii is None else np.asarray(finest_radii, dtype=np.float64))
 
-    def unit_of_cloud(self) -> np.ndarray:
-        """(clouds,) the unit each cloud belongs to."""
-        owner = np.zeros(sum(len(m) for m in self.members), dtype=np.int64)
-        for unit, members in enumerate(self.members):
-            owner[list(members)] = unit
-        return owner
 
 
 def interpenetrating_groups(centres: np.ndarray, radii: np.ndarray, cloud_starts: np.ndarray,
@@ -110,7 +103,7 @@ def lod_units(particles, group: bool = True) -> LodUnits:
         if len(clouds) == 1:
             centre, radius = sphere_centres[clouds[0]], sphere_radii[clouds[0]]
         else:
-            centre, radius = enclosing_sphere(particles.centres[indices], particles.radii[indices])
+            centre, radius = splats_bounding_sphere(particles.centres[indices], particles.radii[indices])
         centres.append(centre)
         radii.append(radius)
         counts.append(len(indices))
@@ -120,11 +113,3 @@ def lod_units(particles, group: bool = True) -> LodUnits:
     return LodUnits(np.array(centres, dtype=np.float64).reshape(-1, 3), np.array(radii, dtype=np.float64),
                     members, np.array(counts, dtype=np.float64), np.array(squares, dtype=np.float64),
                     np.array(finest, dtype=np.float64))
-
-
-def enclosing_sphere(centres: np.ndarray, radii: np.ndarray) -> tuple[np.ndarray, float]:
-    """Centre of the splats' box and the radius that encloses every splat (as `Cloud.bounding_sphere`)."""
-    low = (centres - radii[:, None]).min(axis=0)
-    high = (centres + radii[:, None]).max(axis=0)
-    centre = 0.5 * (low + high)
-    return centre, float((np.linalg.norm(centres - centre, axis=1) + radii).max())

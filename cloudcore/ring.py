@@ -117,7 +117,7 @@ def segment_texture_size(viewport_height: int, fov_y_deg: float, settings: Rende
 
 
 def new_generation(centres, radii, eye, settings: RenderSettings, keys: dict, ids: tuple,
-                   texture_size: tuple = (0, 0)) -> RingGeneration:
+                   texture_size: tuple) -> RingGeneration:
     in_ring = ring_members(centres, radii, eye, settings)
     members = frozenset(ids[i] for i in np.flatnonzero(in_ring))
     generation = RingGeneration(tuple(float(v) for v in eye), float(settings.ring_radius),
@@ -153,10 +153,10 @@ def _needs_rebuild(generation: RingGeneration, eye, settings: RenderSettings, ke
 
 
 def plan_ring(state: RingState, centres, radii, eye, settings: RenderSettings, lighting_keys: tuple,
-              ids: tuple | None = None, texture_size: tuple = (0, 0)) -> RingPlan | None:
+              ids: tuple, texture_size: tuple) -> RingPlan | None:
     """Advance the ring by one frame: start a rebuild if needed, build one segment or step the fade.
 
-    `lighting_keys` has one key per sphere, `ids` one identity (by default its index): the ring
+    `lighting_keys` has one key per sphere, `ids` one identity (a unit's member clouds): the ring
     holds ids, so a scene whose spheres are renumbered (clouds regrouped, one removed) does not
     mistake one cloud for another.  `texture_size` is the segment texture size the screen asks for
     (`segment_texture_size`).  A ring being built when its members' keys change
@@ -168,7 +168,6 @@ def plan_ring(state: RingState, centres, radii, eye, settings: RenderSettings, l
     current, pending, built, fade_step = state.current, state.pending, state.built, state.fade_step
     if pending is not None and (pending.radius != settings.ring_radius or _wrong_size(pending, texture_size)):
         pending = None  # the ring it was being built for is gone: start again
-    ids = tuple(range(len(radii))) if ids is None else ids
     keys = dict(zip(ids, lighting_keys))
     if pending is None and (current is None or _needs_rebuild(current, eye, settings, keys, texture_size)):
         pending, built, fade_step = new_generation(centres, radii, eye, settings, keys, ids, texture_size), 0, 0

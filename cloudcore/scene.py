@@ -113,13 +113,17 @@ class Cloud(_Record):
 
     def bounding_sphere(self) -> tuple[np.ndarray, float]:
         """Centre of the particles' box and the radius that encloses every splat."""
-        if len(self.particles) == 0:
-            return np.zeros(3), 0.0
-        low = (self.centres - self.radii[:, None]).min(axis=0)
-        high = (self.centres + self.radii[:, None]).max(axis=0)
-        centre = 0.5 * (low + high)
-        reach = np.linalg.norm(self.centres - centre, axis=1) + self.radii
-        return centre, float(reach.max())
+        return splats_bounding_sphere(self.centres, self.radii)
+
+
+def splats_bounding_sphere(centres: np.ndarray, radii: np.ndarray) -> tuple[np.ndarray, float]:
+    """Centre of the splats' box and the radius that encloses every splat ((0, 0, 0), 0 for none)."""
+    if len(radii) == 0:
+        return np.zeros(3), 0.0
+    low = (centres - radii[:, None]).min(axis=0)
+    high = (centres + radii[:, None]).max(axis=0)
+    centre = 0.5 * (low + high)
+    return centre, float((np.linalg.norm(centres - centre, axis=1) + radii).max())
 
 
 @dataclass(frozen=True)
