@@ -15,7 +15,9 @@ whose particles interpenetrate, drawn as one; per unit one of
   GL side mixes the two premultiplied images linearly, so the opacity is
   right throughout);
 - ``inside``: the eye is in the cloud: a screen-sized impostor at reduced
-  resolution, redrawn every frame (Harris 3.1),
+  resolution, redrawn every frame (Harris 3.1); units the eye is in at once
+  that follow each other in `draw_items` share one (their particles sorted
+  together, one composite over the screen),
 
 and the `LodState` to carry into the next frame.  In auto mode the choice
 between full 3D and an impostor is by predicted cost within the tolerance:
@@ -41,7 +43,8 @@ from typing import Hashable, Mapping
 
 import numpy as np
 
-from cloudcore.camera import NEAR_PLANE_M, frustum_planes, projection_matrix, spheres_in_frustum, view_matrix
+from cloudcore.camera import (NEAR_PLANE_M, frustum_planes, projection_matrix, spheres_in_frustum, splats_in_frustum,
+                              view_matrix)
 from cloudcore.impostors import (INSIDE_RADII, TRANSLATION_METRICS, ImpostorRecord, budgeted_regenerations,
                                  detail_size_px, quad_half_side, regeneration_priority, regeneration_reason,
                                  required_size, screen_size_px, tolerance_deg_for)
@@ -249,15 +252,17 @@ def plan_frame(units: LodUnits, camera: Camera, viewport: tuple[int, int], setti
         return layer_counts(particles_of(index), from_eye, splits) if splits else (0,)
 
     def full_3d(index: int, radius: float, distance: float) -> Work:
-        """The unit drawn in full 3D: a ball of discs far off, splat by splat (clipped to the screen) near."""
+        """The unit drawn in full 3D: a ball of discs far off; near, splat by splat, only the splats in the
+        frustum (the renderer leaves out the rest), their discs clipped to the screen."""
         if cloud_splats is None or distance >= NEAR_EXACT_RADII * radius:
             return full_work(units.particle_counts[index], units.radius_squares[index], radius, distance, focal_px,
                              screen_pixels)
         splats = [cloud_splats(c) for c in units.members[index]]
-        fragments = screen_pixels * analytic_overdraw(np.concatenate([c for c, _ in splats]),
-                                                      np.concatenate([r for _, r in splats]), view, projection,
+        splat_centres, splat_radii = np.concatenate([c for c, _ in splats]), np.concatenate([r for _, r in splats])
+        seen = splats_in_frustum(planes, splat_centres, splat_radii)
+        fragments = screen_pixels * analytic_overdraw(splat_centres[seen], splat_radii[seen], view, projection,
                                                       NEAR_PLANE_M)
-        return Work(particles=units.particle_counts[index], fragments=fragments)
+        return Work(particles=float(np.count_nonzero(seen)), fragments=fragments)
 
     representations = {}
     update_work, cloud_work = Work(), Work()
@@ -276,7 +281,9 @@ def plan_frame(units: LodUnits, camera: Camera, viewport: tuple[int, int], setti
         if eye_inside:
             clouds.append(CloudPlan(index, "inside", distance, full_weight=individual, split_objects=inside,
                                     splits=splits, layer_counts=counts(index, eye, splits), members=members))
-            cloud_work += full.scaled(settings.inside_resolution_scale ** 2) + Work(quad_pixels=screen_pixels)
+            # a screen impostor has fewer fragments than the screen, not fewer particles; its composite
+            # over the screen is priced per run of inside units, below
+            cloud_work += dataclasses.replace(full, fragments=full.fragments * settings.inside_resolution_scale ** 2)
             continue
         if settings.mode == "full":
             clouds.append(CloudPlan(index, "full", distance, full_weight=1.0, split_objects=inside, splits=splits,
@@ -362,9 +369,11 @@ def plan_frame(units: LodUnits, camera: Camera, viewport: tuple[int, int], setti
                                 regenerations=float(bool(segment)))
     drawn = [c.index for c in clouds if c.kind in ("full", "crossfade", "impostor", "inside")]
     draw_order = tuple(sorted(drawn, key=lambda i: -distances[i]))
-    cloud_work += Work(batches=float(_full_runs([clouds[i].kind for i in draw_order])))
     inside_size = tuple(max(1, math.ceil(side * settings.inside_resolution_scale)) for side in viewport)
     items = _draw_items([clouds[i] for i in draw_order], radii, object_centres, objects_visible, eye)
+    screen_impostors = len(inside_runs(items, clouds))
+    cloud_work += Work(batches=float(_full_runs([clouds[i].kind for i in draw_order]) + screen_impostors),
+                       quad_pixels=screen_impostors * screen_pixels)
     between = {item.index for item in items if item.kind == "object"}
     with_world = tuple(i for i in range(len(object_radii)) if objects_visible[i] and i not in between)
     next_state = LodState(next_records, ring.state if ring is not None else RingState(), representations,
@@ -409,11 +418,30 @@ def _represent(previous: Representation | None, full_ms: float, impostor_ms: flo
     return Representation(target, weight)
 
 
+def inside_runs(items, clouds) -> list[list]:
+    """The draw items of units the eye is inside, in runs that share one screen impostor: consecutive in
+    the cloud pass and drawn at the same weight (nothing is drawn between them, so one sorted batch and
+    one composite give the picture of each drawn in turn, with their particles sorted together)."""
+    runs, previous = [], None
+    for item in items:
+        cloud = clouds[item.index] if item.kind == "cloud" else None
+        if cloud is None or cloud.kind != "inside":
+            previous = None
+            continue
+        if previous is not None and previous.full_weight == cloud.full_weight:
+            runs[-1].append(item)
+        else:
+            runs.append([item])
+        previous = cloud
+    return runs
+
+
 def _full_runs(kinds) -> int:
-    """Splat draws of the cloud pass: each run of consecutive full units is one, every other splatting kind one."""
+    """Splat draws of the cloud pass outside screen impostors: each run of consecutive full units is one,
+    each crossfading unit one."""
     runs, previous = 0, None
     for kind in kinds:
-        if kind in ("crossfade", "inside") or (kind == "full" and previous != "full"):
+        if kind == "crossfade" or (kind == "full" and previous != "full"):
             runs += 1
         previous = kind
     return runs

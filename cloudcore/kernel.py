@@ -13,6 +13,9 @@ import numpy as np
 #: exp(-SPLAT_SHARPNESS * d^2) with d = distance / radius; 4 puts the 1/e point at d = 0.5.
 SPLAT_SHARPNESS = 4.0
 _FLOOR = np.exp(-SPLAT_SHARPNESS)
+#: a billboard of side 2r reaches r sqrt(2) from its centre at the corners, however it faces: the radius
+#: of the sphere that bounds what a splat can cover
+SPLAT_REACH = float(np.sqrt(2.0))
 
 
 def splat_kernel(d) -> np.ndarray:

@@ -6,7 +6,8 @@ import math
 import numpy as np
 import pytest
 
-from cloudcore.frameplan import SWITCH_MARGIN, LodState, plan_frame
+from cloudcore.camera import frustum_planes, projection_matrix, splats_in_frustum, view_matrix
+from cloudcore.frameplan import SWITCH_MARGIN, LodState, inside_runs, plan_frame
 from cloudcore.impostors import impostor_view, parallax_error_deg, translation_error_deg
 from cloudcore.lod_costs import CostModel
 from cloudcore.lod_units import LodUnits
@@ -310,8 +311,42 @@ def test_a_cloud_out_of_view_costs_nothing():
 def test_the_eye_inside_a_cloud_gets_the_screen_impostor(position):
     cloud_plan = plan(camera_at(position, look_at=(0.0, 0.0, -500.0)))
     assert cloud_plan.clouds[0].kind == "inside" and cloud_plan.clouds[0].full_weight == 1.0
-    assert cloud_plan.inside_size == (160, 120)
+    assert cloud_plan.inside_size == (80, 60)
     assert cloud_plan.clouds[0].regenerate is None  # a screen impostor is redrawn every frame, not cached
+
+
+def test_units_the_eye_is_in_at_once_share_one_screen_impostor():
+    eye_in_both = camera_at((0.0, 0.0, 0.0), look_at=(0.0, 0.0, -500.0))
+    both = plan(eye_in_both, centres=((0.0, 0.0, 20.0), (0.0, 0.0, -30.0)), radii=(RADIUS, RADIUS))
+    assert [c.kind for c in both.clouds] == ["inside", "inside"]
+    assert [[item.index for item in run] for run in inside_runs(both.draw_items, both.clouds)] == [[1, 0]]
+    alone = plan(eye_in_both, centres=((0.0, 0.0, 20.0),), radii=(RADIUS,))
+    # one composite over the screen for the two, as for one
+    assert both.cloud_work.quad_pixels == alone.cloud_work.quad_pixels == VIEWPORT[0] * VIEWPORT[1]
+    assert both.cloud_work.batches == alone.cloud_work.batches == 1
+
+
+def test_an_impostor_drawn_between_two_units_the_eye_is_in_parts_their_screen_impostors():
+    eye = camera_at((0.0, 0.0, 0.0), look_at=(0.0, 0.0, -500.0))
+    parted = plan(eye, dataclasses.replace(NO_RING, mode="impostor"),
+                  centres=((0.0, 0.0, 10.0), (0.0, 0.0, -30.0), (0.0, 0.0, 60.0)), radii=(RADIUS, 5.0, RADIUS))
+    assert [c.kind for c in parted.clouds] == ["inside", "impostor", "inside"]
+    assert [[item.index for item in run] for run in inside_runs(parted.draw_items, parted.clouds)] == [[2], [0]]
+    assert parted.cloud_work.quad_pixels > 2 * VIEWPORT[0] * VIEWPORT[1]
+
+
+def test_full_3d_near_the_eye_counts_only_the_splats_in_the_frustum():
+    """Next to a unit, the renderer leaves out the splats behind the eye; the plan prices what it draws."""
+    rng = np.random.default_rng(3)
+    splat_centres = rng.uniform(-RADIUS, RADIUS, (1000, 3))
+    splat_radii = np.full(1000, 5.0)
+    eye = camera_at((0.0, 0.0, 0.0), look_at=(0.0, 0.0, -500.0))
+    units = units_of([(0.0, 0.0, 0.0)], [RADIUS])
+    seen = splats_in_frustum(frustum_planes(projection_matrix(60.0, VIEWPORT[0] / VIEWPORT[1]) @ view_matrix(eye)),
+                             splat_centres, splat_radii)
+    full = plan_frame(units, eye, VIEWPORT, dataclasses.replace(NO_RING, mode="full"), LodState(), 1,
+                      cloud_splats=lambda cloud: (splat_centres, splat_radii))
+    assert full.cloud_work.particles == np.count_nonzero(seen) < 400
 
 
 def test_a_cloud_without_particles_is_planned_as_empty():

@@ -136,3 +136,31 @@ def test_a_sprite_the_eye_stands_in_keeps_its_facing_and_fades_as_the_eye_circle
     assert seen[0] > 10.0, seen  # locked at first sight, in full view
     assert all(later <= earlier + 0.5 for earlier, later in zip(seen, seen[1:])), seen
     assert seen[9] < 0.5 and seen[-1] < 0.5, seen  # edge-on at 90 degrees and beyond: gone
+
+
+def test_splats_left_out_by_the_frustum_change_no_pixel(renderer):
+    """A cloud around the eye: most of its splats are behind it or off screen, and leaving them out is exact."""
+    from cloudcore.camera import frustum_planes, splats_in_frustum
+    from cloudcore.gl.splats import SplatPass, splat_batch
+    from cloudcore.gl.targets import TextureTarget
+
+    rng = np.random.default_rng(5)
+    around = np.column_stack([rng.uniform(-300.0, 300.0, (2000, 3)), rng.uniform(4.0, 40.0, 2000)])
+    particles = ParticleShading((Cloud("around the eye", around, optical_depth=1.0),), Shading(), LIGHTS, AMBIENT)
+    view, projection = view_matrix(CAMERA), projection_matrix(CAMERA.fov_y_deg, WIDTH / HEIGHT)
+    frustum = frustum_planes(projection @ view)
+    renderer.context.make_current()
+    splats, target = SplatPass(), TextureTarget(WIDTH, HEIGHT)
+    try:
+        pictures = []
+        for planes in (None, frustum):
+            target.bind_cleared()
+            batch = splat_batch(particles, [0], CAMERA.position, frustum=planes)
+            splats.draw(batch, view, projection, depth_test=False)
+            pictures.append((len(batch), target.read()))
+    finally:
+        splats.close()
+        target.close()
+    (every, everything), (culled, in_view) = pictures
+    assert culled == np.count_nonzero(splats_in_frustum(frustum, around[:, :3], around[:, 3])) < every / 3
+    assert np.array_equal(everything, in_view)

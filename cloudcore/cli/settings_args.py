@@ -19,7 +19,7 @@ SWEEPABLE = {"tolerance": ("tolerance_deg", float), "ring_radius": ("ring_radius
              "regeneration_budget": ("regeneration_budget", int), "mode": ("mode", str),
              "metric": ("translation_metric", str), "tolerance_px": ("tolerance_px", float),
              "transition_frames": ("transition_frames", int), "frame_budget": ("frame_budget_ms", float),
-             "group_clouds": ("group_clouds", _boolean)}
+             "group_clouds": ("group_clouds", _boolean), "inside_resolution": ("inside_resolution_scale", float)}
 
 
 def add_settings_arguments(parser, default_mode: str = "auto") -> None:

@@ -28,13 +28,13 @@ import time
 import numpy as np
 from OpenGL import GL
 
-from cloudcore.camera import NEAR_PLANE_M, projection_matrix, view_matrix
+from cloudcore.camera import NEAR_PLANE_M, frustum_planes, projection_matrix, view_matrix
 from cloudcore.colour import linear_to_srgb8
 from cloudcore.eye_scattering import ParticleShading
 from cloudcore.facing import CloudFacings
 from cloudcore.formation import formation_state
 from cloudcore.illumination import IlluminationCache
-from cloudcore.frameplan import FramePlan, LodState, plan_frame
+from cloudcore.frameplan import FramePlan, LodState, inside_runs, plan_frame
 from cloudcore.gl.context import HeadlessContext, WindowContext, check_frame_size
 from cloudcore.gl.impostor_store import ImpostorStore
 from cloudcore.gl.objects import ObjectPass
@@ -242,11 +242,12 @@ class FrameRenderer:
         """Execute the plan's cloud pass into the frame target at scene time `time_s`; returns the particles drawn."""
         eye = camera.position
         view_projection = projection @ view
+        frustum = frustum_planes(view_projection)
         self._replay, self._screen_batches = [], []
         drawn = 0
 
         def draw_splats(clouds, depth_ranges) -> int:
-            batch = splat_batch(particles, clouds, eye, depth_ranges, time_s)
+            batch = splat_batch(particles, clouds, eye, depth_ranges, time_s, frustum)
             self._splats.draw(batch, view, projection)
             self._replay.append(lambda: self._splats.draw(batch, view, projection, counting=True))
             self._screen_batches.append(batch)
@@ -268,6 +269,8 @@ class FrameRenderer:
                     draw_quad(corners, target.texture, weight, uv_rect=extent)
 
         full_run = []  # (cloud, (near, far)) of consecutive full-3D layers: they interpenetrate, sorted together
+        # units the eye is in, one after the other: one screen impostor, drawn where the run starts
+        screen_impostors = {id(run[0]): run for run in inside_runs(plan.draw_items, plan.clouds)}
         for item in plan.draw_items:
             cloud = plan.clouds[item.index] if item.kind == "cloud" else None
             if cloud is not None and cloud.kind == "full":
@@ -289,11 +292,13 @@ class FrameRenderer:
                 self.context.bind_target()
                 draw_quad(corners, target.texture, cloud.impostor_weight, uv_rect=extent,
                           layer_texture=layer.texture, layer_weight=cloud.full_weight)
-            elif cloud.kind == "inside":
+            elif cloud.kind == "inside" and id(item) in screen_impostors:
                 target = self._inside_target(plan.inside_size)
                 target.bind_cleared()
-                batch = splat_batch(particles, cloud.members, eye, [(item.near, item.far)] * len(cloud.members),
-                                    time_s)
+                members, depth_ranges = zip(*[(member, (run_item.near, run_item.far))
+                                              for run_item in screen_impostors[id(item)]
+                                              for member in plan.clouds[run_item.index].members])
+                batch = splat_batch(particles, members, eye, depth_ranges, time_s, frustum)
                 self._splats.draw(batch, view, projection)
                 drawn += len(batch)
                 self.context.bind_target()

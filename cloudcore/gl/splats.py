@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 from OpenGL import GL
 
+from cloudcore.camera import splats_in_frustum
 from cloudcore.depth_order import far_to_near
 from cloudcore.eye_scattering import FADE_END_RADII, FADE_START_RADII, ParticleShading
 from cloudcore.facing import FacingState
@@ -70,12 +71,14 @@ class SplatBatch:
         return self.particles.radii[self.order]
 
 
-def splat_batch(particles: ParticleShading, clouds, eye, depth_ranges=None, time_s: float | None = None) -> SplatBatch:
+def splat_batch(particles: ParticleShading, clouds, eye, depth_ranges=None, time_s: float | None = None,
+                frustum: np.ndarray | None = None) -> SplatBatch:
     """The visible particles of `clouds` (indices), sorted far to near from `eye`.
 
     `depth_ranges`, one (near, far) per cloud, keeps only the particles with
     near < distance from `eye` <= far: one layer of a cloud split around objects.
     `time_s`, the scene clock, fades forming and dissipating clouds (`ParticleShading.seen_from`).
+    `frustum`, the draw's planes (`cloudcore.camera.frustum_planes`), leaves out the splats outside it.
     """
     starts = particles.cloud_starts
     ranges = [np.arange(starts[c], starts[c + 1]) for c in clouds]
@@ -88,6 +91,8 @@ def splat_batch(particles: ParticleShading, clouds, eye, depth_ranges=None, time
         near = np.repeat([r[0] for r in depth_ranges], [len(r) for r in ranges])
         far = np.repeat([r[1] for r in depth_ranges], [len(r) for r in ranges])
         kept &= (distances > near) & (distances <= far)
+    if frustum is not None:
+        kept &= splats_in_frustum(frustum, particles.centres[indices], particles.radii[indices])
     indices, distances = indices[kept], distances[kept]
     return SplatBatch(particles, indices[far_to_near(distances)].astype(np.uint32), eye, time_s)
 
