@@ -21,11 +21,15 @@ from cloudcore.editing import History, delete_cloud, delete_particles
 from cloudcore.errors import SceneError
 from cloudcore.limits import scene_limit_problems
 from cloudcore.paths import camera_on_path
-from cloudcore.scene import Camera, Scene
+from cloudcore.scene import Camera, Lighting, Scene, Shading
 from cloudcore.scenefile import load_scene, particles_folder, save_scene
 from cloudcore.settings import RenderSettings
 
 AUTOSAVE_SECONDS = 60.0
+#: the editor's frame budget (`RenderSettings.frame_budget_ms`), the LOD panel's starting value: a new
+#: time of day or shading makes every impostor stale, and remaking the default view's 17 in one frame
+#: would hold the window for 150 ms or more; within the budget they follow over a few frames
+EDITOR_FRAME_BUDGET_MS = 40.0
 RECENT_LIMIT = 8
 #: what a left press in the viewport does, by name: (key, label)
 TOOLS = (("place", "Place"), ("brush", "Brush"), ("move_cloud", "Move cloud"), ("move_particle", "Move particle"))
@@ -47,7 +51,10 @@ class Editor:
         self.history = History(scene)
         self.path = path
         self.saved_scene = scene
-        self.settings = RenderSettings()
+        self.settings = RenderSettings(frame_budget_ms=EDITOR_FRAME_BUDGET_MS)
+        #: while a lighting or shading slider is dragged, the (shading, lighting) it would give: the viewport
+        #: shows them live; the history gets the value once, on release.  None: the scene's own
+        self.dragged_look: tuple[Shading, Lighting] | None = None
         self.camera: Camera = scene.camera
         #: the scene clock the objects move by (seconds, in their path keys' time)
         self.scene_time_s = 0.0
@@ -112,6 +119,11 @@ class Editor:
     @property
     def dirty(self) -> bool:
         return self.scene is not self.saved_scene
+
+    @property
+    def look(self) -> tuple[Shading, Lighting]:
+        """The (shading, lighting) to show: a dragged slider's, else the scene's."""
+        return self.dragged_look if self.dragged_look is not None else (self.scene.shading, self.scene.lighting)
 
     @property
     def time_of_day(self) -> float | None:

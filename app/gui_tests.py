@@ -27,7 +27,8 @@ from cloudcore.scenefile import save_scene
 SETTLE = 4
 
 
-def install(params, editor, viewport, panels, results_path: Path, outcome: dict) -> None:
+def install(params, editor, viewport, panels, results_path: Path, outcome: dict, only=None) -> None:
+    """Register the GUI tests (those named in `only`, if given) to run in the editor, then exit."""
     registered: list = []
 
     def capture(ctx) -> np.ndarray:
@@ -83,18 +84,67 @@ def install(params, editor, viewport, panels, results_path: Path, outcome: dict)
         ctx.item_click("Redo")
         CHECK(editor.scene.particle_count == before + 1)
 
+    def relit(ctx, frames: int = 600) -> None:
+        """Yield until the viewport shows the scene's own lighting, exactly shaded (the worker has it)."""
+        for _ in range(frames):
+            stats = editor.last_stats
+            if (not stats.get("relighting") and stats.get("shown_illumination") == "exact"
+                    and stats.get("shown_time_of_day") == editor.time_of_day):
+                ctx.yield_(SETTLE)  # the impostors follow within the frame budget
+                return
+            ctx.yield_()
+        CHECK(False)
+
     def time_of_day_changes_the_picture(ctx):
         use_window(ctx, "Lighting")
         ctx.item_input_value("Time of day", 12.0)
-        ctx.yield_(SETTLE)
+        relit(ctx)
         noon = capture(ctx)
         ctx.item_input_value("Time of day", 19.0)
         CHECK(abs(editor.time_of_day - 19.0) < 1e-3)
-        ctx.yield_(SETTLE)
+        relit(ctx)
         evening = capture(ctx)
         changed = (np.abs(noon.astype(int) - evening.astype(int)).max(axis=2) > 20).mean()
         outcome["time_of_day_changed_fraction"] = float(changed)
         CHECK(bool(changed > 0.3))  # the sky and the clouds both change
+
+    def dragging_the_time_of_day_relights_live(ctx):
+        """The viewport follows the slider while it moves, shaded in the worker; exact once let go."""
+        use_window(ctx, "Lighting")
+        ctx.item_input_value("Time of day", 9.0)
+        relit(ctx)
+        slider = ctx.item_info("Time of day").rect_full
+        middle_y = 0.5 * (slider.min.y + slider.max.y)
+
+        def at(hours: float) -> imgui.ImVec2:
+            return imgui.ImVec2(slider.min.x + (slider.max.x - slider.min.x) * hours / 24.0, middle_y)
+
+        ctx.mouse_move_to_pos(at(9.0))
+        ctx.mouse_down(0)
+        first = len(editor.frame_times)
+        started = time.perf_counter()
+        steps = max(20, int(slider.max.x - slider.min.x) // 4)  # 9 to 15 hours: a pixel and more a frame
+        for step in range(1, steps + 1):
+            ctx.mouse_teleport_to_pos(at(9.0 + 6.0 * step / steps))
+            ctx.yield_()
+        ctx.mouse_up(0)
+        dragged_s = time.perf_counter() - started
+        during = [stats for stats in list(editor.frame_times)[first:]]
+        shown = [stats["shown_time_of_day"] for stats in during]
+        relit_looks = len({hours for hours in shown}) - 1  # the looks shown after the first
+        gaps_ms = [1e3 * (b["frame_start_s"] - a["frame_start_s"]) for a, b in zip(during, during[1:])]
+        outcome["live_time_of_day"] = {
+            "drag_s": dragged_s, "frames": len(during), "relit_looks": relit_looks,
+            "relit_looks_per_s": relit_looks / dragged_s, "longest_frame_gap_ms": max(gaps_ms, default=0.0),
+            "median_frame_gap_ms": float(np.median(gaps_ms)) if gaps_ms else 0.0,
+            "shading_ms_on_the_gui_thread_max": max(stats["illumination_ms"] for stats in during)}
+        CHECK(relit_looks >= 3)  # the view followed the drag, not just its end
+        CHECK(all(stats["shown_illumination"] in ("preview", "exact") for stats in during))
+        # nothing like the exact light pass (about 2 s) ran where the GUI runs
+        CHECK(max(gaps_ms, default=0.0) < 1000.0)
+        relit(ctx)  # the released hour, exactly
+        outcome["live_time_of_day"]["released_hour"] = editor.time_of_day
+        CHECK(editor.time_of_day > 13.0)  # the drag moved the slider most of the way (the grab's padding aside)
 
     def tolerance_drives_regeneration(ctx):
         use_window(ctx, "LOD")
@@ -386,13 +436,18 @@ def install(params, editor, viewport, panels, results_path: Path, outcome: dict)
         use_window(ctx, "Camera")
         ctx.item_click("Reset to the scene's camera")
 
-    tests = [place_particles_by_clicking, time_of_day_changes_the_picture, tolerance_drives_regeneration,
+    tests = [place_particles_by_clicking, time_of_day_changes_the_picture, dragging_the_time_of_day_relights_live,
+             tolerance_drives_regeneration,
              save_and_reopen, malformed_scene_keeps_the_current_one, recovery_is_offered_and_restores_the_edits,
              place_on_the_cloud_surface,
              brush_stroke_is_one_undo_step, box_fill_adds_sprites, move_cloud_by_dragging,
              delete_key_and_statistics_toggle, heat_map_changes_the_picture, overlays_outline_impostors_and_the_ring,
              playing_a_camera_path_moves_the_camera, recording_runs_in_the_background,
              a_click_within_one_frame_is_not_lost]
+
+    unknown = sorted(set(only or ()) - {function.__name__ for function in tests})
+    if unknown:
+        raise SystemExit(f"cloudview: error: --tests: no GUI test named {', '.join(unknown)}")
 
     def register():
         engine = hello_imgui.get_imgui_test_engine()
@@ -402,6 +457,8 @@ def install(params, editor, viewport, panels, results_path: Path, outcome: dict)
         io.config_saved_settings = False
         io.config_watchdog_kill_test = 120.0
         for function in tests:
+            if only is not None and function.__name__ not in only:
+                continue
             test = te.register_test(engine, "editor", function.__name__)
             test.test_func = function
             registered.append((function.__name__, test))

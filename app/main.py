@@ -1,6 +1,6 @@
 """The editor's window: hello_imgui with a docking layout, the viewport and the panels.
 
-    python -m app [SCENE] [--window-size WIDTHxHEIGHT] [--self-test RESULTS.json]
+    python -m app [SCENE] [--window-size WIDTHxHEIGHT] [--self-test RESULTS.json [--tests NAME,...]]
     python -m app [SCENE] --frames N [--screenshot PNG] [--window-screenshot PNG] [--frame-stats JSON]
 
 The docking layout is remembered between runs (hello_imgui's settings file in
@@ -108,6 +108,7 @@ def main(argv=None) -> int:
                         help="the window's size in pixels (default 1280x800)")
     parser.add_argument("--self-test", type=Path, metavar="RESULTS.json",
                         help="run the GUI tests with the Dear ImGui Test Engine, write results, exit")
+    parser.add_argument("--tests", metavar="NAME,...", help="with --self-test: run only these GUI tests")
     parser.add_argument("--frames", type=int, help="quit after this many frames")
     parser.add_argument("--screenshot", type=Path,
                         help="with --frames: save the viewport's last picture here (PNG, the viewport's size)")
@@ -128,7 +129,8 @@ def main(argv=None) -> int:
     if args.self_test is not None:
         from app.gui_tests import install
 
-        install(params, editor, viewport, panels, args.self_test, outcome)
+        install(params, editor, viewport, panels, args.self_test, outcome,
+                only=None if args.tests is None else args.tests.split(","))
     if args.frames is not None:
         _quit_after(params, args.frames, editor, viewport, outcome)
     immapp.run(params, immapp.AddOnsParams(with_implot=True))

@@ -20,6 +20,10 @@ from cloudcore.navigation import orbited
 from cloudcore.phase import PHASE_NAMES
 from cloudcore.settings import MODES, TRANSLATION_METRICS
 
+#: the Lighting panel's shading sliders: label -> (`Shading` field, low, high)
+_SHADING_SLIDERS = {"Albedo": ("albedo", 0.0, 1.0), "Optical depth": ("optical_depth", 0.0, 50.0),
+                    "g": ("g", -0.99, 0.99)}
+
 
 class Panels:
     def __init__(self, editor: Editor, viewport: Viewport):
@@ -208,9 +212,16 @@ class Panels:
         if hours is not None:
             editor.set_time_of_day(hours)
         shading = scene.shading
-        changes = {"albedo": self._slider_on_release("Albedo", shading.albedo, 0.0, 1.0),
-                   "optical_depth": self._slider_on_release("Optical depth", shading.optical_depth, 0.0, 50.0),
-                   "g": self._slider_on_release("g", shading.g, -0.99, 0.99)}
+        changes = {field: self._slider_on_release(label, getattr(shading, field), low, high)
+                   for label, (field, low, high) in _SHADING_SLIDERS.items()}
+        # the viewport follows a slider being dragged (`cloudcore.relighting`); the edit is made on release
+        dragged = {field: self._dragging[label] for label, (field, _, _) in _SHADING_SLIDERS.items()
+                   if label in self._dragging}
+        dragged_hours = self._dragging.get("Time of day")
+        editor.dragged_look = None if not dragged and dragged_hours is None else (
+            dataclasses.replace(shading, **dragged),
+            scene.lighting if dragged_hours is None else dataclasses.replace(scene.lighting,
+                                                                             time_of_day=float(dragged_hours)))
         changed_phase, phase_index = imgui.combo("Phase function", PHASE_NAMES.index(shading.phase),
                                                  list(PHASE_NAMES))
         changes = {key: value for key, value in changes.items() if value is not None}

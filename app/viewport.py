@@ -14,6 +14,7 @@ Over the picture it outlines the impostors and ring segments of the frame plan
 
 from __future__ import annotations
 
+import dataclasses
 import time
 
 import numpy as np
@@ -26,10 +27,16 @@ from cloudcore.gl.context import WindowContext
 from cloudcore.gl.frame import FrameRenderer
 from cloudcore.gl.image_texture import ImageTexture
 from cloudcore.heatmap import heat_image, ramp_colours
+from cloudcore.illumination import IlluminationCache
 from cloudcore.navigation import moved, turned
 from cloudcore.overlays import impostor_outlines, ring_outlines, to_pixels
+from cloudcore.relighting import EXACT_METHOD, PREVIEW_METHOD, LiveIllumination, Look
 
 TURN_DEG_PER_PIXEL = 0.2
+#: a frame that shows the picture again while the relighting worker runs waits this long first: the
+#: window's own drawing (panels, plots, the X server's copy) takes most of a core on llvmpipe, and the
+#: worker needs it; the window still follows the mouse at about 20 frames a second
+RELIGHT_PAUSE_S = 0.03
 #: outline colours (RGBA): impostors yellow, crossfading clouds orange, ring panels cyan, the picked particle red
 _OUTLINE_COLOURS = {"impostor": (255, 220, 0, 220), "crossfade": (255, 140, 0, 220), "ring": (0, 220, 255, 200)}
 _PICKED_COLOUR = (255, 60, 60, 255)
@@ -50,6 +57,9 @@ class Viewport:
         self.captured: np.ndarray | None = None
         self.outlines_drawn: list = []  # this frame's overlay outlines (`cloudcore.overlays.Outline`)
         self.regenerations_total = 0
+        self.relighting = LiveIllumination(IlluminationCache())
+        self.relighting.start()
+        self._last_inputs, self._last_stats = None, {}  # what the picture shown was drawn from, and its stats
         self._heat_texture: ImageTexture | None = None
         self._last_time = time.perf_counter()
 
@@ -62,11 +72,27 @@ class Viewport:
         available = imgui.get_content_region_avail()
         width, height = max(1, int(available.x)), max(1, int(available.y))
         if self.renderer is None:
-            self.renderer = FrameRenderer(width, height, context=WindowContext(width, height))
+            self.renderer = FrameRenderer(width, height, context=WindowContext(width, height),
+                                          illumination=self.relighting.cache)
         self.renderer.resize(width, height)
         start = time.perf_counter()
-        _, stats = self.renderer.render(editor.scene, camera=editor.camera, settings=editor.settings,
-                                        time_s=editor.scene_time_s, read_back=False)
+        scene, method = self._scene_as_shown()
+        inputs = (scene, method, editor.camera, editor.settings, editor.scene_time_s, (width, height))
+        plan = self.renderer.last_plan
+        if (inputs == self._last_inputs and plan is not None and (plan.settled or self.relighting.busy)
+                and not (self.measure_overdraw or self.heat_map)):
+            # the same inputs and nothing converging, or nothing worth converging to while a new light is on its
+            # way (the impostors and ring would be remade for a light already superseded): the same picture,
+            # and the cores go to the relighting worker
+            stats = self._last_stats | {"picture_reused": True}
+            if self.relighting.busy:
+                time.sleep(RELIGHT_PAUSE_S)
+        else:
+            _, stats = self.renderer.render(scene, camera=editor.camera, settings=editor.settings,
+                                            time_s=editor.scene_time_s, read_back=False, illumination_method=method)
+            self._last_inputs, self._last_stats = inputs, stats
+        stats |= {"relighting": self.relighting.busy, "shown_time_of_day": scene.lighting.time_of_day,
+                  "shown_illumination": method, "frame_start_s": now}
         heat = None
         if self.measure_overdraw or self.heat_map:
             counts, overdraw = self.renderer.measure_overdraw()
@@ -98,6 +124,22 @@ class Viewport:
         hovered = imgui.is_item_hovered()
         self._use_tool(origin, (width, height), clicked, seconds)
         self._navigate(hovered, seconds)
+
+    def _scene_as_shown(self):
+        """(the editor's scene in the look the viewport can show this frame, its illumination method).
+
+        A dragged slider's look is lit by the coarse raster (`PREVIEW_METHOD`), the scene's own exactly;
+        until the worker has it, the last look shown stays (`cloudcore.relighting`)."""
+        editor = self.editor
+        shading, lighting = editor.look
+        wanted = Look(shading, lighting, PREVIEW_METHOD if editor.dragged_look is not None else EXACT_METHOD)
+        look = self.relighting.look_for(editor.scene, wanted)
+        if self.relighting.failure is not None and self.relighting.failure not in editor.messages:
+            editor.messages.append(self.relighting.failure)
+        scene = editor.scene
+        if (look.shading, look.lighting) != (scene.shading, scene.lighting):
+            scene = dataclasses.replace(scene, shading=look.shading, lighting=look.lighting)
+        return scene, look.method
 
     def _use_tool(self, origin, size, clicked: bool, seconds: float) -> None:
         mouse, (width, height) = imgui.get_mouse_pos(), size
@@ -170,3 +212,4 @@ class Viewport:
         if self.renderer is not None:
             self.renderer.close()
             self.renderer = None
+        self.relighting.close()

@@ -189,6 +189,15 @@ class FramePlan:
         }
 
     @property
+    def settled(self) -> bool:
+        """Whether this plan leaves nothing to converge: no impostor remade or postponed, no crossfade
+        and no ring being built or faded in.  The same inputs would then draw the same picture again;
+        the editor keeps it instead (`app.viewport`), leaving the cores to the relighting worker."""
+        ring_settled = self.ring is None or (self.ring.state.pending is None
+                                             and all(weight == 1.0 for _, weight in self.ring.draws))
+        return ring_settled and not any(c.regenerate or c.postponed or c.kind == "crossfade" for c in self.clouds)
+
+    @property
     def objects_between_layers(self) -> tuple:
         """Objects drawn inside the cloud pass; the rest are drawn with the world."""
         return tuple(item.index for item in self.draw_items if item.kind == "object")
@@ -335,7 +344,8 @@ def plan_frame(units: LodUnits, camera: Camera, viewport: tuple[int, int], setti
         if reason is not None:
             ratio = (translation_error(centre, radius, record.eye, eye) / max(tolerance, 1e-300)
                      if record is not None else math.inf)
-            wanted.append((index, regeneration_priority(reason, ratio, bool(splits)), remake.scaled(len(splits) + 1)))
+            wanted.append((index, regeneration_priority(reason, ratio, bool(splits), pixels),
+                           remake.scaled(len(splits) + 1)))
     served = budgeted_regenerations([(index, priority) for index, priority, _ in wanted],
                                     settings.regeneration_budget)
     if settings.frame_budget_ms > 0.0:
@@ -384,11 +394,13 @@ def plan_frame(units: LodUnits, camera: Camera, viewport: tuple[int, int], setti
 
 def _within_frame_budget(wanted, available_ms: float, costs: CostModel) -> set:
     """The wanted regenerations (index, priority, work) that fit in `available_ms`, most urgent first;
-    those that must be made (rank 0: nothing to show, or layers that would cut an object) always."""
+    those that must be made (rank 0: nothing to show, or layers that would cut an object) always, and
+    the most urgent one at least: a budget below the frame's other work slows the picture's
+    convergence (after a relight, say) but never stops it."""
     served, spent = set(), 0.0
     for index, priority, work in sorted(wanted, key=lambda w: w[1]):
         ms = costs.ms(work)
-        if priority[0] == 0 or spent + ms <= available_ms:
+        if priority[0] == 0 or spent + ms <= available_ms or not served:
             served.add(index)
             spent += ms
     return served

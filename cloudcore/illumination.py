@@ -1,4 +1,4 @@
-"""Precomputed illumination of a scene's clouds: incident light per particle and light.
+"""Precomputed illumination of a scene's clouds: incident light per particle and light direction.
 
 Harris shades each cloud on its own (clouds do not shadow each other) once per
 light; this module maps a scene's clouds, shading defaults and lights onto
@@ -24,51 +24,92 @@ def cloud_optics(cloud: Cloud, shading: Shading) -> tuple[np.ndarray, np.ndarray
 
 def illuminate_clouds(clouds, shading: Shading, lights, method: str = "exact", *,
                       resolution: int = DEFAULT_RASTER_RESOLUTION) -> list[np.ndarray]:
-    """Incident light (N_i, L) of each cloud for each light that contributes (`active_lights`).
+    """Incident light (N_i, L) of each cloud for each light that contributes (`active_lights`)."""
+    clouds = list(clouds)
+    columns = [illuminate_direction(clouds, shading, light.direction, method, resolution=resolution)
+               for light in active_lights(lights)]
+    return [np.column_stack([column[i] for column in columns]) if columns else np.zeros((len(cloud.particles), 0))
+            for i, cloud in enumerate(clouds)]
 
-    All clouds go through one `incident_light` call per light, each its own
-    shadowing group, which lets the raster method share its slab walk.
+
+def illuminate_direction(clouds, shading: Shading, direction, method: str = "exact", *,
+                         resolution: int = DEFAULT_RASTER_RESOLUTION) -> list[np.ndarray]:
+    """The fraction (N_i,) of light from `direction` that reaches each particle of each cloud.
+
+    All clouds go through one `incident_light` call, each its own shadowing group,
+    which lets the raster method share its slab walk.  What fraction arrives does
+    not depend on the light's colour or intensity, only on where it comes from.
     """
     clouds = list(clouds)
-    lights = active_lights(lights)
     counts = [len(c.particles) for c in clouds]
-    if not clouds or sum(counts) == 0:
-        return [np.zeros((n, len(lights))) for n in counts]
+    if sum(counts) == 0:
+        return [np.zeros(n) for n in counts]
     optics = [cloud_optics(c, shading) for c in clouds]
-    positions = np.concatenate([c.centres for c in clouds])
-    radii = np.concatenate([c.radii for c in clouds])
-    tau = np.concatenate([o[0] for o in optics])
-    albedo = np.concatenate([o[1] for o in optics])
-    groups = np.repeat(np.arange(len(clouds)), counts)
-    columns = [
-        incident_light(positions, radii, tau, albedo, light.direction,
-                       phase=shading.phase, g=shading.g, method=method, groups=groups,
-                       resolution=resolution)
-        for light in lights
-    ]
-    incident = np.stack(columns, axis=1) if columns else np.zeros((len(positions), 0))
+    incident = incident_light(np.concatenate([c.centres for c in clouds]), np.concatenate([c.radii for c in clouds]),
+                              np.concatenate([o[0] for o in optics]), np.concatenate([o[1] for o in optics]),
+                              direction, phase=shading.phase, g=shading.g, method=method,
+                              groups=np.repeat(np.arange(len(clouds)), counts), resolution=resolution)
     return np.split(incident, np.cumsum(counts)[:-1])
 
 
+def light_directions(lights) -> tuple[tuple[float, ...], ...]:
+    """The directions of the lights that contribute, in `active_lights` order: what illumination depends on."""
+    return tuple(tuple(float(v) for v in light.direction) for light in active_lights(lights))
+
+
 class IlluminationCache:
-    """`illuminate_clouds` that recomputes only clouds it has not seen under the same shading and lights.
+    """Incident light per cloud and light direction, recomputing only what it has not seen.
 
     The editor changes one cloud at a time; recomputing the other 33 clouds of
     the default scene would freeze it for seconds.  Clouds are immutable, so a
-    cloud object seen before (by identity) has the same particles; entries for
-    clouds no longer asked for are dropped.
+    cloud object seen before (by identity) has the same particles.  A light's
+    colour and intensity scale what reaches a particle but not the fraction that
+    does, so the entries are per light direction: a new time of day moves the sun
+    and recolours the skylight, and only the sun is shaded again.  `incident`
+    keeps only what it was last asked for; `store` adds work done elsewhere
+    (`cloudcore.relighting`) beside it.
     """
 
     def __init__(self):
-        self._entries: dict[int, tuple[Cloud, object, np.ndarray]] = {}
-        self.last_recomputed = 0  # clouds shaded by the last call
+        #: (id of the cloud, shading, method) -> (the cloud, {light direction: incident (N,)})
+        self._entries: dict[tuple, tuple[Cloud, dict[tuple, np.ndarray]]] = {}
+        self.last_recomputed = 0  # (cloud, light direction) pairs shaded by the last call
 
     def incident(self, clouds, shading: Shading, lights, method: str = "exact") -> list[np.ndarray]:
+        """`illuminate_clouds(clouds, shading, lights, method)`, from what is held where it can be."""
         clouds = list(clouds)
-        key = (shading, tuple(active_lights(lights)), method)
-        stale = [c for c in clouds if (hit := self._entries.get(id(c))) is None or hit[0] is not c or hit[1] != key]
-        for cloud, incident in zip(stale, illuminate_clouds(stale, shading, lights, method)):
-            self._entries[id(cloud)] = (cloud, key, incident)
-        self._entries = {id(c): self._entries[id(c)] for c in clouds}
-        self.last_recomputed = len(stale)
-        return [self._entries[id(c)][2] for c in clouds]
+        work = self.missing(clouds, shading, lights, method)
+        for direction, stale in work:
+            self.store(stale, shading, method, direction, illuminate_direction(stale, shading, direction, method))
+        directions = light_directions(lights)
+        kept = {}
+        for cloud in clouds:
+            key = self._key(cloud, shading, method)
+            kept[key] = (cloud, {d: self._entries[key][1][d] for d in directions})
+        self._entries = kept
+        self.last_recomputed = sum(len(stale) for _, stale in work)
+        return [np.column_stack([kept[self._key(c, shading, method)][1][d] for d in directions])
+                if directions else np.zeros((len(c.particles), 0)) for c in clouds]
+
+    def missing(self, clouds, shading: Shading, lights, method: str = "exact") -> list[tuple[tuple, list[Cloud]]]:
+        """(light direction, the clouds not held for it) for each direction some cloud lacks."""
+        work = []
+        for direction in light_directions(lights):
+            stale = [c for c in clouds if (hit := self._entries.get(self._key(c, shading, method))) is None
+                     or hit[0] is not c or direction not in hit[1]]
+            if stale:
+                work.append((direction, stale))
+        return work
+
+    def store(self, clouds, shading: Shading, method: str, direction, incident) -> None:
+        """Hold `incident` (`illuminate_direction` of `clouds` from `direction`, computed elsewhere)."""
+        direction = tuple(float(v) for v in direction)
+        for cloud, light in zip(clouds, incident):
+            key = self._key(cloud, shading, method)
+            hit = self._entries.get(key)
+            held = hit[1] if hit is not None and hit[0] is cloud else {}
+            self._entries[key] = (cloud, held | {direction: light})
+
+    @staticmethod
+    def _key(cloud: Cloud, shading: Shading, method: str) -> tuple:
+        return id(cloud), shading, method

@@ -213,10 +213,13 @@ def pixel_angle_deg(fov_y_deg: float, viewport_height: int) -> float:
 _REASON_RANK = {"new": 0, "layers": 0, "lights": 1, "resolution": 2, "translation": 3}
 
 
-def regeneration_priority(reason: str, translation_ratio: float, split: bool) -> tuple[int, float]:
+def regeneration_priority(reason: str, translation_ratio: float, split: bool,
+                          screen_px: float = 0.0) -> tuple[int, float, float]:
     """Sort key of a wanted regeneration, most urgent first; `translation_ratio` is the translation
-    error over the tolerance.  A cloud split around objects is never postponed."""
-    return (0 if split else _REASON_RANK[reason], -translation_ratio)
+    error over the tolerance, `screen_px` the impostor's size on screen, which orders the rest (after
+    a relight from a still eye, the largest on screen are remade first).  A cloud split around
+    objects is never postponed."""
+    return (0 if split else _REASON_RANK[reason], -translation_ratio, -screen_px)
 
 
 def budgeted_regenerations(wanted, budget: int) -> set:

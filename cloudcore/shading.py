@@ -31,6 +31,8 @@ Two methods:
 * "raster": Harris's frame buffer as a grid, walked in depth slabs; particles in
   one slab read the grid together and are splatted together with
   order-independent compositing.  Faster and approximate; see `docs/shading.md`.
+* "preview": the raster method on a grid of `PREVIEW_RASTER_RESOLUTION` cells:
+  what the editor lights with while a lighting slider is dragged.
 """
 
 from __future__ import annotations
@@ -41,11 +43,15 @@ from scipy.spatial import cKDTree
 from cloudcore.kernel import splat_kernel
 from cloudcore.phase import check_phase, phase_function
 
-METHODS = ("exact", "raster")
+METHODS = ("exact", "raster", "preview")
 FOUR_PI = 4.0 * np.pi
 
 #: raster grid cells across the widest axis of a cloud's light-plane footprint.
 DEFAULT_RASTER_RESOLUTION = 48
+#: the preview's grid: the default scene's sun in 0.12 s against the default raster's 0.35 s and exact's
+#: 0.94 s, a mean error of 0.065 in the fraction of light arriving against the default raster's 0.025
+#: (docs/shading.md); coarser slabs would save less than a coarser grid for more error
+PREVIEW_RASTER_RESOLUTION = 16
 #: raster depth-slab thickness as a fraction of the cloud's median particle radius;
 #: thin slabs cost little and remove most of the in-slab self-shadowing error
 #: (docs/shading.md has the sweep).
@@ -103,7 +109,8 @@ def incident_light(
     if method == "exact":
         result = _incident_exact(plane, toward_light, radii, alpha, sigma, groups)
     else:
-        result = _incident_raster(plane, toward_light, radii, alpha, sigma, groups, int(resolution))
+        grid = PREVIEW_RASTER_RESOLUTION if method == "preview" else int(resolution)
+        result = _incident_raster(plane, toward_light, radii, alpha, sigma, groups, grid)
     # Every step is a convex combination of values in [0, 1]; clip only rounding.
     return np.clip(result, 0.0, 1.0)
 

@@ -349,6 +349,20 @@ def test_full_3d_near_the_eye_counts_only_the_splats_in_the_frustum():
     assert full.cloud_work.particles == np.count_nonzero(seen) < 400
 
 
+def test_a_still_eye_settles_once_its_impostors_are_made_and_the_ring_is_in():
+    frames, state = [], LodState()
+    for _ in range(SEGMENTS + 12):
+        frame = plan(orbit(8000.0, 0.0), RING, centres=((0.0, 0.0, 0.0), (0.0, 0.0, -6000.0)),
+                     radii=(RADIUS, RADIUS), state=state)
+        frames.append(frame)
+        state = frame.state
+    assert not frames[0].settled  # the first impostors are made
+    assert frames[-1].settled and frames[-1].ring.draws and frames[-1].stats()["impostors_regenerated"] == 0
+    moved = plan(orbit(8000.0, 5.0), RING, centres=((0.0, 0.0, 0.0), (0.0, 0.0, -6000.0)), radii=(RADIUS, RADIUS),
+                 state=state)
+    assert not moved.settled
+
+
 def test_a_cloud_without_particles_is_planned_as_empty():
     empty = plan(orbit(500.0, 0.0), centres=((0.0, 0.0, 0.0),), radii=(0.0,))
     assert empty.clouds[0].kind == "empty" and empty.draw_order == ()

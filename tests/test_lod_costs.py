@@ -90,6 +90,10 @@ def test_a_frame_budget_postpones_regenerations_and_reports_the_error_it_accepte
     assert (stats["impostors_regenerated"], stats["regenerations_postponed"]) == (2, 3)
     assert tight.predicted_ms <= budget.frame_budget_ms < unlimited.predicted_ms
     assert tight.accepted_error > 1.0 and stats["accepted_error_tolerances"] == tight.accepted_error
+    # a budget below the quads' own cost still serves the most urgent one a frame: the picture converges
+    starved = plan(moved, dataclasses.replace(impostors, frame_budget_ms=1e-6), state=first.state,
+                   centres=RING_OF_CLOUDS, radii=(RADIUS,) * 5, finest_radii=FINEST * 5, costs=FILL_BOUND)
+    assert (starved.stats()["impostors_regenerated"], starved.stats()["regenerations_postponed"]) == (1, 4)
     # new impostors are made whatever the budget: there is nothing else to show
     fresh = plan(start, dataclasses.replace(impostors, frame_budget_ms=1e-6), centres=RING_OF_CLOUDS,
                  radii=(RADIUS,) * 5, costs=FILL_BOUND)

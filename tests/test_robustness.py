@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from cloudcore.camera import NEAR_PLANE_M
+from cloudcore.camera import NEAR_PLANE_M, frustum_planes, projection_matrix, splats_in_frustum, view_matrix
 from cloudcore.errors import SceneError
 from cloudcore.frameplan import TEXTURED
 from cloudcore.gl.context import WindowContext
@@ -192,10 +192,13 @@ def looking_from(eye, at=CLOUD_CENTRE + [0.0, 0.0, -500.0], fov: float = 55.0) -
 
 @pytest.mark.parametrize("mode", ["full", "auto"])
 def test_camera_inside_a_particle(renderer, mode):
-    """The particle holding the eye fades out (`cloudcore.eye_scattering`); the others are drawn."""
+    """The particle holding the eye fades out (`cloudcore.eye_scattering`); the others in view are drawn."""
     camera = looking_from(BASE.clouds[0].particles[0, :3])
     frame = render_checked(renderer, "camera at a particle's centre", BASE, MODES[mode], camera=camera)
-    assert frame.stats["particles_drawn"] == len(BASE.clouds[0].particles) - 1
+    particles = BASE.clouds[0].particles
+    in_view = splats_in_frustum(frustum_planes(projection_matrix(camera.fov_y_deg, renderer.size[0] / renderer.size[1])
+                                               @ view_matrix(camera)), particles[:, :3], particles[:, 3])
+    assert in_view[0] and frame.stats["particles_drawn"] == np.count_nonzero(in_view) - 1
     assert cloud_added(frame, clear_sky(renderer, settings=MODES[mode], camera=camera)) > VISIBLE
     assert frame.kinds == (["full"] if mode == "full" else ["inside"])
 

@@ -55,8 +55,11 @@ from cloudcore.settings import FULL_3D, RenderSettings
 class FrameRenderer:
     """Renders scenes headlessly at a fixed size; use as a context manager or call close()."""
 
-    def __init__(self, width: int, height: int, context=None):
-        """A headless renderer, or with `context` (a `WindowContext`) one inside the current window."""
+    def __init__(self, width: int, height: int, context=None, illumination: IlluminationCache | None = None):
+        """A headless renderer, or with `context` (a `WindowContext`) one inside the current window.
+
+        `illumination` holds the clouds' precomputed light between frames; the editor passes one
+        that a worker fills in the background (`cloudcore.relighting`)."""
         self.context = context if context is not None else HeadlessContext(width, height)
         self.context.make_current()
         self._splats = SplatPass()
@@ -66,7 +69,7 @@ class FrameRenderer:
         self._objects, self._objects_source = None, None
         self._particles, self._particles_source = None, None
         self._facings: CloudFacings | None = None
-        self._illumination = IlluminationCache()
+        self._illumination = illumination if illumination is not None else IlluminationCache()
         #: per cloud, changes whenever that cloud's particle colours may have: its impostor is stale
         self._lighting_keys: tuple = ()
         self._key_serial = 0
@@ -115,9 +118,10 @@ class FrameRenderer:
         # a forming or dissipating cloud's colours change with the clock too: its impostor is stale meanwhile
         cloud_keys = tuple((key, formation_state(cloud.formation, time_s))
                            for key, cloud in zip(self._lighting_keys, scene.clouds))
-        if (particles, settings.group_clouds) != self._units_source:
-            self._units, self._units_source = lod_units(particles, settings.group_clouds), (particles,
-                                                                                             settings.group_clouds)
+        # the units follow the particles' places and sizes, not their light: a relit scene keeps them
+        if (scene.clouds, settings.group_clouds) != self._units_source:
+            self._units = lod_units(particles, settings.group_clouds)
+            self._units_source = (scene.clouds, settings.group_clouds)
         plan = plan_frame(self._units, camera, self.size, settings, self.lod_state, cloud_keys, poses,
                           lambda cloud: particles.centres[starts[cloud]:starts[cloud + 1]], costs,
                           lambda cloud: (particles.centres[starts[cloud]:starts[cloud + 1]],

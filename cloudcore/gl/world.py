@@ -9,6 +9,8 @@ the sky gradient into the linear target (shaders/world.frag.glsl).
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import trimesh
 from OpenGL import GL
@@ -24,10 +26,17 @@ from cloudcore.scene import Camera, Terrain
 from cloudcore.terrain import heightfield_mesh
 
 
-def terrain_vertex_colours(vertices, faces, base_colour, lights, ambient) -> np.ndarray:
+@functools.lru_cache(maxsize=2)
+def terrain_geometry(terrain: Terrain) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(vertices, faces, vertex normals) of a heightfield terrain: kept across lighting changes, which
+    rebuild the world pass (the editor's time of day) and would rebuild these for 25 ms each time."""
+    vertices, faces = heightfield_mesh(terrain)
+    return vertices, faces, trimesh.Trimesh(vertices, faces, process=False).vertex_normals
+
+
+def terrain_vertex_colours(normals, base_colour, lights, ambient) -> np.ndarray:
     """Linear RGB per vertex: base * (ambient + sum over lights of colour * intensity * max(0, n.l))."""
-    normals = trimesh.Trimesh(vertices, faces, process=False).vertex_normals
-    irradiance = np.broadcast_to(np.asarray(ambient, dtype=np.float64), (len(vertices), 3)).copy()
+    irradiance = np.broadcast_to(np.asarray(ambient, dtype=np.float64), (len(normals), 3)).copy()
     for light in active_lights(lights):
         cosine = np.maximum(normals @ np.asarray(light.direction, dtype=np.float64), 0.0)
         irradiance += cosine[:, None] * np.asarray(light.color) * light.intensity
@@ -51,8 +60,8 @@ class WorldPass:
     def _terrain_scene(terrain: Terrain, lights, ambient):
         if terrain.kind not in DRAWN_TERRAIN_KINDS:  # the scene loader refuses these first (cloudcore.limits)
             raise ValueError(f"the GL prototype draws heightfield terrain only, not {terrain.kind!r}")
-        vertices, faces = heightfield_mesh(terrain)
-        colours = terrain_vertex_colours(vertices, faces, terrain.color, lights, ambient)
+        vertices, faces, normals = terrain_geometry(terrain)
+        colours = terrain_vertex_colours(normals, terrain.color, lights, ambient)
         # encoded, because pyrender's 8-bit framebuffer would band linear colour in the shadows
         primitive = pyrender.Primitive(positions=vertices.astype(np.float32), indices=faces.astype(np.uint32),
                                        color_0=srgb_encode(colours).astype(np.float32))
