@@ -137,7 +137,10 @@ def install(params, editor, viewport, panels, results_path: Path, outcome: dict,
             "drag_s": dragged_s, "frames": len(during), "relit_looks": relit_looks,
             "relit_looks_per_s": relit_looks / dragged_s, "longest_frame_gap_ms": max(gaps_ms, default=0.0),
             "median_frame_gap_ms": float(np.median(gaps_ms)) if gaps_ms else 0.0,
-            "shading_ms_on_the_gui_thread_max": max(stats["illumination_ms"] for stats in during)}
+            "shading_ms_on_the_gui_thread_max": max(stats["illumination_ms"] for stats in during),
+            "slowest": [{"gap_ms": gap, **{key: during[i].get(key) for key in (
+                "viewport_ms", "illumination_ms", "impostors_regenerated", "picture_reused", "frame_ms")}}
+                for gap, i in sorted(((gap, i) for i, gap in enumerate(gaps_ms)), reverse=True)[:3]]}
         CHECK(relit_looks >= 3)  # the view followed the drag, not just its end
         CHECK(all(stats["shown_illumination"] in ("preview", "exact") for stats in during))
         # nothing like the exact light pass (about 2 s) ran where the GUI runs

@@ -124,7 +124,7 @@ class LiveIllumination:
         self._running = None
         try:
             results = future.result()
-        except BrokenProcessPool as error:
+        except Exception as error:  # the worker died, or the light pass refused its input: shade here from now
             self._stop(error)
             return
         current = {id(cloud) for cloud in scene.clouds}

@@ -22,9 +22,10 @@ TRANSLATION_METRICS = ("parallax", "centre")
 class RenderSettings:
     mode: str = "auto"
     #: degrees of translation error past which an impostor is regenerated; see `translation_metric`.
-    #: SkyWorks' default is 0.125 (0.9 of a pixel at 480 lines and 60 degrees); measured along the default
-    #: flythrough, 0.5 costs a third less time for 0.4 dB of mean PSNR (docs/performance.md)
-    tolerance_deg: float = 0.5
+    #: SkyWorks' default is 0.125 (0.9 of a pixel at 480 lines and 60 degrees); measured side by side along
+    #: the default flythrough, 1 costs an eighth less time than 0.5 for 0.5 dB of mean PSNR and the same
+    #: worst frame (34.0 dB), where 2 loses 2.5 dB on the worst frame (docs/performance.md)
+    tolerance_deg: float = 1.0
     #: "parallax": the angle between the rays to the impostor's near and far points (Harris, SkyWorks);
     #: "centre": the angle the eye has turned around the cloud's centre (stricter by about D / 2R)
     translation_metric: str = "parallax"
@@ -50,10 +51,11 @@ class RenderSettings:
     #: draw interpenetrating clouds as one unit (one impostor, one sort: `cloudcore.lod_units`); off, each
     #: cloud's impostor is sorted as a whole, Harris's approximation
     group_clouds: bool = True
-    #: per axis: the screen impostor of a cloud the eye is inside has this fraction of the screen's pixels.
-    #: Harris's quarter cost 4 ms more a frame along the default flythrough for 0.6 dB on the 703 of 901
-    #: frames the eye is in a unit (docs/performance.md): the splats next to the eye are screen-sized blurs
-    inside_resolution_scale: float = 0.125
+    #: per axis: the screen impostor of a cloud the eye is inside has this fraction of the screen's pixels
+    #: (Harris's quarter).  An eighth saved 9% of the default flythrough's cloud pass for 0.45 dB, but under
+    #: a stratocumulus deck, whose one unit's sphere holds the eye, it blurred its underside (4.2 dB on
+    #: the worst frame; docs/performance.md)
+    inside_resolution_scale: float = 0.25
     #: the ring is rebuilt when the eye has moved this fraction of ring_radius horizontally / vertically
     ring_rebuild_horizontal: float = 0.15
     ring_rebuild_vertical: float = 0.02
