@@ -85,11 +85,13 @@ class Editor:
         return max((float(o.path[-1, 0]) for o in self.scene.objects if o.path is not None), default=0.0)
 
     @classmethod
-    def open(cls, path: Path) -> "Editor":
+    def open(cls, path: Path) -> Editor:
         editor = cls(load_scene(path), path)
         if recovery_path(path).exists():
-            editor.messages.append(f"a recovery file from an unsaved session exists: {recovery_path(path)} "
-                                   "(Scene panel: Recover unsaved edits)")
+            editor.messages.append(
+                f"a recovery file from an unsaved session exists: {recovery_path(path)} "
+                "(Scene panel: Recover unsaved edits)"
+            )
         return editor
 
     def recover(self) -> bool:
@@ -213,8 +215,9 @@ class Editor:
         self.playing = self.path_time_s < self.scene.camera_path(self.camera_path_name).duration
 
     def set_time_of_day(self, hours: float) -> None:
-        self.edit(dataclasses.replace(self.scene, lighting=dataclasses.replace(self.scene.lighting,
-                                                                               time_of_day=float(hours))))
+        self.edit(
+            dataclasses.replace(self.scene, lighting=dataclasses.replace(self.scene.lighting, time_of_day=float(hours)))
+        )
 
     def undo(self) -> None:
         if not self.history.undo():
@@ -265,8 +268,12 @@ class Editor:
         own particle files (`save_scene`), so writing it never touches the last save.
         """
         now = time.monotonic() if now is None else now
-        if (not self.dirty or self.path is None or self.scene is self._recovered_scene
-                or now - self._last_recovery < AUTOSAVE_SECONDS):
+        if (
+            not self.dirty
+            or self.path is None
+            or self.scene is self._recovered_scene
+            or now - self._last_recovery < AUTOSAVE_SECONDS
+        ):
             return False
         self._last_recovery = now
         try:
@@ -282,4 +289,4 @@ class Editor:
         self.frame_times.append(stats)
 
     def _remember(self, path: Path) -> None:
-        self.recent = [path] + [p for p in self.recent if p != path][:RECENT_LIMIT - 1]
+        self.recent = [path] + [p for p in self.recent if p != path][: RECENT_LIMIT - 1]

@@ -88,8 +88,11 @@ def install(params, editor, viewport, panels, results_path: Path, outcome: dict,
         """Yield until the viewport shows the scene's own lighting, exactly shaded (the worker has it)."""
         for _ in range(frames):
             stats = editor.last_stats
-            if (not stats.get("relighting") and stats.get("shown_illumination") == "exact"
-                    and stats.get("shown_time_of_day") == editor.time_of_day):
+            if (
+                not stats.get("relighting")
+                and stats.get("shown_illumination") == "exact"
+                and stats.get("shown_time_of_day") == editor.time_of_day
+            ):
                 ctx.yield_(SETTLE)  # the impostors follow within the frame budget
                 return
             ctx.yield_()
@@ -134,13 +137,30 @@ def install(params, editor, viewport, panels, results_path: Path, outcome: dict,
         relit_looks = len({hours for hours in shown}) - 1  # the looks shown after the first
         gaps_ms = [1e3 * (b["frame_start_s"] - a["frame_start_s"]) for a, b in zip(during, during[1:])]
         outcome["live_time_of_day"] = {
-            "drag_s": dragged_s, "frames": len(during), "relit_looks": relit_looks,
-            "relit_looks_per_s": relit_looks / dragged_s, "longest_frame_gap_ms": max(gaps_ms, default=0.0),
+            "drag_s": dragged_s,
+            "frames": len(during),
+            "relit_looks": relit_looks,
+            "relit_looks_per_s": relit_looks / dragged_s,
+            "longest_frame_gap_ms": max(gaps_ms, default=0.0),
             "median_frame_gap_ms": float(np.median(gaps_ms)) if gaps_ms else 0.0,
             "shading_ms_on_the_gui_thread_max": max(stats["illumination_ms"] for stats in during),
-            "slowest": [{"gap_ms": gap, **{key: during[i].get(key) for key in (
-                "viewport_ms", "illumination_ms", "impostors_regenerated", "picture_reused", "frame_ms")}}
-                for gap, i in sorted(((gap, i) for i, gap in enumerate(gaps_ms)), reverse=True)[:3]]}
+            "slowest": [
+                {
+                    "gap_ms": gap,
+                    **{
+                        key: during[i].get(key)
+                        for key in (
+                            "viewport_ms",
+                            "illumination_ms",
+                            "impostors_regenerated",
+                            "picture_reused",
+                            "frame_ms",
+                        )
+                    },
+                }
+                for gap, i in sorted(((gap, i) for i, gap in enumerate(gaps_ms)), reverse=True)[:3]
+            ],
+        }
         CHECK(relit_looks >= 3)  # the view followed the drag, not just its end
         CHECK(all(stats["shown_illumination"] in ("preview", "exact") for stats in during))
         # nothing like the exact light pass (about 2 s) ran where the GUI runs
@@ -177,14 +197,17 @@ def install(params, editor, viewport, panels, results_path: Path, outcome: dict,
         ctx.item_click("Orbit left")
         ctx.yield_(SETTLE)
         history = list(editor.frame_times)
-        budgeted = history[next(i for i, s in enumerate(history) if s is marker) + 1:]
+        budgeted = history[next(i for i, s in enumerate(history) if s is marker) + 1 :]
         per_frame = [s.get("impostors_regenerated", 0) for s in budgeted]
         postponed = sum(s.get("regenerations_postponed", 0) for s in budgeted)
         use_window(ctx, "LOD")
         ctx.item_input_value("Regeneration budget", 0)
-        outcome["regenerations"] = {"tolerance 5": lenient, "tolerance 0.1": strict,
-                                    "budget 1, most in a frame": max(per_frame, default=0),
-                                    "budget 1, postponed": postponed}
+        outcome["regenerations"] = {
+            "tolerance 5": lenient,
+            "tolerance 0.1": strict,
+            "budget 1, most in a frame": max(per_frame, default=0),
+            "budget 1, postponed": postponed,
+        }
         CHECK(lenient == 0 and strict > 0)
         CHECK(max(per_frame, default=0) <= 1 and viewport.regenerations_total > before)
         CHECK(postponed > 0)  # the orbit moves both clouds past the tolerance
@@ -432,21 +455,34 @@ def install(params, editor, viewport, panels, results_path: Path, outcome: dict,
                 moved_after = frame
         ctx.run_flags = int(ctx.run_flags) & ~raw
         ctx.yield_(SETTLE)
-        outcome["click_within_one_frame"] = {"tab selected after frames": selected_after,
-                                             "camera orbited after frames": moved_after}
+        outcome["click_within_one_frame"] = {
+            "tab selected after frames": selected_after,
+            "camera orbited after frames": moved_after,
+        }
         CHECK(selected_after is not None and camera_window.active)  # the Camera panel is the one drawn
         CHECK(editor.camera == orbited(start, -panels.orbit_step_deg))  # one orbit, not none and not two
         use_window(ctx, "Camera")
         ctx.item_click("Reset to the scene's camera")
 
-    tests = [place_particles_by_clicking, time_of_day_changes_the_picture, dragging_the_time_of_day_relights_live,
-             tolerance_drives_regeneration,
-             save_and_reopen, malformed_scene_keeps_the_current_one, recovery_is_offered_and_restores_the_edits,
-             place_on_the_cloud_surface,
-             brush_stroke_is_one_undo_step, box_fill_adds_sprites, move_cloud_by_dragging,
-             delete_key_and_statistics_toggle, heat_map_changes_the_picture, overlays_outline_impostors_and_the_ring,
-             playing_a_camera_path_moves_the_camera, recording_runs_in_the_background,
-             a_click_within_one_frame_is_not_lost]
+    tests = [
+        place_particles_by_clicking,
+        time_of_day_changes_the_picture,
+        dragging_the_time_of_day_relights_live,
+        tolerance_drives_regeneration,
+        save_and_reopen,
+        malformed_scene_keeps_the_current_one,
+        recovery_is_offered_and_restores_the_edits,
+        place_on_the_cloud_surface,
+        brush_stroke_is_one_undo_step,
+        box_fill_adds_sprites,
+        move_cloud_by_dragging,
+        delete_key_and_statistics_toggle,
+        heat_map_changes_the_picture,
+        overlays_outline_impostors_and_the_ring,
+        playing_a_camera_path_moves_the_camera,
+        recording_runs_in_the_background,
+        a_click_within_one_frame_is_not_lost,
+    ]
 
     unknown = sorted(set(only or ()) - {function.__name__ for function in tests})
     if unknown:
@@ -476,9 +512,13 @@ def install(params, editor, viewport, panels, results_path: Path, outcome: dict,
             return
         statuses = {name: t.output.status.name for name, t in registered}
         outcome.update(done=True, exit_code=0 if all(s == "success" for s in statuses.values()) else 1)
-        report = {"tests": statuses, **{k: v for k, v in outcome.items() if k not in ("done",)},
-                  "logs": {name: t.output.log.get_text() for name, t in registered
-                           if t.output.status != te.TestStatus.success}}
+        report = {
+            "tests": statuses,
+            **{k: v for k, v in outcome.items() if k not in ("done",)},
+            "logs": {
+                name: t.output.log.get_text() for name, t in registered if t.output.status != te.TestStatus.success
+            },
+        }
         results_path.write_text(json.dumps(report, indent=2) + "\n")
         hello_imgui.get_runner_params().app_shall_exit = True
 

@@ -39,14 +39,15 @@ from cloudcore.errors import SceneError  # noqa: E402
 from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
 
 
-
-def runner_params(editor: Editor, viewport: Viewport, panels: Panels, testing: bool,
-                  window_size: tuple[int, int] = (1280, 800)) -> hello_imgui.RunnerParams:
+def runner_params(
+    editor: Editor, viewport: Viewport, panels: Panels, testing: bool, window_size: tuple[int, int] = (1280, 800)
+) -> hello_imgui.RunnerParams:
     params = hello_imgui.RunnerParams()
     params.app_window_params.window_title = "cloudview"
     params.app_window_params.window_geometry.size = window_size
     params.imgui_window_params.default_imgui_window_type = (
-        hello_imgui.DefaultImGuiWindowType.provide_full_screen_dock_space)
+        hello_imgui.DefaultImGuiWindowType.provide_full_screen_dock_space
+    )
     params.imgui_window_params.show_menu_bar = False
     # a CPU rasteriser pays for every multisample; the splats are smooth already
     options = hello_imgui.OpenGlOptions()
@@ -61,11 +62,16 @@ def runner_params(editor: Editor, viewport: Viewport, panels: Panels, testing: b
     bottom = hello_imgui.DockingSplit("Left", "LeftBottom", imgui.Dir.down, 0.45)
     params.docking_params.docking_splits = [left, bottom]
     windows = []
-    for label, dock, function in (("Viewport", "MainDockSpace", viewport.gui), ("Scene", "Left", panels.scene),
-                                  ("Clouds", "Left", panels.clouds), ("Build", "Left", panels.build),
-                                  ("Lighting", "Left", panels.lighting),
-                                  ("LOD", "Left", panels.lod), ("Camera", "Left", panels.camera),
-                                  ("Statistics", "LeftBottom", panels.statistics)):
+    for label, dock, function in (
+        ("Viewport", "MainDockSpace", viewport.gui),
+        ("Scene", "Left", panels.scene),
+        ("Clouds", "Left", panels.clouds),
+        ("Build", "Left", panels.build),
+        ("Lighting", "Left", panels.lighting),
+        ("LOD", "Left", panels.lod),
+        ("Camera", "Left", panels.camera),
+        ("Statistics", "LeftBottom", panels.statistics),
+    ):
         window = hello_imgui.DockableWindow(label, dock, function)
         windows.append(window)
     params.docking_params.dockable_windows = windows
@@ -96,7 +102,8 @@ def shortcuts(editor: Editor) -> None:
     if not io.want_text_input and imgui.is_key_pressed(imgui.Key.delete, repeat=False):
         editor.delete_selection()
     if imgui.is_key_pressed(imgui.Key.f3, repeat=False) or (
-            io.key_ctrl and imgui.is_key_pressed(imgui.Key.t, repeat=False)):
+        io.key_ctrl and imgui.is_key_pressed(imgui.Key.t, repeat=False)
+    ):
         statistics = hello_imgui.get_runner_params().docking_params.dockable_window_of_name("Statistics")
         statistics.is_visible = not statistics.is_visible
 
@@ -104,16 +111,29 @@ def shortcuts(editor: Editor) -> None:
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="cloudview", description="the cloudview editor")
     parser.add_argument("scene", nargs="?", type=Path, default=DEFAULT_SCENE)
-    parser.add_argument("--window-size", type=window_size, default=(1280, 800), metavar="WIDTHxHEIGHT",
-                        help="the window's size in pixels (default 1280x800)")
-    parser.add_argument("--self-test", type=Path, metavar="RESULTS.json",
-                        help="run the GUI tests with the Dear ImGui Test Engine, write results, exit")
+    parser.add_argument(
+        "--window-size",
+        type=window_size,
+        default=(1280, 800),
+        metavar="WIDTHxHEIGHT",
+        help="the window's size in pixels (default 1280x800)",
+    )
+    parser.add_argument(
+        "--self-test",
+        type=Path,
+        metavar="RESULTS.json",
+        help="run the GUI tests with the Dear ImGui Test Engine, write results, exit",
+    )
     parser.add_argument("--tests", metavar="NAME,...", help="with --self-test: run only these GUI tests")
     parser.add_argument("--frames", type=int, help="quit after this many frames")
-    parser.add_argument("--screenshot", type=Path,
-                        help="with --frames: save the viewport's last picture here (PNG, the viewport's size)")
-    parser.add_argument("--window-screenshot", type=Path,
-                        help="with --frames: save the whole window here (PNG) at the end")
+    parser.add_argument(
+        "--screenshot",
+        type=Path,
+        help="with --frames: save the viewport's last picture here (PNG, the viewport's size)",
+    )
+    parser.add_argument(
+        "--window-screenshot", type=Path, help="with --frames: save the whole window here (PNG) at the end"
+    )
     parser.add_argument("--frame-stats", type=Path, help="with --frames: write every frame's statistics (JSON)")
     args = parser.parse_args(argv)
     try:
@@ -123,14 +143,20 @@ def main(argv=None) -> int:
         return 2
     viewport = Viewport(editor)
     panels = Panels(editor, viewport)
-    params = runner_params(editor, viewport, panels, testing=args.self_test is not None,
-                           window_size=args.window_size)
+    params = runner_params(editor, viewport, panels, testing=args.self_test is not None, window_size=args.window_size)
     outcome = {}
     if args.self_test is not None:
         from app.gui_tests import install
 
-        install(params, editor, viewport, panels, args.self_test, outcome,
-                only=None if args.tests is None else args.tests.split(","))
+        install(
+            params,
+            editor,
+            viewport,
+            panels,
+            args.self_test,
+            outcome,
+            only=None if args.tests is None else args.tests.split(","),
+        )
     if args.frames is not None:
         _quit_after(params, args.frames, editor, viewport, outcome)
     immapp.run(params, immapp.AddOnsParams(with_implot=True))

@@ -13,16 +13,27 @@ from app.editor import TOOLS, Editor, recovery_path
 from app.record_job import RecordJob
 from app.viewport import Viewport
 from cloudcore.cloudgen import PRESETS, TYPICAL_CULL_FRACTION
-from cloudcore.editing import (add_cloud, add_preset_cloud, delete_cloud, fill_box, pick_ray, point_at_altitude,
-                               replace_cloud, with_mean_radius)
+from cloudcore.editing import (
+    add_cloud,
+    add_preset_cloud,
+    delete_cloud,
+    fill_box,
+    pick_ray,
+    point_at_altitude,
+    replace_cloud,
+    with_mean_radius,
+)
 from cloudcore.errors import SceneError
 from cloudcore.navigation import orbited
 from cloudcore.phase import PHASE_NAMES
 from cloudcore.settings import MODES, TRANSLATION_METRICS
 
 #: the Lighting panel's shading sliders: label -> (`Shading` field, low, high)
-_SHADING_SLIDERS = {"Albedo": ("albedo", 0.0, 1.0), "Optical depth": ("optical_depth", 0.0, 50.0),
-                    "g": ("g", -0.99, 0.99)}
+_SHADING_SLIDERS = {
+    "Albedo": ("albedo", 0.0, 1.0),
+    "Optical depth": ("optical_depth", 0.0, 50.0),
+    "g": ("g", -0.99, 0.99),
+}
 
 
 class Panels:
@@ -111,11 +122,13 @@ class Panels:
             tau = scene.shading.optical_depth if cloud.optical_depth is None else cloud.optical_depth
             tau = self._slider_on_release("Cloud optical depth", tau, 0.0, 50.0)
             if tau is not None:
-                editor.edit(replace_cloud(scene, editor.selected_cloud,
-                                          dataclasses.replace(cloud, optical_depth=float(tau))))
+                editor.edit(
+                    replace_cloud(scene, editor.selected_cloud, dataclasses.replace(cloud, optical_depth=float(tau)))
+                )
             if len(cloud.particles):
-                radius = self._slider_on_release("Mean particle radius", float(cloud.radii.mean()), 1.0, 1000.0,
-                                                 "%.1f m")
+                radius = self._slider_on_release(
+                    "Mean particle radius", float(cloud.radii.mean()), 1.0, 1000.0, "%.1f m"
+                )
                 if radius is not None:
                     editor.edit(with_mean_radius(scene, editor.selected_cloud, radius))
         imgui.separator_text("Viewport tool (left mouse)")
@@ -138,8 +151,10 @@ class Panels:
             editor.brush_erases = True
         _, editor.brush_radius = imgui.slider_float("Brush radius (m)", editor.brush_radius, 10.0, 3000.0, "%.0f")
         _, editor.brush_rate = imgui.slider_float("Brush rate (per s)", editor.brush_rate, 1.0, 500.0, "%.0f")
-        imgui.text_wrapped("Move: drag in the viewport (Shift: in the screen's plane). Delete removes the picked "
-                           "particle, or else the selected cloud.")
+        imgui.text_wrapped(
+            "Move: drag in the viewport (Shift: in the screen's plane). Delete removes the picked "
+            "particle, or else the selected cloud."
+        )
 
     # --- Build: Wang's box fill and cloud presets ---------------------------------------------------------
     def build(self) -> None:
@@ -169,8 +184,11 @@ class Panels:
         _, self.preset_scale = imgui.slider_float("Scale", self.preset_scale, 0.1, 3.0)
         if imgui.button("New cloud from preset"):
             try:
-                editor.edit(add_preset_cloud(editor.scene, names[self.preset], self.box_centre, self.preset_scale,
-                                             self.box_seed))
+                editor.edit(
+                    add_preset_cloud(
+                        editor.scene, names[self.preset], self.box_centre, self.preset_scale, self.box_seed
+                    )
+                )
             except ValueError as error:
                 editor.messages.append(f"could not make a {names[self.preset]}: {error}")
                 return
@@ -181,8 +199,16 @@ class Panels:
     def _fill(self, cloud_index: int | None) -> None:
         editor = self.editor
         try:
-            scene, filled = fill_box(editor.scene, cloud_index, self.box_centre, self.box_size,
-                                     self.box_particle_radius, self.box_count, self.box_cull_distance, self.box_seed)
+            scene, filled = fill_box(
+                editor.scene,
+                cloud_index,
+                self.box_centre,
+                self.box_size,
+                self.box_particle_radius,
+                self.box_count,
+                self.box_cull_distance,
+                self.box_seed,
+            )
         except ValueError as error:
             editor.messages.append(f"could not fill the box: {error}")
             return
@@ -212,18 +238,26 @@ class Panels:
         if hours is not None:
             editor.set_time_of_day(hours)
         shading = scene.shading
-        changes = {field: self._slider_on_release(label, getattr(shading, field), low, high)
-                   for label, (field, low, high) in _SHADING_SLIDERS.items()}
+        changes = {
+            field: self._slider_on_release(label, getattr(shading, field), low, high)
+            for label, (field, low, high) in _SHADING_SLIDERS.items()
+        }
         # the viewport follows a slider being dragged (`cloudcore.relighting`); the edit is made on release
-        dragged = {field: self._dragging[label] for label, (field, _, _) in _SHADING_SLIDERS.items()
-                   if label in self._dragging}
+        dragged = {
+            field: self._dragging[label] for label, (field, _, _) in _SHADING_SLIDERS.items() if label in self._dragging
+        }
         dragged_hours = self._dragging.get("Time of day")
-        editor.dragged_look = None if not dragged and dragged_hours is None else (
-            dataclasses.replace(shading, **dragged),
-            scene.lighting if dragged_hours is None else dataclasses.replace(scene.lighting,
-                                                                             time_of_day=float(dragged_hours)))
-        changed_phase, phase_index = imgui.combo("Phase function", PHASE_NAMES.index(shading.phase),
-                                                 list(PHASE_NAMES))
+        editor.dragged_look = (
+            None
+            if not dragged and dragged_hours is None
+            else (
+                dataclasses.replace(shading, **dragged),
+                scene.lighting
+                if dragged_hours is None
+                else dataclasses.replace(scene.lighting, time_of_day=float(dragged_hours)),
+            )
+        )
+        changed_phase, phase_index = imgui.combo("Phase function", PHASE_NAMES.index(shading.phase), list(PHASE_NAMES))
         changes = {key: value for key, value in changes.items() if value is not None}
         if changed_phase:
             changes["phase"] = PHASE_NAMES[phase_index]
@@ -236,8 +270,10 @@ class Panels:
         settings = editor.settings
         changed_mode, mode = imgui.combo("Mode", MODES.index(settings.mode), list(MODES))
         changed_tol, tolerance = imgui.slider_float("Tolerance (deg)", settings.tolerance_deg, 0.0, 5.0, "%.3f")
-        imgui.set_item_tooltip("An impostor is remade once its translation error passes this; by default the "
-                               "parallax between its near and far points (Harris), 0.125 about one pixel.")
+        imgui.set_item_tooltip(
+            "An impostor is remade once its translation error passes this; by default the "
+            "parallax between its near and far points (Harris), 0.125 about one pixel."
+        )
         metrics = list(TRANSLATION_METRICS)
         changed_metric, metric = imgui.combo("Translation error", metrics.index(settings.translation_metric), metrics)
         ring_on = math.isfinite(settings.ring_radius)
@@ -249,34 +285,65 @@ class Panels:
         changed_group, group = imgui.checkbox("Group interpenetrating clouds", settings.group_clouds)
         sizes = [int(math.log2(settings.impostor_min_size)), int(math.log2(settings.impostor_max_size))]
         changed_sizes, sizes = imgui.slider_int2("Impostor size (log2)", sizes, 3, 12)
-        changed_detail, detail = imgui.slider_float("Detail (texels per particle)", settings.impostor_detail_texels,
-                                                    0.0, 8.0, "%.1f")
-        imgui.set_item_tooltip("An impostor texture is never finer than this many texels across the radius of "
-                               "the cloud's smallest particle; 0: the screen's resolution alone decides.")
-        changed_budget, budget = imgui.slider_int("Regeneration budget", settings.regeneration_budget, 0, 32,
-                                                  "%d" if settings.regeneration_budget else "no limit")
-        imgui.set_item_tooltip("Impostors remade per frame at most, those farthest past the tolerance first; "
-                               "0: no limit.")
+        changed_detail, detail = imgui.slider_float(
+            "Detail (texels per particle)", settings.impostor_detail_texels, 0.0, 8.0, "%.1f"
+        )
+        imgui.set_item_tooltip(
+            "An impostor texture is never finer than this many texels across the radius of "
+            "the cloud's smallest particle; 0: the screen's resolution alone decides."
+        )
+        changed_budget, budget = imgui.slider_int(
+            "Regeneration budget",
+            settings.regeneration_budget,
+            0,
+            32,
+            "%d" if settings.regeneration_budget else "no limit",
+        )
+        imgui.set_item_tooltip(
+            "Impostors remade per frame at most, those farthest past the tolerance first; 0: no limit."
+        )
         changed_frame_budget, frame_budget = imgui.slider_float(
-            "Frame budget (ms)", settings.frame_budget_ms, 0.0, 200.0,
-            "%.0f ms" if settings.frame_budget_ms else "none")
-        imgui.set_item_tooltip("Time for impostor updates and the cloud pass together, as the measured costs "
-                               "predict it; over it, regenerations wait and the error drawn grows past the "
-                               "tolerance (Statistics shows by how much). 0: none.")
-        if (changed_mode or changed_tol or changed_metric or changed_ring_on or changed_radius or changed_fade
-                or changed_group or changed_sizes or changed_detail or changed_budget or changed_frame_budget):
+            "Frame budget (ms)", settings.frame_budget_ms, 0.0, 200.0, "%.0f ms" if settings.frame_budget_ms else "none"
+        )
+        imgui.set_item_tooltip(
+            "Time for impostor updates and the cloud pass together, as the measured costs "
+            "predict it; over it, regenerations wait and the error drawn grows past the "
+            "tolerance (Statistics shows by how much). 0: none."
+        )
+        if (
+            changed_mode
+            or changed_tol
+            or changed_metric
+            or changed_ring_on
+            or changed_radius
+            or changed_fade
+            or changed_group
+            or changed_sizes
+            or changed_detail
+            or changed_budget
+            or changed_frame_budget
+        ):
             try:
                 editor.settings = dataclasses.replace(
-                    settings, mode=MODES[mode], tolerance_deg=tolerance,
+                    settings,
+                    mode=MODES[mode],
+                    tolerance_deg=tolerance,
                     ring_radius=radius if ring_on else math.inf,
-                    translation_metric=metrics[metric], transition_frames=transition, group_clouds=group,
-                    impostor_min_size=2 ** min(sizes), impostor_max_size=2 ** max(sizes),
-                    impostor_detail_texels=detail, regeneration_budget=budget, frame_budget_ms=frame_budget)
+                    translation_metric=metrics[metric],
+                    transition_frames=transition,
+                    group_clouds=group,
+                    impostor_min_size=2 ** min(sizes),
+                    impostor_max_size=2 ** max(sizes),
+                    impostor_detail_texels=detail,
+                    regeneration_budget=budget,
+                    frame_budget_ms=frame_budget,
+                )
             except ValueError as error:
                 editor.messages.append(str(error))
         imgui.separator_text("Overlays")
-        _, self.viewport.show_impostor_outlines = imgui.checkbox("Impostor outlines",
-                                                                 self.viewport.show_impostor_outlines)
+        _, self.viewport.show_impostor_outlines = imgui.checkbox(
+            "Impostor outlines", self.viewport.show_impostor_outlines
+        )
         imgui.same_line()
         _, self.viewport.show_ring_segments = imgui.checkbox("Ring segments", self.viewport.show_ring_segments)
 
@@ -298,8 +365,9 @@ class Panels:
         if imgui.button("Reset to the scene's camera"):
             editor.camera = editor.scene.camera
         if editor.scene_duration_s > 0.0:
-            _, editor.scene_time_s = imgui.slider_float("Scene time (s)", editor.scene_time_s, 0.0,
-                                                        editor.scene_duration_s)
+            _, editor.scene_time_s = imgui.slider_float(
+                "Scene time (s)", editor.scene_time_s, 0.0, editor.scene_duration_s
+            )
         self._camera_paths()
 
     def _camera_paths(self) -> None:
@@ -355,8 +423,14 @@ class Panels:
         editor = self.editor
         folder = editor.path.parent if editor.path else Path.cwd()
         try:
-            self.record_job = RecordJob(dataclasses.replace(editor.scene, camera=editor.camera), folder, path_name,
-                                        Path(self.record_out), *self.record_size, self.record_fps)
+            self.record_job = RecordJob(
+                dataclasses.replace(editor.scene, camera=editor.camera),
+                folder,
+                path_name,
+                Path(self.record_out),
+                *self.record_size,
+                self.record_fps,
+            )
         except (OSError, SceneError, ValueError) as error:
             editor.messages.append(f"could not start recording: {error}")
             return
@@ -373,34 +447,59 @@ class Panels:
         if not stats:
             return
         frame = stats.get("viewport_ms", stats["frame_ms"])
-        imgui.text(f"{frame:6.1f} ms ({1000.0 / max(frame, 1e-3):5.1f} fps)  clouds {stats['cloud_ms']:.1f}  "
-                   f"impostor updates {stats['impostor_update_ms']:.1f}  world {stats['world_ms']:.1f}")
-        imgui.text(f"particles drawn {stats['particles_drawn']}, rendered to impostors "
-                   f"{stats['particles_to_impostors']}")
-        imgui.text(f"impostors drawn {stats['impostors_drawn']}, regenerated {stats['impostors_regenerated']} "
-                   f"(total {self.viewport.regenerations_total}), postponed {stats['regenerations_postponed']}, "
-                   f"ring segments built {stats['ring_segments_built']}")
-        imgui.text(f"clouds: full {stats['clouds_full']}, crossfade {stats['clouds_crossfade']}, impostor "
-                   f"{stats['clouds_impostor']}, inside {stats['clouds_inside']}, ring {stats['clouds_ring']}, "
-                   f"culled {stats['clouds_culled']}")
-        imgui.text(f"units {stats['units']} ({stats['units_grouped']} of interpenetrating clouds); predicted "
-                   f"{stats['predicted_ms']:.1f} ms against {stats['impostor_update_ms'] + stats['cloud_ms']:.1f} "
-                   f"measured; largest error drawn {stats['accepted_error_tolerances']:.2f} x the tolerance "
-                   f"({stats['tolerance_deg']:.3f} deg)")
-        imgui.text(f"objects in clouds {stats['objects_in_clouds']}: layers drawn {stats['layers_drawn']}, "
-                   f"rebuilt {stats['layers_rebuilt']}")
+        imgui.text(
+            f"{frame:6.1f} ms ({1000.0 / max(frame, 1e-3):5.1f} fps)  clouds {stats['cloud_ms']:.1f}  "
+            f"impostor updates {stats['impostor_update_ms']:.1f}  world {stats['world_ms']:.1f}"
+        )
+        if stats.get("picture_reused"):
+            imgui.text("picture kept: nothing changed since it was drawn (clouds, updates, world: that frame's)")
+        if stats.get("relighting"):
+            hours = stats.get("shown_time_of_day")
+            imgui.text(
+                f"relighting in the background; shown meanwhile: {stats['shown_illumination']} light"
+                + (f" at {hours:.2f} h" if hours is not None else "")
+            )
+        imgui.text(
+            f"particles drawn {stats['particles_drawn']}, rendered to impostors {stats['particles_to_impostors']}"
+        )
+        imgui.text(
+            f"impostors drawn {stats['impostors_drawn']}, regenerated {stats['impostors_regenerated']} "
+            f"(total {self.viewport.regenerations_total}), postponed {stats['regenerations_postponed']}, "
+            f"ring segments built {stats['ring_segments_built']}"
+        )
+        imgui.text(
+            f"clouds: full {stats['clouds_full']}, crossfade {stats['clouds_crossfade']}, impostor "
+            f"{stats['clouds_impostor']}, inside {stats['clouds_inside']}, ring {stats['clouds_ring']}, "
+            f"culled {stats['clouds_culled']}"
+        )
+        imgui.text(
+            f"units {stats['units']} ({stats['units_grouped']} of interpenetrating clouds); predicted "
+            f"{stats['predicted_ms']:.1f} ms against {stats['impostor_update_ms'] + stats['cloud_ms']:.1f} "
+            f"measured; largest error drawn {stats['accepted_error_tolerances']:.2f} x the tolerance "
+            f"({stats['tolerance_deg']:.3f} deg)"
+        )
+        imgui.text(
+            f"objects in clouds {stats['objects_in_clouds']}: layers drawn {stats['layers_drawn']}, "
+            f"rebuilt {stats['layers_rebuilt']}"
+        )
         imgui.text(f"texture memory {stats['texture_bytes'] / 2**20:.1f} MiB")
         _, self.viewport.measure_overdraw = imgui.checkbox("Measure overdraw", self.viewport.measure_overdraw)
         imgui.same_line()
         _, self.viewport.heat_map = imgui.checkbox("Overdraw heat map", self.viewport.heat_map)
         if "overdraw_mean" in stats:
-            imgui.text(f"overdraw mean {stats['overdraw_mean']:.1f}, max {stats['overdraw_max']:.0f}, "
-                       f"analytic {stats['overdraw_analytic']:.1f}")
+            imgui.text(
+                f"overdraw mean {stats['overdraw_mean']:.1f}, max {stats['overdraw_max']:.0f}, "
+                f"analytic {stats['overdraw_analytic']:.1f}"
+            )
         history = list(editor.frame_times)
         if implot.begin_plot("Frame time (ms)", imgui.ImVec2(-1, 180)):
             frames = np.arange(len(history), dtype=np.float64)
             implot.setup_axes("frame", "ms", implot.AxisFlags_.auto_fit, implot.AxisFlags_.auto_fit)
-            for key, label in (("viewport_ms", "frame"), ("cloud_ms", "cloud pass"),
-                               ("impostor_update_ms", "impostor updates"), ("world_ms", "world")):
+            for key, label in (
+                ("viewport_ms", "frame"),
+                ("cloud_ms", "cloud pass"),
+                ("impostor_update_ms", "impostor updates"),
+                ("world_ms", "world"),
+            ):
                 implot.plot_line(label, frames, np.array([s.get(key, 0.0) for s in history], dtype=np.float64))
             implot.end_plot()

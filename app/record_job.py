@@ -25,6 +25,7 @@ from cloudcore.scenefile import save_scene
 def standalone(scene: Scene, folder: Path) -> Scene:
     """`scene` as it reads from anywhere: mesh files relative to `folder` made absolute, and particle files
     dropped (a save writes the particles with the copy, never over the originals)."""
+
     def absolute(name: str | None) -> str | None:
         return None if name is None else str((folder / name).resolve())
 
@@ -32,21 +33,39 @@ def standalone(scene: Scene, folder: Path) -> Scene:
     if terrain is not None:
         terrain = dataclasses.replace(terrain, mesh=absolute(terrain.mesh))
     return dataclasses.replace(
-        scene, terrain=terrain,
+        scene,
+        terrain=terrain,
         objects=tuple(dataclasses.replace(o, mesh=absolute(o.mesh)) for o in scene.objects),
-        clouds=tuple(dataclasses.replace(c, particles_file=None) for c in scene.clouds))
+        clouds=tuple(dataclasses.replace(c, particles_file=None) for c in scene.clouds),
+    )
 
 
 class RecordJob:
-    def __init__(self, scene: Scene, scene_folder: Path, path_name: str, out: Path, width: int, height: int,
-                 fps: float):
+    def __init__(
+        self, scene: Scene, scene_folder: Path, path_name: str, out: Path, width: int, height: int, fps: float
+    ):
         self.out = Path(out)
         self._folder = Path(tempfile.mkdtemp(prefix="cloudview-record-"))
         scene_file = self._folder / "scene.toml"
         save_scene(standalone(scene, scene_folder), scene_file)
-        command = [sys.executable, "-m", "cloudcore.cli", "record", str(scene_file), "--path", path_name,
-                   "--out", str(self.out), "--width", str(width), "--height", str(height), "--fps", str(fps),
-                   "--no-overdraw"]
+        command = [
+            sys.executable,
+            "-m",
+            "cloudcore.cli",
+            "record",
+            str(scene_file),
+            "--path",
+            path_name,
+            "--out",
+            str(self.out),
+            "--width",
+            str(width),
+            "--height",
+            str(height),
+            "--fps",
+            str(fps),
+            "--no-overdraw",
+        ]
         self._process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
         self.progress = "starting"
         self._reader = threading.Thread(target=self._read_output, daemon=True)

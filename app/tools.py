@@ -10,9 +10,20 @@ from __future__ import annotations
 import numpy as np
 
 from app.editor import Editor
-from cloudcore.editing import (BrushStroke, add_particle, add_particles, delete_particles, drag_offset,
-                               drag_plane_normal, particles_within, pick_particle, point_at_altitude,
-                               point_on_cloud, point_on_plane, translated)
+from cloudcore.editing import (
+    BrushStroke,
+    add_particle,
+    add_particles,
+    delete_particles,
+    drag_offset,
+    drag_plane_normal,
+    particles_within,
+    pick_particle,
+    point_at_altitude,
+    point_on_cloud,
+    point_on_plane,
+    translated,
+)
 
 
 class ViewportTools:
@@ -135,5 +146,10 @@ class ViewportTools:
                 editor.messages.append("the mouse is beyond the horizon of the cloud's plane: nothing to grab")
                 return
         editor.begin_gesture()
-        self._drag = (editor.scene, cloud, particle if one_particle else None, grabbed,
-                      drag_plane_normal(editor.camera, screen_plane))
+        self._drag = (
+            editor.scene,
+            cloud,
+            particle if one_particle else None,
+            grabbed,
+            drag_plane_normal(editor.camera, screen_plane),
+        )

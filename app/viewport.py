@@ -72,15 +72,20 @@ class Viewport:
         available = imgui.get_content_region_avail()
         width, height = max(1, int(available.x)), max(1, int(available.y))
         if self.renderer is None:
-            self.renderer = FrameRenderer(width, height, context=WindowContext(width, height),
-                                          illumination=self.relighting.cache)
+            self.renderer = FrameRenderer(
+                width, height, context=WindowContext(width, height), illumination=self.relighting.cache
+            )
         self.renderer.resize(width, height)
         start = time.perf_counter()
         scene, method = self._scene_as_shown()
         inputs = (scene, method, editor.camera, editor.settings, editor.scene_time_s, (width, height))
         plan = self.renderer.last_plan
-        if (inputs == self._last_inputs and plan is not None and (plan.settled or self.relighting.busy)
-                and not (self.measure_overdraw or self.heat_map)):
+        if (
+            inputs == self._last_inputs
+            and plan is not None
+            and (plan.settled or self.relighting.busy)
+            and not (self.measure_overdraw or self.heat_map)
+        ):
             # the same inputs and nothing converging, or nothing worth converging to while a new light is on its
             # way (the impostors and ring would be remade for a light already superseded): the same picture,
             # and the cores go to the relighting worker
@@ -88,11 +93,21 @@ class Viewport:
             if self.relighting.busy:
                 time.sleep(RELIGHT_PAUSE_S)
         else:
-            _, stats = self.renderer.render(scene, camera=editor.camera, settings=editor.settings,
-                                            time_s=editor.scene_time_s, read_back=False, illumination_method=method)
+            _, stats = self.renderer.render(
+                scene,
+                camera=editor.camera,
+                settings=editor.settings,
+                time_s=editor.scene_time_s,
+                read_back=False,
+                illumination_method=method,
+            )
             self._last_inputs, self._last_stats = inputs, stats
-        stats |= {"relighting": self.relighting.busy, "shown_time_of_day": scene.lighting.time_of_day,
-                  "shown_illumination": method, "frame_start_s": now}
+        stats |= {
+            "relighting": self.relighting.busy,
+            "shown_time_of_day": scene.lighting.time_of_day,
+            "shown_illumination": method,
+            "frame_start_s": now,
+        }
         heat = None
         if self.measure_overdraw or self.heat_map:
             counts, overdraw = self.renderer.measure_overdraw()
@@ -110,8 +125,11 @@ class Viewport:
         if self.capture_next:
             self.captured = heat[0][..., :3] if heat is not None else self.renderer.read_display()
             self.capture_next = False
-        stats |= {"viewport_ms": 1e3 * (time.perf_counter() - start), "viewport_width": width,
-                  "viewport_height": height}
+        stats |= {
+            "viewport_ms": 1e3 * (time.perf_counter() - start),
+            "viewport_width": width,
+            "viewport_height": height,
+        }
         self.regenerations_total += stats.get("impostors_regenerated", 0)
         editor.record_frame(stats)
 
@@ -119,8 +137,11 @@ class Viewport:
         imgui.image(imgui.ImTextureRef(texture), imgui.ImVec2(width, height), uv_top_left, uv_bottom_right)
         self._draw_overlays(origin, (width, height), heat[1] if heat is not None else None)
         imgui.set_cursor_screen_pos(origin)
-        clicked = imgui.invisible_button("canvas", imgui.ImVec2(width, height),
-                                         imgui.ButtonFlags_.mouse_button_left | imgui.ButtonFlags_.mouse_button_right)
+        clicked = imgui.invisible_button(
+            "canvas",
+            imgui.ImVec2(width, height),
+            imgui.ButtonFlags_.mouse_button_left | imgui.ButtonFlags_.mouse_button_right,
+        )
         hovered = imgui.is_item_hovered()
         self._use_tool(origin, (width, height), clicked, seconds)
         self._navigate(hovered, seconds)
@@ -162,16 +183,18 @@ class Viewport:
             outlines += ring_outlines(plan, editor.camera, size, editor.settings.ring_elevation_deg)
         for outline in outlines:
             points = [imgui.ImVec2(origin.x + x, origin.y + y) for x, y in outline.points]
-            draw.add_polyline(points, imgui.IM_COL32(*_OUTLINE_COLOURS[outline.kind]), 1.5,
-                              imgui.ImDrawFlags_.closed.value)
+            draw.add_polyline(
+                points, imgui.IM_COL32(*_OUTLINE_COLOURS[outline.kind]), 1.5, imgui.ImDrawFlags_.closed.value
+            )
         self.outlines_drawn = outlines
         picked = editor.picked_particle
         if picked is not None:
             pixels, in_front = to_pixels(editor.scene.clouds[picked[0]].centres[picked[1]], editor.camera, size)
             if in_front[0]:
                 x, y = pixels[0]
-                draw.add_circle(imgui.ImVec2(origin.x + x, origin.y + y), 6.0, imgui.IM_COL32(*_PICKED_COLOUR),
-                                thickness=2.0)
+                draw.add_circle(
+                    imgui.ImVec2(origin.x + x, origin.y + y), 6.0, imgui.IM_COL32(*_PICKED_COLOUR), thickness=2.0
+                )
         if heat_top is not None:
             self._draw_legend(draw, origin, size, heat_top)
 
@@ -181,13 +204,19 @@ class Viewport:
         left, bottom = origin.x + 10.0, origin.y + size[1] - 10.0
         for step, colour in enumerate(ramp_colours(np.linspace(0.0, 1.0, _LEGEND_STEPS))):
             x = left + step * step_width
-            draw.add_rect_filled(imgui.ImVec2(x, bottom - bar_height), imgui.ImVec2(x + step_width, bottom),
-                                 imgui.IM_COL32(*(int(c) for c in colour), 255))
+            draw.add_rect_filled(
+                imgui.ImVec2(x, bottom - bar_height),
+                imgui.ImVec2(x + step_width, bottom),
+                imgui.IM_COL32(*(int(c) for c in colour), 255),
+            )
         white = imgui.IM_COL32(255, 255, 255, 255)
         label_y = bottom - bar_height - imgui.get_text_line_height() - 2.0
         draw.add_text(imgui.ImVec2(left, label_y), white, "0")
-        draw.add_text(imgui.ImVec2(left + _LEGEND_STEPS * step_width + 6.0, bottom - imgui.get_text_line_height()),
-                      white, f"{top:g} fragments per pixel")
+        draw.add_text(
+            imgui.ImVec2(left + _LEGEND_STEPS * step_width + 6.0, bottom - imgui.get_text_line_height()),
+            white,
+            f"{top:g} fragments per pixel",
+        )
 
     def _navigate(self, hovered: bool, seconds: float) -> None:
         editor, io = self.editor, imgui.get_io()
@@ -197,8 +226,14 @@ class Viewport:
         if not hovered:
             return
         step = self.fly_speed * seconds
-        keys = {imgui.Key.w: (step, 0, 0), imgui.Key.s: (-step, 0, 0), imgui.Key.d: (0, step, 0),
-                imgui.Key.a: (0, -step, 0), imgui.Key.e: (0, 0, step), imgui.Key.q: (0, 0, -step)}
+        keys = {
+            imgui.Key.w: (step, 0, 0),
+            imgui.Key.s: (-step, 0, 0),
+            imgui.Key.d: (0, step, 0),
+            imgui.Key.a: (0, -step, 0),
+            imgui.Key.e: (0, 0, step),
+            imgui.Key.q: (0, 0, -step),
+        }
         for key, (forward, right, up) in keys.items():
             if imgui.is_key_down(key) and not io.key_ctrl:
                 editor.camera = moved(editor.camera, forward, right, up)

@@ -42,23 +42,46 @@ DEFAULT_GROUP_RADII = 3.0
 #: (Wang: "we allow more samples around dawn and dusk").  The sun of cloudcore.lighting rises near
 #: 05:15 and sets near 18:45.
 DEFAULT_LEVEL_PERCENT_BY_HOUR = (
-    (0.0, 10.0), (4.5, 12.0), (5.0, 25.0), (5.5, 45.0), (6.0, 70.0), (7.0, 90.0), (9.0, 100.0),
-    (15.0, 100.0), (17.0, 90.0), (18.0, 70.0), (18.5, 45.0), (19.0, 25.0), (19.5, 12.0),
+    (0.0, 10.0),
+    (4.5, 12.0),
+    (5.0, 25.0),
+    (5.5, 45.0),
+    (6.0, 70.0),
+    (7.0, 90.0),
+    (9.0, 100.0),
+    (15.0, 100.0),
+    (17.0, 90.0),
+    (18.0, 70.0),
+    (18.5, 45.0),
+    (19.0, 25.0),
+    (19.5, 12.0),
 )
 #: the maximum directional colour by hour: cloudcore.lighting's sun beam at these hours (red low in the
 #: sky, warm white by day, none at night), scaled to leave the levels room below white
 DEFAULT_DIRECTIONAL_COLOUR_BY_HOUR = (
-    (0.0, 0.0, 0.0, 0.0), (4.75, 0.0, 0.0, 0.0), (5.25, 0.22, 0.08, 0.02), (5.75, 0.38, 0.24, 0.10),
-    (6.5, 0.42, 0.35, 0.24), (8.0, 0.44, 0.41, 0.34), (12.0, 0.45, 0.43, 0.38), (16.0, 0.44, 0.41, 0.34),
-    (17.5, 0.42, 0.35, 0.24), (18.25, 0.38, 0.24, 0.10), (18.75, 0.22, 0.08, 0.02), (19.25, 0.0, 0.0, 0.0),
+    (0.0, 0.0, 0.0, 0.0),
+    (4.75, 0.0, 0.0, 0.0),
+    (5.25, 0.22, 0.08, 0.02),
+    (5.75, 0.38, 0.24, 0.10),
+    (6.5, 0.42, 0.35, 0.24),
+    (8.0, 0.44, 0.41, 0.34),
+    (12.0, 0.45, 0.43, 0.38),
+    (16.0, 0.44, 0.41, 0.34),
+    (17.5, 0.42, 0.35, 0.24),
+    (18.25, 0.38, 0.24, 0.10),
+    (18.75, 0.22, 0.08, 0.02),
+    (19.25, 0.0, 0.0, 0.0),
 )
 #: (min, median, max) fractions of the directional colour.  Wang leaves them to the artist and gives
 #: no numbers; a median above the middle keeps the terminator lit and puts the gradient on the far side.
 DEFAULT_DIRECTIONAL_RANGE = (0.2, 0.7, 1.0)
 #: a nearly white cloud, greyer at the bottom
 DEFAULT_LEVELS = (
-    (0.0, 0.62, 0.64, 0.68, 1.0), (0.15, 0.70, 0.71, 0.74, 1.0), (0.4, 0.76, 0.77, 0.79, 1.0),
-    (0.7, 0.80, 0.80, 0.82, 1.0), (1.0, 0.82, 0.82, 0.84, 1.0),
+    (0.0, 0.62, 0.64, 0.68, 1.0),
+    (0.15, 0.70, 0.71, 0.74, 1.0),
+    (0.4, 0.76, 0.77, 0.79, 1.0),
+    (0.7, 0.80, 0.80, 0.82, 1.0),
+    (1.0, 0.82, 0.82, 0.84, 1.0),
 )
 
 
@@ -98,10 +121,12 @@ class ArtistShading:
         _check_unit_interval("directional_colour_by_hour", directional[:, 1:], "colours")
         mapping = _rows("directional_range", [self.directional_range], 3)[0]
         if not 0.0 <= mapping[0] <= mapping[1] <= mapping[2] <= 1.0:
-            raise FieldError("directional_range",
-                             f"expected 0 <= min <= median <= max <= 1, got {mapping.tolist()}")
-        for name, value in (("levels", levels), ("level_percent_by_hour", percent),
-                            ("directional_colour_by_hour", directional)):
+            raise FieldError("directional_range", f"expected 0 <= min <= median <= max <= 1, got {mapping.tolist()}")
+        for name, value in (
+            ("levels", levels),
+            ("level_percent_by_hour", percent),
+            ("directional_colour_by_hour", directional),
+        ):
             object.__setattr__(self, name, tuple(tuple(row) for row in value.tolist()))
         object.__setattr__(self, "directional_range", tuple(mapping.tolist()))
 
@@ -235,8 +260,15 @@ def artist_uniforms(model: ArtistShading, hour: float, sun_direction) -> dict[st
     }
 
 
-def artist_colours(model: ArtistShading, vertex_positions, cloud_bottom_y: float, cloud_top_y: float,
-                   group_centres_per_vertex, sun_direction, hour: float) -> np.ndarray:
+def artist_colours(
+    model: ArtistShading,
+    vertex_positions,
+    cloud_bottom_y: float,
+    cloud_top_y: float,
+    group_centres_per_vertex,
+    sun_direction,
+    hour: float,
+) -> np.ndarray:
     """Wang's vertex colour (n, 4) RGBA in [0, 1]: ambient + directional, before texture and formation.
 
     `cloud_bottom_y` and `cloud_top_y` bound the cloud's vertical extent: its
@@ -295,7 +327,7 @@ def _grid_cells(centres: np.ndarray, group_size_m: float) -> np.ndarray:
 
 def _cells_exact(cells: np.ndarray) -> bool:
     """Beyond 2**53 the cell numbers stop being exact integers (an infinite extent is beyond too)."""
-    return bool(np.all(cells < 2.0 ** 53))
+    return bool(np.all(cells < 2.0**53))
 
 
 def default_group_size(radii) -> float:

@@ -80,13 +80,17 @@ def _run(renderer, scene: Scene, views, settings: RenderSettings, reference=None
 
 def _summary(rows) -> dict:
     times = np.array([r["frame_ms"] for r in rows])
-    return {"frame_ms_mean": float(times.mean()), "frame_ms_p95": float(np.percentile(times, 95)),
-            "cloud_ms_mean": float(np.mean([r["cloud_ms"] + r.get("impostor_update_ms", 0.0) for r in rows])),
-            "world_ms_mean": float(np.mean([r["world_ms"] for r in rows]))}
+    return {
+        "frame_ms_mean": float(times.mean()),
+        "frame_ms_p95": float(np.percentile(times, 95)),
+        "cloud_ms_mean": float(np.mean([r["cloud_ms"] + r.get("impostor_update_ms", 0.0) for r in rows])),
+        "world_ms_mean": float(np.mean([r["world_ms"] for r in rows])),
+    }
 
 
-def bench_path(renderer, scene: Scene, path_name: str, frames: int, settings_list, size, progress=None,
-               views=None, warmup: int = 0) -> dict:
+def bench_path(
+    renderer, scene: Scene, path_name: str, frames: int, settings_list, size, progress=None, views=None, warmup: int = 0
+) -> dict:
     """The report: reference (full 3D) and one run per settings object, errors per frame and overall.
 
     The frames are `views` ((scene clock, camera) pairs) when given, else `frames` along the path;
@@ -101,20 +105,32 @@ def bench_path(renderer, scene: Scene, path_name: str, frames: int, settings_lis
         _, rows = _run(renderer, scene, views, settings, reference_images, progress, warmup)
         psnr = np.array([r["psnr_db"] for r in rows])
         summary = _summary(rows)
-        runs.append({
-            "settings": dataclasses.asdict(settings), **summary,
-            "speedup_vs_full": reference["frame_ms_mean"] / summary["frame_ms_mean"],
-            "cloud_speedup_vs_full": reference["cloud_ms_mean"] / summary["cloud_ms_mean"],
-            "psnr_mean": float(psnr.mean()), "psnr_min": float(psnr.min()),
-            "mad_mean": float(np.mean([r["mad"] for r in rows])),
-            "regenerations": int(sum(r.get("impostors_regenerated", 0) for r in rows)),
-            "regenerations_per_frame": float(np.mean([r.get("impostors_regenerated", 0) for r in rows])),
-            "predicted_ms_mean": float(np.mean([r.get("predicted_ms", 0.0) for r in rows])),
-            "frames_below_30_db": int(np.sum(psnr < 30.0)),
-            "texture_bytes_max": int(max(r.get("texture_bytes", 0) for r in rows)),
-            "per_frame": rows})
-    return {"scene": scene.description or "", "path": path_name, "width": size[0], "height": size[1],
-            "frames": frames, "reference": reference, "runs": runs}
+        runs.append(
+            {
+                "settings": dataclasses.asdict(settings),
+                **summary,
+                "speedup_vs_full": reference["frame_ms_mean"] / summary["frame_ms_mean"],
+                "cloud_speedup_vs_full": reference["cloud_ms_mean"] / summary["cloud_ms_mean"],
+                "psnr_mean": float(psnr.mean()),
+                "psnr_min": float(psnr.min()),
+                "mad_mean": float(np.mean([r["mad"] for r in rows])),
+                "regenerations": int(sum(r.get("impostors_regenerated", 0) for r in rows)),
+                "regenerations_per_frame": float(np.mean([r.get("impostors_regenerated", 0) for r in rows])),
+                "predicted_ms_mean": float(np.mean([r.get("predicted_ms", 0.0) for r in rows])),
+                "frames_below_30_db": int(np.sum(psnr < 30.0)),
+                "texture_bytes_max": int(max(r.get("texture_bytes", 0) for r in rows)),
+                "per_frame": rows,
+            }
+        )
+    return {
+        "scene": scene.description or "",
+        "path": path_name,
+        "width": size[0],
+        "height": size[1],
+        "frames": frames,
+        "reference": reference,
+        "runs": runs,
+    }
 
 
 def shading_comparison(scene: Scene, resolutions=(32, 48, 96), repeat: int = 1) -> list[dict]:
@@ -123,14 +139,29 @@ def shading_comparison(scene: Scene, resolutions=(32, 48, 96), repeat: int = 1) 
     rows = []
     for index, light in enumerate(active_lights(lights)):
         exact_s, exact = _timed_shading(scene, light, "exact", repeat)
-        rows.append({"light": index, "method": "exact", "seconds": exact_s, "particles": len(exact),
-                     "max_abs_error_vs_exact": 0.0, "mean_abs_error_vs_exact": 0.0})
+        rows.append(
+            {
+                "light": index,
+                "method": "exact",
+                "seconds": exact_s,
+                "particles": len(exact),
+                "max_abs_error_vs_exact": 0.0,
+                "mean_abs_error_vs_exact": 0.0,
+            }
+        )
         for resolution in resolutions:
             seconds, raster = _timed_shading(scene, light, "raster", repeat, resolution)
             error = np.abs(raster - exact)
-            rows.append({"light": index, "method": f"raster-{resolution}", "seconds": seconds,
-                         "particles": len(raster), "max_abs_error_vs_exact": float(error.max(initial=0.0)),
-                         "mean_abs_error_vs_exact": float(error.mean()) if error.size else 0.0})
+            rows.append(
+                {
+                    "light": index,
+                    "method": f"raster-{resolution}",
+                    "seconds": seconds,
+                    "particles": len(raster),
+                    "max_abs_error_vs_exact": float(error.max(initial=0.0)),
+                    "mean_abs_error_vs_exact": float(error.mean()) if error.size else 0.0,
+                }
+            )
     return rows
 
 
@@ -147,8 +178,11 @@ def _timed_shading(scene: Scene, light, method: str, repeat: int, resolution: in
 def pareto_front(seconds, errors) -> list[int]:
     """Indices of the points no other point beats in both time and error (lower is better in both)."""
     points = list(zip(seconds, errors))
-    return [i for i, (t, e) in enumerate(points)
-            if not any((t2 <= t and e2 <= e) and (t2 < t or e2 < e) for t2, e2 in points)]
+    return [
+        i
+        for i, (t, e) in enumerate(points)
+        if not any((t2 <= t and e2 <= e) and (t2 < t or e2 < e) for t2, e2 in points)
+    ]
 
 
 def machine() -> str:

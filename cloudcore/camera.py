@@ -45,8 +45,9 @@ def view_matrix(camera: Camera) -> np.ndarray:
     return view
 
 
-def projection_matrix(fov_y_deg: float, aspect: float,
-                      near: float = NEAR_PLANE_M, far: float = FAR_PLANE_M) -> np.ndarray:
+def projection_matrix(
+    fov_y_deg: float, aspect: float, near: float = NEAR_PLANE_M, far: float = FAR_PLANE_M
+) -> np.ndarray:
     """OpenGL perspective projection, vertical field of view in degrees, aspect = width / height."""
     focal = 1.0 / np.tan(0.5 * np.radians(fov_y_deg))
     projection = np.zeros((4, 4))
@@ -64,9 +65,16 @@ def frustum_planes(view_projection: np.ndarray) -> np.ndarray:
     Gribb and Hartmann: a point x is inside plane i when planes[i] . (x, 1) >= 0.
     """
     rows = view_projection
-    planes = np.array([rows[3] + rows[0], rows[3] - rows[0],
-                       rows[3] + rows[1], rows[3] - rows[1],
-                       rows[3] + rows[2], rows[3] - rows[2]])
+    planes = np.array(
+        [
+            rows[3] + rows[0],
+            rows[3] - rows[0],
+            rows[3] + rows[1],
+            rows[3] - rows[1],
+            rows[3] + rows[2],
+            rows[3] - rows[2],
+        ]
+    )
     return planes / np.linalg.norm(planes[:, :3], axis=1, keepdims=True)
 
 

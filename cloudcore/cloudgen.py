@@ -46,11 +46,14 @@ def cumulus(centre, size, count: int, particle_radius: float, seed: int) -> np.n
     centre = np.asarray(centre, dtype=np.float64)
     turrets = max(3, int(rng.integers(4, 8)))
     offsets = rng.uniform(-0.5, 0.5, (turrets, 3)) * np.array([width * 0.55, 0.0, depth * 0.55])
-    radii = np.stack([
-        rng.uniform(0.30, 0.45, turrets) * width,
-        rng.uniform(0.55, 1.0, turrets) * height,
-        rng.uniform(0.30, 0.45, turrets) * depth,
-    ], axis=1)
+    radii = np.stack(
+        [
+            rng.uniform(0.30, 0.45, turrets) * width,
+            rng.uniform(0.55, 1.0, turrets) * height,
+            rng.uniform(0.30, 0.45, turrets) * depth,
+        ],
+        axis=1,
+    )
     # the biggest turret sits in the middle so the cloud has a dominant head
     offsets[0] = 0.0
     radii[0] = (0.5 * width, height, 0.5 * depth)
@@ -93,8 +96,9 @@ def cull_close(positions: np.ndarray, cull_distance: float) -> np.ndarray:
     return np.flatnonzero(~dropped)
 
 
-def box_fill(box_min, box_max, particle_radius: float, count: int, cull_distance: float | None = None,
-             seed: int = 0) -> np.ndarray:
+def box_fill(
+    box_min, box_max, particle_radius: float, count: int, cull_distance: float | None = None, seed: int = 0
+) -> np.ndarray:
     """Particles (n, 4) as (x, y, z, radius), n <= count: `count` sprite centres placed uniformly in
     the box [box_min, box_max], then culled (`cull_close`).
 
@@ -164,8 +168,9 @@ def _levels(bottom: Vec3, top: Vec3, alpha: tuple[float, ...] = (1.0,) * 5) -> t
     heights = (0.0, 0.2, 0.45, 0.75, 1.0)
     weights = (0.0, 0.4, 0.7, 0.9, 1.0)
     # rounded so that scene files show the numbers an artist would type
-    return tuple((h, *(round(b + w * (t - b), 3) for b, t in zip(bottom, top)), a)
-                 for h, w, a in zip(heights, weights, alpha))
+    return tuple(
+        (h, *(round(b + w * (t - b), 3) for b, t in zip(bottom, top)), a) for h, w, a in zip(heights, weights, alpha)
+    )
 
 
 #: camera-facing puffs and wisps, any rotation, flat-bottom sprites along the base
@@ -180,59 +185,115 @@ PRESETS: dict[str, CloudPreset] = {
     "cumulus_humilis": CloudPreset(
         size=(900.0, 450.0, 800.0),
         boxes=(((-0.5, 0.0, -0.5), (0.5, 0.45, 0.5)), ((-0.3, 0.3, -0.3), (0.3, 1.0, 0.3))),
-        particle_radius=75.0, count=160, cull_fraction=TYPICAL_CULL_FRACTION,
-        optical_depth=6.0, albedo=0.9, color=(1.0, 1.0, 1.0),
+        particle_radius=75.0,
+        count=160,
+        cull_fraction=TYPICAL_CULL_FRACTION,
+        optical_depth=6.0,
+        albedo=0.9,
+        color=(1.0, 1.0, 1.0),
         sprite=_CUMULUS_SPRITES,
-        artist=ArtistShading(levels=_levels((0.62, 0.64, 0.68), (0.82, 0.82, 0.84)))),
+        artist=ArtistShading(levels=_levels((0.62, 0.64, 0.68), (0.82, 0.82, 0.84))),
+    ),
     "cumulus_congestus": CloudPreset(
         size=(1800.0, 3000.0, 1600.0),
-        boxes=(((-0.5, 0.0, -0.5), (0.5, 0.3, 0.5)), ((-0.35, 0.2, -0.35), (0.35, 0.8, 0.35)),
-               ((-0.2, 0.7, -0.2), (0.25, 1.0, 0.2))),
-        particle_radius=170.0, count=700, cull_fraction=TYPICAL_CULL_FRACTION,
-        optical_depth=10.0, albedo=0.9, color=(0.96, 0.96, 0.98),
+        boxes=(
+            ((-0.5, 0.0, -0.5), (0.5, 0.3, 0.5)),
+            ((-0.35, 0.2, -0.35), (0.35, 0.8, 0.35)),
+            ((-0.2, 0.7, -0.2), (0.25, 1.0, 0.2)),
+        ),
+        particle_radius=170.0,
+        count=700,
+        cull_fraction=TYPICAL_CULL_FRACTION,
+        optical_depth=10.0,
+        albedo=0.9,
+        color=(0.96, 0.96, 0.98),
         sprite=dataclasses.replace(_CUMULUS_SPRITES, flat_bottom_fraction=0.06),
-        artist=ArtistShading(levels=_levels((0.36, 0.38, 0.43), (0.80, 0.80, 0.82)),
-                             directional_range=(0.1, 0.6, 1.0))),
+        artist=ArtistShading(levels=_levels((0.36, 0.38, 0.43), (0.80, 0.80, 0.82)), directional_range=(0.1, 0.6, 1.0)),
+    ),
     "stratus": CloudPreset(
-        size=(9000.0, 300.0, 7000.0), boxes=(_WHOLE,),
-        particle_radius=220.0, count=1000, cull_fraction=TYPICAL_CULL_FRACTION,
-        optical_depth=3.0, albedo=0.85, color=(0.80, 0.82, 0.86),
+        size=(9000.0, 300.0, 7000.0),
+        boxes=(_WHOLE,),
+        particle_radius=220.0,
+        count=1000,
+        cull_fraction=TYPICAL_CULL_FRACTION,
+        optical_depth=3.0,
+        albedo=0.85,
+        color=(0.80, 0.82, 0.86),
         sprite=SpriteStyle(rows=(FOGGY, FOGGY, FOGGY, WISPY)),
-        artist=ArtistShading(levels=_levels((0.50, 0.52, 0.56), (0.62, 0.63, 0.66), (0.5, 0.55, 0.55, 0.5, 0.4)),
-                             directional_range=(0.4, 0.75, 1.0))),
+        artist=ArtistShading(
+            levels=_levels((0.50, 0.52, 0.56), (0.62, 0.63, 0.66), (0.5, 0.55, 0.55, 0.5, 0.4)),
+            directional_range=(0.4, 0.75, 1.0),
+        ),
+    ),
     "stratocumulus": CloudPreset(
         size=(4500.0, 600.0, 4000.0),
-        boxes=(((-0.5, 0.0, -0.5), (0.5, 0.55, 0.5)), ((-0.4, 0.3, -0.35), (-0.05, 1.0, 0.05)),
-               ((0.05, 0.3, -0.1), (0.4, 0.9, 0.4)), ((-0.3, 0.3, 0.15), (0.1, 0.85, 0.45))),
-        particle_radius=200.0, count=800, cull_fraction=TYPICAL_CULL_FRACTION,
-        optical_depth=5.0, albedo=0.88, color=(0.86, 0.87, 0.90),
+        boxes=(
+            ((-0.5, 0.0, -0.5), (0.5, 0.55, 0.5)),
+            ((-0.4, 0.3, -0.35), (-0.05, 1.0, 0.05)),
+            ((0.05, 0.3, -0.1), (0.4, 0.9, 0.4)),
+            ((-0.3, 0.3, 0.15), (0.1, 0.85, 0.45)),
+        ),
+        particle_radius=200.0,
+        count=800,
+        cull_fraction=TYPICAL_CULL_FRACTION,
+        optical_depth=5.0,
+        albedo=0.88,
+        color=(0.86, 0.87, 0.90),
         sprite=SpriteStyle(rows=(FOGGY, PUFFY, PUFFY, WISPY), flat_bottom_fraction=0.1),
-        artist=ArtistShading(levels=_levels((0.40, 0.42, 0.46), (0.66, 0.67, 0.70), (0.9, 0.95, 1.0, 1.0, 0.95)),
-                             directional_range=(0.2, 0.65, 1.0))),
+        artist=ArtistShading(
+            levels=_levels((0.40, 0.42, 0.46), (0.66, 0.67, 0.70), (0.9, 0.95, 1.0, 1.0, 0.95)),
+            directional_range=(0.2, 0.65, 1.0),
+        ),
+    ),
     "cumulonimbus": CloudPreset(
         size=(6000.0, 11000.0, 6000.0),
-        boxes=(((-0.45, 0.0, -0.45), (0.45, 0.25, 0.45)), ((-0.3, 0.15, -0.3), (0.3, 0.85, 0.3)),
-               ((-0.5, 0.82, -0.5), (0.5, 1.0, 0.5))),
-        particle_radius=600.0, count=1400, cull_fraction=DENSE_CULL_FRACTION,
-        optical_depth=16.0, albedo=0.95, color=(0.62, 0.64, 0.68),
+        boxes=(
+            ((-0.45, 0.0, -0.45), (0.45, 0.25, 0.45)),
+            ((-0.3, 0.15, -0.3), (0.3, 0.85, 0.3)),
+            ((-0.5, 0.82, -0.5), (0.5, 1.0, 0.5)),
+        ),
+        particle_radius=600.0,
+        count=1400,
+        cull_fraction=DENSE_CULL_FRACTION,
+        optical_depth=16.0,
+        albedo=0.95,
+        color=(0.62, 0.64, 0.68),
         sprite=SpriteStyle(rows=(PUFFY, PUFFY, FOGGY, WISPY), flat_bottom_fraction=0.05),
-        artist=ArtistShading(levels=_levels((0.12, 0.13, 0.16), (0.42, 0.43, 0.46)),
-                             directional_range=(0.05, 0.5, 1.0))),
+        artist=ArtistShading(
+            levels=_levels((0.12, 0.13, 0.16), (0.42, 0.43, 0.46)), directional_range=(0.05, 0.5, 1.0)
+        ),
+    ),
     "altocumulus": CloudPreset(
-        size=(3000.0, 250.0, 3000.0), boxes=(_WHOLE,),
-        particle_radius=70.0, count=600, cull_fraction=TYPICAL_CULL_FRACTION,
-        optical_depth=4.0, albedo=0.9, color=(0.95, 0.95, 0.97),
+        size=(3000.0, 250.0, 3000.0),
+        boxes=(_WHOLE,),
+        particle_radius=70.0,
+        count=600,
+        cull_fraction=TYPICAL_CULL_FRACTION,
+        optical_depth=4.0,
+        albedo=0.9,
+        color=(0.95, 0.95, 0.97),
         sprite=SpriteStyle(rows=(PUFFY, PUFFY, WISPY)),
-        artist=ArtistShading(levels=_levels((0.58, 0.60, 0.64), (0.76, 0.77, 0.79), (0.8, 0.85, 0.9, 0.9, 0.85)),
-                             directional_range=(0.25, 0.7, 1.0))),
+        artist=ArtistShading(
+            levels=_levels((0.58, 0.60, 0.64), (0.76, 0.77, 0.79), (0.8, 0.85, 0.9, 0.9, 0.85)),
+            directional_range=(0.25, 0.7, 1.0),
+        ),
+    ),
     # few large wisps lying flat, all within 20 degrees of one heading, as high winds comb cirrus
     "cirrus": CloudPreset(
-        size=(7000.0, 300.0, 5000.0), boxes=(_WHOLE,),
-        particle_radius=500.0, count=120, cull_fraction=TYPICAL_CULL_FRACTION,
-        optical_depth=1.5, albedo=0.9, color=(0.97, 0.97, 1.0),
+        size=(7000.0, 300.0, 5000.0),
+        boxes=(_WHOLE,),
+        particle_radius=500.0,
+        count=120,
+        cull_fraction=TYPICAL_CULL_FRACTION,
+        optical_depth=1.5,
+        albedo=0.9,
+        color=(0.97, 0.97, 1.0),
         sprite=SpriteStyle(rows=(WISPY,), rotation_deg=(-20.0, 20.0), facing="horizontal"),
-        artist=ArtistShading(levels=_levels((0.74, 0.76, 0.80), (0.80, 0.82, 0.86), (0.45, 0.5, 0.5, 0.5, 0.45)),
-                             directional_range=(0.5, 0.8, 1.0))),
+        artist=ArtistShading(
+            levels=_levels((0.74, 0.76, 0.80), (0.80, 0.82, 0.86), (0.45, 0.5, 0.5, 0.5, 0.45)),
+            directional_range=(0.5, 0.8, 1.0),
+        ),
+    ),
 }
 
 
@@ -262,6 +323,12 @@ def preset_cloud(preset: str, name: str, base_centre, scale: float = 1.0, seed: 
     per_box = rng.multinomial(p.count, volumes / volumes.sum())
     centres = np.concatenate([rng.uniform(low, high, (n, 3)) for (low, high), n in zip(corners, per_box)])
     kept = centres[cull_close(centres, p.cull_fraction * 2.0 * radius)]
-    return Cloud(name, np.column_stack([kept, np.full(len(kept), radius)]),
-                 optical_depth=p.optical_depth, albedo=p.albedo, color=p.color,
-                 sprite=dataclasses.replace(p.sprite, seed=seed), artist=p.artist)
+    return Cloud(
+        name,
+        np.column_stack([kept, np.full(len(kept), radius)]),
+        optical_depth=p.optical_depth,
+        albedo=p.albedo,
+        color=p.color,
+        sprite=dataclasses.replace(p.sprite, seed=seed),
+        artist=p.artist,
+    )

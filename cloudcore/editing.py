@@ -198,8 +198,16 @@ def drag_offset(origin, direction, grabbed, normal) -> np.ndarray | None:
     return None if point is None else point - np.asarray(grabbed, dtype=np.float64)
 
 
-def fill_box(scene: Scene, cloud_index: int | None, centre, size, particle_radius: float, count: int,
-             cull_distance: float | None = None, seed: int = 0) -> tuple[Scene, int]:
+def fill_box(
+    scene: Scene,
+    cloud_index: int | None,
+    centre,
+    size,
+    particle_radius: float,
+    count: int,
+    cull_distance: float | None = None,
+    seed: int = 0,
+) -> tuple[Scene, int]:
     """(scene, index of the filled cloud): Wang's box fill (`cloudgen.box_fill`) of the box `size` around
     `centre`, added to cloud `cloud_index`, or to a new cloud when it is None.
 
@@ -234,7 +242,7 @@ def _unique_name(scene: Scene, stem: str) -> str:
 
 
 def delete_cloud(scene: Scene, cloud_index: int) -> Scene:
-    return dataclasses.replace(scene, clouds=scene.clouds[:cloud_index] + scene.clouds[cloud_index + 1:])
+    return dataclasses.replace(scene, clouds=scene.clouds[:cloud_index] + scene.clouds[cloud_index + 1 :])
 
 
 def replace_cloud(scene: Scene, cloud_index: int, cloud: Cloud) -> Scene:
@@ -276,7 +284,7 @@ class History:
             self._push_undo(start)
 
     def _push_undo(self, scene: Scene) -> None:
-        self._undo = (self._undo + [scene])[-self._limit:]
+        self._undo = (self._undo + [scene])[-self._limit :]
 
     def undo(self) -> bool:
         self.end_gesture()

@@ -45,8 +45,16 @@ FADE_END_RADII = 1.5
 class ParticleShading:
     """All particles of a scene's clouds, concatenated, with their illumination precomputed."""
 
-    def __init__(self, clouds, shading: Shading, lights, ambient, method: str = "exact",
-                 cache: IlluminationCache | None = None, styles: ParticleStyles | None = None):
+    def __init__(
+        self,
+        clouds,
+        shading: Shading,
+        lights,
+        ambient,
+        method: str = "exact",
+        cache: IlluminationCache | None = None,
+        styles: ParticleStyles | None = None,
+    ):
         """`cache` keeps the illumination of unchanged clouds between instances (the editor);
         `styles` (`cloudcore.particle_styles`, by default at the default hour) say which clouds
         are sprites or artist-shaded."""
@@ -54,9 +62,9 @@ class ParticleShading:
         self.styles = styles if styles is not None else particle_styles(clouds, Lighting())
         self.phase, self.g = shading.phase, shading.g
         lights = active_lights(lights)
-        self.light_directions = np.array([l.direction for l in lights], dtype=np.float64).reshape(-1, 3)
-        self.light_radiance = np.array([np.asarray(l.color) * l.intensity for l in lights],
-                                       dtype=np.float64).reshape(-1, 3)
+        self.light_directions = np.array([light.direction for light in lights], dtype=np.float64).reshape(-1, 3)
+        radiance = [np.asarray(light.color) * light.intensity for light in lights]
+        self.light_radiance = np.array(radiance, dtype=np.float64).reshape(-1, 3)
         self.ambient = np.asarray(ambient, dtype=np.float64)
 
         counts = np.array([len(c.particles) for c in clouds], dtype=np.int64)
@@ -72,8 +80,11 @@ class ParticleShading:
         self._near_faded = self.styles.near_faded
         self.scattering = scattering_coefficient(tau, albedo, shading.phase, shading.g)
         self.tint = np.repeat(np.array([c.color for c in clouds], dtype=np.float64).reshape(-1, 3), counts, axis=0)
-        incident = (cache.incident(clouds, shading, lights, method) if cache is not None
-                    else illuminate_clouds(clouds, shading, lights, method))
+        incident = (
+            cache.incident(clouds, shading, lights, method)
+            if cache is not None
+            else illuminate_clouds(clouds, shading, lights, method)
+        )
         #: (n, lights): light that reached each particle, per light (Harris's light pass)
         self.incident = _concatenated(incident, (0, len(lights)))
 
@@ -81,15 +92,21 @@ class ParticleShading:
         detail = np.where(self.styles.sprite_index >= 0, self.radii * (2.0 / CELL_PIXELS), self.radii)
         #: (clouds,) metres: the finest detail in each cloud (0 for an empty one), which bounds how
         #: fine an impostor texture needs to be (`cloudcore.impostors.detail_size_px`)
-        self.finest_radii = np.array([detail[start:stop].min() if stop > start else 0.0
-                                      for start, stop in zip(self.cloud_starts[:-1], self.cloud_starts[1:])])
+        self.finest_radii = np.array(
+            [
+                detail[start:stop].min() if stop > start else 0.0
+                for start, stop in zip(self.cloud_starts[:-1], self.cloud_starts[1:])
+            ]
+        )
         spheres = [c.bounding_sphere() for c in clouds]
         self.bounding_centres = np.array([s[0] for s in spheres], dtype=np.float64).reshape(-1, 3)
         self.bounding_radii = np.array([s[1] for s in spheres], dtype=np.float64)
         # only clouds that form or dissipate: (first particle, end, formation, core distances)
-        self._forming = [(start, stop, c.formation, core_distances(c.centres))
-                         for c, start, stop in zip(clouds, self.cloud_starts[:-1], self.cloud_starts[1:])
-                         if c.formation is not None]
+        self._forming = [
+            (start, stop, c.formation, core_distances(c.centres))
+            for c, start, stop in zip(clouds, self.cloud_starts[:-1], self.cloud_starts[1:])
+            if c.formation is not None
+        ]
         self._formation_memo: tuple[float, np.ndarray] | None = None
 
     def seen_from(self, eye, indices: np.ndarray, *, time_s: float | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -121,7 +138,9 @@ class ParticleShading:
         Splats vanish next to the eye (the near fade); sprites lock there instead and stay.
         Harris's opacity is the particle's own, the artist model's its colour level's.
         """
-        kept = ((distances > FADE_START_RADII * self.radii[indices]) | ~self._near_faded[indices]) & self._opaque[indices]
+        kept = ((distances > FADE_START_RADII * self.radii[indices]) | ~self._near_faded[indices]) & self._opaque[
+            indices
+        ]
         factors = self.formation_factors(time_s)
         return kept if factors is None else kept & (factors[indices] > 0.0)
 

@@ -104,8 +104,10 @@ class FacingLocks:
         radii = np.asarray(radii, dtype=np.float64)
         count = len(self._locked)
         if eye.shape != (3,) or centres.shape != (count, 3) or radii.shape != (count,):
-            raise ValueError(f"expected an eye (3,), centres ({count}, 3) and radii ({count},), "
-                             f"got {eye.shape}, {centres.shape} and {radii.shape}")
+            raise ValueError(
+                f"expected an eye (3,), centres ({count}, 3) and radii ({count},), "
+                f"got {eye.shape}, {centres.shape} and {radii.shape}"
+            )
         if not (np.all(np.isfinite(eye)) and np.all(np.isfinite(centres)) and np.all(np.isfinite(radii))):
             raise ValueError("eye, centres and radii must be finite")
         with np.errstate(over="ignore"):

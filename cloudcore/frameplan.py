@@ -38,16 +38,32 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Hashable, Mapping
 from dataclasses import dataclass, field
-from typing import Hashable, Mapping
 
 import numpy as np
 
-from cloudcore.camera import (NEAR_PLANE_M, frustum_planes, projection_matrix, spheres_in_frustum, splats_in_frustum,
-                              view_matrix)
-from cloudcore.impostors import (INSIDE_RADII, TRANSLATION_METRICS, ImpostorRecord, budgeted_regenerations,
-                                 detail_size_px, quad_half_side, regeneration_priority, regeneration_reason,
-                                 required_size, screen_size_px, tolerance_deg_for)
+from cloudcore.camera import (
+    NEAR_PLANE_M,
+    frustum_planes,
+    projection_matrix,
+    spheres_in_frustum,
+    splats_in_frustum,
+    view_matrix,
+)
+from cloudcore.impostors import (
+    INSIDE_RADII,
+    TRANSLATION_METRICS,
+    ImpostorRecord,
+    budgeted_regenerations,
+    detail_size_px,
+    quad_half_side,
+    regeneration_priority,
+    regeneration_reason,
+    required_size,
+    screen_size_px,
+    tolerance_deg_for,
+)
 from cloudcore.lod_costs import CostEstimator, CostModel, Work, full_work, quad_work, regeneration_work
 from cloudcore.lod_units import LodUnits
 from cloudcore.overdraw import analytic_overdraw
@@ -126,7 +142,7 @@ class LodState:
     eye: tuple | None = None  # last frame's eye: the speed that predicts an impostor's lifetime
     costs: CostEstimator = CostEstimator()
 
-    def measured(self, measurements) -> "LodState":
+    def measured(self, measurements) -> LodState:
         """The state with this frame's (predicted work, measured ms) pairs folded into the cost fit."""
         return dataclasses.replace(self, costs=self.costs.observe(measurements))
 
@@ -175,10 +191,14 @@ class FramePlan:
             "impostors_regenerated": sum(reasons.values()),
             "regeneration_reasons": reasons,
             "regenerations_postponed": sum(1 for c in self.clouds if c.postponed),
-            "ring_segments_built": int(self.ring is not None and self.ring.state.pending is not None
-                                       and self.ring.build_segment in self.ring.state.pending.occupied_segments),
-            "ring_panels_drawn": (sum(len(g.occupied_segments) for g, _ in self.ring.draws)
-                                  if self.ring is not None else 0),
+            "ring_segments_built": int(
+                self.ring is not None
+                and self.ring.state.pending is not None
+                and self.ring.build_segment in self.ring.state.pending.occupied_segments
+            ),
+            "ring_panels_drawn": (
+                sum(len(g.occupied_segments) for g, _ in self.ring.draws) if self.ring is not None else 0
+            ),
             "objects_in_clouds": len(self.objects_between_layers),
             "layers_drawn": sum(c.layers for c in self.clouds if c.splits),
             "layers_rebuilt": sum(c.layers for c in self.clouds if c.splits and c.regenerate),
@@ -193,8 +213,9 @@ class FramePlan:
         """Whether this plan leaves nothing to converge: no impostor remade or postponed, no crossfade
         and no ring being built or faded in.  The same inputs would then draw the same picture again;
         the editor keeps it instead (`app.viewport`), leaving the cores to the relighting worker."""
-        ring_settled = self.ring is None or (self.ring.state.pending is None
-                                             and all(weight == 1.0 for _, weight in self.ring.draws))
+        ring_settled = self.ring is None or (
+            self.ring.state.pending is None and all(weight == 1.0 for _, weight in self.ring.draws)
+        )
         return ring_settled and not any(c.regenerate or c.postponed or c.kind == "crossfade" for c in self.clouds)
 
     @property
@@ -203,9 +224,18 @@ class FramePlan:
         return tuple(item.index for item in self.draw_items if item.kind == "object")
 
 
-def plan_frame(units: LodUnits, camera: Camera, viewport: tuple[int, int], settings: RenderSettings,
-               state: LodState, lighting_key: Hashable, objects=(), cloud_particles=None,
-               costs: CostModel | None = None, cloud_splats=None) -> FramePlan:
+def plan_frame(
+    units: LodUnits,
+    camera: Camera,
+    viewport: tuple[int, int],
+    settings: RenderSettings,
+    state: LodState,
+    lighting_key: Hashable,
+    objects=(),
+    cloud_particles=None,
+    costs: CostModel | None = None,
+    cloud_splats=None,
+) -> FramePlan:
     """Plan one frame of `units` (`cloudcore.lod_units.LodUnits`) seen by `camera`.
 
     `lighting_key` identifies what the particles' colours were computed from: one key for
@@ -226,8 +256,16 @@ def plan_frame(units: LodUnits, camera: Camera, viewport: tuple[int, int], setti
     distances = np.linalg.norm(centres - eye, axis=1)
     cloud_keys = lighting_key if isinstance(lighting_key, tuple) else (lighting_key,) * sum(map(len, units.members))
     keys = tuple(tuple(cloud_keys[c] for c in members) for members in units.members)
-    ring = plan_ring(state.ring, centres, radii, eye, settings, keys, units.members,
-                     segment_texture_size(height, camera.fov_y_deg, settings))
+    ring = plan_ring(
+        state.ring,
+        centres,
+        radii,
+        eye,
+        settings,
+        keys,
+        units.members,
+        segment_texture_size(height, camera.fov_y_deg, settings),
+    )
     records = state.records
     next_records = {members: record for members, record in records.items() if members in set(units.members)}
     object_centres = np.array([o.centre for o in objects], dtype=np.float64).reshape(-1, 3)
@@ -248,8 +286,11 @@ def plan_frame(units: LodUnits, camera: Camera, viewport: tuple[int, int], setti
 
     def split_at(index: int, from_eye) -> tuple[tuple, tuple]:
         """(objects inside the unit far to near from `from_eye`, their distances: the layers' boundaries)."""
-        inside = objects_inside(centres[index], radii[index], object_centres, object_radii) if (
-            settings.split_objects) else ()
+        inside = (
+            objects_inside(centres[index], radii[index], object_centres, object_radii)
+            if (settings.split_objects)
+            else ()
+        )
         if not len(inside):
             return (), ()
         gaps = np.linalg.norm(object_centres[inside] - np.asarray(from_eye, dtype=np.float64), axis=1)
@@ -264,13 +305,15 @@ def plan_frame(units: LodUnits, camera: Camera, viewport: tuple[int, int], setti
         """The unit drawn in full 3D: a ball of discs far off; near, splat by splat, only the splats in the
         frustum (the renderer leaves out the rest), their discs clipped to the screen."""
         if cloud_splats is None or distance >= NEAR_EXACT_RADII * radius:
-            return full_work(units.particle_counts[index], units.radius_squares[index], radius, distance, focal_px,
-                             screen_pixels)
+            return full_work(
+                units.particle_counts[index], units.radius_squares[index], radius, distance, focal_px, screen_pixels
+            )
         splats = [cloud_splats(c) for c in units.members[index]]
         splat_centres, splat_radii = np.concatenate([c for c, _ in splats]), np.concatenate([r for _, r in splats])
         seen = splats_in_frustum(planes, splat_centres, splat_radii)
-        fragments = screen_pixels * analytic_overdraw(splat_centres[seen], splat_radii[seen], view, projection,
-                                                      NEAR_PLANE_M)
+        fragments = screen_pixels * analytic_overdraw(
+            splat_centres[seen], splat_radii[seen], view, projection, NEAR_PLANE_M
+        )
         return Work(particles=float(np.count_nonzero(seen)), fragments=fragments)
 
     representations = {}
@@ -280,32 +323,66 @@ def plan_frame(units: LodUnits, camera: Camera, viewport: tuple[int, int], setti
         distance, members = float(distance), units.members[index]
         individual = 1.0 - (ring.weight_of(members) if ring is not None else 0.0)
         if radius <= 0.0 or individual <= 0.0 or not visible[index]:
-            clouds.append(CloudPlan(index, "empty" if radius <= 0.0 else "ring" if individual <= 0.0 else "culled",
-                                    distance, members=members))
+            clouds.append(
+                CloudPlan(
+                    index,
+                    "empty" if radius <= 0.0 else "ring" if individual <= 0.0 else "culled",
+                    distance,
+                    members=members,
+                )
+            )
             continue
         inside, splits = split_at(index, eye)
         eye_inside = settings.mode != "full" and distance < INSIDE_RADII * radius
         # impostor mode draws no unit in full 3D but the one the eye is in: nothing else to price
         full = full_3d(index, radius, distance) if settings.mode != "impostor" or eye_inside else Work()
         if eye_inside:
-            clouds.append(CloudPlan(index, "inside", distance, full_weight=individual, split_objects=inside,
-                                    splits=splits, layer_counts=counts(index, eye, splits), members=members))
+            clouds.append(
+                CloudPlan(
+                    index,
+                    "inside",
+                    distance,
+                    full_weight=individual,
+                    split_objects=inside,
+                    splits=splits,
+                    layer_counts=counts(index, eye, splits),
+                    members=members,
+                )
+            )
             # a screen impostor has fewer fragments than the screen, not fewer particles; its composite
             # over the screen is priced per run of inside units, below
-            cloud_work += dataclasses.replace(full, fragments=full.fragments * settings.inside_resolution_scale ** 2)
+            cloud_work += dataclasses.replace(full, fragments=full.fragments * settings.inside_resolution_scale**2)
             continue
         if settings.mode == "full":
-            clouds.append(CloudPlan(index, "full", distance, full_weight=1.0, split_objects=inside, splits=splits,
-                                    layer_counts=counts(index, eye, splits), members=members))
+            clouds.append(
+                CloudPlan(
+                    index,
+                    "full",
+                    distance,
+                    full_weight=1.0,
+                    split_objects=inside,
+                    splits=splits,
+                    layer_counts=counts(index, eye, splits),
+                    members=members,
+                )
+            )
             cloud_work += full
             continue
         pixels = screen_size_px(radius, distance, height, camera.fov_y_deg)
-        size = required_size(min(pixels, detail_size_px(radius, distance, units.finest_radii[index],
-                                                        settings.impostor_detail_texels)),
-                             settings.impostor_min_size, settings.impostor_max_size)
+        size = required_size(
+            min(pixels, detail_size_px(radius, distance, units.finest_radii[index], settings.impostor_detail_texels)),
+            settings.impostor_min_size,
+            settings.impostor_max_size,
+        )
         quad = quad_work(pixels, screen_pixels)
-        remake = regeneration_work(units.particle_counts[index], units.radius_squares[index], radius, distance,
-                                   quad_half_side(radius, distance), size)
+        remake = regeneration_work(
+            units.particle_counts[index],
+            units.radius_squares[index],
+            radius,
+            distance,
+            quad_half_side(radius, distance),
+            size,
+        )
         # a unit fading into or out of the ring is drawn as an impostor: one layer scales exactly
         weight, full_ms, impostor_ms = 0.0, costs.ms(full), math.inf
         if settings.mode == "auto" and individual == 1.0:
@@ -317,37 +394,68 @@ def plan_frame(units: LodUnits, camera: Camera, viewport: tuple[int, int], setti
             budgeted = bool(settings.regeneration_budget or settings.frame_budget_ms)
             # an impostor within half its tolerance of the picture full 3D gives, or one remade from this very
             # eye, differs from it by less than a regeneration's own step: the switch needs no crossfade
-            close = {"impostor": error <= 0.5 * tolerance or (error > tolerance and not budgeted),
-                     "full": error <= 0.5 * tolerance}
-            representation = _represent(state.representations.get(members), full_ms, impostor_ms,
-                                        settings.transition_frames, close)
+            close = {
+                "impostor": error <= 0.5 * tolerance or (error > tolerance and not budgeted),
+                "full": error <= 0.5 * tolerance,
+            }
+            representation = _represent(
+                state.representations.get(members), full_ms, impostor_ms, settings.transition_frames, close
+            )
             representations[members] = representation
             weight = representation.full_weight
         if weight == 1.0:
-            clouds.append(CloudPlan(index, "full", distance, full_weight=1.0, split_objects=inside, splits=splits,
-                                    layer_counts=counts(index, eye, splits), members=members, full_ms=full_ms,
-                                    impostor_ms=impostor_ms))
+            clouds.append(
+                CloudPlan(
+                    index,
+                    "full",
+                    distance,
+                    full_weight=1.0,
+                    split_objects=inside,
+                    splits=splits,
+                    layer_counts=counts(index, eye, splits),
+                    members=members,
+                    full_ms=full_ms,
+                    impostor_ms=impostor_ms,
+                )
+            )
             cloud_work += full
             continue
         record = records.get(members)
         # the layers the impostor's textures would hold now: split where the objects are, seen from its eye
-        held_counts = counts(index, record.eye, split_at(index, record.eye)[1]) if (
-            record is not None and splits) else None
-        reason = regeneration_reason(record, centre, radius, eye, size, keys[index], tolerance, held_counts,
-                                     settings.translation_metric)
+        held_counts = (
+            counts(index, record.eye, split_at(index, record.eye)[1]) if (record is not None and splits) else None
+        )
+        reason = regeneration_reason(
+            record, centre, radius, eye, size, keys[index], tolerance, held_counts, settings.translation_metric
+        )
         kind = "crossfade" if weight > 0.0 else "impostor"
-        clouds.append(CloudPlan(index, kind, distance, full_weight=weight * individual,
-                                impostor_weight=(1.0 - weight) * individual, regenerate=reason,
-                                texture_size=size, split_objects=inside, splits=splits, members=members,
-                                full_ms=full_ms, impostor_ms=impostor_ms))
+        clouds.append(
+            CloudPlan(
+                index,
+                kind,
+                distance,
+                full_weight=weight * individual,
+                impostor_weight=(1.0 - weight) * individual,
+                regenerate=reason,
+                texture_size=size,
+                split_objects=inside,
+                splits=splits,
+                members=members,
+                full_ms=full_ms,
+                impostor_ms=impostor_ms,
+            )
+        )
         cloud_work += quad + (full + Work(quad_pixels=screen_pixels) if weight > 0.0 else Work())  # the layer
         if reason is not None:
-            ratio = (translation_error(centre, radius, record.eye, eye) / max(tolerance, 1e-300)
-                     if record is not None else math.inf)
-            wanted.append((index, regeneration_priority(reason, ratio, bool(splits), pixels),
-                           remake.scaled(len(splits) + 1)))
-    served = budgeted_regenerations([(index, priority) for index, priority, _ in wanted],
-                                    settings.regeneration_budget)
+            ratio = (
+                translation_error(centre, radius, record.eye, eye) / max(tolerance, 1e-300)
+                if record is not None
+                else math.inf
+            )
+            wanted.append(
+                (index, regeneration_priority(reason, ratio, bool(splits), pixels), remake.scaled(len(splits) + 1))
+            )
+    served = budgeted_regenerations([(index, priority) for index, priority, _ in wanted], settings.regeneration_budget)
     if settings.frame_budget_ms > 0.0:
         served &= _within_frame_budget(wanted, settings.frame_budget_ms - costs.ms(cloud_work), costs)
     for index, _, remake in wanted:
@@ -359,37 +467,71 @@ def plan_frame(units: LodUnits, camera: Camera, viewport: tuple[int, int], setti
             continue
         record = records.get(cloud.members)
         if index not in served and record is not None:
-            accepted = max(accepted, translation_error(centres[index], radii[index], record.eye, eye)
-                           / max(tolerance, 1e-300))
+            accepted = max(
+                accepted, translation_error(centres[index], radii[index], record.eye, eye) / max(tolerance, 1e-300)
+            )
         if index in served:
             record = next_records[cloud.members] = ImpostorRecord(
-                tuple(float(v) for v in eye), cloud.texture_size, keys[index], cloud.splits,
-                counts(index, eye, cloud.splits))
+                tuple(float(v) for v in eye),
+                cloud.texture_size,
+                keys[index],
+                cloud.splits,
+                counts(index, eye, cloud.splits),
+            )
         regenerate, postponed = (cloud.regenerate, None) if index in served else (None, cloud.regenerate)
-        clouds[index] = dataclasses.replace(cloud, regenerate=regenerate, postponed=postponed,
-                                            texture_size=record.size,
-                                            layer_counts=record.layer_counts if cloud.splits else (0,))
+        clouds[index] = dataclasses.replace(
+            cloud,
+            regenerate=regenerate,
+            postponed=postponed,
+            texture_size=record.size,
+            layer_counts=record.layer_counts if cloud.splits else (0,),
+        )
     if ring is not None:
-        cloud_work += Work(quad_pixels=RING_PANEL_SCREEN_SHARE * screen_pixels * sum(
-            len(generation.occupied_segments) for generation, _ in ring.draws) / 2.0)
+        cloud_work += Work(
+            quad_pixels=RING_PANEL_SCREEN_SHARE
+            * screen_pixels
+            * sum(len(generation.occupied_segments) for generation, _ in ring.draws)
+            / 2.0
+        )
         if ring.build_segment is not None and ring.state.pending is not None:
             segment = ring.state.pending.segment_members[ring.build_segment]
             index_of = {members: index for index, members in enumerate(units.members)}
-            update_work += Work(particles=float(sum(units.particle_counts[index_of[u]] for u in segment)),
-                                regenerations=float(bool(segment)))
+            update_work += Work(
+                particles=float(sum(units.particle_counts[index_of[u]] for u in segment)),
+                regenerations=float(bool(segment)),
+            )
     drawn = [c.index for c in clouds if c.kind in ("full", "crossfade", "impostor", "inside")]
     draw_order = tuple(sorted(drawn, key=lambda i: -distances[i]))
     inside_size = tuple(max(1, math.ceil(side * settings.inside_resolution_scale)) for side in viewport)
     items = _draw_items([clouds[i] for i in draw_order], radii, object_centres, objects_visible, eye)
     screen_impostors = len(inside_runs(items, clouds))
-    cloud_work += Work(batches=float(_full_runs([clouds[i].kind for i in draw_order]) + screen_impostors),
-                       quad_pixels=screen_impostors * screen_pixels)
+    cloud_work += Work(
+        batches=float(_full_runs([clouds[i].kind for i in draw_order]) + screen_impostors),
+        quad_pixels=screen_impostors * screen_pixels,
+    )
     between = {item.index for item in items if item.kind == "object"}
     with_world = tuple(i for i in range(len(object_radii)) if objects_visible[i] and i not in between)
-    next_state = LodState(next_records, ring.state if ring is not None else RingState(), representations,
-                          tuple(float(v) for v in eye), state.costs)
-    return FramePlan(tuple(clouds), draw_order, ring, next_state, inside_size, items, with_world, update_work,
-                     cloud_work, costs, tolerance, accepted)
+    next_state = LodState(
+        next_records,
+        ring.state if ring is not None else RingState(),
+        representations,
+        tuple(float(v) for v in eye),
+        state.costs,
+    )
+    return FramePlan(
+        tuple(clouds),
+        draw_order,
+        ring,
+        next_state,
+        inside_size,
+        items,
+        with_world,
+        update_work,
+        cloud_work,
+        costs,
+        tolerance,
+        accepted,
+    )
 
 
 def _within_frame_budget(wanted, available_ms: float, costs: CostModel) -> set:
@@ -406,8 +548,9 @@ def _within_frame_budget(wanted, available_ms: float, costs: CostModel) -> set:
     return served
 
 
-def _represent(previous: Representation | None, full_ms: float, impostor_ms: float, transition_frames: int,
-               close: dict) -> Representation:
+def _represent(
+    previous: Representation | None, full_ms: float, impostor_ms: float, transition_frames: int, close: dict
+) -> Representation:
     """Auto mode's next step for a unit: aim at the cheaper representation (by `SWITCH_MARGIN` against the
     one aimed at already), and move the full-3D weight one transition step toward it.
 
@@ -425,8 +568,7 @@ def _represent(previous: Representation | None, full_ms: float, impostor_ms: flo
         if close[target] and previous.full_weight in (0.0, 1.0):
             return Representation(target, 1.0 if target == "full" else 0.0)
     step = 1.0 / transition_frames
-    weight = (min(1.0, previous.full_weight + step) if target == "full"
-              else max(0.0, previous.full_weight - step))
+    weight = min(1.0, previous.full_weight + step) if target == "full" else max(0.0, previous.full_weight - step)
     return Representation(target, weight)
 
 

@@ -22,18 +22,24 @@ def cloud_optics(cloud: Cloud, shading: Shading) -> tuple[np.ndarray, np.ndarray
     return np.full(n, tau), np.full(n, albedo)
 
 
-def illuminate_clouds(clouds, shading: Shading, lights, method: str = "exact", *,
-                      resolution: int = DEFAULT_RASTER_RESOLUTION) -> list[np.ndarray]:
+def illuminate_clouds(
+    clouds, shading: Shading, lights, method: str = "exact", *, resolution: int = DEFAULT_RASTER_RESOLUTION
+) -> list[np.ndarray]:
     """Incident light (N_i, L) of each cloud for each light that contributes (`active_lights`)."""
     clouds = list(clouds)
-    columns = [illuminate_direction(clouds, shading, light.direction, method, resolution=resolution)
-               for light in active_lights(lights)]
-    return [np.column_stack([column[i] for column in columns]) if columns else np.zeros((len(cloud.particles), 0))
-            for i, cloud in enumerate(clouds)]
+    columns = [
+        illuminate_direction(clouds, shading, light.direction, method, resolution=resolution)
+        for light in active_lights(lights)
+    ]
+    return [
+        np.column_stack([column[i] for column in columns]) if columns else np.zeros((len(cloud.particles), 0))
+        for i, cloud in enumerate(clouds)
+    ]
 
 
-def illuminate_direction(clouds, shading: Shading, direction, method: str = "exact", *,
-                         resolution: int = DEFAULT_RASTER_RESOLUTION) -> list[np.ndarray]:
+def illuminate_direction(
+    clouds, shading: Shading, direction, method: str = "exact", *, resolution: int = DEFAULT_RASTER_RESOLUTION
+) -> list[np.ndarray]:
     """The fraction (N_i,) of light from `direction` that reaches each particle of each cloud.
 
     All clouds go through one `incident_light` call, each its own shadowing group,
@@ -45,10 +51,18 @@ def illuminate_direction(clouds, shading: Shading, direction, method: str = "exa
     if sum(counts) == 0:
         return [np.zeros(n) for n in counts]
     optics = [cloud_optics(c, shading) for c in clouds]
-    incident = incident_light(np.concatenate([c.centres for c in clouds]), np.concatenate([c.radii for c in clouds]),
-                              np.concatenate([o[0] for o in optics]), np.concatenate([o[1] for o in optics]),
-                              direction, phase=shading.phase, g=shading.g, method=method,
-                              groups=np.repeat(np.arange(len(clouds)), counts), resolution=resolution)
+    incident = incident_light(
+        np.concatenate([c.centres for c in clouds]),
+        np.concatenate([c.radii for c in clouds]),
+        np.concatenate([o[0] for o in optics]),
+        np.concatenate([o[1] for o in optics]),
+        direction,
+        phase=shading.phase,
+        g=shading.g,
+        method=method,
+        groups=np.repeat(np.arange(len(clouds)), counts),
+        resolution=resolution,
+    )
     return np.split(incident, np.cumsum(counts)[:-1])
 
 
@@ -88,15 +102,24 @@ class IlluminationCache:
             kept[key] = (cloud, {d: self._entries[key][1][d] for d in directions})
         self._entries = kept
         self.last_recomputed = sum(len(stale) for _, stale in work)
-        return [np.column_stack([kept[self._key(c, shading, method)][1][d] for d in directions])
-                if directions else np.zeros((len(c.particles), 0)) for c in clouds]
+        return [
+            np.column_stack([kept[self._key(c, shading, method)][1][d] for d in directions])
+            if directions
+            else np.zeros((len(c.particles), 0))
+            for c in clouds
+        ]
 
     def missing(self, clouds, shading: Shading, lights, method: str = "exact") -> list[tuple[tuple, list[Cloud]]]:
         """(light direction, the clouds not held for it) for each direction some cloud lacks."""
         work = []
         for direction in light_directions(lights):
-            stale = [c for c in clouds if (hit := self._entries.get(self._key(c, shading, method))) is None
-                     or hit[0] is not c or direction not in hit[1]]
+            stale = [
+                c
+                for c in clouds
+                if (hit := self._entries.get(self._key(c, shading, method))) is None
+                or hit[0] is not c
+                or direction not in hit[1]
+            ]
             if stale:
                 work.append((direction, stale))
         return work

@@ -18,8 +18,8 @@ screen asks for.
 from __future__ import annotations
 
 import math
+from collections.abc import Hashable
 from dataclasses import dataclass
-from typing import Hashable
 
 import numpy as np
 
@@ -79,8 +79,9 @@ def impostor_view(centre, radius: float, eye) -> ImpostorView:
 CROP_MARGIN_TEXELS = 2.0
 
 
-def particle_extent(view: np.ndarray, projection: np.ndarray, centres: np.ndarray, radii: np.ndarray,
-                    size: tuple[int, int]) -> tuple[float, float, float, float]:
+def particle_extent(
+    view: np.ndarray, projection: np.ndarray, centres: np.ndarray, radii: np.ndarray, size: tuple[int, int]
+) -> tuple[float, float, float, float]:
     """(u0, v0, u1, v1) in [0, 1]: the part of a texture rendered through (view, projection) that the
     splats at `centres` (n, 3) with `radii` can cover, plus `CROP_MARGIN_TEXELS`.
 
@@ -213,8 +214,9 @@ def pixel_angle_deg(fov_y_deg: float, viewport_height: int) -> float:
 _REASON_RANK = {"new": 0, "layers": 0, "lights": 1, "resolution": 2, "translation": 3}
 
 
-def regeneration_priority(reason: str, translation_ratio: float, split: bool,
-                          screen_px: float = 0.0) -> tuple[int, float, float]:
+def regeneration_priority(
+    reason: str, translation_ratio: float, split: bool, screen_px: float = 0.0
+) -> tuple[int, float, float]:
     """Sort key of a wanted regeneration, most urgent first; `translation_ratio` is the translation
     error over the tolerance, `screen_px` the impostor's size on screen, which orders the rest (after
     a relight from a still eye, the largest on screen are remade first).  A cloud split around
@@ -232,12 +234,20 @@ def budgeted_regenerations(wanted, budget: int) -> set:
         return {index for index, _ in wanted}
     ranked = sorted(wanted, key=lambda w: w[1])
     must = sum(1 for _, priority in ranked if priority[0] == 0)
-    return {index for index, _ in ranked[:max(budget, must)]}
+    return {index for index, _ in ranked[: max(budget, must)]}
 
 
-def regeneration_reason(record: ImpostorRecord | None, centre, radius: float, eye, size: int,
-                        lighting_key: Hashable, tolerance_deg: float, layer_counts=None,
-                        metric: str = "parallax") -> str | None:
+def regeneration_reason(
+    record: ImpostorRecord | None,
+    centre,
+    radius: float,
+    eye,
+    size: int,
+    lighting_key: Hashable,
+    tolerance_deg: float,
+    layer_counts=None,
+    metric: str = "parallax",
+) -> str | None:
     """Why the impostor must be remade this frame ("new", "lights", "resolution", "translation",
     "layers"), or None.
 

@@ -112,4 +112,4 @@ def scene_lights(lighting: Lighting) -> tuple[tuple[Light, ...], np.ndarray]:
 
 def active_lights(lights) -> tuple[Light, ...]:
     """Lights that contribute something: no shading pass for the rest."""
-    return tuple(l for l in lights if l.intensity > 0 and max(l.color) > 0)
+    return tuple(light for light in lights if light.intensity > 0 and max(light.color) > 0)

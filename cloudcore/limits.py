@@ -33,11 +33,20 @@ def scene_limit_problems(scene, unchanged=None) -> list[tuple[str, str]]:
     if scene.lighting.lights:
         shining = len(active_lights(scene.lighting.lights))
         if shining > MAX_LIGHTS:
-            problems.append(("lighting.lights", f"at most {MAX_LIGHTS} lights can shine on clouds at once, "
-                                                f"the scene has {shining} (lights of intensity 0 or black do not count)"))
+            problems.append(
+                (
+                    "lighting.lights",
+                    f"at most {MAX_LIGHTS} lights can shine on clouds at once, "
+                    f"the scene has {shining} (lights of intensity 0 or black do not count)",
+                )
+            )
     if scene.terrain is not None and scene.terrain.kind not in DRAWN_TERRAIN_KINDS:
-        problems.append(("terrain.kind", f"the renderer draws {' or '.join(DRAWN_TERRAIN_KINDS)} terrain only, "
-                                         f"not {scene.terrain.kind!r}"))
+        problems.append(
+            (
+                "terrain.kind",
+                f"the renderer draws {' or '.join(DRAWN_TERRAIN_KINDS)} terrain only, not {scene.terrain.kind!r}",
+            )
+        )
     previous = {id(cloud) for cloud in unchanged.clouds} if unchanged is not None else set()
     for i, cloud in enumerate(scene.clouds):
         if cloud.artist is None or not len(cloud.particles) or id(cloud) in previous:
@@ -45,6 +54,11 @@ def scene_limit_problems(scene, unchanged=None) -> list[tuple[str, str]]:
         size = cloud.shading_group_size or default_group_size(cloud.radii)
         if not shading_grid_fits(cloud.centres, size):
             field = "shading_group_size" if cloud.shading_group_size else "particles"
-            problems.append((f"clouds[{i}].{field}", f"shading groups of {size:g} m are too small for a cloud this "
-                                                     "large (more than 2**53 groups across)"))
+            problems.append(
+                (
+                    f"clouds[{i}].{field}",
+                    f"shading groups of {size:g} m are too small for a cloud this "
+                    "large (more than 2**53 groups across)",
+                )
+            )
     return problems

@@ -37,10 +37,10 @@ class Work:
     regenerations: float = 0.0  # impostor textures (or ring segments) remade: target switch, clear, draw call
     batches: float = 0.0  # splat draws of the cloud pass: an upload of the order, a dispatch, a draw call
 
-    def __add__(self, other: "Work") -> "Work":
+    def __add__(self, other: Work) -> Work:
         return Work(*(a + b for a, b in zip(self.vector(), other.vector())))
 
-    def scaled(self, factor: float) -> "Work":
+    def scaled(self, factor: float) -> Work:
         return Work(*(factor * v for v in self.vector()))
 
     def vector(self) -> np.ndarray:
@@ -85,34 +85,41 @@ def inverse_square_depth(radius: float, distance: float) -> float:
         distance = radius * (1.0 + 1e-6)
     t = radius / distance
     if t < 0.2:
-        return (1.0 + 0.6 * t * t + 3.0 / 7.0 * t ** 4 + t ** 6 / 3.0) / (distance * distance)
-    return 3.0 * (distance * math.log1p(2.0 * radius / (distance - radius)) - 2.0 * radius) / (2.0 * radius ** 3)
+        return (1.0 + 0.6 * t * t + 3.0 / 7.0 * t**4 + t**6 / 3.0) / (distance * distance)
+    return 3.0 * (distance * math.log1p(2.0 * radius / (distance - radius)) - 2.0 * radius) / (2.0 * radius**3)
 
 
-def splat_fragments(radius_squares: float, radius: float, distance: float, focal_px: float, particles: float,
-                    screen_pixels: float) -> float:
+def splat_fragments(
+    radius_squares: float, radius: float, distance: float, focal_px: float, particles: float, screen_pixels: float
+) -> float:
     """Fragments of a unit's splats seen from `distance`: their disc areas pi (f r / z)^2 summed, z spread
     over the unit's bounding ball (`inverse_square_depth`); each disc at most the screen."""
     area = math.pi * focal_px * focal_px * radius_squares * inverse_square_depth(radius, distance)
     return min(area, particles * screen_pixels)
 
 
-def full_work(particles: float, radius_squares: float, radius: float, distance: float, focal_px: float,
-              screen_pixels: float) -> Work:
+def full_work(
+    particles: float, radius_squares: float, radius: float, distance: float, focal_px: float, screen_pixels: float
+) -> Work:
     """A unit drawn in full 3D: every particle splatted to the screen."""
-    return Work(particles=particles, fragments=splat_fragments(radius_squares, radius, distance, focal_px,
-                                                               particles, screen_pixels))
+    return Work(
+        particles=particles,
+        fragments=splat_fragments(radius_squares, radius, distance, focal_px, particles, screen_pixels),
+    )
 
 
-def regeneration_work(particles: float, radius_squares: float, radius: float, distance: float,
-                      quad_half_side: float, texture_size: int) -> Work:
+def regeneration_work(
+    particles: float, radius_squares: float, radius: float, distance: float, quad_half_side: float, texture_size: int
+) -> Work:
     """Remaking a unit's impostor: its particles splatted into a texture whose side spans the quad
     (`quad_half_side` at the centre's `distance`)."""
     focal_texels = texture_size * distance / (2.0 * max(quad_half_side, np.finfo(float).tiny))
     texels = float(texture_size) ** 2
-    return Work(particles=particles, texture_fragments=splat_fragments(radius_squares, radius, distance,
-                                                                       focal_texels, particles, texels),
-                regenerations=1.0)
+    return Work(
+        particles=particles,
+        texture_fragments=splat_fragments(radius_squares, radius, distance, focal_texels, particles, texels),
+        regenerations=1.0,
+    )
 
 
 def quad_work(side_px: float, screen_pixels: float) -> Work:
@@ -152,7 +159,7 @@ class CostEstimator:
         if self.right is None:
             object.__setattr__(self, "right", np.zeros(size))
 
-    def observe(self, measurements) -> "CostEstimator":
+    def observe(self, measurements) -> CostEstimator:
         """Add this frame's (work, measured ms) pairs, one per timed pass."""
         normal, right = FORGETTING * self.normal, FORGETTING * self.right
         prior = self.prior.vector()

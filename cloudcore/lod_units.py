@@ -45,40 +45,53 @@ class LodUnits:
     finest_radii: np.ndarray  # (units,) metres: the finest detail in the unit (0: unknown)
 
     @staticmethod
-    def of_spheres(centres, radii, finest_radii=None, particle_counts=None, radius_squares=None) -> "LodUnits":
+    def of_spheres(centres, radii, finest_radii=None, particle_counts=None, radius_squares=None) -> LodUnits:
         """One unit per sphere (tests, and scenes planned without particles)."""
         radii = np.asarray(radii, dtype=np.float64).reshape(-1)
         count = len(radii)
         zeros = np.zeros(count)
-        return LodUnits(np.asarray(centres, dtype=np.float64).reshape(-1, 3), radii,
-                        tuple((i,) for i in range(count)),
-                        zeros if particle_counts is None else np.asarray(particle_counts, dtype=np.float64),
-                        zeros if radius_squares is None else np.asarray(radius_squares, dtype=np.float64),
-                        zeros if finest_radii is None else np.asarray(finest_radii, dtype=np.float64))
+        return LodUnits(
+            np.asarray(centres, dtype=np.float64).reshape(-1, 3),
+            radii,
+            tuple((i,) for i in range(count)),
+            zeros if particle_counts is None else np.asarray(particle_counts, dtype=np.float64),
+            zeros if radius_squares is None else np.asarray(radius_squares, dtype=np.float64),
+            zeros if finest_radii is None else np.asarray(finest_radii, dtype=np.float64),
+        )
 
 
-
-def interpenetrating_groups(centres: np.ndarray, radii: np.ndarray, cloud_starts: np.ndarray,
-                            sphere_centres: np.ndarray, sphere_radii: np.ndarray) -> tuple:
+def interpenetrating_groups(
+    centres: np.ndarray,
+    radii: np.ndarray,
+    cloud_starts: np.ndarray,
+    sphere_centres: np.ndarray,
+    sphere_radii: np.ndarray,
+) -> tuple:
     """Clouds grouped by interpenetrating splats (connected components), each group's clouds ascending, groups
     ordered by their first cloud.  Only pairs whose bounding spheres meet are looked at."""
     clouds = len(sphere_radii)
     gaps = np.linalg.norm(sphere_centres[:, None] - sphere_centres[None], axis=2)
-    candidates = np.argwhere(np.triu(gaps < sphere_radii[:, None] + sphere_radii[None], k=1)
-                             & (sphere_radii[:, None] > 0) & (sphere_radii[None] > 0))
+    candidates = np.argwhere(
+        np.triu(gaps < sphere_radii[:, None] + sphere_radii[None], k=1)
+        & (sphere_radii[:, None] > 0)
+        & (sphere_radii[None] > 0)
+    )
     trees: dict[int, cKDTree] = {}
 
     def tree(cloud: int) -> cKDTree:
         if cloud not in trees:
-            trees[cloud] = cKDTree(centres[cloud_starts[cloud]:cloud_starts[cloud + 1]])
+            trees[cloud] = cKDTree(centres[cloud_starts[cloud] : cloud_starts[cloud + 1]])
         return trees[cloud]
 
     touching = []
     for a, b in candidates:
-        a_radii = radii[cloud_starts[a]:cloud_starts[a + 1]]
-        b_largest = radii[cloud_starts[b]:cloud_starts[b + 1]].max()
-        nearest, _ = tree(b).query(centres[cloud_starts[a]:cloud_starts[a + 1]], k=1,
-                                   distance_upper_bound=TOUCH_RADII * (a_radii.max() + b_largest))
+        a_radii = radii[cloud_starts[a] : cloud_starts[a + 1]]
+        b_largest = radii[cloud_starts[b] : cloud_starts[b + 1]].max()
+        nearest, _ = tree(b).query(
+            centres[cloud_starts[a] : cloud_starts[a + 1]],
+            k=1,
+            distance_upper_bound=TOUCH_RADII * (a_radii.max() + b_largest),
+        )
         if np.any(nearest < TOUCH_RADII * (a_radii + b_largest)):
             touching.append((a, b))
     pairs = np.array(touching, dtype=np.int64).reshape(-1, 2)
@@ -94,8 +107,11 @@ def lod_units(particles, group: bool = True) -> LodUnits:
     """The units of a `ParticleShading`: its clouds, interpenetrating ones grouped (`group`)."""
     starts = particles.cloud_starts
     sphere_centres, sphere_radii = particles.bounding_centres, particles.bounding_radii
-    members = (interpenetrating_groups(particles.centres, particles.radii, starts, sphere_centres, sphere_radii)
-               if group else tuple((i,) for i in range(len(sphere_radii))))
+    members = (
+        interpenetrating_groups(particles.centres, particles.radii, starts, sphere_centres, sphere_radii)
+        if group
+        else tuple((i,) for i in range(len(sphere_radii)))
+    )
     centres, radii, counts, squares, finest = [], [], [], [], []
     for clouds in members:
         ranges = [np.arange(starts[c], starts[c + 1]) for c in clouds]
@@ -110,6 +126,11 @@ def lod_units(particles, group: bool = True) -> LodUnits:
         squares.append(float(np.sum(particles.radii[indices] ** 2)))
         detail = [particles.finest_radii[c] for c in clouds if particles.finest_radii[c] > 0.0]
         finest.append(min(detail) if detail else 0.0)
-    return LodUnits(np.array(centres, dtype=np.float64).reshape(-1, 3), np.array(radii, dtype=np.float64),
-                    members, np.array(counts, dtype=np.float64), np.array(squares, dtype=np.float64),
-                    np.array(finest, dtype=np.float64))
+    return LodUnits(
+        np.array(centres, dtype=np.float64).reshape(-1, 3),
+        np.array(radii, dtype=np.float64),
+        members,
+        np.array(counts, dtype=np.float64),
+        np.array(squares, dtype=np.float64),
+        np.array(finest, dtype=np.float64),
+    )

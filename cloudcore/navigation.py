@@ -18,8 +18,9 @@ def moved(camera: Camera, forward: float = 0.0, right: float = 0.0, up: float = 
     """The camera and its look-at point shifted along its right, up and forward axes (metres)."""
     pose = camera_pose(camera)
     offset = pose[:3, 0] * right + pose[:3, 1] * up - pose[:3, 2] * forward
-    return dataclasses.replace(camera, position=tuple(np.add(camera.position, offset)),
-                               look_at=tuple(np.add(camera.look_at, offset)))
+    return dataclasses.replace(
+        camera, position=tuple(np.add(camera.position, offset)), look_at=tuple(np.add(camera.look_at, offset))
+    )
 
 
 def _direction(yaw: float, pitch: float) -> np.ndarray:

@@ -13,9 +13,11 @@ import numpy as np
 def hash01(ix: np.ndarray, iz: np.ndarray, seed: int) -> np.ndarray:
     """A value in [0, 1) per integer pair (ix, iz) (splitmix-style integer mixing)."""
     with np.errstate(over="ignore"):  # the mixing wraps modulo 2^64 on purpose
-        h = (np.asarray(ix).astype(np.uint64) * np.uint64(0x9E3779B97F4A7C15)
-             ^ np.asarray(iz).astype(np.uint64) * np.uint64(0xC2B2AE3D27D4EB4F)
-             ^ np.uint64(seed) * np.uint64(0x165667B19E3779F9))
+        h = (
+            np.asarray(ix).astype(np.uint64) * np.uint64(0x9E3779B97F4A7C15)
+            ^ np.asarray(iz).astype(np.uint64) * np.uint64(0xC2B2AE3D27D4EB4F)
+            ^ np.uint64(seed) * np.uint64(0x165667B19E3779F9)
+        )
         h ^= h >> np.uint64(31)
         h *= np.uint64(0xBF58476D1CE4E5B9)
         h ^= h >> np.uint64(29)

@@ -13,7 +13,7 @@ and a small aircraft (fuselage along +x, wings along z).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cache
 
 import numpy as np
 import trimesh
@@ -42,7 +42,7 @@ def object_mesh(obj: SceneObject) -> trimesh.Trimesh:
     return _primitive(obj.primitive).copy()
 
 
-@lru_cache(maxsize=None)
+@cache
 def _primitive(name: str) -> trimesh.Trimesh:
     if name == "box":
         return trimesh.creation.box((1.0, 1.0, 1.0))

@@ -16,16 +16,20 @@ from __future__ import annotations
 
 import numpy as np
 
+
 def overdraw_statistics(counts: np.ndarray) -> dict:
     """Mean over the screen, mean over covered pixels, and maximum of a per-pixel fragment count."""
     covered = counts > 0
-    return {"overdraw_mean": float(counts.mean()) if counts.size else 0.0,
-            "overdraw_mean_covered": float(counts[covered].mean()) if covered.any() else 0.0,
-            "overdraw_max": float(counts.max()) if counts.size else 0.0}
+    return {
+        "overdraw_mean": float(counts.mean()) if counts.size else 0.0,
+        "overdraw_mean_covered": float(counts[covered].mean()) if covered.any() else 0.0,
+        "overdraw_max": float(counts.max()) if counts.size else 0.0,
+    }
 
 
-def analytic_overdraw(centres: np.ndarray, radii: np.ndarray, view: np.ndarray, projection: np.ndarray,
-                      near: float) -> float:
+def analytic_overdraw(
+    centres: np.ndarray, radii: np.ndarray, view: np.ndarray, projection: np.ndarray, near: float
+) -> float:
     """Sum of the splats' on-screen disc areas over the screen area (both in normalised device units).
 
     A splat is a disc of radius r parallel to the image plane at eye depth z, so
@@ -37,8 +41,10 @@ def analytic_overdraw(centres: np.ndarray, radii: np.ndarray, view: np.ndarray, 
     eye_space = centres @ view[:3, :3].T + view[:3, 3]
     depth = -eye_space[:, 2]
     drawn = depth > near
-    centre_ndc = np.column_stack([projection[0, 0] * eye_space[drawn, 0],
-                                  projection[1, 1] * eye_space[drawn, 1]]) / depth[drawn, None]
+    centre_ndc = (
+        np.column_stack([projection[0, 0] * eye_space[drawn, 0], projection[1, 1] * eye_space[drawn, 1]])
+        / depth[drawn, None]
+    )
     semi_axes = radii[drawn, None] * np.array([projection[0, 0], projection[1, 1]]) / depth[drawn, None]
     inside = np.clip(centre_ndc + semi_axes, -1.0, 1.0) - np.clip(centre_ndc - semi_axes, -1.0, 1.0)
     on_screen = np.prod(inside / (2.0 * semi_axes), axis=1)
@@ -49,8 +55,9 @@ def analytic_overdraw(centres: np.ndarray, radii: np.ndarray, view: np.ndarray, 
 WANG_BLOCK_SIZE_M = 4000.0
 
 
-def cloud_block_overdraw(centres: np.ndarray, radii: np.ndarray,
-                         block_size: float = WANG_BLOCK_SIZE_M) -> tuple[np.ndarray, np.ndarray]:
+def cloud_block_overdraw(
+    centres: np.ndarray, radii: np.ndarray, block_size: float = WANG_BLOCK_SIZE_M
+) -> tuple[np.ndarray, np.ndarray]:
     """(blocks (k, 2), overdraw (k,)) of the non-empty ground blocks (Wang 2004, section 6.3).
 
     The ground (x, z; y is up) is cut into squares of side `block_size`
@@ -74,9 +81,11 @@ def cloud_block_overdraw(centres: np.ndarray, radii: np.ndarray,
 
 def cloud_block_overdraw_statistics(overdraw: np.ndarray) -> dict:
     """Maximum and mean of the non-empty blocks' overdraw, and how many there are."""
-    return {"block_overdraw_max": float(overdraw.max()) if overdraw.size else 0.0,
-            "block_overdraw_mean": float(overdraw.mean()) if overdraw.size else 0.0,
-            "blocks": int(overdraw.size)}
+    return {
+        "block_overdraw_max": float(overdraw.max()) if overdraw.size else 0.0,
+        "block_overdraw_mean": float(overdraw.mean()) if overdraw.size else 0.0,
+        "blocks": int(overdraw.size),
+    }
 
 
 def scene_block_overdraw_statistics(clouds, block_size: float = WANG_BLOCK_SIZE_M) -> dict:

@@ -77,12 +77,21 @@ def particle_styles(clouds, lighting: Lighting) -> ParticleStyles:
             cells, turns = np.full(count, -1, dtype=np.int32), np.zeros(count)
         sprites.append(cells)
         rotations.append(turns)
-        styles.append(CloudStyle(
-            facing=FACING_SPLAT if cloud.sprite is None else _FACINGS[cloud.sprite.facing],
-            artist=None if cloud.artist is None else artist_uniforms(cloud.artist, hour, sun),
-            bottom_y=bottom, top_y=top))
-    return ParticleStyles(_joined(cloud_index, np.int64, (0,)), _joined(groups, np.float64, (0, 3)),
-                          _joined(sprites, np.int32, (0,)), _joined(rotations, np.float64, (0,)), tuple(styles))
+        styles.append(
+            CloudStyle(
+                facing=FACING_SPLAT if cloud.sprite is None else _FACINGS[cloud.sprite.facing],
+                artist=None if cloud.artist is None else artist_uniforms(cloud.artist, hour, sun),
+                bottom_y=bottom,
+                top_y=top,
+            )
+        )
+    return ParticleStyles(
+        _joined(cloud_index, np.int64, (0,)),
+        _joined(groups, np.float64, (0, 3)),
+        _joined(sprites, np.int32, (0,)),
+        _joined(rotations, np.float64, (0,)),
+        tuple(styles),
+    )
 
 
 def _joined(parts, dtype, empty_shape) -> np.ndarray:

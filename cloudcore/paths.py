@@ -28,8 +28,7 @@ def sample(keys: np.ndarray, t: float) -> np.ndarray:
     m1 = (p2 - p0) / max(times[min(i + 1, len(times) - 1)] - times[max(i - 1, 0)], 1e-300) * dt
     m2 = (p3 - p1) / max(times[min(i + 2, len(times) - 1)] - times[i], 1e-300) * dt
     s2, s3 = s * s, s * s * s
-    return ((2 * s3 - 3 * s2 + 1) * p1 + (s3 - 2 * s2 + s) * m1
-            + (-2 * s3 + 3 * s2) * p2 + (s3 - s2) * m2)
+    return (2 * s3 - 3 * s2 + 1) * p1 + (s3 - 2 * s2 + s) * m1 + (-2 * s3 + 3 * s2) * p2 + (s3 - s2) * m2
 
 
 def camera_on_path(path, t: float, fov_y_deg: float) -> Camera:

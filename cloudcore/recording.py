@@ -7,9 +7,24 @@ import math
 import numpy as np
 
 #: the columns of `cloudview record --stats`, in order; other_ms is frame_ms less the cloud pass and impostor updates
-COLUMNS = ("frame", "time_s", "frame_ms", "cloud_ms", "impostor_update_ms", "other_ms", "particles_drawn",
-           "clouds_drawn", "impostors_drawn", "impostors_regenerated", "layers_drawn", "layers_rebuilt",
-           "overdraw_mean", "overdraw_max", "overdraw_analytic", "texture_bytes")
+COLUMNS = (
+    "frame",
+    "time_s",
+    "frame_ms",
+    "cloud_ms",
+    "impostor_update_ms",
+    "other_ms",
+    "particles_drawn",
+    "clouds_drawn",
+    "impostors_drawn",
+    "impostors_regenerated",
+    "layers_drawn",
+    "layers_rebuilt",
+    "overdraw_mean",
+    "overdraw_max",
+    "overdraw_analytic",
+    "texture_bytes",
+)
 
 
 def frame_times(duration: float, fps: float, frames: int | None = None) -> np.ndarray:
@@ -34,11 +49,20 @@ def frame_row(frame: int, time_s: float, stats: dict) -> dict:
     report are 0 (it has no split layers).
     """
     ms = {key: round(stats[key], 3) for key in ("frame_ms", "cloud_ms", "impostor_update_ms")}
-    overdraw = {key: round(stats[key], 4) if key in stats else "" for key in
-                ("overdraw_mean", "overdraw_max", "overdraw_analytic")}
-    return {"frame": frame, "time_s": round(time_s, 6), **ms,
-            "other_ms": round(stats["frame_ms"] - stats["cloud_ms"] - stats["impostor_update_ms"], 3),
-            **{key: stats[key] for key in ("particles_drawn", "clouds_drawn", "impostors_drawn",
-                                           "impostors_regenerated", "texture_bytes")},
-            "layers_drawn": stats.get("layers_drawn", 0), "layers_rebuilt": stats.get("layers_rebuilt", 0),
-            **overdraw}
+    overdraw = {
+        key: round(stats[key], 4) if key in stats else ""
+        for key in ("overdraw_mean", "overdraw_max", "overdraw_analytic")
+    }
+    return {
+        "frame": frame,
+        "time_s": round(time_s, 6),
+        **ms,
+        "other_ms": round(stats["frame_ms"] - stats["cloud_ms"] - stats["impostor_update_ms"], 3),
+        **{
+            key: stats[key]
+            for key in ("particles_drawn", "clouds_drawn", "impostors_drawn", "impostors_regenerated", "texture_bytes")
+        },
+        "layers_drawn": stats.get("layers_drawn", 0),
+        "layers_rebuilt": stats.get("layers_rebuilt", 0),
+        **overdraw,
+    }

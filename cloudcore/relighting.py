@@ -130,8 +130,9 @@ class LiveIllumination:
         current = {id(cloud) for cloud in scene.clouds}
         for (direction, clouds), incident in zip(work, results):
             kept = [(cloud, light) for cloud, light in zip(clouds, incident) if id(cloud) in current]
-            self.cache.store([cloud for cloud, _ in kept], look.shading, look.method, direction,
-                             [light for _, light in kept])
+            self.cache.store(
+                [cloud for cloud, _ in kept], look.shading, look.method, direction, [light for _, light in kept]
+            )
         self._shown = look
         if self._waiting is not None:
             waiting, self._waiting = self._waiting, None

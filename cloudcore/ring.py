@@ -6,16 +6,17 @@ eight textures of 45 degrees each; the panels form an octagon at the ring
 radius.  The ring is remade when the eye has moved more than a fraction of
 the radius (15% horizontally, 2% vertically, as in the paper), the lights
 changed, or the screen now asks for finer (or far coarser) segment textures
-than the ring was made with (a window grown from its first, tiny frame): one segment a frame, then the new ring crossfades in over a few
-frames while the old one fades out.  Pure numpy; the GL side renders what
+than the ring was made with (a window grown from its first, tiny frame): one
+segment a frame, then the new ring crossfades in over a few frames while the
+old one fades out.  Pure numpy; the GL side renders what
 `RingPlan` says.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Hashable
 from dataclasses import dataclass, field, replace
-from typing import Hashable
 
 import numpy as np
 
@@ -103,8 +104,11 @@ def ring_members(centres: np.ndarray, radii: np.ndarray, eye, settings: RenderSe
     elevation = np.degrees(np.arctan2(np.abs(offset[:, 1]), horizontal))
     with np.errstate(divide="ignore", invalid="ignore"):
         angular_radius = np.degrees(np.arcsin(np.clip(radii / distance, 0.0, 1.0)))
-    return (radii > 0) & (horizontal - radii > settings.ring_radius) & (
-        elevation + np.nan_to_num(angular_radius, nan=90.0) <= settings.ring_elevation_deg)
+    return (
+        (radii > 0)
+        & (horizontal - radii > settings.ring_radius)
+        & (elevation + np.nan_to_num(angular_radius, nan=90.0) <= settings.ring_elevation_deg)
+    )
 
 
 def segment_texture_size(viewport_height: int, fov_y_deg: float, settings: RenderSettings) -> tuple[int, int]:
@@ -112,16 +116,25 @@ def segment_texture_size(viewport_height: int, fov_y_deg: float, settings: Rende
     pixels_per_tangent = viewport_height / (2.0 * math.tan(math.radians(fov_y_deg) / 2.0))
     width = 2.0 * math.tan(math.radians(SEGMENT_DEG / 2.0)) * pixels_per_tangent
     height = 2.0 * math.tan(math.radians(settings.ring_elevation_deg)) * pixels_per_tangent
-    return (required_size(width, settings.impostor_min_size, settings.impostor_max_size),
-            required_size(height, settings.impostor_min_size, settings.impostor_max_size))
+    return (
+        required_size(width, settings.impostor_min_size, settings.impostor_max_size),
+        required_size(height, settings.impostor_min_size, settings.impostor_max_size),
+    )
 
 
-def new_generation(centres, radii, eye, settings: RenderSettings, keys: dict, ids: tuple,
-                   texture_size: tuple) -> RingGeneration:
+def new_generation(
+    centres, radii, eye, settings: RenderSettings, keys: dict, ids: tuple, texture_size: tuple
+) -> RingGeneration:
     in_ring = ring_members(centres, radii, eye, settings)
     members = frozenset(ids[i] for i in np.flatnonzero(in_ring))
-    generation = RingGeneration(tuple(float(v) for v in eye), float(settings.ring_radius),
-                                _members_key(members, keys), members, (), tuple(texture_size))
+    generation = RingGeneration(
+        tuple(float(v) for v in eye),
+        float(settings.ring_radius),
+        _members_key(members, keys),
+        members,
+        (),
+        tuple(texture_size),
+    )
     per_segment = []
     for segment in range(SEGMENTS):
         view, projection = segment_camera(generation, segment, settings.ring_elevation_deg)
@@ -138,22 +151,32 @@ def _members_key(members: frozenset, keys: dict) -> tuple:
 
 def _wrong_size(generation: RingGeneration, texture_size: tuple) -> bool:
     """The screen asks for finer segment textures than the generation has, or for far coarser ones."""
-    return any(held < wanted or held >= SHRINK_FACTOR * wanted
-               for held, wanted in zip(generation.texture_size, texture_size))
+    return any(
+        held < wanted or held >= SHRINK_FACTOR * wanted for held, wanted in zip(generation.texture_size, texture_size)
+    )
 
 
-def _needs_rebuild(generation: RingGeneration, eye, settings: RenderSettings, keys: dict,
-                   texture_size: tuple) -> bool:
+def _needs_rebuild(generation: RingGeneration, eye, settings: RenderSettings, keys: dict, texture_size: tuple) -> bool:
     moved = np.asarray(eye, dtype=np.float64) - np.asarray(generation.eye)
-    return (generation.lighting_key != _members_key(generation.members, keys)
-            or _wrong_size(generation, texture_size)
-            or generation.radius != settings.ring_radius
-            or math.hypot(moved[0], moved[2]) > settings.ring_rebuild_horizontal * settings.ring_radius
-            or abs(moved[1]) > settings.ring_rebuild_vertical * settings.ring_radius)
+    return (
+        generation.lighting_key != _members_key(generation.members, keys)
+        or _wrong_size(generation, texture_size)
+        or generation.radius != settings.ring_radius
+        or math.hypot(moved[0], moved[2]) > settings.ring_rebuild_horizontal * settings.ring_radius
+        or abs(moved[1]) > settings.ring_rebuild_vertical * settings.ring_radius
+    )
 
 
-def plan_ring(state: RingState, centres, radii, eye, settings: RenderSettings, lighting_keys: tuple,
-              ids: tuple, texture_size: tuple) -> RingPlan | None:
+def plan_ring(
+    state: RingState,
+    centres,
+    radii,
+    eye,
+    settings: RenderSettings,
+    lighting_keys: tuple,
+    ids: tuple,
+    texture_size: tuple,
+) -> RingPlan | None:
     """Advance the ring by one frame: start a rebuild if needed, build one segment or step the fade.
 
     `lighting_keys` has one key per sphere, `ids` one identity (a unit's member clouds): the ring

@@ -36,8 +36,10 @@ INLINE_PARTICLE_LIMIT = 64
 def _error(source, field: str, problem: str) -> SceneError:
     """A SceneError kept to one line: line breaks and other control characters (from keys,
     file names or library messages) are escaped."""
+
     def one_line(text) -> str:
         return "".join(ch if ch.isprintable() else ascii(ch)[1:-1] for ch in str(text))
+
     return SceneError(one_line(source), one_line(field), one_line(problem))
 
 
@@ -122,8 +124,9 @@ class _Table:
     def integers(self, key, default) -> tuple[int, ...]:
         """A flat array of integers (their range is the record's to check)."""
         value = self.data.get(key, default)
-        if not isinstance(value, (list, tuple)) or not all(isinstance(x, int) and not isinstance(x, bool)
-                                                           for x in value):
+        if not isinstance(value, (list, tuple)) or not all(
+            isinstance(x, int) and not isinstance(x, bool) for x in value
+        ):
             self.fail(key, f"expected an array of integers, got {value!r}")
         return tuple(value)
 
@@ -155,7 +158,7 @@ class _Table:
         except FieldError as error:
             self.fail(error.field, error.problem)
 
-    def tables(self, key) -> list["_Table"]:
+    def tables(self, key) -> list[_Table]:
         value = self.data.get(key, [])
         if not isinstance(value, list):
             self.fail(key, "expected an array of tables ([[...]])")
@@ -167,7 +170,8 @@ def _checked_matrix(value, columns, source, field, allow_empty) -> np.ndarray:
         array = np.array(value, dtype=np.float64)
         # numpy would take the strings "1.5" and booleans as numbers: TOML input must hold numbers
         if not isinstance(value, np.ndarray) and not all(
-                isinstance(x, (int, float)) and not isinstance(x, bool) for x in np.array(value, dtype=object).flat):
+            isinstance(x, (int, float)) and not isinstance(x, bool) for x in np.array(value, dtype=object).flat
+        ):
             raise TypeError
     except (TypeError, ValueError, OverflowError):  # OverflowError: an integer too large for a float
         raise _error(source, field, f"expected rows of {columns} numbers") from None
@@ -204,8 +208,9 @@ def load_scene(path) -> Scene:
 
 def scene_from_dict(data: dict, source: str = "<scene>", base_dir=Path(".")) -> Scene:
     root = _Table(source, "", data)
-    root.reject_unknown(("description", "camera", "lighting", "shading", "clouds", "terrain", "objects",
-                         "camera_paths"))
+    root.reject_unknown(
+        ("description", "camera", "lighting", "shading", "clouds", "terrain", "objects", "camera_paths")
+    )
     clouds = tuple(_cloud(t, Path(base_dir)) for t in root.tables("clouds"))
     _unique_names(root, "clouds", clouds)
     objects = tuple(_object(t, Path(base_dir)) for t in root.tables("objects"))
@@ -252,8 +257,13 @@ def _lighting(t: _Table) -> Lighting:
     lights = []
     for lt in t.tables("lights"):
         lt.reject_unknown(("direction", "color", "intensity"))
-        lights.append(Light(lt.vector("direction", unit=True), lt.vector("color", (1.0, 1.0, 1.0), low=0.0),
-                            lt.number("intensity", 1.0, low=0.0)))
+        lights.append(
+            Light(
+                lt.vector("direction", unit=True),
+                lt.vector("color", (1.0, 1.0, 1.0), low=0.0),
+                lt.number("intensity", 1.0, low=0.0),
+            )
+        )
     # Explicit lights replace the sun and skylight; a time of day still sets the sky.
     if t.has("time_of_day"):
         time_of_day = t.number("time_of_day", low=0.0, high=24.0)
@@ -275,8 +285,20 @@ def _shading(t: _Table) -> Shading:
 
 
 def _cloud(t: _Table, base_dir: Path) -> Cloud:
-    t.reject_unknown(("name", "particles", "particles_file", "optical_depth", "albedo", "color", "formation",
-                      "sprite", "artist", "shading_group_size"))
+    t.reject_unknown(
+        (
+            "name",
+            "particles",
+            "particles_file",
+            "optical_depth",
+            "albedo",
+            "color",
+            "formation",
+            "sprite",
+            "artist",
+            "shading_group_size",
+        )
+    )
     name = t.string("name")
     if t.has("particles") == t.has("particles_file"):
         t.fail("particles", "give exactly one of particles (inline) or particles_file (.npy)")
@@ -300,7 +322,8 @@ def _cloud(t: _Table, base_dir: Path) -> Cloud:
         sprite=t.table("sprite", _sprite),
         artist=t.table("artist", _artist),
         shading_group_size=t.number("shading_group_size", None, low=0.0, low_open=True)
-        if t.has("shading_group_size") else None,
+        if t.has("shading_group_size")
+        else None,
     )
 
 
@@ -449,14 +472,22 @@ def scene_to_dict(scene: Scene) -> dict:
     if scene.lighting.ambient is not None:
         lighting["ambient"] = list(scene.lighting.ambient)
     if scene.lighting.lights:
-        lighting["lights"] = [{"direction": list(l.direction), "color": list(l.color), "intensity": l.intensity}
-                              for l in scene.lighting.lights]
+        lighting["lights"] = [
+            {"direction": list(light.direction), "color": list(light.color), "intensity": light.intensity}
+            for light in scene.lighting.lights
+        ]
     data["lighting"] = lighting
     data["shading"] = {"albedo": s.albedo, "optical_depth": s.optical_depth, "phase": s.phase, "g": s.g}
     if scene.terrain is not None:
         t = scene.terrain
-        terrain = {"kind": t.kind, "size": list(t.size), "resolution": t.resolution, "height": t.height,
-                   "seed": t.seed, "color": list(t.color)}
+        terrain = {
+            "kind": t.kind,
+            "size": list(t.size),
+            "resolution": t.resolution,
+            "height": t.height,
+            "seed": t.seed,
+            "color": list(t.color),
+        }
         if t.mesh is not None:
             terrain["mesh"] = t.mesh
         data["terrain"] = terrain
@@ -538,10 +569,20 @@ def save_scene(scene: Scene, path) -> Scene:
     path = Path(path)
     saved_clouds = tuple(
         dataclasses.replace(cloud, particles_file=_store_particles(cloud, path))
-        if cloud.particles_file is not None or len(cloud.particles) > INLINE_PARTICLE_LIMIT else cloud
-        for cloud in scene.clouds)
-    saved = Scene(scene.camera, scene.lighting, scene.shading, saved_clouds, scene.terrain,
-                  scene.objects, scene.camera_paths, scene.description)
+        if cloud.particles_file is not None or len(cloud.particles) > INLINE_PARTICLE_LIMIT
+        else cloud
+        for cloud in scene.clouds
+    )
+    saved = Scene(
+        scene.camera,
+        scene.lighting,
+        scene.shading,
+        saved_clouds,
+        scene.terrain,
+        scene.objects,
+        scene.camera_paths,
+        scene.description,
+    )
     document = tomlkit.dumps(scene_to_dict(saved)).encode("utf-8")
     _atomic_write(path, lambda f: f.write(document))
     _remove_unnamed_particle_files(path, {c.particles_file for c in saved_clouds if c.particles_file is not None})

@@ -22,10 +22,10 @@ TRANSLATION_METRICS = ("parallax", "centre")
 class RenderSettings:
     mode: str = "auto"
     #: degrees of translation error past which an impostor is regenerated; see `translation_metric`.
-    #: SkyWorks' default is 0.125 (0.9 of a pixel at 480 lines and 60 degrees); measured side by side along
-    #: the default flythrough, 1 costs an eighth less time than 0.5 for 0.5 dB of mean PSNR and the same
-    #: worst frame (34.0 dB), where 2 loses 2.5 dB on the worst frame (docs/performance.md)
-    tolerance_deg: float = 1.0
+    #: SkyWorks' default is 0.125 (0.9 of a pixel at 480 lines and 60 degrees).  Measured side by side,
+    #: 1 saved an eighth of the default flythrough's cloud pass for 0.5 dB, but on a cumulus field the
+    #: project was not tuned on it saved nothing and cost 5 dB on the worst frame (docs/performance.md)
+    tolerance_deg: float = 0.5
     #: "parallax": the angle between the rays to the impostor's near and far points (Harris, SkyWorks);
     #: "centre": the angle the eye has turned around the cloud's centre (stricter by about D / 2R)
     translation_metric: str = "parallax"
@@ -74,8 +74,9 @@ class RenderSettings:
         if not 0.0 <= self.tolerance_deg <= 180.0:
             problems.append(f"tolerance_deg must be within [0, 180], got {self.tolerance_deg}")
         if self.translation_metric not in TRANSLATION_METRICS:
-            problems.append(f"translation_metric must be one of {', '.join(TRANSLATION_METRICS)}, "
-                            f"got {self.translation_metric!r}")
+            problems.append(
+                f"translation_metric must be one of {', '.join(TRANSLATION_METRICS)}, got {self.translation_metric!r}"
+            )
         if not 0.0 <= self.tolerance_px < math.inf:
             problems.append(f"tolerance_px must be >= 0 and finite (0: use tolerance_deg), got {self.tolerance_px}")
         if not (self.ring_radius >= 0.0):
@@ -87,8 +88,9 @@ class RenderSettings:
         if not 0.0 <= self.impostor_detail_texels < math.inf:
             problems.append(f"impostor_detail_texels must be >= 0 and finite, got {self.impostor_detail_texels}")
         if not (isinstance(self.regeneration_budget, int) and self.regeneration_budget >= 0):
-            problems.append("regeneration_budget must be an integer >= 0 (0: no limit), "
-                            f"got {self.regeneration_budget!r}")
+            problems.append(
+                f"regeneration_budget must be an integer >= 0 (0: no limit), got {self.regeneration_budget!r}"
+            )
         if not 0.0 <= self.frame_budget_ms < math.inf:
             problems.append(f"frame_budget_ms must be >= 0 and finite (0: no budget), got {self.frame_budget_ms}")
         if self.impostor_min_size > self.impostor_max_size:

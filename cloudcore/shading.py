@@ -181,7 +181,8 @@ def _overlaps_in_light_order(plane: np.ndarray, radii: np.ndarray):
         for band in np.unique(octave[positive]):
             in_band = np.flatnonzero((octave == band) & positive)
             found = cKDTree(plane[in_band]).sparse_distance_matrix(
-                tree, float(radii[in_band].max()), output_type="ndarray")
+                tree, float(radii[in_band].max()), output_type="ndarray"
+            )
             found_source.append(in_band[found["i"]])
             found_target.append(found["j"])
         source, target = np.concatenate(found_source), np.concatenate(found_target)
@@ -210,8 +211,9 @@ def _incident_exact(plane, toward_light, radii, alpha, sigma, groups):
         targets.append(target + start)
         weights.append(weight)
     incident = np.empty(n)
-    incident[order] = _incident_in_light_order(np.concatenate(sources), np.concatenate(targets),
-                                               np.concatenate(weights), alpha, sigma)
+    incident[order] = _incident_in_light_order(
+        np.concatenate(sources), np.concatenate(targets), np.concatenate(weights), alpha, sigma
+    )
     return incident
 
 
@@ -235,9 +237,7 @@ def _incident_in_light_order(source, target, weight, alpha, sigma):
         if lit.size:
             edges = _concatenated_ranges(in_start[lit], in_count[lit])
             src, w = in_source[edges], in_weight[edges]
-            through, scattered = _compose_segments(
-                1.0 - alpha[src] * w, sigma[src] * incident[src] * w, in_count[lit]
-            )
+            through, scattered = _compose_segments(1.0 - alpha[src] * w, sigma[src] * incident[src] * w, in_count[lit])
             incident[lit] = through + scattered  # the frame buffer starts at 1
         released = out_target[_concatenated_ranges(out_start[ready], out_count[ready])]
         np.subtract.at(waiting, released, 1)
@@ -341,10 +341,13 @@ def _bilinear(grid, offset, resolution, point):
     p = np.clip(point - 0.5, 0.0, resolution - 1.0)
     i0 = np.minimum(p.astype(np.int64), resolution - 2)
     f = p - i0
+
     def at(dx, dy):
         return grid[offset + (i0[:, 1] + dy) * resolution + i0[:, 0] + dx]
-    return ((at(0, 0) * (1 - f[:, 0]) + at(1, 0) * f[:, 0]) * (1 - f[:, 1])
-            + (at(0, 1) * (1 - f[:, 0]) + at(1, 1) * f[:, 0]) * f[:, 1])
+
+    return (at(0, 0) * (1 - f[:, 0]) + at(1, 0) * f[:, 0]) * (1 - f[:, 1]) + (
+        at(0, 1) * (1 - f[:, 0]) + at(1, 1) * f[:, 0]
+    ) * f[:, 1]
 
 
 def _footprints(centre, radius, resolution):

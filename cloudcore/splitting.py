@@ -19,8 +19,9 @@ import math
 import numpy as np
 
 
-def objects_inside(cloud_centre, cloud_radius: float, object_centres: np.ndarray,
-                   object_radii: np.ndarray) -> np.ndarray:
+def objects_inside(
+    cloud_centre, cloud_radius: float, object_centres: np.ndarray, object_radii: np.ndarray
+) -> np.ndarray:
     """Indices of the objects whose bounding spheres reach into the cloud's bounding sphere."""
     if cloud_radius <= 0.0 or len(object_radii) == 0:
         return np.zeros(0, dtype=np.int64)

@@ -101,7 +101,9 @@ def _foggy(x, y, parameter, seed):
     wide = 0.7 + 0.1 * parameter(0)
     low = _fbm(x, y, seed, 2.5, octaves=3)
     distance = np.hypot(x / wide, y / (0.45 + 0.1 * parameter(1))) * (1.0 + 0.18 * low)
-    alpha = (0.55 + 0.1 * parameter(2)) * (1.0 - smoothstep(0.15, 1.0, distance)) * (0.8 + 0.2 * _fbm(x, y, seed + 7, 6.0))
+    alpha = (
+        (0.55 + 0.1 * parameter(2)) * (1.0 - smoothstep(0.15, 1.0, distance)) * (0.8 + 0.2 * _fbm(x, y, seed + 7, 6.0))
+    )
     brightness = 0.9 + 0.06 * low
     return alpha, brightness, FOGGY_TINT
 
@@ -109,8 +111,9 @@ def _foggy(x, y, parameter, seed):
 def _puffy(x, y, parameter, seed):
     """A cauliflower cluster of rounded puffs: Wang's cumulus detail."""
     billow = np.abs(_fbm(x, y, seed, 6.0))  # creases where the noise crosses zero
-    body = _blobs(x * (1.0 + 0.15 * billow), y * (1.0 + 0.15 * billow), parameter, 6, 0,
-                  (-0.35, 0.35), (-0.3, 0.3), (0.22, 0.4))
+    body = _blobs(
+        x * (1.0 + 0.15 * billow), y * (1.0 + 0.15 * billow), parameter, 6, 0, (-0.35, 0.35), (-0.3, 0.3), (0.22, 0.4)
+    )
     alpha = smoothstep(0.02, 0.55, body) * (0.85 + 0.15 * billow)
     brightness = 0.7 + 0.18 * smoothstep(-0.6, 0.6, y) + 0.22 * billow
     return alpha, brightness, np.ones(3)
@@ -128,6 +131,6 @@ def _wispy(x, y, parameter, seed):
         width = 0.08 + 0.1 * parameter(k + 3)
         fibres = 1.0 - np.abs(value_noise(along * 3.0, across * 22.0, seed + strand))  # thin lines along the streak
         profile = (1.0 - smoothstep(0.0, width, np.abs(across))) * (1.0 - smoothstep(0.25, 0.75, np.abs(along)))
-        alpha = np.maximum(alpha, profile * (0.35 + 0.45 * fibres ** 2))
+        alpha = np.maximum(alpha, profile * (0.35 + 0.45 * fibres**2))
     brightness = 0.9 + 0.08 * _fbm(x, y, seed, 4.0, octaves=3)
     return alpha * (0.75 + 0.25 * parameter(20)), brightness, np.ones(3)

@@ -79,15 +79,20 @@ class SpriteStyle:
 
     def __post_init__(self):
         rows = tuple(self.rows)
-        if not rows or not all(isinstance(r, (int, np.integer)) and not isinstance(r, bool) and 0 <= r < ATLAS_GRID
-                               for r in rows):
+        if not rows or not all(
+            isinstance(r, (int, np.integer)) and not isinstance(r, bool) and 0 <= r < ATLAS_GRID for r in rows
+        ):
             raise FieldError("rows", f"expected one or more atlas rows in 0..{ATLAS_GRID - 1}, got {list(rows)}")
         object.__setattr__(self, "rows", tuple(int(r) for r in rows))
         for name in ("rotation_deg", "flat_bottom_rotation_deg"):
             object.__setattr__(self, name, _rotation_range(name, getattr(self, name)))
         if self.facing not in FACINGS:
             raise FieldError("facing", f"{self.facing!r} is not one of: {', '.join(FACINGS)}")
-        if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) or not 0 <= self.seed <= MAX_SEED:
+        if (
+            isinstance(self.seed, bool)
+            or not isinstance(self.seed, (int, np.integer))
+            or not 0 <= self.seed <= MAX_SEED
+        ):
             raise FieldError("seed", f"expected an integer in [0, {MAX_SEED}], got {self.seed!r}")
         object.__setattr__(self, "seed", int(self.seed))
         fraction = float(self.flat_bottom_fraction)
@@ -157,8 +162,8 @@ def atlas_cell_uv(index: int) -> tuple[float, float, float, float]:
     (array row 0 first).  So v0 < v1 and v0 is the cell's top edge: a quad
     corner at the sprite's upper left takes (u0, v0), its lower right (u1, v1).
     """
-    if isinstance(index, bool) or not isinstance(index, (int, np.integer)) or not 0 <= index < ATLAS_GRID ** 2:
-        raise ValueError(f"atlas cell index must be an integer in [0, {ATLAS_GRID ** 2 - 1}], got {index!r}")
+    if isinstance(index, bool) or not isinstance(index, (int, np.integer)) or not 0 <= index < ATLAS_GRID**2:
+        raise ValueError(f"atlas cell index must be an integer in [0, {ATLAS_GRID**2 - 1}], got {index!r}")
     row, column = divmod(int(index), ATLAS_GRID)
     return column / ATLAS_GRID, row / ATLAS_GRID, (column + 1) / ATLAS_GRID, (row + 1) / ATLAS_GRID
 
@@ -171,8 +176,10 @@ def load_atlas() -> np.ndarray:
     pixels = iio.imread(ATLAS_PATH)
     side = ATLAS_GRID * CELL_PIXELS
     if pixels.shape != (side, side, 4) or pixels.dtype != np.uint8:
-        raise ValueError(f"{ATLAS_PATH}: expected {side}x{side} RGBA 8-bit, got {pixels.shape} {pixels.dtype}; "
-                         "regenerate it with scripts/make_sprite_atlas.py")
+        raise ValueError(
+            f"{ATLAS_PATH}: expected {side}x{side} RGBA 8-bit, got {pixels.shape} {pixels.dtype}; "
+            "regenerate it with scripts/make_sprite_atlas.py"
+        )
     atlas = pixels.astype(np.float32) / np.float32(255.0)
     atlas.flags.writeable = False
     return atlas

@@ -19,7 +19,7 @@ def height_at(terrain: Terrain, x, z) -> np.ndarray:
     x, z = np.asarray(x, dtype=np.float64), np.asarray(z, dtype=np.float64)
     half_x = 0.5 * terrain.size[0]
     across = np.clip(np.abs(x) / half_x, 0.0, 1.0)
-    valley = across ** 1.6
+    valley = across**1.6
     wavelength = 0.35 * min(terrain.size)
     noise = np.zeros(np.broadcast(x, z).shape)
     amplitude, total = 1.0, 0.0

@@ -32,8 +32,18 @@ _TIMES = ("window_frame_ms", "viewport_ms", "frame_ms", "cloud_ms", "world_ms", 
 
 
 def run_editor(scene: Path, size: str, frames: int, stats_file: Path, home: Path) -> None:
-    command = [sys.executable, "-m", "app", str(scene), "--window-size", size, "--frames", str(frames),
-               "--frame-stats", str(stats_file)]
+    command = [
+        sys.executable,
+        "-m",
+        "app",
+        str(scene),
+        "--window-size",
+        size,
+        "--frames",
+        str(frames),
+        "--frame-stats",
+        str(stats_file),
+    ]
     if not os.environ.get("DISPLAY"):
         if shutil.which("xvfb-run") is None:
             sys.exit("bench_editor: no display and no xvfb-run (install xvfb)")
@@ -48,13 +58,18 @@ def summarise(frames: list[dict], warm_up: int) -> dict:
     measured = frames[warm_up:]
     if not measured:
         raise SystemExit(f"bench_editor: only {len(frames)} frames recorded, none after {warm_up} warm-up frames")
-    summary = {"frames": len(measured),
-               "viewport": [measured[-1]["viewport_width"], measured[-1]["viewport_height"]],
-               "particles_drawn_mean": float(np.mean([f["particles_drawn"] for f in measured]))}
+    summary = {
+        "frames": len(measured),
+        "viewport": [measured[-1]["viewport_width"], measured[-1]["viewport_height"]],
+        "particles_drawn_mean": float(np.mean([f["particles_drawn"] for f in measured])),
+    }
     for key in _TIMES:
         values = np.array([f[key] for f in measured], dtype=np.float64)
-        summary[key] = {"mean": float(values.mean()), "median": float(np.median(values)),
-                        "p95": float(np.percentile(values, 95))}
+        summary[key] = {
+            "mean": float(values.mean()),
+            "median": float(np.median(values)),
+            "p95": float(np.percentile(values, 95)),
+        }
     summary["fps_mean"] = 1e3 / summary["window_frame_ms"]["mean"]
     return summary
 
@@ -71,8 +86,14 @@ def main() -> None:
         stats_file = Path(folder) / "frames.json"
         run_editor(args.scene.resolve(), args.size, args.frames, stats_file, Path(folder))
         frames = json.loads(stats_file.read_text())
-    report = {"scene": str(args.scene), "window": args.size, "mode": "auto", "machine": machine(),
-              "cpus": os.cpu_count(), **summarise(frames, args.warm_up)}
+    report = {
+        "scene": str(args.scene),
+        "window": args.size,
+        "mode": "auto",
+        "machine": machine(),
+        "cpus": os.cpu_count(),
+        **summarise(frames, args.warm_up),
+    }
     write_report(report, args.json)
 
 

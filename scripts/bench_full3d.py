@@ -36,8 +36,12 @@ def bench_size(scene, width: int, height: int, views) -> dict:
             _, stats = renderer.render(scene, camera=camera, settings=FULL_3D)
             stats |= renderer.measure_overdraw()[1]
             samples.append(stats)
-    summary = {"width": width, "height": height, "frames": len(samples),
-               "particles_drawn_mean": float(np.mean([s["particles_drawn"] for s in samples]))}
+    summary = {
+        "width": width,
+        "height": height,
+        "frames": len(samples),
+        "particles_drawn_mean": float(np.mean([s["particles_drawn"] for s in samples])),
+    }
     for key in _TIMES:
         summary[f"{key}_mean"] = float(np.mean([s[key] for s in samples]))
         summary[f"{key}_median"] = float(np.median([s[key] for s in samples]))
@@ -60,8 +64,12 @@ def main() -> None:
     scene = load_scene(args.scene)
     views = [scene.camera] + ([camera for _, camera in path_views(scene, args.path, args.frames)] if args.path else [])
     sizes = [tuple(int(v) for v in size.split("x")) for size in args.sizes.split(",")]
-    result = {"scene": str(args.scene), "path": args.path, "machine": machine(),
-              "runs": [bench_size(scene, w, h, views) for w, h in sizes]}
+    result = {
+        "scene": str(args.scene),
+        "path": args.path,
+        "machine": machine(),
+        "runs": [bench_size(scene, w, h, views) for w, h in sizes],
+    }
     write_report(result, args.json, [{k: v for k, v in run.items() if k != "per_frame"} for run in result["runs"]])
 
 

@@ -35,6 +35,7 @@ os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from bench_many_particles import cloud_field  # noqa: E402  (a sibling script: the same 1.2M field)
+
 from cloudcore.benchmark import bench_path, machine, orbit_views, path_views, still_views, write_report  # noqa: E402
 from cloudcore.cloudgen import preset_cloud  # noqa: E402
 from cloudcore.gl import FrameRenderer  # noqa: E402
@@ -54,25 +55,39 @@ def flight(name: str, start, end, look_ahead_m: float = 2000.0, speed_m_s: float
     start, end = np.asarray(start, dtype=np.float64), np.asarray(end, dtype=np.float64)
     direction = (end - start) / np.linalg.norm(end - start)
     duration = float(np.linalg.norm(end - start)) / speed_m_s
-    keys = [[t * duration, *(start + t * (end - start)), *(start + t * (end - start) + look_ahead_m * direction)]
-            for t in np.linspace(0.0, 1.0, 5)]
+    keys = [
+        [t * duration, *(start + t * (end - start)), *(start + t * (end - start) + look_ahead_m * direction)]
+        for t in np.linspace(0.0, 1.0, 5)
+    ]
     return CameraPath(name, np.array(keys))
 
 
 def untuned_scenes(valley: Scene) -> dict:
     """Two scenes the LOD was never tuned on: (scene, path name) by name."""
     cumulus = dataclasses.replace(
-        valley, clouds=cloud_field(60_000, 1_500, seed=41), objects=(),
-        camera_paths=(flight("through", (-900.0, 950.0, 2200.0), (700.0, 980.0, -1400.0)),))
+        valley,
+        clouds=cloud_field(60_000, 1_500, seed=41),
+        objects=(),
+        camera_paths=(flight("through", (-900.0, 950.0, 2200.0), (700.0, 980.0, -1400.0)),),
+    )
     rng = np.random.default_rng(7)
-    deck = tuple(preset_cloud("stratocumulus", f"deck_{i:02d}",
-                              (x + rng.uniform(-150, 150), rng.uniform(1150.0, 1250.0), z + rng.uniform(-150, 150)),
-                              seed=i)
-                 for i, (x, z) in enumerate((x, z) for x in np.arange(-2400.0, 2401.0, 1200.0)
-                                            for z in np.arange(-2400.0, 2401.0, 1200.0)))
+    deck = tuple(
+        preset_cloud(
+            "stratocumulus",
+            f"deck_{i:02d}",
+            (x + rng.uniform(-150, 150), rng.uniform(1150.0, 1250.0), z + rng.uniform(-150, 150)),
+            seed=i,
+        )
+        for i, (x, z) in enumerate(
+            (x, z) for x in np.arange(-2400.0, 2401.0, 1200.0) for z in np.arange(-2400.0, 2401.0, 1200.0)
+        )
+    )
     stratus = dataclasses.replace(
-        valley, clouds=deck, objects=(),
-        camera_paths=(flight("under_and_into", (2600.0, 900.0, 2600.0), (-1800.0, 1200.0, -1800.0)),))
+        valley,
+        clouds=deck,
+        objects=(),
+        camera_paths=(flight("under_and_into", (2600.0, 900.0, 2600.0), (-1800.0, 1200.0, -1800.0)),),
+    )
     return {"cumulus_field": (cumulus, "through"), "stratocumulus_deck": (stratus, "under_and_into")}
 
 
@@ -99,15 +114,31 @@ def cases(names, quick: bool) -> list:
 
 def summary(name: str, report: dict) -> list[dict]:
     reference = report["reference"]
-    rows = [{"case": name, "mode": "full", "frame_ms": reference["frame_ms_mean"],
-             "cloud_ms": reference["cloud_ms_mean"], "fps": 1e3 / reference["frame_ms_mean"]}]
+    rows = [
+        {
+            "case": name,
+            "mode": "full",
+            "frame_ms": reference["frame_ms_mean"],
+            "cloud_ms": reference["cloud_ms_mean"],
+            "fps": 1e3 / reference["frame_ms_mean"],
+        }
+    ]
     for run in report["runs"]:
-        rows.append({"case": name, "mode": run["settings"]["mode"], "frame_ms": run["frame_ms_mean"],
-                     "cloud_ms": run["cloud_ms_mean"], "fps": 1e3 / run["frame_ms_mean"],
-                     "cloud_speedup": run["cloud_speedup_vs_full"], "frame_speedup": run["speedup_vs_full"],
-                     "psnr_mean": run["psnr_mean"], "psnr_min": run["psnr_min"],
-                     "regenerations_per_frame": run["regenerations_per_frame"],
-                     "predicted_ms": run["predicted_ms_mean"]})
+        rows.append(
+            {
+                "case": name,
+                "mode": run["settings"]["mode"],
+                "frame_ms": run["frame_ms_mean"],
+                "cloud_ms": run["cloud_ms_mean"],
+                "fps": 1e3 / run["frame_ms_mean"],
+                "cloud_speedup": run["cloud_speedup_vs_full"],
+                "frame_speedup": run["speedup_vs_full"],
+                "psnr_mean": run["psnr_mean"],
+                "psnr_min": run["psnr_min"],
+                "regenerations_per_frame": run["regenerations_per_frame"],
+                "predicted_ms": run["predicted_ms_mean"],
+            }
+        )
     return rows
 
 
@@ -121,11 +152,13 @@ def plot(rows, path: Path) -> None:
     figure, axes = plt.subplots(figsize=(6.4, 4.2), dpi=120)
     for mode, marker in (("impostor", "o"), ("auto", "s")):
         points = [r for r in rows if r["mode"] == mode]
-        axes.scatter([r["cloud_speedup"] for r in points], [r["psnr_mean"] for r in points], marker=marker,
-                     label=mode, zorder=3)
+        axes.scatter(
+            [r["cloud_speedup"] for r in points], [r["psnr_mean"] for r in points], marker=marker, label=mode, zorder=3
+        )
         for r in points if mode == "auto" else ():
-            axes.annotate(r["case"], (r["cloud_speedup"], r["psnr_mean"]), fontsize=7, xytext=(5, 4),
-                          textcoords="offset points")
+            axes.annotate(
+                r["case"], (r["cloud_speedup"], r["psnr_mean"]), fontsize=7, xytext=(5, 4), textcoords="offset points"
+            )
     axes.set_xscale("log")
     axes.set_xlabel("cloud pass + impostor updates, speed-up over full 3D (same run)")
     axes.set_ylabel("mean PSNR against full 3D (dB)")
@@ -145,8 +178,13 @@ def main() -> None:
     parser.add_argument("--plot", type=Path)
     args = parser.parse_args()
     names = set(args.cases.split(","))
-    result = {"machine": machine(), "date": time.strftime("%Y-%m-%d"), "settings": dataclasses.asdict(MODES[1]),
-              "cases": {}, "summary": []}
+    result = {
+        "machine": machine(),
+        "date": time.strftime("%Y-%m-%d"),
+        "settings": dataclasses.asdict(MODES[1]),
+        "cases": {},
+        "summary": [],
+    }
     for name, scene, views, size, warmup in cases(names, args.quick):
         start = time.perf_counter()
         with FrameRenderer(*size) as renderer:
@@ -156,8 +194,11 @@ def main() -> None:
         rows = summary(name, report)
         result["summary"] += rows
         for row in rows:
-            print(" ".join(f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}" for k, v in row.items()),
-                  file=sys.stderr, flush=True)
+            print(
+                " ".join(f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}" for k, v in row.items()),
+                file=sys.stderr,
+                flush=True,
+            )
     if args.plot:
         plot([r for r in result["summary"] if r["mode"] != "full"], args.plot)
     write_report(result, args.json, summary=result["summary"])

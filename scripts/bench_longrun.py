@@ -32,14 +32,17 @@ from cloudcore.scenefile import load_scene  # noqa: E402
 from cloudcore.settings import MODES, RenderSettings  # noqa: E402
 
 
-
 def sample(renderer: FrameRenderer, started: float, frames: int, frame_ms: list[float]) -> dict:
     """Where memory stands now, and the frames since the last sample."""
     linear = renderer.context.read_linear_rgb() if renderer.last_plan is not None else np.zeros(1)
-    return {"elapsed_s": time.perf_counter() - started, "frames": frames,
-            "texture_bytes": renderer.texture_bytes, "resident_bytes": resident_memory_bytes(),
-            "frame_ms_mean": float(np.mean(frame_ms)) if frame_ms else None,
-            "frame_finite": bool(np.isfinite(linear).all())}
+    return {
+        "elapsed_s": time.perf_counter() - started,
+        "frames": frames,
+        "texture_bytes": renderer.texture_bytes,
+        "resident_bytes": resident_memory_bytes(),
+        "frame_ms_mean": float(np.mean(frame_ms)) if frame_ms else None,
+        "frame_finite": bool(np.isfinite(linear).all()),
+    }
 
 
 def long_run(scene, views, settings: RenderSettings, size, seconds: float, sample_seconds: float) -> dict:
@@ -64,15 +67,24 @@ def long_run(scene, views, settings: RenderSettings, size, seconds: float, sampl
     before, first, last = samples[0], samples[1], samples[-1]
     # memory is compared from the end of the first loop, when every cache along the path has filled
     warm = next((s for s in samples if s["frames"] == len(views)), None)
-    return {"frames": frames, "loops": frames / len(views), "seconds": last["elapsed_s"],
-            "frame_ms_mean": total_ms / max(frames - 1, 1), "first_frame_ms": first["frame_ms_mean"],
-            "texture_bytes_after_first_frame": first["texture_bytes"],
-            "texture_bytes_after_first_loop": warm and warm["texture_bytes"], "texture_bytes_end": last["texture_bytes"],
-            "texture_bytes_max": max(s["texture_bytes"] for s in samples),
-            "resident_bytes_start": before["resident_bytes"], "resident_bytes_after_first_frame":
-                first["resident_bytes"], "resident_bytes_after_first_loop": warm and warm["resident_bytes"],
-            "resident_bytes_end": last["resident_bytes"], "resident_bytes_max": max(s["resident_bytes"] for s in samples),
-            "sampled_frames_finite": all(s["frame_finite"] for s in samples), "samples": samples}
+    return {
+        "frames": frames,
+        "loops": frames / len(views),
+        "seconds": last["elapsed_s"],
+        "frame_ms_mean": total_ms / max(frames - 1, 1),
+        "first_frame_ms": first["frame_ms_mean"],
+        "texture_bytes_after_first_frame": first["texture_bytes"],
+        "texture_bytes_after_first_loop": warm and warm["texture_bytes"],
+        "texture_bytes_end": last["texture_bytes"],
+        "texture_bytes_max": max(s["texture_bytes"] for s in samples),
+        "resident_bytes_start": before["resident_bytes"],
+        "resident_bytes_after_first_frame": first["resident_bytes"],
+        "resident_bytes_after_first_loop": warm and warm["resident_bytes"],
+        "resident_bytes_end": last["resident_bytes"],
+        "resident_bytes_max": max(s["resident_bytes"] for s in samples),
+        "sampled_frames_finite": all(s["frame_finite"] for s in samples),
+        "samples": samples,
+    }
 
 
 def main() -> None:
@@ -92,11 +104,25 @@ def main() -> None:
     scene = load_scene(args.scene)
     path = scene.camera_path(args.path)
     views = path_views(scene, args.path, max(2, round(path.duration * args.fps) + 1))
-    result = {"scene": str(args.scene), "path": args.path, "mode": args.mode, "width": args.width,
-              "height": args.height, "minutes": args.minutes, "path_frames": len(views),
-              "machine": machine(), "date": time.strftime("%Y-%m-%d"),
-              **long_run(scene, views, RenderSettings(mode=args.mode), (args.width, args.height),
-                         60.0 * args.minutes, args.sample_seconds)}
+    result = {
+        "scene": str(args.scene),
+        "path": args.path,
+        "mode": args.mode,
+        "width": args.width,
+        "height": args.height,
+        "minutes": args.minutes,
+        "path_frames": len(views),
+        "machine": machine(),
+        "date": time.strftime("%Y-%m-%d"),
+        **long_run(
+            scene,
+            views,
+            RenderSettings(mode=args.mode),
+            (args.width, args.height),
+            60.0 * args.minutes,
+            args.sample_seconds,
+        ),
+    }
     write_report(result, args.json, {k: v for k, v in result.items() if k != "samples"})
 
 

@@ -54,39 +54,55 @@ def cloud_field(total: int, per_cloud: int, seed: int = 9) -> tuple[Cloud, ...]:
         base[[0, 2]] += rng.uniform(-0.2, 0.2, 2) * SPACING_M
         size = np.array([rng.uniform(380, 760), rng.uniform(200, 380), rng.uniform(380, 760)])
         particles = min(per_cloud, total - index * per_cloud)
-        clouds.append(Cloud(f"cumulus_{index:03d}", cumulus(base, size, particles, 0.085 * size[[0, 2]].min(),
-                                                            seed + index)))
+        clouds.append(
+            Cloud(f"cumulus_{index:03d}", cumulus(base, size, particles, 0.085 * size[[0, 2]].min(), seed + index))
+        )
     return tuple(clouds)
 
 
 def finite_frame(renderer: FrameRenderer) -> dict:
     linear = renderer.context.read_linear_rgb()
-    return {"frame_non_finite_values": int(np.count_nonzero(~np.isfinite(linear))),
-            "frame_linear_max": float(np.nanmax(linear))}
+    return {
+        "frame_non_finite_values": int(np.count_nonzero(~np.isfinite(linear))),
+        "frame_linear_max": float(np.nanmax(linear)),
+    }
 
 
 def bench_mode(renderer: FrameRenderer, scene: Scene, mode: str, frames: int, illumination: str) -> dict:
-    stats = [renderer.render(scene, illumination_method=illumination, settings=RenderSettings(mode=mode),
-                             read_back=False)[1] for _ in range(frames)]
+    stats = [
+        renderer.render(scene, illumination_method=illumination, settings=RenderSettings(mode=mode), read_back=False)[1]
+        for _ in range(frames)
+    ]
     later, steady = stats[1:] or stats, stats[-STEADY_FRAMES:]
     last = stats[-1]
-    return {"mode": mode, "frames": frames, "first_frame_ms": stats[0]["frame_ms"],
-            "frame_ms_mean": float(np.mean([s["frame_ms"] for s in later])),
-            "steady_frame_ms_mean": float(np.mean([s["frame_ms"] for s in steady])),
-            "steady_cloud_ms_mean": float(np.mean([s["cloud_ms"] for s in steady])),
-            "particles_drawn": last["particles_drawn"], "clouds_drawn": last["clouds_drawn"],
-            "clouds_culled": last["clouds_culled"], "clouds_ring": last["clouds_ring"],
-            "impostors_drawn": last["impostors_drawn"],
-            "texture_bytes": last["texture_bytes"], "resident_bytes": resident_memory_bytes(),
-            **finite_frame(renderer)}
+    return {
+        "mode": mode,
+        "frames": frames,
+        "first_frame_ms": stats[0]["frame_ms"],
+        "frame_ms_mean": float(np.mean([s["frame_ms"] for s in later])),
+        "steady_frame_ms_mean": float(np.mean([s["frame_ms"] for s in steady])),
+        "steady_cloud_ms_mean": float(np.mean([s["cloud_ms"] for s in steady])),
+        "particles_drawn": last["particles_drawn"],
+        "clouds_drawn": last["clouds_drawn"],
+        "clouds_culled": last["clouds_culled"],
+        "clouds_ring": last["clouds_ring"],
+        "impostors_drawn": last["impostors_drawn"],
+        "texture_bytes": last["texture_bytes"],
+        "resident_bytes": resident_memory_bytes(),
+        **finite_frame(renderer),
+    }
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--particles", type=int, default=1_200_000)
     parser.add_argument("--per-cloud", type=int, default=2_700)
-    parser.add_argument("--frames", type=int, default=20,
-                        help="frames per mode; the first builds the impostors, the ring takes 16 (default %(default)s)")
+    parser.add_argument(
+        "--frames",
+        type=int,
+        default=20,
+        help="frames per mode; the first builds the impostors, the ring takes 16 (default %(default)s)",
+    )
     parser.add_argument("--modes", default="full,auto")
     parser.add_argument("--illumination", choices=("exact", "raster"), default="exact")
     parser.add_argument("--width", type=int, default=640)
@@ -97,16 +113,25 @@ def main() -> None:
     start = time.perf_counter()
     scene = dataclasses.replace(load_scene(DEFAULT_SCENE), clouds=cloud_field(args.particles, args.per_cloud))
     generated_s = time.perf_counter() - start
-    result = {"particles": scene.particle_count, "clouds": len(scene.clouds), "width": args.width,
-              "height": args.height, "illumination": args.illumination, "generation_s": generated_s,
-              "machine": machine(), "date": time.strftime("%Y-%m-%d"),
-              "resident_bytes_before": resident_memory_bytes()}
+    result = {
+        "particles": scene.particle_count,
+        "clouds": len(scene.clouds),
+        "width": args.width,
+        "height": args.height,
+        "illumination": args.illumination,
+        "generation_s": generated_s,
+        "machine": machine(),
+        "date": time.strftime("%Y-%m-%d"),
+        "resident_bytes_before": resident_memory_bytes(),
+    }
     with FrameRenderer(args.width, args.height) as renderer:
-        _, first = renderer.render(scene, illumination_method=args.illumination, settings=RenderSettings(mode="full"),
-                                   read_back=False)
+        _, first = renderer.render(
+            scene, illumination_method=args.illumination, settings=RenderSettings(mode="full"), read_back=False
+        )
         result["illumination_ms"] = first["illumination_ms"]
-        result["runs"] = [bench_mode(renderer, scene, mode, args.frames, args.illumination)
-                          for mode in args.modes.split(",")]
+        result["runs"] = [
+            bench_mode(renderer, scene, mode, args.frames, args.illumination) for mode in args.modes.split(",")
+        ]
     write_report(result, args.json)
 
 

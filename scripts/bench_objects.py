@@ -35,9 +35,12 @@ from cloudcore.scenefile import load_scene  # noqa: E402
 from cloudcore.settings import FULL_3D, RenderSettings  # noqa: E402
 
 SCENES = resource_path("scenes")
-VARIANTS = {"full 3D, split": FULL_3D, "full 3D, naive": RenderSettings(mode="full", split_objects=False),
-            "impostor, split": RenderSettings(mode="impostor"),
-            "impostor, naive": RenderSettings(mode="impostor", split_objects=False)}
+VARIANTS = {
+    "full 3D, split": FULL_3D,
+    "full 3D, naive": RenderSettings(mode="full", split_objects=False),
+    "impostor, split": RenderSettings(mode="impostor"),
+    "impostor, naive": RenderSettings(mode="impostor", split_objects=False),
+}
 INSTANTS_S = (8.0, 10.0, 12.0)
 
 
@@ -48,14 +51,21 @@ def split_against_naive(size) -> tuple[list[dict], list]:
         for time_s in INSTANTS_S:
             (pose,) = object_poses(scene.objects, time_s)
             rows_, columns = screen_box(pose.centre, 1.6 * pose.radius, scene.camera, size)
-            images = {name: renderer.render(scene, settings=settings, time_s=time_s)[0]
-                      for name, settings in VARIANTS.items()}
+            images = {
+                name: renderer.render(scene, settings=settings, time_s=time_s)[0] for name, settings in VARIANTS.items()
+            }
             reference = images["full 3D, split"]
             for name, image in images.items():
                 whole, around = compare(image, reference), compare(image[rows_, columns], reference[rows_, columns])
-                rows.append({"time_s": time_s, "variant": name, "psnr_db": min(whole.psnr_db, 100.0),
-                             "psnr_around_aircraft_db": min(around.psnr_db, 100.0),
-                             "max_abs_around_aircraft": around.max_abs})
+                rows.append(
+                    {
+                        "time_s": time_s,
+                        "variant": name,
+                        "psnr_db": min(whole.psnr_db, 100.0),
+                        "psnr_around_aircraft_db": min(around.psnr_db, 100.0),
+                        "max_abs_around_aircraft": around.max_abs,
+                    }
+                )
             crops.append([(name, images[name][rows_, columns]) for name in VARIANTS])
     return rows, crops
 
@@ -69,13 +79,18 @@ def flythrough_cost(frames: int, size) -> dict:
         # one renderer each, one after the other: pyrender's EGL contexts cannot be closed while another lives
         with FrameRenderer(*size) as renderer:
             renderer.render(variant, camera=views[0][1])  # shading precompute, shader compiles
-            stats[label] = [renderer.render(variant, camera=camera, time_s=time_s, read_back=False)[1]
-                            for time_s, camera in views]
-    result = {label: {"frame_ms_mean": float(np.mean([s["frame_ms"] for s in rows])),
-                      "frame_ms_p95": float(np.percentile([s["frame_ms"] for s in rows], 95)),
-                      "frames_with_object_in_cloud": int(sum(s["objects_in_clouds"] > 0 for s in rows)),
-                      "layers_rebuilt": int(sum(s["layers_rebuilt"] for s in rows))}
-              for label, rows in stats.items()}
+            stats[label] = [
+                renderer.render(variant, camera=camera, time_s=time_s, read_back=False)[1] for time_s, camera in views
+            ]
+    result = {
+        label: {
+            "frame_ms_mean": float(np.mean([s["frame_ms"] for s in rows])),
+            "frame_ms_p95": float(np.percentile([s["frame_ms"] for s in rows], 95)),
+            "frames_with_object_in_cloud": int(sum(s["objects_in_clouds"] > 0 for s in rows)),
+            "layers_rebuilt": int(sum(s["layers_rebuilt"] for s in rows)),
+        }
+        for label, rows in stats.items()
+    }
     result["ratio"] = result["with aircraft"]["frame_ms_mean"] / result["without objects"]["frame_ms_mean"]
     return result
 
@@ -109,15 +124,21 @@ def main() -> None:
     size = (640, 480)
     rows, crops = split_against_naive(size)
     for row in rows:
-        print(f"t={row['time_s']:g} {row['variant']:16s} frame {row['psnr_db']:6.2f} dB, around the aircraft "
-              f"{row['psnr_around_aircraft_db']:6.2f} dB (max |diff| {row['max_abs_around_aircraft']})")
+        print(
+            f"t={row['time_s']:g} {row['variant']:16s} frame {row['psnr_db']:6.2f} dB, around the aircraft "
+            f"{row['psnr_around_aircraft_db']:6.2f} dB (max |diff| {row['max_abs_around_aircraft']})"
+        )
     cost = flythrough_cost(args.frames, size)
-    print(f"flythrough, auto: {cost['with aircraft']['frame_ms_mean']:.1f} ms with the aircraft "
-          f"({cost['with aircraft']['frames_with_object_in_cloud']} frames with it in a cloud), "
-          f"{cost['without objects']['frame_ms_mean']:.1f} ms without: x{cost['ratio']:.2f}")
+    print(
+        f"flythrough, auto: {cost['with aircraft']['frame_ms_mean']:.1f} ms with the aircraft "
+        f"({cost['with aircraft']['frames_with_object_in_cloud']} frames with it in a cloud), "
+        f"{cost['without objects']['frame_ms_mean']:.1f} ms without: x{cost['ratio']:.2f}"
+    )
     args.json.parent.mkdir(parents=True, exist_ok=True)
-    args.json.write_text(json.dumps({"width": size[0], "height": size[1], "split_against_naive": rows,
-                                     "flythrough": cost}, indent=2) + "\n")
+    args.json.write_text(
+        json.dumps({"width": size[0], "height": size[1], "split_against_naive": rows, "flythrough": cost}, indent=2)
+        + "\n"
+    )
     if args.figure:
         write_figure(crops, rows, args.figure)
 

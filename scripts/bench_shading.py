@@ -20,7 +20,6 @@ from cloudcore.scenefile import load_scene
 from cloudcore.shading import DEFAULT_RASTER_RESOLUTION
 
 
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("scene", nargs="?", default=str(DEFAULT_SCENE))
@@ -33,9 +32,14 @@ def main() -> None:
     rows = shading_comparison(scene, tuple(int(r) for r in args.resolutions.split(",")), args.repeat)
     for row in rows:
         row["particles_per_second"] = row["particles"] / row["seconds"]
-    report = {"scene": args.scene, "machine": machine(),
-              "python": platform.python_version(), "clouds": len(scene.clouds),
-              "particles": scene.particle_count, "shading": rows}
+    report = {
+        "scene": args.scene,
+        "machine": machine(),
+        "python": platform.python_version(),
+        "clouds": len(scene.clouds),
+        "particles": scene.particle_count,
+        "shading": rows,
+    }
     write_report(report, args.json)
 
 

@@ -27,15 +27,20 @@ THIN_OPTICAL_DEPTH = 3.0
 
 
 def build() -> Scene:
-    cloud = Cloud("cumulus", cumulus(CLOUD_BASE, CLOUD_SIZE, 1400, 0.085 * CLOUD_SIZE[0], SEED),
-                  optical_depth=THIN_OPTICAL_DEPTH)
+    cloud = Cloud(
+        "cumulus", cumulus(CLOUD_BASE, CLOUD_SIZE, 1400, 0.085 * CLOUD_SIZE[0], SEED), optical_depth=THIN_OPTICAL_DEPTH
+    )
     heart = cloud.centres.mean(axis=0)
     # straight through the heart, 45 degrees across the camera's view, 60 m/s
     across = np.array([1.0, 0.0, -1.0]) / np.sqrt(2.0)
     path = np.array([[t, *(heart + across * 60.0 * (t - 10.0) + [0.0, 40.0, 150.0])] for t in (0.0, 10.0, 20.0)])
     eye = heart + [120.0, 60.0, 620.0]
-    orbit = np.array([[t, *(heart + 650.0 * np.array([np.sin(a), 0.15, np.cos(a)])), *heart]
-                      for t, a in zip(np.linspace(0.0, 20.0, 9), np.linspace(0.0, 2.0 * np.pi, 9))])
+    orbit = np.array(
+        [
+            [t, *(heart + 650.0 * np.array([np.sin(a), 0.15, np.cos(a)])), *heart]
+            for t, a in zip(np.linspace(0.0, 20.0, 9), np.linspace(0.0, 2.0 * np.pi, 9))
+        ]
+    )
     return Scene(
         camera=Camera(tuple(eye), tuple(heart), 45.0),
         lighting=Lighting(time_of_day=15.5),
@@ -44,7 +49,7 @@ def build() -> Scene:
         objects=(SceneObject("aircraft", primitive="aircraft", scale=70.0, path=path),),
         camera_paths=(CameraPath("orbit", orbit),),
         description=f"An aircraft flying through one cumulus (split-layer tests); "
-                    f"scripts/make_aircraft_scene.py, seed {SEED}.",
+        f"scripts/make_aircraft_scene.py, seed {SEED}.",
     )
 
 

@@ -39,12 +39,16 @@ def build() -> Scene:
         cloud = preset_cloud("cumulus_humilis", name, (x, CLOUD_BASE_Y, 0.0), seed=seed)
         return dataclasses.replace(cloud, formation=formation)
 
-    clouds = (humilis("forming", -SPACING, SEED, FORMING), humilis("steady", 0.0, SEED + 1, None),
-              humilis("dissipating", SPACING, SEED + 2, DISSIPATING))
+    clouds = (
+        humilis("forming", -SPACING, SEED, FORMING),
+        humilis("steady", 0.0, SEED + 1, None),
+        humilis("dissipating", SPACING, SEED + 2, DISSIPATING),
+    )
     middle = (0.0, CLOUD_BASE_Y + 250.0, 0.0)
     # a slow dolly in from just below the cloud base, so the clouds stand against the sky, all three in view
-    watch = np.array([[0.0, 0.0, CLOUD_BASE_Y - 100.0, 2800.0, *middle],
-                      [WATCH_S, 0.0, CLOUD_BASE_Y - 100.0, 2300.0, *middle]])
+    watch = np.array(
+        [[0.0, 0.0, CLOUD_BASE_Y - 100.0, 2800.0, *middle], [WATCH_S, 0.0, CLOUD_BASE_Y - 100.0, 2300.0, *middle]]
+    )
     return Scene(
         camera=Camera(tuple(watch[0, 1:4]), middle, 60.0),
         lighting=Lighting(time_of_day=15.5),
@@ -53,8 +57,8 @@ def build() -> Scene:
         terrain=Terrain(size=(12000.0, 12000.0), height=500.0),
         camera_paths=(CameraPath("watch", watch),),
         description=f"Cloud formation and dissipation (Wang 2004, Listing 1): left forms from 1 s to 7 s, "
-                    f"right dissipates from 3 s to 9 s, middle steady; scripts/make_formation_scene.py, "
-                    f"seed {SEED}.",
+        f"right dissipates from 3 s to 9 s, middle steady; scripts/make_formation_scene.py, "
+        f"seed {SEED}.",
     )
 
 

@@ -53,12 +53,19 @@ def build() -> Scene:
     start = np.array([0.0, 700.0, 3000.0])
     by_distance = sorted(clouds, key=lambda c: np.linalg.norm(heart(c)[[0, 2]] - start[[0, 2]]))
     first = heart(by_distance[0])
-    second = min((c for c in clouds if heart(c)[2] < first[2] - 1500),
-                 key=lambda c: abs(heart(c)[0] - first[0]) + abs(heart(c)[2] - first[2] + 2200))
+    second = min(
+        (c for c in clouds if heart(c)[2] < first[2] - 1500),
+        key=lambda c: abs(heart(c)[0] - first[0]) + abs(heart(c)[2] - first[2] + 2200),
+    )
     second = heart(second)
     exit_point = second + (second - first) / np.linalg.norm(second - first) * 1600 + [0, 250, 0]
-    stations = [(0.0, start), (9.0, first), (14.0, 0.5 * (first + second) + [0, 120, 0]), (19.0, second),
-                (30.0, exit_point)]
+    stations = [
+        (0.0, start),
+        (9.0, first),
+        (14.0, 0.5 * (first + second) + [0, 120, 0]),
+        (19.0, second),
+        (30.0, exit_point),
+    ]
     keys = []
     for i, (t, position) in enumerate(stations):
         ahead = stations[min(i + 1, len(stations) - 1)][1]
@@ -71,8 +78,9 @@ def build() -> Scene:
     across = np.cross(first - start, [0.0, 1.0, 0.0])
     across[1] = 0.0
     across /= np.linalg.norm(across)
-    aircraft_path = np.array([[t, *(first + across * 70.0 * (t - 6.0) + [0.0, 30.0 * np.sin(t / 6.0), 0.0])]
-                              for t in np.linspace(0, 30, 7)])
+    aircraft_path = np.array(
+        [[t, *(first + across * 70.0 * (t - 6.0) + [0.0, 30.0 * np.sin(t / 6.0), 0.0])] for t in np.linspace(0, 30, 7)]
+    )
     return Scene(
         # an establishing view up the valley; the flythrough has its own keys
         camera=Camera((450.0, 330.0, 2900.0), (-250.0, 850.0, -600.0), 60.0),
@@ -83,7 +91,7 @@ def build() -> Scene:
         objects=(SceneObject("aircraft", primitive="aircraft", scale=40.0, path=aircraft_path),),
         camera_paths=(CameraPath("flythrough", np.array(keys)),),
         description=f"Default scene: cumulus over a valley after Harris 2002 fig. 3; "
-                    f"scripts/make_valley.py, seed {SEED}.",
+        f"scripts/make_valley.py, seed {SEED}.",
     )
 
 

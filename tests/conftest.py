@@ -39,18 +39,29 @@ def small_scene() -> Scene:
     large = np.column_stack([rng.normal(size=(200, 3)) * 80 + [400, 900, 0], rng.uniform(15, 30, 200)])
     return Scene(
         camera=Camera((0.0, 500.0, 1500.0), (0.0, 800.0, 0.0), 55.0),
-        lighting=Lighting(time_of_day=None, ambient=(0.1, 0.1, 0.12),
-                          lights=(Light((0.0, 1.0, 0.0), (1.0, 0.9, 0.8), 1.0),
-                                  Light((0.6, 0.8, 0.0), (0.5, 0.6, 1.0), 0.3))),
+        lighting=Lighting(
+            time_of_day=None,
+            ambient=(0.1, 0.1, 0.12),
+            lights=(Light((0.0, 1.0, 0.0), (1.0, 0.9, 0.8), 1.0), Light((0.6, 0.8, 0.0), (0.5, 0.6, 1.0), 0.3)),
+        ),
         shading=Shading(albedo=0.8, optical_depth=6.5, phase="henyey-greenstein", g=0.7),
-        clouds=(Cloud("small", small, optical_depth=3.0, color=(1.0, 0.95, 0.9),
-                      sprite=SpriteStyle(rows=(0, 2, 2), rotation_deg=(-30.0, 200.0), seed=11,
-                                         flat_bottom_fraction=0.2),
-                      artist=ArtistShading(directional_range=(0.1, 0.55, 0.9)), shading_group_size=40.0),
-                Cloud("large", large, albedo=0.95)),
+        clouds=(
+            Cloud(
+                "small",
+                small,
+                optical_depth=3.0,
+                color=(1.0, 0.95, 0.9),
+                sprite=SpriteStyle(rows=(0, 2, 2), rotation_deg=(-30.0, 200.0), seed=11, flat_bottom_fraction=0.2),
+                artist=ArtistShading(directional_range=(0.1, 0.55, 0.9)),
+                shading_group_size=40.0,
+            ),
+            Cloud("large", large, albedo=0.95),
+        ),
         terrain=Terrain(size=(2000.0, 3000.0), resolution=33, height=300.0, seed=3),
-        objects=(SceneObject("crate", primitive="box", scale=12.5, position=(10.0, 700.0, 5.0)),
-                 SceneObject("plane", primitive="aircraft", path=np.array([[0, 0, 900, 0], [10, 500, 900, 0]]))),
+        objects=(
+            SceneObject("crate", primitive="box", scale=12.5, position=(10.0, 700.0, 5.0)),
+            SceneObject("plane", primitive="aircraft", path=np.array([[0, 0, 900, 0], [10, 500, 900, 0]])),
+        ),
         camera_paths=(CameraPath("orbit", np.array([[0, 0, 500, 1500, 0, 800, 0], [5, 1500, 600, 0, 0, 800, 0]])),),
         description="every field",
     )
@@ -65,5 +76,8 @@ def pytest_collection_modifyitems(items):
 
 
 def pytest_addoption(parser):
-    parser.addoption("--regenerate-goldens", action="store_true",
-                     help="rewrite tests/golden/*.png from the current renderer instead of comparing")
+    parser.addoption(
+        "--regenerate-goldens",
+        action="store_true",
+        help="rewrite tests/golden/*.png from the current renderer instead of comparing",
+    )

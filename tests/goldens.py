@@ -37,7 +37,8 @@ def check_golden(image, name: str, request) -> None:
         iio.imwrite(FAILURES / f"{name}-actual.png", image)
         iio.imwrite(FAILURES / f"{name}-expected.png", golden)
         iio.imwrite(FAILURES / f"{name}-diff.png", diff_image(image, golden))
-        pytest.fail(f"{name}: {difference} (limits: PSNR >= {MIN_PSNR_DB} dB, max |diff| <= {MAX_ABS}); "
-                    f"images in {FAILURES}")
+        pytest.fail(
+            f"{name}: {difference} (limits: PSNR >= {MIN_PSNR_DB} dB, max |diff| <= {MAX_ABS}); images in {FAILURES}"
+        )
     # every golden shows something: no NaN-black frame, no flat colour
     assert image.max(axis=2).min() > 0 and image.std() > 1.0

@@ -3,18 +3,34 @@
 import numpy as np
 import pytest
 
-from cloudcore.artist_shading import (DEFAULT_GROUP_RADII, ArtistShading, artist_colours, artist_uniforms,
-                                      default_group_size, directional_factor, height_fractions, shading_groups,
-                                      vertical_colour)
+from cloudcore.artist_shading import (
+    DEFAULT_GROUP_RADII,
+    ArtistShading,
+    artist_colours,
+    artist_uniforms,
+    default_group_size,
+    directional_factor,
+    height_fractions,
+    shading_groups,
+    vertical_colour,
+)
 from cloudcore.cloudgen import preset_cloud
 from cloudcore.errors import FieldError
 from cloudcore.lighting import sun_direction
 
-LEVELS = ((0.0, 0.2, 0.3, 0.4, 1.0), (0.25, 0.4, 0.4, 0.5, 0.9), (0.5, 0.6, 0.6, 0.6, 0.8),
-          (0.75, 0.8, 0.7, 0.7, 0.7), (1.0, 1.0, 0.9, 0.8, 0.6))
-MODEL = ArtistShading(levels=LEVELS, level_percent_by_hour=((1.0, 50.0), (12.0, 100.0), (23.0, 100.0)),
-                      directional_colour_by_hour=((6.0, 0.6, 0.3, 0.1), (12.0, 0.4, 0.4, 0.4)),
-                      directional_range=(0.1, 0.6, 0.9))
+LEVELS = (
+    (0.0, 0.2, 0.3, 0.4, 1.0),
+    (0.25, 0.4, 0.4, 0.5, 0.9),
+    (0.5, 0.6, 0.6, 0.6, 0.8),
+    (0.75, 0.8, 0.7, 0.7, 0.7),
+    (1.0, 1.0, 0.9, 0.8, 0.6),
+)
+MODEL = ArtistShading(
+    levels=LEVELS,
+    level_percent_by_hour=((1.0, 50.0), (12.0, 100.0), (23.0, 100.0)),
+    directional_colour_by_hour=((6.0, 0.6, 0.3, 0.1), (12.0, 0.4, 0.4, 0.4)),
+    directional_range=(0.1, 0.6, 0.9),
+)
 UP = np.array([0.0, 1.0, 0.0])
 
 
@@ -103,8 +119,13 @@ def test_a_shader_fed_the_uniforms_reproduces_the_reference():
 def test_artist_uniforms_are_plain_float_arrays():
     u = artist_uniforms(MODEL, 6.0, [0.0, 2.0, 0.0])
     shapes = {key: value.shape for key, value in u.items()}
-    assert shapes == {"level_heights": (5,), "level_colours": (5, 4), "directional_colour": (3,),
-                      "directional_range": (3,), "sun_direction": (3,)}
+    assert shapes == {
+        "level_heights": (5,),
+        "level_colours": (5, 4),
+        "directional_colour": (3,),
+        "directional_range": (3,),
+        "sun_direction": (3,),
+    }
     assert all(value.dtype == np.float64 for value in u.values())
     np.testing.assert_array_equal(u["sun_direction"], UP)
     np.testing.assert_allclose(u["directional_colour"], [0.6, 0.3, 0.1])
@@ -120,10 +141,15 @@ def test_colours_stay_finite_and_in_range_for_any_hour_and_awkward_geometry(hour
         colours = artist_colours(model, vertices, 1000.0, 1000.0, groups, sun_direction(hour), hour)
         assert np.all(np.isfinite(colours)) and colours.min() >= 0.0 and colours.max() <= 1.0
         # a flat cloud sits at the middle of its levels
-        np.testing.assert_allclose(colours[0], np.clip(vertical_colour(model, [0.5], hour)[0]
-                                                       + np.append(artist_uniforms(model, hour, UP)
-                                                                   ["directional_colour"] * model.directional_range[1],
-                                                                   0.0), 0.0, 1.0))
+        np.testing.assert_allclose(
+            colours[0],
+            np.clip(
+                vertical_colour(model, [0.5], hour)[0]
+                + np.append(artist_uniforms(model, hour, UP)["directional_colour"] * model.directional_range[1], 0.0),
+                0.0,
+                1.0,
+            ),
+        )
 
 
 def test_night_leaves_the_ambient_percentage_and_no_sun():
@@ -135,8 +161,9 @@ def test_night_leaves_the_ambient_percentage_and_no_sun():
 
 
 def test_height_fractions():
-    np.testing.assert_array_equal(height_fractions([900.0, 1000.0, 1100.0, 1300.0], 1000.0, 1200.0),
-                                  [0.0, 0.0, 0.5, 1.0])
+    np.testing.assert_array_equal(
+        height_fractions([900.0, 1000.0, 1100.0, 1300.0], 1000.0, 1200.0), [0.0, 0.0, 0.5, 1.0]
+    )
     np.testing.assert_array_equal(height_fractions([5.0, 7.0], 6.0, 6.0), [0.5, 0.5])
     with pytest.raises(ValueError, match="bottom_y"):
         height_fractions([1.0], 2.0, 1.0)
@@ -171,22 +198,25 @@ def test_default_groups_hold_wangs_1_to_30_sprites():
     assert sizes.max() <= 30 and np.median(sizes) >= 2
 
 
-@pytest.mark.parametrize("change, field", [
-    (dict(levels=LEVELS[:4]), "levels"),
-    (dict(levels=((0.5,) * 5,) * 5), "levels"),  # heights not increasing
-    (dict(levels=((-0.1, 0, 0, 0, 1),) + LEVELS[1:]), "levels"),
-    (dict(levels=((0.0, 1.5, 0, 0, 1),) + LEVELS[1:]), "levels"),
-    (dict(levels=((0.0, 0, 0, np.nan, 1),) + LEVELS[1:]), "levels"),
-    (dict(level_percent_by_hour=()), "level_percent_by_hour"),
-    (dict(level_percent_by_hour=((24.0, 50.0),)), "level_percent_by_hour"),
-    (dict(level_percent_by_hour=((5.0, 50.0), (5.0, 60.0))), "level_percent_by_hour"),
-    (dict(level_percent_by_hour=((5.0, -1.0),)), "level_percent_by_hour"),
-    (dict(directional_colour_by_hour=((5.0, 0.5, 0.5),)), "directional_colour_by_hour"),
-    (dict(directional_colour_by_hour=((5.0, 0.5, 0.5, 2.0),)), "directional_colour_by_hour"),
-    (dict(directional_range=(0.6, 0.5, 1.0)), "directional_range"),
-    (dict(directional_range=(0.0, 0.5, 1.5)), "directional_range"),
-    (dict(directional_range=(0.0, 0.5)), "directional_range"),
-])
+@pytest.mark.parametrize(
+    "change, field",
+    [
+        (dict(levels=LEVELS[:4]), "levels"),
+        (dict(levels=((0.5,) * 5,) * 5), "levels"),  # heights not increasing
+        (dict(levels=((-0.1, 0, 0, 0, 1),) + LEVELS[1:]), "levels"),
+        (dict(levels=((0.0, 1.5, 0, 0, 1),) + LEVELS[1:]), "levels"),
+        (dict(levels=((0.0, 0, 0, np.nan, 1),) + LEVELS[1:]), "levels"),
+        (dict(level_percent_by_hour=()), "level_percent_by_hour"),
+        (dict(level_percent_by_hour=((24.0, 50.0),)), "level_percent_by_hour"),
+        (dict(level_percent_by_hour=((5.0, 50.0), (5.0, 60.0))), "level_percent_by_hour"),
+        (dict(level_percent_by_hour=((5.0, -1.0),)), "level_percent_by_hour"),
+        (dict(directional_colour_by_hour=((5.0, 0.5, 0.5),)), "directional_colour_by_hour"),
+        (dict(directional_colour_by_hour=((5.0, 0.5, 0.5, 2.0),)), "directional_colour_by_hour"),
+        (dict(directional_range=(0.6, 0.5, 1.0)), "directional_range"),
+        (dict(directional_range=(0.0, 0.5, 1.5)), "directional_range"),
+        (dict(directional_range=(0.0, 0.5)), "directional_range"),
+    ],
+)
 def test_bad_models_are_refused_naming_the_field(change, field):
     with pytest.raises(FieldError) as caught:
         ArtistShading(**change)

@@ -6,14 +6,23 @@ import sys
 
 import numpy as np
 import pytest
+from conftest import VALLEY
 
 from cloudcore.benchmark import bench_path, pareto_front
 from cloudcore.scenefile import load_scene
 from cloudcore.settings import FULL_3D, RenderSettings
-from conftest import VALLEY
 
-CONTRACT_RUN_KEYS = {"settings", "frame_ms_mean", "frame_ms_p95", "speedup_vs_full", "psnr_mean", "psnr_min",
-                     "mad_mean", "regenerations", "texture_bytes_max"}
+CONTRACT_RUN_KEYS = {
+    "settings",
+    "frame_ms_mean",
+    "frame_ms_p95",
+    "speedup_vs_full",
+    "psnr_mean",
+    "psnr_min",
+    "mad_mean",
+    "regenerations",
+    "texture_bytes_max",
+}
 
 
 def test_pareto_front_keeps_the_points_nothing_beats():
@@ -30,8 +39,13 @@ class FakeRenderer:
 
     def render(self, scene, camera=None, settings=None, time_s=0.0):
         level = 100 if settings == FULL_3D else 100 + self.offset
-        stats = {"frame_ms": 40.0 if settings == FULL_3D else 10.0, "world_ms": 5.0, "cloud_ms": 30.0,
-                 "impostors_regenerated": 1, "texture_bytes": 1024}
+        stats = {
+            "frame_ms": 40.0 if settings == FULL_3D else 10.0,
+            "world_ms": 5.0,
+            "cloud_ms": 30.0,
+            "impostors_regenerated": 1,
+            "texture_bytes": 1024,
+        }
         return np.full((4, 4, 3), level, dtype=np.uint8), stats
 
 
@@ -49,32 +63,66 @@ def test_bench_path_reports_the_error_and_speedup_it_measured():
 
 def test_bench_cli_writes_the_contract(tmp_path):
     out = tmp_path / "bench.json"
-    result = subprocess.run([sys.executable, "-m", "cloudcore.cli", "bench", str(VALLEY), "--path", "flythrough",
-                             "--frames", "2", "--width", "48", "--height", "32", "--sweep", "tolerance=0.15,2",
-                             "--sweep", "regeneration_budget=0,1", "--without-terrain",
-                             "--json", str(out), "--plot", str(tmp_path / "plot.png"), "--no-shading"],
-                            capture_output=True, text=True)
+    result = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "cloudcore.cli",
+            "bench",
+            str(VALLEY),
+            "--path",
+            "flythrough",
+            "--frames",
+            "2",
+            "--width",
+            "48",
+            "--height",
+            "32",
+            "--sweep",
+            "tolerance=0.15,2",
+            "--sweep",
+            "regeneration_budget=0,1",
+            "--without-terrain",
+            "--json",
+            str(out),
+            "--plot",
+            str(tmp_path / "plot.png"),
+            "--no-shading",
+        ],
+        capture_output=True,
+        text=True,
+    )
     if result.returncode != 0 and "EGL" in result.stderr:
         pytest.skip("no headless OpenGL (EGL) context")
     assert result.returncode == 0, result.stderr
     report = json.loads(out.read_text())
     assert {"scene", "path", "width", "height", "frames", "reference", "runs", "shading"} <= set(report)
     assert [(r["settings"]["tolerance_deg"], r["settings"]["regeneration_budget"]) for r in report["runs"]] == [
-        (0.15, 0), (0.15, 1), (2.0, 0), (2.0, 1)]
+        (0.15, 0),
+        (0.15, 1),
+        (2.0, 0),
+        (2.0, 1),
+    ]
     assert all(CONTRACT_RUN_KEYS <= set(r) and len(r["per_frame"]) == 2 for r in report["runs"])
     assert report["without_terrain"] is True
     assert (tmp_path / "plot.png").stat().st_size > 0
 
 
-@pytest.mark.parametrize("args, message", [
-    (["--path", "nowhere"], "no camera path named 'nowhere'"),
-    (["--path", "flythrough", "--sweep", "colour=1,2"], "--sweep"),
-    (["--path", "flythrough", "--sweep", "impostor_max_size=300"], "power of two"),
-    (["--path", "flythrough", "--regeneration-budget", "-1"], "regeneration_budget"),
-])
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--path", "nowhere"], "no camera path named 'nowhere'"),
+        (["--path", "flythrough", "--sweep", "colour=1,2"], "--sweep"),
+        (["--path", "flythrough", "--sweep", "impostor_max_size=300"], "power of two"),
+        (["--path", "flythrough", "--regeneration-budget", "-1"], "regeneration_budget"),
+    ],
+)
 def test_bad_bench_arguments_exit_2_in_one_line(tmp_path, args, message):
-    result = subprocess.run([sys.executable, "-m", "cloudcore.cli", "bench", str(VALLEY), "--json",
-                             str(tmp_path / "b.json"), *args], capture_output=True, text=True)
+    result = subprocess.run(
+        [sys.executable, "-m", "cloudcore.cli", "bench", str(VALLEY), "--json", str(tmp_path / "b.json"), *args],
+        capture_output=True,
+        text=True,
+    )
     assert result.returncode == 2
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and message in lines[0], result.stderr

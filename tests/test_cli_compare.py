@@ -67,11 +67,14 @@ def test_grey_rgba_and_16_bit_are_read_as_the_same_rgb(tmp_path, gradient, capsy
         assert "identical" in capsys.readouterr().out
 
 
-@pytest.mark.parametrize("case, message", [
-    ("missing", "missing.png: (file): no such file"),
-    ("not an image", "notes.png: (file): not a readable image"),
-    ("sizes differ", "small.png: (size): is 32x24, but"),
-])
+@pytest.mark.parametrize(
+    "case, message",
+    [
+        ("missing", "missing.png: (file): no such file"),
+        ("not an image", "notes.png: (file): not a readable image"),
+        ("sizes differ", "small.png: (size): is 32x24, but"),
+    ],
+)
 def test_bad_input_exits_2_in_one_line(tmp_path, gradient, capsys, case, message):
     a = write(tmp_path / "a.png", gradient)
     if case == "missing":
@@ -90,7 +93,9 @@ def test_bad_input_exits_2_in_one_line(tmp_path, gradient, capsys, case, message
 
 def test_compare_imports_neither_opengl_nor_the_gui(tmp_path, gradient):
     a = write(tmp_path / "a.png", gradient)
-    code = (f"import sys; from cloudcore.cli import main; assert main(['compare', {a!r}, {a!r}]) == 0; "
-            "assert not [m for m in sys.modules if m.startswith(('OpenGL', 'imgui_bundle', 'app', 'cloudcore.gl'))]")
+    code = (
+        f"import sys; from cloudcore.cli import main; assert main(['compare', {a!r}, {a!r}]) == 0; "
+        "assert not [m for m in sys.modules if m.startswith(('OpenGL', 'imgui_bundle', 'app', 'cloudcore.gl'))]"
+    )
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert result.returncode == 0, result.stderr

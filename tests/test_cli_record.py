@@ -9,9 +9,9 @@ import time
 import imageio.v3 as iio
 import imageio_ffmpeg
 import pytest
+from conftest import VALLEY
 
 from cloudcore.recording import COLUMNS
-from conftest import VALLEY
 
 pytestmark = pytest.mark.gl
 
@@ -19,8 +19,9 @@ SIZE = ["--width", "64", "--height", "48"]
 
 
 def run_cli(*args):
-    return subprocess.run([sys.executable, "-m", "cloudcore.cli", "record", str(VALLEY), *args],
-                          capture_output=True, text=True)
+    return subprocess.run(
+        [sys.executable, "-m", "cloudcore.cli", "record", str(VALLEY), *args], capture_output=True, text=True
+    )
 
 
 def skip_without_egl(result):
@@ -41,8 +42,19 @@ def flythrough(tmp_path_factory):
     count and duration arithmetic is the same at 2 fps.
     """
     out = tmp_path_factory.mktemp("record")
-    result = run_cli("--path", "flythrough", "--fps", "2", *SIZE, "--out", str(out / "fly.mp4"),
-                     "--frames-dir", str(out / "frames"), "--stats", str(out / "fly.csv"))
+    result = run_cli(
+        "--path",
+        "flythrough",
+        "--fps",
+        "2",
+        *SIZE,
+        "--out",
+        str(out / "fly.mp4"),
+        "--frames-dir",
+        str(out / "frames"),
+        "--stats",
+        str(out / "fly.csv"),
+    )
     skip_without_egl(result)
     assert result.returncode == 0, result.stderr
     return out
@@ -70,8 +82,20 @@ def test_one_csv_row_and_one_png_per_frame(flythrough):
 
 def test_the_same_inputs_give_the_same_frames(flythrough, tmp_path):
     """Measuring overdraw (done in the first run, not here) leaves the frames alone too."""
-    result = run_cli("--path", "flythrough", "--fps", "2", *SIZE, "--frames", "4", "--frames-dir", str(tmp_path / "f"),
-                     "--stats", str(tmp_path / "s.csv"), "--no-overdraw")
+    result = run_cli(
+        "--path",
+        "flythrough",
+        "--fps",
+        "2",
+        *SIZE,
+        "--frames",
+        "4",
+        "--frames-dir",
+        str(tmp_path / "f"),
+        "--stats",
+        str(tmp_path / "s.csv"),
+        "--no-overdraw",
+    )
     assert result.returncode == 0, result.stderr
     assert [row["overdraw_mean"] for row in csv_rows(tmp_path / "s.csv")] == [""] * 4
     again = sorted((tmp_path / "f").iterdir())
@@ -82,9 +106,25 @@ def test_the_same_inputs_give_the_same_frames(flythrough, tmp_path):
 
 def test_ctrl_c_keeps_a_playable_video_of_the_frames_so_far(tmp_path):
     video, table = tmp_path / "cut.mp4", tmp_path / "cut.csv"
-    process = subprocess.Popen([sys.executable, "-m", "cloudcore.cli", "record", str(VALLEY), "--path", "flythrough",
-                                *SIZE, "--out", str(video), "--stats", str(table)],
-                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    process = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "cloudcore.cli",
+            "record",
+            str(VALLEY),
+            "--path",
+            "flythrough",
+            *SIZE,
+            "--out",
+            str(video),
+            "--stats",
+            str(table),
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     deadline = time.monotonic() + 60
     while process.poll() is None and time.monotonic() < deadline:
         if table.exists() and len(table.read_text().splitlines()) > 3:  # the header and three frames
@@ -100,18 +140,24 @@ def test_ctrl_c_keeps_a_playable_video_of_the_frames_so_far(tmp_path):
     assert imageio_ffmpeg.count_frames_and_secs(str(video))[0] == len(rows)
 
 
-@pytest.mark.parametrize("args, message", [
-    (["--path", "flythrough"], "give --out FILE.mp4, --frames-dir DIR, or both"),
-    (["--path", "nowhere", "--frames-dir", "{tmp}/f"], "no camera path named 'nowhere'"),
-    (["--path", "flythrough", "--out", "{tmp}/x.mp4", "--width", "63"], "needs an even width and height"),
-    (["--path", "flythrough", "--out", "{tmp}/x.mp4", "--fps", "0"], "--fps"),
-    (["--path", "flythrough", "--out", "{tmp}/x.mp4", "--fps", "nan"], "--fps"),
-    (["--path", "flythrough", "--out", "{tmp}/x.mp4", "--fps", "inf"], "--fps"),
-    (["--path", "flythrough", "--out", "{tmp}/x.mp4", "--frames", "0"], "--frames"),
-    (["--path", "flythrough", "--out", "{tmp}/file/x.mp4"], "{tmp}/file/x.mp4: output:"),
-    (["--path", "flythrough", "--frames-dir", "{tmp}/file"], "{tmp}/file: output:"),
-    (["--path", "flythrough", "--frames-dir", "{tmp}/f", "--stats", "{tmp}/file/s.csv"], "{tmp}/file/s.csv: output:"),
-])
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--path", "flythrough"], "give --out FILE.mp4, --frames-dir DIR, or both"),
+        (["--path", "nowhere", "--frames-dir", "{tmp}/f"], "no camera path named 'nowhere'"),
+        (["--path", "flythrough", "--out", "{tmp}/x.mp4", "--width", "63"], "needs an even width and height"),
+        (["--path", "flythrough", "--out", "{tmp}/x.mp4", "--fps", "0"], "--fps"),
+        (["--path", "flythrough", "--out", "{tmp}/x.mp4", "--fps", "nan"], "--fps"),
+        (["--path", "flythrough", "--out", "{tmp}/x.mp4", "--fps", "inf"], "--fps"),
+        (["--path", "flythrough", "--out", "{tmp}/x.mp4", "--frames", "0"], "--frames"),
+        (["--path", "flythrough", "--out", "{tmp}/file/x.mp4"], "{tmp}/file/x.mp4: output:"),
+        (["--path", "flythrough", "--frames-dir", "{tmp}/file"], "{tmp}/file: output:"),
+        (
+            ["--path", "flythrough", "--frames-dir", "{tmp}/f", "--stats", "{tmp}/file/s.csv"],
+            "{tmp}/file/s.csv: output:",
+        ),
+    ],
+)
 def test_bad_record_arguments_exit_2_in_one_line(tmp_path, args, message):
     (tmp_path / "file").write_text("a file where a folder is needed")
     result = run_cli(*(arg.format(tmp=tmp_path) for arg in args))
@@ -122,7 +168,20 @@ def test_bad_record_arguments_exit_2_in_one_line(tmp_path, args, message):
 
 
 def test_a_missing_scene_is_one_line(tmp_path):
-    result = subprocess.run([sys.executable, "-m", "cloudcore.cli", "record", str(tmp_path / "none.toml"),
-                             "--path", "flythrough", "--out", str(tmp_path / "x.mp4")], capture_output=True, text=True)
+    result = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "cloudcore.cli",
+            "record",
+            str(tmp_path / "none.toml"),
+            "--path",
+            "flythrough",
+            "--out",
+            str(tmp_path / "x.mp4"),
+        ],
+        capture_output=True,
+        text=True,
+    )
     assert result.returncode == 2 and len(result.stderr.strip().splitlines()) == 1, result.stderr
     assert "none.toml" in result.stderr

@@ -81,18 +81,21 @@ def test_ten_thousand_candidates_take_well_under_a_second():
     assert closest_gap(particles[:, :3]) > 40.0 * 2.0 / 3.0
 
 
-@pytest.mark.parametrize("change, message", [
-    (dict(box_max=[0.0, 0.0, 0.0]), "box_max"),
-    (dict(box_min=[0.0, np.nan, 0.0]), "finite"),
-    (dict(box_min=[-1.7e308, 0.0, 0.0], box_max=[1.7e308, 1.0, 1.0]), "finite"),
-    (dict(box_min=[0.0, 0.0]), "3-vectors"),
-    (dict(particle_radius=0.0), "particle_radius"),
-    (dict(particle_radius=np.inf), "particle_radius"),
-    (dict(count=-1), "count"),
-    (dict(count=2.5), "count"),
-    (dict(cull_distance=-1.0), "cull_distance"),
-    (dict(cull_distance=np.nan), "cull_distance"),
-])
+@pytest.mark.parametrize(
+    "change, message",
+    [
+        (dict(box_max=[0.0, 0.0, 0.0]), "box_max"),
+        (dict(box_min=[0.0, np.nan, 0.0]), "finite"),
+        (dict(box_min=[-1.7e308, 0.0, 0.0], box_max=[1.7e308, 1.0, 1.0]), "finite"),
+        (dict(box_min=[0.0, 0.0]), "3-vectors"),
+        (dict(particle_radius=0.0), "particle_radius"),
+        (dict(particle_radius=np.inf), "particle_radius"),
+        (dict(count=-1), "count"),
+        (dict(count=2.5), "count"),
+        (dict(cull_distance=-1.0), "cull_distance"),
+        (dict(cull_distance=np.nan), "cull_distance"),
+    ],
+)
 def test_bad_box_fill_input_is_refused(change, message):
     arguments = dict(box_min=LOW, box_max=HIGH, particle_radius=60.0, count=10) | change
     with pytest.raises(ValueError, match=message):
@@ -112,8 +115,15 @@ def clouds() -> dict[str, Cloud]:
 
 
 def test_presets_cover_wangs_cloud_types():
-    assert set(PRESETS) == {"cumulus_humilis", "cumulus_congestus", "stratus", "stratocumulus", "cumulonimbus",
-                            "altocumulus", "cirrus"}
+    assert set(PRESETS) == {
+        "cumulus_humilis",
+        "cumulus_congestus",
+        "stratus",
+        "stratocumulus",
+        "cumulonimbus",
+        "altocumulus",
+        "cirrus",
+    }
 
 
 def test_each_preset_is_a_sensible_cloud_in_its_boxes(clouds):
@@ -125,8 +135,7 @@ def test_each_preset_is_a_sensible_cloud_in_its_boxes(clouds):
         low = np.array([100.0, 1200.0, -50.0]) - [size[0] / 2, 0.0, size[2] / 2]
         assert np.all(cloud.centres >= low) and np.all(cloud.centres <= low + size), name
         assert closest_gap(cloud.centres) > preset.cull_fraction * 2.0 * preset.particle_radius, name
-        assert (cloud.optical_depth, cloud.albedo, cloud.color) == (preset.optical_depth, preset.albedo,
-                                                                   preset.color)
+        assert (cloud.optical_depth, cloud.albedo, cloud.color) == (preset.optical_depth, preset.albedo, preset.color)
 
 
 def test_presets_differ_the_way_the_cloud_types_do(clouds):
@@ -158,16 +167,20 @@ def test_preset_scale_scales_the_same_shape():
 
 
 def test_presets_are_deterministic_for_a_seed():
-    assert preset_cloud("stratus", "s", (0.0, 500.0, 0.0), seed=1) == preset_cloud("stratus", "s", (0.0, 500.0, 0.0),
-                                                                                    seed=1)
+    assert preset_cloud("stratus", "s", (0.0, 500.0, 0.0), seed=1) == preset_cloud(
+        "stratus", "s", (0.0, 500.0, 0.0), seed=1
+    )
 
 
-@pytest.mark.parametrize("call, message", [
-    (lambda: preset_cloud("nimbostratus", "c", (0.0, 0.0, 0.0)), "stratus"),
-    (lambda: preset_cloud("stratus", "c", (0.0, 0.0, 0.0), scale=0.0), "scale"),
-    (lambda: preset_cloud("stratus", "c", (0.0, 0.0, 0.0), scale=1e306), "finite"),
-    (lambda: preset_cloud("stratus", "c", (0.0, np.nan, 0.0)), "base_centre"),
-])
+@pytest.mark.parametrize(
+    "call, message",
+    [
+        (lambda: preset_cloud("nimbostratus", "c", (0.0, 0.0, 0.0)), "stratus"),
+        (lambda: preset_cloud("stratus", "c", (0.0, 0.0, 0.0), scale=0.0), "scale"),
+        (lambda: preset_cloud("stratus", "c", (0.0, 0.0, 0.0), scale=1e306), "finite"),
+        (lambda: preset_cloud("stratus", "c", (0.0, np.nan, 0.0)), "base_centre"),
+    ],
+)
 def test_bad_preset_input_is_refused(call, message):
     with pytest.raises(ValueError, match=message):
         call()

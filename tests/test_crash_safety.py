@@ -19,11 +19,11 @@ import time
 
 import numpy as np
 import pytest
+from conftest import ROOT
 
 from app.editor import AUTOSAVE_SECONDS, Editor, recovery_path
 from cloudcore.scene import Camera, Cloud, Scene
 from cloudcore.scenefile import INLINE_PARTICLE_LIMIT, load_scene, particles_folder, save_scene
-from conftest import ROOT
 
 pytestmark = pytest.mark.skipif(not hasattr(signal, "SIGKILL"), reason="needs SIGKILL (POSIX)")
 
@@ -44,7 +44,9 @@ if ANNOUNCE:
     os.replace = _announced_replace
 """
 
-SAVING_CHILD = ANNOUNCE_RENAMES + """
+SAVING_CHILD = (
+    ANNOUNCE_RENAMES
+    + """
 import itertools, sys
 from cloudcore.scenefile import load_scene, save_scene
 
@@ -55,8 +57,11 @@ for scene in itertools.cycle([new, old]) if LOOP else [new]:
     save_scene(scene, target)
 print("done", flush=True)
 """
+)
 
-EDITING_CHILD = ANNOUNCE_RENAMES + """
+EDITING_CHILD = (
+    ANNOUNCE_RENAMES
+    + """
 import dataclasses, itertools, sys, time
 import numpy as np
 from app.editor import Editor
@@ -72,6 +77,7 @@ for i in itertools.count(1):
         print("autosaved", i, flush=True)
     time.sleep(0.005)  # an artist's pace, which also keeps the undo history's memory small
 """
+)
 
 #: simulated seconds between two edits of the editing child: an autosave every sixth edit
 EDIT_SECONDS = 10.0
@@ -80,10 +86,14 @@ EDIT_SECONDS = 10.0
 def large_scene(description: str, seed: int) -> Scene:
     """Three clouds in particle files (the last the same in every version) and one inline."""
     rng = np.random.default_rng(seed)
-    clouds = [Cloud(f"cumulus {i}", np.column_stack([rng.normal(size=(20_000, 3)) * 500, rng.uniform(20, 60, 20_000)]))
-              for i in range(2)]
+    clouds = [
+        Cloud(f"cumulus {i}", np.column_stack([rng.normal(size=(20_000, 3)) * 500, rng.uniform(20, 60, 20_000)]))
+        for i in range(2)
+    ]
     clouds.append(Cloud("steady", np.column_stack([np.arange(3000.0).repeat(3).reshape(-1, 3), np.ones(3000)])))
-    clouds.append(Cloud("wisp", np.column_stack([rng.normal(size=(INLINE_PARTICLE_LIMIT, 3)), np.ones(INLINE_PARTICLE_LIMIT)])))
+    clouds.append(
+        Cloud("wisp", np.column_stack([rng.normal(size=(INLINE_PARTICLE_LIMIT, 3)), np.ones(INLINE_PARTICLE_LIMIT)]))
+    )
     return Scene(camera=Camera(fov_y_deg=40.0 + seed), clouds=tuple(clouds), description=description)
 
 
@@ -97,8 +107,13 @@ class Child:
 
     def __init__(self, code: str, constants: dict, *args):
         preamble = "".join(f"{name} = {value!r}\n" for name, value in constants.items())
-        self.process = subprocess.Popen([sys.executable, "-c", preamble + textwrap.dedent(code), *map(str, args)],
-                                        cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        self.process = subprocess.Popen(
+            [sys.executable, "-c", preamble + textwrap.dedent(code), *map(str, args)],
+            cwd=ROOT,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
         self.lines: list[str] = []
 
     def read_until(self, done) -> None:
@@ -158,7 +173,7 @@ def test_a_save_killed_at_any_rename_leaves_the_old_scene_whole(tmp_path, versio
     for killed_before, name in enumerate(renames):
         target = saved_old(f"killed before rename {killed_before}")
         child = Child(SAVING_CHILD, {"ANNOUNCE": True, "LOOP": False}, *versions, target)
-        child.read_until(lambda lines: sum(line.startswith("rename") for line in lines) > killed_before)
+        child.read_until(lambda lines, before=killed_before: sum(line.startswith("rename") for line in lines) > before)
         child.kill()
         assert content(load_scene(target)) == old, f"killed before renaming {name}"
         save_scene(old, target)  # the next save clears what the killed one left
@@ -197,8 +212,9 @@ def check_recovery_after_the_crash(path, saved: Scene, child: Child) -> None:
     edits = int(recovered.description.split()[1])
     assert max(child.numbers("autosaved")) <= edits <= max(child.numbers("edit"))
     assert (max(child.numbers("edit")) - edits) * EDIT_SECONDS <= AUTOSAVE_SECONDS
-    np.testing.assert_array_equal(recovered.clouds[0].particles[len(saved.clouds[0].particles):, 0],
-                                  np.arange(1.0, edits + 1))
+    np.testing.assert_array_equal(
+        recovered.clouds[0].particles[len(saved.clouds[0].particles) :, 0], np.arange(1.0, edits + 1)
+    )
 
     editor = Editor.open(path)
     assert any(str(recovery_path(path)) in message for message in editor.messages)
@@ -237,8 +253,11 @@ def test_the_recovery_copy_never_touches_the_saved_scene_s_files(scene_file):
     before = {name: (scene_file.parent / name).read_bytes() for name in saved_files(scene_file)}
     editor = Editor.open(scene_file)
     cloud = editor.scene.clouds[0]
-    editor.edit(dataclasses.replace(editor.scene, clouds=(dataclasses.replace(cloud, particles=cloud.particles[1:]),
-                                                          *editor.scene.clouds[1:])))
+    editor.edit(
+        dataclasses.replace(
+            editor.scene, clouds=(dataclasses.replace(cloud, particles=cloud.particles[1:]), *editor.scene.clouds[1:])
+        )
+    )
     assert editor.autosave(now=time.monotonic() + AUTOSAVE_SECONDS)
     assert {name: (scene_file.parent / name).read_bytes() for name in before} == before
     assert len(load_scene(recovery_path(scene_file)).clouds[0].particles) == len(cloud.particles) - 1

@@ -2,12 +2,12 @@
 
 import numpy as np
 import pytest
+from conftest import VALLEY
 
 from cloudcore.lighting import elevation_deg, sun_direction
 from cloudcore.paths import sample
 from cloudcore.scenefile import load_scene
 from cloudcore.terrain import heightfield_mesh
-from conftest import VALLEY
 
 
 @pytest.fixture(scope="module")
@@ -17,8 +17,7 @@ def valley():
 
 def inside_clouds(scene, point):
     """Names of the clouds with a particle whose core (half radius) contains `point`."""
-    return {c.name for c in scene.clouds
-            if np.any(np.linalg.norm(c.centres - point, axis=1) < 0.5 * c.radii)}
+    return {c.name for c in scene.clouds if np.any(np.linalg.norm(c.centres - point, axis=1) < 0.5 * c.radii)}
 
 
 def test_after_harris_figure_3(valley):

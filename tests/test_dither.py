@@ -1,11 +1,11 @@
 """The one dither at the 8-bit output: no banding in dark gradients, and the editor's shader agrees with it."""
 
 import numpy as np
+from conftest import VALLEY
 
 from cloudcore.colour import dither_thresholds, linear_to_srgb8, srgb_encode
 from cloudcore.scenefile import load_scene
 from cloudcore.settings import FULL_3D
-from conftest import VALLEY
 
 
 def srgb_decode(encoded: np.ndarray) -> np.ndarray:

@@ -49,7 +49,9 @@ def test_navigation_keeps_distances_and_orbits_by_the_asked_angle():
     assert np.linalg.norm(np.subtract(around.position, around.look_at)) == pytest.approx(500.0)
     ahead = moved(camera, forward=100.0)
     np.testing.assert_allclose(ahead.position, [0.0, 100.0, 400.0], atol=1e-9)
-    np.testing.assert_allclose(np.subtract(ahead.look_at, ahead.position), [0.0, 0.0, -500.0], atol=1e-9)  # look-at moves along
+    np.testing.assert_allclose(
+        np.subtract(ahead.look_at, ahead.position), [0.0, 0.0, -500.0], atol=1e-9
+    )  # look-at moves along
     up = turned(camera, 0.0, 200.0)  # clamped short of straight up
     assert 0.0 < np.subtract(up.look_at, up.position)[1] < 500.0
 
@@ -84,8 +86,7 @@ def test_a_click_lands_on_the_selected_cloud_surface_and_picks_across_clouds():
 
 
 def test_particles_are_added_erased_moved_and_resized():
-    from cloudcore.editing import (add_particles, delete_particles, particles_within, translated,
-                                   with_mean_radius)
+    from cloudcore.editing import add_particles, delete_particles, particles_within, translated, with_mean_radius
 
     scene = Scene(clouds=(Cloud("a", [[0.0, 0.0, 0.0, 10.0], [100.0, 0.0, 0.0, 30.0]]), Cloud("b")))
     grown = add_particles(scene, 0, [[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]], 7.0)
@@ -119,8 +120,9 @@ def test_a_brush_scatters_in_its_ball_at_its_rate_the_same_for_the_same_seed():
     distances = np.linalg.norm(dab - [100.0, 0.0, 0.0], axis=1)
     assert distances.max() <= 20.0
     assert np.mean(distances < 10.0) == pytest.approx(1 / 8, abs=0.03)  # uniform in volume
-    np.testing.assert_array_equal(BrushStroke(seed=3, rate=1.0).dab((0, 0, 0), 5.0, 4),
-                                  BrushStroke(seed=3, rate=1.0).dab((0, 0, 0), 5.0, 4))
+    np.testing.assert_array_equal(
+        BrushStroke(seed=3, rate=1.0).dab((0, 0, 0), 5.0, 4), BrushStroke(seed=3, rate=1.0).dab((0, 0, 0), 5.0, 4)
+    )
 
 
 def test_a_drag_follows_the_mouse_on_a_plane_through_the_grabbed_point():
@@ -130,8 +132,7 @@ def test_a_drag_follows_the_mouse_on_a_plane_through_the_grabbed_point():
     grabbed = np.array([0.0, 0.0, -100.0])
     horizontal = drag_plane_normal(camera, screen=False)
     # the mouse moved so that the ray now meets the grabbed point's altitude 50 m farther
-    offset = drag_offset(camera.position, np.array([0.0, -100.0, -150.0]) / np.hypot(100.0, 150.0),
-                         grabbed, horizontal)
+    offset = drag_offset(camera.position, np.array([0.0, -100.0, -150.0]) / np.hypot(100.0, 150.0), grabbed, horizontal)
     np.testing.assert_allclose(offset, [0.0, 0.0, -50.0], atol=1e-9)
     screen = drag_plane_normal(camera, screen=True)
     np.testing.assert_allclose(screen, [0.0, 0.0, 1.0], atol=1e-12)
@@ -170,8 +171,9 @@ def test_box_fill_and_presets_make_undoable_scenes():
     filled, index = fill_box(scene, 0, (100.0, 1000.0, 0.0), (400.0, 200.0, 300.0), 30.0, 300, seed=4)
     added = filled.clouds[0].particles[1:]
     assert index == 0 and 0 < len(added) <= 300
-    np.testing.assert_array_equal(added, box_fill((-100.0, 900.0, -150.0), (300.0, 1100.0, 150.0), 30.0, 300,
-                                                  seed=4))  # Wang's default cull: a third of the sprite size
+    np.testing.assert_array_equal(
+        added, box_fill((-100.0, 900.0, -150.0), (300.0, 1100.0, 150.0), 30.0, 300, seed=4)
+    )  # Wang's default cull: a third of the sprite size
     new, index = fill_box(scene, None, (0.0, 0.0, 0.0), (100.0, 100.0, 100.0), 10.0, 50, cull_distance=0.0)
     assert index == 1 and len(new.clouds[1].particles) == 50 and new.clouds[0] is scene.clouds[0]
     two = add_preset_cloud(add_preset_cloud(scene, "stratus", (0.0, 2000.0, 0.0)), "stratus", (0.0, 2000.0, 0.0))

@@ -13,9 +13,9 @@ import sys
 
 import imageio.v3 as iio
 import pytest
+from conftest import VALLEY
 
 from cloudcore.imagecompare import compare
-from conftest import VALLEY
 
 pytestmark = pytest.mark.gui
 
@@ -51,16 +51,35 @@ def test_the_viewport_equals_cloudview_render_of_the_same_view(tmp_path, window)
     shot = tmp_path / "viewport.png"
     env = {k: v for k, v in os.environ.items() if k != "PYOPENGL_PLATFORM"}
     env["HOME"] = str(tmp_path)  # no layout file of the user's is read or written
-    result = subprocess.run([sys.executable, "-m", "app", str(VALLEY), "--window-size", window,
-                             "--frames", str(FRAMES), "--screenshot", str(shot)],
-                            capture_output=True, text=True, env=env, timeout=300)
+    result = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "app",
+            str(VALLEY),
+            "--window-size",
+            window,
+            "--frames",
+            str(FRAMES),
+            "--screenshot",
+            str(shot),
+        ],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=300,
+    )
     assert result.returncode == 0 and shot.exists(), result.stderr[-3000:]
     shown = iio.imread(shot)
     height, width = shown.shape[:2]
     # headless in a process of its own: closing a second EGL display here would end the session's
     reference = tmp_path / "rendered.png"
-    result = subprocess.run([sys.executable, "-c", HEADLESS, str(VALLEY), str(width), str(height), str(FRAMES),
-                             str(reference)], capture_output=True, text=True, timeout=300)
+    result = subprocess.run(
+        [sys.executable, "-c", HEADLESS, str(VALLEY), str(width), str(height), str(FRAMES), str(reference)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert result.returncode == 0, result.stderr[-3000:]
     rendered = iio.imread(reference)
     difference = compare(shown, rendered)

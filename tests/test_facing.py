@@ -3,12 +3,21 @@
 import numpy as np
 import pytest
 
-from cloudcore.facing import (CORNERS, FALLBACK_NORMAL, HORIZONTAL_NORMAL, LOCK_RADII, UNLOCK_RADII, FacingLocks,
-                              sprite_axes, sprite_corners)
+from cloudcore.facing import (
+    CORNERS,
+    FALLBACK_NORMAL,
+    HORIZONTAL_NORMAL,
+    LOCK_RADII,
+    UNLOCK_RADII,
+    FacingLocks,
+    sprite_axes,
+    sprite_corners,
+)
 
 # five sprites strung along x, a little off the camera's line so it passes beside their centres
-CENTRES = np.array([[0.0, 1000.0, 0.0], [120.0, 1010.0, 5.0], [260.0, 995.0, -8.0], [400.0, 1000.0, 12.0],
-                    [520.0, 1004.0, 0.0]])
+CENTRES = np.array(
+    [[0.0, 1000.0, 0.0], [120.0, 1010.0, 5.0], [260.0, 995.0, -8.0], [400.0, 1000.0, 12.0], [520.0, 1004.0, 0.0]]
+)
 RADII = np.array([60.0, 50.0, 80.0, 40.0, 70.0])
 ROTATIONS = np.radians([0.0, 45.0, 170.0, 300.0, 90.0])
 
@@ -72,8 +81,7 @@ def test_fade_falls_as_the_camera_swings_around_a_locked_sprite():
     locks = FacingLocks(1)
     reach = 0.3 * radius[0]
     angles = np.radians(np.arange(0.0, 181.0, 5.0))
-    states = [locks.update(centre[0] + reach * np.array([np.cos(a), 0.0, np.sin(a)]), centre, radius)
-              for a in angles]
+    states = [locks.update(centre[0] + reach * np.array([np.cos(a), 0.0, np.sin(a)]), centre, radius) for a in angles]
     fade = np.array([s.fade[0] for s in states])
     assert all(s.locked[0] for s in states)
     assert fade[0] == 1.0
@@ -118,8 +126,9 @@ def test_state_arrays_are_read_only_and_shapes_are_checked():
 def test_sprite_axes_are_upright_and_orthonormal():
     rng = np.random.default_rng(6)
     normals = rng.normal(size=(200, 3))
-    normals = np.concatenate([normals / np.linalg.norm(normals, axis=1, keepdims=True),
-                              [HORIZONTAL_NORMAL, [0.0, -1.0, 0.0]]])
+    normals = np.concatenate(
+        [normals / np.linalg.norm(normals, axis=1, keepdims=True), [HORIZONTAL_NORMAL, [0.0, -1.0, 0.0]]]
+    )
     rights, ups = sprite_axes(normals)
     for a, b in ((rights, ups), (rights, normals), (ups, normals)):
         np.testing.assert_allclose(np.einsum("ij,ij->i", a, b), 0.0, atol=1e-12)

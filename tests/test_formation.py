@@ -56,8 +56,9 @@ def test_dissipation_is_formation_played_backwards():
     distances = np.linspace(0.0, 1.0, 11)
     forming, dissipating = Formation("form", 0.0, 8.0), Formation("dissipate", 0.0, 8.0)
     for t in np.linspace(0.0, 8.0, 17):
-        np.testing.assert_allclose(opacity_factor(dissipating, distances, t),
-                                   opacity_factor(forming, distances, 8.0 - t), atol=1e-15)
+        np.testing.assert_allclose(
+            opacity_factor(dissipating, distances, t), opacity_factor(forming, distances, 8.0 - t), atol=1e-15
+        )
 
 
 def test_zero_duration_is_instant():
@@ -74,12 +75,15 @@ def test_progress_is_clamped_and_linear():
     assert [progress(f, t) for t in (0.0, 10.0, 11.0, 12.0, 14.0, 1e300)] == [0.0, 0.0, 0.25, 0.5, 1.0, 1.0]
 
 
-@pytest.mark.parametrize("particles, expected", [
-    (np.zeros((0, 4)), []),
-    (np.array([[5.0, 6.0, 7.0, 1.0]]), [0.0]),
-    (np.tile([1.0, 2.0, 3.0, 4.0], (5, 1)), [0.0] * 5),
-    (np.array([[-1.0, 0.0, 0.0, 1.0], [0.0, 0.0, 0.0, 1.0], [3.0, 0.0, 0.0, 1.0]]), [1.0, 0.5, 1.0]),
-])
+@pytest.mark.parametrize(
+    "particles, expected",
+    [
+        (np.zeros((0, 4)), []),
+        (np.array([[5.0, 6.0, 7.0, 1.0]]), [0.0]),
+        (np.tile([1.0, 2.0, 3.0, 4.0], (5, 1)), [0.0] * 5),
+        (np.array([[-1.0, 0.0, 0.0, 1.0], [0.0, 0.0, 0.0, 1.0], [3.0, 0.0, 0.0, 1.0]]), [1.0, 0.5, 1.0]),
+    ],
+)
 def test_core_distances_of_degenerate_clouds(particles, expected):
     np.testing.assert_allclose(core_distances(particles[:, :3]), expected, atol=1e-15)
     for kind in ("form", "dissipate"):
@@ -101,16 +105,19 @@ def test_core_distances_at_the_ends_of_the_float_range_are_finite():
     assert np.all(np.isfinite(distances)) and distances.max() == 1.0
 
 
-@pytest.mark.parametrize("make, message", [
-    (lambda: Formation("grow", 0.0, 1.0), "grow"),
-    (lambda: Formation("form", 0.0, -1.0), "duration_s"),
-    (lambda: Formation("form", 0.0, math.nan), "duration_s"),
-    (lambda: Formation("form", math.inf, 1.0), "start_s"),
-    (lambda: Formation("form", math.nan, 1.0), "start_s"),
-    (lambda: progress(Formation("form", 0.0, 1.0), math.nan), "time_s"),
-    (lambda: opacity_factor(Formation("form", 0.0, 1.0), np.array([0.5]), math.inf), "time_s"),
-    (lambda: opacity_factor(Formation("form", 0.0, 1.0), np.array([math.nan]), 0.5), "NaN"),
-])
+@pytest.mark.parametrize(
+    "make, message",
+    [
+        (lambda: Formation("grow", 0.0, 1.0), "grow"),
+        (lambda: Formation("form", 0.0, -1.0), "duration_s"),
+        (lambda: Formation("form", 0.0, math.nan), "duration_s"),
+        (lambda: Formation("form", math.inf, 1.0), "start_s"),
+        (lambda: Formation("form", math.nan, 1.0), "start_s"),
+        (lambda: progress(Formation("form", 0.0, 1.0), math.nan), "time_s"),
+        (lambda: opacity_factor(Formation("form", 0.0, 1.0), np.array([0.5]), math.inf), "time_s"),
+        (lambda: opacity_factor(Formation("form", 0.0, 1.0), np.array([math.nan]), 0.5), "NaN"),
+    ],
+)
 def test_out_of_domain_input_is_refused_with_a_message(make, message):
     with pytest.raises(ValueError, match=message):
         make()
@@ -131,8 +138,10 @@ def test_state_is_constant_outside_the_animation_and_changes_inside():
 
 def test_formation_survives_a_save_and_load(tmp_path, small_scene):
     forming = Formation("form", 12.5, 40.0)
-    clouds = (dataclasses.replace(small_scene.clouds[0], formation=forming),
-              dataclasses.replace(small_scene.clouds[1], formation=Formation("dissipate", 0.0, 0.0)))
+    clouds = (
+        dataclasses.replace(small_scene.clouds[0], formation=forming),
+        dataclasses.replace(small_scene.clouds[1], formation=Formation("dissipate", 0.0, 0.0)),
+    )
     scene = dataclasses.replace(small_scene, clouds=clouds)
     saved = save_scene(scene, tmp_path / "s.toml")
     loaded = load_scene(tmp_path / "s.toml")
@@ -156,17 +165,20 @@ formation = {formation}
 """
 
 
-@pytest.mark.parametrize("formation, field, problem", [
-    ('{ kind = "grow", duration_s = 3 }', "clouds[0].formation.kind", "form, dissipate"),
-    ('{ duration_s = 3 }', "clouds[0].formation.kind", "missing"),
-    ('{ kind = "form" }', "clouds[0].formation.duration_s", "missing"),
-    ('{ kind = "form", duration_s = -1 }', "clouds[0].formation.duration_s", "within"),
-    ('{ kind = "form", duration_s = nan }', "clouds[0].formation.duration_s", "finite"),
-    ('{ kind = "form", duration_s = 3, start_s = inf }', "clouds[0].formation.start_s", "finite"),
-    ('{ kind = "form", duration_s = "3" }', "clouds[0].formation.duration_s", "expected a number"),
-    ('{ kind = "form", duration_s = 3, speed = 2 }', "clouds[0].formation.speed", "unknown key"),
-    ('"form"', "clouds[0].formation", "expected a table"),
-])
+@pytest.mark.parametrize(
+    "formation, field, problem",
+    [
+        ('{ kind = "grow", duration_s = 3 }', "clouds[0].formation.kind", "form, dissipate"),
+        ("{ duration_s = 3 }", "clouds[0].formation.kind", "missing"),
+        ('{ kind = "form" }', "clouds[0].formation.duration_s", "missing"),
+        ('{ kind = "form", duration_s = -1 }', "clouds[0].formation.duration_s", "within"),
+        ('{ kind = "form", duration_s = nan }', "clouds[0].formation.duration_s", "finite"),
+        ('{ kind = "form", duration_s = 3, start_s = inf }', "clouds[0].formation.start_s", "finite"),
+        ('{ kind = "form", duration_s = "3" }', "clouds[0].formation.duration_s", "expected a number"),
+        ('{ kind = "form", duration_s = 3, speed = 2 }', "clouds[0].formation.speed", "unknown key"),
+        ('"form"', "clouds[0].formation", "expected a table"),
+    ],
+)
 def test_bad_formation_names_file_field_and_problem(tmp_path, formation, field, problem):
     path = tmp_path / "bad.toml"
     path.write_text(SCENE.format(formation=formation))
@@ -188,15 +200,17 @@ EYE = np.array([0.0, 900.0, 3000.0])
 
 def test_seen_from_scales_colour_and_opacity_of_forming_clouds_only():
     steady = Cloud("steady", ragged_cloud(seed=1))
-    forming = Cloud("forming", ragged_cloud(seed=2) + [2000.0, 0.0, 0.0, 0.0],
-                    formation=Formation("form", START, DURATION))
+    forming = Cloud(
+        "forming", ragged_cloud(seed=2) + [2000.0, 0.0, 0.0, 0.0], formation=Formation("form", START, DURATION)
+    )
     particles = shading_of((steady, forming))
     indices = np.arange(particles.cloud_starts[-1])[::-1]
     colour, alpha = particles.seen_from(EYE, indices)
     t = START + 0.4 * DURATION
     colour_t, alpha_t = particles.seen_from(EYE, indices, time_s=t)
-    factor = np.concatenate([np.ones(len(steady.particles)),
-                             opacity_factor(forming.formation, core_distances(forming.centres), t)])[indices]
+    factor = np.concatenate(
+        [np.ones(len(steady.particles)), opacity_factor(forming.formation, core_distances(forming.centres), t)]
+    )[indices]
     np.testing.assert_array_equal(alpha_t, alpha * factor)
     np.testing.assert_array_equal(colour_t, colour * factor[:, None])
     assert np.any((0.0 < factor) & (factor < 1.0))  # the instant shows a partly formed cloud

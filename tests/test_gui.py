@@ -21,13 +21,20 @@ pytestmark = pytest.mark.gui
 
 
 def small_editor_scene() -> Scene:
-    clouds = tuple(Cloud(f"c{i}", cumulus((x, 900.0, z), (700.0, 350.0, 500.0), 250, 60.0, seed=i))
-                   for i, (x, z) in enumerate([(-600.0, -2000.0), (500.0, -2600.0), (0.0, -6000.0)]))
-    pan = CameraPath("pan", [[0.0, 0.0, 400.0, 0.0, 0.0, 900.0, -2000.0],
-                             [2.0, 600.0, 500.0, 300.0, 0.0, 900.0, -2000.0]])
-    return Scene(camera=Camera((0.0, 400.0, 0.0), (0.0, 900.0, -2000.0), 60.0), lighting=Lighting(15.5),
-                 clouds=clouds, terrain=Terrain(size=(8000.0, 8000.0), resolution=33, height=300.0, seed=2),
-                 camera_paths=(pan,))
+    clouds = tuple(
+        Cloud(f"c{i}", cumulus((x, 900.0, z), (700.0, 350.0, 500.0), 250, 60.0, seed=i))
+        for i, (x, z) in enumerate([(-600.0, -2000.0), (500.0, -2600.0), (0.0, -6000.0)])
+    )
+    pan = CameraPath(
+        "pan", [[0.0, 0.0, 400.0, 0.0, 0.0, 900.0, -2000.0], [2.0, 600.0, 500.0, 300.0, 0.0, 900.0, -2000.0]]
+    )
+    return Scene(
+        camera=Camera((0.0, 400.0, 0.0), (0.0, 900.0, -2000.0), 60.0),
+        lighting=Lighting(15.5),
+        clouds=clouds,
+        terrain=Terrain(size=(8000.0, 8000.0), resolution=33, height=300.0, seed=2),
+        camera_paths=(pan,),
+    )
 
 
 @pytest.fixture(scope="module")
@@ -43,22 +50,40 @@ def gui_results(tmp_path_factory):
 def run_editor(scene_path, folder, *options) -> tuple[subprocess.CompletedProcess, dict]:
     env = {k: v for k, v in os.environ.items() if k != "PYOPENGL_PLATFORM"}
     env["HOME"] = str(folder)  # the layout file and nothing else of the user's is touched
-    result = subprocess.run([sys.executable, "-m", "app", str(scene_path), "--self-test",
-                             str(folder / "results.json"), *options], capture_output=True, text=True, env=env,
-                            timeout=300)
+    result = subprocess.run(
+        [sys.executable, "-m", "app", str(scene_path), "--self-test", str(folder / "results.json"), *options],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=300,
+    )
     results_file = folder / "results.json"
     assert results_file.exists(), f"the editor exited {result.returncode} without results:\n{result.stderr[-3000:]}"
     return result, json.loads(results_file.read_text())
 
 
-@pytest.mark.parametrize("name", ["place_particles_by_clicking", "time_of_day_changes_the_picture",
-                                  "dragging_the_time_of_day_relights_live", "tolerance_drives_regeneration", "save_and_reopen",
-                                  "malformed_scene_keeps_the_current_one", "recovery_is_offered_and_restores_the_edits",
-                                  "place_on_the_cloud_surface",
-                                  "brush_stroke_is_one_undo_step", "box_fill_adds_sprites", "move_cloud_by_dragging",
-                                  "delete_key_and_statistics_toggle", "heat_map_changes_the_picture",
-                                  "overlays_outline_impostors_and_the_ring", "playing_a_camera_path_moves_the_camera",
-                                  "recording_runs_in_the_background", "a_click_within_one_frame_is_not_lost"])
+@pytest.mark.parametrize(
+    "name",
+    [
+        "place_particles_by_clicking",
+        "time_of_day_changes_the_picture",
+        "dragging_the_time_of_day_relights_live",
+        "tolerance_drives_regeneration",
+        "save_and_reopen",
+        "malformed_scene_keeps_the_current_one",
+        "recovery_is_offered_and_restores_the_edits",
+        "place_on_the_cloud_surface",
+        "brush_stroke_is_one_undo_step",
+        "box_fill_adds_sprites",
+        "move_cloud_by_dragging",
+        "delete_key_and_statistics_toggle",
+        "heat_map_changes_the_picture",
+        "overlays_outline_impostors_and_the_ring",
+        "playing_a_camera_path_moves_the_camera",
+        "recording_runs_in_the_background",
+        "a_click_within_one_frame_is_not_lost",
+    ],
+)
 def test_gui(gui_results, name):
     result, report = gui_results
     assert report["tests"][name] == "success", report["logs"].get(name, "") + result.stdout[-2000:]
@@ -75,9 +100,12 @@ def test_dragging_the_time_of_day_on_the_default_scene_relights_in_the_worker(tm
         pytest.skip("no display: run the suite through ./run tests, which starts Xvfb")
     result, report = run_editor(DEFAULT_SCENE, tmp_path, "--tests", "dragging_the_time_of_day_relights_live")
     assert report["tests"] == {"dragging_the_time_of_day_relights_live": "success"}, (
-        report["logs"].get("dragging_the_time_of_day_relights_live", "") + result.stdout[-2000:])
+        report["logs"].get("dragging_the_time_of_day_relights_live", "") + result.stdout[-2000:]
+    )
     live = report["live_time_of_day"]
     with capsys.disabled():  # the measurement (docs/performance.md), printed where the suite runs
-        print("\nlive time of day, default scene: " + ", ".join(f"{k} {v:.3g}" for k, v in live.items()
-                                                                if isinstance(v, float | int)))
+        print(
+            "\nlive time of day, default scene: "
+            + ", ".join(f"{k} {v:.3g}" for k, v in live.items() if isinstance(v, float | int))
+        )
     assert live["shading_ms_on_the_gui_thread_max"] < 100.0  # every relight came from the worker

@@ -25,23 +25,44 @@ from cloudcore.scenefile import load_scene
 pytestmark = pytest.mark.gl
 
 CLOUD = '[[clouds]]\nname = "c"\nparticles = [[0, 800, 0, 50], [100, 850, 0, 60]]\n'
-ARTIST_CLOUD = ('[[clouds]]\nname = "c"\nparticles = [[0, 800, 0, 50], [1e5, 850, 0, 60]]\n'
-                'shading_group_size = {size}\nartist = {{}}\n')
+ARTIST_CLOUD = (
+    '[[clouds]]\nname = "c"\nparticles = [[0, 800, 0, 50], [1e5, 850, 0, 60]]\n'
+    "shading_group_size = {size}\nartist = {{}}\n"
+)
 
 
 def lights_toml(count: int, dark: int = 0) -> str:
-    return "".join(f'[[lighting.lights]]\ndirection = [0, 1, 0]\nintensity = {0 if i < dark else 1}\n'
-                   for i in range(count)) + CLOUD
+    return (
+        "".join(
+            f"[[lighting.lights]]\ndirection = [0, 1, 0]\nintensity = {0 if i < dark else 1}\n" for i in range(count)
+        )
+        + CLOUD
+    )
 
 
 #: (name, file past the limit, field, words of the problem, file just within it)
 LIMITS = [
-    ("lights", lights_toml(MAX_LIGHTS + 1), "lighting.lights", f"at most {MAX_LIGHTS} lights",
-     lights_toml(MAX_LIGHTS + 1, dark=1)),
-    ("terrain kind", '[terrain]\nkind = "mesh"\nmesh = "ground.obj"\n' + CLOUD, "terrain.kind",
-     "heightfield terrain only", '[terrain]\nkind = "heightfield"\n' + CLOUD),
-    ("shading groups", ARTIST_CLOUD.format(size=1e-12), "clouds[0].shading_group_size", "too small",
-     ARTIST_CLOUD.format(size=1.0)),
+    (
+        "lights",
+        lights_toml(MAX_LIGHTS + 1),
+        "lighting.lights",
+        f"at most {MAX_LIGHTS} lights",
+        lights_toml(MAX_LIGHTS + 1, dark=1),
+    ),
+    (
+        "terrain kind",
+        '[terrain]\nkind = "mesh"\nmesh = "ground.obj"\n' + CLOUD,
+        "terrain.kind",
+        "heightfield terrain only",
+        '[terrain]\nkind = "heightfield"\n' + CLOUD,
+    ),
+    (
+        "shading groups",
+        ARTIST_CLOUD.format(size=1e-12),
+        "clouds[0].shading_group_size",
+        "too small",
+        ARTIST_CLOUD.format(size=1.0),
+    ),
 ]
 
 
@@ -53,14 +74,18 @@ def past_limit(name: str) -> Scene:
         return dataclasses.replace(base, lighting=Lighting(time_of_day=None, lights=lights))
     if name == "terrain kind":
         return dataclasses.replace(base, terrain=Terrain(kind="mesh", mesh="ground.obj"))
-    cloud = Cloud("c", np.array([[0, 800, 0, 50], [1e5, 850, 0, 60]], float), artist=ArtistShading(),
-                  shading_group_size=1e-12)
+    cloud = Cloud(
+        "c", np.array([[0, 800, 0, 50], [1e5, 850, 0, 60]], float), artist=ArtistShading(), shading_group_size=1e-12
+    )
     return dataclasses.replace(base, clouds=(cloud,))
 
 
 #: what the GL side says past each limit, had the scene got that far
-RENDERER_REFUSALS = {"lights": f"at most {MAX_LIGHTS} lights", "terrain kind": "heightfield terrain only",
-                     "shading groups": "too small for a cloud this large"}
+RENDERER_REFUSALS = {
+    "lights": f"at most {MAX_LIGHTS} lights",
+    "terrain kind": "heightfield terrain only",
+    "shading groups": "too small for a cloud this large",
+}
 
 
 @pytest.mark.parametrize("name", [limit[0] for limit in LIMITS])
@@ -70,8 +95,7 @@ def test_the_renderer_fails_past_the_limit_so_the_check_guards_something(rendere
 
 
 @pytest.mark.parametrize("name, text, field, problem, within", LIMITS)
-def test_the_loader_refuses_a_scene_past_the_limit_naming_file_and_field(tmp_path, name, text, field, problem,
-                                                                          within):
+def test_the_loader_refuses_a_scene_past_the_limit_naming_file_and_field(tmp_path, name, text, field, problem, within):
     (tmp_path / "ok.toml").write_text(within)
     load_scene(tmp_path / "ok.toml")  # just within: loads
     path = tmp_path / "bad.toml"
@@ -86,8 +110,11 @@ def test_the_loader_refuses_a_scene_past_the_limit_naming_file_and_field(tmp_pat
 def test_cloudview_render_refuses_it_in_one_line_with_status_2(tmp_path, name, text, field, problem, within):
     path = tmp_path / "bad.toml"
     path.write_text(text)
-    result = subprocess.run([sys.executable, "-m", "cloudcore.cli", "render", str(path), "--out",
-                             str(tmp_path / "x.png")], capture_output=True, text=True)
+    result = subprocess.run(
+        [sys.executable, "-m", "cloudcore.cli", "render", str(path), "--out", str(tmp_path / "x.png")],
+        capture_output=True,
+        text=True,
+    )
     assert result.returncode == 2
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith(f"cloudview: error: {path}: {field}: ") and problem in lines[0]
@@ -106,8 +133,9 @@ def test_the_editor_refuses_the_edit_with_a_message_and_keeps_the_scene(name, te
 
 
 def test_placing_a_particle_far_outside_an_artist_cloud_is_refused_and_the_cloud_kept():
-    cloud = Cloud("c", np.array([[0, 800, 0, 50.0], [10, 800, 0, 50.0]]), artist=ArtistShading(),
-                  shading_group_size=1.0)
+    cloud = Cloud(
+        "c", np.array([[0, 800, 0, 50.0], [10, 800, 0, 50.0]]), artist=ArtistShading(), shading_group_size=1.0
+    )
     editor = Editor(Scene(clouds=(cloud,)), None)
     assert editor.change(lambda: add_particle(editor.scene, 0, (1e17, 800.0, 0.0), 50.0)) is False
     assert editor.scene.clouds[0] is cloud
@@ -136,7 +164,10 @@ def test_the_shader_s_light_array_is_sized_by_the_same_constant():
 
 @pytest.mark.parametrize("side, status", [(MAX_FRAME_SIDE + 1, 2), (0, 2)])
 def test_a_frame_side_past_the_limit_is_refused_at_the_command_line(tmp_path, side, status):
-    result = subprocess.run([sys.executable, "-m", "cloudcore.cli", "render", "--out", str(tmp_path / "x.png"),
-                             "--width", str(side)], capture_output=True, text=True)
+    result = subprocess.run(
+        [sys.executable, "-m", "cloudcore.cli", "render", "--out", str(tmp_path / "x.png"), "--width", str(side)],
+        capture_output=True,
+        text=True,
+    )
     assert result.returncode == status
     assert len(result.stderr.strip().splitlines()) == 1 and "--width" in result.stderr

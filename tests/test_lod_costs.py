@@ -5,17 +5,25 @@ import math
 
 import numpy as np
 import pytest
+from test_frameplan import FILL_BOUND, FINEST, NO_RING, RADIUS, camera_at, plan
 
 from cloudcore.frameplan import LodState
-from cloudcore.lod_costs import (LLVMPIPE_COSTS, CostEstimator, CostModel, Work, inverse_square_depth, quad_work,
-                                 regeneration_work, splat_fragments)
-from test_frameplan import FILL_BOUND, FINEST, NO_RING, RADIUS, camera_at, plan
+from cloudcore.lod_costs import (
+    LLVMPIPE_COSTS,
+    CostEstimator,
+    CostModel,
+    Work,
+    inverse_square_depth,
+    quad_work,
+    regeneration_work,
+    splat_fragments,
+)
 
 
 def test_splat_fragments_are_the_discs_areas_and_never_more_than_the_screen_each():
     # 100 splats of 2 m in a point-like unit at 1000 m, focal 500 px: discs of 1 px radius
-    assert splat_fragments(100 * 2.0 ** 2, 0.0, 1000.0, 500.0, 100, 640 * 480) == pytest.approx(100 * math.pi)
-    assert splat_fragments(100 * 2.0 ** 2, 10.0, 0.0, 500.0, 100, 640 * 480) == 100 * 640 * 480
+    assert splat_fragments(100 * 2.0**2, 0.0, 1000.0, 500.0, 100, 640 * 480) == pytest.approx(100 * math.pi)
+    assert splat_fragments(100 * 2.0**2, 10.0, 0.0, 500.0, 100, 640 * 480) == 100 * 640 * 480
     assert np.isfinite(splat_fragments(1e30, 1.0, 1e-300, 1e4, 1, 1.0))
 
 
@@ -28,7 +36,7 @@ def test_the_inverse_square_depth_of_a_ball_against_sampling_it(distance):
     sampled = np.mean(1.0 / (distance + points[:, 2]) ** 2)
     assert inverse_square_depth(1.0, distance) == pytest.approx(sampled, rel=0.02)
     assert inverse_square_depth(1.0, 1e6) * 1e12 == pytest.approx(1.0)
-    assert inverse_square_depth(1.0, 1.05) * 1.05 ** 2 == pytest.approx(3.14, rel=0.01)  # the near side looms
+    assert inverse_square_depth(1.0, 1.05) * 1.05**2 == pytest.approx(3.14, rel=0.01)  # the near side looms
 
 
 def test_remaking_an_impostor_costs_its_particles_and_a_fill_that_grows_with_the_texture():
@@ -40,15 +48,21 @@ def test_remaking_an_impostor_costs_its_particles_and_a_fill_that_grows_with_the
 
 def test_the_estimator_recovers_the_coefficients_that_made_the_times():
     """Frames of varied work timed by a hidden model: the fit converges to it from the llvmpipe prior."""
-    truth = CostModel(particles=3e-4, fragments=1e-5, texture_fragments=2e-5, quad_pixels=5e-6, regenerations=2.0,
-                      batches=0.05)
+    truth = CostModel(
+        particles=3e-4, fragments=1e-5, texture_fragments=2e-5, quad_pixels=5e-6, regenerations=2.0, batches=0.05
+    )
     rng = np.random.default_rng(3)
     estimator = CostEstimator()
     for _ in range(200):
-        updates = Work(particles=rng.uniform(0, 2e4), texture_fragments=rng.uniform(0, 2e6),
-                       regenerations=rng.integers(0, 16))
-        clouds = Work(particles=rng.uniform(0, 8e4), fragments=rng.uniform(0, 2e7), quad_pixels=rng.uniform(0, 6e5),
-                      batches=rng.integers(1, 4))
+        updates = Work(
+            particles=rng.uniform(0, 2e4), texture_fragments=rng.uniform(0, 2e6), regenerations=rng.integers(0, 16)
+        )
+        clouds = Work(
+            particles=rng.uniform(0, 8e4),
+            fragments=rng.uniform(0, 2e7),
+            quad_pixels=rng.uniform(0, 6e5),
+            batches=rng.integers(1, 4),
+        )
         estimator = estimator.observe([(updates, truth.ms(updates)), (clouds, truth.ms(clouds))])
     fitted = estimator.model().vector()
     # within 15%: the prior still pulls a little on the small terms (a quad pixel, a regeneration's fixed cost),
@@ -61,8 +75,9 @@ def test_the_estimator_recovers_the_coefficients_that_made_the_times():
 
 
 def test_the_estimator_ignores_broken_timings_and_keeps_coefficients_positive():
-    estimator = CostEstimator().observe([(Work(particles=1e4), math.nan), (Work(particles=1e4), -5.0),
-                                         (Work(particles=1e4), math.inf)])
+    estimator = CostEstimator().observe(
+        [(Work(particles=1e4), math.nan), (Work(particles=1e4), -5.0), (Work(particles=1e4), math.inf)]
+    )
     assert estimator.model() == LLVMPIPE_COSTS
     for _ in range(50):  # times far below what any work could cost: clipped, not negative or zero
         estimator = estimator.observe([(Work(particles=1e5, fragments=1e7), 1e-9)])
@@ -75,28 +90,55 @@ RING_OF_CLOUDS = tuple((600.0 * math.sin(a), 0.0, -600.0 * math.cos(a)) for a in
 def test_a_frame_budget_postpones_regenerations_and_reports_the_error_it_accepted():
     impostors = dataclasses.replace(NO_RING, mode="impostor")
     start = camera_at((0.0, 0.0, 0.0), (0.0, 0.0, -1.0))
-    first = plan(start, impostors, centres=RING_OF_CLOUDS, radii=(RADIUS,) * 5, finest_radii=FINEST * 5,
-                 costs=FILL_BOUND)
+    first = plan(
+        start, impostors, centres=RING_OF_CLOUDS, radii=(RADIUS,) * 5, finest_radii=FINEST * 5, costs=FILL_BOUND
+    )
     moved = camera_at((40.0, 0.0, 0.0), (40.0, 0.0, -1.0))
-    unlimited = plan(moved, impostors, state=first.state, centres=RING_OF_CLOUDS, radii=(RADIUS,) * 5,
-                     finest_radii=FINEST * 5, costs=FILL_BOUND)
+    unlimited = plan(
+        moved,
+        impostors,
+        state=first.state,
+        centres=RING_OF_CLOUDS,
+        radii=(RADIUS,) * 5,
+        finest_radii=FINEST * 5,
+        costs=FILL_BOUND,
+    )
     assert unlimited.stats()["impostors_regenerated"] == 5 and unlimited.accepted_error <= 1.0
     # room for the quads and two regenerations: the two farthest past the tolerance are served
     one = FILL_BOUND.ms(unlimited.update_work) / 5
     budget = dataclasses.replace(impostors, frame_budget_ms=FILL_BOUND.ms(unlimited.cloud_work) + 2.5 * one)
-    tight = plan(moved, budget, state=first.state, centres=RING_OF_CLOUDS, radii=(RADIUS,) * 5,
-                 finest_radii=FINEST * 5, costs=FILL_BOUND)
+    tight = plan(
+        moved,
+        budget,
+        state=first.state,
+        centres=RING_OF_CLOUDS,
+        radii=(RADIUS,) * 5,
+        finest_radii=FINEST * 5,
+        costs=FILL_BOUND,
+    )
     stats = tight.stats()
     assert (stats["impostors_regenerated"], stats["regenerations_postponed"]) == (2, 3)
     assert tight.predicted_ms <= budget.frame_budget_ms < unlimited.predicted_ms
     assert tight.accepted_error > 1.0 and stats["accepted_error_tolerances"] == tight.accepted_error
     # a budget below the quads' own cost still serves the most urgent one a frame: the picture converges
-    starved = plan(moved, dataclasses.replace(impostors, frame_budget_ms=1e-6), state=first.state,
-                   centres=RING_OF_CLOUDS, radii=(RADIUS,) * 5, finest_radii=FINEST * 5, costs=FILL_BOUND)
+    starved = plan(
+        moved,
+        dataclasses.replace(impostors, frame_budget_ms=1e-6),
+        state=first.state,
+        centres=RING_OF_CLOUDS,
+        radii=(RADIUS,) * 5,
+        finest_radii=FINEST * 5,
+        costs=FILL_BOUND,
+    )
     assert (starved.stats()["impostors_regenerated"], starved.stats()["regenerations_postponed"]) == (1, 4)
     # new impostors are made whatever the budget: there is nothing else to show
-    fresh = plan(start, dataclasses.replace(impostors, frame_budget_ms=1e-6), centres=RING_OF_CLOUDS,
-                 radii=(RADIUS,) * 5, costs=FILL_BOUND)
+    fresh = plan(
+        start,
+        dataclasses.replace(impostors, frame_budget_ms=1e-6),
+        centres=RING_OF_CLOUDS,
+        radii=(RADIUS,) * 5,
+        costs=FILL_BOUND,
+    )
     assert fresh.stats()["impostors_regenerated"] == 5
 
 

@@ -6,8 +6,7 @@ import numpy as np
 
 from cloudcore.frameplan import LodState, plan_frame
 from cloudcore.lod_units import LodUnits, interpenetrating_groups, lod_units
-from cloudcore.scene import splats_bounding_sphere
-from cloudcore.scene import Camera
+from cloudcore.scene import Camera, splats_bounding_sphere
 from cloudcore.settings import RenderSettings
 
 RNG = np.random.default_rng(11)
@@ -37,8 +36,9 @@ CLOUDS = Packed([blob((0, 0, 0)), blob((60, 0, 0)), blob((330, 0, 0)), blob((300
 
 
 def test_clouds_whose_splats_interpenetrate_are_grouped_and_the_rest_stand_alone():
-    groups = interpenetrating_groups(CLOUDS.centres, CLOUDS.radii, CLOUDS.cloud_starts, CLOUDS.bounding_centres,
-                                     CLOUDS.bounding_radii)
+    groups = interpenetrating_groups(
+        CLOUDS.centres, CLOUDS.radii, CLOUDS.cloud_starts, CLOUDS.bounding_centres, CLOUDS.bounding_radii
+    )
     assert groups == ((0, 1), (2,), (3,))
     gap = np.linalg.norm(CLOUDS.bounding_centres[1] - CLOUDS.bounding_centres[2])
     assert gap < CLOUDS.bounding_radii[1] + CLOUDS.bounding_radii[2]  # the spheres alone would have grouped it
@@ -65,8 +65,9 @@ def test_a_group_shares_one_impostor_made_from_all_its_particles():
     stats = first.stats()
     assert stats["clouds_impostor"] == 3 and stats["units"] == 3 and stats["units_grouped"] == 1
     # one cloud of the group changes: the group's impostor is remade, the other unit's is not
-    relit = plan_frame(units, camera, (640, 480), RenderSettings(mode="impostor", ring_radius=np.inf), first.state,
-                       (1, 2, 1, 1))
+    relit = plan_frame(
+        units, camera, (640, 480), RenderSettings(mode="impostor", ring_radius=np.inf), first.state, (1, 2, 1, 1)
+    )
     assert [c.regenerate for c in relit.clouds[:2]] == ["lights", None]
 
 

@@ -36,8 +36,11 @@ def test_an_overcast_layer_reaches_wangs_overcast_figure():
 def test_no_particles_give_no_blocks():
     blocks, overdraw = cloud_block_overdraw(np.zeros((0, 3)), np.zeros(0), 100.0)
     assert blocks.shape == (0, 2) and overdraw.shape == (0,) and overdraw.dtype == np.float64
-    assert cloud_block_overdraw_statistics(overdraw) == {"block_overdraw_max": 0.0, "block_overdraw_mean": 0.0,
-                                                         "blocks": 0}
+    assert cloud_block_overdraw_statistics(overdraw) == {
+        "block_overdraw_max": 0.0,
+        "block_overdraw_mean": 0.0,
+        "blocks": 0,
+    }
 
 
 @pytest.mark.parametrize("scale", [1e-6, 1.0, 1e6, 1e150])

@@ -7,8 +7,8 @@ import pytest
 
 from cloudcore.editing import pick_ray
 from cloudcore.frameplan import LodState, plan_frame
-from cloudcore.lod_units import LodUnits
 from cloudcore.impostors import screen_size_px
+from cloudcore.lod_units import LodUnits
 from cloudcore.overlays import clip_to_near, impostor_outlines, ring_outlines, screen_polygon, to_pixels
 from cloudcore.scene import Camera
 from cloudcore.settings import RenderSettings
@@ -36,15 +36,16 @@ def test_a_polygon_is_cut_at_the_near_plane():
     assert clip_to_near(square + [0.0, 0.0, 10.0], 1.0) is None
     ahead = screen_polygon([[-1.0, -1.0, -10.0], [1.0, -1.0, -10.0], [1.0, 1.0, -10.0]], CAMERA, VIEWPORT)
     focal = 1.0 / math.tan(math.radians(30.0))  # a tenth of the way to the edge of a 60-degree view, times f
-    np.testing.assert_allclose(ahead, 0.5 * np.array(VIEWPORT) * (1.0 + 0.1 * focal * np.array(
-        [[-3 / 4, 1.0], [3 / 4, 1.0], [3 / 4, -1.0]])))
+    np.testing.assert_allclose(
+        ahead, 0.5 * np.array(VIEWPORT) * (1.0 + 0.1 * focal * np.array([[-3 / 4, 1.0], [3 / 4, 1.0], [3 / 4, -1.0]]))
+    )
 
 
 def test_an_impostor_outline_is_its_quad_on_screen():
     distance, radius = 3000.0, 200.0
     centres, radii = np.array([[0.0, 0.0, -distance], [0.0, 0.0, -15.0]]), np.array([radius, 10.0])
     # the far cloud's splats fill more than its quad, the near one has none to draw: impostor, full
-    units = LodUnits.of_spheres(centres, radii, particle_counts=[3000, 0], radius_squares=[3000 * 40.0 ** 2, 0.0])
+    units = LodUnits.of_spheres(centres, radii, particle_counts=[3000, 0], radius_squares=[3000 * 40.0**2, 0.0])
     plan = plan_frame(units, CAMERA, VIEWPORT, RenderSettings(ring_radius=math.inf), LodState(), 1)
     assert [c.kind for c in plan.clouds] == ["impostor", "full"]
     (outline,) = impostor_outlines(plan, units, CAMERA, VIEWPORT)  # the full cloud has none
@@ -76,5 +77,12 @@ def test_the_ring_outlines_are_the_panels_in_front_of_the_eye():
         ys = outline.points[:, 1]
         assert ys.min() + ys.max() == pytest.approx(VIEWPORT[1], abs=1e-6)
         assert ys.min() <= 0.0
-    assert ring_outlines(plan_frame(units, CAMERA, VIEWPORT, RenderSettings(ring_radius=math.inf), LodState(), 1),
-                         CAMERA, VIEWPORT, 30.0) == []
+    assert (
+        ring_outlines(
+            plan_frame(units, CAMERA, VIEWPORT, RenderSettings(ring_radius=math.inf), LodState(), 1),
+            CAMERA,
+            VIEWPORT,
+            30.0,
+        )
+        == []
+    )

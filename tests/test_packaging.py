@@ -17,13 +17,18 @@ PYPROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
 
 def test_every_file_the_program_reads_at_run_time_is_declared_package_data():
     declared = PYPROJECT["tool"]["setuptools"]["package-data"]
-    for package, folder in (("cloudcore.resources", ROOT / "cloudcore" / "resources"),
-                            ("cloudcore.gl", ROOT / "cloudcore" / "gl" / "shaders")):
+    for package, folder in (
+        ("cloudcore.resources", ROOT / "cloudcore" / "resources"),
+        ("cloudcore.gl", ROOT / "cloudcore" / "gl" / "shaders"),
+    ):
         base = ROOT.joinpath(*package.split("."))
         files = [f for f in folder.rglob("*") if f.is_file() and f.suffix not in (".py", ".pyc")]
         assert files
-        undeclared = [str(f.relative_to(base)) for f in files
-                      if not any(fnmatch.fnmatch(f.relative_to(base).as_posix(), glob) for glob in declared[package])]
+        undeclared = [
+            str(f.relative_to(base))
+            for f in files
+            if not any(fnmatch.fnmatch(f.relative_to(base).as_posix(), glob) for glob in declared[package])
+        ]
         assert not undeclared, f"not shipped in the wheel: {undeclared}"
 
 
@@ -35,8 +40,12 @@ def test_the_classifiers_name_the_pythons_verified_and_requires_python_admits_th
 
 
 def test_version_is_one_line_with_ours_python_and_the_gl_libraries():
-    result = subprocess.run([sys.executable, "-m", "cloudcore.cli", "--version"], capture_output=True, text=True,
-                            env={"COLUMNS": "30", "PATH": ""})
+    result = subprocess.run(
+        [sys.executable, "-m", "cloudcore.cli", "--version"],
+        capture_output=True,
+        text=True,
+        env={"COLUMNS": "30", "PATH": ""},
+    )
     assert result.returncode == 0, result.stderr
     line = result.stdout.strip()
     assert "\n" not in line

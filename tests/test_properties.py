@@ -5,7 +5,8 @@ import math
 import numpy as np
 import pytest
 import tomlkit
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 from cloudcore.errors import SceneError
@@ -23,9 +24,12 @@ def clouds(draw, index):
     n = draw(st.integers(0, 80))
     centres = draw(arrays(np.float64, (n, 3), elements=finite))
     radii = draw(arrays(np.float64, (n, 1), elements=positive))
-    return Cloud(f"cloud{index}", np.hstack([centres, radii]),
-                 optical_depth=draw(st.none() | st.floats(0, 1e6)),
-                 albedo=draw(st.none() | st.floats(0, 1)))
+    return Cloud(
+        f"cloud{index}",
+        np.hstack([centres, radii]),
+        optical_depth=draw(st.none() | st.floats(0, 1e6)),
+        albedo=draw(st.none() | st.floats(0, 1)),
+    )
 
 
 @st.composite
@@ -36,9 +40,12 @@ def scenes(draw):
     return Scene(
         camera=Camera(position, look_at, draw(st.floats(1, 170))),
         lighting=Lighting(time_of_day=draw(st.floats(0, 24))),
-        shading=Shading(draw(st.floats(0, 1)), draw(st.floats(0, 1e6)),
-                        draw(st.sampled_from(["rayleigh", "henyey-greenstein", "cornette-shanks"])),
-                        draw(st.floats(-0.999, 0.999))),
+        shading=Shading(
+            draw(st.floats(0, 1)),
+            draw(st.floats(0, 1e6)),
+            draw(st.sampled_from(["rayleigh", "henyey-greenstein", "cornette-shanks"])),
+            draw(st.floats(-0.999, 0.999)),
+        ),
         clouds=tuple(draw(clouds(i)) for i in range(count)),
     )
 
@@ -76,8 +83,11 @@ def invalid_documents(draw):
     document = scene_to_dict(draw(scenes()))
     mistakes = [
         (("camera", "fov_y_deg"), outside(1.0, 170.0)),
-        (("camera", "position"), st.lists(finite, max_size=5).filter(lambda v: len(v) != 3)
-         | st.tuples(finite, not_finite, finite).map(list)),
+        (
+            ("camera", "position"),
+            st.lists(finite, max_size=5).filter(lambda v: len(v) != 3)
+            | st.tuples(finite, not_finite, finite).map(list),
+        ),
         (("lighting", "time_of_day"), outside(0.0, 24.0)),
         (("shading", "albedo"), outside(0.0, 1.0)),
         (("shading", "optical_depth"), st.floats(max_value=-1e-300) | not_finite),

@@ -22,7 +22,8 @@ def test_a_copy_for_recording_names_its_meshes_absolutely_and_keeps_its_particle
     scene = Scene(
         clouds=(Cloud("big", np.ones((3, 4)), particles_file="other.particles/big.npy"),),
         terrain=Terrain(kind="mesh", mesh="ground.obj"),
-        objects=(SceneObject("tower", mesh="meshes/tower.obj"), SceneObject("box", primitive="box")))
+        objects=(SceneObject("tower", mesh="meshes/tower.obj"), SceneObject("box", primitive="box")),
+    )
     copy = standalone(scene, tmp_path)
     assert copy.terrain.mesh == str(tmp_path.resolve() / "ground.obj")
     assert [o.mesh for o in copy.objects] == [str(tmp_path.resolve() / "meshes" / "tower.obj"), None]
@@ -46,8 +47,15 @@ def test_a_recording_runs_in_the_background_and_reports_how_it_ended(small_scene
 
 def test_a_stopped_recording_ends_like_ctrl_c(small_scene, tmp_path):
     long_path = CameraPath("long", [[0, 0, 500, 1500, 0, 800, 0], [600, 1500, 600, 0, 0, 800, 0]])
-    job = RecordJob(Scene(clouds=small_scene.clouds, camera_paths=(long_path,)), tmp_path, "long",
-                    tmp_path / "long.mp4", 32, 24, fps=30.0)
+    job = RecordJob(
+        Scene(clouds=small_scene.clouds, camera_paths=(long_path,)),
+        tmp_path,
+        "long",
+        tmp_path / "long.mp4",
+        32,
+        24,
+        fps=30.0,
+    )
     deadline = time.monotonic() + 60.0
     while "frame" not in job.progress and time.monotonic() < deadline:  # tqdm's bar: frames are being drawn
         time.sleep(0.1)

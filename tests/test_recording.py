@@ -35,9 +35,18 @@ def test_frame_rates_must_be_finite_and_positive(fps):
         frame_times(30.0, fps)
 
 
-STATS = {"frame_ms": 10.0, "world_ms": 2.5, "cloud_ms": 6.0, "impostor_update_ms": 1.5, "particles_drawn": 1200,
-         "clouds_drawn": 5, "impostors_drawn": 3, "impostors_regenerated": 1, "texture_bytes": 4096,
-         "regeneration_reasons": {"angle": 1}}
+STATS = {
+    "frame_ms": 10.0,
+    "world_ms": 2.5,
+    "cloud_ms": 6.0,
+    "impostor_update_ms": 1.5,
+    "particles_drawn": 1200,
+    "clouds_drawn": 5,
+    "impostors_drawn": 3,
+    "impostors_regenerated": 1,
+    "texture_bytes": 4096,
+    "regeneration_reasons": {"angle": 1},
+}
 
 
 def test_row_splits_the_frame_time_and_defaults_what_the_renderer_does_not_report():
@@ -50,8 +59,14 @@ def test_row_splits_the_frame_time_and_defaults_what_the_renderer_does_not_repor
 
 
 def test_row_takes_layers_and_overdraw_when_given():
-    stats = STATS | {"layers_drawn": 4, "layers_rebuilt": 2, "overdraw_mean": 3.25, "overdraw_max": 17.0,
-                     "overdraw_analytic": 3.5, "overdraw_mean_covered": 5.0}
+    stats = STATS | {
+        "layers_drawn": 4,
+        "layers_rebuilt": 2,
+        "overdraw_mean": 3.25,
+        "overdraw_max": 17.0,
+        "overdraw_analytic": 3.5,
+        "overdraw_mean_covered": 5.0,
+    }
     row = frame_row(0, 0.0, stats)
     assert (row["layers_drawn"], row["layers_rebuilt"]) == (4, 2)
     assert (row["overdraw_mean"], row["overdraw_max"], row["overdraw_analytic"]) == (3.25, 17.0, 3.5)

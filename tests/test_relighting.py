@@ -28,8 +28,9 @@ def test_the_cache_gives_what_illuminate_clouds_gives_and_shades_only_the_moved_
     clouds = [cloud(0, 300), cloud(1, 200)]
     cache = IlluminationCache()
     noon, _ = scene_lights(Lighting(time_of_day=12.0))
-    for got, expected in zip(cache.incident(clouds, SHADING, noon, "raster"),
-                             illuminate_clouds(clouds, SHADING, noon, "raster")):
+    for got, expected in zip(
+        cache.incident(clouds, SHADING, noon, "raster"), illuminate_clouds(clouds, SHADING, noon, "raster")
+    ):
         np.testing.assert_array_equal(got, expected)
     assert cache.last_recomputed == 4  # two clouds, sun and skylight
     brighter_sky = (noon[0], dataclasses.replace(noon[1], intensity=2.0 * noon[1].intensity))

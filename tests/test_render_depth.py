@@ -41,8 +41,10 @@ def renders(renderer, request):
     assert all(line_of_sight_blocked(p[:3] + [0.0, p[3], 0.0]) for p in puff(behind).particles)
     assert not line_of_sight_blocked(in_front)
     settings = request.param
-    images = {name: renderer.render(scene_with(*clouds), settings=settings)[0] for name, clouds in
-              {"none": (), "in_front": (puff(in_front),), "behind": (puff(behind),)}.items()}
+    images = {
+        name: renderer.render(scene_with(*clouds), settings=settings)[0]
+        for name, clouds in {"none": (), "in_front": (puff(in_front),), "behind": (puff(behind),)}.items()
+    }
     images["behind_without_hill"] = renderer.render(scene_with(puff(behind), terrain=None), settings=settings)[0]
     images["none_without_hill"] = renderer.render(scene_with(terrain=None), settings=settings)[0]
     return images

@@ -17,9 +17,11 @@ from cloudcore.scene import Camera, Cloud, Light, Shading
 
 WIDTH, HEIGHT = 160, 120
 CAMERA = Camera((0.0, 0.0, 0.0), (0.0, 0.0, -1.0), 60.0)
-LIGHTS = (Light((0.0, 0.0, 1.0), (1.0, 0.9, 0.8), 1.2),  # behind the eye: back scattering
-          Light((0.0, 0.6, -0.8), (0.9, 0.95, 1.0), 0.8),  # ahead: forward scattering
-          Light((1.0, 0.0, 0.0), (0.3, 0.4, 0.9), 0.5))
+LIGHTS = (
+    Light((0.0, 0.0, 1.0), (1.0, 0.9, 0.8), 1.2),  # behind the eye: back scattering
+    Light((0.0, 0.6, -0.8), (0.9, 0.95, 1.0), 0.8),  # ahead: forward scattering
+    Light((1.0, 0.0, 0.0), (0.3, 0.4, 0.9), 0.5),
+)
 AMBIENT = (0.05, 0.06, 0.09)
 
 
@@ -33,9 +35,15 @@ def test_the_shader_colours_particles_as_the_reference_does(renderer, phase, g):
     from cloudcore.gl.splats import SplatPass, splat_batch
     from cloudcore.gl.targets import TextureTarget
 
-    clouds = (Cloud("steady", particle_grid(-100.0), optical_depth=2.0, color=(1.0, 0.9, 0.8)),
-              Cloud("forming", particle_grid(-100.0) + [0.0, 0.0, -0.5, 0.0], optical_depth=20.0,
-                    formation=Formation("form", 0.0, 10.0)))
+    clouds = (
+        Cloud("steady", particle_grid(-100.0), optical_depth=2.0, color=(1.0, 0.9, 0.8)),
+        Cloud(
+            "forming",
+            particle_grid(-100.0) + [0.0, 0.0, -0.5, 0.0],
+            optical_depth=20.0,
+            formation=Formation("form", 0.0, 10.0),
+        ),
+    )
     particles = ParticleShading(clouds, Shading(albedo=0.85, phase=phase, g=g), LIGHTS, AMBIENT)
     view, projection = view_matrix(CAMERA), projection_matrix(CAMERA.fov_y_deg, WIDTH / HEIGHT)
     time_s = 4.0  # the forming cloud's core is in, its edge not yet
@@ -44,8 +52,9 @@ def test_the_shader_colours_particles_as_the_reference_does(renderer, phase, g):
     try:
         for cloud in range(2):
             target.bind_cleared()
-            splats.draw(splat_batch(particles, [cloud], CAMERA.position, time_s=time_s), view, projection,
-                        depth_test=False)
+            splats.draw(
+                splat_batch(particles, [cloud], CAMERA.position, time_s=time_s), view, projection, depth_test=False
+            )
             pixels = target.read()
             indices = np.arange(particles.cloud_starts[cloud], particles.cloud_starts[cloud + 1])
             colour, alpha = particles.seen_from(CAMERA.position, indices, time_s=time_s)
@@ -60,8 +69,13 @@ def test_the_shader_colours_particles_as_the_reference_does(renderer, phase, g):
                     assert np.all(pixel == 0.0), f"particle {index} should be invisible, got {pixel}"
                     continue
                 assert kernel_floor * expected_alpha * 0.99 <= pixel[3] <= expected_alpha * 1.01, (index, pixel)
-                np.testing.assert_allclose(pixel[:3] / pixel[3], expected_colour / expected_alpha, rtol=0.01,
-                                           atol=2e-4, err_msg=f"particle {index} ({phase}, g={g})")
+                np.testing.assert_allclose(
+                    pixel[:3] / pixel[3],
+                    expected_colour / expected_alpha,
+                    rtol=0.01,
+                    atol=2e-4,
+                    err_msg=f"particle {index} ({phase}, g={g})",
+                )
             if cloud == 1:  # the formation reached the shader: some particles in, some still out
                 assert 0 < np.count_nonzero(alpha) < len(alpha)
     finally:
@@ -122,8 +136,9 @@ def test_a_sprite_the_eye_stands_in_keeps_its_facing_and_fades_as_the_eye_circle
 
     cloud = Cloud("sprite", [[0.0, 0.0, 0.0, 100.0]], sprite=SpriteStyle(rows=(PUFFY,), rotation_deg=(0.0, 0.0)))
     scene = Scene(lighting=Lighting(12.0), clouds=(cloud,))
-    sky = renderer.render(dataclasses.replace(scene, clouds=()), camera=Camera((0.0, 0.0, 30.0), (0.0, 0.0, 0.0)),
-                          settings=FULL_3D)[0].astype(float)
+    sky = renderer.render(
+        dataclasses.replace(scene, clouds=()), camera=Camera((0.0, 0.0, 30.0), (0.0, 0.0, 0.0)), settings=FULL_3D
+    )[0].astype(float)
 
     def visible(angle_deg: float) -> float:
         """Mean brightness the sprite adds, seen from 30 m (0.3 radii) at `angle_deg` around it."""

@@ -2,6 +2,8 @@
 command that regenerates them: tests/goldens.py)."""
 
 import pytest
+from conftest import VALLEY
+from goldens import MAX_ABS, MIN_PSNR_DB, check_golden
 
 from cloudcore.imagecompare import compare, diff_image
 from cloudcore.lighting import sun_direction
@@ -9,8 +11,6 @@ from cloudcore.paths import sample
 from cloudcore.scene import Camera, Scene
 from cloudcore.scenefile import load_scene
 from cloudcore.settings import FULL_3D
-from conftest import VALLEY
-from goldens import MAX_ABS, MIN_PSNR_DB, check_golden
 
 
 @pytest.fixture(scope="module")

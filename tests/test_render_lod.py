@@ -10,6 +10,9 @@ import dataclasses
 
 import numpy as np
 import pytest
+from conftest import VALLEY
+from test_frameplan import FILL_BOUND, UPKEEP_BOUND
+from test_render_golden import inside_a_cloud, into_the_sun
 
 from cloudcore.imagecompare import compare
 from cloudcore.navigation import orbited
@@ -17,12 +20,9 @@ from cloudcore.ring import SEGMENTS
 from cloudcore.scene import Camera
 from cloudcore.scenefile import load_scene
 from cloudcore.settings import FULL_3D, RenderSettings
-from conftest import VALLEY
-from test_frameplan import FILL_BOUND, UPKEEP_BOUND
 
 #: full 3D all but free, an impostor's quad dear: auto moves every unit to full 3D
 FULL_CHEAP = dataclasses.replace(UPKEEP_BOUND, quad_pixels=1.0)
-from test_render_golden import inside_a_cloud, into_the_sun
 
 #: enough frames to build all ring segments and fade the ring in
 SETTLE_FRAMES = SEGMENTS + RenderSettings().ring_fade_frames + 1
@@ -74,13 +74,16 @@ def test_the_crossfade_mixes_full_3d_and_impostor_linearly(renderer, valley):
     scene = dataclasses.replace(valley, clouds=(cloud,), terrain=None)
     # the impostor is made from one eye and seen from another, three quarters of the tolerance round:
     # kept, but far enough from full 3D that switching to it calls for the crossfade
-    auto = dataclasses.replace(RenderSettings(), ring_radius=np.inf, transition_frames=5, translation_metric="centre",
-                               tolerance_deg=1.0)
+    auto = dataclasses.replace(
+        RenderSettings(), ring_radius=np.inf, transition_frames=5, translation_metric="centre", tolerance_deg=1.0
+    )
     made_from = Camera(tuple(centre + [0.0, 0.0, 3.0 * radius]), tuple(centre), 60.0)
     camera = orbited(made_from, 0.75)
     renderer.render(scene, camera=made_from, settings=dataclasses.replace(auto, mode="impostor"))
-    ends = [renderer.render(scene, camera=camera, settings=s)[0].astype(float).mean()
-            for s in (FULL_3D, dataclasses.replace(auto, mode="impostor"))]
+    ends = [
+        renderer.render(scene, camera=camera, settings=s)[0].astype(float).mean()
+        for s in (FULL_3D, dataclasses.replace(auto, mode="impostor"))
+    ]
     assert renderer.last_plan.clouds[0].regenerate is None
     means, weights = [], []
     for frame in range(8):

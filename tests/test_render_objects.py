@@ -44,8 +44,11 @@ def test_split_impostors_match_split_full_3d_and_the_naive_impostor_cuts_the_air
     naive, naive_stats = renderer.render(scene, settings=NAIVE_IMPOSTOR, time_s=time_s)
     assert naive_stats["layers_drawn"] == 0 and naive_stats["objects_in_clouds"] == 0
     box = aircraft_box(scene, renderer, time_s)
-    whole, around_split, around_naive = (compare(split, reference), compare(split[box], reference[box]),
-                                         compare(naive[box], reference[box]))
+    whole, around_split, around_naive = (
+        compare(split, reference),
+        compare(split[box], reference[box]),
+        compare(naive[box], reference[box]),
+    )
     print(f"t={time_s}: split impostor {whole} ({around_split} around the aircraft); naive {around_naive}")
     assert whole.psnr_db >= 45.0 and around_split.psnr_db >= 50.0
     assert around_naive.psnr_db < 35.0 and around_naive.max_abs > 50
@@ -69,10 +72,10 @@ def test_an_object_outside_clouds_hides_the_cloud_behind_it(renderer, scene):
 
 def test_objects_do_not_change_a_scene_without_them_in_view(renderer, scene):
     """Behind the camera, the aircraft costs no pass and changes no pixel."""
-    turned = scene.camera.__class__(scene.camera.position, tuple(2 * np.asarray(scene.camera.position)
-                                                                 - np.asarray(scene.camera.look_at)), 45.0)
+    turned = scene.camera.__class__(
+        scene.camera.position, tuple(2 * np.asarray(scene.camera.position) - np.asarray(scene.camera.look_at)), 45.0
+    )
     with_aircraft, stats = renderer.render(scene, camera=turned, settings=FULL_3D, time_s=10.0)
-    without, _ = renderer.render(dataclasses.replace(scene, objects=()), camera=turned,
-                                 settings=FULL_3D)
+    without, _ = renderer.render(dataclasses.replace(scene, objects=()), camera=turned, settings=FULL_3D)
     assert renderer.last_plan.objects_with_world == () and renderer.last_plan.objects_between_layers == ()
     assert np.array_equal(with_aircraft, without)

@@ -7,11 +7,11 @@ import math
 
 import numpy as np
 import pytest
+from goldens import check_golden
 
 from cloudcore.cloudgen import PRESETS, preset_cloud
 from cloudcore.scene import Camera, Lighting, Scene
 from cloudcore.settings import FULL_3D
-from goldens import check_golden
 
 HOURS = {"noon": 12.0, "sunset": 18.6}
 BASE = np.array([0.0, 1500.0, 0.0])
@@ -42,6 +42,7 @@ def test_preset_matches_golden(preset, model, hour_name, renderer, request):
 def test_the_two_shading_models_differ_and_both_warm_at_sunset(renderer):
     """The artist model is not Harris's under another name, and both follow the hour (on the cloud's
     pixels: those that differ from the empty sky)."""
+
     def render(model, hour, clouds=True):
         scene = preset_scene("cumulus_congestus", model, hour)
         scene = scene if clouds else dataclasses.replace(scene, clouds=())

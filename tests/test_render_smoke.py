@@ -7,11 +7,13 @@ import dataclasses
 
 import numpy as np
 import pytest
+from conftest import RENDER_HEIGHT as HEIGHT
+from conftest import RENDER_WIDTH as WIDTH
+from conftest import VALLEY
 
 from cloudcore.scene import Camera
 from cloudcore.scenefile import load_scene
 from cloudcore.settings import FULL_3D
-from conftest import RENDER_HEIGHT as HEIGHT, RENDER_WIDTH as WIDTH, VALLEY
 
 STATS_KEYS = {"frame_ms", "world_ms", "cloud_ms", "particles_drawn", "clouds_drawn", "clouds_culled"}
 

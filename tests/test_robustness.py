@@ -50,9 +50,12 @@ def puff(count: int = 150, radius: float = 30.0, spread: float = 80.0, seed: int
     return np.column_stack([centres, np.full(count, radius)])
 
 
-BASE = Scene(camera=Camera(EYE, tuple(CLOUD_CENTRE), 55.0), lighting=Lighting(time_of_day=15.5),
-             clouds=(Cloud("puff", puff()),),
-             terrain=Terrain(size=(3000.0, 3000.0), resolution=17, height=300.0, seed=3))
+BASE = Scene(
+    camera=Camera(EYE, tuple(CLOUD_CENTRE), 55.0),
+    lighting=Lighting(time_of_day=15.5),
+    clouds=(Cloud("puff", puff()),),
+    terrain=Terrain(size=(3000.0, 3000.0), resolution=17, height=300.0, seed=3),
+)
 
 
 def with_particles(particles: np.ndarray, **cloud_fields) -> Scene:
@@ -81,8 +84,9 @@ class Frame:
     overdraw_max: float
 
 
-def render_checked(renderer: FrameRenderer, row: str, scene: Scene, settings: RenderSettings = FULL_3D, *,
-                   camera: Camera | None = None) -> Frame:
+def render_checked(
+    renderer: FrameRenderer, row: str, scene: Scene, settings: RenderSettings = FULL_3D, *, camera: Camera | None = None
+) -> Frame:
     """Render one frame and check the matrix's promise: every float buffer finite, the frame time bounded."""
     _, stats = renderer.render(scene, camera=camera, settings=settings, read_back=False)
     buffers = float_buffers(renderer)
@@ -92,18 +96,20 @@ def render_checked(renderer: FrameRenderer, row: str, scene: Scene, settings: Re
     numbers = {key: value for key, value in stats.items() if isinstance(value, (int, float))}
     assert all(math.isfinite(value) for value in numbers.values()), numbers
     assert 0.0 <= stats["frame_ms"] < FRAME_TIME_LIMIT_MS
-    frame = Frame(buffers["frame"], stats, [cloud.kind for cloud in renderer.last_plan.clouds],
-                  float(buffers["overdraw"].max()))
-    print(f"\nROW {row} [{settings.mode}]: {len(buffers)} float buffers finite; frame max {frame.linear.max():.4g}, "
-          f"min {frame.linear.min():.4g}; overdraw max {frame.overdraw_max:g}; {stats['frame_ms']:.1f} ms; "
-          f"{stats['particles_drawn']} particles drawn; plan {frame.kinds}")
+    frame = Frame(
+        buffers["frame"], stats, [cloud.kind for cloud in renderer.last_plan.clouds], float(buffers["overdraw"].max())
+    )
+    print(
+        f"\nROW {row} [{settings.mode}]: {len(buffers)} float buffers finite; frame max {frame.linear.max():.4g}, "
+        f"min {frame.linear.min():.4g}; overdraw max {frame.overdraw_max:g}; {stats['frame_ms']:.1f} ms; "
+        f"{stats['particles_drawn']} particles drawn; plan {frame.kinds}"
+    )
     return frame
 
 
 def clear_sky(renderer, scene: Scene = BASE, settings: RenderSettings = FULL_3D, camera=None) -> np.ndarray:
     """The frame without its clouds: what an invisible cloud must leave exactly."""
-    return render_checked(renderer, "no clouds", dataclasses.replace(scene, clouds=()), settings,
-                          camera=camera).linear
+    return render_checked(renderer, "no clouds", dataclasses.replace(scene, clouds=()), settings, camera=camera).linear
 
 
 def cloud_added(frame: Frame, clear: np.ndarray) -> float:
@@ -141,15 +147,18 @@ def test_optical_depth(renderer, tau, mode):
 
 def test_optically_thick_clouds_saturate_instead_of_growing(renderer):
     """Beyond tau ~ 10 every particle is opaque and forward-scatters what it stops: 1e3 and 1e6 look the same."""
-    thick, thicker = (render_checked(renderer, f"optical depth {tau:g}", with_particles(puff(), optical_depth=tau))
-                      for tau in (1e3, 1e6))
+    thick, thicker = (
+        render_checked(renderer, f"optical depth {tau:g}", with_particles(puff(), optical_depth=tau))
+        for tau in (1e3, 1e6)
+    )
     np.testing.assert_allclose(thick.linear, thicker.linear, atol=HALF_FLOAT_ATOL)
 
 
 def test_albedo_0_and_1(renderer):
     clear = clear_sky(renderer)
-    absorbing, scattering = (render_checked(renderer, f"albedo {albedo:g}", with_particles(puff(), albedo=albedo))
-                             for albedo in (0.0, 1.0))
+    absorbing, scattering = (
+        render_checked(renderer, f"albedo {albedo:g}", with_particles(puff(), albedo=albedo)) for albedo in (0.0, 1.0)
+    )
     cloud = np.abs(scattering.linear - clear).max(axis=2) > VISIBLE
     assert cloud.mean() > 0.01
     # albedo 0 only absorbs (plus the ambient term): the same cloud is darker than at albedo 1
@@ -196,8 +205,11 @@ def test_camera_inside_a_particle(renderer, mode):
     camera = looking_from(BASE.clouds[0].particles[0, :3])
     frame = render_checked(renderer, "camera at a particle's centre", BASE, MODES[mode], camera=camera)
     particles = BASE.clouds[0].particles
-    in_view = splats_in_frustum(frustum_planes(projection_matrix(camera.fov_y_deg, renderer.size[0] / renderer.size[1])
-                                               @ view_matrix(camera)), particles[:, :3], particles[:, 3])
+    in_view = splats_in_frustum(
+        frustum_planes(projection_matrix(camera.fov_y_deg, renderer.size[0] / renderer.size[1]) @ view_matrix(camera)),
+        particles[:, :3],
+        particles[:, 3],
+    )
     assert in_view[0] and frame.stats["particles_drawn"] == np.count_nonzero(in_view) - 1
     assert cloud_added(frame, clear_sky(renderer, settings=MODES[mode], camera=camera)) > VISIBLE
     assert frame.kinds == (["full"] if mode == "full" else ["inside"])
@@ -232,8 +244,13 @@ def test_particle_at_the_near_plane(renderer, mode):
     clear = clear_sky(renderer, settings=MODES[mode], camera=camera)
     for distance, drawn in ((NEAR_PLANE_M, False), (NEAR_PLANE_M + 0.05, True)):
         particle = [*(np.array(EYE) + distance * forward), 0.5]
-        frame = render_checked(renderer, f"particle {distance:g} m from the eye", with_particles(np.array([particle])),
-                               MODES[mode], camera=camera)
+        frame = render_checked(
+            renderer,
+            f"particle {distance:g} m from the eye",
+            with_particles(np.array([particle])),
+            MODES[mode],
+            camera=camera,
+        )
         assert (cloud_added(frame, clear) > VISIBLE) == drawn
 
 
@@ -318,8 +335,13 @@ def test_impostor_tolerance_0_remakes_on_any_move(renderer):
     render_checked(renderer, "tolerance 0", BASE, settings)
     still = render_checked(renderer, "tolerance 0, eye still", BASE, settings)
     assert still.stats["impostors_regenerated"] == 0, still.stats["regeneration_reasons"]
-    moved = render_checked(renderer, "tolerance 0, eye 1 mm aside", BASE, settings,
-                           camera=looking_from(np.add(EYE, [1e-3, 0.0, 0.0]), CLOUD_CENTRE))
+    moved = render_checked(
+        renderer,
+        "tolerance 0, eye 1 mm aside",
+        BASE,
+        settings,
+        camera=looking_from(np.add(EYE, [1e-3, 0.0, 0.0]), CLOUD_CENTRE),
+    )
     assert moved.stats["regeneration_reasons"] == {"translation": 1}
 
 
@@ -327,10 +349,14 @@ def test_impostor_tolerance_90_keeps_the_impostor_a_quarter_turn_round(renderer)
     settings = dataclasses.replace(MODES["impostor"], tolerance_deg=90.0)
     render_checked(renderer, "tolerance 90", BASE, settings)
     offset = np.array(EYE) - CLOUD_CENTRE
-    turned = CLOUD_CENTRE + [offset[2] * math.sin(math.radians(80.0)), offset[1],
-                             offset[2] * math.cos(math.radians(80.0))]
-    frame = render_checked(renderer, "tolerance 90, eye 80 degrees round", BASE, settings,
-                           camera=looking_from(turned, CLOUD_CENTRE))
+    turned = CLOUD_CENTRE + [
+        offset[2] * math.sin(math.radians(80.0)),
+        offset[1],
+        offset[2] * math.cos(math.radians(80.0)),
+    ]
+    frame = render_checked(
+        renderer, "tolerance 90, eye 80 degrees round", BASE, settings, camera=looking_from(turned, CLOUD_CENTRE)
+    )
     assert frame.stats["impostors_regenerated"] == 0
 
 
@@ -380,8 +406,9 @@ def test_window_resized_to_1x1(window_renderer, mode):
     window_renderer.resize(1, 1)
     frame = render_checked(window_renderer, "window 1x1", BASE, MODES[mode])
     assert frame.linear.shape == (1, 1, 3)
-    inside = render_checked(window_renderer, "window 1x1, camera in the cloud", BASE, MODES[mode],
-                            camera=looking_from(CLOUD_CENTRE))
+    inside = render_checked(
+        window_renderer, "window 1x1, camera in the cloud", BASE, MODES[mode], camera=looking_from(CLOUD_CENTRE)
+    )
     assert inside.linear.shape == (1, 1, 3)
     window_renderer.resize(64, 48)
     assert render_checked(window_renderer, "window back to 64x48", BASE, MODES[mode]).linear.shape == (48, 64, 3)

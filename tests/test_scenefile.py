@@ -2,15 +2,15 @@
 
 import subprocess
 import sys
+import tomllib
 
 import numpy as np
 import pytest
-import tomllib
+from conftest import VALLEY
 
 import cloudcore.scenefile as scenefile
 from cloudcore.errors import SceneError
 from cloudcore.scenefile import load_scene, save_scene, scene_to_dict
-from conftest import VALLEY
 
 
 def test_round_trip_is_lossless(tmp_path, small_scene):
@@ -22,8 +22,9 @@ def test_round_trip_is_lossless(tmp_path, small_scene):
     for original, again in zip(small_scene.clouds, loaded.clouds):
         np.testing.assert_array_equal(original.particles, again.particles)  # bit for bit
     save_scene(loaded, tmp_path / "again.toml")
-    assert (tmp_path / "again.toml").read_text().replace("again.particles", "s.particles") == \
-        (tmp_path / "s.toml").read_text()
+    assert (tmp_path / "again.toml").read_text().replace("again.particles", "s.particles") == (
+        tmp_path / "s.toml"
+    ).read_text()
 
 
 def test_default_scene_round_trips(tmp_path):
@@ -34,6 +35,7 @@ def test_default_scene_round_trips(tmp_path):
 
 def test_awkward_floats_survive(tmp_path, small_scene):
     from dataclasses import replace
+
     particles = np.array([[0.1 + 0.2, 1e-300, -2.5e17, 1e-6], [1 / 3, 5e-324, 1e6, 1e6]])
     scene = replace(small_scene, clouds=(replace(small_scene.clouds[0], particles=particles),))
     save_scene(scene, tmp_path / "f.toml")
@@ -59,7 +61,7 @@ MALFORMED = [
     ("[0.0, 800.0, 0.0, 20.0]", "[0.0, 800.0, 0.0, -20.0]", "clouds[0].particles", "radius must be > 0"),
     ("[0.0, 800.0, 0.0, 20.0]", "[0.0, nan, 0.0, 20.0]", "clouds[0].particles", "not finite"),
     ("[0.0, 800.0, 0.0, 20.0]", "[0.0, 800.0, 20.0]", "clouds[0].particles", "rows of 4"),
-    ("[0.0, 800.0, 0.0, 20.0]", "[0.0, \"x\", 0.0, 20.0]", "clouds[0].particles", "rows of 4"),
+    ("[0.0, 800.0, 0.0, 20.0]", '[0.0, "x", 0.0, 20.0]', "clouds[0].particles", "rows of 4"),
     ('name = "a"', 'name = "a"\noptical_depth = -1.0', "clouds[0].optical_depth", "within"),
     ('name = "a"', 'name = "a"\nalbedo = 1.5', "clouds[0].albedo", "within"),
     ('name = "a"', "", "clouds[0].name", "missing"),
@@ -67,7 +69,7 @@ MALFORMED = [
     ("time_of_day = 14.0", "time_of_day = 25.0", "lighting.time_of_day", "within"),
     ("time_of_day = 14.0", 'time_of_day = "noon"', "lighting.time_of_day", "expected a number"),
     ("time_of_day = 14.0", "time_of_day = inf", "lighting.time_of_day", "finite"),
-    ("[lighting]", "[shading]\nphase = \"mie\"\n[lighting]", "shading.phase", "rayleigh"),
+    ("[lighting]", '[shading]\nphase = "mie"\n[lighting]', "shading.phase", "rayleigh"),
     ("[lighting]", "[shading]\ng = 1.0\n[lighting]", "shading.g", "within"),
     ("[lighting]", "[shading]\noptical_depth = -8.0\n[lighting]", "shading.optical_depth", "within"),
     ("[lighting]", "[shading]\nalbedo = nan\n[lighting]", "shading.albedo", "finite"),
@@ -75,50 +77,99 @@ MALFORMED = [
     ("look_at = [0.0, 800.0, 0.0]", "look_at = [0.0, 500.0, 1500.0]", "camera.look_at", "differ"),
     ("look_at = [0.0, 800.0, 0.0]", "look_at = [0.0, 800.0]", "camera.look_at", "rows of 3"),
     ("[camera]", "[camera]\nfov_y_deg = 0.0", "camera.fov_y_deg", "within"),
-    ("time_of_day = 14.0", "time_of_day = 14.0\n[[lighting.lights]]\ndirection = [0, 0, 0]",
-     "lighting.lights[0].direction", "zero vector"),
+    (
+        "time_of_day = 14.0",
+        "time_of_day = 14.0\n[[lighting.lights]]\ndirection = [0, 0, 0]",
+        "lighting.lights[0].direction",
+        "zero vector",
+    ),
     ("[5, 100, 500", "[0, 100, 500", "camera_paths[0].keys", "increase strictly"),
     ('name = "p"', 'name = "p"\nspeed = 3', "camera_paths[0].speed", "unknown key"),
-    ("[camera]", "[[objects]]\nname = \"o\"\nprimitive = \"teapot\"\n[camera]", "objects[0].primitive", "aircraft"),
-    ("[camera]", "[[objects]]\nname = \"o\"\nprimitive = \"box\"\nscale = 0\n[camera]", "objects[0].scale", "within"),
-    ("[camera]", "[[objects]]\nname = \"o\"\n[camera]", "objects[0].mesh", "exactly one"),
+    ("[camera]", '[[objects]]\nname = "o"\nprimitive = "teapot"\n[camera]', "objects[0].primitive", "aircraft"),
+    ("[camera]", '[[objects]]\nname = "o"\nprimitive = "box"\nscale = 0\n[camera]', "objects[0].scale", "within"),
+    ("[camera]", '[[objects]]\nname = "o"\n[camera]', "objects[0].mesh", "exactly one"),
     ("[camera]", "[terrain]\nresolution = 1\n[camera]", "terrain.resolution", "within"),
     ("[camera]", "[terrain]\nsize = [100.0]\n[camera]", "terrain.size", "size_x"),
     ("[camera]", "colour = 3\n[camera]", "colour", "unknown key"),
-    ("[[camera_paths]]", "[[clouds]]\nname = \"a\"\nparticles = []\n[[camera_paths]]", "clouds[1].name", "duplicate"),
+    ("[[camera_paths]]", '[[clouds]]\nname = "a"\nparticles = []\n[[camera_paths]]', "clouds[1].name", "duplicate"),
     ("[lighting]", "[lighting", "(toml)", "line"),
     # sprites and artist shading (Wang 2004, sections 3.2 and 5)
     ('name = "a"', 'name = "a"\nsprite = { rows = [4] }', "clouds[0].sprite.rows", "0..3"),
     ('name = "a"', 'name = "a"\nsprite = { rows = [] }', "clouds[0].sprite.rows", "one or more"),
     ('name = "a"', 'name = "a"\nsprite = { rows = [1.0] }', "clouds[0].sprite.rows", "integers"),
-    ('name = "a"', 'name = "a"\nsprite = { rotation_deg = [10.0, 0.0] }', "clouds[0].sprite.rotation_deg",
-     "low <= high"),
-    ('name = "a"', 'name = "a"\nsprite = { rotation_deg = [0.0, 400.0] }', "clouds[0].sprite.rotation_deg",
-     "low + 360"),
+    (
+        'name = "a"',
+        'name = "a"\nsprite = { rotation_deg = [10.0, 0.0] }',
+        "clouds[0].sprite.rotation_deg",
+        "low <= high",
+    ),
+    (
+        'name = "a"',
+        'name = "a"\nsprite = { rotation_deg = [0.0, 400.0] }',
+        "clouds[0].sprite.rotation_deg",
+        "low + 360",
+    ),
     ('name = "a"', 'name = "a"\nsprite = { rotation_deg = [0.0] }', "clouds[0].sprite.rotation_deg", "rows of 2"),
     ('name = "a"', 'name = "a"\nsprite = { facing = "up" }', "clouds[0].sprite.facing", "horizontal"),
     ('name = "a"', 'name = "a"\nsprite = { seed = -1 }', "clouds[0].sprite.seed", "within"),
-    ('name = "a"', 'name = "a"\nsprite = { flat_bottom_fraction = 1.5 }', "clouds[0].sprite.flat_bottom_fraction",
-     "within [0, 1]"),
+    (
+        'name = "a"',
+        'name = "a"\nsprite = { flat_bottom_fraction = 1.5 }',
+        "clouds[0].sprite.flat_bottom_fraction",
+        "within [0, 1]",
+    ),
     ('name = "a"', 'name = "a"\nsprite = { colour = 1 }', "clouds[0].sprite.colour", "unknown key"),
     ('name = "a"', 'name = "a"\nsprite = 3', "clouds[0].sprite", "expected a table"),
-    ('name = "a"', 'name = "a"\nartist = { levels = [[0, 1, 1, 1, 1], [1, 1, 1, 1, 1]] }', "clouds[0].artist.levels",
-     "expected 5 levels"),
-    ('name = "a"', 'name = "a"\nartist = { levels = [[0, 1, 1, 1, 1]' + ", [0.5, 1, 1, 1, 1]" * 3 + ", [1, 1, 1, 1, 1]] }",
-     "clouds[0].artist.levels", "increase strictly"),
-    ('name = "a"', 'name = "a"\nartist = { levels = [[0, 2, 1, 1, 1], [0.25, 1, 1, 1, 1], [0.5, 1, 1, 1, 1], '
-                   '[0.75, 1, 1, 1, 1], [1, 1, 1, 1, 1]] }', "clouds[0].artist.levels", "within [0, 1]"),
+    (
+        'name = "a"',
+        'name = "a"\nartist = { levels = [[0, 1, 1, 1, 1], [1, 1, 1, 1, 1]] }',
+        "clouds[0].artist.levels",
+        "expected 5 levels",
+    ),
+    (
+        'name = "a"',
+        'name = "a"\nartist = { levels = [[0, 1, 1, 1, 1]' + ", [0.5, 1, 1, 1, 1]" * 3 + ", [1, 1, 1, 1, 1]] }",
+        "clouds[0].artist.levels",
+        "increase strictly",
+    ),
+    (
+        'name = "a"',
+        'name = "a"\nartist = { levels = [[0, 2, 1, 1, 1], [0.25, 1, 1, 1, 1], [0.5, 1, 1, 1, 1], '
+        "[0.75, 1, 1, 1, 1], [1, 1, 1, 1, 1]] }",
+        "clouds[0].artist.levels",
+        "within [0, 1]",
+    ),
     ('name = "a"', 'name = "a"\nartist = { levels = [[0, 1, 1, 1]] }', "clouds[0].artist.levels", "rows of 5"),
-    ('name = "a"', 'name = "a"\nartist = { level_percent_by_hour = [[24.0, 50.0]] }',
-     "clouds[0].artist.level_percent_by_hour", "[0, 24)"),
-    ('name = "a"', 'name = "a"\nartist = { level_percent_by_hour = [[12.0, -5.0]] }',
-     "clouds[0].artist.level_percent_by_hour", ">= 0"),
-    ('name = "a"', 'name = "a"\nartist = { directional_colour_by_hour = [[12.0, 1.0, "x", 1.0]] }',
-     "clouds[0].artist.directional_colour_by_hour", "rows of 4"),
-    ('name = "a"', 'name = "a"\nartist = { directional_range = [0.8, 0.5, 1.0] }', "clouds[0].artist.directional_range",
-     "min <= median"),
-    ('name = "a"', 'name = "a"\nartist = { directional_range = [0.1, nan, 1.0] }',
-     "clouds[0].artist.directional_range", "not finite"),
+    (
+        'name = "a"',
+        'name = "a"\nartist = { level_percent_by_hour = [[24.0, 50.0]] }',
+        "clouds[0].artist.level_percent_by_hour",
+        "[0, 24)",
+    ),
+    (
+        'name = "a"',
+        'name = "a"\nartist = { level_percent_by_hour = [[12.0, -5.0]] }',
+        "clouds[0].artist.level_percent_by_hour",
+        ">= 0",
+    ),
+    (
+        'name = "a"',
+        'name = "a"\nartist = { directional_colour_by_hour = [[12.0, 1.0, "x", 1.0]] }',
+        "clouds[0].artist.directional_colour_by_hour",
+        "rows of 4",
+    ),
+    (
+        'name = "a"',
+        'name = "a"\nartist = { directional_range = [0.8, 0.5, 1.0] }',
+        "clouds[0].artist.directional_range",
+        "min <= median",
+    ),
+    (
+        'name = "a"',
+        'name = "a"\nartist = { directional_range = [0.1, nan, 1.0] }',
+        "clouds[0].artist.directional_range",
+        "not finite",
+    ),
     ('name = "a"', 'name = "a"\nartist = { ambient = 1 }', "clouds[0].artist.ambient", "unknown key"),
     ('name = "a"', 'name = "a"\nshading_group_size = 0.0', "clouds[0].shading_group_size", "within"),
 ]
@@ -155,13 +206,16 @@ def test_a_byte_order_mark_anywhere_but_the_start_is_still_refused(tmp_path):
     assert caught.value.field == "(toml)"
 
 
-@pytest.mark.parametrize("content, problem", [
-    (None, "no such file"),
-    (b"\x93NUMPY\x01\x00", "not a readable .npy"),
-    ("truncated", "not a readable .npy"),
-    ("3 columns", "rows of 4"),
-    ("strings", "numeric array"),
-])
+@pytest.mark.parametrize(
+    "content, problem",
+    [
+        (None, "no such file"),
+        (b"\x93NUMPY\x01\x00", "not a readable .npy"),
+        ("truncated", "not a readable .npy"),
+        ("3 columns", "rows of 4"),
+        ("strings", "numeric array"),
+    ],
+)
 def test_bad_particle_files_are_refused(tmp_path, content, problem):
     npy = tmp_path / "p.npy"
     if content == "truncated":
@@ -204,11 +258,11 @@ def test_saved_document_is_plain_toml(tmp_path, small_scene):
 def test_cli_refuses_a_malformed_scene_in_one_line_with_status_2(tmp_path):
     path = tmp_path / "bad.toml"
     path.write_text(BASE.replace("20.0]", "-20.0]", 1))
-    result = subprocess.run([sys.executable, "-m", "cloudcore.cli", "shade", str(path)],
-                            capture_output=True, text=True)
+    result = subprocess.run([sys.executable, "-m", "cloudcore.cli", "shade", str(path)], capture_output=True, text=True)
     assert result.returncode == 2
     assert result.stderr.strip().splitlines() == [
-        f"cloudview: error: {path}: clouds[0].particles: radius must be > 0 (row 0 has -20.0)"]
+        f"cloudview: error: {path}: clouds[0].particles: radius must be > 0 (row 0 has -20.0)"
+    ]
     assert "Traceback" not in result.stderr
 
 
@@ -225,8 +279,11 @@ def test_sprites_and_artist_shading_round_trip(tmp_path):
     loaded = load_scene(tmp_path / "p.toml")
     assert loaded == saved
     for cloud, again in zip(clouds, loaded.clouds):
-        assert (again.sprite, again.artist, again.shading_group_size) == (cloud.sprite, cloud.artist,
-                                                                          cloud.shading_group_size)
+        assert (again.sprite, again.artist, again.shading_group_size) == (
+            cloud.sprite,
+            cloud.artist,
+            cloud.shading_group_size,
+        )
     save_scene(loaded, tmp_path / "p.toml")
     assert load_scene(tmp_path / "p.toml") == loaded
     data = tomllib.loads((tmp_path / "p.toml").read_text())

@@ -2,9 +2,9 @@
 
 import numpy as np
 import pytest
+from oracle import literal_incident_light
 
 from cloudcore.shading import incident_light, scattering_coefficient
-from oracle import literal_incident_light
 
 RNG = np.random.default_rng(20021)
 
@@ -43,8 +43,9 @@ def test_chain_reproduces_the_literal_recurrence_where_stable(tau):
         expected.append(sigma * expected[-1] + np.exp(-tau) * expected[-1])
     got = incident_light(chain(40), 1.0, tau, 0.9, [0, 1, 0])
     np.testing.assert_allclose(got, expected, rtol=1e-9)
-    np.testing.assert_allclose(got, literal_incident_light(chain(40), 1.0, tau, 0.9, [0, 1, 0], stable=False),
-                               rtol=1e-9)
+    np.testing.assert_allclose(
+        got, literal_incident_light(chain(40), 1.0, tau, 0.9, [0, 1, 0], stable=False), rtol=1e-9
+    )
 
 
 @pytest.mark.parametrize("tau", [1e-12, 1e-6, 1e-2, 1.0, 8.0, 9.3, 9.4, 50.0, 1e3, 1e6])
@@ -110,8 +111,9 @@ def test_particles_out_of_each_others_splats_are_fully_lit():
 def test_groups_shade_independently():
     a, ra = random_cloud(150, seed=1)
     b, rb = random_cloud(120, seed=2)
-    together = incident_light(np.vstack([a, b]), np.concatenate([ra, rb]), 8.0, 0.9, [0, 1, 0],
-                              groups=np.repeat([0, 1], [150, 120]))
+    together = incident_light(
+        np.vstack([a, b]), np.concatenate([ra, rb]), 8.0, 0.9, [0, 1, 0], groups=np.repeat([0, 1], [150, 120])
+    )
     np.testing.assert_allclose(together[:150], incident_light(a, ra, 8.0, 0.9, [0, 1, 0]), rtol=1e-12)
     np.testing.assert_allclose(together[150:], incident_light(b, rb, 8.0, 0.9, [0, 1, 0]), rtol=1e-12)
 
@@ -138,18 +140,21 @@ def test_raster_mode_is_finite_at_the_extremes(tau):
     assert np.all(np.isfinite(got)) and np.all((got >= 0) & (got <= 1))
 
 
-@pytest.mark.parametrize("change, message", [
-    (dict(positions=[[np.nan, 0, 0]]), "positions must be finite"),
-    (dict(positions=[[np.inf, 0, 0]]), "positions must be finite"),
-    (dict(radii=[-1.0]), "radii must be >= 0"),
-    (dict(optical_depth=[-0.1]), "optical_depth must be >= 0"),
-    (dict(optical_depth=[np.nan]), "optical_depth must be finite"),
-    (dict(albedo=[1.5]), "albedo"),
-    (dict(light_dir=[0, 0, 0]), "zero vector"),
-    (dict(light_dir=[0, np.nan, 1]), "light_dir"),
-    (dict(positions=[[0, 0]]), r"shape \(N, 3\)"),
-    (dict(radii=[1.0, 2.0]), "radii must have shape"),
-])
+@pytest.mark.parametrize(
+    "change, message",
+    [
+        (dict(positions=[[np.nan, 0, 0]]), "positions must be finite"),
+        (dict(positions=[[np.inf, 0, 0]]), "positions must be finite"),
+        (dict(radii=[-1.0]), "radii must be >= 0"),
+        (dict(optical_depth=[-0.1]), "optical_depth must be >= 0"),
+        (dict(optical_depth=[np.nan]), "optical_depth must be finite"),
+        (dict(albedo=[1.5]), "albedo"),
+        (dict(light_dir=[0, 0, 0]), "zero vector"),
+        (dict(light_dir=[0, np.nan, 1]), "light_dir"),
+        (dict(positions=[[0, 0]]), r"shape \(N, 3\)"),
+        (dict(radii=[1.0, 2.0]), "radii must have shape"),
+    ],
+)
 def test_bad_input_raises_value_error_with_a_message(change, message):
     arguments = dict(positions=[[0.0, 0.0, 0.0]], radii=[1.0], optical_depth=[8.0], albedo=[0.9], light_dir=[0, 1, 0])
     arguments.update(change)

@@ -4,6 +4,7 @@ import math
 
 import numpy as np
 import pytest
+from conftest import VALLEY
 
 from cloudcore.frameplan import LodState, plan_frame
 from cloudcore.lod_units import LodUnits
@@ -12,7 +13,6 @@ from cloudcore.scene import Camera
 from cloudcore.scenefile import load_scene
 from cloudcore.settings import RenderSettings
 from cloudcore.splitting import layer_of
-from conftest import VALLEY
 
 VIEWPORT = (640, 480)
 RNG = np.random.default_rng(5)
@@ -29,8 +29,9 @@ def pose(position, radius=5.0) -> ObjectPose:
 
 
 def plan(camera, objects, settings=RenderSettings(mode="full"), records=None, particles=lambda _: PARTICLES):
-    units = LodUnits.of_spheres(CENTRE, RADIUS, particle_counts=[len(PARTICLES)],
-                                radius_squares=[len(PARTICLES) * 25.0])
+    units = LodUnits.of_spheres(
+        CENTRE, RADIUS, particle_counts=[len(PARTICLES)], radius_squares=[len(PARTICLES) * 25.0]
+    )
     return plan_frame(units, camera, VIEWPORT, settings, LodState(records or {}), 1, objects, particles)
 
 
@@ -113,8 +114,9 @@ def test_a_scene_without_objects_in_clouds_looks_at_no_particle():
         frame = plan(camera, outside, RenderSettings(mode=mode), particles=refuse)
         assert frame.objects_with_world == (0,) and frame.objects_between_layers == ()
         assert frame.stats()["layers_drawn"] == 0
-    no_split = plan(camera, (pose((0.0, 0.0, 0.0)),), RenderSettings(mode="full", split_objects=False),
-                    particles=refuse)
+    no_split = plan(
+        camera, (pose((0.0, 0.0, 0.0)),), RenderSettings(mode="full", split_objects=False), particles=refuse
+    )
     assert no_split.objects_with_world == (0,) and no_split.clouds[0].layers == 1
 
 
@@ -127,8 +129,16 @@ def test_an_object_behind_the_camera_is_not_drawn_but_still_splits():
 
 def test_objects_in_an_empty_or_zero_radius_cloud_are_finite():
     camera = Camera((0.0, 0.0, 700.0), (0.0, 0.0, 0.0), 50.0)
-    frame = plan_frame(LodUnits.of_spheres(np.zeros((1, 3)), np.zeros(1)), camera, VIEWPORT, RenderSettings(),
-                       LodState(), 1, (pose((0.0, 0.0, 0.0), radius=0.0),), lambda _: np.zeros((0, 3)))
+    frame = plan_frame(
+        LodUnits.of_spheres(np.zeros((1, 3)), np.zeros(1)),
+        camera,
+        VIEWPORT,
+        RenderSettings(),
+        LodState(),
+        1,
+        (pose((0.0, 0.0, 0.0), radius=0.0),),
+        lambda _: np.zeros((0, 3)),
+    )
     assert frame.clouds[0].kind == "empty" and frame.objects_with_world == (0,)
 
 
@@ -140,8 +150,12 @@ def test_no_frame_of_the_default_flythrough_has_a_layer_order_error():
     path = scene.camera_path("flythrough")
     from cloudcore.paths import camera_on_path
 
-    units = LodUnits.of_spheres(centres, radii, particle_counts=[len(c.particles) for c in scene.clouds],
-                                radius_squares=[float(np.sum(c.radii ** 2)) for c in scene.clouds])
+    units = LodUnits.of_spheres(
+        centres,
+        radii,
+        particle_counts=[len(c.particles) for c in scene.clouds],
+        radius_squares=[float(np.sum(c.radii**2)) for c in scene.clouds],
+    )
     state, split_frames, errors = LodState(), 0, []
     settings = RenderSettings()
     for frame_index in range(int(path.duration * 30) + 1):
@@ -151,7 +165,14 @@ def test_no_frame_of_the_default_flythrough_has_a_layer_order_error():
         frame = plan_frame(units, camera, VIEWPORT, settings, state, 1, poses, lambda i: scene.clouds[i].centres)
         state = frame.state
         split_frames += bool(frame.objects_between_layers)
-        errors += [f"t={t:.2f}: {e}" for e in layer_order_errors(
-            frame, np.array([p.centre for p in poses]), np.asarray(camera.position), lambda i: scene.clouds[i].centres)]
+        errors += [
+            f"t={t:.2f}: {e}"
+            for e in layer_order_errors(
+                frame,
+                np.array([p.centre for p in poses]),
+                np.asarray(camera.position),
+                lambda i: scene.clouds[i].centres,
+            )
+        ]
     assert errors == []
     assert split_frames > 100, "the aircraft should cross a drawn cloud for seconds of the path"

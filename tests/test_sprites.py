@@ -5,9 +5,22 @@ import pytest
 
 from cloudcore.errors import FieldError
 from cloudcore.sprite_art import render_atlas
-from cloudcore.sprites import (ATLAS_GRID, ATLAS_MAX_MIP_LEVEL, CELL_MARGIN_PIXELS, CELL_PIXELS, FLAT_BOTTOM,
-                               FOGGY, PUFFY, ROWS, WISPY, SpriteStyle, atlas_cell_uv, load_atlas, particle_sprites,
-                               sprite_choices)
+from cloudcore.sprites import (
+    ATLAS_GRID,
+    ATLAS_MAX_MIP_LEVEL,
+    CELL_MARGIN_PIXELS,
+    CELL_PIXELS,
+    FLAT_BOTTOM,
+    FOGGY,
+    PUFFY,
+    ROWS,
+    WISPY,
+    SpriteStyle,
+    atlas_cell_uv,
+    load_atlas,
+    particle_sprites,
+    sprite_choices,
+)
 
 
 def cells(atlas: np.ndarray) -> np.ndarray:
@@ -74,7 +87,7 @@ def test_cell_coordinates_run_from_the_top_left():
     atlas = load_atlas()
     u0, v0, u1, v1 = atlas_cell_uv(FLAT_BOTTOM * ATLAS_GRID + 2)
     side = atlas.shape[0]
-    cell = atlas[int(v0 * side):int(v1 * side), int(u0 * side):int(u1 * side)]
+    cell = atlas[int(v0 * side) : int(v1 * side), int(u0 * side) : int(u1 * side)]
     np.testing.assert_array_equal(cell, cells(atlas)[FLAT_BOTTOM, 2])
     for bad in (-1, 16, 2.0, True):
         with pytest.raises(ValueError, match="cell index"):
@@ -122,19 +135,22 @@ def test_the_base_of_the_cloud_draws_flat_bottoms_with_a_narrow_rotation():
         sprite_choices(style, 10)
 
 
-@pytest.mark.parametrize("change, field", [
-    (dict(rows=()), "rows"),
-    (dict(rows=(4,)), "rows"),
-    (dict(rows=(True,)), "rows"),
-    (dict(rotation_deg=(10.0, 0.0)), "rotation_deg"),
-    (dict(rotation_deg=(0.0, 361.0)), "rotation_deg"),
-    (dict(rotation_deg=(0.0, np.inf)), "rotation_deg"),
-    (dict(flat_bottom_rotation_deg=(5.0, -5.0)), "flat_bottom_rotation_deg"),
-    (dict(facing="up"), "facing"),
-    (dict(seed=-1), "seed"),
-    (dict(seed=2**31), "seed"),
-    (dict(flat_bottom_fraction=1.5), "flat_bottom_fraction"),
-])
+@pytest.mark.parametrize(
+    "change, field",
+    [
+        (dict(rows=()), "rows"),
+        (dict(rows=(4,)), "rows"),
+        (dict(rows=(True,)), "rows"),
+        (dict(rotation_deg=(10.0, 0.0)), "rotation_deg"),
+        (dict(rotation_deg=(0.0, 361.0)), "rotation_deg"),
+        (dict(rotation_deg=(0.0, np.inf)), "rotation_deg"),
+        (dict(flat_bottom_rotation_deg=(5.0, -5.0)), "flat_bottom_rotation_deg"),
+        (dict(facing="up"), "facing"),
+        (dict(seed=-1), "seed"),
+        (dict(seed=2**31), "seed"),
+        (dict(flat_bottom_fraction=1.5), "flat_bottom_fraction"),
+    ],
+)
 def test_bad_styles_are_refused_naming_the_field(change, field):
     with pytest.raises(FieldError) as caught:
         SpriteStyle(**change)

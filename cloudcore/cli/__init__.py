@@ -22,13 +22,16 @@ class _OneLineParser(argparse.ArgumentParser):
 
 def version_line() -> str:
     """`cloudview --version`: ours, then the Python and the libraries that decide whether it runs."""
+
     def installed(name: str) -> str:
         try:
             return metadata.version(name)
         except metadata.PackageNotFoundError:
             return "not installed"
-    libraries = ", ".join(f"{name} {installed(name)}" for name in ("pyrender-maintained", "PyOpenGL", "numpy",
-                                                                    "imgui-bundle"))
+
+    libraries = ", ".join(
+        f"{name} {installed(name)}" for name in ("pyrender-maintained", "PyOpenGL", "numpy", "imgui-bundle")
+    )
     return f"cloudview {installed('cloudview')} (Python {platform.python_version()}; {libraries})"
 
 
@@ -36,8 +39,11 @@ def build_parser() -> tuple[argparse.ArgumentParser, argparse._SubParsersAction]
     from cloudcore.cli import bench, compare, record, render, shade
 
     # raw text: the version stays one line however narrow the terminal
-    parser = _OneLineParser(prog="cloudview", description="Real-time volumetric particle clouds.",
-                            formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = _OneLineParser(
+        prog="cloudview",
+        description="Real-time volumetric particle clouds.",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     parser.add_argument("--version", action="version", version=version_line())
     commands = parser.add_subparsers(dest="command", parser_class=_OneLineParser, metavar="COMMAND")
     shade.add_parser(commands)
@@ -67,9 +73,11 @@ def main(argv=None) -> int:
 def _editor(argv: list[str]) -> int:
     """`cloudview [SCENE]`: the editor window (imported only here: headless commands never load the GUI)."""
     if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
-        print("cloudview: error: the editor needs a display (none is set); on a headless machine try "
-              "`xvfb-run -a cloudview`, or the headless commands: cloudview render|record|bench|compare --help",
-              file=sys.stderr)
+        print(
+            "cloudview: error: the editor needs a display (none is set); on a headless machine try "
+            "`xvfb-run -a cloudview`, or the headless commands: cloudview render|record|bench|compare --help",
+            file=sys.stderr,
+        )
         return 2
     from app.main import main as editor_main
 

@@ -27,22 +27,34 @@ def add_parser(commands) -> None:
     views = parser.add_mutually_exclusive_group(required=True)
     views.add_argument("--path", help="camera path of the scene to fly")
     views.add_argument("--still", action="store_true", help="the scene's camera, still, for --frames frames")
-    views.add_argument("--orbit", type=float, metavar="DEG",
-                       help="the scene's camera orbiting its look-at point DEG degrees a frame")
+    views.add_argument(
+        "--orbit", type=float, metavar="DEG", help="the scene's camera orbiting its look-at point DEG degrees a frame"
+    )
     parser.add_argument("--json", required=True, type=Path, help="report to write")
-    parser.add_argument("--sweep", action="append", type=parse_sweep, default=[],
-                        help=f"NAME=V1,V2,... with NAME one of {', '.join(SWEEPABLE)}; "
-                             "several --sweep options combine")
+    parser.add_argument(
+        "--sweep",
+        action="append",
+        type=parse_sweep,
+        default=[],
+        help=f"NAME=V1,V2,... with NAME one of {', '.join(SWEEPABLE)}; several --sweep options combine",
+    )
     parser.add_argument("--frames", type=int, default=60, help="frames spread along the path (default 60)")
-    parser.add_argument("--warmup", type=int, default=0,
-                        help="unmeasured frames of the first view before each run: 20 build a still view's "
-                             "impostors and ring (default %(default)s)")
+    parser.add_argument(
+        "--warmup",
+        type=int,
+        default=0,
+        help="unmeasured frames of the first view before each run: 20 build a still view's "
+        "impostors and ring (default %(default)s)",
+    )
     parser.add_argument("--width", type=pixel_count, default=640)
     parser.add_argument("--height", type=pixel_count, default=480)
     parser.add_argument("--plot", type=Path, help="write the error-against-time plot here (PNG)")
     parser.add_argument("--no-shading", action="store_true", help="skip the shading precompute comparison")
-    parser.add_argument("--without-terrain", action="store_true",
-                        help="fly the scene without its terrain: the whole frame is then the sky and the clouds")
+    parser.add_argument(
+        "--without-terrain",
+        action="store_true",
+        help="fly the scene without its terrain: the whole frame is then the sky and the clouds",
+    )
     add_settings_arguments(parser)
     parser.set_defaults(run=run)
 
@@ -62,23 +74,41 @@ def run(args) -> int:
         raise SceneError("--warmup", "warmup", f"must be >= 0, got {args.warmup}")
     if args.orbit is not None and not abs(args.orbit) < 360.0:
         raise SceneError("--orbit", "orbit", f"must be within (-360, 360) degrees a frame, got {args.orbit}")
-    views = (still_views(scene, args.frames) if args.still else orbit_views(scene, args.frames, args.orbit)
-             if args.orbit is not None else None)
+    views = (
+        still_views(scene, args.frames)
+        if args.still
+        else orbit_views(scene, args.frames, args.orbit)
+        if args.orbit is not None
+        else None
+    )
     motion = "still" if args.still else f"orbit {args.orbit:g} deg/frame" if args.orbit is not None else args.path
     base = settings_from(args)
     fields = [field for field, _ in args.sweep]
-    settings_list = [settings_from(args, **dict(zip(fields, values)))
-                     for values in itertools.product(*(values for _, values in args.sweep))] or [base]
+    settings_list = [
+        settings_from(args, **dict(zip(fields, values)))
+        for values in itertools.product(*(values for _, values in args.sweep))
+    ] or [base]
 
     os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
     from tqdm import tqdm
 
     from cloudcore.gl import FrameRenderer
 
-    with FrameRenderer(args.width, args.height) as renderer, \
-            tqdm(total=(args.frames + args.warmup) * (1 + len(settings_list)), unit="frame", desc="bench") as bar:
-        report = bench_path(renderer, scene, args.path, args.frames, settings_list, (args.width, args.height),
-                            progress=bar.update, views=views, warmup=args.warmup)
+    with (
+        FrameRenderer(args.width, args.height) as renderer,
+        tqdm(total=(args.frames + args.warmup) * (1 + len(settings_list)), unit="frame", desc="bench") as bar,
+    ):
+        report = bench_path(
+            renderer,
+            scene,
+            args.path,
+            args.frames,
+            settings_list,
+            (args.width, args.height),
+            progress=bar.update,
+            views=views,
+            warmup=args.warmup,
+        )
     report["path"] = motion
     report["scene"] = str(args.scene)
     report["without_terrain"] = args.without_terrain
@@ -89,10 +119,12 @@ def run(args) -> int:
     print(f"full 3D: {reference['frame_ms_mean']:.1f} ms mean, {reference['frame_ms_p95']:.1f} ms p95")
     for run_ in report["runs"]:
         changed = {k: v for k, v in run_["settings"].items() if v != dataclasses.asdict(base)[k]}
-        print(f"{changed or run_['settings']['mode']}: {run_['frame_ms_mean']:.1f} ms "
-              f"(x{run_['speedup_vs_full']:.2f} frame, x{run_['cloud_speedup_vs_full']:.2f} clouds), "
-              f"PSNR mean {run_['psnr_mean']:.2f} dB, min {run_['psnr_min']:.2f} dB, "
-              f"{run_['regenerations_per_frame']:.2f} regenerations a frame")
+        print(
+            f"{changed or run_['settings']['mode']}: {run_['frame_ms_mean']:.1f} ms "
+            f"(x{run_['speedup_vs_full']:.2f} frame, x{run_['cloud_speedup_vs_full']:.2f} clouds), "
+            f"PSNR mean {run_['psnr_mean']:.2f} dB, min {run_['psnr_min']:.2f} dB, "
+            f"{run_['regenerations_per_frame']:.2f} regenerations a frame"
+        )
     if args.plot:
         plot_error_against_time(report, args.plot)
     print(f"wrote {args.json}" + (f" and {args.plot}" if args.plot else ""))
@@ -112,15 +144,21 @@ def plot_error_against_time(report: dict, path: Path) -> None:
     front = sorted(pareto_front(seconds, errors), key=lambda i: seconds[i])
     figure, axes = plt.subplots(figsize=(6.4, 4.2), dpi=120)
     axes.scatter(seconds, errors, color="tab:blue", zorder=3, label="settings")
-    axes.plot([seconds[i] for i in front], [errors[i] for i in front], color="tab:orange", zorder=2,
-              label="Pareto front")
+    axes.plot(
+        [seconds[i] for i in front], [errors[i] for i in front], color="tab:orange", zorder=2, label="Pareto front"
+    )
     for run_, x, y in zip(runs, seconds, errors):
         settings = run_["settings"]
         budget = settings["regeneration_budget"] or "none"
-        axes.annotate(f"{settings['mode']} tol {settings['tolerance_deg']:g} budget {budget}"
-                      f"\nring {settings['ring_radius']:g} max {settings['impostor_max_size']}"
-                      f" detail {settings['impostor_detail_texels']:g}", (x, y), fontsize=6, textcoords="offset points",
-                      xytext=(4, 4))
+        axes.annotate(
+            f"{settings['mode']} tol {settings['tolerance_deg']:g} budget {budget}"
+            f"\nring {settings['ring_radius']:g} max {settings['impostor_max_size']}"
+            f" detail {settings['impostor_detail_texels']:g}",
+            (x, y),
+            fontsize=6,
+            textcoords="offset points",
+            xytext=(4, 4),
+        )
     axes.axvline(report["reference"]["frame_ms_mean"], color="grey", linestyle="--", label="full 3D (error 0)")
     axes.set_xlabel("mean frame time (ms)")
     axes.set_ylabel("mean |difference| from full 3D (8-bit levels)")

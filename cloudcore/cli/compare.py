@@ -26,10 +26,16 @@ def add_parser(commands) -> None:
     parser = commands.add_parser("compare", help="compare two images: PSNR, mean and max difference")
     parser.add_argument("a", type=Path, metavar="A.png", help="first image (PNG, 8- or 16-bit)")
     parser.add_argument("b", type=Path, metavar="B.png", help="second image, the same size")
-    parser.add_argument("--tolerance-psnr", type=decibels, default=DEFAULT_TOLERANCE_DB, metavar="DB",
-                        help=f"lowest PSNR that passes (default {DEFAULT_TOLERANCE_DB:g} dB)")
-    parser.add_argument("--diff", type=Path, metavar="OUT.png",
-                        help="write the amplified per-pixel difference here (red on black)")
+    parser.add_argument(
+        "--tolerance-psnr",
+        type=decibels,
+        default=DEFAULT_TOLERANCE_DB,
+        metavar="DB",
+        help=f"lowest PSNR that passes (default {DEFAULT_TOLERANCE_DB:g} dB)",
+    )
+    parser.add_argument(
+        "--diff", type=Path, metavar="OUT.png", help="write the amplified per-pixel difference here (red on black)"
+    )
     parser.set_defaults(run=run)
 
 
@@ -44,8 +50,7 @@ def decibels(text: str) -> float:
 def run(args) -> int:
     a, b = load_rgb8(args.a), load_rgb8(args.b)
     if a.shape != b.shape:
-        raise SceneError(args.b, "(size)", f"is {b.shape[1]}x{b.shape[0]}, "
-                                           f"but {args.a} is {a.shape[1]}x{a.shape[0]}")
+        raise SceneError(args.b, "(size)", f"is {b.shape[1]}x{b.shape[0]}, but {args.a} is {a.shape[1]}x{a.shape[0]}")
     difference = compare(a, b)
     if args.diff:
         import imageio.v3 as iio

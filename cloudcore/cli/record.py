@@ -36,8 +36,11 @@ def add_parser(commands) -> None:
     parser.add_argument("--frames", type=frame_count, help="record only the first N frames")
     parser.add_argument("--width", type=pixel_count, default=640)
     parser.add_argument("--height", type=pixel_count, default=480)
-    parser.add_argument("--no-overdraw", action="store_true",
-                        help="leave the overdraw columns empty (measuring replays each frame's cloud draws)")
+    parser.add_argument(
+        "--no-overdraw",
+        action="store_true",
+        help="leave the overdraw columns empty (measuring replays each frame's cloud draws)",
+    )
     # many frames: impostors pay off
     add_settings_arguments(parser, default_mode="auto")
     parser.set_defaults(run=run)
@@ -63,8 +66,9 @@ def run(args) -> int:
     if args.out is None and args.frames_dir is None:
         raise SceneError("record", "output", "give --out FILE.mp4, --frames-dir DIR, or both")
     if args.out is not None and (args.width % 2 or args.height % 2):
-        raise SceneError(str(args.out), "size", f"H.264 (yuv420p) needs an even width and height, "
-                                                f"got {args.width}x{args.height}")
+        raise SceneError(
+            str(args.out), "size", f"H.264 (yuv420p) needs an even width and height, got {args.width}x{args.height}"
+        )
     scene = load_scene(args.scene)
     try:
         path = scene.camera_path(args.path)
@@ -111,8 +115,10 @@ def run(args) -> int:
             if stop.requested:
                 break
     written = ", ".join(str(p) for p in (args.out, args.frames_dir, args.stats) if p)
-    summary = (f"{len(frame_ms)} frames ({len(frame_ms) / args.fps:.2f} s at {args.fps:g} fps, "
-               f"{args.width}x{args.height}) to {written}; frame {sum(frame_ms) / len(frame_ms):.1f} ms mean")
+    summary = (
+        f"{len(frame_ms)} frames ({len(frame_ms) / args.fps:.2f} s at {args.fps:g} fps, "
+        f"{args.width}x{args.height}) to {written}; frame {sum(frame_ms) / len(frame_ms):.1f} ms mean"
+    )
     if stop.requested:
         print(f"cloudview: interrupted: wrote {summary}", file=sys.stderr)
         return 130
@@ -147,8 +153,9 @@ def _video(path: Path, size: tuple[int, int], fps: float):
     import imageio_ffmpeg
 
     # macro_block_size 2: sizes are even, so imageio-ffmpeg never rescales the frames
-    writer = imageio_ffmpeg.write_frames(str(path), size, fps=fps, codec="libx264", pix_fmt_out="yuv420p",
-                                         macro_block_size=2)
+    writer = imageio_ffmpeg.write_frames(
+        str(path), size, fps=fps, codec="libx264", pix_fmt_out="yuv420p", macro_block_size=2
+    )
     writer.send(None)  # starts ffmpeg
     try:
         yield writer

@@ -34,8 +34,9 @@ def add_parser(commands) -> None:
 
 def add_scene_argument(parser) -> None:
     """The optional SCENE argument: without it, the built-in default scene (shipped in the package)."""
-    parser.add_argument("scene", nargs="?", default=str(DEFAULT_SCENE),
-                        help="scene file (.toml); default: the built-in valley scene")
+    parser.add_argument(
+        "scene", nargs="?", default=str(DEFAULT_SCENE), help="scene file (.toml); default: the built-in valley scene"
+    )
 
 
 def pixel_count(text: str) -> int:
@@ -75,14 +76,18 @@ def run(args) -> int:
         _write(args.overdraw, lambda path: iio.imwrite(path, heat_image(counts)[0][..., :3]))
     if args.stats:
         _write(args.stats, lambda path: path.write_text(json.dumps(stats, indent=2) + "\n"))
-    print(f"wrote {args.out} ({args.width}x{args.height}): frame {stats['frame_ms']:.1f} ms "
-          f"(world {stats['world_ms']:.1f}, clouds {stats['cloud_ms']:.1f}), "
-          f"{stats['particles_drawn']} particles, {stats['clouds_drawn']} clouds drawn, "
-          f"{stats['clouds_culled']} culled")
+    print(
+        f"wrote {args.out} ({args.width}x{args.height}): frame {stats['frame_ms']:.1f} ms "
+        f"(world {stats['world_ms']:.1f}, clouds {stats['cloud_ms']:.1f}), "
+        f"{stats['particles_drawn']} particles, {stats['clouds_drawn']} clouds drawn, "
+        f"{stats['clouds_culled']} culled"
+    )
     if "overdraw_mean" in stats:
-        print(f"overdraw: mean {stats['overdraw_mean']:.2f}, max {stats['overdraw_max']:.0f} "
-              f"(analytic estimate {stats['overdraw_analytic']:.2f}); cloud blocks: mean "
-              f"{stats['block_overdraw_mean']:.2f}, max {stats['block_overdraw_max']:.2f} over {stats['blocks']}")
+        print(
+            f"overdraw: mean {stats['overdraw_mean']:.2f}, max {stats['overdraw_max']:.0f} "
+            f"(analytic estimate {stats['overdraw_analytic']:.2f}); cloud blocks: mean "
+            f"{stats['block_overdraw_mean']:.2f}, max {stats['block_overdraw_max']:.2f} over {stats['blocks']}"
+        )
     return 0
 
 

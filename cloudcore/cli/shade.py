@@ -24,8 +24,10 @@ def run(args) -> int:
     scene = load_scene(args.scene)
     lights, _ = scene_lights(scene.lighting)
     lights = active_lights(lights)
-    print(f"{args.scene}: {len(scene.clouds)} clouds, {scene.particle_count} particles, "
-          f"{len(lights)} active light(s), method {args.method}")
+    print(
+        f"{args.scene}: {len(scene.clouds)} clouds, {scene.particle_count} particles, "
+        f"{len(lights)} active light(s), method {args.method}"
+    )
     print(f"{'cloud':<16}{'particles':>10}{'ms':>10}   incident light min / mean / max per light")
     rows, total = [], 0.0
     # the bar appears only on a terminal, and only once shading has taken a second
@@ -36,8 +38,7 @@ def run(args) -> int:
         total += elapsed
         rows.append((cloud, elapsed, incident))
     for cloud, elapsed, incident in rows:
-        summary = "  ".join(f"{c.min():.3f} / {c.mean():.3f} / {c.max():.3f}" if c.size else "-"
-                            for c in incident.T)
+        summary = "  ".join(f"{c.min():.3f} / {c.mean():.3f} / {c.max():.3f}" if c.size else "-" for c in incident.T)
         print(f"{cloud.name:<16}{len(cloud.particles):>10}{1e3 * elapsed:>10.1f}   {summary}")
     rate = scene.particle_count * max(len(lights), 1) / total if total > 0 else float("inf")
     print(f"total {total:.2f} s ({rate:,.0f} particle-lights per second)")

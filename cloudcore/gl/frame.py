@@ -33,7 +33,6 @@ from cloudcore.colour import linear_to_srgb8
 from cloudcore.eye_scattering import ParticleShading
 from cloudcore.facing import CloudFacings
 from cloudcore.formation import formation_state
-from cloudcore.illumination import IlluminationCache
 from cloudcore.frameplan import FramePlan, LodState, inside_runs, plan_frame
 from cloudcore.gl.context import HeadlessContext, WindowContext, check_frame_size
 from cloudcore.gl.impostor_store import ImpostorStore
@@ -43,6 +42,7 @@ from cloudcore.gl.quads import SCREEN_CORNERS, QuadPass
 from cloudcore.gl.splats import SplatPass, splat_batch
 from cloudcore.gl.targets import TextureTarget, blit_depth, depth_renderbuffer
 from cloudcore.gl.world import WorldPass
+from cloudcore.illumination import IlluminationCache
 from cloudcore.lighting import scene_hour, scene_lights, sky_colors
 from cloudcore.lod_costs import CostModel
 from cloudcore.lod_units import LodUnits, lod_units
@@ -94,10 +94,18 @@ class FrameRenderer:
     def size(self) -> tuple[int, int]:
         return self.context.width, self.context.height
 
-    def render(self, scene: Scene, *, time_of_day: float | None = None, camera: Camera | None = None,
-               illumination_method: str = "exact", settings: RenderSettings = RenderSettings(),
-               time_s: float = 0.0, read_back: bool = True,
-               costs: CostModel | None = None) -> tuple[np.ndarray | None, dict]:
+    def render(
+        self,
+        scene: Scene,
+        *,
+        time_of_day: float | None = None,
+        camera: Camera | None = None,
+        illumination_method: str = "exact",
+        settings: RenderSettings = RenderSettings(),
+        time_s: float = 0.0,
+        read_back: bool = True,
+        costs: CostModel | None = None,
+    ) -> tuple[np.ndarray | None, dict]:
         """(sRGB uint8 (height, width, 3), stats); `time_of_day` and `camera` override the scene's.
 
         Auto mode prices its choices with the cost model fitted to the frames rendered so far, or
@@ -108,24 +116,37 @@ class FrameRenderer:
         With `read_back=False` the image stays on the GPU (None is returned in its place): the
         editor shows it through `display_texture`.
         """
-        lighting = scene.lighting if time_of_day is None else dataclasses.replace(
-            scene.lighting, time_of_day=time_of_day)
+        lighting = (
+            scene.lighting if time_of_day is None else dataclasses.replace(scene.lighting, time_of_day=time_of_day)
+        )
         camera = scene.camera if camera is None else camera
         stats = {"illumination_ms": self._prepare(scene, lighting, illumination_method)}
         particles = self._particles
         poses = self._objects.poses(time_s) if self._objects is not None else ()
         starts = particles.cloud_starts
         # a forming or dissipating cloud's colours change with the clock too: its impostor is stale meanwhile
-        cloud_keys = tuple((key, formation_state(cloud.formation, time_s))
-                           for key, cloud in zip(self._lighting_keys, scene.clouds))
+        cloud_keys = tuple(
+            (key, formation_state(cloud.formation, time_s)) for key, cloud in zip(self._lighting_keys, scene.clouds)
+        )
         # the units follow the particles' places and sizes, not their light: a relit scene keeps them
         if (scene.clouds, settings.group_clouds) != self._units_source:
             self._units = lod_units(particles, settings.group_clouds)
             self._units_source = (scene.clouds, settings.group_clouds)
-        plan = plan_frame(self._units, camera, self.size, settings, self.lod_state, cloud_keys, poses,
-                          lambda cloud: particles.centres[starts[cloud]:starts[cloud + 1]], costs,
-                          lambda cloud: (particles.centres[starts[cloud]:starts[cloud + 1]],
-                                         particles.radii[starts[cloud]:starts[cloud + 1]]))
+        plan = plan_frame(
+            self._units,
+            camera,
+            self.size,
+            settings,
+            self.lod_state,
+            cloud_keys,
+            poses,
+            lambda cloud: particles.centres[starts[cloud] : starts[cloud + 1]],
+            costs,
+            lambda cloud: (
+                particles.centres[starts[cloud] : starts[cloud + 1]],
+                particles.radii[starts[cloud] : starts[cloud + 1]],
+            ),
+        )
         self.last_plan = plan
 
         view = view_matrix(camera)
@@ -148,15 +169,20 @@ class FrameRenderer:
         drawn = self._draw_clouds(plan, particles, camera, view, projection, settings, poses, time_s)
         GL.glFinish()
         done = time.perf_counter()
-        self.lod_state = plan.state.measured([(plan.update_work, 1e3 * (updates_done - world_done)),
-                                              (plan.cloud_work, 1e3 * (done - updates_done))])
+        self.lod_state = plan.state.measured(
+            [(plan.update_work, 1e3 * (updates_done - world_done)), (plan.cloud_work, 1e3 * (done - updates_done))]
+        )
         stats |= plan.stats() | {
-            "frame_ms": 1e3 * (done - start), "world_ms": 1e3 * (world_done - start),
-            "impostor_update_ms": 1e3 * (updates_done - world_done), "cloud_ms": 1e3 * (done - updates_done),
-            "particles_drawn": drawn, "particles_to_impostors": rendered,
+            "frame_ms": 1e3 * (done - start),
+            "world_ms": 1e3 * (world_done - start),
+            "impostor_update_ms": 1e3 * (updates_done - world_done),
+            "cloud_ms": 1e3 * (done - updates_done),
+            "particles_drawn": drawn,
+            "particles_to_impostors": rendered,
             "clouds_drawn": sum(len(plan.clouds[i].members) for i in plan.draw_order),
             "clouds_culled": sum(len(c.members) for c in plan.of_kind("culled")),
-            "texture_bytes": self.texture_bytes}
+            "texture_bytes": self.texture_bytes,
+        }
         return (linear_to_srgb8(self.context.read_linear_rgb()) if read_back else None), stats
 
     def display_texture(self) -> int:
@@ -225,15 +251,26 @@ class FrameRenderer:
         if particles_source == self._particles_source:
             return 0.0
         start = time.perf_counter()
-        self._particles = ParticleShading(scene.clouds, scene.shading, lights, ambient, illumination_method,
-                                          self._illumination, particle_styles(scene.clouds, lighting))
+        self._particles = ParticleShading(
+            scene.clouds,
+            scene.shading,
+            lights,
+            ambient,
+            illumination_method,
+            self._illumination,
+            particle_styles(scene.clouds, lighting),
+        )
         self._facings = CloudFacings(self._particles)
-        old_clouds, old_lighting = ((), None) if self._particles_source is None else (
-            self._particles_source[0], self._particles_source[1:])
+        old_clouds, old_lighting = (
+            ((), None) if self._particles_source is None else (self._particles_source[0], self._particles_source[1:])
+        )
         same_lighting = old_lighting == particles_source[1:]
         self._lighting_keys = tuple(
-            self._lighting_keys[i] if same_lighting and i < len(old_clouds) and old_clouds[i] is cloud
-            else self._next_key() for i, cloud in enumerate(scene.clouds))
+            self._lighting_keys[i]
+            if same_lighting and i < len(old_clouds) and old_clouds[i] is cloud
+            else self._next_key()
+            for i, cloud in enumerate(scene.clouds)
+        )
         self._particles_source = particles_source
         return 1e3 * (time.perf_counter() - start)
 
@@ -241,8 +278,17 @@ class FrameRenderer:
         self._key_serial += 1
         return self._key_serial
 
-    def _draw_clouds(self, plan: FramePlan, particles: ParticleShading, camera: Camera, view, projection,
-                     settings: RenderSettings, poses, time_s: float) -> int:
+    def _draw_clouds(
+        self,
+        plan: FramePlan,
+        particles: ParticleShading,
+        camera: Camera,
+        view,
+        projection,
+        settings: RenderSettings,
+        poses,
+        time_s: float,
+    ) -> int:
         """Execute the plan's cloud pass into the frame target at scene time `time_s`; returns the particles drawn."""
         eye = camera.position
         view_projection = projection @ view
@@ -257,19 +303,20 @@ class FrameRenderer:
             self._screen_batches.append(batch)
             return len(batch)
 
-        def draw_quad(corners, texture, weight, *, screen: bool = False, uv_rect=(0.0, 0.0, 1.0, 1.0),
-                      **layer) -> None:
+        def draw_quad(corners, texture, weight, *, screen: bool = False, uv_rect=(0.0, 0.0, 1.0, 1.0), **layer) -> None:
             """A world-space quad, depth-tested; or with `screen`, clip-space corners over everything."""
             matrix, depth_test = (np.eye(4), False) if screen else (view_projection, True)
             self._quads.draw(corners, matrix, texture, weight, depth_test=depth_test, uv_rect=uv_rect, **layer)
-            self._replay.append(lambda: self._quads.draw(corners, matrix, 0, 1.0, depth_test=depth_test,
-                                                         counting=True, uv_rect=uv_rect))
+            self._replay.append(
+                lambda: self._quads.draw(corners, matrix, 0, 1.0, depth_test=depth_test, counting=True, uv_rect=uv_rect)
+            )
 
         if plan.ring is not None:
             for generation, weight in plan.ring.draws:
                 for segment in generation.occupied_segments:
-                    target, corners, extent = self._impostors.ring_panel(generation, segment,
-                                                                         settings.ring_elevation_deg)
+                    target, corners, extent = self._impostors.ring_panel(
+                        generation, segment, settings.ring_elevation_deg
+                    )
                     draw_quad(corners, target.texture, weight, uv_rect=extent)
 
         full_run = []  # (cloud, (near, far)) of consecutive full-3D layers: they interpenetrate, sorted together
@@ -294,14 +341,24 @@ class FrameRenderer:
                 layer.bind_cleared()
                 drawn += draw_splats(cloud.members, [(item.near, item.far)] * len(cloud.members))
                 self.context.bind_target()
-                draw_quad(corners, target.texture, cloud.impostor_weight, uv_rect=extent,
-                          layer_texture=layer.texture, layer_weight=cloud.full_weight)
+                draw_quad(
+                    corners,
+                    target.texture,
+                    cloud.impostor_weight,
+                    uv_rect=extent,
+                    layer_texture=layer.texture,
+                    layer_weight=cloud.full_weight,
+                )
             elif cloud.kind == "inside" and id(item) in screen_impostors:
                 target = self._inside_target(plan.inside_size)
                 target.bind_cleared()
-                members, depth_ranges = zip(*[(member, (run_item.near, run_item.far))
-                                              for run_item in screen_impostors[id(item)]
-                                              for member in plan.clouds[run_item.index].members])
+                members, depth_ranges = zip(
+                    *[
+                        (member, (run_item.near, run_item.far))
+                        for run_item in screen_impostors[id(item)]
+                        for member in plan.clouds[run_item.index].members
+                    ]
+                )
                 batch = splat_batch(particles, members, eye, depth_ranges, time_s, frustum)
                 self._splats.draw(batch, view, projection)
                 drawn += len(batch)
@@ -344,14 +401,17 @@ class FrameRenderer:
             raise RuntimeError("render a frame before measuring its overdraw")
         self.context.make_current()
         if self._overdraw_target is None:
-            self._overdraw_target = TextureTarget(*self.size, GL.GL_R32F,
-                                                  depth_renderbuffer=self.context.depth_renderbuffer)
+            self._overdraw_target = TextureTarget(
+                *self.size, GL.GL_R32F, depth_renderbuffer=self.context.depth_renderbuffer
+            )
         self._overdraw_target.bind_cleared()
         for count_fragments in self._replay:
             count_fragments()
         view, projection = self._last_matrices
-        analytic = sum(analytic_overdraw(batch.centres, batch.radii, view, projection, NEAR_PLANE_M)
-                       for batch in self._screen_batches)
+        analytic = sum(
+            analytic_overdraw(batch.centres, batch.radii, view, projection, NEAR_PLANE_M)
+            for batch in self._screen_batches
+        )
         counts = self._overdraw_target.read()
         self.context.bind_target()
         return counts, overdraw_statistics(counts) | {"overdraw_analytic": analytic}
@@ -387,9 +447,17 @@ class FrameRenderer:
         self.close()
 
 
-def render_full(scene: Scene, width: int, height: int, *, time_of_day: float | None = None,
-                camera: Camera | None = None, illumination_method: str = "exact") -> tuple[np.ndarray, dict]:
+def render_full(
+    scene: Scene,
+    width: int,
+    height: int,
+    *,
+    time_of_day: float | None = None,
+    camera: Camera | None = None,
+    illumination_method: str = "exact",
+) -> tuple[np.ndarray, dict]:
     """Render one full-3D frame of `scene` in a context of its own; see `FrameRenderer.render`."""
     with FrameRenderer(width, height) as renderer:
-        return renderer.render(scene, time_of_day=time_of_day, camera=camera,
-                               illumination_method=illumination_method, settings=FULL_3D)
+        return renderer.render(
+            scene, time_of_day=time_of_day, camera=camera, illumination_method=illumination_method, settings=FULL_3D
+        )

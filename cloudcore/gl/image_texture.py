@@ -31,8 +31,7 @@ class ImageTexture:
         pixels = np.ascontiguousarray(rgba)
         GL.glBindTexture(GL.GL_TEXTURE_2D, self.texture)
         if self.shape != (height, width):
-            GL.glTexImage2D(GL.GL_TEXTURE_2D, 0, GL.GL_RGBA8, width, height, 0, GL.GL_RGBA, GL.GL_UNSIGNED_BYTE,
-                            pixels)
+            GL.glTexImage2D(GL.GL_TEXTURE_2D, 0, GL.GL_RGBA8, width, height, 0, GL.GL_RGBA, GL.GL_UNSIGNED_BYTE, pixels)
             self.shape = (height, width)
         else:
             GL.glTexSubImage2D(GL.GL_TEXTURE_2D, 0, 0, 0, width, height, GL.GL_RGBA, GL.GL_UNSIGNED_BYTE, pixels)

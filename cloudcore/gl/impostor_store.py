@@ -35,8 +35,9 @@ class ImpostorStore:
         self._clouds: dict[tuple, tuple[list[TextureTarget], ImpostorView, tuple]] = {}
         self._ring: dict[tuple[RingGeneration, int], tuple[TextureTarget, tuple]] = {}  # (texture, extent)
 
-    def update(self, plan: FramePlan, units: LodUnits, particles: ParticleShading, settings: RenderSettings,
-               time_s: float) -> int:
+    def update(
+        self, plan: FramePlan, units: LodUnits, particles: ParticleShading, settings: RenderSettings, time_s: float
+    ) -> int:
         """Render this frame's regenerations and ring segment at scene time `time_s`; returns the particles rendered."""
         rendered = 0
         for cloud in plan.clouds:
@@ -45,17 +46,30 @@ class ImpostorStore:
             record = plan.records[cloud.members]
             view = impostor_view(units.centres[cloud.index], units.radii[cloud.index], record.eye)
             targets = self._cloud_targets(cloud.members, cloud.texture_size, len(record.splits) + 1)
-            self._clouds[cloud.members] = (targets, view, _extent(particles, cloud.members, view.view,
-                                                                  view.projection, (cloud.texture_size,) * 2))
+            self._clouds[cloud.members] = (
+                targets,
+                view,
+                _extent(particles, cloud.members, view.view, view.projection, (cloud.texture_size,) * 2),
+            )
             for layer, target in enumerate(targets):
                 depth_range = layer_bounds(record.splits, layer)
-                rendered += self._render(target, particles, cloud.members, record.eye, view.view, view.projection,
-                                         time_s, [depth_range] * len(cloud.members))
+                rendered += self._render(
+                    target,
+                    particles,
+                    cloud.members,
+                    record.eye,
+                    view.view,
+                    view.projection,
+                    time_s,
+                    [depth_range] * len(cloud.members),
+                )
         for index in set(self._clouds) - set(plan.records):
             self._release(self._clouds.pop(index)[0])
 
         ring = plan.ring
-        if ring is not None and ring.build_segment in (ring.state.pending.occupied_segments if ring.state.pending else ()):
+        if ring is not None and ring.build_segment in (
+            ring.state.pending.occupied_segments if ring.state.pending else ()
+        ):
             generation, segment = ring.state.pending, ring.build_segment
             size = generation.texture_size
             target = self.pool.acquire(*size)
@@ -74,8 +88,9 @@ class ImpostorStore:
         targets, view, extent = self._clouds[members]
         return targets[layer], cropped_corners(view.corners, extent), extent
 
-    def ring_panel(self, generation: RingGeneration, segment: int,
-                   elevation_deg: float) -> tuple[TextureTarget, np.ndarray, tuple]:
+    def ring_panel(
+        self, generation: RingGeneration, segment: int, elevation_deg: float
+    ) -> tuple[TextureTarget, np.ndarray, tuple]:
         """(texture, cropped world corners, extent) of a ring segment's panel, as `cloud_impostor`."""
         target, extent = self._ring[generation, segment]
         return target, cropped_corners(panel_corners(generation, segment, elevation_deg), extent), extent
@@ -91,8 +106,9 @@ class ImpostorStore:
         for target in targets:
             self.pool.release(target)
 
-    def _render(self, target: TextureTarget, particles, clouds, eye, view, projection, time_s: float,
-                depth_ranges=None) -> int:
+    def _render(
+        self, target: TextureTarget, particles, clouds, eye, view, projection, time_s: float, depth_ranges=None
+    ) -> int:
         """The clouds alone, no depth test: the texture holds their premultiplied colour and opacity."""
         batch = splat_batch(particles, clouds, eye, depth_ranges, time_s)
         target.bind_cleared()

@@ -42,11 +42,11 @@ class ObjectPass:
             self._scene.add(node, pose=_light_pose(np.asarray(light.direction, dtype=np.float64)))
         self._nodes = []
         for obj, mesh in zip(self.objects, meshes):
-            material = pyrender.MetallicRoughnessMaterial(baseColorFactor=(*obj.color, 1.0), metallicFactor=0.0,
-                                                          roughnessFactor=1.0)
+            material = pyrender.MetallicRoughnessMaterial(
+                baseColorFactor=(*obj.color, 1.0), metallicFactor=0.0, roughnessFactor=1.0
+            )
             self._nodes.append(self._scene.add(pyrender.Mesh.from_trimesh(mesh, material=material, smooth=False)))
-        self._camera_node = self._scene.add(
-            pyrender.PerspectiveCamera(yfov=1.0, znear=NEAR_PLANE_M, zfar=FAR_PLANE_M))
+        self._camera_node = self._scene.add(pyrender.PerspectiveCamera(yfov=1.0, znear=NEAR_PLANE_M, zfar=FAR_PLANE_M))
         self._program = build_program("objects", vertex="world")
         self._vertex_array = GL.glGenVertexArrays(1)
         self._colour, self._depth, self._framebuffer = _colour_and_depth_target(*size)

@@ -52,8 +52,9 @@ def _compile(kind: int, file: str, defines: dict[str, int | float]) -> int:
     if not version.startswith("#version"):
         raise ShaderError(f"{file}: the first line must be the #version directive")
     # integers stay integers (array sizes); everything else is written as a float literal
-    lines = [version] + [f"#define {key} {value if isinstance(value, int) else float(value)!r}"
-                         for key, value in defines.items()]
+    lines = [version] + [
+        f"#define {key} {value if isinstance(value, int) else float(value)!r}" for key, value in defines.items()
+    ]
     # keep the driver's line numbers pointing into the file
     lines.append("#line 2")
     shader = GL.glCreateShader(kind)
@@ -72,8 +73,9 @@ def _text(log) -> str:
 
 def set_matrix(program: int, name: str, matrix) -> None:
     """Upload a 4x4 numpy matrix (row-major, as numpy stores it) to a mat4 uniform."""
-    GL.glUniformMatrix4fv(GL.glGetUniformLocation(program, name), 1, GL.GL_TRUE,
-                          np.ascontiguousarray(matrix, dtype=np.float32))
+    GL.glUniformMatrix4fv(
+        GL.glGetUniformLocation(program, name), 1, GL.GL_TRUE, np.ascontiguousarray(matrix, dtype=np.float32)
+    )
 
 
 def set_vec3(program: int, name: str, value) -> None:

@@ -20,8 +20,11 @@ import pyrender
 
 #: (class, attribute, why we need it); instance attributes are checked on a live renderer
 PRIVATE_API = (
-    ("Renderer", "_configure_forward_pass_viewport",
-     "WindowContext overrides it to draw the world into our framebuffer (gl/context.py)"),
+    (
+        "Renderer",
+        "_configure_forward_pass_viewport",
+        "WindowContext overrides it to draw the world into our framebuffer (gl/context.py)",
+    ),
     ("OffscreenRenderer", "_platform", "its EGL context, made current before our own GL calls"),
     ("OffscreenRenderer", "_renderer", "its Renderer, whose resolved framebuffer we blit from"),
     ("Renderer", "_main_fb", "the resolved framebuffer a headless render leaves behind"),

@@ -24,20 +24,30 @@ class QuadPass:
         #: with the other attribute-less passes
         self.vertex_array = GL.glGenVertexArrays(1)
 
-    def draw(self, corners: np.ndarray, view_projection: np.ndarray, texture: int, impostor_weight: float,
-             *, layer_texture: int | None = None, layer_weight: float = 0.0, depth_test: bool = True,
-             counting: bool = False, uv_rect=(0.0, 0.0, 1.0, 1.0)) -> None:
+    def draw(
+        self,
+        corners: np.ndarray,
+        view_projection: np.ndarray,
+        texture: int,
+        impostor_weight: float,
+        *,
+        layer_texture: int | None = None,
+        layer_weight: float = 0.0,
+        depth_test: bool = True,
+        counting: bool = False,
+        uv_rect=(0.0, 0.0, 1.0, 1.0),
+    ) -> None:
         """Blend `texture` (premultiplied) over the bound target on the quad `corners` (4, 3), which show
         the part `uv_rect` (u0, v0, u1, v1) of the texture."""
         program = self._counting_program if counting else self._program
         GL.glUseProgram(program)
-        GL.glUniform3fv(GL.glGetUniformLocation(program, "corners"), 4,
-                        np.ascontiguousarray(corners, dtype=np.float32))
+        GL.glUniform3fv(GL.glGetUniformLocation(program, "corners"), 4, np.ascontiguousarray(corners, dtype=np.float32))
         set_matrix(program, "view_projection", view_projection)
         GL.glUniform4f(GL.glGetUniformLocation(program, "uv_rect"), *map(float, uv_rect))
         GL.glUniform1f(GL.glGetUniformLocation(program, "impostor_weight"), float(impostor_weight))
-        GL.glUniform1f(GL.glGetUniformLocation(program, "layer_weight"),
-                       float(layer_weight) if layer_texture is not None else 0.0)
+        GL.glUniform1f(
+            GL.glGetUniformLocation(program, "layer_weight"), float(layer_weight) if layer_texture is not None else 0.0
+        )
         GL.glActiveTexture(GL.GL_TEXTURE0)
         GL.glBindTexture(GL.GL_TEXTURE_2D, texture)
         if layer_texture is not None:

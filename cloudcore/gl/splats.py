@@ -43,8 +43,9 @@ _CLOUD_FLOATS = 40
 #: per particle, written by the compute shader: four corners and four colours (vec4 each)
 _INSTANCE_BYTES = 8 * 16
 _UNLOCKED = (0.0, 0.0, 0.0, -1.0)
-(_PARTICLES_BINDING, _FORMATION_BINDING, _ORDER_BINDING, _INSTANCES_BINDING, _CLOUDS_BINDING,
- _FACING_BINDING) = range(6)
+(_PARTICLES_BINDING, _FORMATION_BINDING, _ORDER_BINDING, _INSTANCES_BINDING, _CLOUDS_BINDING, _FACING_BINDING) = range(
+    6
+)
 #: the compute shader's local_size_x
 _SHADE_GROUP = 64
 
@@ -71,8 +72,14 @@ class SplatBatch:
         return self.particles.radii[self.order]
 
 
-def splat_batch(particles: ParticleShading, clouds, eye, depth_ranges=None, time_s: float | None = None,
-                frustum: np.ndarray | None = None) -> SplatBatch:
+def splat_batch(
+    particles: ParticleShading,
+    clouds,
+    eye,
+    depth_ranges=None,
+    time_s: float | None = None,
+    frustum: np.ndarray | None = None,
+) -> SplatBatch:
     """The visible particles of `clouds` (indices), sorted far to near from `eye`.
 
     `depth_ranges`, one (near, far) per cloud, keeps only the particles with
@@ -102,19 +109,35 @@ class SplatPass:
         defines = {"SPLAT_SHARPNESS": SPLAT_SHARPNESS, "ATLAS_GRID": ATLAS_GRID}
         self._program = build_program("splat", defines)
         self._counting_program = build_program("splat", defines | {"COUNT_FRAGMENTS": 1})
-        self._shade_program = build_compute_program("splat_shade", {
-            "MAX_LIGHTS": MAX_LIGHTS, "FADE_START_RADII": FADE_START_RADII, "FADE_END_RADII": FADE_END_RADII})
+        self._shade_program = build_compute_program(
+            "splat_shade",
+            {"MAX_LIGHTS": MAX_LIGHTS, "FADE_START_RADII": FADE_START_RADII, "FADE_END_RADII": FADE_END_RADII},
+        )
         self._vertex_array = GL.glGenVertexArrays(1)
-        (self._corner_index_buffer, self._order_buffer, self._instance_buffer, self._particle_buffer,
-         self._formation_buffer, self._cloud_buffer, self._facing_buffer) = self._buffers = GL.glGenBuffers(7)
+        (
+            self._corner_index_buffer,
+            self._order_buffer,
+            self._instance_buffer,
+            self._particle_buffer,
+            self._formation_buffer,
+            self._cloud_buffer,
+            self._facing_buffer,
+        ) = self._buffers = GL.glGenBuffers(7)
         self._atlas: int | None = None  # the sprite atlas texture, made when a cloud first needs it
         self._quads_indexed = 0
         self._instance_capacity = 0
         self._resident: ParticleShading | None = None
         self._formation_time: float | None = None
 
-    def draw(self, batch: SplatBatch, view: np.ndarray, projection: np.ndarray, *, depth_test: bool = True,
-             counting: bool = False) -> None:
+    def draw(
+        self,
+        batch: SplatBatch,
+        view: np.ndarray,
+        projection: np.ndarray,
+        *,
+        depth_test: bool = True,
+        counting: bool = False,
+    ) -> None:
         """Blend the batch over the bound target (premultiplied), or add 1 per fragment when counting."""
         if not len(batch):
             return
@@ -165,10 +188,14 @@ class SplatPass:
             GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, self._instance_buffer)
             GL.glBufferData(GL.GL_SHADER_STORAGE_BUFFER, needed, None, GL.GL_DYNAMIC_COPY)
             self._instance_capacity = needed
-        for binding, buffer in ((_PARTICLES_BINDING, self._particle_buffer),
-                                (_FORMATION_BINDING, self._formation_buffer),
-                                (_ORDER_BINDING, self._order_buffer), (_INSTANCES_BINDING, self._instance_buffer),
-                                (_CLOUDS_BINDING, self._cloud_buffer), (_FACING_BINDING, self._facing_buffer)):
+        for binding, buffer in (
+            (_PARTICLES_BINDING, self._particle_buffer),
+            (_FORMATION_BINDING, self._formation_buffer),
+            (_ORDER_BINDING, self._order_buffer),
+            (_INSTANCES_BINDING, self._instance_buffer),
+            (_CLOUDS_BINDING, self._cloud_buffer),
+            (_FACING_BINDING, self._facing_buffer),
+        ):
             GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, binding, buffer)
         GL.glUseProgram(self._shade_program)
         GL.glUniform1ui(GL.glGetUniformLocation(self._shade_program, "count"), len(batch))
@@ -183,8 +210,11 @@ class SplatPass:
         if particles is not self._resident:
             _store(self._particle_buffer, _particle_records(particles))
             _store(self._cloud_buffer, _cloud_records(particles.styles))
-            _store(self._facing_buffer, np.tile(np.array(_UNLOCKED, dtype=np.float32),
-                                                (max(len(particles.radii), 1), 1)), GL.GL_DYNAMIC_DRAW)
+            _store(
+                self._facing_buffer,
+                np.tile(np.array(_UNLOCKED, dtype=np.float32), (max(len(particles.radii), 1), 1)),
+                GL.GL_DYNAMIC_DRAW,
+            )
             if self._atlas is None and np.any(particles.styles.sprite_index >= 0):
                 self._atlas = _atlas_texture()
             _store(self._formation_buffer, np.ones(max(len(particles.radii), 1), dtype=np.float32))
@@ -196,8 +226,10 @@ class SplatPass:
         factors = particles.formation_factors(time_s)
         held = None if factors is None else time_s  # the time the buffer's factors are for; None: all 1
         if held != self._formation_time:
-            _store(self._formation_buffer, (np.ones(max(len(particles.radii), 1)) if factors is None
-                                            else factors).astype(np.float32))
+            _store(
+                self._formation_buffer,
+                (np.ones(max(len(particles.radii), 1)) if factors is None else factors).astype(np.float32),
+            )
             self._formation_time = held
 
     def close(self) -> None:
@@ -228,7 +260,7 @@ def _particle_records(particles: ParticleShading) -> np.ndarray:
     records[:n, 15] = styles.cloud_index
     records[:n, 16] = styles.sprite_index
     records[:n, 17] = styles.rotation
-    records[:n, 20:20 + lights] = particles.incident
+    records[:n, 20 : 20 + lights] = particles.incident
     return records
 
 
@@ -271,10 +303,16 @@ def _set_light_uniforms(program: int, particles: ParticleShading) -> None:
     lights = len(particles.light_directions)
     GL.glUniform1i(GL.glGetUniformLocation(program, "light_count"), lights)
     if lights:
-        GL.glUniform3fv(GL.glGetUniformLocation(program, "light_direction"), lights,
-                        np.ascontiguousarray(particles.light_directions, dtype=np.float32))
-        GL.glUniform3fv(GL.glGetUniformLocation(program, "light_radiance"), lights,
-                        np.ascontiguousarray(particles.light_radiance, dtype=np.float32))
+        GL.glUniform3fv(
+            GL.glGetUniformLocation(program, "light_direction"),
+            lights,
+            np.ascontiguousarray(particles.light_directions, dtype=np.float32),
+        )
+        GL.glUniform3fv(
+            GL.glGetUniformLocation(program, "light_radiance"),
+            lights,
+            np.ascontiguousarray(particles.light_radiance, dtype=np.float32),
+        )
     GL.glUniform1i(GL.glGetUniformLocation(program, "phase_kind"), PHASE_NAMES.index(particles.phase))
     GL.glUniform1f(GL.glGetUniformLocation(program, "g"), float(particles.g))
 

@@ -16,10 +16,10 @@ import trimesh
 from OpenGL import GL
 
 from cloudcore.camera import FAR_PLANE_M, NEAR_PLANE_M, camera_pose
+from cloudcore.colour import srgb_encode
 from cloudcore.gl.context import HeadlessContext
 from cloudcore.gl.programs import build_program, set_matrix, set_vec3
 from cloudcore.gl.pyrender_compat import pyrender
-from cloudcore.colour import srgb_encode
 from cloudcore.lighting import active_lights
 from cloudcore.limits import DRAWN_TERRAIN_KINDS
 from cloudcore.scene import Camera, Terrain
@@ -63,8 +63,11 @@ class WorldPass:
         vertices, faces, normals = terrain_geometry(terrain)
         colours = terrain_vertex_colours(normals, terrain.color, lights, ambient)
         # encoded, because pyrender's 8-bit framebuffer would band linear colour in the shadows
-        primitive = pyrender.Primitive(positions=vertices.astype(np.float32), indices=faces.astype(np.uint32),
-                                       color_0=srgb_encode(colours).astype(np.float32))
+        primitive = pyrender.Primitive(
+            positions=vertices.astype(np.float32),
+            indices=faces.astype(np.uint32),
+            color_0=srgb_encode(colours).astype(np.float32),
+        )
         scene = pyrender.Scene(bg_color=(0.0, 0.0, 0.0, 0.0))
         scene.add(pyrender.Mesh([primitive]))
         camera = pyrender.PerspectiveCamera(yfov=np.radians(60.0), znear=NEAR_PLANE_M, zfar=FAR_PLANE_M)
