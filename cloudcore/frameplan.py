@@ -301,6 +301,20 @@ def plan_frame(
         """Particles per layer seen from `from_eye`; the particles are looked at only when there are splits."""
         return layer_counts(particles_of(index), from_eye, splits) if splits else (0,)
 
+    def in_full(index: int, distance: float, inside: tuple, splits: tuple, **prices) -> CloudPlan:
+        """The plan of a unit drawn in full 3D (split around the objects `inside` it at `splits`)."""
+        return CloudPlan(
+            index,
+            "full",
+            distance,
+            full_weight=1.0,
+            split_objects=inside,
+            splits=splits,
+            layer_counts=counts(index, eye, splits),
+            members=units.members[index],
+            **prices,
+        )
+
     def full_3d(index: int, radius: float, distance: float) -> Work:
         """The unit drawn in full 3D: a ball of discs far off; near, splat by splat, only the splats in the
         frustum (the renderer leaves out the rest), their discs clipped to the screen."""
@@ -354,18 +368,7 @@ def plan_frame(
             cloud_work += dataclasses.replace(full, fragments=full.fragments * settings.inside_resolution_scale**2)
             continue
         if settings.mode == "full":
-            clouds.append(
-                CloudPlan(
-                    index,
-                    "full",
-                    distance,
-                    full_weight=1.0,
-                    split_objects=inside,
-                    splits=splits,
-                    layer_counts=counts(index, eye, splits),
-                    members=members,
-                )
-            )
+            clouds.append(in_full(index, distance, inside, splits))
             cloud_work += full
             continue
         pixels = screen_size_px(radius, distance, height, camera.fov_y_deg)
@@ -404,20 +407,7 @@ def plan_frame(
             representations[members] = representation
             weight = representation.full_weight
         if weight == 1.0:
-            clouds.append(
-                CloudPlan(
-                    index,
-                    "full",
-                    distance,
-                    full_weight=1.0,
-                    split_objects=inside,
-                    splits=splits,
-                    layer_counts=counts(index, eye, splits),
-                    members=members,
-                    full_ms=full_ms,
-                    impostor_ms=impostor_ms,
-                )
-            )
+            clouds.append(in_full(index, distance, inside, splits, full_ms=full_ms, impostor_ms=impostor_ms))
             cloud_work += full
             continue
         record = records.get(members)

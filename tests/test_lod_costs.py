@@ -90,55 +90,35 @@ RING_OF_CLOUDS = tuple((600.0 * math.sin(a), 0.0, -600.0 * math.cos(a)) for a in
 def test_a_frame_budget_postpones_regenerations_and_reports_the_error_it_accepted():
     impostors = dataclasses.replace(NO_RING, mode="impostor")
     start = camera_at((0.0, 0.0, 0.0), (0.0, 0.0, -1.0))
-    first = plan(
-        start, impostors, centres=RING_OF_CLOUDS, radii=(RADIUS,) * 5, finest_radii=FINEST * 5, costs=FILL_BOUND
-    )
+
+    def five_clouds(camera, settings, state=None, finest_radii=FINEST * 5):
+        return plan(
+            camera,
+            settings,
+            state=state,
+            centres=RING_OF_CLOUDS,
+            radii=(RADIUS,) * 5,
+            finest_radii=finest_radii,
+            costs=FILL_BOUND,
+        )
+
+    first = five_clouds(start, impostors)
     moved = camera_at((40.0, 0.0, 0.0), (40.0, 0.0, -1.0))
-    unlimited = plan(
-        moved,
-        impostors,
-        state=first.state,
-        centres=RING_OF_CLOUDS,
-        radii=(RADIUS,) * 5,
-        finest_radii=FINEST * 5,
-        costs=FILL_BOUND,
-    )
+    unlimited = five_clouds(moved, impostors, first.state)
     assert unlimited.stats()["impostors_regenerated"] == 5 and unlimited.accepted_error <= 1.0
     # room for the quads and two regenerations: the two farthest past the tolerance are served
     one = FILL_BOUND.ms(unlimited.update_work) / 5
     budget = dataclasses.replace(impostors, frame_budget_ms=FILL_BOUND.ms(unlimited.cloud_work) + 2.5 * one)
-    tight = plan(
-        moved,
-        budget,
-        state=first.state,
-        centres=RING_OF_CLOUDS,
-        radii=(RADIUS,) * 5,
-        finest_radii=FINEST * 5,
-        costs=FILL_BOUND,
-    )
+    tight = five_clouds(moved, budget, first.state)
     stats = tight.stats()
     assert (stats["impostors_regenerated"], stats["regenerations_postponed"]) == (2, 3)
     assert tight.predicted_ms <= budget.frame_budget_ms < unlimited.predicted_ms
     assert tight.accepted_error > 1.0 and stats["accepted_error_tolerances"] == tight.accepted_error
     # a budget below the quads' own cost still serves the most urgent one a frame: the picture converges
-    starved = plan(
-        moved,
-        dataclasses.replace(impostors, frame_budget_ms=1e-6),
-        state=first.state,
-        centres=RING_OF_CLOUDS,
-        radii=(RADIUS,) * 5,
-        finest_radii=FINEST * 5,
-        costs=FILL_BOUND,
-    )
+    starved = five_clouds(moved, dataclasses.replace(impostors, frame_budget_ms=1e-6), first.state)
     assert (starved.stats()["impostors_regenerated"], starved.stats()["regenerations_postponed"]) == (1, 4)
     # new impostors are made whatever the budget: there is nothing else to show
-    fresh = plan(
-        start,
-        dataclasses.replace(impostors, frame_budget_ms=1e-6),
-        centres=RING_OF_CLOUDS,
-        radii=(RADIUS,) * 5,
-        costs=FILL_BOUND,
-    )
+    fresh = five_clouds(start, dataclasses.replace(impostors, frame_budget_ms=1e-6), finest_radii=None)
     assert fresh.stats()["impostors_regenerated"] == 5
 
 
