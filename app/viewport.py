@@ -89,7 +89,7 @@ class Viewport:
             # the same inputs and nothing converging, or nothing worth converging to while a new light is on its
             # way (the impostors and ring would be remade for a light already superseded): the same picture,
             # and the cores go to the relighting worker
-            stats = self._last_stats | {"picture_reused": True}
+            stats = self._last_stats | {"picture_reused": True, "impostors_regenerated": 0, "regeneration_reasons": {}}
             if self.relighting.busy:
                 time.sleep(RELIGHT_PAUSE_S)
         else:

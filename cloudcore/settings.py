@@ -22,9 +22,9 @@ TRANSLATION_METRICS = ("parallax", "centre")
 class RenderSettings:
     mode: str = "auto"
     #: degrees of translation error past which an impostor is regenerated; see `translation_metric`.
-    #: SkyWorks' default is 0.125 (0.9 of a pixel at 480 lines and 60 degrees).  Measured side by side,
-    #: 1 saved an eighth of the default flythrough's cloud pass for 0.5 dB, but on a cumulus field the
-    #: project was not tuned on it saved nothing and cost 5 dB on the worst frame (docs/performance.md)
+    #: SkyWorks' default is 0.125 (0.9 of a pixel at 480 lines and 60 degrees).  1 saved an eighth of the
+    #: default flythrough's cloud pass for 0.5 dB (side by side), but on a cumulus field the project was not
+    #: tuned on it saved a tenth and cost 5 dB on the worst frame, 40.4 to 35.2 (docs/performance.md)
     tolerance_deg: float = 0.5
     #: "parallax": the angle between the rays to the impostor's near and far points (Harris, SkyWorks);
     #: "centre": the angle the eye has turned around the cloud's centre (stricter by about D / 2R)
