@@ -494,7 +494,10 @@ class Panels:
         history = list(editor.frame_times)
         if implot.begin_plot("Frame time (ms)", imgui.ImVec2(-1, 180)):
             frames = np.arange(len(history), dtype=np.float64)
-            implot.setup_axes("frame", "ms", implot.AxisFlags_.auto_fit, implot.AxisFlags_.auto_fit)
+            implot.setup_axes("frame", "ms", implot.AxisFlags_.auto_fit, 0)
+            # scaled to the frames' 95th percentile: the start's shading (seconds) would flatten the rest
+            typical = np.percentile([s.get("viewport_ms", 0.0) for s in history], 95) if history else 1.0
+            implot.setup_axis_limits(implot.ImAxis_.y1, 0.0, 1.25 * max(typical, 1.0), implot.Cond_.always)
             for key, label in (
                 ("viewport_ms", "frame"),
                 ("cloud_ms", "cloud pass"),
