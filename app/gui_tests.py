@@ -27,6 +27,28 @@ from cloudcore.scenefile import save_scene
 SETTLE = 4
 
 
+#: the GUI tests, in the order they run; `tests/test_gui.py` reads this list
+GUI_TESTS = (
+    "place_particles_by_clicking",
+    "time_of_day_changes_the_picture",
+    "dragging_the_time_of_day_relights_live",
+    "tolerance_drives_regeneration",
+    "save_and_reopen",
+    "malformed_scene_keeps_the_current_one",
+    "recovery_is_offered_and_restores_the_edits",
+    "place_on_the_cloud_surface",
+    "brush_stroke_is_one_undo_step",
+    "box_fill_adds_sprites",
+    "move_cloud_by_dragging",
+    "delete_key_and_statistics_toggle",
+    "heat_map_changes_the_picture",
+    "overlays_outline_impostors_and_the_ring",
+    "playing_a_camera_path_moves_the_camera",
+    "recording_runs_in_the_background",
+    "a_click_within_one_frame_is_not_lost",
+)
+
+
 def install(params, editor, viewport, panels, results_path: Path, outcome: dict, only=None) -> None:
     """Register the GUI tests (those named in `only`, if given) to run in the editor, then exit."""
     registered: list = []
@@ -464,25 +486,8 @@ def install(params, editor, viewport, panels, results_path: Path, outcome: dict,
         use_window(ctx, "Camera")
         ctx.item_click("Reset to the scene's camera")
 
-    tests = [
-        place_particles_by_clicking,
-        time_of_day_changes_the_picture,
-        dragging_the_time_of_day_relights_live,
-        tolerance_drives_regeneration,
-        save_and_reopen,
-        malformed_scene_keeps_the_current_one,
-        recovery_is_offered_and_restores_the_edits,
-        place_on_the_cloud_surface,
-        brush_stroke_is_one_undo_step,
-        box_fill_adds_sprites,
-        move_cloud_by_dragging,
-        delete_key_and_statistics_toggle,
-        heat_map_changes_the_picture,
-        overlays_outline_impostors_and_the_ring,
-        playing_a_camera_path_moves_the_camera,
-        recording_runs_in_the_background,
-        a_click_within_one_frame_is_not_lost,
-    ]
+    defined = locals()
+    tests = [defined[name] for name in GUI_TESTS]  # a KeyError names a listed test not defined above
 
     unknown = sorted(set(only or ()) - {function.__name__ for function in tests})
     if unknown:

@@ -12,6 +12,7 @@ import sys
 
 import pytest
 
+from app.gui_tests import GUI_TESTS
 from cloudcore.cloudgen import cumulus
 from cloudcore.resources import DEFAULT_SCENE
 from cloudcore.scene import Camera, CameraPath, Cloud, Lighting, Scene, Terrain
@@ -62,28 +63,7 @@ def run_editor(scene_path, folder, *options) -> tuple[subprocess.CompletedProces
     return result, json.loads(results_file.read_text())
 
 
-@pytest.mark.parametrize(
-    "name",
-    [
-        "place_particles_by_clicking",
-        "time_of_day_changes_the_picture",
-        "dragging_the_time_of_day_relights_live",
-        "tolerance_drives_regeneration",
-        "save_and_reopen",
-        "malformed_scene_keeps_the_current_one",
-        "recovery_is_offered_and_restores_the_edits",
-        "place_on_the_cloud_surface",
-        "brush_stroke_is_one_undo_step",
-        "box_fill_adds_sprites",
-        "move_cloud_by_dragging",
-        "delete_key_and_statistics_toggle",
-        "heat_map_changes_the_picture",
-        "overlays_outline_impostors_and_the_ring",
-        "playing_a_camera_path_moves_the_camera",
-        "recording_runs_in_the_background",
-        "a_click_within_one_frame_is_not_lost",
-    ],
-)
+@pytest.mark.parametrize("name", GUI_TESTS)
 def test_gui(gui_results, name):
     result, report = gui_results
     assert report["tests"][name] == "success", report["logs"].get(name, "") + result.stdout[-2000:]
