@@ -190,6 +190,24 @@ def machine() -> str:
     return platform.processor() or platform.machine()
 
 
+def headless_pyplot():
+    """matplotlib's pyplot on the Agg backend (no display, no GUI toolkit), imported only when a plot is asked."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def save_figure(figure, path: Path) -> None:
+    """Lay out `figure`, write it to `path` (folders made as needed) and free it."""
+    figure.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    figure.savefig(path)
+    headless_pyplot().close(figure)
+
+
 def write_report(report: dict, path: Path | None, summary=None) -> None:
     """Print `summary` (by default the report) as JSON and write the whole report to `path` (if given)."""
     if path is not None:

@@ -267,7 +267,8 @@ def plan_frame(
         segment_texture_size(height, camera.fov_y_deg, settings),
     )
     records = state.records
-    next_records = {members: record for members, record in records.items() if members in set(units.members)}
+    present = set(units.members)
+    next_records = {members: record for members, record in records.items() if members in present}
     object_centres = np.array([o.centre for o in objects], dtype=np.float64).reshape(-1, 3)
     object_radii = np.array([o.radius for o in objects], dtype=np.float64)
     objects_visible = spheres_in_frustum(planes, object_centres, object_radii)

@@ -36,7 +36,16 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from bench_many_particles import cloud_field  # noqa: E402  (a sibling script: the same 1.2M field)
 
-from cloudcore.benchmark import bench_path, machine, orbit_views, path_views, still_views, write_report  # noqa: E402
+from cloudcore.benchmark import (  # noqa: E402
+    bench_path,
+    headless_pyplot,
+    machine,
+    orbit_views,
+    path_views,
+    save_figure,
+    still_views,
+    write_report,
+)
 from cloudcore.cloudgen import preset_cloud  # noqa: E402
 from cloudcore.gl import FrameRenderer  # noqa: E402
 from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
@@ -144,11 +153,7 @@ def summary(name: str, report: dict) -> list[dict]:
 
 def plot(rows, path: Path) -> None:
     """Cloud-pass speed-up against mean PSNR, one point per mode and case."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    plt = headless_pyplot()
     figure, axes = plt.subplots(figsize=(6.4, 4.2), dpi=120)
     for mode, marker in (("impostor", "o"), ("auto", "s")):
         points = [r for r in rows if r["mode"] == mode]
@@ -164,10 +169,7 @@ def plot(rows, path: Path) -> None:
     axes.set_ylabel("mean PSNR against full 3D (dB)")
     axes.set_title("The level of detail on llvmpipe: error against time")
     axes.legend(fontsize=7)
-    figure.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    figure.savefig(path)
-    plt.close(figure)
+    save_figure(figure, path)
 
 
 def main() -> None:

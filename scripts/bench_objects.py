@@ -25,7 +25,7 @@ import numpy as np
 
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 
-from cloudcore.benchmark import path_views  # noqa: E402  (the GL imports need the platform above)
+from cloudcore.benchmark import headless_pyplot, path_views, save_figure  # noqa: E402  (GL needs the platform above)
 from cloudcore.camera import screen_box  # noqa: E402
 from cloudcore.gl import FrameRenderer  # noqa: E402
 from cloudcore.imagecompare import compare  # noqa: E402
@@ -96,11 +96,7 @@ def flythrough_cost(frames: int, size) -> dict:
 
 
 def write_figure(crops, rows, path: Path) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")  # headless
-    import matplotlib.pyplot as plt
-
+    plt = headless_pyplot()
     figure, axes = plt.subplots(len(crops), len(VARIANTS), figsize=(2.3 * len(VARIANTS), 2.1 * len(crops)), dpi=110)
     for r, (row_crops, time_s) in enumerate(zip(crops, INSTANTS_S)):
         for c, (name, crop) in enumerate(row_crops):
@@ -109,10 +105,7 @@ def write_figure(crops, rows, path: Path) -> None:
             axes[r, c].set_xticks([])
             axes[r, c].set_yticks([])
             axes[r, c].set_title(f"{name}\nt={time_s:g} s" + ("" if c == 0 else f", {psnr:.1f} dB"), fontsize=7)
-    figure.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    figure.savefig(path)
-    plt.close(figure)
+    save_figure(figure, path)
 
 
 def main() -> None:

@@ -14,7 +14,15 @@ import json
 import os
 from pathlib import Path
 
-from cloudcore.benchmark import bench_path, orbit_views, pareto_front, shading_comparison, still_views
+from cloudcore.benchmark import (
+    bench_path,
+    headless_pyplot,
+    orbit_views,
+    pareto_front,
+    save_figure,
+    shading_comparison,
+    still_views,
+)
 from cloudcore.cli.render import pixel_count
 from cloudcore.cli.settings_args import SWEEPABLE, add_settings_arguments, parse_sweep, settings_from
 from cloudcore.errors import SceneError
@@ -133,11 +141,7 @@ def run(args) -> int:
 
 def plot_error_against_time(report: dict, path: Path) -> None:
     """One point per setting (frame time, mean absolute difference), the Pareto front joined, full 3D marked."""
-    import matplotlib
-
-    matplotlib.use("Agg")  # headless: no display, no GUI toolkit
-    import matplotlib.pyplot as plt
-
+    plt = headless_pyplot()
     runs = report["runs"]
     seconds = [r["frame_ms_mean"] for r in runs]
     errors = [r["mad_mean"] for r in runs]
@@ -164,7 +168,4 @@ def plot_error_against_time(report: dict, path: Path) -> None:
     axes.set_ylabel("mean |difference| from full 3D (8-bit levels)")
     axes.set_title(f"{Path(report['scene']).name}, path {report['path']}, {report['width']}x{report['height']}")
     axes.legend(fontsize=7)
-    figure.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    figure.savefig(path)
-    plt.close(figure)
+    save_figure(figure, path)
