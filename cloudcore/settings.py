@@ -66,6 +66,9 @@ class RenderSettings:
     #: split clouds into layers around the objects inside them (Harris 3.1.1); off, objects are drawn
     #: with the world and clouds are depth-tested against them (the naive picture, for comparison)
     split_objects: bool = True
+    #: draw batches of plain splats as point sprites (one vertex per particle) where the picture is the
+    #: same (`cloudcore.point_sprites`); off, always as quads (for comparison; docs/performance.md)
+    point_sprites: bool = True
 
     def __post_init__(self):
         problems = []
@@ -105,7 +108,7 @@ class RenderSettings:
             problems.append(f"ring_elevation_deg must be within (0, 90), got {self.ring_elevation_deg}")
         if not (isinstance(self.ring_fade_frames, int) and self.ring_fade_frames >= 1):
             problems.append(f"ring_fade_frames must be an integer >= 1, got {self.ring_fade_frames!r}")
-        for name in ("split_objects", "group_clouds"):
+        for name in ("split_objects", "group_clouds", "point_sprites"):
             if not isinstance(getattr(self, name), bool):
                 problems.append(f"{name} must be true or false, got {getattr(self, name)!r}")
         if problems:

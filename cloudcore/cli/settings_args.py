@@ -27,6 +27,7 @@ SWEEPABLE = {
     "frame_budget": ("frame_budget_ms", float),
     "group_clouds": ("group_clouds", _boolean),
     "inside_resolution": ("inside_resolution_scale", float),
+    "point_sprites": ("point_sprites", _boolean),
 }
 
 
@@ -72,6 +73,12 @@ def add_settings_arguments(parser, default_mode: str = "auto") -> None:
         help="sort each cloud's impostor as a whole even where clouds interpenetrate",
     )
     parser.add_argument(
+        "--no-point-sprites",
+        dest="point_sprites",
+        action="store_false",
+        help="draw every splat as a quad, even where a point sprite gives the same picture",
+    )
+    parser.add_argument(
         "--ring-radius",
         type=float,
         default=defaults.ring_radius,
@@ -113,6 +120,7 @@ def settings_from(args, **overrides) -> RenderSettings:
             tolerance_px=args.tolerance_px,
             transition_frames=args.transition_frames,
             group_clouds=args.group_clouds,
+            point_sprites=args.point_sprites,
             frame_budget_ms=args.frame_budget,
         )
         | overrides

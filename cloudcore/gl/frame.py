@@ -293,13 +293,14 @@ class FrameRenderer:
         eye = camera.position
         view_projection = projection @ view
         frustum = frustum_planes(view_projection)
+        points = settings.point_sprites
         self._replay, self._screen_batches = [], []
         drawn = 0
 
         def draw_splats(clouds, depth_ranges) -> int:
             batch = splat_batch(particles, clouds, eye, depth_ranges, time_s, frustum)
-            self._splats.draw(batch, view, projection)
-            self._replay.append(lambda: self._splats.draw(batch, view, projection, counting=True))
+            self._splats.draw(batch, view, projection, point_sprites=points)
+            self._replay.append(lambda: self._splats.draw(batch, view, projection, counting=True, point_sprites=points))
             self._screen_batches.append(batch)
             return len(batch)
 
@@ -360,7 +361,7 @@ class FrameRenderer:
                     ]
                 )
                 batch = splat_batch(particles, members, eye, depth_ranges, time_s, frustum)
-                self._splats.draw(batch, view, projection)
+                self._splats.draw(batch, view, projection, point_sprites=points)
                 drawn += len(batch)
                 self.context.bind_target()
                 draw_quad(SCREEN_CORNERS, target.texture, cloud.full_weight, screen=True)

@@ -61,6 +61,7 @@ class ImpostorStore:
                     view.view,
                     view.projection,
                     time_s,
+                    settings.point_sprites,
                     [depth_range] * len(cloud.members),
                 )
         for index in set(self._clouds) - set(plan.records):
@@ -76,7 +77,9 @@ class ImpostorStore:
             view, projection = segment_camera(generation, segment, settings.ring_elevation_deg)
             clouds = [cloud for unit in generation.segment_members[segment] for cloud in unit]
             self._ring[generation, segment] = (target, _extent(particles, clouds, view, projection, size))
-            rendered += self._render(target, particles, clouds, generation.eye, view, projection, time_s)
+            rendered += self._render(
+                target, particles, clouds, generation.eye, view, projection, time_s, settings.point_sprites
+            )
         live = {plan.ring_state.current, plan.ring_state.pending}
         for key in [key for key in self._ring if key[0] not in live]:
             self.pool.release(self._ring.pop(key)[0])
@@ -107,12 +110,21 @@ class ImpostorStore:
             self.pool.release(target)
 
     def _render(
-        self, target: TextureTarget, particles, clouds, eye, view, projection, time_s: float, depth_ranges=None
+        self,
+        target: TextureTarget,
+        particles,
+        clouds,
+        eye,
+        view,
+        projection,
+        time_s: float,
+        point_sprites: bool,
+        depth_ranges=None,
     ) -> int:
         """The clouds alone, no depth test: the texture holds their premultiplied colour and opacity."""
         batch = splat_batch(particles, clouds, eye, depth_ranges, time_s)
         target.bind_cleared()
-        self._splats.draw(batch, view, projection, depth_test=False)
+        self._splats.draw(batch, view, projection, depth_test=False, point_sprites=point_sprites)
         return len(batch)
 
     def close(self) -> None:

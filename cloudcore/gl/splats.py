@@ -31,6 +31,7 @@ from cloudcore.kernel import SPLAT_SHARPNESS
 from cloudcore.limits import MAX_LIGHTS
 from cloudcore.particle_styles import ParticleStyles
 from cloudcore.phase import PHASE_NAMES
+from cloudcore.point_sprites import draw_runs, guard_band, plain_splats, point_sprite_mask
 from cloudcore.sprites import ATLAS_GRID, ATLAS_MAX_MIP_LEVEL, load_atlas
 
 #: two triangles over a particle's four corners (lower left, lower right, upper left, upper right)
@@ -107,8 +108,16 @@ def splat_batch(
 class SplatPass:
     def __init__(self):
         defines = {"SPLAT_SHARPNESS": SPLAT_SHARPNESS, "ATLAS_GRID": ATLAS_GRID}
-        self._program = build_program("splat", defines)
-        self._counting_program = build_program("splat", defines | {"COUNT_FRAGMENTS": 1})
+        counting, points = {"COUNT_FRAGMENTS": 1}, {"POINT_SPRITE": 1}
+        #: (points?, counting?) -> program
+        self._programs = {
+            (False, False): build_program("splat", defines),
+            (False, True): build_program("splat", defines | counting),
+            (True, False): build_program("splat", defines | points, vertex="splat_point"),
+            (True, True): build_program("splat", defines | points | counting, vertex="splat_point"),
+        }
+        self._point_sizes_px = tuple(float(size) for size in GL.glGetFloatv(GL.GL_POINT_SIZE_RANGE))
+        self._plain: np.ndarray = np.zeros(0, dtype=bool)  # of the resident particles: `plain_splats`
         self._shade_program = build_compute_program(
             "splat_shade",
             {"MAX_LIGHTS": MAX_LIGHTS, "FADE_START_RADII": FADE_START_RADII, "FADE_END_RADII": FADE_END_RADII},
@@ -137,26 +146,61 @@ class SplatPass:
         *,
         depth_test: bool = True,
         counting: bool = False,
-    ) -> None:
-        """Blend the batch over the bound target (premultiplied), or add 1 per fragment when counting."""
+        point_sprites: bool = True,
+    ) -> int:
+        """Blend the batch over the bound target (premultiplied), or add 1 per fragment when counting.
+
+        With `point_sprites`, the runs of the batch that `cloudcore.point_sprites` allows are drawn as
+        points, the rest as quads, in the batch's order; returns the particles drawn as points.
+        """
         if not len(batch):
-            return
+            return 0
         self._shade(batch, view)
-        program = self._counting_program if counting else self._program
-        GL.glUseProgram(program)
         view_rotation = np.array(view, dtype=np.float64)
         view_rotation[:3, 3] = 0.0  # corners come relative to the batch's eye, the view's own
-        set_matrix(program, "view_rotation", view_rotation)
-        set_matrix(program, "projection", projection)
+        pieces, target_viewport = [(0, len(batch), False)], None
+        if point_sprites and self._plain[batch.order].any():
+            # the same pixels through a clip volume wider than the target (cloudcore.point_sprites)
+            target_viewport = GL.glGetIntegerv(GL.GL_VIEWPORT)
+            projection, viewport = guard_band(projection, target_viewport[2:], self._point_sizes_px[1])
+            pieces = self._runs(batch, view_rotation, projection, viewport[2:])
+            GL.glViewport(*viewport)
+        for as_points in {piece[2] for piece in pieces}:
+            program = self._programs[as_points, counting]
+            GL.glUseProgram(program)
+            set_matrix(program, "view_rotation", view_rotation)
+            set_matrix(program, "projection", projection)
+            if as_points:
+                GL.glUniform1f(GL.glGetUniformLocation(program, "viewport_height"), float(viewport[3]))
         if self._atlas is not None:
             GL.glActiveTexture(GL.GL_TEXTURE0)
             GL.glBindTexture(GL.GL_TEXTURE_2D, self._atlas)
         GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _INSTANCES_BINDING, self._instance_buffer)
         GL.glBindVertexArray(self._vertex_array)
         self._index_quads(len(batch))
+        GL.glEnable(GL.GL_PROGRAM_POINT_SIZE)
         with cloud_blending(depth_test, counting):
-            GL.glDrawElements(GL.GL_TRIANGLES, 6 * len(batch), GL.GL_UNSIGNED_INT, ctypes.c_void_p(0))
+            for start, stop, as_points in pieces:
+                GL.glUseProgram(self._programs[as_points, counting])
+                if as_points:
+                    GL.glDrawArrays(GL.GL_POINTS, start, stop - start)
+                else:
+                    offset = ctypes.c_void_p(6 * 4 * start)  # six uint32 indices a particle
+                    GL.glDrawElements(GL.GL_TRIANGLES, 6 * (stop - start), GL.GL_UNSIGNED_INT, offset)
+        GL.glDisable(GL.GL_PROGRAM_POINT_SIZE)
         GL.glBindVertexArray(0)
+        if target_viewport is not None:
+            GL.glViewport(*target_viewport)
+        return sum(stop - start for start, stop, as_points in pieces if as_points)
+
+    def _runs(self, batch: SplatBatch, view_rotation, projection, viewport) -> list[tuple[int, int, bool]]:
+        """The batch's runs of points and of quads (`cloudcore.point_sprites.draw_runs`) in a (width, height)
+        viewport."""
+        size = (int(viewport[0]), int(viewport[1]))
+        fit = point_sprite_mask(
+            batch.centres - batch.eye, batch.radii, view_rotation, projection, size, self._point_sizes_px
+        )
+        return draw_runs(self._plain[batch.order] & fit)
 
     def _index_quads(self, count: int) -> None:
         """Grow the (bound vertex array's) element buffer to hold the triangles of `count` particles."""
@@ -215,6 +259,7 @@ class SplatPass:
                 np.tile(np.array(_UNLOCKED, dtype=np.float32), (max(len(particles.radii), 1), 1)),
                 GL.GL_DYNAMIC_DRAW,
             )
+            self._plain = plain_splats(particles.styles)
             if self._atlas is None and np.any(particles.styles.sprite_index >= 0):
                 self._atlas = _atlas_texture()
             _store(self._formation_buffer, np.ones(max(len(particles.radii), 1), dtype=np.float32))
@@ -234,7 +279,7 @@ class SplatPass:
 
     def close(self) -> None:
         """Free the GL objects (the context must be current)."""
-        for program in (self._program, self._counting_program, self._shade_program):
+        for program in (*self._programs.values(), self._shade_program):
             GL.glDeleteProgram(program)
         if self._atlas is not None:
             GL.glDeleteTextures([self._atlas])

@@ -4,9 +4,15 @@
 // (cloudcore.sprites): its cell's texture, alpha the sprite's opacity and rgb a
 // brightness that multiplies the colour.  Output is premultiplied for
 // glBlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA).  With COUNT_FRAGMENTS defined every
-// fragment kept writes 1, for additive blending into the overdraw counter.
+// fragment kept writes 1, for additive blending into the overdraw counter.  With POINT_SPRITE
+// defined it draws the point sprites of splat_point.vert.glsl.
 
+#ifdef POINT_SPRITE
+// a point's square, y up as the quad's (gl_PointCoord has its origin at the upper left)
+#define splat_position vec2(2.0 * gl_PointCoord.x - 1.0, 1.0 - 2.0 * gl_PointCoord.y)
+#else
 in vec2 splat_position;
+#endif
 in vec4 colour;
 flat in int sprite;
 out vec4 frag_colour;
