@@ -30,8 +30,10 @@ import numpy as np
 
 from cloudcore.particle_styles import FACING_SPLAT, ParticleStyles
 
-#: a run of points pays for its own draw call beyond this many particles (measured: docs/performance.md)
-SHORTEST_POINT_RUN = 256
+#: a run of points costs two more draws (one each side) than drawing it with its neighbours as quads: on
+#: llvmpipe 3.4 us a draw against about 1 us saved a particle, even at 6-7 particles; twice that for
+#: margin (scripts/bench_point_sprites.py, docs/performance.md)
+SHORTEST_POINT_RUN = 16
 
 
 def plain_splats(styles: ParticleStyles) -> np.ndarray:

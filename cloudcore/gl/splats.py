@@ -113,8 +113,8 @@ class SplatPass:
         self._programs = {
             (False, False): build_program("splat", defines),
             (False, True): build_program("splat", defines | counting),
-            (True, False): build_program("splat", defines | points, vertex="splat_point"),
-            (True, True): build_program("splat", defines | points | counting, vertex="splat_point"),
+            (True, False): build_program("splat", defines | points),
+            (True, True): build_program("splat", defines | points | counting),
         }
         self._point_sizes_px = tuple(float(size) for size in GL.glGetFloatv(GL.GL_POINT_SIZE_RANGE))
         self._plain: np.ndarray = np.zeros(0, dtype=bool)  # of the resident particles: `plain_splats`

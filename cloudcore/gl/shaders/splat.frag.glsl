@@ -5,7 +5,7 @@
 // brightness that multiplies the colour.  Output is premultiplied for
 // glBlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA).  With COUNT_FRAGMENTS defined every
 // fragment kept writes 1, for additive blending into the overdraw counter.  With POINT_SPRITE
-// defined it draws the point sprites of splat_point.vert.glsl.
+// defined it draws the point sprites of splat.vert.glsl.
 
 #ifdef POINT_SPRITE
 // a point's square, y up as the quad's (gl_PointCoord has its origin at the upper left)

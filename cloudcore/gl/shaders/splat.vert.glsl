@@ -2,7 +2,11 @@
 // Draws the quads splat_shade.comp.glsl built: four vertices per particle,
 // as indexed triangles rather than instances (a software rasteriser runs its
 // vertex pipeline once per instance).  Corners come relative to the eye,
-// so the view matrix applies without its translation.
+// so the view matrix applies without its translation.  With POINT_SPRITE
+// defined, one vertex per particle instead, a point sprite of the quad's
+// square (cloudcore.point_sprites says when the picture is the same); its
+// centre and radius come back from the corners, so that one compute shader
+// serves both ways of drawing.
 
 struct Instance {
     vec4 corners[4];  // relative to the eye; w: atlas cell (-1: Gaussian splat)
@@ -13,9 +17,26 @@ layout(std430, binding = 3) readonly buffer Instances { Instance instances[]; };
 uniform mat4 view_rotation;  // the view matrix without its translation
 uniform mat4 projection;
 
-out vec2 splat_position;  // corner in radii: the kernel's d = length(splat_position)
 out vec4 colour;          // per corner: the artist model's varies up a sprite
 flat out int sprite;      // atlas cell, -1 for a Gaussian splat
+
+#ifdef POINT_SPRITE
+uniform float viewport_height;  // pixels
+
+void main()
+{
+    Instance instance = instances[gl_VertexID];
+    // corners 0 and 3 are opposite, (-1, -1) and (1, 1); 0 and 1 are 2r apart along the image's right
+    vec3 centre = 0.5 * (instance.corners[0].xyz + instance.corners[3].xyz);
+    float radius = 0.5 * length(instance.corners[1].xyz - instance.corners[0].xyz);
+    gl_Position = projection * (view_rotation * vec4(centre, 1.0));
+    // the square's side in pixels: 2r * projection[1][1] / w of the 2 that viewport_height spans
+    gl_PointSize = radius * projection[1][1] * viewport_height / gl_Position.w;
+    colour = instance.colours[0];
+    sprite = -1;
+}
+#else
+out vec2 splat_position;  // corner in radii: the kernel's d = length(splat_position)
 
 const vec2 CORNERS[4] = vec2[](vec2(-1.0, -1.0), vec2(1.0, -1.0), vec2(-1.0, 1.0), vec2(1.0, 1.0));
 
@@ -28,3 +49,4 @@ void main()
     colour = instances[slot].colours[k];
     sprite = int(corner.w);
 }
+#endif
