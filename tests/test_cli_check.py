@@ -3,6 +3,7 @@ they are, `--update` makes them pass, broken goldens say so, the same view rende
 
 import dataclasses
 import math
+from pathlib import Path
 
 import imageio.v3 as iio
 import numpy as np
@@ -10,6 +11,7 @@ import pytest
 
 from cloudcore.cli import main
 from cloudcore.overlays import to_pixels
+from cloudcore.resources import resource_path
 from cloudcore.scene import Camera, CameraPath, Cloud, Lighting, Scene, View
 from cloudcore.scenefile import load_scene, save_scene
 from cloudcore.screenshot_check import encode_png, view_camera
@@ -17,6 +19,11 @@ from cloudcore.screenshot_check import encode_png, view_camera
 pytestmark = pytest.mark.gl
 
 SIZE = (96, 72)
+#: the views of a shipped example scene, checked as a user's CI would check theirs; regenerated on purpose with
+#:   cloudview check cloudcore/resources/scenes/aircraft_in_cloud.toml --goldens tests/check_goldens \
+#:       --size 160x120 --update
+EXAMPLE = resource_path("scenes", "aircraft_in_cloud.toml")
+EXAMPLE_GOLDENS = Path(__file__).parent / "check_goldens"
 VIEWS = ("default", "dusk", "along", "impostors")
 
 
@@ -205,3 +212,11 @@ def test_bad_input_is_one_line_and_status_2(tmp_path, capsys):
     with pytest.raises(SystemExit) as exited:
         main(["check", str(tmp_path / "a"), "--goldens", str(tmp_path / "g"), "--size", "96"])
     assert exited.value.code == 2 and "invalid frame_size value: '96'" in capsys.readouterr().err
+
+
+def test_the_example_scene_matches_its_committed_goldens(capsys):
+    assert main(["check", str(EXAMPLE), "--goldens", str(EXAMPLE_GOLDENS), "--size", "160x120"]) == 0
+    output = lines(capsys)
+    assert [line.split(": ")[:2] for line in output[:-1]] == [
+        [f"aircraft_in_cloud/{view}", "pass"] for view in ("default", "sunset", "orbit_quarter")
+    ]
