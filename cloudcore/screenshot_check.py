@@ -228,7 +228,7 @@ def _report_row(entry: ReportEntry) -> str:
     detail = check.problem or str(check.tolerance)
     status = "pass" if check.passed else "fail"
     return (
-        f"<tr class='{status}'>{cell(check.scene, check.scene)}{cell(check.view, check.view)}"
+        f"<tr class='{status}'>{cell(check.label, check.label)}"
         f"<td data-sort='{int(check.passed)}'><b>{html.escape(verdict)}</b><br><small>{html.escape(detail)}</small>"
         f"</td>{numbers}{image(entry.expected)}{image(entry.actual)}{image(entry.diff)}</tr>"
     )
@@ -242,23 +242,26 @@ _PAGE = """<!DOCTYPE html>
 <style>
 body {{ font-family: sans-serif; margin: 1.5em; color: #222; }}
 table {{ border-collapse: collapse; }}
-th, td {{ border: 1px solid #ccc; padding: 4px 8px; text-align: left; vertical-align: middle; }}
+th, td {{ border: 1px solid #ccc; padding: 4px 6px; text-align: left; vertical-align: middle; }}
 th {{ background: #eee; cursor: pointer; user-select: none; white-space: nowrap; }}
 th:hover {{ background: #ddd; }}
 th.sorted::after {{ content: " \\25B2"; }}
 th.sorted.descending::after {{ content: " \\25BC"; }}
-tr.fail td:nth-child(3) {{ color: #b00; }}
-tr.pass td:nth-child(3) {{ color: #070; }}
-td.none {{ color: #999; text-align: center; }}
-img {{ width: 200px; display: block; background: #000; }}
+td:nth-child(2) {{ max-width: 15em; overflow-wrap: anywhere; }}
+td:nth-child(3), td:nth-child(4), td:nth-child(5) {{ text-align: right; font-variant-numeric: tabular-nums; }}
+tr.fail td:nth-child(2) b {{ color: #b00; }}
+tr.pass td:nth-child(2) b {{ color: #070; }}
+td.none {{ color: #999; text-align: center; width: 160px; }}
+/* pixelated: a thumbnail smaller than its image must not blur a few changed pixels of the diff away */
+img {{ width: 160px; display: block; background: #000; image-rendering: pixelated; }}
 small {{ color: #666; }}
 </style>
 </head>
 <body>
 <h1>{title}</h1>
-<p>{summary}. Click a column to sort by it; click an image for full size.</p>
+<p>{summary}. Click a column to sort by it, again to reverse; click an image for full size.</p>
 <table id="views">
-<thead><tr><th>scene</th><th>view</th><th>result</th><th>PSNR (dB)</th><th>mean |diff|</th><th>max |diff|</th>
+<thead><tr><th>scene / view</th><th>result</th><th>PSNR (dB)</th><th>mean |diff|</th><th>max |diff|</th>
 <th>expected</th><th>actual</th><th>diff (x8)</th></tr></thead>
 <tbody>
 {rows}
