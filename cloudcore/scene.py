@@ -190,7 +190,8 @@ class View:
     The eye is at `position` looking at `look_at`, or `t` seconds along the
     camera path named `camera_path`; what a view leaves out (None) is the
     scene's camera's, so a view that only sets `time_of_day` moves with
-    `[camera]`.  `mode` and `settings` (RenderSettings field names and values,
+    `[camera]`.  `time_s` is the scene clock (objects on their paths, clouds
+    forming).  `mode` and `settings` (RenderSettings field names and values,
     in file order) say how the clouds are drawn; `tolerance_psnr` and
     `max_diff` override the check's tolerance for this view alone.
     """
@@ -202,6 +203,7 @@ class View:
     camera_path: str | None = None
     t: float = 0.0
     time_of_day: float | None = None
+    time_s: float = 0.0
     mode: str = "full"
     settings: tuple[tuple[str, object], ...] = ()
     tolerance_psnr: float | None = None

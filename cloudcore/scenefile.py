@@ -270,6 +270,7 @@ def _view(t: _Table, camera: Camera, paths: tuple[CameraPath, ...]) -> View:
             "camera_path",
             "t",
             "time_of_day",
+            "time_s",
             "mode",
             "settings",
             "tolerance_psnr",
@@ -312,6 +313,7 @@ def _view(t: _Table, camera: Camera, paths: tuple[CameraPath, ...]) -> View:
         camera_path=camera_path,
         t=t_s,
         time_of_day=t.number("time_of_day", None, low=0.0, high=24.0) if t.has("time_of_day") else None,
+        time_s=t.number("time_s", 0.0),
         mode=mode,
         settings=settings,
         tolerance_psnr=t.number("tolerance_psnr", None, low=0.0) if t.has("tolerance_psnr") else None,
@@ -616,6 +618,8 @@ def _view_dict(view: View) -> dict:
         out["t"] = view.t
     if view.time_of_day is not None:
         out["time_of_day"] = view.time_of_day
+    if view.time_s:
+        out["time_s"] = view.time_s
     out["mode"] = view.mode
     if view.settings:
         out["settings"] = dict(view.settings)

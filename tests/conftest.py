@@ -75,7 +75,7 @@ def small_scene() -> Scene:
                 tolerance_psnr=35.0,
                 max_diff=20,
             ),
-            View("orbiting", camera_path="orbit", t=2.5, fov_y_deg=40.0),
+            View("orbiting", camera_path="orbit", t=2.5, fov_y_deg=40.0, time_s=7.5),
         ),
     )
 

@@ -14,7 +14,7 @@ from cloudcore.overlays import to_pixels
 from cloudcore.resources import resource_path
 from cloudcore.scene import Camera, CameraPath, Cloud, Lighting, Scene, View
 from cloudcore.scenefile import load_scene, save_scene
-from cloudcore.screenshot_check import encode_png, view_camera
+from cloudcore.screenshot_check import Tolerance, check_view, encode_png, view_camera
 
 pytestmark = pytest.mark.gl
 
@@ -218,5 +218,8 @@ def test_the_example_scene_matches_its_committed_goldens(capsys):
     assert main(["check", str(EXAMPLE), "--goldens", str(EXAMPLE_GOLDENS), "--size", "160x120"]) == 0
     output = lines(capsys)
     assert [line.split(": ")[:2] for line in output[:-1]] == [
-        [f"aircraft_in_cloud/{view}", "pass"] for view in ("default", "sunset", "orbit_quarter")
+        [f"aircraft_in_cloud/{view}", "pass"] for view in ("default", "sunset", "aircraft_inside", "orbit_quarter")
     ]
+    # the view at 10 s on the scene clock has the aircraft in the cloud's heart, where the default view at 0 s has not
+    inside = iio.imread(EXAMPLE_GOLDENS / "aircraft_in_cloud" / "aircraft_inside.png")
+    assert not check_view("a", "v", inside, EXAMPLE_GOLDENS / "aircraft_in_cloud" / "default.png", Tolerance()).passed

@@ -78,6 +78,7 @@ def test_view_settings_and_tolerance():
         ({"t": 1.0}, "views[0].t", "this view has none"),
         ({"look_at": [0.0, 500.0, 1500.0]}, "views[0].look_at", "must differ from position"),
         ({"time_of_day": 25}, "views[0].time_of_day", "must be within [0.0, 24.0]"),
+        ({"time_s": "noon"}, "views[0].time_s", "expected a number"),
         ({"mode": "fast"}, "views[0].mode", "'fast' is not one of: auto, full, impostor"),
         ({"settings": {"mode": "auto"}}, "views[0].settings.mode", "unknown key"),
         ({"settings": {"tolerance_deg": 200.0}}, "views[0].settings", "tolerance_deg must be within [0, 180]"),

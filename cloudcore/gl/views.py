@@ -34,6 +34,7 @@ class ViewRenderer:
             time_of_day=view.time_of_day,
             camera=view_camera(scene, view),
             settings=view_settings(view),
+            time_s=view.time_s,
             costs=LLVMPIPE_COSTS,
         )
         return image
