@@ -298,7 +298,9 @@ def _view(t: _Table, camera: Camera, paths: tuple[CameraPath, ...]) -> View:
     elif t.has("t"):
         t.fail("t", "t is seconds along camera_path, and this view has none")
     elif np.allclose(position or camera.position, look_at or camera.look_at, rtol=0, atol=0):
-        t.fail("look_at" if look_at is not None else "position", "must differ from position (look_at)")
+        if look_at is not None:
+            t.fail("look_at", "must differ from position")
+        t.fail("position", "must differ from look_at (the scene camera's)")
     mode = t.string("mode", "full", choices=MODES)
     settings = t.table("settings", _view_settings) or ()
     try:
@@ -339,7 +341,7 @@ def _view_settings(t: _Table) -> tuple[tuple[str, object], ...]:
             value = t.raw(key)
         elif isinstance(default, int):
             value = t.integer(key, None, low=0, high=2**31 - 1)
-        elif isinstance(default, str):
+        elif isinstance(default, str):  # translation_metric: the one string field but mode
             value = t.string(key, choices=TRANSLATION_METRICS)
         elif key == "ring_radius" and t.raw(key) == math.inf:  # inf: no ring, as on the command line
             value = math.inf

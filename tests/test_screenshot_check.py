@@ -77,6 +77,7 @@ def test_view_settings_and_tolerance():
         ({"camera_path": "pass", "t": 9.0}, "views[0].t", "must be within [0.0, 8.0]"),
         ({"t": 1.0}, "views[0].t", "this view has none"),
         ({"look_at": [0.0, 500.0, 1500.0]}, "views[0].look_at", "must differ from position"),
+        ({"position": [0.0, 800.0, 0.0]}, "views[0].position", "must differ from look_at (the scene camera's)"),
         ({"time_of_day": 25}, "views[0].time_of_day", "must be within [0.0, 24.0]"),
         ({"time_s": "noon"}, "views[0].time_s", "expected a number"),
         ({"mode": "fast"}, "views[0].mode", "'fast' is not one of: auto, full, impostor"),
