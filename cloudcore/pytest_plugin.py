@@ -27,7 +27,6 @@ from pathlib import Path
 import pytest
 
 GOLDENS_FOLDER = "cloudview_goldens"
-DEFAULT_SIZE = (160, 120)
 
 
 def pytest_addoption(parser):
@@ -81,15 +80,24 @@ def _cloudview_session(request, tmp_path_factory):
 
 @pytest.fixture
 def cloudview_check(request, _cloudview_session):
-    """`cloudview_check(scene, view="default", *, size=(160, 120), tolerance_psnr=None, max_diff=None)`: render
+    """`cloudview_check(scene, view="default", *, size=(320, 240), tolerance_psnr=None, max_diff=None)`: render
     the view and fail the test unless it matches its golden; returns the `ViewCheck`."""
     from cloudcore.errors import SceneError
+    from cloudcore.scene import DEFAULT_VIEW_NAME
     from cloudcore.scenefile import load_scene
-    from cloudcore.screenshot_check import Tolerance, check_view, find_view, golden_path, keep_images, update_golden
+    from cloudcore.screenshot_check import (
+        DEFAULT_SIZE,
+        Tolerance,
+        check_view,
+        find_view,
+        golden_path,
+        keep_images,
+        update_golden,
+    )
 
     session, here = _cloudview_session, request.path.parent
 
-    def check(scene, view: str = "default", *, size=DEFAULT_SIZE, tolerance_psnr=None, max_diff=None):
+    def check(scene, view: str = DEFAULT_VIEW_NAME, *, size=DEFAULT_SIZE, tolerance_psnr=None, max_diff=None):
         scene_file = here / scene
         try:
             loaded = load_scene(scene_file)

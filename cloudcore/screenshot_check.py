@@ -29,6 +29,8 @@ from cloudcore.settings import RenderSettings
 #: builds and GPUs may differ by rounding, not by a visible change)
 DEFAULT_MIN_PSNR_DB = 40.0
 DEFAULT_MAX_DIFF = 12
+#: frame size (width, height) of a view unless the check says otherwise
+DEFAULT_SIZE = (320, 240)
 
 
 @dataclass(frozen=True)

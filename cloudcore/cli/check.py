@@ -22,6 +22,7 @@ from cloudcore.scenefile import load_scene
 from cloudcore.screenshot_check import (
     DEFAULT_MAX_DIFF,
     DEFAULT_MIN_PSNR_DB,
+    DEFAULT_SIZE,
     Tolerance,
     check_view,
     golden_path,
@@ -29,8 +30,6 @@ from cloudcore.screenshot_check import (
     update_golden,
     write_report,
 )
-
-DEFAULT_SIZE = (320, 240)
 
 
 def add_parser(commands) -> None:
