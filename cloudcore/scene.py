@@ -179,6 +179,37 @@ class CameraPath(_Record):
         return float(self.keys[-1, 0] - self.keys[0, 0])
 
 
+#: the view every scene has: its `[camera]`, its lighting, full 3D (a `[[views]]` entry may not take the name)
+DEFAULT_VIEW_NAME = "default"
+
+
+@dataclass(frozen=True)
+class View:
+    """A named picture of the scene for screenshot tests (`cloudview check`).
+
+    The eye is at `position` looking at `look_at`, or `t` seconds along the
+    camera path named `camera_path`; what a view leaves out (None) is the
+    scene's camera's, so a view that only sets `time_of_day` moves with
+    `[camera]`.  `time_s` is the scene clock (objects on their paths, clouds
+    forming).  `mode` and `settings` (RenderSettings field names and values,
+    in file order) say how the clouds are drawn; `tolerance_psnr` and
+    `max_diff` override the check's tolerance for this view alone.
+    """
+
+    name: str
+    position: Vec3 | None = None
+    look_at: Vec3 | None = None
+    fov_y_deg: float | None = None
+    camera_path: str | None = None
+    t: float = 0.0
+    time_of_day: float | None = None
+    time_s: float = 0.0
+    mode: str = "full"
+    settings: tuple[tuple[str, object], ...] = ()
+    tolerance_psnr: float | None = None
+    max_diff: int | None = None
+
+
 @dataclass(frozen=True)
 class Scene:
     camera: Camera = Camera()
@@ -189,6 +220,8 @@ class Scene:
     objects: tuple[SceneObject, ...] = ()
     camera_paths: tuple[CameraPath, ...] = ()
     description: str = ""
+    #: the named views of `[[views]]`; `all_views` adds the default one first
+    views: tuple[View, ...] = ()
 
     @property
     def particle_count(self) -> int:
@@ -200,3 +233,8 @@ class Scene:
                 return path
         known = ", ".join(p.name for p in self.camera_paths) or "none"
         raise KeyError(f"no camera path named {name!r}; the scene has: {known}")
+
+    @property
+    def all_views(self) -> tuple[View, ...]:
+        """The default view (the scene's camera and lighting, full 3D), then the named ones."""
+        return (View(DEFAULT_VIEW_NAME), *self.views)

@@ -24,7 +24,20 @@ from cloudcore.errors import FieldError, SceneError
 from cloudcore.formation import FORMATION_KINDS, Formation
 from cloudcore.limits import scene_limit_problems
 from cloudcore.phase import MAX_ABS_G, PHASE_NAMES
-from cloudcore.scene import Camera, CameraPath, Cloud, Light, Lighting, Scene, SceneObject, Shading, Terrain
+from cloudcore.scene import (
+    DEFAULT_VIEW_NAME,
+    Camera,
+    CameraPath,
+    Cloud,
+    Light,
+    Lighting,
+    Scene,
+    SceneObject,
+    Shading,
+    Terrain,
+    View,
+)
+from cloudcore.settings import MODES, TRANSLATION_METRICS, RenderSettings
 from cloudcore.sprites import FACINGS, MAX_SEED, SpriteStyle
 
 PRIMITIVES = ("box", "sphere", "aircraft")
@@ -209,7 +222,7 @@ def load_scene(path) -> Scene:
 def scene_from_dict(data: dict, source: str = "<scene>", base_dir=Path(".")) -> Scene:
     root = _Table(source, "", data)
     root.reject_unknown(
-        ("description", "camera", "lighting", "shading", "clouds", "terrain", "objects", "camera_paths")
+        ("description", "camera", "lighting", "shading", "clouds", "terrain", "objects", "camera_paths", "views")
     )
     clouds = tuple(_cloud(t, Path(base_dir)) for t in root.tables("clouds"))
     _unique_names(root, "clouds", clouds)
@@ -217,8 +230,11 @@ def scene_from_dict(data: dict, source: str = "<scene>", base_dir=Path(".")) -> 
     _unique_names(root, "objects", objects)
     paths = tuple(_camera_path(t) for t in root.tables("camera_paths"))
     _unique_names(root, "camera_paths", paths)
+    camera = _camera(_Table(source, "camera", root.raw("camera", {})))
+    views = tuple(_view(t, camera, paths) for t in root.tables("views"))
+    _unique_names(root, "views", views)
     scene = Scene(
-        camera=_camera(_Table(source, "camera", root.raw("camera", {}))),
+        camera=camera,
         lighting=_lighting(_Table(source, "lighting", root.raw("lighting", {}))),
         shading=_shading(_Table(source, "shading", root.raw("shading", {}))),
         clouds=clouds,
@@ -226,6 +242,7 @@ def scene_from_dict(data: dict, source: str = "<scene>", base_dir=Path(".")) -> 
         objects=objects,
         camera_paths=paths,
         description=root.string("description", ""),
+        views=views,
     )
     # what every field allows, the renderer may still not draw: refuse that here, not in the GL code
     problems = scene_limit_problems(scene)
@@ -240,6 +257,98 @@ def _unique_names(root: _Table, key: str, items) -> None:
         if item.name in seen:
             raise _error(root.source, f"{key}[{i}].name", f"duplicate name {item.name!r}")
         seen.add(item.name)
+
+
+def _view(t: _Table, camera: Camera, paths: tuple[CameraPath, ...]) -> View:
+    """One `[[views]]` table; what it leaves out of the camera is `camera`'s (the scene's)."""
+    t.reject_unknown(
+        (
+            "name",
+            "position",
+            "look_at",
+            "fov_y_deg",
+            "camera_path",
+            "t",
+            "time_of_day",
+            "time_s",
+            "mode",
+            "settings",
+            "tolerance_psnr",
+            "max_diff",
+        )
+    )
+    name = t.string("name")
+    if name == DEFAULT_VIEW_NAME:
+        t.fail("name", f"{DEFAULT_VIEW_NAME!r} is the scene's [camera]; give this view another name")
+    # the name is a file name too: the golden is <goldens>/<scene>/<view>.png
+    if not name or name.startswith(".") or not all(ch.isalnum() or ch in "-_." for ch in name):
+        t.fail("name", f"{name!r} must be letters, digits, '-', '_' or '.' (not first), to name a golden file")
+    position = t.vector("position", None) if t.has("position") else None
+    look_at = t.vector("look_at", None) if t.has("look_at") else None
+    camera_path = t.string("camera_path") if t.has("camera_path") else None
+    t_s = 0.0
+    if camera_path is not None:
+        if position is not None or look_at is not None:
+            t.fail("camera_path", "give either position and look_at, or camera_path and t, not both")
+        path = next((p for p in paths if p.name == camera_path), None)
+        if path is None:
+            known = ", ".join(p.name for p in paths) or "none"
+            t.fail("camera_path", f"no camera path named {camera_path!r}; the scene has: {known}")
+        t_s = t.number("t", 0.0, low=0.0, high=path.duration)
+    elif t.has("t"):
+        t.fail("t", "t is seconds along camera_path, and this view has none")
+    elif np.allclose(position or camera.position, look_at or camera.look_at, rtol=0, atol=0):
+        if look_at is not None:
+            t.fail("look_at", "must differ from position")
+        t.fail("position", "must differ from look_at (the scene camera's)")
+    mode = t.string("mode", "full", choices=MODES)
+    settings = t.table("settings", _view_settings) or ()
+    try:
+        RenderSettings(mode=mode, **dict(settings))
+    except ValueError as error:
+        t.fail("settings", str(error))
+    return View(
+        name=name,
+        position=position,
+        look_at=look_at,
+        fov_y_deg=t.number("fov_y_deg", None, low=1.0, high=170.0) if t.has("fov_y_deg") else None,
+        camera_path=camera_path,
+        t=t_s,
+        time_of_day=t.number("time_of_day", None, low=0.0, high=24.0) if t.has("time_of_day") else None,
+        time_s=t.number("time_s", 0.0),
+        mode=mode,
+        settings=settings,
+        tolerance_psnr=t.number("tolerance_psnr", None, low=0.0) if t.has("tolerance_psnr") else None,
+        max_diff=t.integer("max_diff", None, low=0, high=255) if t.has("max_diff") else None,
+    )
+
+
+#: what a view's [views.settings] may set: every RenderSettings field but `mode` (a key of the view itself)
+VIEW_SETTINGS = tuple(f.name for f in dataclasses.fields(RenderSettings) if f.name != "mode")
+
+
+def _view_settings(t: _Table) -> tuple[tuple[str, object], ...]:
+    """RenderSettings overrides, each of its field's type; their ranges are RenderSettings' own (checked by the
+    caller, with the view's mode)."""
+    t.reject_unknown(VIEW_SETTINGS)
+    defaults = RenderSettings()
+    values = []
+    for key in t.data:
+        default = getattr(defaults, key)
+        if isinstance(default, bool):
+            if not isinstance(t.raw(key), bool):
+                t.fail(key, f"expected true or false, got {t.raw(key)!r}")
+            value = t.raw(key)
+        elif isinstance(default, int):
+            value = t.integer(key, None, low=0, high=2**31 - 1)
+        elif isinstance(default, str):  # translation_metric: the one string field but mode
+            value = t.string(key, choices=TRANSLATION_METRICS)
+        elif key == "ring_radius" and t.raw(key) == math.inf:  # inf: no ring, as on the command line
+            value = math.inf
+        else:
+            value = t.number(key)
+        values.append((key, value))
+    return tuple(values)
 
 
 def _camera(t: _Table) -> Camera:
@@ -494,7 +603,32 @@ def scene_to_dict(scene: Scene) -> dict:
     data["clouds"] = [_cloud_dict(cloud) for cloud in scene.clouds]
     data["objects"] = [_object_dict(o) for o in scene.objects]
     data["camera_paths"] = [{"name": p.name, "keys": _rows(p.keys)} for p in scene.camera_paths]
+    data["views"] = [_view_dict(view) for view in scene.views]
     return {k: v for k, v in data.items() if v != []}
+
+
+def _view_dict(view: View) -> dict:
+    """A view's table: only what it sets (left out, the scene's camera and the defaults apply)."""
+    out: dict = {"name": view.name}
+    for key in ("position", "look_at"):
+        if getattr(view, key) is not None:
+            out[key] = list(getattr(view, key))
+    for key in ("fov_y_deg", "camera_path"):
+        if getattr(view, key) is not None:
+            out[key] = getattr(view, key)
+    if view.camera_path is not None:
+        out["t"] = view.t
+    if view.time_of_day is not None:
+        out["time_of_day"] = view.time_of_day
+    if view.time_s:
+        out["time_s"] = view.time_s
+    out["mode"] = view.mode
+    if view.settings:
+        out["settings"] = dict(view.settings)
+    for key in ("tolerance_psnr", "max_diff"):
+        if getattr(view, key) is not None:
+            out[key] = getattr(view, key)
+    return out
 
 
 def _cloud_dict(cloud: Cloud) -> dict:
@@ -573,18 +707,9 @@ def save_scene(scene: Scene, path) -> Scene:
         else cloud
         for cloud in scene.clouds
     )
-    saved = Scene(
-        scene.camera,
-        scene.lighting,
-        scene.shading,
-        saved_clouds,
-        scene.terrain,
-        scene.objects,
-        scene.camera_paths,
-        scene.description,
-    )
+    saved = dataclasses.replace(scene, clouds=saved_clouds)
     document = tomlkit.dumps(scene_to_dict(saved)).encode("utf-8")
-    _atomic_write(path, lambda f: f.write(document))
+    atomic_write(path, lambda f: f.write(document))
     _remove_unnamed_particle_files(path, {c.particles_file for c in saved_clouds if c.particles_file is not None})
     return saved
 
@@ -612,7 +737,7 @@ def _store_particles(cloud: Cloud, path: Path) -> str:
         if _holds(path.parent / relative, particles):
             return relative
     relative = by_digest if (path.parent / default).exists() else default
-    _atomic_write(path.parent / relative, lambda f: np.save(f, particles))
+    atomic_write(path.parent / relative, lambda f: np.save(f, particles))
     return relative
 
 
@@ -627,7 +752,7 @@ def _holds(file: Path, particles: np.ndarray) -> bool:
 
 def _remove_unnamed_particle_files(path: Path, named: set) -> None:
     """After a save's commit: delete the .npy files in the scene's own folder its TOML no longer names, and
-    the temporary files that saves of this scene killed mid-write left (`_atomic_write` names them)."""
+    the temporary files that saves of this scene killed mid-write left (`atomic_write` names them)."""
     folder = path.parent / particles_folder(path)
     named_files = {(path.parent / relative).resolve() for relative in named}
     for file in [*folder.glob("*.npy"), *folder.glob(".*.tmp"), *path.parent.glob(f".{path.name}.*.tmp")]:
@@ -635,7 +760,7 @@ def _remove_unnamed_particle_files(path: Path, named: set) -> None:
             file.unlink(missing_ok=True)
 
 
-def _atomic_write(path: Path, write) -> None:
+def atomic_write(path: Path, write) -> None:
     """Write through a temporary file in the same folder, fsync, then rename over `path`."""
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)

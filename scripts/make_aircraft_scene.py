@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from cloudcore.cloudgen import cumulus
-from cloudcore.scene import Camera, CameraPath, Cloud, Lighting, Scene, SceneObject, Shading
+from cloudcore.scene import Camera, CameraPath, Cloud, Lighting, Scene, SceneObject, Shading, View
 from cloudcore.scenefile import save_scene
 
 SEED = 311
@@ -48,6 +48,14 @@ def build() -> Scene:
         clouds=(cloud,),
         objects=(SceneObject("aircraft", primitive="aircraft", scale=70.0, path=path),),
         camera_paths=(CameraPath("orbit", orbit),),
+        # named views for `cloudview check` (docs/screenshot-tests.md): the cloud at sunset; the aircraft in its
+        # heart at 10 s, the cloud split in layers around it; and from the side a quarter of the way round the
+        # orbit, in auto mode as the editor draws it
+        views=(
+            View("sunset", time_of_day=18.6),
+            View("aircraft_inside", time_s=10.0),
+            View("orbit_quarter", camera_path="orbit", t=5.0, mode="auto"),
+        ),
         description=f"An aircraft flying through one cumulus (split-layer tests); "
         f"scripts/make_aircraft_scene.py, seed {SEED}.",
     )

@@ -1,3 +1,4 @@
+import math
 import os
 from pathlib import Path
 
@@ -6,7 +7,7 @@ import pytest
 
 from cloudcore.artist_shading import ArtistShading
 from cloudcore.resources import DEFAULT_SCENE
-from cloudcore.scene import Camera, CameraPath, Cloud, Light, Lighting, Scene, SceneObject, Shading, Terrain
+from cloudcore.scene import Camera, CameraPath, Cloud, Light, Lighting, Scene, SceneObject, Shading, Terrain, View
 from cloudcore.sprites import SpriteStyle
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -33,7 +34,7 @@ def renderer():
 @pytest.fixture
 def small_scene() -> Scene:
     """A scene that touches every field: inline and file particles, sprites and artist shading, explicit
-    lights, objects, paths."""
+    lights, objects, paths, views."""
     rng = np.random.default_rng(4)
     small = np.column_stack([rng.normal(size=(12, 3)) * 50 + [0, 800, 0], rng.uniform(10, 20, 12)])
     large = np.column_stack([rng.normal(size=(200, 3)) * 80 + [400, 900, 0], rng.uniform(15, 30, 200)])
@@ -64,6 +65,18 @@ def small_scene() -> Scene:
         ),
         camera_paths=(CameraPath("orbit", np.array([[0, 0, 500, 1500, 0, 800, 0], [5, 1500, 600, 0, 0, 800, 0]])),),
         description="every field",
+        views=(
+            View(
+                "noon_from_above",
+                position=(0.0, 2000.0, 800.0),
+                time_of_day=12.0,
+                mode="auto",
+                settings=(("tolerance_deg", 0.25), ("ring_radius", math.inf), ("group_clouds", False)),
+                tolerance_psnr=35.0,
+                max_diff=20,
+            ),
+            View("orbiting", camera_path="orbit", t=2.5, fov_y_deg=40.0, time_s=7.5),
+        ),
     )
 
 

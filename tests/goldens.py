@@ -1,44 +1,36 @@
 """Comparing renders with committed golden PNGs (tests/golden/), shared by the golden-image tests.
 
-Tolerance: PSNR >= 40 dB and no channel off by more than 12 levels of 255, so
-llvmpipe builds and GPUs may differ by rounding but not by a visible change.
-On failure the numbers are printed and tests/_failures/ gets the rendered
-image, the golden and an amplified diff.  Goldens are made on llvmpipe and
-rewritten only on purpose:
+The comparison is `cloudview check`'s (`cloudcore.screenshot_check`), with its
+default tolerance: PSNR >= 40 dB and no channel off by more than 12 levels of
+255, so llvmpipe builds and GPUs may differ by rounding but not by a visible
+change.  On failure the line says why and tests/_failures/golden/ gets the
+rendered image, the golden and an amplified diff.  Goldens are made on
+llvmpipe and rewritten only on purpose (those whose pixels changed):
 
     ./run tests tests/test_render_golden.py tests/test_render_presets.py --regenerate-goldens
 """
 
 from pathlib import Path
 
-import imageio.v3 as iio
 import pytest
 
-from cloudcore.imagecompare import compare, diff_image
+from cloudcore.screenshot_check import Tolerance, check_view, keep_images, update_golden
 
 GOLDEN = Path(__file__).parent / "golden"
 FAILURES = Path(__file__).parent / "_failures"
-MIN_PSNR_DB = 40.0
-MAX_ABS = 12
+TOLERANCE = Tolerance()
+MIN_PSNR_DB, MAX_ABS = TOLERANCE.min_psnr_db, TOLERANCE.max_diff
+REGENERATE = "./run tests tests/test_render_golden.py tests/test_render_presets.py --regenerate-goldens"
 
 
 def check_golden(image, name: str, request) -> None:
     """Fail unless `image` matches tests/golden/NAME.png (or rewrite it under --regenerate-goldens)."""
-    golden_path = GOLDEN / f"{name}.png"
+    result = check_view("golden", name, image, GOLDEN / f"{name}.png", TOLERANCE)
     if request.config.getoption("--regenerate-goldens"):
-        golden_path.parent.mkdir(exist_ok=True)
-        iio.imwrite(golden_path, image)
-        pytest.skip(f"regenerated {golden_path}")
-    assert golden_path.exists(), f"no golden {golden_path}: run with --regenerate-goldens on purpose"
-    golden = iio.imread(golden_path)
-    difference = compare(image, golden)
-    if not difference.within(MIN_PSNR_DB, MAX_ABS):
-        FAILURES.mkdir(exist_ok=True)
-        iio.imwrite(FAILURES / f"{name}-actual.png", image)
-        iio.imwrite(FAILURES / f"{name}-expected.png", golden)
-        iio.imwrite(FAILURES / f"{name}-diff.png", diff_image(image, golden))
-        pytest.fail(
-            f"{name}: {difference} (limits: PSNR >= {MIN_PSNR_DB} dB, max |diff| <= {MAX_ABS}); images in {FAILURES}"
-        )
+        if update_golden(result, image):
+            pytest.skip(f"regenerated {result.golden}")
+    elif not result.passed:
+        keep_images(FAILURES, result, image)
+        pytest.fail(f"{result.line(REGENERATE)}; images in {FAILURES / result.scene}", pytrace=False)
     # every golden shows something: no NaN-black frame, no flat colour
     assert image.max(axis=2).min() > 0 and image.std() > 1.0

@@ -7,6 +7,8 @@ we override or reach into must fail here, not as a black viewport.
 import inspect
 from importlib import metadata
 
+import numpy as np
+
 
 def test_the_pinned_libraries_are_the_ones_installed():
     assert metadata.version("pyrender-maintained")
@@ -31,7 +33,18 @@ def test_every_private_attribute_exists_on_a_live_headless_renderer(renderer, sm
 
     renderer.render(small_scene)  # with terrain: pyrender renders, and leaves its resolved framebuffer
     offscreen = renderer.context.renderer
-    objects = {"OffscreenRenderer": offscreen, "Renderer": offscreen._renderer}
+    objects = {"OffscreenRenderer": offscreen, "Renderer": offscreen._renderer, "EGLPlatform": offscreen._platform}
     missing = [f"{kind}.{name} ({why})" for kind, name, why in PRIVATE_API if not hasattr(objects[kind], name)]
     assert not missing, f"pyrender no longer has: {missing}"
     assert offscreen._renderer._main_fb, "no resolved framebuffer to blit the world from"
+
+
+def test_closing_a_headless_renderer_leaves_the_others_rendering(renderer, small_scene):
+    """pyrender terminates the process's one EGL display with each context it deletes; ours keep it while
+    other headless contexts are open (`cloudview check` in-process, the pytest plugin beside a user's own)."""
+    from cloudcore.gl import FrameRenderer
+
+    before = renderer.render(small_scene)[0]
+    with FrameRenderer(32, 24) as other:
+        other.render(small_scene)
+    assert np.array_equal(renderer.render(small_scene)[0], before)

@@ -36,7 +36,7 @@ def version_line() -> str:
 
 
 def build_parser() -> tuple[argparse.ArgumentParser, argparse._SubParsersAction]:
-    from cloudcore.cli import bench, compare, record, render, shade
+    from cloudcore.cli import bench, check, compare, record, render, shade
 
     # raw text: the version stays one line however narrow the terminal
     parser = _OneLineParser(
@@ -49,6 +49,7 @@ def build_parser() -> tuple[argparse.ArgumentParser, argparse._SubParsersAction]
     shade.add_parser(commands)
     render.add_parser(commands)
     compare.add_parser(commands)
+    check.add_parser(commands)
     bench.add_parser(commands)
     record.add_parser(commands)
     return parser, commands
@@ -75,7 +76,7 @@ def _editor(argv: list[str]) -> int:
     if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
         print(
             "cloudview: error: the editor needs a display (none is set); on a headless machine try "
-            "`xvfb-run -a cloudview`, or the headless commands: cloudview render|record|bench|compare --help",
+            "`xvfb-run -a cloudview`, or the headless commands: cloudview render|record|bench|compare|check --help",
             file=sys.stderr,
         )
         return 2

@@ -11,13 +11,10 @@ Exit status: 0 when PSNR >= --tolerance-psnr (identical images always are), 1 wh
 from __future__ import annotations
 
 import math
-import warnings
 from pathlib import Path
 
-import numpy as np
-
 from cloudcore.errors import SceneError
-from cloudcore.imagecompare import compare, diff_image
+from cloudcore.imagecompare import compare, diff_image, load_rgb8
 
 DEFAULT_TOLERANCE_DB = 40.0  # the golden render tests' threshold
 
@@ -68,34 +65,3 @@ def run(args) -> int:
         verdict = f"{difference}; {side} the {args.tolerance_psnr:g} dB tolerance"
     print(f"{args.a} vs {args.b}: {verdict}")
     return 0 if within else 1
-
-
-def load_rgb8(path: Path) -> np.ndarray:
-    """The image at `path` as an (H, W, 3) uint8 array; anything else is a SceneError."""
-    import imageio.v3 as iio
-
-    try:
-        data = path.read_bytes()
-    except FileNotFoundError:
-        raise SceneError(path, "(file)", "no such file") from None
-    except OSError as error:
-        raise SceneError(path, "(file)", f"cannot read: {error.strerror or error}") from None
-    # Decoding bytes leaves imageio no file to leak; its plugins warn (deprecations) while they
-    # probe a file that is not an image, which would break the one-line error.
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            image = np.asarray(iio.imread(data, index=0))
-    except Exception:  # imageio raises many kinds (OSError, ValueError, struct.error), often multi-line
-        raise SceneError(path, "(file)", "not a readable image") from None
-    if image.dtype == np.uint16:
-        image = (image >> 8).astype(np.uint8)
-    elif image.dtype != np.uint8:
-        raise SceneError(path, "(pixels)", f"expected 8- or 16-bit integers, got {image.dtype}")
-    if image.ndim == 2:
-        image = image[..., None]
-    if image.ndim != 3 or image.shape[2] not in (1, 2, 3, 4):
-        raise SceneError(path, "(pixels)", f"expected grey, RGB or RGBA, got shape {image.shape}")
-    # grey (+alpha) repeats its one colour channel; RGB(A) keeps its first three
-    colour = image[..., :1] if image.shape[2] <= 2 else image[..., :3]
-    return np.ascontiguousarray(np.broadcast_to(colour, (*image.shape[:2], 3)))

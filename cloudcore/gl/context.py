@@ -81,9 +81,13 @@ class RenderTargets:
 class HeadlessContext(RenderTargets):
     """An EGL context of a fixed size (PYOPENGL_PLATFORM=egl) with our targets."""
 
+    #: headless contexts open in this process; they share its one EGL display (`close`)
+    open_count = 0
+
     def __init__(self, width: int, height: int):
         check_frame_size(width, height)
         self.renderer = pyrender.OffscreenRenderer(int(width), int(height))
+        HeadlessContext.open_count += 1
         self.make_current()
         super().__init__(width, height)
 
@@ -116,8 +120,28 @@ class HeadlessContext(RenderTargets):
             return
         self.make_current()
         self.close_targets()
+        HeadlessContext.open_count -= 1
+        if HeadlessContext.open_count:
+            _destroy_only_the_context(self.renderer._platform)
         self.renderer.delete()
         self.renderer = None
+
+
+def _destroy_only_the_context(platform) -> None:
+    """Make pyrender's `delete_context` destroy the EGL context alone.
+
+    pyrender deletes a context with eglTerminate of its display too, and EGL has one display per device
+    for the whole process, not counted: that would kill every other headless context still open (the
+    next call on one fails with EGL_BAD_DISPLAY).  The last one to close terminates it as pyrender does.
+    """
+    from OpenGL.EGL import EGL_NO_CONTEXT, EGL_NO_SURFACE, eglDestroyContext, eglMakeCurrent
+
+    def delete_context() -> None:
+        eglMakeCurrent(platform._egl_display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT)
+        eglDestroyContext(platform._egl_display, platform._egl_context)
+        platform._egl_context = platform._egl_display = None
+
+    platform.delete_context = delete_context
 
 
 class _RendererIntoFramebuffer(pyrender.Renderer):

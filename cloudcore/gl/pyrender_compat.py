@@ -9,7 +9,7 @@ and the 3x3 uniform matrix setter.  Its PyOpenGL requirement is open
 3.13 where 0.1.45's exact pin of 3.1.0 fails.  Everything else in
 `cloudcore.gl` takes pyrender from this module.
 
-We reach past pyrender's public API in three places, named in `PRIVATE_API`;
+We reach past pyrender's public API in four places, named in `PRIVATE_API`;
 tests/test_pyrender_compat.py fails if an upgrade removes any of them.
 
 Set PYOPENGL_PLATFORM=egl in the environment before this import for headless
@@ -28,6 +28,8 @@ PRIVATE_API = (
     ("OffscreenRenderer", "_platform", "its EGL context, made current before our own GL calls"),
     ("OffscreenRenderer", "_renderer", "its Renderer, whose resolved framebuffer we blit from"),
     ("Renderer", "_main_fb", "the resolved framebuffer a headless render leaves behind"),
+    ("EGLPlatform", "_egl_display", "closing one headless context must not terminate the display (gl/context.py)"),
+    ("EGLPlatform", "_egl_context", "the context destroyed alone while other headless contexts are open"),
 )
 
 __all__ = ["PRIVATE_API", "pyrender"]
