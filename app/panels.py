@@ -26,7 +26,7 @@ from cloudcore.editing import (
 from cloudcore.errors import SceneError
 from cloudcore.navigation import orbited
 from cloudcore.phase import PHASE_NAMES
-from cloudcore.settings import MODES, TRANSLATION_METRICS
+from cloudcore.settings import Option, RenderSettings, setting_options
 
 #: the Lighting panel's shading sliders: label -> (`Shading` field, low, high)
 _SHADING_SLIDERS = {
@@ -266,78 +266,20 @@ class Panels:
 
     # --- LOD ------------------------------------------------------------------------------------------------
     def lod(self) -> None:
+        """The settings' widgets, in their fields' order, made from their `Option`s (`cloudcore.settings`)."""
         editor = self.editor
         settings = editor.settings
-        changed_mode, mode = imgui.combo("Mode", MODES.index(settings.mode), list(MODES))
-        changed_tol, tolerance = imgui.slider_float("Tolerance (deg)", settings.tolerance_deg, 0.0, 5.0, "%.3f")
-        imgui.set_item_tooltip(
-            "An impostor is remade once its translation error passes this; by default the "
-            "parallax between its near and far points (Harris), 0.125 about one pixel."
-        )
-        metrics = list(TRANSLATION_METRICS)
-        changed_metric, metric = imgui.combo("Translation error", metrics.index(settings.translation_metric), metrics)
-        ring_on = math.isfinite(settings.ring_radius)
-        changed_ring_on, ring_on = imgui.checkbox("Impostor ring", ring_on)
-        radius = settings.ring_radius if math.isfinite(settings.ring_radius) else 4000.0
-        changed_radius, radius = imgui.slider_float("Ring radius (m)", radius, 0.0, 20000.0, "%.0f")
-        changed_fade, transition = imgui.slider_int("Transition (frames)", settings.transition_frames, 1, 60)
-        imgui.set_item_tooltip("Frames of crossfade when auto mode moves a cloud between full 3D and its impostor.")
-        changed_group, group = imgui.checkbox("Group interpenetrating clouds", settings.group_clouds)
-        sizes = [int(math.log2(settings.impostor_min_size)), int(math.log2(settings.impostor_max_size))]
-        changed_sizes, sizes = imgui.slider_int2("Impostor size (log2)", sizes, 3, 12)
-        changed_detail, detail = imgui.slider_float(
-            "Detail (texels per particle)", settings.impostor_detail_texels, 0.0, 8.0, "%.1f"
-        )
-        imgui.set_item_tooltip(
-            "An impostor texture is never finer than this many texels across the radius of "
-            "the cloud's smallest particle; 0: the screen's resolution alone decides."
-        )
-        changed_budget, budget = imgui.slider_int(
-            "Regeneration budget",
-            settings.regeneration_budget,
-            0,
-            32,
-            "%d" if settings.regeneration_budget else "no limit",
-        )
-        imgui.set_item_tooltip(
-            "Impostors remade per frame at most, those farthest past the tolerance first; 0: no limit."
-        )
-        changed_frame_budget, frame_budget = imgui.slider_float(
-            "Frame budget (ms)", settings.frame_budget_ms, 0.0, 200.0, "%.0f ms" if settings.frame_budget_ms else "none"
-        )
-        imgui.set_item_tooltip(
-            "Time for impostor updates and the cloud pass together, as the measured costs "
-            "predict it; over it, regenerations wait and the error drawn grows past the "
-            "tolerance (Statistics shows by how much). 0: none."
-        )
-        if (
-            changed_mode
-            or changed_tol
-            or changed_metric
-            or changed_ring_on
-            or changed_radius
-            or changed_fade
-            or changed_group
-            or changed_sizes
-            or changed_detail
-            or changed_budget
-            or changed_frame_budget
-        ):
+        changes = {}
+        for name, option in setting_options().items():
+            if name in _COMPOUND_WIDGETS:
+                changes |= _COMPOUND_WIDGETS[name](settings, option)
+            elif option.label is not None:
+                changed, value = _setting_widget(option, getattr(settings, name))
+                if changed:
+                    changes[name] = value
+        if changes:
             try:
-                editor.settings = dataclasses.replace(
-                    settings,
-                    mode=MODES[mode],
-                    tolerance_deg=tolerance,
-                    ring_radius=radius if ring_on else math.inf,
-                    translation_metric=metrics[metric],
-                    transition_frames=transition,
-                    group_clouds=group,
-                    impostor_min_size=2 ** min(sizes),
-                    impostor_max_size=2 ** max(sizes),
-                    impostor_detail_texels=detail,
-                    regeneration_budget=budget,
-                    frame_budget_ms=frame_budget,
-                )
+                editor.settings = dataclasses.replace(settings, **changes)
             except ValueError as error:
                 editor.messages.append(str(error))
         imgui.separator_text("Overlays")
@@ -506,3 +448,45 @@ class Panels:
             ):
                 implot.plot_line(label, frames, np.array([s.get(key, 0.0) for s in history], dtype=np.float64))
             implot.end_plot()
+
+
+def _tooltip(option: Option) -> None:
+    imgui.set_item_tooltip(option.help[:1].upper() + option.help[1:] + ".")
+
+
+def _setting_widget(option: Option, value):
+    """(changed, value) of one setting's combo, checkbox or slider."""
+    display = option.zero_display if value == 0 and option.zero_display else option.display
+    if option.choices:
+        changed, index = imgui.combo(option.label, option.choices.index(value), list(option.choices))
+        value = option.choices[index]
+    elif isinstance(value, bool):
+        changed, value = imgui.checkbox(option.label, value)
+    elif isinstance(value, int):
+        changed, value = imgui.slider_int(option.label, value, int(option.low), int(option.high), display)
+    else:
+        changed, value = imgui.slider_float(option.label, value, option.low, option.high, display)
+    _tooltip(option)
+    return changed, value
+
+
+def _ring_widgets(settings: RenderSettings, option: Option) -> dict:
+    """The ring on or off (an infinite radius) and its radius."""
+    ring_on = math.isfinite(settings.ring_radius)
+    changed_on, ring_on = imgui.checkbox("Impostor ring", ring_on)
+    radius = settings.ring_radius if ring_on else RenderSettings().ring_radius
+    changed_radius, radius = imgui.slider_float("Ring radius (m)", radius, 0.0, 20000.0, "%.0f")
+    _tooltip(option)
+    return {"ring_radius": radius if ring_on else math.inf} if changed_on or changed_radius else {}
+
+
+def _impostor_size_widgets(settings: RenderSettings, option: Option) -> dict:
+    """The smallest and largest impostor texture sides, as powers of two, on one slider."""
+    sizes = [int(math.log2(settings.impostor_min_size)), int(math.log2(settings.impostor_max_size))]
+    changed, sizes = imgui.slider_int2("Impostor size (log2)", sizes, 3, 12)
+    imgui.set_item_tooltip("The smallest and largest impostor texture sides, powers of two.")
+    return {"impostor_min_size": 2 ** min(sizes), "impostor_max_size": 2 ** max(sizes)} if changed else {}
+
+
+#: settings drawn by one widget of their own (the panel leaves their fellows, such as the largest size, out)
+_COMPOUND_WIDGETS = {"ring_radius": _ring_widgets, "impostor_min_size": _impostor_size_widgets}

@@ -37,7 +37,7 @@ from cloudcore.scene import (
     Terrain,
     View,
 )
-from cloudcore.settings import MODES, TRANSLATION_METRICS, RenderSettings
+from cloudcore.settings import MODES, RenderSettings, setting_options
 from cloudcore.sprites import FACINGS, MAX_SEED, SpriteStyle
 
 PRIMITIVES = ("box", "sphere", "aircraft")
@@ -341,8 +341,8 @@ def _view_settings(t: _Table) -> tuple[tuple[str, object], ...]:
             value = t.raw(key)
         elif isinstance(default, int):
             value = t.integer(key, None, low=0, high=2**31 - 1)
-        elif isinstance(default, str):  # translation_metric: the one string field but mode
-            value = t.string(key, choices=TRANSLATION_METRICS)
+        elif isinstance(default, str):
+            value = t.string(key, choices=setting_options()[key].choices)
         elif key == "ring_radius" and t.raw(key) == math.inf:  # inf: no ring, as on the command line
             value = math.inf
         else:

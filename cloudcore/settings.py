@@ -6,12 +6,17 @@ chooses per cloud, each frame, the representation predicted cheapest within
 the tolerance (`cloudcore.frameplan`, with the measured `cloudcore.lod_costs`),
 crossfading over `transition_frames` when it changes, and the ring beyond
 `ring_radius`.
+
+Each field that is set from outside the engine carries an `Option` (its
+command-line flag, help, and editor widget): `cloudcore.cli.settings_args`
+makes the options and sweep names of `render`, `record` and `bench` from them,
+and `app.panels` the LOD panel's widgets, so a setting is named in one place.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field, fields
 
 MODES = ("auto", "full", "impostor")
 #: the names of `cloudcore.impostors.TRANSLATION_METRICS` (kept here so settings import no geometry)
@@ -19,43 +24,146 @@ TRANSLATION_METRICS = ("parallax", "centre")
 
 
 @dataclass(frozen=True)
+class Option:
+    """How a setting is named and shown outside the engine.
+
+    `flag` is its command-line option; a setting that is on by default is
+    spelled `--no-...` and turns it off.  `help` is one sentence, for --help
+    and the widget's tooltip.  `choices` are a string setting's values.  With
+    a `label` the LOD panel shows it: a combo (choices), a checkbox (bool) or
+    a slider over [`low`, `high`] showing `display` (a printf format), or
+    `zero_display` at 0 where 0 means "off".
+    """
+
+    flag: str
+    help: str
+    choices: tuple[str, ...] = ()
+    label: str | None = None
+    low: float = 0.0
+    high: float = 1.0
+    display: str = ""
+    zero_display: str = ""
+
+    @property
+    def sweep_name(self) -> str:
+        """The setting's name in `cloudview bench --sweep NAME=...`: the flag's words."""
+        return self.flag.removeprefix("--").removeprefix("no-").replace("-", "_")
+
+
+def _setting(default, **option):
+    return field(default=default, metadata={"option": Option(**option)})
+
+
+@dataclass(frozen=True)
 class RenderSettings:
-    mode: str = "auto"
+    mode: str = _setting(
+        "auto",
+        flag="--mode",
+        help="how clouds are drawn: full 3D, impostors, or chosen per cloud by predicted error and cost",
+        choices=MODES,
+        label="Mode",
+    )
     #: degrees of translation error past which an impostor is regenerated; see `translation_metric`.
     #: SkyWorks' default is 0.125 (0.9 of a pixel at 480 lines and 60 degrees).  1 saved an eighth of the
     #: default flythrough's cloud pass for 0.5 dB (side by side), but on a cumulus field the project was not
     #: tuned on it saved a tenth and cost 5 dB on the worst frame, 40.4 to 35.2 (docs/performance.md)
-    tolerance_deg: float = 0.5
+    tolerance_deg: float = _setting(
+        0.5,
+        flag="--tolerance",
+        help="an impostor is remade once its translation error passes this many degrees; by default the "
+        "parallax between its near and far points (Harris), 0.125 about one pixel",
+        label="Tolerance (deg)",
+        high=5.0,
+        display="%.3f",
+    )
     #: "parallax": the angle between the rays to the impostor's near and far points (Harris, SkyWorks);
     #: "centre": the angle the eye has turned around the cloud's centre (stricter by about D / 2R)
-    translation_metric: str = "parallax"
+    translation_metric: str = _setting(
+        "parallax",
+        flag="--translation-metric",
+        help="parallax: the angle between the rays to the impostor's near and far points (Harris); "
+        "centre: the angle turned around the cloud's centre",
+        choices=TRANSLATION_METRICS,
+        label="Translation error",
+    )
     #: pixels: when > 0, the tolerance is this many pixels at the screen's centre instead of tolerance_deg
-    tolerance_px: float = 0.0
+    tolerance_px: float = _setting(
+        0.0, flag="--tolerance-px", help="impostor tolerance in pixels at the screen's centre; 0: use --tolerance"
+    )
     #: metres: clouds wholly beyond this horizontal distance join Wang's ring of 8 impostors; inf: no ring
-    ring_radius: float = 4000.0
+    ring_radius: float = _setting(
+        4000.0, flag="--ring-radius", help="metres beyond which clouds join the impostor ring; inf for none"
+    )
     #: impostor texture sides, powers of two
-    impostor_min_size: int = 16
-    impostor_max_size: int = 512
+    impostor_min_size: int = _setting(
+        16, flag="--impostor-min-size", help="smallest impostor texture side, a power of two"
+    )
+    impostor_max_size: int = _setting(
+        512, flag="--impostor-max-size", help="largest impostor texture side, a power of two"
+    )
     #: texels across the radius of a cloud's finest particle that an impostor texture must give; a finer
     #: texture only resamples smooth Gaussians, so none is made (0: the screen's resolution alone decides)
-    impostor_detail_texels: float = 2.0
+    impostor_detail_texels: float = _setting(
+        2.0,
+        flag="--detail-texels",
+        help="an impostor texture is never finer than this many texels across the radius of its cloud's "
+        "smallest particle; 0: the screen's resolution alone decides",
+        label="Detail (texels per particle)",
+        high=8.0,
+        display="%.1f",
+    )
     #: impostors remade per frame at most; those past their tolerance wait, the farthest past it first
     #: (0: no limit, every impostor past its tolerance is remade at once)
-    regeneration_budget: int = 0
+    regeneration_budget: int = _setting(
+        0,
+        flag="--regeneration-budget",
+        help="impostors remade per frame at most, those farthest past the tolerance first; 0: no limit",
+        label="Regeneration budget",
+        high=32,
+        display="%d",
+        zero_display="no limit",
+    )
     #: milliseconds the impostor updates and the cloud pass may take together, as the measured cost model
     #: predicts them; over it, regenerations wait (most urgent first) and the error drawn exceeds the
     #: tolerance by what the statistics report (0: no budget)
-    frame_budget_ms: float = 0.0
+    frame_budget_ms: float = _setting(
+        0.0,
+        flag="--frame-budget",
+        help="milliseconds for impostor updates and the cloud pass together, as the measured costs predict "
+        "them; over it, regenerations wait, most urgent first, and the error drawn grows past the "
+        "tolerance (the statistics say by how much); 0: none",
+        label="Frame budget (ms)",
+        high=200.0,
+        display="%.0f ms",
+        zero_display="none",
+    )
     #: frames over which a cloud crossfades when auto mode changes its representation (no pop)
-    transition_frames: int = 6
+    transition_frames: int = _setting(
+        6,
+        flag="--transition-frames",
+        help="frames of crossfade when auto mode moves a cloud between full 3D and its impostor",
+        label="Transition (frames)",
+        low=1,
+        high=60,
+        display="%d",
+    )
     #: draw interpenetrating clouds as one unit (one impostor, one sort: `cloudcore.lod_units`); off, each
     #: cloud's impostor is sorted as a whole, Harris's approximation
-    group_clouds: bool = True
+    group_clouds: bool = _setting(
+        True,
+        flag="--no-group-clouds",
+        help="sort each cloud's impostor as a whole even where clouds interpenetrate",
+        label="Group interpenetrating clouds",
+    )
     #: per axis: the screen impostor of a cloud the eye is inside has this fraction of the screen's pixels
     #: (Harris's quarter).  An eighth saved 9% of the default flythrough's cloud pass for 0.45 dB, but under
     #: a stratocumulus deck, whose one unit's sphere holds the eye, it blurred its underside (4.2 dB on
     #: the worst frame; docs/performance.md)
-    inside_resolution_scale: float = 0.25
+    inside_resolution_scale: float = _setting(
+        0.25,
+        flag="--inside-resolution",
+        help="per axis, the fraction of the screen's resolution of the screen impostor of a cloud the eye is in",
+    )
     #: the ring is rebuilt when the eye has moved this fraction of ring_radius horizontally / vertically
     ring_rebuild_horizontal: float = 0.15
     ring_rebuild_vertical: float = 0.02
@@ -68,7 +176,11 @@ class RenderSettings:
     split_objects: bool = True
     #: draw batches of plain splats as point sprites (one vertex per particle) where the picture is the
     #: same (`cloudcore.point_sprites`); off, always as quads (for comparison; docs/performance.md)
-    point_sprites: bool = True
+    point_sprites: bool = _setting(
+        True,
+        flag="--no-point-sprites",
+        help="draw every splat as a quad, even where a point sprite gives the same picture",
+    )
 
     def __post_init__(self):
         problems = []
@@ -117,6 +229,11 @@ class RenderSettings:
     @property
     def uses_ring(self) -> bool:
         return self.mode != "full" and math.isfinite(self.ring_radius)
+
+
+def setting_options() -> dict[str, Option]:
+    """{field name: its Option} of the settings set from outside the engine, in the fields' order."""
+    return {f.name: f.metadata["option"] for f in fields(RenderSettings) if "option" in f.metadata}
 
 
 #: every particle every frame: the reference picture the approximations are measured against

@@ -27,6 +27,7 @@ from cloudcore.cli.render import pixel_count
 from cloudcore.cli.settings_args import SWEEPABLE, add_settings_arguments, parse_sweep, settings_from
 from cloudcore.errors import SceneError
 from cloudcore.scenefile import load_scene
+from cloudcore.settings import setting_options
 
 
 def add_parser(commands) -> None:
@@ -139,6 +140,21 @@ def run(args) -> int:
     return 0
 
 
+def sweep_label(settings: dict, runs: list[dict]) -> str:
+    """The settings of one run that differ between the runs, by their sweep names (its mode if none do)."""
+    varying = [
+        (name, option.sweep_name)
+        for name, option in setting_options().items()
+        if len({repr(r["settings"][name]) for r in runs}) > 1
+    ]
+    if not varying:
+        return settings["mode"]
+    return ", ".join(
+        f"{sweep} {settings[name]:g}" if isinstance(settings[name], float) else f"{sweep} {settings[name]}"
+        for name, sweep in varying
+    )
+
+
 def plot_error_against_time(report: dict, path: Path) -> None:
     """One point per setting (frame time, mean absolute difference), the Pareto front joined, full 3D marked."""
     plt = headless_pyplot()
@@ -152,16 +168,8 @@ def plot_error_against_time(report: dict, path: Path) -> None:
         [seconds[i] for i in front], [errors[i] for i in front], color="tab:orange", zorder=2, label="Pareto front"
     )
     for run_, x, y in zip(runs, seconds, errors):
-        settings = run_["settings"]
-        budget = settings["regeneration_budget"] or "none"
         axes.annotate(
-            f"{settings['mode']} tol {settings['tolerance_deg']:g} budget {budget}"
-            f"\nring {settings['ring_radius']:g} max {settings['impostor_max_size']}"
-            f" detail {settings['impostor_detail_texels']:g}",
-            (x, y),
-            fontsize=6,
-            textcoords="offset points",
-            xytext=(4, 4),
+            sweep_label(run_["settings"], runs), (x, y), fontsize=6, textcoords="offset points", xytext=(4, 4)
         )
     axes.axvline(report["reference"]["frame_ms_mean"], color="grey", linestyle="--", label="full 3D (error 0)")
     axes.set_xlabel("mean frame time (ms)")
