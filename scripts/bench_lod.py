@@ -165,6 +165,9 @@ def plot(rows, path: Path) -> None:
                 r["case"], (r["cloud_speedup"], r["psnr_mean"]), fontsize=7, xytext=(5, 4), textcoords="offset points"
             )
     axes.set_xscale("log")
+    ticks = [2, 3, 5, 10, 20, 50, 100, 200]
+    axes.set_xticks(ticks, [f"x{tick}" for tick in ticks])
+    axes.minorticks_off()  # the log axis' own minor labels overprint each other
     axes.set_xlabel("cloud pass + impostor updates, speed-up over full 3D (same run)")
     axes.set_ylabel("mean PSNR against full 3D (dB)")
     axes.set_title("The level of detail on llvmpipe: error against time")
