@@ -15,10 +15,12 @@ import shutil
 import time
 from collections import deque
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
 from cloudcore.editing import History, delete_cloud, delete_particles
 from cloudcore.errors import SceneError
+from cloudcore.frame_stats import FrameStats
 from cloudcore.limits import scene_limit_problems
 from cloudcore.paths import camera_on_path
 from cloudcore.scene import Camera, Lighting, Scene, Shading
@@ -46,6 +48,30 @@ def discard_recovery(path: Path) -> None:
     recovery = recovery_path(path)
     recovery.unlink(missing_ok=True)
     shutil.rmtree(recovery.with_name(particles_folder(recovery)), ignore_errors=True)
+
+
+@dataclass(frozen=True)
+class ShownFrame:
+    """One window frame of the viewport: the frame whose picture it shows, and what the editor showed."""
+
+    frame: FrameStats  # of the frame that drew the picture (an earlier one when `picture_reused`)
+    picture_reused: bool  # nothing it is drawn from changed, or a newer light is on its way: not redrawn
+    relighting: bool  # the light pass is running in the background
+    shown_time_of_day: float
+    shown_illumination: str  # the shading method of the light shown (`cloudcore.relighting`)
+    frame_start_s: float  # perf_counter at the window frame's start
+    viewport_ms: float
+    viewport_width: int
+    viewport_height: int
+
+    @property
+    def impostors_regenerated(self) -> int:
+        return 0 if self.picture_reused else self.frame.plan.impostors_regenerated
+
+    def as_dict(self) -> dict:
+        """The flat form (the frame's `as_dict` and the editor's own), for `python -m app --frame-stats`."""
+        shown = {f.name: getattr(self, f.name) for f in dataclasses.fields(self) if f.name != "frame"}
+        return self.frame.as_dict() | shown | {"impostors_regenerated": self.impostors_regenerated}
 
 
 class Editor:
@@ -76,8 +102,8 @@ class Editor:
         self.playing = False
         self.messages: deque[str] = deque(maxlen=6)
         self.recent: list[Path] = [path] if path else []
-        self.frame_times: deque[dict] = deque(maxlen=240)
-        self.last_stats: dict = {}
+        self.frame_times: deque[ShownFrame] = deque(maxlen=240)
+        self.last_stats: ShownFrame | None = None
         self._last_recovery = time.monotonic()
         self._recovered_scene: Scene | None = None  # the scene the recovery copy last written holds
 
@@ -286,7 +312,7 @@ class Editor:
         self._recovered_scene = self.scene
         return True
 
-    def record_frame(self, stats: dict) -> None:
+    def record_frame(self, stats: ShownFrame) -> None:
         self.last_stats = stats
         self.frame_times.append(stats)
 

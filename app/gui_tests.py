@@ -109,11 +109,12 @@ def install(params, editor, viewport, panels, results_path: Path, outcome: dict,
     def relit(ctx, frames: int = 600) -> None:
         """Yield until the viewport shows the scene's own lighting, exactly shaded (the worker has it)."""
         for _ in range(frames):
-            stats = editor.last_stats
+            shown = editor.last_stats
             if (
-                not stats.get("relighting")
-                and stats.get("shown_illumination") == "exact"
-                and stats.get("shown_time_of_day") == editor.time_of_day
+                shown is not None
+                and not shown.relighting
+                and shown.shown_illumination == "exact"
+                and shown.shown_time_of_day == editor.time_of_day
             ):
                 ctx.yield_(SETTLE)  # the impostors follow within the frame budget
                 return
@@ -155,9 +156,9 @@ def install(params, editor, viewport, panels, results_path: Path, outcome: dict,
         ctx.mouse_up(0)
         dragged_s = time.perf_counter() - started
         during = [stats for stats in list(editor.frame_times)[first:]]
-        shown = [stats["shown_time_of_day"] for stats in during]
+        shown = [frame.shown_time_of_day for frame in during]
         relit_looks = len({hours for hours in shown}) - 1  # the looks shown after the first
-        gaps_ms = [1e3 * (b["frame_start_s"] - a["frame_start_s"]) for a, b in zip(during, during[1:])]
+        gaps_ms = [1e3 * (b.frame_start_s - a.frame_start_s) for a, b in zip(during, during[1:])]
         outcome["live_time_of_day"] = {
             "drag_s": dragged_s,
             "frames": len(during),
@@ -165,26 +166,21 @@ def install(params, editor, viewport, panels, results_path: Path, outcome: dict,
             "relit_looks_per_s": relit_looks / dragged_s,
             "longest_frame_gap_ms": max(gaps_ms, default=0.0),
             "median_frame_gap_ms": float(np.median(gaps_ms)) if gaps_ms else 0.0,
-            "shading_ms_on_the_gui_thread_max": max(stats["illumination_ms"] for stats in during),
+            "shading_ms_on_the_gui_thread_max": max(frame.frame.illumination_ms for frame in during),
             "slowest": [
                 {
                     "gap_ms": gap,
-                    **{
-                        key: during[i].get(key)
-                        for key in (
-                            "viewport_ms",
-                            "illumination_ms",
-                            "impostors_regenerated",
-                            "picture_reused",
-                            "frame_ms",
-                        )
-                    },
+                    "viewport_ms": during[i].viewport_ms,
+                    "illumination_ms": during[i].frame.illumination_ms,
+                    "impostors_regenerated": during[i].impostors_regenerated,
+                    "picture_reused": during[i].picture_reused,
+                    "frame_ms": during[i].frame.frame_ms,
                 }
                 for gap, i in sorted(((gap, i) for i, gap in enumerate(gaps_ms)), reverse=True)[:3]
             ],
         }
         CHECK(relit_looks >= 3)  # the view followed the drag, not just its end
-        CHECK(all(stats["shown_illumination"] in ("preview", "exact") for stats in during))
+        CHECK(all(frame.shown_illumination in ("preview", "exact") for frame in during))
         # nothing like the exact light pass (about 2 s) ran where the GUI runs
         CHECK(max(gaps_ms, default=0.0) < 1000.0)
         relit(ctx)  # the released hour, exactly
@@ -220,8 +216,8 @@ def install(params, editor, viewport, panels, results_path: Path, outcome: dict,
         ctx.yield_(SETTLE)
         history = list(editor.frame_times)
         budgeted = history[next(i for i, s in enumerate(history) if s is marker) + 1 :]
-        per_frame = [s.get("impostors_regenerated", 0) for s in budgeted]
-        postponed = sum(s.get("regenerations_postponed", 0) for s in budgeted)
+        per_frame = [s.impostors_regenerated for s in budgeted]
+        postponed = sum(s.frame.plan.regenerations_postponed for s in budgeted if not s.picture_reused)
         use_window(ctx, "LOD")
         ctx.item_input_value("Regeneration budget", 0)
         outcome["regenerations"] = {

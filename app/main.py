@@ -188,8 +188,8 @@ def _quit_after(params, frames: int, editor: Editor, viewport: Viewport, outcome
 
     def count():
         now = time.perf_counter()
-        if editor.last_stats and editor.last_stats is not previous["stats"]:
-            recorded.append(editor.last_stats | {"window_frame_ms": 1e3 * (now - previous["time"])})
+        if editor.last_stats is not None and editor.last_stats is not previous["stats"]:
+            recorded.append(editor.last_stats.as_dict() | {"window_frame_ms": 1e3 * (now - previous["time"])})
         previous.update(stats=editor.last_stats, time=now)
         if len(recorded) == frames - 1:
             viewport.capture_next = True

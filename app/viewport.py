@@ -20,7 +20,7 @@ import time
 import numpy as np
 from imgui_bundle import imgui
 
-from app.editor import Editor
+from app.editor import Editor, ShownFrame
 from app.tools import ViewportTools
 from cloudcore.editing import pick_ray
 from cloudcore.gl.context import WindowContext
@@ -59,7 +59,7 @@ class Viewport:
         self.regenerations_total = 0
         self.relighting = LiveIllumination(IlluminationCache())
         self.relighting.start()
-        self._last_inputs, self._last_stats = None, {}  # what the picture shown was drawn from, and its stats
+        self._last_inputs, self._last_stats = None, None  # what the picture shown was drawn from, and its stats
         self._heat_texture: ImageTexture | None = None
         self._last_time = time.perf_counter()
 
@@ -89,7 +89,7 @@ class Viewport:
             # the same inputs and nothing converging, or nothing worth converging to while a new light is on its
             # way (the impostors and ring would be remade for a light already superseded): the same picture,
             # and the cores go to the relighting worker
-            stats = self._last_stats | {"picture_reused": True, "impostors_regenerated": 0, "regeneration_reasons": {}}
+            stats, reused = self._last_stats, True
             if self.relighting.busy:
                 time.sleep(RELIGHT_PAUSE_S)
         else:
@@ -101,17 +101,11 @@ class Viewport:
                 read_back=False,
                 illumination_method=method,
             )
-            self._last_inputs, self._last_stats = inputs, stats
-        stats |= {
-            "relighting": self.relighting.busy,
-            "shown_time_of_day": scene.lighting.time_of_day,
-            "shown_illumination": method,
-            "frame_start_s": now,
-        }
+            self._last_inputs, self._last_stats, reused = inputs, stats, False
         heat = None
         if self.measure_overdraw or self.heat_map:
             counts, overdraw = self.renderer.measure_overdraw()
-            stats |= overdraw
+            stats = stats.with_overdraw(overdraw)
             heat = heat_image(counts) if self.heat_map else None
         texture = self.renderer.display_texture()
         # texture coordinates of the image's top left and bottom right corners: the frame's rows are bottom
@@ -125,13 +119,19 @@ class Viewport:
         if self.capture_next:
             self.captured = heat[0][..., :3] if heat is not None else self.renderer.read_display()
             self.capture_next = False
-        stats |= {
-            "viewport_ms": 1e3 * (time.perf_counter() - start),
-            "viewport_width": width,
-            "viewport_height": height,
-        }
-        self.regenerations_total += stats.get("impostors_regenerated", 0)
-        editor.record_frame(stats)
+        shown = ShownFrame(
+            frame=stats,
+            picture_reused=reused,
+            relighting=self.relighting.busy,
+            shown_time_of_day=scene.lighting.time_of_day,
+            shown_illumination=method,
+            frame_start_s=now,
+            viewport_ms=1e3 * (time.perf_counter() - start),
+            viewport_width=width,
+            viewport_height=height,
+        )
+        self.regenerations_total += shown.impostors_regenerated
+        editor.record_frame(shown)
 
         origin = imgui.get_cursor_screen_pos()
         imgui.image(imgui.ImTextureRef(texture), imgui.ImVec2(width, height), uv_top_left, uv_bottom_right)

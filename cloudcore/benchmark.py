@@ -66,7 +66,7 @@ def _run(renderer, scene: Scene, views, settings: RenderSettings, reference=None
             progress()
     for frame, (time_s, camera) in enumerate(views):
         image, stats = renderer.render(scene, camera=camera, settings=settings, time_s=time_s)
-        row = {"frame": frame, **{k: v for k, v in stats.items() if isinstance(v, (int, float))}}
+        row = {"frame": frame, **{k: v for k, v in stats.as_dict().items() if isinstance(v, (int, float))}}
         if reference is not None:
             difference = compare(image, reference[frame])
             row |= {"psnr_db": min(difference.psnr_db, PSNR_CAP_DB), "mad": difference.mean_abs}

@@ -51,6 +51,7 @@ from cloudcore.camera import (
     splats_in_frustum,
     view_matrix,
 )
+from cloudcore.frame_stats import PlanStats
 from cloudcore.impostors import (
     INSIDE_RADII,
     TRANSLATION_METRICS,
@@ -177,36 +178,37 @@ class FramePlan:
     def of_kind(self, *kinds: str) -> list:
         return [c for c in self.clouds if c.kind in kinds]
 
-    def stats(self) -> dict:
-        counts = {f"clouds_{kind}": 0 for kind in KINDS}
+    def stats(self) -> PlanStats:
+        clouds_by_kind = dict.fromkeys(KINDS, 0)
         reasons: dict = {}
         for unit in self.clouds:
-            counts[f"clouds_{unit.kind}"] += len(unit.members)
+            clouds_by_kind[unit.kind] += len(unit.members)
             if unit.regenerate:
                 reasons[unit.regenerate] = reasons.get(unit.regenerate, 0) + 1
-        return counts | {
-            "units": len(self.clouds),
-            "units_grouped": sum(1 for unit in self.clouds if len(unit.members) > 1),
-            "impostors_drawn": len(self.of_kind(*TEXTURED)) + len(self.of_kind("inside")),
-            "impostors_regenerated": sum(reasons.values()),
-            "regeneration_reasons": reasons,
-            "regenerations_postponed": sum(1 for c in self.clouds if c.postponed),
-            "ring_segments_built": int(
+        return PlanStats(
+            clouds_by_kind=clouds_by_kind,
+            units=len(self.clouds),
+            units_grouped=sum(1 for unit in self.clouds if len(unit.members) > 1),
+            impostors_drawn=len(self.of_kind(*TEXTURED)) + len(self.of_kind("inside")),
+            impostors_regenerated=sum(reasons.values()),
+            regeneration_reasons=reasons,
+            regenerations_postponed=sum(1 for c in self.clouds if c.postponed),
+            ring_segments_built=int(
                 self.ring is not None
                 and self.ring.state.pending is not None
                 and self.ring.build_segment in self.ring.state.pending.occupied_segments
             ),
-            "ring_panels_drawn": (
+            ring_panels_drawn=(
                 sum(len(g.occupied_segments) for g, _ in self.ring.draws) if self.ring is not None else 0
             ),
-            "objects_in_clouds": len(self.objects_between_layers),
-            "layers_drawn": sum(c.layers for c in self.clouds if c.splits),
-            "layers_rebuilt": sum(c.layers for c in self.clouds if c.splits and c.regenerate),
-            "predicted_ms": self.predicted_ms,
-            "tolerance_deg": self.tolerance_deg,
-            "accepted_error_tolerances": self.accepted_error,
-            **{f"cost_{name}_ms": value for name, value in dataclasses.asdict(self.costs).items()},
-        }
+            objects_in_clouds=len(self.objects_between_layers),
+            layers_drawn=sum(c.layers for c in self.clouds if c.splits),
+            layers_rebuilt=sum(c.layers for c in self.clouds if c.splits and c.regenerate),
+            predicted_ms=self.predicted_ms,
+            tolerance_deg=self.tolerance_deg,
+            accepted_error_tolerances=self.accepted_error,
+            costs=self.costs,
+        )
 
     @property
     def settled(self) -> bool:

@@ -14,17 +14,31 @@ area (`cloud_block_overdraw`).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 
-def overdraw_statistics(counts: np.ndarray) -> dict:
-    """Mean over the screen, mean over covered pixels, and maximum of a per-pixel fragment count."""
+@dataclass(frozen=True)
+class Overdraw:
+    """Fragments blended per pixel by the frame's cloud pass (counted), and the analytic estimate."""
+
+    mean: float  # over the screen
+    mean_covered: float  # over the pixels any splat covers
+    max: float
+    analytic: float  # summed splat disc areas over the screen's (`analytic_overdraw`)
+
+
+def overdraw_statistics(counts: np.ndarray, analytic: float) -> Overdraw:
+    """Mean over the screen, mean over covered pixels, and maximum of a per-pixel fragment count, beside the
+    `analytic` estimate."""
     covered = counts > 0
-    return {
-        "overdraw_mean": float(counts.mean()) if counts.size else 0.0,
-        "overdraw_mean_covered": float(counts[covered].mean()) if covered.any() else 0.0,
-        "overdraw_max": float(counts.max()) if counts.size else 0.0,
-    }
+    return Overdraw(
+        mean=float(counts.mean()) if counts.size else 0.0,
+        mean_covered=float(counts[covered].mean()) if covered.any() else 0.0,
+        max=float(counts.max()) if counts.size else 0.0,
+        analytic=analytic,
+    )
 
 
 def analytic_overdraw(

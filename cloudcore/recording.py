@@ -6,6 +6,8 @@ import math
 
 import numpy as np
 
+from cloudcore.frame_stats import FrameStats
+
 #: the columns of `cloudview record --stats`, in order; other_ms is frame_ms less the cloud pass and impostor updates
 COLUMNS = (
     "frame",
@@ -42,27 +44,24 @@ def frame_times(duration: float, fps: float, frames: int | None = None) -> np.nd
     return np.arange(count) / fps
 
 
-def frame_row(frame: int, time_s: float, stats: dict) -> dict:
-    """The `COLUMNS` of one frame from `FrameRenderer.render`'s stats, with `measure_overdraw`'s if measured.
-
-    Overdraw not measured is left empty; layer counts a renderer does not
-    report are 0 (it has no split layers).
-    """
-    ms = {key: round(stats[key], 3) for key in ("frame_ms", "cloud_ms", "impostor_update_ms")}
-    overdraw = {
-        key: round(stats[key], 4) if key in stats else ""
-        for key in ("overdraw_mean", "overdraw_max", "overdraw_analytic")
-    }
+def frame_row(frame: int, time_s: float, stats: FrameStats) -> dict:
+    """The `COLUMNS` of one frame from `FrameRenderer.render`'s stats; overdraw not measured is left empty."""
+    overdraw = stats.overdraw
     return {
         "frame": frame,
         "time_s": round(time_s, 6),
-        **ms,
-        "other_ms": round(stats["frame_ms"] - stats["cloud_ms"] - stats["impostor_update_ms"], 3),
-        **{
-            key: stats[key]
-            for key in ("particles_drawn", "clouds_drawn", "impostors_drawn", "impostors_regenerated", "texture_bytes")
-        },
-        "layers_drawn": stats.get("layers_drawn", 0),
-        "layers_rebuilt": stats.get("layers_rebuilt", 0),
-        **overdraw,
+        "frame_ms": round(stats.frame_ms, 3),
+        "cloud_ms": round(stats.cloud_ms, 3),
+        "impostor_update_ms": round(stats.impostor_update_ms, 3),
+        "other_ms": round(stats.frame_ms - stats.cloud_ms - stats.impostor_update_ms, 3),
+        "particles_drawn": stats.particles_drawn,
+        "clouds_drawn": stats.clouds_drawn,
+        "impostors_drawn": stats.plan.impostors_drawn,
+        "impostors_regenerated": stats.plan.impostors_regenerated,
+        "texture_bytes": stats.texture_bytes,
+        "layers_drawn": stats.plan.layers_drawn,
+        "layers_rebuilt": stats.plan.layers_rebuilt,
+        "overdraw_mean": round(overdraw.mean, 4) if overdraw else "",
+        "overdraw_max": round(overdraw.max, 4) if overdraw else "",
+        "overdraw_analytic": round(overdraw.analytic, 4) if overdraw else "",
     }

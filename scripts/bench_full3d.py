@@ -34,8 +34,7 @@ def bench_size(scene, width: int, height: int, views) -> dict:
         renderer.render(scene, camera=views[0], settings=FULL_3D)  # shading precompute, shader compiles
         for camera in views:
             _, stats = renderer.render(scene, camera=camera, settings=FULL_3D)
-            stats |= renderer.measure_overdraw()[1]
-            samples.append(stats)
+            samples.append(stats.with_overdraw(renderer.measure_overdraw()[1]).as_dict())
     summary = {
         "width": width,
         "height": height,

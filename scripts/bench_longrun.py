@@ -53,8 +53,8 @@ def long_run(scene, views, settings: RenderSettings, size, seconds: float, sampl
         for time_s, camera in itertools.cycle(views):
             _, stats = renderer.render(scene, camera=camera, settings=settings, time_s=time_s)
             frames += 1
-            frame_ms.append(stats["frame_ms"])
-            total_ms += stats["frame_ms"] if frames > 1 else 0.0  # the first frame builds every impostor
+            frame_ms.append(stats.frame_ms)
+            total_ms += stats.frame_ms if frames > 1 else 0.0  # the first frame builds every impostor
             now = time.perf_counter()
             finished = now - started >= seconds
             if frames in (1, len(views)) or now >= next_sample or finished:

@@ -78,16 +78,16 @@ def bench_mode(renderer: FrameRenderer, scene: Scene, mode: str, frames: int, il
     return {
         "mode": mode,
         "frames": frames,
-        "first_frame_ms": stats[0]["frame_ms"],
-        "frame_ms_mean": float(np.mean([s["frame_ms"] for s in later])),
-        "steady_frame_ms_mean": float(np.mean([s["frame_ms"] for s in steady])),
-        "steady_cloud_ms_mean": float(np.mean([s["cloud_ms"] for s in steady])),
-        "particles_drawn": last["particles_drawn"],
-        "clouds_drawn": last["clouds_drawn"],
-        "clouds_culled": last["clouds_culled"],
-        "clouds_ring": last["clouds_ring"],
-        "impostors_drawn": last["impostors_drawn"],
-        "texture_bytes": last["texture_bytes"],
+        "first_frame_ms": stats[0].frame_ms,
+        "frame_ms_mean": float(np.mean([s.frame_ms for s in later])),
+        "steady_frame_ms_mean": float(np.mean([s.frame_ms for s in steady])),
+        "steady_cloud_ms_mean": float(np.mean([s.cloud_ms for s in steady])),
+        "particles_drawn": last.particles_drawn,
+        "clouds_drawn": last.clouds_drawn,
+        "clouds_culled": last.clouds_culled,
+        "clouds_ring": last.plan.clouds_by_kind["ring"],
+        "impostors_drawn": last.plan.impostors_drawn,
+        "texture_bytes": last.texture_bytes,
         "resident_bytes": resident_memory_bytes(),
         **finite_frame(renderer),
     }
@@ -128,7 +128,7 @@ def main() -> None:
         _, first = renderer.render(
             scene, illumination_method=args.illumination, settings=RenderSettings(mode="full"), read_back=False
         )
-        result["illumination_ms"] = first["illumination_ms"]
+        result["illumination_ms"] = first.illumination_ms
         result["runs"] = [
             bench_mode(renderer, scene, mode, args.frames, args.illumination) for mode in args.modes.split(",")
         ]

@@ -84,10 +84,10 @@ def flythrough_cost(frames: int, size) -> dict:
             ]
     result = {
         label: {
-            "frame_ms_mean": float(np.mean([s["frame_ms"] for s in rows])),
-            "frame_ms_p95": float(np.percentile([s["frame_ms"] for s in rows], 95)),
-            "frames_with_object_in_cloud": int(sum(s["objects_in_clouds"] > 0 for s in rows)),
-            "layers_rebuilt": int(sum(s["layers_rebuilt"] for s in rows)),
+            "frame_ms_mean": float(np.mean([s.frame_ms for s in rows])),
+            "frame_ms_p95": float(np.percentile([s.frame_ms for s in rows], 95)),
+            "frames_with_object_in_cloud": int(sum(s.plan.objects_in_clouds > 0 for s in rows)),
+            "layers_rebuilt": int(sum(s.plan.layers_rebuilt for s in rows)),
         }
         for label, rows in stats.items()
     }

@@ -9,6 +9,7 @@ import pytest
 from conftest import VALLEY
 
 from cloudcore.benchmark import bench_path, pareto_front
+from cloudcore.frame_stats import FrameStats, PlanStats
 from cloudcore.scenefile import load_scene
 from cloudcore.settings import FULL_3D, RenderSettings
 
@@ -39,13 +40,13 @@ class FakeRenderer:
 
     def render(self, scene, camera=None, settings=None, time_s=0.0):
         level = 100 if settings == FULL_3D else 100 + self.offset
-        stats = {
-            "frame_ms": 40.0 if settings == FULL_3D else 10.0,
-            "world_ms": 5.0,
-            "cloud_ms": 30.0,
-            "impostors_regenerated": 1,
-            "texture_bytes": 1024,
-        }
+        stats = FrameStats(
+            PlanStats(impostors_regenerated=1),
+            frame_ms=40.0 if settings == FULL_3D else 10.0,
+            world_ms=5.0,
+            cloud_ms=30.0,
+            texture_bytes=1024,
+        )
         return np.full((4, 4, 3), level, dtype=np.uint8), stats
 
 

@@ -194,14 +194,14 @@ def test_a_regeneration_budget_serves_the_impostors_farthest_past_their_toleranc
     start = camera_at((0.0, 0.0, 0.0), (0.0, 0.0, -1.0))
     first = plan(start, budget, centres=RING_OF_CLOUDS, radii=(RADIUS,) * 5)
     # new impostors are never postponed: there is nothing else to show
-    assert [c.regenerate for c in first.clouds] == ["new"] * 5 and first.stats()["regenerations_postponed"] == 0
+    assert [c.regenerate for c in first.clouds] == ["new"] * 5 and first.stats().regenerations_postponed == 0
     moved = camera_at((40.0, 0.0, 0.0), (40.0, 0.0, -1.0))  # the outer clouds turn farthest
     second = plan(moved, budget, first.records, centres=RING_OF_CLOUDS, radii=(RADIUS,) * 5)
     errors = [translation_error_deg(c, first.records[(i,)].eye, moved.position) for i, c in enumerate(RING_OF_CLOUDS)]
     served = [c.index for c in second.clouds if c.regenerate]
     assert sorted(served) == sorted(np.argsort(errors)[-2:].tolist())
     assert all(c.postponed == "translation" for c in second.clouds if c.index not in served)
-    assert second.stats()["regenerations_postponed"] == 3
+    assert second.stats().regenerations_postponed == 3
     # a postponed impostor keeps its texture and its record, and is served on a later frame
     for cloud in second.clouds:
         if cloud.index not in served:
@@ -361,7 +361,7 @@ def test_the_modes_override_the_distance_choice():
 def test_a_cloud_out_of_view_costs_nothing():
     behind = plan(camera_at((0.0, 0.0, 2000.0), look_at=(0.0, 0.0, 4000.0)))
     assert behind.clouds[0].kind == "culled" and behind.clouds[0].regenerate is None
-    assert behind.draw_order == () and behind.stats()["impostors_regenerated"] == 0
+    assert behind.draw_order == () and behind.stats().impostors_regenerated == 0
 
 
 @pytest.mark.parametrize("position", [(0.0, 0.0, 0.0), (30.0, 0.0, 0.0), (0.0, 0.0, 104.0)])
@@ -433,7 +433,7 @@ def test_a_still_eye_settles_once_its_impostors_are_made_and_the_ring_is_in():
         frames.append(frame)
         state = frame.state
     assert not frames[0].settled  # the first impostors are made
-    assert frames[-1].settled and frames[-1].ring.draws and frames[-1].stats()["impostors_regenerated"] == 0
+    assert frames[-1].settled and frames[-1].ring.draws and frames[-1].stats().impostors_regenerated == 0
     moved = plan(
         orbit(8000.0, 5.0), RING, centres=((0.0, 0.0, 0.0), (0.0, 0.0, -6000.0)), radii=(RADIUS, RADIUS), state=state
     )
@@ -495,7 +495,7 @@ def test_the_ring_builds_one_segment_a_frame_then_fades_in():
     plans, state = run_ring((0.0, 100.0, 0.0), SEGMENTS + RING.ring_fade_frames + 1)
     assert [p.ring.build_segment for p in plans[:SEGMENTS]] == list(range(SEGMENTS))
     # while the ring is built, its clouds are drawn one by one
-    assert all(p.stats()["clouds_ring"] == 0 for p in plans[:SEGMENTS])
+    assert all(p.stats().clouds_by_kind["ring"] == 0 for p in plans[:SEGMENTS])
     fading = plans[SEGMENTS : SEGMENTS + RING.ring_fade_frames - 1]
     weights = [p.ring.draws[0][1] for p in fading]
     assert weights == sorted(weights) and 0 < weights[0] < 1
@@ -503,7 +503,7 @@ def test_the_ring_builds_one_segment_a_frame_then_fades_in():
         in_view = [cloud for cloud in p.clouds if cloud.kind != "culled"]
         assert in_view and all(c.impostor_weight + p.ring.weight_of(c.members) == pytest.approx(1.0) for c in in_view)
     assert state.current is not None and state.pending is None
-    assert plans[-1].stats()["clouds_ring"] == len(FAR_CLOUDS) and plans[-1].draw_order == ()
+    assert plans[-1].stats().clouds_by_kind["ring"] == len(FAR_CLOUDS) and plans[-1].draw_order == ()
     # every cloud is rendered into the segments it reaches, and into no others
     assert set().union(*map(set, state.current.segment_members)) == {(i,) for i in range(len(FAR_CLOUDS))}
 

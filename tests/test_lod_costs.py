@@ -105,21 +105,21 @@ def test_a_frame_budget_postpones_regenerations_and_reports_the_error_it_accepte
     first = five_clouds(start, impostors)
     moved = camera_at((40.0, 0.0, 0.0), (40.0, 0.0, -1.0))
     unlimited = five_clouds(moved, impostors, first.state)
-    assert unlimited.stats()["impostors_regenerated"] == 5 and unlimited.accepted_error <= 1.0
+    assert unlimited.stats().impostors_regenerated == 5 and unlimited.accepted_error <= 1.0
     # room for the quads and two regenerations: the two farthest past the tolerance are served
     one = FILL_BOUND.ms(unlimited.update_work) / 5
     budget = dataclasses.replace(impostors, frame_budget_ms=FILL_BOUND.ms(unlimited.cloud_work) + 2.5 * one)
     tight = five_clouds(moved, budget, first.state)
     stats = tight.stats()
-    assert (stats["impostors_regenerated"], stats["regenerations_postponed"]) == (2, 3)
+    assert (stats.impostors_regenerated, stats.regenerations_postponed) == (2, 3)
     assert tight.predicted_ms <= budget.frame_budget_ms < unlimited.predicted_ms
-    assert tight.accepted_error > 1.0 and stats["accepted_error_tolerances"] == tight.accepted_error
+    assert tight.accepted_error > 1.0 and stats.accepted_error_tolerances == tight.accepted_error
     # a budget below the quads' own cost still serves the most urgent one a frame: the picture converges
     starved = five_clouds(moved, dataclasses.replace(impostors, frame_budget_ms=1e-6), first.state)
-    assert (starved.stats()["impostors_regenerated"], starved.stats()["regenerations_postponed"]) == (1, 4)
+    assert (starved.stats().impostors_regenerated, starved.stats().regenerations_postponed) == (1, 4)
     # new impostors are made whatever the budget: there is nothing else to show
     fresh = five_clouds(start, dataclasses.replace(impostors, frame_budget_ms=1e-6), finest_radii=None)
-    assert fresh.stats()["impostors_regenerated"] == 5
+    assert fresh.stats().impostors_regenerated == 5
 
 
 def test_the_plan_predicts_the_work_it_schedules():

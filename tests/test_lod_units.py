@@ -63,7 +63,7 @@ def test_a_group_shares_one_impostor_made_from_all_its_particles():
     assert (grouped.kind, grouped.members, grouped.regenerate) == ("impostor", (0, 1), "new")
     assert set(first.records) == {(0, 1), (2,)}  # the far cloud is out of view
     stats = first.stats()
-    assert stats["clouds_impostor"] == 3 and stats["units"] == 3 and stats["units_grouped"] == 1
+    assert stats.clouds_by_kind["impostor"] == 3 and stats.units == 3 and stats.units_grouped == 1
     # one cloud of the group changes: the group's impostor is remade, the other unit's is not
     relit = plan_frame(
         units, camera, (640, 480), RenderSettings(mode="impostor", ring_radius=np.inf), first.state, (1, 2, 1, 1)

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from cloudcore.camera import NEAR_PLANE_M, projection_matrix, view_matrix
-from cloudcore.overdraw import analytic_overdraw, overdraw_statistics
+from cloudcore.overdraw import Overdraw, analytic_overdraw, overdraw_statistics
 from cloudcore.scene import Camera, Cloud, Scene
 from cloudcore.settings import FULL_3D
 
@@ -31,16 +31,16 @@ def test_splats_behind_the_near_plane_are_not_estimated():
 
 def test_statistics_of_known_counts():
     counts = np.array([[0.0, 2.0], [4.0, 0.0]], dtype=np.float32)
-    assert overdraw_statistics(counts) == {"overdraw_mean": 1.5, "overdraw_mean_covered": 3.0, "overdraw_max": 4.0}
+    assert overdraw_statistics(counts, 2.0) == Overdraw(mean=1.5, mean_covered=3.0, max=4.0, analytic=2.0)
 
 
 def test_counted_fragments_match_the_disc_and_stack(renderer):
     one = splat_scene([0.0, 0.0, 0.0, 150.0])
     renderer.render(one, time_of_day=12.0, settings=FULL_3D)
     counts, stats = renderer.measure_overdraw()
-    assert stats["overdraw_max"] == 1.0
+    assert stats.max == 1.0
     # pixel coverage of a disc ~1,700 pixels large agrees with its area within rasterisation error
-    assert stats["overdraw_mean"] == pytest.approx(stats["overdraw_analytic"], rel=0.03)
+    assert stats.mean == pytest.approx(stats.analytic, rel=0.03)
 
     renderer.render(splat_scene([0.0, 0.0, 0.0, 150.0], [0.0, 0.0, 0.0, 150.0]), time_of_day=12.0, settings=FULL_3D)
     counts_two, _ = renderer.measure_overdraw()

@@ -1,10 +1,13 @@
 """Frame times at a frame rate and the per-frame statistics row of `cloudview record`."""
 
+import dataclasses
 import math
 
 import numpy as np
 import pytest
 
+from cloudcore.frame_stats import FrameStats, PlanStats
+from cloudcore.overdraw import Overdraw
 from cloudcore.recording import COLUMNS, frame_row, frame_times
 
 
@@ -35,21 +38,19 @@ def test_frame_rates_must_be_finite_and_positive(fps):
         frame_times(30.0, fps)
 
 
-STATS = {
-    "frame_ms": 10.0,
-    "world_ms": 2.5,
-    "cloud_ms": 6.0,
-    "impostor_update_ms": 1.5,
-    "particles_drawn": 1200,
-    "clouds_drawn": 5,
-    "impostors_drawn": 3,
-    "impostors_regenerated": 1,
-    "texture_bytes": 4096,
-    "regeneration_reasons": {"angle": 1},
-}
+STATS = FrameStats(
+    PlanStats(impostors_drawn=3, impostors_regenerated=1, regeneration_reasons={"angle": 1}),
+    frame_ms=10.0,
+    world_ms=2.5,
+    cloud_ms=6.0,
+    impostor_update_ms=1.5,
+    particles_drawn=1200,
+    clouds_drawn=5,
+    texture_bytes=4096,
+)
 
 
-def test_row_splits_the_frame_time_and_defaults_what_the_renderer_does_not_report():
+def test_row_splits_the_frame_time_and_leaves_overdraw_not_measured_empty():
     row = frame_row(7, 0.25, STATS)
     assert set(row) == set(COLUMNS)
     assert row["frame"] == 7 and row["time_s"] == 0.25
@@ -59,14 +60,9 @@ def test_row_splits_the_frame_time_and_defaults_what_the_renderer_does_not_repor
 
 
 def test_row_takes_layers_and_overdraw_when_given():
-    stats = STATS | {
-        "layers_drawn": 4,
-        "layers_rebuilt": 2,
-        "overdraw_mean": 3.25,
-        "overdraw_max": 17.0,
-        "overdraw_analytic": 3.5,
-        "overdraw_mean_covered": 5.0,
-    }
+    stats = dataclasses.replace(
+        STATS, plan=dataclasses.replace(STATS.plan, layers_drawn=4, layers_rebuilt=2)
+    ).with_overdraw(Overdraw(mean=3.25, mean_covered=5.0, max=17.0, analytic=3.5))
     row = frame_row(0, 0.0, stats)
     assert (row["layers_drawn"], row["layers_rebuilt"]) == (4, 2)
     assert (row["overdraw_mean"], row["overdraw_max"], row["overdraw_analytic"]) == (3.25, 17.0, 3.5)

@@ -80,8 +80,8 @@ def test_the_impostor_is_remade_while_the_cloud_forms_and_only_then(renderer, st
 
     def regenerated(time_s):
         stats = renderer.render(forming, settings=IMPOSTOR, time_s=time_s)[1]
-        assert stats["clouds_impostor"] == 1
-        return stats["regeneration_reasons"]
+        assert stats.plan.clouds_by_kind["impostor"] == 1
+        return stats.plan.regeneration_reasons
 
     regenerated(0.0)  # whatever the renderer held before, the impostor is now the unformed cloud's
     assert regenerated(0.5) == {}

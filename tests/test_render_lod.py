@@ -47,9 +47,9 @@ def test_impostor_renders_agree_with_full_3d(renderer, valley, view, min_psnr_db
     image, stats = settled(renderer, valley, camera, RenderSettings(mode=mode))
     difference = compare(image, reference)
     assert difference.psnr_db >= min_psnr_db, f"{view}, {mode}: {difference}"
-    assert stats["impostors_drawn"] > 0
-    fewer = stats["particles_drawn"] < full_stats["particles_drawn"]
-    assert fewer if mode == "impostor" else stats["particles_drawn"] <= full_stats["particles_drawn"]
+    assert stats.plan.impostors_drawn > 0
+    fewer = stats.particles_drawn < full_stats.particles_drawn
+    assert fewer if mode == "impostor" else stats.particles_drawn <= full_stats.particles_drawn
     if view == "inside_a_cloud":
         assert len(renderer.last_plan.of_kind("inside")) == 1
 
@@ -57,10 +57,14 @@ def test_impostor_renders_agree_with_full_3d(renderer, valley, view, min_psnr_db
 def test_the_default_view_still_is_drawn_from_impostors_and_the_ring(renderer, valley):
     """A still eye: every impostor lasts, so auto draws every unit from one (none is cheaper in full 3D)."""
     _, stats = settled(renderer, valley, None, RenderSettings())
-    assert stats["clouds_ring"] > 0 and stats["clouds_impostor"] > 0 and stats["clouds_full"] == 0
-    assert stats["units_grouped"] > 0  # the default scene has interpenetrating clouds
+    assert (
+        stats.plan.clouds_by_kind["ring"] > 0
+        and stats.plan.clouds_by_kind["impostor"] > 0
+        and stats.plan.clouds_by_kind["full"] == 0
+    )
+    assert stats.plan.units_grouped > 0  # the default scene has interpenetrating clouds
     _, again = renderer.render(valley, settings=RenderSettings())
-    assert again["impostors_regenerated"] == 0 and again["ring_segments_built"] == 0  # nothing moved
+    assert again.plan.impostors_regenerated == 0 and again.plan.ring_segments_built == 0  # nothing moved
 
 
 def test_the_crossfade_mixes_full_3d_and_impostor_linearly(renderer, valley):
@@ -101,4 +105,4 @@ def test_textures_of_a_dropped_ring_are_reused_not_added(renderer, valley):
     settled(renderer, valley, None, RenderSettings())
     with_ring = renderer.texture_bytes
     _, stats = settled(renderer, valley, None, dataclasses.replace(RenderSettings(), ring_radius=np.inf))
-    assert stats["ring_panels_drawn"] == 0 and stats["texture_bytes"] <= with_ring
+    assert stats.plan.ring_panels_drawn == 0 and stats.texture_bytes <= with_ring

@@ -38,11 +38,11 @@ def aircraft_box(scene, renderer, time_s):
 @pytest.mark.parametrize("time_s", [8.0, 10.0, 12.0])
 def test_split_impostors_match_split_full_3d_and_the_naive_impostor_cuts_the_aircraft(renderer, scene, time_s):
     reference, stats = renderer.render(scene, settings=FULL_3D, time_s=time_s)
-    assert stats["objects_in_clouds"] == 1 and stats["layers_drawn"] == 2
+    assert stats.plan.objects_in_clouds == 1 and stats.plan.layers_drawn == 2
     split, split_stats = renderer.render(scene, settings=SPLIT_IMPOSTOR, time_s=time_s)
-    assert split_stats["layers_drawn"] == 2 and split_stats["impostors_drawn"] == 1
+    assert split_stats.plan.layers_drawn == 2 and split_stats.plan.impostors_drawn == 1
     naive, naive_stats = renderer.render(scene, settings=NAIVE_IMPOSTOR, time_s=time_s)
-    assert naive_stats["layers_drawn"] == 0 and naive_stats["objects_in_clouds"] == 0
+    assert naive_stats.plan.layers_drawn == 0 and naive_stats.plan.objects_in_clouds == 0
     box = aircraft_box(scene, renderer, time_s)
     whole, around_split, around_naive = (
         compare(split, reference),
@@ -59,7 +59,7 @@ def test_an_object_outside_clouds_hides_the_cloud_behind_it(renderer, scene):
     eye, heart = np.asarray(scene.camera.position), np.asarray(scene.camera.look_at)
     parked = dataclasses.replace(scene.objects[0], path=None, position=tuple(eye + 0.2 * (heart - eye)))
     with_aircraft, stats = renderer.render(dataclasses.replace(scene, objects=(parked,)), settings=FULL_3D)
-    assert stats["objects_in_clouds"] == 0 and stats["layers_drawn"] == 0
+    assert stats.plan.objects_in_clouds == 0 and stats.plan.layers_drawn == 0
     assert renderer.last_plan.objects_with_world == (0,)
     without, _ = renderer.render(dataclasses.replace(scene, objects=()), settings=FULL_3D)
     (pose,) = object_poses((parked,), 0.0)

@@ -35,7 +35,7 @@ def preset_scene(preset: str, model: str, hour: float) -> Scene:
 @pytest.mark.parametrize("preset", PRESETS)
 def test_preset_matches_golden(preset, model, hour_name, renderer, request):
     image, stats = renderer.render(preset_scene(preset, model, HOURS[hour_name]), settings=FULL_3D)
-    assert stats["particles_drawn"] > 0
+    assert stats.particles_drawn > 0
     check_golden(image, f"preset_{preset}_{model}_{hour_name}", request)
 
 

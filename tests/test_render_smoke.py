@@ -36,10 +36,11 @@ def test_frame_is_a_valid_image_with_stats(afternoon, valley):
     rgb, stats = afternoon
     assert rgb.shape == (HEIGHT, WIDTH, 3) and rgb.dtype == np.uint8
     assert rgb.std() > 5  # not a blank frame
-    assert STATS_KEYS <= stats.keys()
-    assert all(np.isfinite(stats[key]) and stats[key] >= 0 for key in STATS_KEYS)
-    assert stats["clouds_drawn"] + stats["clouds_culled"] == len(valley.clouds)
-    assert 0 < stats["particles_drawn"] <= valley.particle_count
+    row = stats.as_dict()
+    assert STATS_KEYS <= row.keys()
+    assert all(np.isfinite(row[key]) and row[key] >= 0 for key in STATS_KEYS)
+    assert stats.clouds_drawn + stats.clouds_culled == len(valley.clouds)
+    assert 0 < stats.particles_drawn <= valley.particle_count
 
 
 def test_sky_at_the_top_is_blue(afternoon):

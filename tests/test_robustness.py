@@ -22,6 +22,7 @@ from scipy.optimize import brentq
 
 from cloudcore.camera import NEAR_PLANE_M, frustum_planes, projection_matrix, splats_in_frustum, view_matrix
 from cloudcore.errors import SceneError
+from cloudcore.frame_stats import FrameStats
 from cloudcore.frameplan import TEXTURED
 from cloudcore.gl.context import WindowContext
 from cloudcore.gl.frame import FrameRenderer
@@ -79,7 +80,7 @@ def float_buffers(renderer: FrameRenderer) -> dict[str, np.ndarray]:
 @dataclasses.dataclass
 class Frame:
     linear: np.ndarray  # the RGBA16F frame's RGB, linear light
-    stats: dict
+    stats: FrameStats
     kinds: list  # each cloud's kind in the frame plan
     overdraw_max: float
 
@@ -93,16 +94,16 @@ def render_checked(
     for name, pixels in buffers.items():
         bad = np.count_nonzero(~np.isfinite(pixels))
         assert bad == 0, f"{row}: {bad} NaN/Inf values in the {name} buffer"
-    numbers = {key: value for key, value in stats.items() if isinstance(value, (int, float))}
+    numbers = {key: value for key, value in stats.as_dict().items() if isinstance(value, (int, float))}
     assert all(math.isfinite(value) for value in numbers.values()), numbers
-    assert 0.0 <= stats["frame_ms"] < FRAME_TIME_LIMIT_MS
+    assert 0.0 <= stats.frame_ms < FRAME_TIME_LIMIT_MS
     frame = Frame(
         buffers["frame"], stats, [cloud.kind for cloud in renderer.last_plan.clouds], float(buffers["overdraw"].max())
     )
     print(
         f"\nROW {row} [{settings.mode}]: {len(buffers)} float buffers finite; frame max {frame.linear.max():.4g}, "
-        f"min {frame.linear.min():.4g}; overdraw max {frame.overdraw_max:g}; {stats['frame_ms']:.1f} ms; "
-        f"{stats['particles_drawn']} particles drawn; plan {frame.kinds}"
+        f"min {frame.linear.min():.4g}; overdraw max {frame.overdraw_max:g}; {stats.frame_ms:.1f} ms; "
+        f"{stats.particles_drawn} particles drawn; plan {frame.kinds}"
     )
     return frame
 
@@ -210,7 +211,7 @@ def test_camera_inside_a_particle(renderer, mode):
         particles[:, :3],
         particles[:, 3],
     )
-    assert in_view[0] and frame.stats["particles_drawn"] == np.count_nonzero(in_view) - 1
+    assert in_view[0] and frame.stats.particles_drawn == np.count_nonzero(in_view) - 1
     assert cloud_added(frame, clear_sky(renderer, settings=MODES[mode], camera=camera)) > VISIBLE
     assert frame.kinds == (["full"] if mode == "full" else ["inside"])
 
@@ -228,10 +229,10 @@ def test_camera_exactly_at_an_impostor_s_creation_point(renderer):
     settings = dataclasses.replace(MODES["impostor"], tolerance_deg=1.0)
     scene = with_particles(puff())  # a cloud the renderer has not seen: its impostor is made at EYE
     first = render_checked(renderer, "impostor made here", scene, settings)
-    assert first.stats["impostors_regenerated"] == 1
+    assert first.stats.plan.impostors_regenerated == 1
     render_checked(renderer, "0.4 degrees aside", scene, settings, camera=looking_from((10.0, 600.0, 1500.0)))
     back = render_checked(renderer, "back at the creation point", scene, settings)
-    assert back.stats["impostors_regenerated"] == 0
+    assert back.stats.plan.impostors_regenerated == 0
     np.testing.assert_array_equal(back.linear, first.linear)
 
 
@@ -334,7 +335,7 @@ def test_impostor_tolerance_0_remakes_on_any_move(renderer):
     settings = dataclasses.replace(MODES["impostor"], tolerance_deg=0.0)
     render_checked(renderer, "tolerance 0", BASE, settings)
     still = render_checked(renderer, "tolerance 0, eye still", BASE, settings)
-    assert still.stats["impostors_regenerated"] == 0, still.stats["regeneration_reasons"]
+    assert still.stats.plan.impostors_regenerated == 0, still.stats.plan.regeneration_reasons
     moved = render_checked(
         renderer,
         "tolerance 0, eye 1 mm aside",
@@ -342,7 +343,7 @@ def test_impostor_tolerance_0_remakes_on_any_move(renderer):
         settings,
         camera=looking_from(np.add(EYE, [1e-3, 0.0, 0.0]), CLOUD_CENTRE),
     )
-    assert moved.stats["regeneration_reasons"] == {"translation": 1}
+    assert moved.stats.plan.regeneration_reasons == {"translation": 1}
 
 
 def test_impostor_tolerance_90_keeps_the_impostor_a_quarter_turn_round(renderer):
@@ -357,7 +358,7 @@ def test_impostor_tolerance_90_keeps_the_impostor_a_quarter_turn_round(renderer)
     frame = render_checked(
         renderer, "tolerance 90, eye 80 degrees round", BASE, settings, camera=looking_from(turned, CLOUD_CENTRE)
     )
-    assert frame.stats["impostors_regenerated"] == 0
+    assert frame.stats.plan.impostors_regenerated == 0
 
 
 def settle_ring(renderer, row: str, settings: RenderSettings) -> Frame:
@@ -377,7 +378,7 @@ def test_ring_radius_0_puts_the_cloud_on_the_ring(renderer):
 def test_ring_radius_larger_than_the_scene_holds_nothing(renderer):
     settings = dataclasses.replace(MODES["auto"], ring_radius=1e9)
     frame = settle_ring(renderer, "ring radius 1e9 m", settings)
-    assert frame.kinds == ["impostor"] and frame.stats["ring_panels_drawn"] == 0  # an empty ring costs nothing
+    assert frame.kinds == ["impostor"] and frame.stats.plan.ring_panels_drawn == 0  # an empty ring costs nothing
     assert cloud_added(frame, clear_sky(renderer)) > VISIBLE
 
 

@@ -73,7 +73,7 @@ def test_two_objects_in_one_cloud_give_three_layers_in_order_from_any_side(azimu
     far, near = sorted(range(2), key=lambda i: -np.linalg.norm(objects[i].centre - eye))
     assert kinds == [("cloud", 0), ("object", far), ("cloud", 1), ("object", near), ("cloud", 2)]
     assert layer_order_errors(frame, np.array([o.centre for o in objects]), eye, lambda _: PARTICLES) == []
-    assert frame.stats()["layers_drawn"] == 3 and frame.stats()["objects_in_clouds"] == 2
+    assert frame.stats().layers_drawn == 3 and frame.stats().objects_in_clouds == 2
 
 
 def test_an_object_leaving_the_cloud_returns_it_to_one_impostor():
@@ -87,7 +87,7 @@ def test_an_object_leaving_the_cloud_returns_it_to_one_impostor():
     assert left.clouds[0].layers == 1 and left.clouds[0].regenerate == "layers"
     assert [item.kind for item in left.draw_items] == ["cloud"] and left.objects_with_world == (0,)
     again = plan(camera, (pose((0.0, 0.0, 400.0)),), impostor, left.records)
-    assert again.clouds[0].regenerate is None and again.stats()["layers_rebuilt"] == 0
+    assert again.clouds[0].regenerate is None and again.stats().layers_rebuilt == 0
 
 
 def test_layers_are_remade_when_the_object_moves_particles_between_them_and_not_before():
@@ -101,7 +101,7 @@ def test_layers_are_remade_when_the_object_moves_particles_between_them_and_not_
     within = plan(camera, (pose((0.0, 0.0, 0.5 * gap_near)),), impostor, first.records)
     assert within.clouds[0].regenerate is None
     across = plan(camera, (pose((0.0, 0.0, -2.0 * gap_far - 1.0)),), impostor, within.records)
-    assert across.clouds[0].regenerate == "layers" and across.stats()["layers_rebuilt"] == 2
+    assert across.clouds[0].regenerate == "layers" and across.stats().layers_rebuilt == 2
 
 
 def test_a_scene_without_objects_in_clouds_looks_at_no_particle():
@@ -113,7 +113,7 @@ def test_a_scene_without_objects_in_clouds_looks_at_no_particle():
     for mode in ("full", "impostor", "auto"):
         frame = plan(camera, outside, RenderSettings(mode=mode), particles=refuse)
         assert frame.objects_with_world == (0,) and frame.objects_between_layers == ()
-        assert frame.stats()["layers_drawn"] == 0
+        assert frame.stats().layers_drawn == 0
     no_split = plan(
         camera, (pose((0.0, 0.0, 0.0)),), RenderSettings(mode="full", split_objects=False), particles=refuse
     )

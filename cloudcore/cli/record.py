@@ -102,7 +102,7 @@ def run(args) -> int:
             camera = camera_on_path(path, t, scene.camera.fov_y_deg)
             image, stats = renderer.render(scene, camera=camera, settings=settings, time_s=path.keys[0, 0] + t)
             if not args.no_overdraw:
-                stats |= renderer.measure_overdraw()[1]
+                stats = stats.with_overdraw(renderer.measure_overdraw()[1])
             if video is not None:
                 video.send(image)
             if args.frames_dir:
@@ -110,7 +110,7 @@ def run(args) -> int:
             if rows is not None:
                 rows.writerow(frame_row(index, t, stats))
                 table.flush()  # a run cut short, even by a kill, keeps its rows
-            frame_ms.append(stats["frame_ms"])
+            frame_ms.append(stats.frame_ms)
             bar.update()
             if stop.requested:
                 break

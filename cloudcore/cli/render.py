@@ -69,24 +69,27 @@ def run(args) -> int:
         image, stats = renderer.render(scene, time_of_day=args.time, camera=camera, settings=settings)
         if args.overdraw or args.stats:
             counts, overdraw = renderer.measure_overdraw()
-            stats |= overdraw
-            stats |= scene_block_overdraw_statistics(scene.clouds)  # Wang's view-independent counterpart
+            stats = stats.with_overdraw(overdraw)
+    report = stats.as_dict()
+    if stats.overdraw is not None:
+        report |= scene_block_overdraw_statistics(scene.clouds)  # Wang's view-independent counterpart
     _write(args.out, lambda path: iio.imwrite(path, image))
     if args.overdraw:
         _write(args.overdraw, lambda path: iio.imwrite(path, heat_image(counts)[0][..., :3]))
     if args.stats:
-        _write(args.stats, lambda path: path.write_text(json.dumps(stats, indent=2) + "\n"))
+        _write(args.stats, lambda path: path.write_text(json.dumps(report, indent=2) + "\n"))
     print(
-        f"wrote {args.out} ({args.width}x{args.height}): frame {stats['frame_ms']:.1f} ms "
-        f"(world {stats['world_ms']:.1f}, clouds {stats['cloud_ms']:.1f}), "
-        f"{stats['particles_drawn']} particles, {stats['clouds_drawn']} clouds drawn, "
-        f"{stats['clouds_culled']} culled"
+        f"wrote {args.out} ({args.width}x{args.height}): frame {stats.frame_ms:.1f} ms "
+        f"(world {stats.world_ms:.1f}, clouds {stats.cloud_ms:.1f}), "
+        f"{stats.particles_drawn} particles, {stats.clouds_drawn} clouds drawn, "
+        f"{stats.clouds_culled} culled"
     )
-    if "overdraw_mean" in stats:
+    if stats.overdraw is not None:
+        overdraw = stats.overdraw
         print(
-            f"overdraw: mean {stats['overdraw_mean']:.2f}, max {stats['overdraw_max']:.0f} "
-            f"(analytic estimate {stats['overdraw_analytic']:.2f}); cloud blocks: mean "
-            f"{stats['block_overdraw_mean']:.2f}, max {stats['block_overdraw_max']:.2f} over {stats['blocks']}"
+            f"overdraw: mean {overdraw.mean:.2f}, max {overdraw.max:.0f} "
+            f"(analytic estimate {overdraw.analytic:.2f}); cloud blocks: mean "
+            f"{report['block_overdraw_mean']:.2f}, max {report['block_overdraw_max']:.2f} over {report['blocks']}"
         )
     return 0
 

@@ -33,6 +33,7 @@ from cloudcore.colour import linear_to_srgb8
 from cloudcore.eye_scattering import ParticleShading
 from cloudcore.facing import CloudFacings
 from cloudcore.formation import formation_state
+from cloudcore.frame_stats import FrameStats
 from cloudcore.frameplan import FramePlan, LodState, inside_runs, plan_frame
 from cloudcore.gl.context import HeadlessContext, WindowContext, check_frame_size
 from cloudcore.gl.impostor_store import ImpostorStore
@@ -120,7 +121,7 @@ class FrameRenderer:
             scene.lighting if time_of_day is None else dataclasses.replace(scene.lighting, time_of_day=time_of_day)
         )
         camera = scene.camera if camera is None else camera
-        stats = {"illumination_ms": self._prepare(scene, lighting, illumination_method)}
+        illumination_ms = self._prepare(scene, lighting, illumination_method)
         particles = self._particles
         poses = self._objects.poses(time_s) if self._objects is not None else ()
         starts = particles.cloud_starts
@@ -157,6 +158,7 @@ class FrameRenderer:
         for start, facing in self._facings.update(camera.position):
             self._splats.update_facing(particles, start, facing)
         start = time.perf_counter()
+        self._splats.particles_as_points = 0
         self._world.draw(self.context, camera, projection @ view)
         if plan.objects_with_world:
             self._objects.draw(self.context, camera, poses, plan.objects_with_world, write_depth=True)
@@ -172,17 +174,19 @@ class FrameRenderer:
         self.lod_state = plan.state.measured(
             [(plan.update_work, 1e3 * (updates_done - world_done)), (plan.cloud_work, 1e3 * (done - updates_done))]
         )
-        stats |= plan.stats() | {
-            "frame_ms": 1e3 * (done - start),
-            "world_ms": 1e3 * (world_done - start),
-            "impostor_update_ms": 1e3 * (updates_done - world_done),
-            "cloud_ms": 1e3 * (done - updates_done),
-            "particles_drawn": drawn,
-            "particles_to_impostors": rendered,
-            "clouds_drawn": sum(len(plan.clouds[i].members) for i in plan.draw_order),
-            "clouds_culled": sum(len(c.members) for c in plan.of_kind("culled")),
-            "texture_bytes": self.texture_bytes,
-        }
+        stats = FrameStats(
+            plan=plan.stats(),
+            illumination_ms=illumination_ms,
+            frame_ms=1e3 * (done - start),
+            world_ms=1e3 * (world_done - start),
+            impostor_update_ms=1e3 * (updates_done - world_done),
+            cloud_ms=1e3 * (done - updates_done),
+            particles_drawn=drawn,
+            particles_as_points=self._splats.particles_as_points,
+            particles_to_impostors=rendered,
+            clouds_drawn=sum(len(plan.clouds[i].members) for i in plan.draw_order),
+            texture_bytes=self.texture_bytes,
+        )
         return (linear_to_srgb8(self.context.read_linear_rgb()) if read_back else None), stats
 
     def display_texture(self) -> int:
@@ -415,7 +419,7 @@ class FrameRenderer:
         )
         counts = self._overdraw_target.read()
         self.context.bind_target()
-        return counts, overdraw_statistics(counts) | {"overdraw_analytic": analytic}
+        return counts, overdraw_statistics(counts, analytic)
 
     def _close_screen_targets(self) -> None:
         """Free the targets whose size is the frame's."""

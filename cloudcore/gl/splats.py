@@ -118,6 +118,8 @@ class SplatPass:
         }
         self._point_sizes_px = tuple(float(size) for size in GL.glGetFloatv(GL.GL_POINT_SIZE_RANGE))
         self._plain: np.ndarray = np.zeros(0, dtype=bool)  # of the resident particles: `plain_splats`
+        #: particles drawn as point sprites since the frame's renderer last set it to 0 (for its statistics)
+        self.particles_as_points = 0
         self._shade_program = build_compute_program(
             "splat_shade",
             {"MAX_LIGHTS": MAX_LIGHTS, "FADE_START_RADII": FADE_START_RADII, "FADE_END_RADII": FADE_END_RADII},
@@ -191,7 +193,9 @@ class SplatPass:
         GL.glBindVertexArray(0)
         if target_viewport is not None:
             GL.glViewport(*target_viewport)
-        return sum(stop - start for start, stop, as_points in pieces if as_points)
+        as_points = sum(stop - start for start, stop, as_points in pieces if as_points)
+        self.particles_as_points += as_points
+        return as_points
 
     def _runs(self, batch: SplatBatch, view_rotation, projection, viewport) -> list[tuple[int, int, bool]]:
         """The batch's runs of points and of quads (`cloudcore.point_sprites.draw_runs`) in a (width, height)

@@ -1,0 +1,80 @@
+"""What a frame drew and what it cost: the statistics of one `FrameRenderer.render`, typed (pure).
+
+The plan's counts come from `FramePlan.stats`, the measured times and what
+was drawn from the renderer, the overdraw (when measured) from
+`FrameRenderer.measure_overdraw`.  Readers use the attributes; `as_dict` is
+the one flat form for JSON and CSV (`cloudview render --stats`, `record`,
+`bench`), whose keys are the attributes' names (the clouds per kind as
+`clouds_<kind>`, the cost model's coefficients as `cost_<work>_ms`, the
+overdraw's as `overdraw_<name>`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+
+from cloudcore.lod_costs import CostModel
+from cloudcore.overdraw import Overdraw
+
+
+@dataclass(frozen=True)
+class PlanStats:
+    """What the frame plan chose (`FramePlan.stats`); the defaults are an empty plan's."""
+
+    #: clouds (not units) per draw kind; `FramePlan.stats` names every kind of `frameplan.KINDS`
+    clouds_by_kind: dict[str, int] = field(default_factory=dict)
+    units: int = 0
+    units_grouped: int = 0  # units of several interpenetrating clouds
+    impostors_drawn: int = 0
+    impostors_regenerated: int = 0
+    regeneration_reasons: dict[str, int] = field(default_factory=dict)
+    regenerations_postponed: int = 0
+    ring_segments_built: int = 0
+    ring_panels_drawn: int = 0
+    objects_in_clouds: int = 0
+    layers_drawn: int = 0
+    layers_rebuilt: int = 0
+    predicted_ms: float = 0.0
+    tolerance_deg: float = 0.0
+    accepted_error_tolerances: float = 0.0  # the largest error drawn, in tolerances
+    costs: CostModel = field(default_factory=CostModel)  # the coefficients the plan priced its choices with
+
+
+@dataclass(frozen=True)
+class FrameStats:
+    """One frame: the plan's choices, what the renderer drew, and the passes' times (to glFinish); the
+    defaults are an empty frame's."""
+
+    plan: PlanStats = field(default_factory=PlanStats)
+    illumination_ms: float = 0.0  # shading the particles' light, when the scene or its light changed
+    frame_ms: float = 0.0  # world, impostor updates and cloud pass
+    world_ms: float = 0.0
+    impostor_update_ms: float = 0.0
+    cloud_ms: float = 0.0
+    particles_drawn: int = 0  # on the screen
+    particles_as_points: int = 0  # of those and of the regenerations', drawn as point sprites
+    particles_to_impostors: int = 0
+    clouds_drawn: int = 0
+    texture_bytes: int = 0
+    overdraw: Overdraw | None = None
+
+    @property
+    def clouds_culled(self) -> int:
+        return self.plan.clouds_by_kind.get("culled", 0)
+
+    def with_overdraw(self, overdraw: Overdraw) -> FrameStats:
+        return dataclasses.replace(self, overdraw=overdraw)
+
+    def as_dict(self) -> dict:
+        """The flat form: every number by name, the regeneration reasons as a dict."""
+        plan = self.plan
+        row = {f.name: getattr(self, f.name) for f in dataclasses.fields(self) if f.name not in ("plan", "overdraw")}
+        row |= {f"clouds_{kind}": count for kind, count in plan.clouds_by_kind.items()}
+        row |= {
+            f.name: getattr(plan, f.name) for f in dataclasses.fields(plan) if f.name not in ("clouds_by_kind", "costs")
+        }
+        row |= {f"cost_{name}_ms": value for name, value in dataclasses.asdict(plan.costs).items()}
+        if self.overdraw is not None:
+            row |= {f"overdraw_{name}": value for name, value in dataclasses.asdict(self.overdraw).items()}
+        return row
