@@ -430,10 +430,12 @@ def install(params, editor, viewport, panels, results_path: Path, outcome: dict,
         ctx.item_input_value("Frames per second", 1.0)  # the 2 s path: 3 frames
         ctx.item_click("Record the path to video")
         started, deadline = imgui.get_frame_count(), time.monotonic() + 120.0
-        while panels.record_job is not None and time.monotonic() < deadline:
+        while panels.camera.record_job is not None and time.monotonic() < deadline:
             ctx.yield_()
         outcome["frames_drawn_while_recording"] = imgui.get_frame_count() - started
-        CHECK(panels.record_job is None and any(m.startswith("recorded: wrote 3 frames") for m in editor.messages))
+        CHECK(
+            panels.camera.record_job is None and any(m.startswith("recorded: wrote 3 frames") for m in editor.messages)
+        )
         CHECK(video.exists() and imgui.get_frame_count() - started > 10)  # the editor kept drawing meanwhile
 
     def a_click_within_one_frame_is_not_lost(ctx):
@@ -478,7 +480,7 @@ def install(params, editor, viewport, panels, results_path: Path, outcome: dict,
             "camera orbited after frames": moved_after,
         }
         CHECK(selected_after is not None and camera_window.active)  # the Camera panel is the one drawn
-        CHECK(editor.camera == orbited(start, -panels.orbit_step_deg))  # one orbit, not none and not two
+        CHECK(editor.camera == orbited(start, -panels.camera.orbit_step_deg))  # one orbit, not none and not two
         use_window(ctx, "Camera")
         ctx.item_click("Reset to the scene's camera")
 

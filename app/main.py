@@ -62,16 +62,7 @@ def runner_params(
     bottom = hello_imgui.DockingSplit("Left", "LeftBottom", imgui.Dir.down, 0.45)
     params.docking_params.docking_splits = [left, bottom]
     windows = []
-    for label, dock, function in (
-        ("Viewport", "MainDockSpace", viewport.gui),
-        ("Scene", "Left", panels.scene),
-        ("Clouds", "Left", panels.clouds),
-        ("Build", "Left", panels.build),
-        ("Lighting", "Left", panels.lighting),
-        ("LOD", "Left", panels.lod),
-        ("Camera", "Left", panels.camera),
-        ("Statistics", "LeftBottom", panels.statistics),
-    ):
+    for label, dock, function in [("Viewport", "MainDockSpace", viewport.gui), *panels.windows()]:
         window = hello_imgui.DockableWindow(label, dock, function)
         windows.append(window)
     params.docking_params.dockable_windows = windows

@@ -10,7 +10,7 @@ crossfading over `transition_frames` when it changes, and the ring beyond
 Each field that is set from outside the engine carries an `Option` (its
 command-line flag, help, and editor widget): `cloudcore.cli.settings_args`
 makes the options and sweep names of `render`, `record` and `bench` from them,
-and `app.panels` the LOD panel's widgets, so a setting is named in one place.
+and `app.panels.lod` the LOD panel's widgets, so a setting is named in one place.
 """
 
 from __future__ import annotations

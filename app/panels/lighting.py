@@ -1,0 +1,59 @@
+"""The Lighting panel: the time of day and the shading, the viewport following a slider as it is dragged."""
+
+from __future__ import annotations
+
+import dataclasses
+
+from imgui_bundle import imgui
+
+from app.editor import Editor
+from app.panels.widgets import ReleasedSliders
+from cloudcore.phase import PHASE_NAMES
+
+#: the shading sliders: label -> (`Shading` field, low, high)
+_SHADING_SLIDERS = {
+    "Albedo": ("albedo", 0.0, 1.0),
+    "Optical depth": ("optical_depth", 0.0, 50.0),
+    "g": ("g", -0.99, 0.99),
+}
+
+
+class LightingPanel:
+    def __init__(self, editor: Editor, sliders: ReleasedSliders):
+        self.editor, self._sliders = editor, sliders
+
+    def draw(self) -> None:
+        editor = self.editor
+        scene = editor.scene
+        hours = editor.time_of_day if editor.time_of_day is not None else 12.0
+        hours = self._sliders.slider("Time of day", hours, 0.0, 24.0, "%.2f h")
+        if hours is not None:
+            editor.set_time_of_day(hours)
+        shading = scene.shading
+        changes = {
+            field: self._sliders.slider(label, getattr(shading, field), low, high)
+            for label, (field, low, high) in _SHADING_SLIDERS.items()
+        }
+        # the viewport follows a slider being dragged (`cloudcore.relighting`); the edit is made on release
+        dragged = {
+            field: self._sliders.dragged(label)
+            for label, (field, _, _) in _SHADING_SLIDERS.items()
+            if self._sliders.dragged(label) is not None
+        }
+        dragged_hours = self._sliders.dragged("Time of day")
+        editor.dragged_look = (
+            None
+            if not dragged and dragged_hours is None
+            else (
+                dataclasses.replace(shading, **dragged),
+                scene.lighting
+                if dragged_hours is None
+                else dataclasses.replace(scene.lighting, time_of_day=float(dragged_hours)),
+            )
+        )
+        changed_phase, phase_index = imgui.combo("Phase function", PHASE_NAMES.index(shading.phase), list(PHASE_NAMES))
+        changes = {key: value for key, value in changes.items() if value is not None}
+        if changed_phase:
+            changes["phase"] = PHASE_NAMES[phase_index]
+        if changes:
+            editor.edit(dataclasses.replace(scene, shading=dataclasses.replace(shading, **changes)))

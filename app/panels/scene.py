@@ -1,0 +1,45 @@
+"""The Scene panel: open, save, undo, recover, and the editor's messages."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from imgui_bundle import imgui
+
+from app.editor import Editor, recovery_path
+
+
+class ScenePanel:
+    def __init__(self, editor: Editor):
+        self.editor = editor
+        self.file_field = str(editor.path or "")
+
+    def draw(self) -> None:
+        editor = self.editor
+        imgui.text(f"{editor.path or '(unsaved scene)'}{' *' if editor.dirty else ''}")
+        _, self.file_field = imgui.input_text("File", self.file_field)
+        if imgui.button("Open"):
+            editor.open_file(Path(self.file_field))
+        imgui.same_line()
+        if imgui.button("Save"):
+            editor.save()
+        imgui.same_line()
+        if imgui.button("Save as"):
+            editor.save(Path(self.file_field))
+        imgui.same_line()
+        if imgui.button("Undo"):
+            editor.undo()
+        imgui.same_line()
+        if imgui.button("Redo"):
+            editor.redo()
+        if editor.path is not None and recovery_path(editor.path).exists():
+            if imgui.button("Recover unsaved edits"):
+                editor.recover()
+            imgui.set_item_tooltip(f"load {recovery_path(editor.path)}, written before the last session ended")
+        for path in editor.recent[1:]:
+            if imgui.small_button(f"recent: {path}"):
+                self.file_field = str(path)
+                editor.open_file(path)
+        imgui.separator()
+        for message in reversed(editor.messages):
+            imgui.text_wrapped(message)

@@ -1,0 +1,29 @@
+"""Widgets the panels share."""
+
+from __future__ import annotations
+
+from imgui_bundle import imgui
+
+
+class ReleasedSliders:
+    """Sliders whose new value counts once, on release: dragging does not re-shade every frame or fill the
+    undo history.  While one is dragged, `dragged` gives the value shown (the viewport can follow it)."""
+
+    def __init__(self):
+        self._dragging: dict[str, float] = {}
+
+    def slider(self, label: str, value: float, low: float, high: float, fmt: str = "%.3f") -> float | None:
+        """The slider `label`; returns the released value, or None."""
+        shown = self._dragging.get(label, value)
+        changed, shown = imgui.slider_float(label, shown, low, high, fmt)
+        if changed:
+            self._dragging[label] = shown
+        if imgui.is_item_deactivated_after_edit():
+            return self._dragging.pop(label, shown)
+        if not imgui.is_item_active():
+            self._dragging.pop(label, None)
+        return None
+
+    def dragged(self, label: str) -> float | None:
+        """The value the slider `label` shows while it is being dragged, else None."""
+        return self._dragging.get(label)
