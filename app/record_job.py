@@ -54,7 +54,7 @@ class RecordJob:
             "cloudcore.cli",
             "record",
             str(scene_file),
-            "--path",
+            "--camera-path",
             path_name,
             "--out",
             str(self.out),

@@ -1,10 +1,10 @@
 """Full-3D frame time and overdraw of a scene at several sizes: the record impostors must beat. JSON out.
 
     python scripts/bench_full3d.py [cloudcore/resources/scenes/valley.toml] [--sizes 640x480,1600x1200]
-                                   [--path flythrough --frames 8] [--json out/bench_full3d.json]
+                                   [--camera-path flythrough --frames 8] [--json out/bench_full3d.json]
 
 For each size renders the scene's camera view, then --frames views spread along
---path (if given), after one warm-up frame that pays the shading precompute;
+--camera-path (if given), after one warm-up frame that pays the shading precompute;
 reports frame, world-pass and cloud-pass times (mean and median, timed to
 glFinish, read-back excluded) and measured and analytic overdraw.
 """
@@ -55,17 +55,19 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("scene", nargs="?", default=str(DEFAULT_SCENE))
     parser.add_argument("--sizes", default="640x480,1600x1200")
-    parser.add_argument("--path", help="also time views along this camera path")
-    parser.add_argument("--frames", type=int, default=8, help="views along --path")
+    parser.add_argument("--camera-path", help="also time views along this camera path")
+    parser.add_argument("--frames", type=int, default=8, help="views along --camera-path")
     parser.add_argument("--json", type=Path, help="write the results here as well as to stdout")
     args = parser.parse_args()
 
     scene = load_scene(args.scene)
-    views = [scene.camera] + ([camera for _, camera in path_views(scene, args.path, args.frames)] if args.path else [])
+    views = [scene.camera] + (
+        [camera for _, camera in path_views(scene, args.camera_path, args.frames)] if args.camera_path else []
+    )
     sizes = [tuple(int(v) for v in size.split("x")) for size in args.sizes.split(",")]
     result = {
         "scene": str(args.scene),
-        "path": args.path,
+        "path": args.camera_path,
         "machine": machine(),
         "runs": [bench_size(scene, w, h, views) for w, h in sizes],
     }

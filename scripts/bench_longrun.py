@@ -1,6 +1,6 @@
 """Long run: a camera path looped headless for minutes; texture and process memory must stay flat. JSON out.
 
-    python scripts/bench_longrun.py [cloudcore/resources/scenes/valley.toml] [--path flythrough] [--minutes 10]
+    python scripts/bench_longrun.py [cloudcore/resources/scenes/valley.toml] [--camera-path flythrough] [--minutes 10]
                                     [--width 640 --height 480] [--mode auto] [--json out/longrun.json]
 
 Renders the path's frames (--fps per second of path time) over and over, as
@@ -90,7 +90,7 @@ def long_run(scene, views, settings: RenderSettings, size, seconds: float, sampl
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("scene", nargs="?", default=str(DEFAULT_SCENE))
-    parser.add_argument("--path", default="flythrough", help="camera path to loop (default %(default)s)")
+    parser.add_argument("--camera-path", default="flythrough", help="camera path to loop (default %(default)s)")
     parser.add_argument("--minutes", type=float, default=10.0)
     parser.add_argument("--sample-seconds", type=float, default=60.0)
     # 5 frames per second of path time: llvmpipe loops the 30 s flythrough (151 frames) about 8 times in 10 minutes
@@ -102,11 +102,11 @@ def main() -> None:
     args = parser.parse_args()
 
     scene = load_scene(args.scene)
-    path = scene.camera_path(args.path)
-    views = path_views(scene, args.path, max(2, round(path.duration * args.fps) + 1))
+    path = scene.camera_path(args.camera_path)
+    views = path_views(scene, args.camera_path, max(2, round(path.duration * args.fps) + 1))
     result = {
         "scene": str(args.scene),
-        "path": args.path,
+        "path": args.camera_path,
         "mode": args.mode,
         "width": args.width,
         "height": args.height,

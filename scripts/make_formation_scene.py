@@ -1,7 +1,7 @@
 """Regenerate cloudcore/resources/scenes/formation.toml: one cloud forming, one dissipating, one steady between them.
 
     python scripts/make_formation_scene.py [--out cloudcore/resources/scenes/formation.toml]
-    cloudview record cloudcore/resources/scenes/formation.toml --path watch --out formation.mp4
+    cloudview record cloudcore/resources/scenes/formation.toml --camera-path watch --out formation.mp4
 
 The demo of Wang's formation and dissipation (2004, section 4 and Listing 1):
 over the 10 s camera path `watch` the left cloud grows from its core outward

@@ -71,7 +71,7 @@ def test_bench_cli_writes_the_contract(tmp_path):
             "cloudcore.cli",
             "bench",
             str(VALLEY),
-            "--path",
+            "--camera-path",
             "flythrough",
             "--frames",
             "2",
@@ -112,10 +112,10 @@ def test_bench_cli_writes_the_contract(tmp_path):
 @pytest.mark.parametrize(
     "args, message",
     [
-        (["--path", "nowhere"], "no camera path named 'nowhere'"),
-        (["--path", "flythrough", "--sweep", "colour=1,2"], "--sweep"),
-        (["--path", "flythrough", "--sweep", "impostor_max_size=300"], "power of two"),
-        (["--path", "flythrough", "--regeneration-budget", "-1"], "regeneration_budget"),
+        (["--camera-path", "nowhere"], "no camera path named 'nowhere'"),
+        (["--camera-path", "flythrough", "--sweep", "colour=1,2"], "--sweep"),
+        (["--camera-path", "flythrough", "--sweep", "impostor_max_size=300"], "power of two"),
+        (["--camera-path", "flythrough", "--regeneration-budget", "-1"], "regeneration_budget"),
     ],
 )
 def test_bad_bench_arguments_exit_2_in_one_line(tmp_path, args, message):

@@ -43,7 +43,7 @@ def flythrough(tmp_path_factory):
     """
     out = tmp_path_factory.mktemp("record")
     result = run_cli(
-        "--path",
+        "--camera-path",
         "flythrough",
         "--fps",
         "2",
@@ -83,7 +83,7 @@ def test_one_csv_row_and_one_png_per_frame(flythrough):
 def test_the_same_inputs_give_the_same_frames(flythrough, tmp_path):
     """Measuring overdraw (done in the first run, not here) leaves the frames alone too."""
     result = run_cli(
-        "--path",
+        "--camera-path",
         "flythrough",
         "--fps",
         "2",
@@ -113,7 +113,7 @@ def test_ctrl_c_keeps_a_playable_video_of_the_frames_so_far(tmp_path):
             "cloudcore.cli",
             "record",
             str(VALLEY),
-            "--path",
+            "--camera-path",
             "flythrough",
             *SIZE,
             "--out",
@@ -143,17 +143,17 @@ def test_ctrl_c_keeps_a_playable_video_of_the_frames_so_far(tmp_path):
 @pytest.mark.parametrize(
     "args, message",
     [
-        (["--path", "flythrough"], "give --out FILE.mp4, --frames-dir DIR, or both"),
-        (["--path", "nowhere", "--frames-dir", "{tmp}/f"], "no camera path named 'nowhere'"),
-        (["--path", "flythrough", "--out", "{tmp}/x.mp4", "--width", "63"], "needs an even width and height"),
-        (["--path", "flythrough", "--out", "{tmp}/x.mp4", "--fps", "0"], "--fps"),
-        (["--path", "flythrough", "--out", "{tmp}/x.mp4", "--fps", "nan"], "--fps"),
-        (["--path", "flythrough", "--out", "{tmp}/x.mp4", "--fps", "inf"], "--fps"),
-        (["--path", "flythrough", "--out", "{tmp}/x.mp4", "--frames", "0"], "--frames"),
-        (["--path", "flythrough", "--out", "{tmp}/file/x.mp4"], "{tmp}/file/x.mp4: output:"),
-        (["--path", "flythrough", "--frames-dir", "{tmp}/file"], "{tmp}/file: output:"),
+        (["--camera-path", "flythrough"], "give --out FILE.mp4, --frames-dir DIR, or both"),
+        (["--camera-path", "nowhere", "--frames-dir", "{tmp}/f"], "no camera path named 'nowhere'"),
+        (["--camera-path", "flythrough", "--out", "{tmp}/x.mp4", "--width", "63"], "needs an even width and height"),
+        (["--camera-path", "flythrough", "--out", "{tmp}/x.mp4", "--fps", "0"], "--fps"),
+        (["--camera-path", "flythrough", "--out", "{tmp}/x.mp4", "--fps", "nan"], "--fps"),
+        (["--camera-path", "flythrough", "--out", "{tmp}/x.mp4", "--fps", "inf"], "--fps"),
+        (["--camera-path", "flythrough", "--out", "{tmp}/x.mp4", "--frames", "0"], "--frames"),
+        (["--camera-path", "flythrough", "--out", "{tmp}/file/x.mp4"], "{tmp}/file/x.mp4: output:"),
+        (["--camera-path", "flythrough", "--frames-dir", "{tmp}/file"], "{tmp}/file: output:"),
         (
-            ["--path", "flythrough", "--frames-dir", "{tmp}/f", "--stats", "{tmp}/file/s.csv"],
+            ["--camera-path", "flythrough", "--frames-dir", "{tmp}/f", "--stats", "{tmp}/file/s.csv"],
             "{tmp}/file/s.csv: output:",
         ),
     ],
@@ -175,7 +175,7 @@ def test_a_missing_scene_is_one_line(tmp_path):
             "cloudcore.cli",
             "record",
             str(tmp_path / "none.toml"),
-            "--path",
+            "--camera-path",
             "flythrough",
             "--out",
             str(tmp_path / "x.mp4"),

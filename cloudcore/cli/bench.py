@@ -1,4 +1,4 @@
-"""`cloudview bench SCENE --path NAME --json OUT.json`: error against run time along a camera path, headless.
+"""`cloudview bench SCENE --camera-path NAME --json OUT.json`: error against run time along a camera path, headless.
 
 Each setting of the sweeps is rendered along the path beside the full-3D
 reference in the same run; the report is `cloudcore.benchmark.bench_path`'s,
@@ -34,7 +34,7 @@ def add_parser(commands) -> None:
     parser = commands.add_parser("bench", help="frame time and image error of settings against full 3D")
     parser.add_argument("scene", help="scene file (.toml)")
     views = parser.add_mutually_exclusive_group(required=True)
-    views.add_argument("--path", help="camera path of the scene to fly")
+    views.add_argument("--camera-path", help="camera path of the scene to fly")
     views.add_argument("--still", action="store_true", help="the scene's camera, still, for --frames frames")
     views.add_argument(
         "--orbit", type=float, metavar="DEG", help="the scene's camera orbiting its look-at point DEG degrees a frame"
@@ -72,9 +72,9 @@ def run(args) -> int:
     scene = load_scene(args.scene)
     if args.without_terrain:
         scene = dataclasses.replace(scene, terrain=None)
-    if args.path is not None:
+    if args.camera_path is not None:
         try:
-            scene.camera_path(args.path)
+            scene.camera_path(args.camera_path)
         except KeyError as error:
             raise SceneError(args.scene, "camera_paths", error.args[0]) from None
     if args.frames < 1:
@@ -90,7 +90,9 @@ def run(args) -> int:
         if args.orbit is not None
         else None
     )
-    motion = "still" if args.still else f"orbit {args.orbit:g} deg/frame" if args.orbit is not None else args.path
+    motion = (
+        "still" if args.still else f"orbit {args.orbit:g} deg/frame" if args.orbit is not None else args.camera_path
+    )
     base = settings_from(args)
     fields = [field for field, _ in args.sweep]
     settings_list = [
@@ -110,7 +112,7 @@ def run(args) -> int:
         report = bench_path(
             renderer,
             scene,
-            args.path,
+            args.camera_path,
             args.frames,
             settings_list,
             (args.width, args.height),

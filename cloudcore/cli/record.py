@@ -1,4 +1,4 @@
-"""`cloudview record SCENE --path NAME --out FILE.mp4`: every frame of a camera path, headless, to H.264 and/or PNGs.
+"""`cloudview record SCENE --camera-path NAME --out F.mp4`: each frame of a camera path, headless, to H.264 and/or PNGs.
 
 Frame i shows the path at i / fps seconds; --stats writes one CSV row per
 frame (`cloudcore.recording.COLUMNS`).  Ctrl-C stops after the frame being
@@ -28,7 +28,7 @@ from cloudcore.scenefile import load_scene
 def add_parser(commands) -> None:
     parser = commands.add_parser("record", help="render every frame of a camera path to a video and/or PNGs")
     add_scene_argument(parser)
-    parser.add_argument("--path", required=True, help="camera path of the scene to fly")
+    parser.add_argument("--camera-path", required=True, help="camera path of the scene to fly")
     parser.add_argument("--out", type=Path, help="H.264 video to write (.mp4); needs an even width and height")
     parser.add_argument("--frames-dir", type=Path, help="folder to write frame_00000.png, frame_00001.png, ... into")
     parser.add_argument("--stats", type=Path, help="one row of frame statistics per frame (CSV)")
@@ -71,7 +71,7 @@ def run(args) -> int:
         )
     scene = load_scene(args.scene)
     try:
-        path = scene.camera_path(args.path)
+        path = scene.camera_path(args.camera_path)
     except KeyError as error:
         raise SceneError(args.scene, "camera_paths", error.args[0]) from None
     settings = settings_from(args)

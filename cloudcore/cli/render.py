@@ -22,9 +22,9 @@ def add_parser(commands) -> None:
     parser.add_argument("--out", required=True, type=Path, help="PNG to write")
     parser.add_argument("--width", type=pixel_count, default=640)
     parser.add_argument("--height", type=pixel_count, default=480)
-    parser.add_argument("--time", type=float, help="time of day in hours, overriding the scene's")
+    parser.add_argument("--time-of-day", type=float, help="time of day in hours, overriding the scene's")
     parser.add_argument("--camera-path", help="take the camera from this path of the scene")
-    parser.add_argument("--t", type=float, default=0.0, help="seconds along --camera-path")
+    parser.add_argument("--path-time", type=float, default=0.0, help="seconds along --camera-path (default 0)")
     parser.add_argument("--overdraw", type=Path, help="write the overdraw heat map here (PNG)")
     parser.add_argument("--stats", type=Path, help="write frame statistics, overdraw included, here (JSON)")
     # one frame: the reference picture unless asked otherwise (impostors pay off over many frames)
@@ -49,8 +49,8 @@ def pixel_count(text: str) -> int:
 
 def run(args) -> int:
     scene = load_scene(args.scene)
-    if args.time is not None and not 0.0 <= args.time <= 24.0:
-        raise SceneError("--time", "time_of_day", f"must be within [0, 24] hours, got {args.time}")
+    if args.time_of_day is not None and not 0.0 <= args.time_of_day <= 24.0:
+        raise SceneError("--time-of-day", "time_of_day", f"must be within [0, 24] hours, got {args.time_of_day}")
     settings = settings_from(args)
     camera = scene.camera
     if args.camera_path is not None:
@@ -58,7 +58,7 @@ def run(args) -> int:
             path = scene.camera_path(args.camera_path)
         except KeyError as error:
             raise SceneError(args.scene, "camera_paths", error.args[0]) from None
-        camera = camera_on_path(path, args.t, camera.fov_y_deg)
+        camera = camera_on_path(path, args.path_time, camera.fov_y_deg)
     # headless: EGL must be chosen before OpenGL is first imported
     os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
     import imageio.v3 as iio
@@ -66,7 +66,7 @@ def run(args) -> int:
     from cloudcore.gl import FrameRenderer
 
     with FrameRenderer(args.width, args.height) as renderer:
-        image, stats = renderer.render(scene, time_of_day=args.time, camera=camera, settings=settings)
+        image, stats = renderer.render(scene, time_of_day=args.time_of_day, camera=camera, settings=settings)
         if args.overdraw or args.stats:
             counts, overdraw = renderer.measure_overdraw()
             stats = stats.with_overdraw(overdraw)
