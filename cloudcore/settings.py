@@ -28,8 +28,9 @@ class Option:
     """How a setting is named and shown outside the engine.
 
     `flag` is its command-line option; a setting that is on by default is
-    spelled `--no-...` and turns it off.  `help` is one sentence, for --help
-    and the widget's tooltip.  `choices` are a string setting's values.  With
+    spelled `--no-...` and turns it off.  `help` is one sentence saying what
+    the setting does (for a switch, when on), for --help and the widget's
+    tooltip.  `choices` are a string setting's values.  With
     a `label` the LOD panel shows it: a combo (choices), a checkbox (bool) or
     a slider over [`low`, `high`] showing `display` (a printf format), or
     `zero_display` at 0 where 0 means "off".
@@ -152,7 +153,7 @@ class RenderSettings:
     group_clouds: bool = _setting(
         True,
         flag="--no-group-clouds",
-        help="sort each cloud's impostor as a whole even where clouds interpenetrate",
+        help="draw interpenetrating clouds as one unit: one impostor, one far-to-near sort",
         label="Group interpenetrating clouds",
     )
     #: per axis: the screen impostor of a cloud the eye is inside has this fraction of the screen's pixels
@@ -163,6 +164,10 @@ class RenderSettings:
         0.25,
         flag="--inside-resolution",
         help="per axis, the fraction of the screen's resolution of the screen impostor of a cloud the eye is in",
+        label="Screen impostor (of the screen)",
+        low=0.05,
+        high=1.0,
+        display="%.3f",
     )
     #: the ring is rebuilt when the eye has moved this fraction of ring_radius horizontally / vertically
     ring_rebuild_horizontal: float = 0.15
@@ -179,7 +184,8 @@ class RenderSettings:
     point_sprites: bool = _setting(
         True,
         flag="--no-point-sprites",
-        help="draw every splat as a quad, even where a point sprite gives the same picture",
+        help="draw plain splats as point sprites (one vertex instead of four) where the picture is the same",
+        label="Point sprites",
     )
 
     def __post_init__(self):

@@ -31,7 +31,10 @@ def add_settings_arguments(parser, default_mode: str = "auto") -> None:
         default = default_mode if name == "mode" else getattr(defaults, name)
         if isinstance(default, bool):  # a switch: its flag turns the default around
             parser.add_argument(
-                option.flag, dest=name, action="store_false" if default else "store_true", help=option.help
+                option.flag,
+                dest=name,
+                action="store_false" if default else "store_true",
+                help=f"do not {option.help}" if default else option.help,
             )
         else:
             parser.add_argument(
