@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import dataclasses
 import time
+from dataclasses import dataclass
 
 import numpy as np
 from OpenGL import GL
@@ -51,6 +52,25 @@ from cloudcore.overdraw import analytic_overdraw, overdraw_statistics
 from cloudcore.particle_styles import particle_styles
 from cloudcore.scene import Camera, Lighting, Scene
 from cloudcore.settings import FULL_3D, RenderSettings
+
+
+@dataclass(frozen=True)
+class _CloudPassFrame:
+    """What every draw of one frame's cloud pass shares."""
+
+    plan: FramePlan
+    particles: ParticleShading
+    camera: Camera
+    view: np.ndarray
+    projection: np.ndarray
+    view_projection: np.ndarray
+    frustum: np.ndarray  # the view's planes (`cloudcore.camera.frustum_planes`)
+    poses: tuple
+    time_s: float
+
+    @property
+    def eye(self) -> np.ndarray:
+        return np.asarray(self.camera.position, dtype=np.float64)
 
 
 class FrameRenderer:
@@ -293,85 +313,103 @@ class FrameRenderer:
         poses,
         time_s: float,
     ) -> int:
-        """Execute the plan's cloud pass into the frame target at scene time `time_s`; returns the particles drawn."""
-        eye = camera.position
+        """Execute the plan's cloud pass into the frame target at scene time `time_s`, one method per draw kind;
+        returns the particles drawn."""
         view_projection = projection @ view
-        frustum = frustum_planes(view_projection)
+        frame = _CloudPassFrame(
+            plan, particles, camera, view, projection, view_projection, frustum_planes(view_projection), poses, time_s
+        )
         points = settings.point_sprites
         self._replay, self._screen_batches = [], []
-        drawn = 0
-
-        def draw_splats(clouds, depth_ranges) -> int:
-            batch = splat_batch(particles, clouds, eye, depth_ranges, time_s, frustum)
-            self._splats.draw(batch, view, projection, point_sprites=points)
-            self._replay.append(lambda: self._splats.draw(batch, view, projection, counting=True, point_sprites=points))
-            self._screen_batches.append(batch)
-            return len(batch)
-
-        def draw_quad(corners, texture, weight, *, screen: bool = False, uv_rect=(0.0, 0.0, 1.0, 1.0), **layer) -> None:
-            """A world-space quad, depth-tested; or with `screen`, clip-space corners over everything."""
-            matrix, depth_test = (np.eye(4), False) if screen else (view_projection, True)
-            self._quads.draw(corners, matrix, texture, weight, depth_test=depth_test, uv_rect=uv_rect, **layer)
-            self._replay.append(
-                lambda: self._quads.draw(corners, matrix, 0, 1.0, depth_test=depth_test, counting=True, uv_rect=uv_rect)
-            )
-
         if plan.ring is not None:
-            for generation, weight in plan.ring.draws:
-                for segment in generation.occupied_segments:
-                    target, corners, extent = self._impostors.ring_panel(
-                        generation, segment, settings.ring_elevation_deg
-                    )
-                    draw_quad(corners, target.texture, weight, uv_rect=extent)
-
-        full_run = []  # (cloud, (near, far)) of consecutive full-3D layers: they interpenetrate, sorted together
+            self._draw_ring(frame, settings.ring_elevation_deg)
+        kinds = {"impostor": self._draw_impostor, "crossfade": self._draw_crossfade}
         # units the eye is in, one after the other: one screen impostor, drawn where the run starts
         screen_impostors = {id(run[0]): run for run in inside_runs(plan.draw_items, plan.clouds)}
+        full_run = []  # (cloud, (near, far)) of consecutive full-3D layers: they interpenetrate, sorted together
+        drawn = 0
         for item in plan.draw_items:
             cloud = plan.clouds[item.index] if item.kind == "cloud" else None
             if cloud is not None and cloud.kind == "full":
                 full_run += [(member, (item.near, item.far)) for member in cloud.members]
                 continue
             if full_run:
-                drawn += draw_splats(*zip(*full_run))
+                drawn += self._draw_splats(frame, points, *zip(*full_run))
                 full_run = []
             if cloud is None:
                 self._objects.draw(self.context, camera, poses, [item.index], write_depth=False)
-            elif cloud.kind == "impostor":
-                target, corners, extent = self._impostors.cloud_impostor(cloud.members, item.layer)
-                draw_quad(corners, target.texture, cloud.impostor_weight, uv_rect=extent)
-            elif cloud.kind == "crossfade":
-                target, corners, extent = self._impostors.cloud_impostor(cloud.members, item.layer)
-                layer = self._screen_layer()
-                layer.bind_cleared()
-                drawn += draw_splats(cloud.members, [(item.near, item.far)] * len(cloud.members))
-                self.context.bind_target()
-                draw_quad(
-                    corners,
-                    target.texture,
-                    cloud.impostor_weight,
-                    uv_rect=extent,
-                    layer_texture=layer.texture,
-                    layer_weight=cloud.full_weight,
-                )
-            elif cloud.kind == "inside" and id(item) in screen_impostors:
-                target = self._inside_target(plan.inside_size)
-                target.bind_cleared()
-                members, depth_ranges = zip(
-                    *[
-                        (member, (run_item.near, run_item.far))
-                        for run_item in screen_impostors[id(item)]
-                        for member in plan.clouds[run_item.index].members
-                    ]
-                )
-                batch = splat_batch(particles, members, eye, depth_ranges, time_s, frustum)
-                self._splats.draw(batch, view, projection, point_sprites=points)
-                drawn += len(batch)
-                self.context.bind_target()
-                draw_quad(SCREEN_CORNERS, target.texture, cloud.full_weight, screen=True)
+            elif cloud.kind == "inside":
+                if id(item) in screen_impostors:  # the rest of its run is in the same screen impostor
+                    drawn += self._draw_inside(frame, points, screen_impostors[id(item)], cloud.full_weight)
+            else:
+                drawn += kinds[cloud.kind](frame, points, item, cloud)
         if full_run:
-            drawn += draw_splats(*zip(*full_run))
+            drawn += self._draw_splats(frame, points, *zip(*full_run))
         return drawn
+
+    def _draw_splats(self, frame: _CloudPassFrame, points: bool, clouds, depth_ranges) -> int:
+        """Full 3D: the clouds' splats (each cloud's within its depth range) sorted together, on the screen."""
+        batch = splat_batch(frame.particles, clouds, frame.eye, depth_ranges, frame.time_s, frame.frustum)
+        view, projection = frame.view, frame.projection
+        self._splats.draw(batch, view, projection, point_sprites=points)
+        self._replay.append(lambda: self._splats.draw(batch, view, projection, counting=True, point_sprites=points))
+        self._screen_batches.append(batch)
+        return len(batch)
+
+    def _draw_quad(
+        self, frame: _CloudPassFrame, corners, texture, weight, *, screen=False, uv_rect=(0.0, 0.0, 1.0, 1.0), **layer
+    ) -> None:
+        """A world-space quad, depth-tested; or with `screen`, clip-space corners over everything."""
+        matrix, depth_test = (np.eye(4), False) if screen else (frame.view_projection, True)
+        self._quads.draw(corners, matrix, texture, weight, depth_test=depth_test, uv_rect=uv_rect, **layer)
+        self._replay.append(
+            lambda: self._quads.draw(corners, matrix, 0, 1.0, depth_test=depth_test, counting=True, uv_rect=uv_rect)
+        )
+
+    def _draw_ring(self, frame: _CloudPassFrame, elevation_deg: float) -> None:
+        """Wang's ring: the panels of the generations drawn (two while a rebuilt one fades in)."""
+        for generation, weight in frame.plan.ring.draws:
+            for segment in generation.occupied_segments:
+                target, corners, extent = self._impostors.ring_panel(generation, segment, elevation_deg)
+                self._draw_quad(frame, corners, target.texture, weight, uv_rect=extent)
+
+    def _draw_impostor(self, frame: _CloudPassFrame, points: bool, item, cloud) -> int:
+        """A unit's impostor (one layer of it, when split around objects) as a quad."""
+        target, corners, extent = self._impostors.cloud_impostor(cloud.members, item.layer)
+        self._draw_quad(frame, corners, target.texture, cloud.impostor_weight, uv_rect=extent)
+        return 0
+
+    def _draw_crossfade(self, frame: _CloudPassFrame, points: bool, item, cloud) -> int:
+        """A unit between its impostor and full 3D: its splats into a screen layer, mixed with the impostor."""
+        target, corners, extent = self._impostors.cloud_impostor(cloud.members, item.layer)
+        layer = self._screen_layer()
+        layer.bind_cleared()
+        drawn = self._draw_splats(frame, points, cloud.members, [(item.near, item.far)] * len(cloud.members))
+        self.context.bind_target()
+        self._draw_quad(
+            frame,
+            corners,
+            target.texture,
+            cloud.impostor_weight,
+            uv_rect=extent,
+            layer_texture=layer.texture,
+            layer_weight=cloud.full_weight,
+        )
+        return drawn
+
+    def _draw_inside(self, frame: _CloudPassFrame, points: bool, run, weight: float) -> int:
+        """Harris's screen impostor of the units the eye is in (`run`, consecutive draw items), their
+        particles sorted together at the plan's reduced resolution, then laid over the screen."""
+        target = self._inside_target(frame.plan.inside_size)
+        target.bind_cleared()
+        members, depth_ranges = zip(
+            *[(member, (item.near, item.far)) for item in run for member in frame.plan.clouds[item.index].members]
+        )
+        batch = splat_batch(frame.particles, members, frame.eye, depth_ranges, frame.time_s, frame.frustum)
+        self._splats.draw(batch, frame.view, frame.projection, point_sprites=points)
+        self.context.bind_target()
+        self._draw_quad(frame, SCREEN_CORNERS, target.texture, weight, screen=True)
+        return len(batch)
 
     def _screen_layer(self) -> TextureTarget:
         if self._layer is None:
