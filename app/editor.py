@@ -22,9 +22,10 @@ from cloudcore.editing import History, delete_cloud, delete_particles
 from cloudcore.errors import SceneError
 from cloudcore.frame_stats import FrameStats
 from cloudcore.limits import scene_limit_problems
+from cloudcore.particle_files import particles_folder
 from cloudcore.paths import camera_on_path
 from cloudcore.scene import Camera, Lighting, Scene, Shading
-from cloudcore.scenefile import load_scene, particles_folder, save_scene
+from cloudcore.scenefile import load_scene, save_scene
 from cloudcore.settings import RenderSettings
 
 AUTOSAVE_SECONDS = 60.0

@@ -9,10 +9,7 @@ valid ones listed, so a typo never passes silently.
 from __future__ import annotations
 
 import dataclasses
-import hashlib
 import math
-import os
-import tempfile
 import tomllib
 from pathlib import Path
 
@@ -20,9 +17,9 @@ import numpy as np
 import tomlkit
 
 from cloudcore.artist_shading import ArtistShading
-from cloudcore.errors import FieldError, SceneError
 from cloudcore.formation import FORMATION_KINDS, Formation
 from cloudcore.limits import scene_limit_problems
+from cloudcore.particle_files import atomic_write, remove_unnamed_particle_files, store_particles
 from cloudcore.phase import MAX_ABS_G, PHASE_NAMES
 from cloudcore.scene import (
     DEFAULT_VIEW_NAME,
@@ -39,166 +36,12 @@ from cloudcore.scene import (
 )
 from cloudcore.settings import MODES, RenderSettings, setting_options
 from cloudcore.sprites import FACINGS, MAX_SEED, SpriteStyle
+from cloudcore.toml_table import Table, checked_matrix, field_error
 
 PRIMITIVES = ("box", "sphere", "aircraft")
 TERRAIN_KINDS = ("heightfield", "mesh")
 #: TOML arrays are slow to parse; clouds larger than this are saved to .npy.
 INLINE_PARTICLE_LIMIT = 64
-
-
-def _error(source, field: str, problem: str) -> SceneError:
-    """A SceneError kept to one line: line breaks and other control characters (from keys,
-    file names or library messages) are escaped."""
-
-    def one_line(text) -> str:
-        return "".join(ch if ch.isprintable() else ascii(ch)[1:-1] for ch in str(text))
-
-    return SceneError(one_line(source), one_line(field), one_line(problem))
-
-
-class _Table:
-    """Typed access to one TOML table; remembers which keys were read."""
-
-    def __init__(self, source: str, field: str, data):
-        if not isinstance(data, dict):
-            raise _error(source, field, f"expected a table, got {type(data).__name__}")
-        self.source, self.field, self.data = source, field, data
-
-    def path(self, key: str) -> str:
-        return f"{self.field}.{key}" if self.field else key
-
-    def fail(self, key: str, problem: str):
-        raise _error(self.source, self.path(key), problem)
-
-    def reject_unknown(self, known: tuple[str, ...]):
-        for key in self.data:
-            if key not in known:
-                self.fail(key, f"unknown key; valid keys: {', '.join(known)}")
-
-    def has(self, key: str) -> bool:
-        return key in self.data
-
-    def raw(self, key: str, default=None):
-        return self.data.get(key, default)
-
-    def number(self, key, default=None, *, low=-math.inf, high=math.inf, low_open=False):
-        if key not in self.data:
-            if default is None:
-                self.fail(key, "required number is missing")
-            return default
-        value = self.data[key]
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            self.fail(key, f"expected a number, got {value!r}")
-        try:
-            value = float(value)
-        except OverflowError:
-            self.fail(key, "must be finite, got an integer too large for a float")
-        if not math.isfinite(value):
-            self.fail(key, f"must be finite, got {value}")
-        if value < low or (low_open and value == low) or value > high:
-            bound = "(" if low_open else "["
-            self.fail(key, f"must be within {bound}{low}, {high}], got {value}")
-        return value
-
-    def integer(self, key, default, *, low, high):
-        value = self.data.get(key, default)
-        if isinstance(value, bool) or not isinstance(value, int):
-            self.fail(key, f"expected an integer, got {value!r}")
-        if not low <= value <= high:
-            self.fail(key, f"must be within [{low}, {high}], got {value}")
-        return value
-
-    def string(self, key, default=None, *, choices=None):
-        if key not in self.data:
-            if default is None:
-                self.fail(key, "required string is missing")
-            return default
-        value = self.data[key]
-        if not isinstance(value, str):
-            self.fail(key, f"expected a string, got {value!r}")
-        if choices is not None and value not in choices:
-            self.fail(key, f"{value!r} is not one of: {', '.join(choices)}")
-        return value
-
-    def matrix(self, key, columns: int, *, allow_empty=False) -> np.ndarray:
-        value = self.data.get(key)
-        if value is None:
-            self.fail(key, "required array is missing")
-        return _checked_matrix(value, columns, self.source, self.path(key), allow_empty)
-
-    def row(self, key, length: int, default=None) -> tuple[float, ...]:
-        """A flat array of `length` finite numbers."""
-        if key not in self.data:
-            if default is None:
-                self.fail(key, f"required array of {length} numbers is missing")
-            return default
-        return tuple(float(x) for x in _checked_matrix([self.data[key]], length, self.source, self.path(key), False)[0])
-
-    def integers(self, key, default) -> tuple[int, ...]:
-        """A flat array of integers (their range is the record's to check)."""
-        value = self.data.get(key, default)
-        if not isinstance(value, (list, tuple)) or not all(
-            isinstance(x, int) and not isinstance(x, bool) for x in value
-        ):
-            self.fail(key, f"expected an array of integers, got {value!r}")
-        return tuple(value)
-
-    def vector(self, key, default=None, *, low=-math.inf, high=math.inf, unit=False):
-        if key not in self.data:
-            if default is None:
-                self.fail(key, "required 3-vector is missing")
-            return default
-        row = np.array(self.row(key, 3))
-        if np.any(row < low) or np.any(row > high):
-            self.fail(key, f"components must be within [{low}, {high}], got {row.tolist()}")
-        if unit:
-            largest = float(np.abs(row).max())
-            if not largest > 0:
-                self.fail(key, "direction must not be the zero vector")
-            if not 1e-150 < largest < 1e150:  # the norm would overflow to inf or underflow to 0
-                row = row / largest
-            row = row / np.linalg.norm(row)
-        return tuple(float(x) for x in row)
-
-    def table(self, key, parse):
-        """`parse` of the sub-table `key`, or None where there is none."""
-        return parse(_Table(self.source, self.path(key), self.data[key])) if key in self.data else None
-
-    def record(self, kind, **values):
-        """`kind(**values)`, with a rule the record itself refuses (a FieldError) reported at its field."""
-        try:
-            return kind(**values)
-        except FieldError as error:
-            self.fail(error.field, error.problem)
-
-    def tables(self, key) -> list[_Table]:
-        value = self.data.get(key, [])
-        if not isinstance(value, list):
-            self.fail(key, "expected an array of tables ([[...]])")
-        return [_Table(self.source, f"{self.path(key)}[{i}]", item) for i, item in enumerate(value)]
-
-
-def _checked_matrix(value, columns, source, field, allow_empty) -> np.ndarray:
-    try:
-        array = np.array(value, dtype=np.float64)
-        # numpy would take the strings "1.5" and booleans as numbers: TOML input must hold numbers
-        if not isinstance(value, np.ndarray) and not all(
-            isinstance(x, (int, float)) and not isinstance(x, bool) for x in np.array(value, dtype=object).flat
-        ):
-            raise TypeError
-    except (TypeError, ValueError, OverflowError):  # OverflowError: an integer too large for a float
-        raise _error(source, field, f"expected rows of {columns} numbers") from None
-    if array.size == 0 and allow_empty:
-        return np.zeros((0, columns))
-    if array.ndim != 2 or array.shape[1] != columns:
-        raise _error(source, field, f"expected rows of {columns} numbers, got shape {array.shape}")
-    bad = np.flatnonzero(~np.isfinite(array).all(axis=1))
-    if bad.size:
-        raise _error(source, field, f"row {bad[0]} is not finite: {array[bad[0]].tolist()}")
-    return array
-
-
-# ---------------------------------------------------------------- loading
 
 
 def load_scene(path) -> Scene:
@@ -209,18 +52,18 @@ def load_scene(path) -> Scene:
         # utf-8-sig: a byte-order mark (Windows editors write one) is not part of the TOML
         data = tomllib.loads(path.read_text(encoding="utf-8-sig"))
     except FileNotFoundError:
-        raise _error(source, "(file)", "no such file") from None
+        raise field_error(source, "(file)", "no such file") from None
     except (OSError, UnicodeDecodeError) as error:
-        raise _error(source, "(file)", f"cannot read: {error}") from None
+        raise field_error(source, "(file)", f"cannot read: {error}") from None
     except RecursionError:
-        raise _error(source, "(toml)", "arrays or tables nested too deeply") from None
+        raise field_error(source, "(toml)", "arrays or tables nested too deeply") from None
     except ValueError as error:  # TOMLDecodeError, or tomllib's ValueError for an integer of over 4300 digits
-        raise _error(source, "(toml)", str(error)) from None
+        raise field_error(source, "(toml)", str(error)) from None
     return scene_from_dict(data, source, path.parent)
 
 
 def scene_from_dict(data: dict, source: str = "<scene>", base_dir=Path(".")) -> Scene:
-    root = _Table(source, "", data)
+    root = Table(source, "", data)
     root.reject_unknown(
         ("description", "camera", "lighting", "shading", "clouds", "terrain", "objects", "camera_paths", "views")
     )
@@ -230,15 +73,15 @@ def scene_from_dict(data: dict, source: str = "<scene>", base_dir=Path(".")) -> 
     _unique_names(root, "objects", objects)
     paths = tuple(_camera_path(t) for t in root.tables("camera_paths"))
     _unique_names(root, "camera_paths", paths)
-    camera = _camera(_Table(source, "camera", root.raw("camera", {})))
+    camera = _camera(Table(source, "camera", root.raw("camera", {})))
     views = tuple(_view(t, camera, paths) for t in root.tables("views"))
     _unique_names(root, "views", views)
     scene = Scene(
         camera=camera,
-        lighting=_lighting(_Table(source, "lighting", root.raw("lighting", {}))),
-        shading=_shading(_Table(source, "shading", root.raw("shading", {}))),
+        lighting=_lighting(Table(source, "lighting", root.raw("lighting", {}))),
+        shading=_shading(Table(source, "shading", root.raw("shading", {}))),
         clouds=clouds,
-        terrain=_terrain(_Table(source, "terrain", root.raw("terrain"))) if root.has("terrain") else None,
+        terrain=_terrain(Table(source, "terrain", root.raw("terrain"))) if root.has("terrain") else None,
         objects=objects,
         camera_paths=paths,
         description=root.string("description", ""),
@@ -247,19 +90,19 @@ def scene_from_dict(data: dict, source: str = "<scene>", base_dir=Path(".")) -> 
     # what every field allows, the renderer may still not draw: refuse that here, not in the GL code
     problems = scene_limit_problems(scene)
     if problems:
-        raise _error(source, *problems[0])
+        raise field_error(source, *problems[0])
     return scene
 
 
-def _unique_names(root: _Table, key: str, items) -> None:
+def _unique_names(root: Table, key: str, items) -> None:
     seen = set()
     for i, item in enumerate(items):
         if item.name in seen:
-            raise _error(root.source, f"{key}[{i}].name", f"duplicate name {item.name!r}")
+            raise field_error(root.source, f"{key}[{i}].name", f"duplicate name {item.name!r}")
         seen.add(item.name)
 
 
-def _view(t: _Table, camera: Camera, paths: tuple[CameraPath, ...]) -> View:
+def _view(t: Table, camera: Camera, paths: tuple[CameraPath, ...]) -> View:
     """One `[[views]]` table; what it leaves out of the camera is `camera`'s (the scene's)."""
     t.reject_unknown(
         (
@@ -327,7 +170,7 @@ def _view(t: _Table, camera: Camera, paths: tuple[CameraPath, ...]) -> View:
 VIEW_SETTINGS = tuple(f.name for f in dataclasses.fields(RenderSettings) if f.name != "mode")
 
 
-def _view_settings(t: _Table) -> tuple[tuple[str, object], ...]:
+def _view_settings(t: Table) -> tuple[tuple[str, object], ...]:
     """RenderSettings overrides, each of its field's type; their ranges are RenderSettings' own (checked by the
     caller, with the view's mode)."""
     t.reject_unknown(VIEW_SETTINGS)
@@ -351,7 +194,7 @@ def _view_settings(t: _Table) -> tuple[tuple[str, object], ...]:
     return tuple(values)
 
 
-def _camera(t: _Table) -> Camera:
+def _camera(t: Table) -> Camera:
     t.reject_unknown(("position", "look_at", "fov_y_deg"))
     default = Camera()
     position = t.vector("position", default.position)
@@ -361,7 +204,7 @@ def _camera(t: _Table) -> Camera:
     return Camera(position, look_at, t.number("fov_y_deg", default.fov_y_deg, low=1.0, high=170.0))
 
 
-def _lighting(t: _Table) -> Lighting:
+def _lighting(t: Table) -> Lighting:
     t.reject_unknown(("time_of_day", "lights", "ambient"))
     lights = []
     for lt in t.tables("lights"):
@@ -382,7 +225,7 @@ def _lighting(t: _Table) -> Lighting:
     return Lighting(time_of_day, tuple(lights), ambient)
 
 
-def _shading(t: _Table) -> Shading:
+def _shading(t: Table) -> Shading:
     t.reject_unknown(("albedo", "optical_depth", "phase", "g"))
     d = Shading()
     return Shading(
@@ -393,7 +236,7 @@ def _shading(t: _Table) -> Shading:
     )
 
 
-def _cloud(t: _Table, base_dir: Path) -> Cloud:
+def _cloud(t: Table, base_dir: Path) -> Cloud:
     t.reject_unknown(
         (
             "name",
@@ -436,7 +279,7 @@ def _cloud(t: _Table, base_dir: Path) -> Cloud:
     )
 
 
-def _formation(t: _Table) -> Formation:
+def _formation(t: Table) -> Formation:
     t.reject_unknown(("kind", "start_s", "duration_s"))
     return Formation(
         kind=t.string("kind", choices=FORMATION_KINDS),
@@ -445,7 +288,7 @@ def _formation(t: _Table) -> Formation:
     )
 
 
-def _sprite(t: _Table) -> SpriteStyle:
+def _sprite(t: Table) -> SpriteStyle:
     t.reject_unknown(tuple(f.name for f in dataclasses.fields(SpriteStyle)))
     d = SpriteStyle()
     return t.record(
@@ -459,7 +302,7 @@ def _sprite(t: _Table) -> SpriteStyle:
     )
 
 
-def _artist(t: _Table) -> ArtistShading:
+def _artist(t: Table) -> ArtistShading:
     t.reject_unknown(tuple(f.name for f in dataclasses.fields(ArtistShading)))
     d = ArtistShading()
 
@@ -475,10 +318,10 @@ def _artist(t: _Table) -> ArtistShading:
     )
 
 
-def _read_particles(t: _Table, file: Path) -> np.ndarray:
+def _read_particles(t: Table, file: Path) -> np.ndarray:
     try:
         # mmap_mode: a header that claims more data than the file holds fails here instead of
-        # allocating it; _checked_matrix copies the data out of the map
+        # allocating it; checked_matrix copies the data out of the map
         array = np.load(file, mmap_mode="r", allow_pickle=False)
     except FileNotFoundError:
         t.fail("particles_file", f"{file}: no such file")
@@ -486,17 +329,17 @@ def _read_particles(t: _Table, file: Path) -> np.ndarray:
         t.fail("particles_file", f"{file}: not a readable .npy ({error})")
     if not isinstance(array, np.ndarray) or array.dtype.kind not in "fiu":
         t.fail("particles_file", f"{file}: expected a numeric array")
-    return _checked_matrix(array, 4, t.source, t.path("particles_file"), True)
+    return checked_matrix(array, 4, t.source, t.path("particles_file"), True)
 
 
-def _terrain(t: _Table) -> Terrain:
+def _terrain(t: Table) -> Terrain:
     t.reject_unknown(("kind", "size", "resolution", "height", "seed", "mesh", "color"))
     d = Terrain()
     kind = t.string("kind", d.kind, choices=TERRAIN_KINDS)
     size = t.raw("size", list(d.size))
     if not (isinstance(size, list) and len(size) == 2):
         t.fail("size", f"expected [size_x, size_z] in metres, got {size!r}")
-    sx = _Table(t.source, t.path("size"), {"x": size[0], "z": size[1]})
+    sx = Table(t.source, t.path("size"), {"x": size[0], "z": size[1]})
     return Terrain(
         kind=kind,
         size=(sx.number("x", low=0.0, low_open=True), sx.number("z", low=0.0, low_open=True)),
@@ -508,7 +351,7 @@ def _terrain(t: _Table) -> Terrain:
     )
 
 
-def _object(t: _Table, base_dir: Path) -> SceneObject:
+def _object(t: Table, base_dir: Path) -> SceneObject:
     t.reject_unknown(("name", "mesh", "primitive", "scale", "position", "path", "color"))
     if t.has("mesh") == t.has("primitive"):
         t.fail("mesh", "give exactly one of mesh (a file) or primitive")
@@ -531,7 +374,7 @@ def _object(t: _Table, base_dir: Path) -> SceneObject:
     )
 
 
-def _read_mesh(t: _Table, file: Path) -> tuple[np.ndarray, np.ndarray]:
+def _read_mesh(t: Table, file: Path) -> tuple[np.ndarray, np.ndarray]:
     """The triangles of a mesh file trimesh reads (all its geometry merged), checked finite."""
     import trimesh
 
@@ -549,7 +392,7 @@ def _read_mesh(t: _Table, file: Path) -> tuple[np.ndarray, np.ndarray]:
     return vertices, faces
 
 
-def _camera_path(t: _Table) -> CameraPath:
+def _camera_path(t: Table) -> CameraPath:
     t.reject_unknown(("name", "keys"))
     keys = t.matrix("keys", 7)
     if len(keys) < 2:
@@ -560,7 +403,7 @@ def _camera_path(t: _Table) -> CameraPath:
     return CameraPath(t.string("name"), keys)
 
 
-def _check_times(t: _Table, key: str, times: np.ndarray) -> None:
+def _check_times(t: Table, key: str, times: np.ndarray) -> None:
     if np.any(np.diff(times) <= 0):
         t.fail(key, "key times must increase strictly")
 
@@ -678,22 +521,11 @@ def _rows(matrix: np.ndarray):
     return array.multiline(True)
 
 
-def particles_file_for(scene_path, cloud_name: str) -> str:
-    """Where `save_scene` puts a large cloud's particles, relative to the scene file (when that file is free)."""
-    safe = "".join(ch if ch.isalnum() or ch in "-_" else "_" for ch in cloud_name)
-    return f"{particles_folder(scene_path)}/{safe}.npy"
-
-
-def particles_folder(scene_path) -> str:
-    """The folder beside a scene that belongs to it: its saves write and delete particle files there only."""
-    return f"{Path(scene_path).stem}.particles"
-
-
 def save_scene(scene: Scene, path) -> Scene:
     """Write `scene` to `path` atomically, particle files included; return the scene as saved.
 
     Clouds with more than INLINE_PARTICLE_LIMIT particles or with a particles_file
-    are stored as .npy (`_store_particles`).  No existing particle file is ever
+    are stored as .npy (`cloudcore.particle_files.store_particles`).  No existing particle file is ever
     overwritten with other particles, so until the TOML is replaced, in one rename
     that commits the save, the previous TOML and every file it names are intact: a
     crash at any moment leaves the old scene or the new one, never a mix.  After
@@ -702,7 +534,7 @@ def save_scene(scene: Scene, path) -> Scene:
     """
     path = Path(path)
     saved_clouds = tuple(
-        dataclasses.replace(cloud, particles_file=_store_particles(cloud, path))
+        dataclasses.replace(cloud, particles_file=store_particles(cloud, path))
         if cloud.particles_file is not None or len(cloud.particles) > INLINE_PARTICLE_LIMIT
         else cloud
         for cloud in scene.clouds
@@ -710,66 +542,5 @@ def save_scene(scene: Scene, path) -> Scene:
     saved = dataclasses.replace(scene, clouds=saved_clouds)
     document = tomlkit.dumps(scene_to_dict(saved)).encode("utf-8")
     atomic_write(path, lambda f: f.write(document))
-    _remove_unnamed_particle_files(path, {c.particles_file for c in saved_clouds if c.particles_file is not None})
+    remove_unnamed_particle_files(path, {c.particles_file for c in saved_clouds if c.particles_file is not None})
     return saved
-
-
-def _store_particles(cloud: Cloud, path: Path) -> str:
-    """The particles_file, relative to the scene at `path`, that holds `cloud`'s particles, written if need be.
-
-    The cloud's own particles_file is kept when it holds exactly these particles,
-    unless it lies in another scene's folder (that scene's saves may change or
-    delete it: a scene saved under a new name, or a recovery copy, gets copies of
-    its own).  Otherwise the particles go into this scene's folder, under the
-    cloud's name or, where that file holds other particles the current TOML may
-    still name, under a name with their digest.
-    """
-    particles = np.ascontiguousarray(cloud.particles, dtype=np.float64)
-    own_folder, default = particles_folder(path), particles_file_for(path, cloud.name)
-    digest = hashlib.sha256(particles.tobytes()).hexdigest()[:16]
-    by_digest = f"{own_folder}/{Path(default).stem}-{digest}.npy"
-    candidates = [default, by_digest]
-    if cloud.particles_file is not None:
-        parts = Path(cloud.particles_file).parts
-        if not parts or parts[0] == own_folder or not parts[0].endswith(".particles"):
-            candidates.insert(0, cloud.particles_file)
-    for relative in candidates:
-        if _holds(path.parent / relative, particles):
-            return relative
-    relative = by_digest if (path.parent / default).exists() else default
-    atomic_write(path.parent / relative, lambda f: np.save(f, particles))
-    return relative
-
-
-def _holds(file: Path, particles: np.ndarray) -> bool:
-    """Whether `file` is a .npy of exactly `particles` (float64, bit for bit)."""
-    try:
-        stored = np.load(file, mmap_mode="r", allow_pickle=False)
-    except Exception:  # missing, unreadable or corrupt (np.load raises many kinds): it does not hold them
-        return False
-    return stored.dtype == np.float64 and stored.shape == particles.shape and np.array_equal(stored, particles)
-
-
-def _remove_unnamed_particle_files(path: Path, named: set) -> None:
-    """After a save's commit: delete the .npy files in the scene's own folder its TOML no longer names, and
-    the temporary files that saves of this scene killed mid-write left (`atomic_write` names them)."""
-    folder = path.parent / particles_folder(path)
-    named_files = {(path.parent / relative).resolve() for relative in named}
-    for file in [*folder.glob("*.npy"), *folder.glob(".*.tmp"), *path.parent.glob(f".{path.name}.*.tmp")]:
-        if file.resolve() not in named_files:
-            file.unlink(missing_ok=True)
-
-
-def atomic_write(path: Path, write) -> None:
-    """Write through a temporary file in the same folder, fsync, then rename over `path`."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as f:
-            write(f)
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(temporary, path)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise

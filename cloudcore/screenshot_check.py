@@ -20,9 +20,9 @@ import numpy as np
 
 from cloudcore.errors import SceneError
 from cloudcore.imagecompare import Difference, compare, diff_image, load_rgb8
+from cloudcore.particle_files import atomic_write
 from cloudcore.paths import camera_on_path
 from cloudcore.scene import Camera, Scene, View
-from cloudcore.scenefile import atomic_write
 from cloudcore.settings import RenderSettings
 
 #: the goldens' tolerance unless a view or the command line says otherwise (as our own tests/golden: llvmpipe

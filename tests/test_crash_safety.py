@@ -22,8 +22,9 @@ import pytest
 from conftest import ROOT
 
 from app.editor import AUTOSAVE_SECONDS, Editor, recovery_path
+from cloudcore.particle_files import particles_folder
 from cloudcore.scene import Camera, Cloud, Scene
-from cloudcore.scenefile import INLINE_PARTICLE_LIMIT, load_scene, particles_folder, save_scene
+from cloudcore.scenefile import INLINE_PARTICLE_LIMIT, load_scene, save_scene
 
 pytestmark = pytest.mark.skipif(not hasattr(signal, "SIGKILL"), reason="needs SIGKILL (POSIX)")
 
