@@ -235,17 +235,17 @@ def _incident_in_light_order(source, target, weight, alpha, sigma):
     while ready.size:
         lit = ready[in_count[ready] > 0]
         if lit.size:
-            edges = _concatenated_ranges(in_start[lit], in_count[lit])
+            edges = concatenated_ranges(in_start[lit], in_count[lit])
             src, w = in_source[edges], in_weight[edges]
             through, scattered = _compose_segments(1.0 - alpha[src] * w, sigma[src] * incident[src] * w, in_count[lit])
             incident[lit] = through + scattered  # the frame buffer starts at 1
-        released = out_target[_concatenated_ranges(out_start[ready], out_count[ready])]
+        released = out_target[concatenated_ranges(out_start[ready], out_count[ready])]
         np.subtract.at(waiting, released, 1)
         ready = np.unique(released[waiting[released] == 0])
     return incident
 
 
-def _concatenated_ranges(starts: np.ndarray, counts: np.ndarray) -> np.ndarray:
+def concatenated_ranges(starts: np.ndarray, counts: np.ndarray) -> np.ndarray:
     """concatenate(arange(s, s + c) for s, c in zip(starts, counts)), vectorised."""
     total = int(counts.sum())
     if total == 0:

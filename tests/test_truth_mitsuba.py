@@ -1,0 +1,108 @@
+"""The path-traced truth (Mitsuba 3, `cloudview[truth]`): transmittance, determinism, orientation, the CLI."""
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from cloudcore.scene import Camera, Cloud, Light, Lighting, Scene, Shading
+from cloudcore.scenefile import save_scene
+from cloudcore.truth import medium_grids, mitsuba_scene_description, mitsuba_variant, optical_depths, render_truth
+
+mi = pytest.importorskip("mitsuba")
+
+CENTRE = (0.0, 1000.0, 0.0)
+RADIUS = 50.0
+
+
+def particle_scene(tau, albedo=0.9, lights=(Light((0.3, 0.9, 0.3), (1.0, 1.0, 1.0), 1.0),), ambient=(0.0, 0.0, 0.0)):
+    return Scene(
+        camera=Camera((0.0, 1000.0, 300.0), CENTRE, 40.0),
+        lighting=Lighting(time_of_day=None, lights=lights, ambient=ambient),
+        shading=Shading(albedo=albedo, optical_depth=tau),
+        clouds=(Cloud("one", [[*CENTRE, RADIUS]]),),
+    )
+
+
+@pytest.mark.parametrize("tau", [0.3, 4.0])
+def test_the_background_through_a_particle_s_centre_is_dimmed_by_exp_minus_tau(tau):
+    """Absorbing only, lit by nothing but a visible white environment: each pixel is the transmittance."""
+    scene = particle_scene(tau, albedo=0.0, lights=(), ambient=(1.0, 1.0, 1.0))
+    # a narrow view (about 3 m across at the particle) of rays through its centre
+    camera = Camera((0.0, 1000.0, 1000.0), CENTRE, 0.2)
+    mitsuba_variant()
+    grids = medium_grids(scene, 6.0)
+    description = mitsuba_scene_description(grids, scene, camera, 4, 4)
+    description["integrator"]["hide_emitters"] = False
+    image = np.asarray(mi.render(mi.load_dict(description), spp=1024, seed=3), dtype=np.float64)
+    seen = image.mean()
+    # the grid's own optical depth through the centre, within 2% of tau (tests/test_truth.py)
+    marched = optical_depths(grids, [camera.position], [[0.0, 0.0, -1.0]])[0][0]
+    assert marched == pytest.approx(tau, rel=0.02)
+    # the estimator of an absorbing medium is a hit or a miss per sample: binomial noise over 16 x 1024 samples
+    expected = np.exp(-marched)
+    noise = np.sqrt(expected * (1 - expected) / (16 * 1024))
+    assert abs(seen - expected) < 4 * noise + 0.002 * expected
+
+
+def test_a_seed_gives_the_same_picture_and_another_seed_another():
+    scene = particle_scene(4.0)
+    first, again, other = (render_truth(scene, 16, 12, spp=16, seed=seed) for seed in (5, 5, 6))
+    np.testing.assert_array_equal(first.linear, again.linear)
+    assert not np.array_equal(first.linear, other.linear)
+    assert np.all(np.isfinite(first.linear)) and first.linear.min() >= 0
+
+
+def test_the_picture_is_oriented_as_the_camera_module_says():
+    """A lit particle up and to the right of the view centre shows there, where its alpha (from
+    cloudcore.camera's rays) says it is."""
+    scene = particle_scene(6.0)
+    camera = Camera((0.0, 1000.0, 300.0), (-40.0, 980.0, 0.0), 40.0)  # the particle is right of and above it
+    truth = render_truth(scene, 32, 24, camera=camera, spp=32)
+    brightness = truth.radiance.sum(axis=2)
+    rows, columns = np.indices(brightness.shape)
+
+    def centroid(weight):
+        return np.array([(rows * weight).sum(), (columns * weight).sum()]) / weight.sum()
+
+    row, column = centroid(truth.alpha)
+    assert row < 11.5 and column > 16.5  # the top half, the right half
+    np.testing.assert_allclose(centroid(brightness), centroid(truth.alpha), atol=1.0)
+
+
+def test_cloudview_truth_writes_the_picture(tmp_path):
+    save_scene(particle_scene(4.0), tmp_path / "s.toml")
+    out = tmp_path / "t.png"
+    result = subprocess.run(
+        [sys.executable, "-m", "cloudcore.cli", "truth", str(tmp_path / "s.toml"), "--out", str(out)]
+        + ["--width", "16", "--height", "12", "--spp", "8"],
+        capture_output=True,
+        text=True,
+    )
+    assert result.returncode == 0, result.stderr
+    assert out.exists() and "8 spp" in result.stdout
+
+
+@pytest.mark.gl
+def test_the_report_compares_every_shading_method_region_by_region(tmp_path):
+    save_scene(particle_scene(4.0, ambient=(0.1, 0.1, 0.12)), tmp_path / "s.toml")
+    report_path = tmp_path / "r.json"
+    result = subprocess.run(
+        [sys.executable, "-m", "cloudcore.cli", "truth", str(tmp_path / "s.toml"), "--out", str(tmp_path / "t.png")]
+        + ["--width", "32", "--height", "24", "--spp", "16", "--json", str(report_path)]
+        + ["--model-images", str(tmp_path / "models")],
+        capture_output=True,
+        text=True,
+    )
+    assert result.returncode == 0, result.stderr
+    report = json.loads(report_path.read_text())
+    assert set(report["models"]) == {"harris-exact", "harris-raster", "harris-preview"}
+    assert 10 < report["truth"]["noise_psnr_db"] < 100
+    exact = report["models"]["harris-exact"]
+    assert set(exact["errors"]) == {"image", "sky", "silhouette", "lit", "shadowed"}
+    assert report["regions"]["sky"] > 0 and report["regions"]["lit"] > 0
+    # the sky behind is the same picture in both: only the clouds differ
+    assert exact["errors"]["sky"]["psnr_db"] > 35
+    assert (tmp_path / "models" / "exact.png").exists() and (tmp_path / "models" / "exact_diff.png").exists()
