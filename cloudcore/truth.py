@@ -264,9 +264,10 @@ def optical_depths(
         columns = int(np.ceil(far / step)) + 1
         depth = np.zeros((len(o), columns))
         for grid, (t0, t1) in zip(grids, segments):
-            first = np.maximum(np.ceil(t0 / step - 0.5), 0).astype(np.int64)
-            last = np.floor(t1 / step - 0.5).astype(np.int64)
-            counts = np.where(t1 > t0, np.maximum(last - first + 1, 0), 0)
+            crossed = t1 > t0  # a missed box has t1 <= t0, possibly infinite
+            first = np.where(crossed, np.ceil(t0 / step - 0.5), 0).astype(np.int64)
+            last = np.where(crossed, np.floor(t1 / step - 0.5), -1).astype(np.int64)
+            counts = np.maximum(last - first + 1, 0)
             if not counts.any():
                 continue
             ray = np.repeat(np.arange(len(o)), counts)

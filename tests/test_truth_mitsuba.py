@@ -7,13 +7,17 @@ import sys
 import numpy as np
 import pytest
 
+from cloudcore.phase import phase_function
 from cloudcore.scene import Camera, Cloud, Light, Lighting, Scene, Shading
 from cloudcore.scenefile import save_scene
+from cloudcore.shading import scattering_coefficient
 from cloudcore.truth import medium_grids, mitsuba_scene_description, mitsuba_variant, optical_depths, render_truth
 
 mi = pytest.importorskip("mitsuba")
 
 CENTRE = (0.0, 1000.0, 0.0)
+#: a light of intensity 0: explicit lights that give none (no lights at all would mean the time of day's)
+DARK = (Light((0.0, 1.0, 0.0), intensity=0.0),)
 RADIUS = 50.0
 
 
@@ -29,7 +33,7 @@ def particle_scene(tau, albedo=0.9, lights=(Light((0.3, 0.9, 0.3), (1.0, 1.0, 1.
 @pytest.mark.parametrize("tau", [0.3, 4.0])
 def test_the_background_through_a_particle_s_centre_is_dimmed_by_exp_minus_tau(tau):
     """Absorbing only, lit by nothing but a visible white environment: each pixel is the transmittance."""
-    scene = particle_scene(tau, albedo=0.0, lights=(), ambient=(1.0, 1.0, 1.0))
+    scene = particle_scene(tau, albedo=0.0, lights=DARK, ambient=(1.0, 1.0, 1.0))
     # a narrow view (about 3 m across at the particle) of rays through its centre
     camera = Camera((0.0, 1000.0, 1000.0), CENTRE, 0.2)
     mitsuba_variant()
@@ -106,3 +110,24 @@ def test_the_report_compares_every_shading_method_region_by_region(tmp_path):
     # the sky behind is the same picture in both: only the clouds differ
     assert exact["errors"]["sky"]["psnr_db"] > 35
     assert (tmp_path / "models" / "exact.png").exists() and (tmp_path / "models" / "exact_diff.png").exists()
+
+
+def test_a_thin_particle_scatters_the_sun_as_harris_s_eye_pass_says():
+    """Optically thin, the truth is single scattering, which is what the model's eye pass computes: the
+    sun's irradiance times the scattering coefficient times the phase function (here at 90 degrees)."""
+    scene = particle_scene(0.02, albedo=1.0, lights=(Light((1.0, 0.0, 0.0), (1.0, 1.0, 1.0), 1.0),))
+    camera = Camera((0.0, 1000.0, 300.0), CENTRE, 2.0)
+    truth = render_truth(scene, 4, 4, camera=camera, spp=4096, voxels_per_radius=6.0)
+    marched = optical_depths(medium_grids(scene, 6.0), [camera.position], [[0.0, 0.0, -1.0]])[0][0]
+    model = scattering_coefficient(marched, 1.0) * phase_function(0.0)
+    # second-order scattering and the sun's dimming inside are both of order tau: a few percent
+    assert truth.radiance.mean() == pytest.approx(model, rel=0.05)
+
+
+def test_in_the_ambient_light_alone_a_white_cloud_returns_the_model_s_ambient_term():
+    """A cloud of albedo 1 in a uniform radiance L sends L (1 - T) toward the eye, exactly what the
+    model's ambient term adds (ambient * opacity)."""
+    scene = particle_scene(2.0, albedo=1.0, lights=DARK, ambient=(0.5, 0.5, 0.5))
+    camera = Camera((0.0, 1000.0, 300.0), CENTRE, 2.0)
+    truth = render_truth(scene, 4, 4, camera=camera, spp=1024, voxels_per_radius=6.0)
+    assert truth.radiance.mean() == pytest.approx(0.5 * truth.alpha.mean(), rel=0.01)
