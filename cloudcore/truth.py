@@ -565,9 +565,10 @@ def luminance(srgb8: np.ndarray) -> np.ndarray:
 
 
 def region_errors(truth8: np.ndarray, model8: np.ndarray, regions: dict[str, np.ndarray]) -> dict[str, dict]:
-    """Per region: pixels, PSNR of the 8-bit images (capped at PSNR_CAP_DB), mean luminance error
-    (model - truth, linear: negative is too dark) and mean absolute luminance error."""
-    difference = luminance(model8) - luminance(truth8)
+    """Per region: pixels, PSNR of the 8-bit images (capped at PSNR_CAP_DB), the truth's mean luminance,
+    mean luminance error (model - truth, linear: negative is too dark) and mean absolute luminance error."""
+    truth_luminance = luminance(truth8)
+    difference = luminance(model8) - truth_luminance
     errors = {}
     for name, mask in regions.items():
         pixels = int(mask.sum())
@@ -577,6 +578,7 @@ def region_errors(truth8: np.ndarray, model8: np.ndarray, regions: dict[str, np.
         errors[name] = {
             "pixels": pixels,
             "psnr_db": min(compare(truth8[mask], model8[mask]).psnr_db, PSNR_CAP_DB),
+            "truth_luminance": float(truth_luminance[mask].mean()),
             "mean_luminance_error": float(difference[mask].mean()),
             "mean_abs_luminance_error": float(np.abs(difference[mask]).mean()),
         }

@@ -2,6 +2,9 @@
 
 import itertools
 import math
+import os
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -14,6 +17,7 @@ from cloudcore.phase import phase_function
 from cloudcore.scene import Camera, Cloud, Scene, Shading
 from cloudcore.truth import (
     KERNEL_DIAMETER_INTEGRAL,
+    luminance,
     medium_grids,
     optical_depths,
     peak_extinction,
@@ -177,5 +181,22 @@ def test_region_errors_sign_the_luminance_error():
     assert same["image"]["psnr_db"] == 100.0 and same["image"]["mean_luminance_error"] == 0.0
     errors = region_errors(truth, brighter, regions)
     assert errors["lit"]["pixels"] == 4 and errors["lit"]["mean_luminance_error"] > 0
+    assert errors["lit"]["truth_luminance"] == pytest.approx(luminance(truth[0, 0]))
     assert errors["shadowed"] == {"pixels": 0}
     assert errors["sky"]["psnr_db"] == pytest.approx(20 * math.log10(255 / 20))
+
+
+def test_cloudview_truth_without_mitsuba_is_one_line_and_exit_2(tmp_path):
+    # a `mitsuba` module that cannot be imported stands in for a machine without the truth extra
+    (tmp_path / "mitsuba.py").write_text("raise ImportError('not here')\n")
+    env = dict(os.environ, PYTHONPATH=str(tmp_path))
+    result = subprocess.run(
+        [sys.executable, "-m", "cloudcore.cli", "truth", "--out", str(tmp_path / "t.png")],
+        capture_output=True,
+        text=True,
+        env=env,
+    )
+    assert result.returncode == 2
+    assert result.stderr.strip() == (
+        "cloudview: error: cloudview truth: mitsuba: not installed (pip install 'cloudview[truth]')"
+    )
