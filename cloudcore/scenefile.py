@@ -38,6 +38,7 @@ from cloudcore.scene import (
     View,
 )
 from cloudcore.settings import MODES, TRANSLATION_METRICS, RenderSettings
+from cloudcore.shading import EYE_PASSES
 from cloudcore.sprites import FACINGS, MAX_SEED, SpriteStyle
 
 PRIMITIVES = ("box", "sphere", "aircraft")
@@ -383,13 +384,14 @@ def _lighting(t: _Table) -> Lighting:
 
 
 def _shading(t: _Table) -> Shading:
-    t.reject_unknown(("albedo", "optical_depth", "phase", "g"))
+    t.reject_unknown(("albedo", "optical_depth", "phase", "g", "eye_pass"))
     d = Shading()
     return Shading(
         albedo=t.number("albedo", d.albedo, low=0.0, high=1.0),
         optical_depth=t.number("optical_depth", d.optical_depth, low=0.0),
         phase=t.string("phase", d.phase, choices=PHASE_NAMES),
         g=t.number("g", d.g, low=-MAX_ABS_G, high=MAX_ABS_G),
+        eye_pass=t.string("eye_pass", d.eye_pass, choices=EYE_PASSES),
     )
 
 
@@ -587,6 +589,8 @@ def scene_to_dict(scene: Scene) -> dict:
         ]
     data["lighting"] = lighting
     data["shading"] = {"albedo": s.albedo, "optical_depth": s.optical_depth, "phase": s.phase, "g": s.g}
+    if s.eye_pass != Shading().eye_pass:  # files that keep Harris's eye pass stay as they were
+        data["shading"]["eye_pass"] = s.eye_pass
     if scene.terrain is not None:
         t = scene.terrain
         terrain = {

@@ -102,14 +102,15 @@ def test_the_report_compares_every_shading_method_region_by_region(tmp_path):
     )
     assert result.returncode == 0, result.stderr
     report = json.loads(report_path.read_text())
-    assert set(report["models"]) == {"harris-exact", "harris-raster", "harris-preview"}
+    assert set(report["models"]) == {"harris-exact", "harris-raster", "harris-preview", "saturated-exact"}
     assert 10 < report["truth"]["noise_psnr_db"] < 100
     exact = report["models"]["harris-exact"]
     assert set(exact["errors"]) == {"image", "sky", "silhouette", "lit", "shadowed"}
     assert report["regions"]["sky"] > 0 and report["regions"]["lit"] > 0
     # the sky behind is the same picture in both: only the clouds differ
     assert exact["errors"]["sky"]["psnr_db"] > 35
-    assert (tmp_path / "models" / "exact.png").exists() and (tmp_path / "models" / "exact_diff.png").exists()
+    assert (tmp_path / "models" / "harris-exact.png").exists()
+    assert (tmp_path / "models" / "saturated-exact_diff.png").exists()
 
 
 def test_a_thin_particle_scatters_the_sun_as_harris_s_eye_pass_says():

@@ -1,9 +1,9 @@
 """`cloudview truth SCENE --out T.png`: the path-traced reference (Mitsuba 3); with --json, the models against it.
 
-The truth and the models both show the clouds over the sky, the terrain and objects left out
+The models are Harris's with each illumination method of `cloudcore.shading` and the saturated eye
+pass with the exact one.  The truth and the models both show the clouds over the sky, the terrain and objects left out
 (`cloudcore.truth` says what the medium and the lights are).  The report renders the truth again
-with the next seed, for its own noise, and each shading method of `cloudcore.shading` through the
-GL renderer in full 3D.
+with the next seed, for its own noise, and each model through the GL renderer in full 3D.
 """
 
 from __future__ import annotations
@@ -126,17 +126,17 @@ def run(args) -> int:
         "regions": {name: int(mask.sum()) for name, mask in regions.items()},
         "models": {},
     }
-    for method, (model, stats, seconds) in _model_renders(scene, camera, args).items():
-        report["models"][f"harris-{method}"] = {
+    for name, (model, stats, seconds) in _model_renders(scene, camera, args).items():
+        report["models"][name] = {
             "seconds": seconds,
             "illumination_ms": stats["illumination_ms"],
             "frame_ms": stats["frame_ms"],
             "errors": region_errors(image, model, regions),
         }
         if args.model_images is not None:
-            write_output(args.model_images / f"{method}.png", lambda path, picture=model: iio.imwrite(path, picture))
+            write_output(args.model_images / f"{name}.png", lambda path, picture=model: iio.imwrite(path, picture))
             write_output(
-                args.model_images / f"{method}_diff.png",
+                args.model_images / f"{name}_diff.png",
                 lambda path, picture=model: iio.imwrite(path, diff_image(image, picture)),
             )
     write_output(args.json, lambda path: path.write_text(json.dumps(report, indent=2) + "\n"))
@@ -170,8 +170,12 @@ def _render(scene, camera, args, seed: int):
             raise SceneError(args.scene, "truth", str(error)) from None
 
 
+#: the models compared with the truth: name -> (eye pass, illumination method)
+MODELS = {f"harris-{method}": ("harris", method) for method in METHODS} | {"saturated-exact": ("saturated", "exact")}
+
+
 def _model_renders(scene, camera, args) -> dict[str, tuple[np.ndarray, dict, float]]:
-    """Each shading method's full-3D picture of the truth's world (the sky; no terrain, no objects)."""
+    """Each model's full-3D picture of the truth's world (the sky; no terrain, no objects)."""
     # headless: EGL must be chosen before OpenGL is first imported
     os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
     from cloudcore.gl import FrameRenderer
@@ -180,10 +184,11 @@ def _model_renders(scene, camera, args) -> dict[str, tuple[np.ndarray, dict, flo
     world = dataclasses.replace(scene, terrain=None, objects=())
     renders = {}
     with FrameRenderer(args.width, args.height) as renderer:
-        for method in METHODS:
+        for name, (eye_pass, method) in MODELS.items():
+            model_world = dataclasses.replace(world, shading=dataclasses.replace(world.shading, eye_pass=eye_pass))
             start = time.perf_counter()
             image, stats = renderer.render(
-                world, camera=camera, time_of_day=args.time, illumination_method=method, settings=FULL_3D
+                model_world, camera=camera, time_of_day=args.time, illumination_method=method, settings=FULL_3D
             )
-            renders[method] = (image, stats, time.perf_counter() - start)
+            renders[name] = (image, stats, time.perf_counter() - start)
     return renders
