@@ -81,9 +81,10 @@ def eye_pass_coefficients(
     of I p(theta) radiance) * scattering + ambient * ambient weight.
 
     "harris": `scattering_coefficient` and the opacity alpha (Harris eq. 5).  "saturated": a (1 - e^-tau)
-    / (4 pi), which is a tau / (4 pi) for thin particles but stops growing once a particle is opaque
-    (light scattered once toward the eye comes from within about one optical depth of its surface:
-    Harris's grows to 0.57 at tau 8, eight times what a thick medium of albedo 0.9 can send), and
+    / (4 pi) (with the same cap, alpha / p(0)), which is a tau / (4 pi) for thin particles but stops
+    growing once a particle is opaque (light scattered once toward the eye comes from within about one
+    optical depth of its surface: Harris's grows to 0.57 at tau 8, eight times what a thick medium of
+    albedo 0.9 can send), and
     alpha times the reflectance of a thick medium (1 - s) / (1 + s), s = sqrt(1 - a) (two-stream; 1 at
     albedo 1, where Harris's ambient term is exact).  Against the path-traced truth of the default view
     at 160x120: 13.0 -> 23.6 dB at noon, 15.0 -> 24.0 dB at 18:15, at the same cost (docs/shading.md).
@@ -96,7 +97,9 @@ def eye_pass_coefficients(
     if eye_pass == "harris":
         return scattering_coefficient(tau, albedo, phase, g), alpha
     s = np.sqrt(1.0 - albedo)
-    return albedo * alpha / FOUR_PI, alpha * (1.0 - s) / (1.0 + s)
+    # the same cap as Harris's: no particle sends more light forward than it stops
+    p_forward = float(phase_function(1.0, phase, g))
+    return np.minimum(albedo * alpha / FOUR_PI, alpha / p_forward), alpha * (1.0 - s) / (1.0 + s)
 
 
 def incident_light(

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 from oracle import literal_incident_light
 
+from cloudcore.phase import phase_function
 from cloudcore.shading import eye_pass_coefficients, incident_light, scattering_coefficient
 
 RNG = np.random.default_rng(20021)
@@ -182,6 +183,9 @@ def test_the_saturated_eye_pass_is_harris_s_for_thin_particles_and_bounded_for_t
     assert ambient == pytest.approx((1 - s) / (1 + s), rel=1e-3)
     # at albedo 1 the ambient term is Harris's (a white cloud in uniform light returns it exactly)
     assert eye_pass_coefficients(thick, 1.0, eye_pass="saturated")[1] == pytest.approx(-np.expm1(-thick))
+    # a strong forward lobe keeps Harris's cap: no more light forward than the particle stops
+    forward, _ = eye_pass_coefficients(thick, 0.9, "henyey-greenstein", 0.9, eye_pass="saturated")
+    assert forward * phase_function(1.0, "henyey-greenstein", 0.9) == pytest.approx(-np.expm1(-thick))
     with pytest.raises(ValueError, match="harris, saturated"):
         eye_pass_coefficients(thick, 0.9, eye_pass="magic")
 
