@@ -31,6 +31,7 @@ SETTLE = 4
 GUI_TESTS = (
     "place_particles_by_clicking",
     "time_of_day_changes_the_picture",
+    "the_saturated_eye_pass_darkens_the_clouds",
     "dragging_the_time_of_day_relights_live",
     "tolerance_drives_regeneration",
     "save_and_reopen",
@@ -133,6 +134,21 @@ def install(params, editor, viewport, panels, results_path: Path, outcome: dict,
         changed = (np.abs(noon.astype(int) - evening.astype(int)).max(axis=2) > 20).mean()
         outcome["time_of_day_changed_fraction"] = float(changed)
         CHECK(bool(changed > 0.3))  # the sky and the clouds both change
+
+    def the_saturated_eye_pass_darkens_the_clouds(ctx):
+        use_window(ctx, "Lighting")
+        relit(ctx)
+        harris = capture(ctx)
+        ctx.combo_click("Eye pass/saturated")
+        CHECK(editor.scene.shading.eye_pass == "saturated")
+        ctx.yield_(SETTLE)
+        relit(ctx)
+        saturated = capture(ctx)
+        darker = (harris.astype(int).sum(axis=2) - saturated.astype(int).sum(axis=2) > 30).mean()
+        outcome["saturated_eye_pass_darker_fraction"] = float(darker)
+        CHECK(bool(darker > 0.05))  # the clouds, not the sky
+        undo(ctx)
+        CHECK(editor.scene.shading.eye_pass == "harris")
 
     def dragging_the_time_of_day_relights_live(ctx):
         """The viewport follows the slider while it moves, shaded in the worker; exact once let go."""

@@ -59,6 +59,21 @@ def projection_matrix(
     return projection
 
 
+def pixel_rays(camera: Camera, width: int, height: int) -> np.ndarray:
+    """Unit world directions (height, width, 3), top row first, through each pixel's centre.
+
+    The rays of `projection_matrix` and `camera_pose`: what a fragment at the pixel centre sees, so
+    a path tracer given the same pose and field of view lines up with the GL frame pixel for pixel.
+    """
+    pose = camera_pose(camera)
+    half_height = np.tan(0.5 * np.radians(camera.fov_y_deg))
+    x = ((np.arange(width) + 0.5) / width * 2.0 - 1.0) * half_height * width / height
+    y = (1.0 - (np.arange(height) + 0.5) / height * 2.0) * half_height
+    right, up, back = pose[:3, 0], pose[:3, 1], pose[:3, 2]
+    rays = x[None, :, None] * right + y[:, None, None] * up - back
+    return rays / np.linalg.norm(rays, axis=2, keepdims=True)
+
+
 def frustum_planes(view_projection: np.ndarray) -> np.ndarray:
     """The six planes (a, b, c, d) of the clip volume, normals inward and unit length.
 

@@ -14,6 +14,12 @@ def srgb_encode(linear) -> np.ndarray:
     return np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1.0 / 2.4) - 0.055)
 
 
+def srgb_decode(encoded) -> np.ndarray:
+    """sRGB-encoded [0, 1] to linear [0, 1] (the inverse of `srgb_encode`; world.frag.glsl's `srgb_decode`)."""
+    c = np.clip(np.asarray(encoded, dtype=np.float64), 0.0, 1.0)
+    return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+
+
 #: the 4x4 ordered-dither (Bayer) matrix: each pixel's rounding threshold is (entry + 0.5) / 16
 BAYER_4 = np.array([[0, 8, 2, 10], [12, 4, 14, 6], [3, 11, 1, 9], [15, 7, 13, 5]], dtype=np.float64)
 

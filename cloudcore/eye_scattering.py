@@ -33,7 +33,7 @@ from cloudcore.particle_styles import ParticleStyles, particle_styles
 from cloudcore.phase import phase_function
 from cloudcore.ramps import smoothstep
 from cloudcore.scene import Lighting, Shading
-from cloudcore.shading import scattering_coefficient
+from cloudcore.shading import eye_pass_coefficients
 from cloudcore.sprites import CELL_PIXELS
 
 #: a particle fades out between these distances from the eye, in radii, so the
@@ -78,7 +78,10 @@ class ParticleShading:
         artist = np.array([c.artist is not None for c in clouds], dtype=bool)
         self._opaque = (self.alpha > 0.0) | np.repeat(artist, counts)
         self._near_faded = self.styles.near_faded
-        self.scattering = scattering_coefficient(tau, albedo, shading.phase, shading.g)
+        #: per particle: what multiplies the scattered light, and the ambient light, toward the eye
+        self.scattering, self.ambient_weight = eye_pass_coefficients(
+            tau, albedo, shading.phase, shading.g, shading.eye_pass
+        )
         self.tint = np.repeat(np.array([c.color for c in clouds], dtype=np.float64).reshape(-1, 3), counts, axis=0)
         incident = (
             cache.incident(clouds, shading, lights, method)
@@ -124,7 +127,8 @@ class ParticleShading:
             phase = phase_function(view @ direction, self.phase, self.g)
             scattered += (self.incident[indices, light] * phase)[:, None] * radiance
         alpha = self.alpha[indices]
-        colour = (scattered * self.scattering[indices, None] + self.ambient * alpha[:, None]) * self.tint[indices]
+        ambient = self.ambient * self.ambient_weight[indices, None]
+        colour = (scattered * self.scattering[indices, None] + ambient) * self.tint[indices]
         radii = self.radii[indices]
         fade = smoothstep(FADE_START_RADII * radii, FADE_END_RADII * radii, distance)
         factors = self.formation_factors(time_s)

@@ -7,6 +7,8 @@ light; this module maps a scene's clouds, shading defaults and lights onto
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from cloudcore.lighting import active_lights
@@ -135,4 +137,5 @@ class IlluminationCache:
 
     @staticmethod
     def _key(cloud: Cloud, shading: Shading, method: str) -> tuple:
-        return id(cloud), shading, method
+        # the light pass does not depend on what the eye pass makes of its result
+        return id(cloud), dataclasses.replace(shading, eye_pass=Shading().eye_pass), method

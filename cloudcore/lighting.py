@@ -78,6 +78,17 @@ def sky_colors(hours: float) -> tuple[np.ndarray, np.ndarray]:
     return zenith, horizon
 
 
+def sky_gradient(directions, zenith, horizon) -> np.ndarray:
+    """Linear RGB (..., 3) of the sky background seen along unit `directions` (..., 3).
+
+    The horizon colour at and below the horizon line, the zenith colour straight up, and between them
+    by the square root of the ray's height, which keeps the pale band near the horizon narrow; the
+    world pass draws the same (shaders/world.frag.glsl, `sky`).
+    """
+    height = np.sqrt(np.clip(np.asarray(directions, dtype=np.float64)[..., 1:2], 0.0, 1.0))
+    return (1.0 - height) * np.asarray(horizon, dtype=np.float64) + height * np.asarray(zenith, dtype=np.float64)
+
+
 def daylight(hours: float) -> tuple[tuple[Light, ...], np.ndarray]:
     """Sun and skylight for `hours`, and the ambient term (Harris section 2.3.1)."""
     direction = sun_direction(hours)

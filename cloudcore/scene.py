@@ -71,10 +71,15 @@ class Lighting:
 
 @dataclass(frozen=True)
 class Shading:
+    """Harris's defaults for every cloud; `eye_pass` chooses what a particle sends to the eye
+    (`cloudcore.shading.EYE_PASSES`: Harris's eq. 5, or its saturated form, closer to the path-traced
+    truth: docs/shading.md)."""
+
     albedo: float = 0.9
     optical_depth: float = 8.0
     phase: str = "rayleigh"
     g: float = 0.0
+    eye_pass: str = "harris"
 
 
 @dataclass(frozen=True, eq=False)

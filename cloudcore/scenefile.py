@@ -35,6 +35,7 @@ from cloudcore.scene import (
     View,
 )
 from cloudcore.settings import MODES, RenderSettings, setting_options
+from cloudcore.shading import EYE_PASSES
 from cloudcore.sprites import FACINGS, MAX_SEED, SpriteStyle
 from cloudcore.toml_table import Table, checked_matrix, field_error
 
@@ -226,13 +227,14 @@ def _lighting(t: Table) -> Lighting:
 
 
 def _shading(t: Table) -> Shading:
-    t.reject_unknown(("albedo", "optical_depth", "phase", "g"))
+    t.reject_unknown(("albedo", "optical_depth", "phase", "g", "eye_pass"))
     d = Shading()
     return Shading(
         albedo=t.number("albedo", d.albedo, low=0.0, high=1.0),
         optical_depth=t.number("optical_depth", d.optical_depth, low=0.0),
         phase=t.string("phase", d.phase, choices=PHASE_NAMES),
         g=t.number("g", d.g, low=-MAX_ABS_G, high=MAX_ABS_G),
+        eye_pass=t.string("eye_pass", d.eye_pass, choices=EYE_PASSES),
     )
 
 
@@ -430,6 +432,8 @@ def scene_to_dict(scene: Scene) -> dict:
         ]
     data["lighting"] = lighting
     data["shading"] = {"albedo": s.albedo, "optical_depth": s.optical_depth, "phase": s.phase, "g": s.g}
+    if s.eye_pass != Shading().eye_pass:  # files that keep Harris's eye pass stay as they were
+        data["shading"]["eye_pass"] = s.eye_pass
     if scene.terrain is not None:
         t = scene.terrain
         terrain = {

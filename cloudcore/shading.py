@@ -44,6 +44,9 @@ from cloudcore.kernel import splat_kernel
 from cloudcore.phase import check_phase, phase_function
 
 METHODS = ("exact", "raster", "preview")
+#: what a particle sends toward the eye (`cloudcore.eye_scattering`): Harris's eq. 5 as printed, or
+#: "saturated", its scattering coefficient and ambient term made those of a thick medium
+EYE_PASSES = ("harris", "saturated")
 FOUR_PI = 4.0 * np.pi
 
 #: raster grid cells across the widest axis of a cloud's light-plane footprint.
@@ -69,6 +72,34 @@ def scattering_coefficient(optical_depth, albedo, phase: str = "rayleigh", g: fl
     alpha = -np.expm1(-tau)
     p_forward = float(phase_function(1.0, phase, g))
     return np.minimum(np.asarray(albedo, dtype=np.float64) * tau / FOUR_PI, alpha / p_forward)
+
+
+def eye_pass_coefficients(
+    optical_depth, albedo, phase: str = "rayleigh", g: float = 0.0, eye_pass: str = "harris"
+) -> tuple[np.ndarray, np.ndarray]:
+    """(scattering coefficient, ambient weight) per particle for the eye pass: colour = (sum over lights
+    of I p(theta) radiance) * scattering + ambient * ambient weight.
+
+    "harris": `scattering_coefficient` and the opacity alpha (Harris eq. 5).  "saturated": a (1 - e^-tau)
+    / (4 pi) (with the same cap, alpha / p(0)), which is a tau / (4 pi) for thin particles but stops
+    growing once a particle is opaque (light scattered once toward the eye comes from within about one
+    optical depth of its surface: Harris's grows to 0.57 at tau 8, eight times what a thick medium of
+    albedo 0.9 can send), and
+    alpha times the reflectance of a thick medium (1 - s) / (1 + s), s = sqrt(1 - a) (two-stream; 1 at
+    albedo 1, where Harris's ambient term is exact).  Against the path-traced truth of the default view
+    at 160x120: 13.0 -> 23.6 dB at noon, 15.0 -> 24.0 dB at 18:15, at the same cost (docs/shading.md).
+    """
+    if eye_pass not in EYE_PASSES:
+        raise ValueError(f"unknown eye pass {eye_pass!r}; valid: {', '.join(EYE_PASSES)}")
+    tau = np.asarray(optical_depth, dtype=np.float64)
+    albedo = np.asarray(albedo, dtype=np.float64)
+    alpha = -np.expm1(-tau)
+    if eye_pass == "harris":
+        return scattering_coefficient(tau, albedo, phase, g), alpha
+    s = np.sqrt(1.0 - albedo)
+    # the same cap as Harris's: no particle sends more light forward than it stops
+    p_forward = float(phase_function(1.0, phase, g))
+    return np.minimum(albedo * alpha / FOUR_PI, alpha / p_forward), alpha * (1.0 - s) / (1.0 + s)
 
 
 def incident_light(
@@ -235,17 +266,17 @@ def _incident_in_light_order(source, target, weight, alpha, sigma):
     while ready.size:
         lit = ready[in_count[ready] > 0]
         if lit.size:
-            edges = _concatenated_ranges(in_start[lit], in_count[lit])
+            edges = concatenated_ranges(in_start[lit], in_count[lit])
             src, w = in_source[edges], in_weight[edges]
             through, scattered = _compose_segments(1.0 - alpha[src] * w, sigma[src] * incident[src] * w, in_count[lit])
             incident[lit] = through + scattered  # the frame buffer starts at 1
-        released = out_target[_concatenated_ranges(out_start[ready], out_count[ready])]
+        released = out_target[concatenated_ranges(out_start[ready], out_count[ready])]
         np.subtract.at(waiting, released, 1)
         ready = np.unique(released[waiting[released] == 0])
     return incident
 
 
-def _concatenated_ranges(starts: np.ndarray, counts: np.ndarray) -> np.ndarray:
+def concatenated_ranges(starts: np.ndarray, counts: np.ndarray) -> np.ndarray:
     """concatenate(arange(s, s + c) for s, c in zip(starts, counts)), vectorised."""
     total = int(counts.sum())
     if total == 0:

@@ -30,8 +30,16 @@ def particle_grid(z: float) -> np.ndarray:
     return np.column_stack([xs.ravel(), ys.ravel(), np.full(xs.size, z), np.full(xs.size, 6.0)])
 
 
-@pytest.mark.parametrize("phase, g", [("rayleigh", 0.0), ("henyey-greenstein", 0.8), ("cornette-shanks", -0.5)])
-def test_the_shader_colours_particles_as_the_reference_does(renderer, phase, g):
+@pytest.mark.parametrize(
+    "phase, g, eye_pass",
+    [
+        ("rayleigh", 0.0, "harris"),
+        ("henyey-greenstein", 0.8, "harris"),
+        ("cornette-shanks", -0.5, "harris"),
+        ("rayleigh", 0.0, "saturated"),
+    ],
+)
+def test_the_shader_colours_particles_as_the_reference_does(renderer, phase, g, eye_pass):
     from cloudcore.gl.splats import SplatPass, splat_batch
     from cloudcore.gl.targets import TextureTarget
 
@@ -44,7 +52,7 @@ def test_the_shader_colours_particles_as_the_reference_does(renderer, phase, g):
             formation=Formation("form", 0.0, 10.0),
         ),
     )
-    particles = ParticleShading(clouds, Shading(albedo=0.85, phase=phase, g=g), LIGHTS, AMBIENT)
+    particles = ParticleShading(clouds, Shading(albedo=0.85, phase=phase, g=g, eye_pass=eye_pass), LIGHTS, AMBIENT)
     view, projection = view_matrix(CAMERA), projection_matrix(CAMERA.fov_y_deg, WIDTH / HEIGHT)
     time_s = 4.0  # the forming cloud's core is in, its edge not yet
     renderer.context.make_current()

@@ -10,6 +10,7 @@ from conftest import VALLEY
 
 import cloudcore.scenefile as scenefile
 from cloudcore.errors import SceneError
+from cloudcore.scene import Scene, Shading
 from cloudcore.scenefile import load_scene, save_scene, scene_to_dict
 
 
@@ -305,3 +306,15 @@ def test_sprite_and_artist_tables_take_their_defaults(tmp_path):
     (tmp_path / "d.toml").write_text(BASE.replace('name = "a"', 'name = "a"\nsprite = {}\nartist = {}', 1))
     cloud = load_scene(tmp_path / "d.toml").clouds[0]
     assert cloud.sprite == SpriteStyle() and cloud.artist == ArtistShading()
+
+
+def test_the_eye_pass_is_kept_in_the_file_only_when_it_is_not_harris_s(tmp_path):
+    scene = Scene(shading=Shading(eye_pass="saturated"))
+    save_scene(scene, tmp_path / "s.toml")
+    assert 'eye_pass = "saturated"' in (tmp_path / "s.toml").read_text()
+    assert load_scene(tmp_path / "s.toml").shading.eye_pass == "saturated"
+    save_scene(Scene(), tmp_path / "h.toml")
+    assert "eye_pass" not in (tmp_path / "h.toml").read_text()
+    (tmp_path / "bad.toml").write_text('[shading]\neye_pass = "magic"\n')
+    with pytest.raises(SceneError, match="eye_pass"):
+        load_scene(tmp_path / "bad.toml")

@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 from oracle import literal_incident_light
 
-from cloudcore.shading import incident_light, scattering_coefficient
+from cloudcore.phase import phase_function
+from cloudcore.shading import eye_pass_coefficients, incident_light, scattering_coefficient
 
 RNG = np.random.default_rng(20021)
 
@@ -165,3 +166,36 @@ def test_bad_input_raises_value_error_with_a_message(change, message):
 def test_unknown_method_is_refused():
     with pytest.raises(ValueError, match="exact, raster"):
         incident_light([[0, 0, 0]], [1], [1], [1], [0, 1, 0], method="magic")
+
+
+def test_the_saturated_eye_pass_is_harris_s_for_thin_particles_and_bounded_for_thick_ones():
+    thin, thick = np.array([1e-4]), np.array([8.0])
+    for tau in (thin, thick):
+        harris = eye_pass_coefficients(tau, 0.9, eye_pass="harris")
+        assert harris[0] == pytest.approx(scattering_coefficient(tau, 0.9)) and harris[1] == pytest.approx(
+            -np.expm1(-tau)
+        )
+    scattering, ambient = eye_pass_coefficients(thin, 0.9, eye_pass="saturated")
+    assert scattering == pytest.approx(0.9 * thin / (4 * np.pi), rel=1e-3)
+    scattering, ambient = eye_pass_coefficients(thick, 0.9, eye_pass="saturated")
+    assert scattering == pytest.approx(0.9 / (4 * np.pi), rel=1e-3)  # Harris: 0.57, eight times this
+    s = np.sqrt(0.1)
+    assert ambient == pytest.approx((1 - s) / (1 + s), rel=1e-3)
+    # at albedo 1 the ambient term is Harris's (a white cloud in uniform light returns it exactly)
+    assert eye_pass_coefficients(thick, 1.0, eye_pass="saturated")[1] == pytest.approx(-np.expm1(-thick))
+    # a strong forward lobe keeps Harris's cap: no more light forward than the particle stops
+    forward, _ = eye_pass_coefficients(thick, 0.9, "henyey-greenstein", 0.9, eye_pass="saturated")
+    assert forward * phase_function(1.0, "henyey-greenstein", 0.9) == pytest.approx(-np.expm1(-thick))
+    with pytest.raises(ValueError, match="harris, saturated"):
+        eye_pass_coefficients(thick, 0.9, eye_pass="magic")
+
+
+def test_changing_the_eye_pass_shades_nothing_again():
+    from cloudcore.illumination import IlluminationCache
+    from cloudcore.scene import Cloud, Light, Shading
+
+    cloud = Cloud("c", [[0.0, 0.0, 0.0, 10.0], [5.0, 5.0, 0.0, 10.0]])
+    cache, lights = IlluminationCache(), (Light((0.0, 1.0, 0.0)),)
+    cache.incident([cloud], Shading(), lights)
+    cache.incident([cloud], Shading(eye_pass="saturated"), lights)
+    assert cache.last_recomputed == 0

@@ -9,6 +9,7 @@ from imgui_bundle import imgui
 from app.editor import Editor
 from app.panels.widgets import ReleasedSliders
 from cloudcore.phase import PHASE_NAMES
+from cloudcore.shading import EYE_PASSES
 
 #: the shading sliders: label -> (`Shading` field, low, high)
 _SHADING_SLIDERS = {
@@ -52,8 +53,15 @@ class LightingPanel:
             )
         )
         changed_phase, phase_index = imgui.combo("Phase function", PHASE_NAMES.index(shading.phase), list(PHASE_NAMES))
+        changed_eye_pass, eye_pass_index = imgui.combo("Eye pass", EYE_PASSES.index(shading.eye_pass), list(EYE_PASSES))
+        imgui.set_item_tooltip(
+            "harris: Harris's eye scattering; saturated: its scattering saturated for opaque particles and the "
+            "ambient light a thick medium's (closer to the path-traced truth: docs/shading.md)."
+        )
         changes = {key: value for key, value in changes.items() if value is not None}
         if changed_phase:
             changes["phase"] = PHASE_NAMES[phase_index]
+        if changed_eye_pass:
+            changes["eye_pass"] = EYE_PASSES[eye_pass_index]
         if changes:
             editor.edit(dataclasses.replace(scene, shading=dataclasses.replace(shading, **changes)))

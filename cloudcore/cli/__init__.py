@@ -36,7 +36,7 @@ def version_line() -> str:
 
 
 def build_parser() -> tuple[argparse.ArgumentParser, argparse._SubParsersAction]:
-    from cloudcore.cli import bench, check, compare, record, render, shade
+    from cloudcore.cli import bench, check, compare, record, render, shade, truth
 
     # raw text: the version stays one line however narrow the terminal
     parser = _OneLineParser(
@@ -52,6 +52,7 @@ def build_parser() -> tuple[argparse.ArgumentParser, argparse._SubParsersAction]
     check.add_parser(commands)
     bench.add_parser(commands)
     record.add_parser(commands)
+    truth.add_parser(commands)
     return parser, commands
 
 
@@ -76,7 +77,8 @@ def _editor(argv: list[str]) -> int:
     if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
         print(
             "cloudview: error: the editor needs a display (none is set); on a headless machine try "
-            "`xvfb-run -a cloudview`, or the headless commands: cloudview render|record|bench|compare|check --help",
+            "`xvfb-run -a cloudview`, or the headless commands: "
+            "cloudview render|record|bench|compare|check|truth --help",
             file=sys.stderr,
         )
         return 2

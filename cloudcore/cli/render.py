@@ -13,6 +13,7 @@ from cloudcore.limits import MAX_FRAME_SIDE
 from cloudcore.overdraw import scene_block_overdraw_statistics
 from cloudcore.paths import camera_on_path
 from cloudcore.resources import DEFAULT_SCENE
+from cloudcore.scene import Camera
 from cloudcore.scenefile import load_scene
 
 
@@ -47,18 +48,28 @@ def pixel_count(text: str) -> int:
     return value
 
 
+def check_time_argument(hours: float | None) -> None:
+    """--time-of-day, when given, is an hour of the day."""
+    if hours is not None and not 0.0 <= hours <= 24.0:
+        raise SceneError("--time-of-day", "time_of_day", f"must be within [0, 24] hours, got {hours}")
+
+
+def camera_argument(args, scene) -> Camera:
+    """The scene's camera, or the one `--path-time` seconds along `--camera-path`."""
+    if args.camera_path is None:
+        return scene.camera
+    try:
+        path = scene.camera_path(args.camera_path)
+    except KeyError as error:
+        raise SceneError(args.scene, "camera_paths", error.args[0]) from None
+    return camera_on_path(path, args.path_time, scene.camera.fov_y_deg)
+
+
 def run(args) -> int:
     scene = load_scene(args.scene)
-    if args.time_of_day is not None and not 0.0 <= args.time_of_day <= 24.0:
-        raise SceneError("--time-of-day", "time_of_day", f"must be within [0, 24] hours, got {args.time_of_day}")
+    check_time_argument(args.time_of_day)
     settings = settings_from(args)
-    camera = scene.camera
-    if args.camera_path is not None:
-        try:
-            path = scene.camera_path(args.camera_path)
-        except KeyError as error:
-            raise SceneError(args.scene, "camera_paths", error.args[0]) from None
-        camera = camera_on_path(path, args.path_time, camera.fov_y_deg)
+    camera = camera_argument(args, scene)
     # headless: EGL must be chosen before OpenGL is first imported
     os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
     import imageio.v3 as iio
@@ -73,11 +84,11 @@ def run(args) -> int:
     report = stats.as_dict()
     if stats.overdraw is not None:
         report |= scene_block_overdraw_statistics(scene.clouds)  # Wang's view-independent counterpart
-    _write(args.out, lambda path: iio.imwrite(path, image))
+    write_output(args.out, lambda path: iio.imwrite(path, image))
     if args.overdraw:
-        _write(args.overdraw, lambda path: iio.imwrite(path, heat_image(counts)[0][..., :3]))
+        write_output(args.overdraw, lambda path: iio.imwrite(path, heat_image(counts)[0][..., :3]))
     if args.stats:
-        _write(args.stats, lambda path: path.write_text(json.dumps(report, indent=2) + "\n"))
+        write_output(args.stats, lambda path: path.write_text(json.dumps(report, indent=2) + "\n"))
     print(
         f"wrote {args.out} ({args.width}x{args.height}): frame {stats.frame_ms:.1f} ms "
         f"(world {stats.world_ms:.1f}, clouds {stats.cloud_ms:.1f}), "
@@ -94,7 +105,7 @@ def run(args) -> int:
     return 0
 
 
-def _write(path: Path, write) -> None:
+def write_output(path: Path, write) -> None:
     """Create the parent folder, then write; an unwritable path is a one-line error."""
     try:
         path.parent.mkdir(parents=True, exist_ok=True)

@@ -303,7 +303,7 @@ def _particle_records(particles: ParticleShading) -> np.ndarray:
     records[:n, 3] = particles.radii
     records[:n, 4:7] = particles.scattering[:, None] * particles.tint
     records[:n, 7] = particles.alpha
-    records[:n, 8:11] = particles.ambient * particles.alpha[:, None] * particles.tint
+    records[:n, 8:11] = particles.ambient * particles.ambient_weight[:, None] * particles.tint
     styles = particles.styles
     records[:n, 12:15] = styles.group_centres
     records[:n, 15] = styles.cloud_index

@@ -1,0 +1,196 @@
+"""`cloudview truth SCENE --out T.png`: the path-traced reference (Mitsuba 3); with --json, the models against it.
+
+The models are Harris's with each illumination method of `cloudcore.shading` and the saturated eye
+pass with the exact one.  The truth and the models both show the clouds over the sky, the terrain and objects left out
+(`cloudcore.truth` says what the medium and the lights are).  The report renders the truth again
+with the next seed, for its own noise, and each model through the GL renderer in full 3D.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from cloudcore.benchmark import PSNR_CAP_DB
+from cloudcore.cli.render import add_scene_argument, camera_argument, check_time_argument, pixel_count, write_output
+from cloudcore.colour import linear_to_srgb8
+from cloudcore.errors import SceneError
+from cloudcore.imagecompare import compare, diff_image
+from cloudcore.lighting import scene_hour
+from cloudcore.scenefile import load_scene
+from cloudcore.shading import METHODS
+from cloudcore.truth import (
+    BODY_ALPHA,
+    CLOUD_ALPHA,
+    DEFAULT_VOXELS_PER_RADIUS,
+    VARIANTS,
+    mitsuba_variant,
+    region_errors,
+    render_truth,
+    truth_regions,
+)
+
+REGION_DEFINITION = (
+    f"from the truth: sky where its alpha (1 - transmittance along the pixel's central ray) < {CLOUD_ALPHA}, "
+    f"silhouette where {CLOUD_ALPHA} <= alpha < {BODY_ALPHA}; the body (alpha >= {BODY_ALPHA}) is lit where the "
+    "optical depth toward the sun from the point where the view ray's optical depth reaches 1 is below 1, "
+    "shadowed elsewhere"
+)
+
+
+def positive_int(text: str) -> int:
+    value = int(text)
+    if value < 1:
+        raise ValueError(text)
+    return value
+
+
+def add_parser(commands) -> None:
+    parser = commands.add_parser(
+        "truth", help="path trace a reference picture (Mitsuba 3) and compare the shading models with it"
+    )
+    add_scene_argument(parser)
+    parser.add_argument("--out", required=True, type=Path, help="PNG to write (sRGB, as cloudview render)")
+    # path tracing thick clouds is slow on a CPU: smaller than cloudview render's default frame
+    parser.add_argument("--width", type=pixel_count, default=160)
+    parser.add_argument("--height", type=pixel_count, default=120)
+    parser.add_argument("--spp", type=positive_int, default=64, help="samples per pixel (default 64)")
+    parser.add_argument("--time-of-day", type=float, help="time of day in hours, overriding the scene's")
+    parser.add_argument("--camera-path", help="take the camera from this path of the scene")
+    parser.add_argument("--path-time", type=float, default=0.0, help="seconds along --camera-path")
+    parser.add_argument("--seed", type=int, default=0, help="the same seed gives the same picture (default 0)")
+    parser.add_argument(
+        "--voxels-per-radius",
+        type=float,
+        default=DEFAULT_VOXELS_PER_RADIUS,
+        help=f"voxels across the median particle radius (default {DEFAULT_VOXELS_PER_RADIUS:g})",
+    )
+    parser.add_argument("--variant", choices=VARIANTS, help="Mitsuba variant (default: the first that loads)")
+    parser.add_argument("--json", type=Path, help="compare the shading models with the truth; write the report here")
+    parser.add_argument("--model-images", type=Path, help="with --json: write each model's picture and diff here")
+    parser.set_defaults(run=run)
+
+
+def run(args) -> int:
+    try:
+        mitsuba_variant(args.variant)
+    except ImportError:
+        raise SceneError("cloudview truth", "mitsuba", "not installed (pip install 'cloudview[truth]')") from None
+    except RuntimeError as error:
+        raise SceneError("cloudview truth", "--variant", str(error)) from None
+    import imageio.v3 as iio
+
+    scene = load_scene(args.scene)
+    check_time_argument(args.time_of_day)
+    camera = camera_argument(args, scene)
+    truth = _render(scene, camera, args, args.seed)
+    image = linear_to_srgb8(truth.linear)
+    write_output(args.out, lambda path: iio.imwrite(path, image))
+    print(
+        f"wrote {args.out} ({args.width}x{args.height}, {args.spp} spp, seed {args.seed}, {truth.variant}): "
+        f"{truth.seconds:.1f} s, {truth.voxels:,} voxels"
+    )
+    if args.json is None:
+        return 0
+
+    second = _render(scene, camera, args, args.seed + 1)
+    noise = compare(image, linear_to_srgb8(second.linear)).psnr_db
+    regions = truth_regions(truth.alpha, truth.sun_depth)
+    hour = scene_hour(
+        scene.lighting
+        if args.time_of_day is None
+        else dataclasses.replace(scene.lighting, time_of_day=args.time_of_day)
+    )
+    report = {
+        "scene": str(args.scene),
+        "width": args.width,
+        "height": args.height,
+        "camera": dataclasses.asdict(camera),
+        "time_of_day": hour,
+        "truth": {
+            "spp": args.spp,
+            "seed": args.seed,
+            "seconds": truth.seconds,
+            "variant": truth.variant,
+            "voxels": truth.voxels,
+            "voxels_per_radius": args.voxels_per_radius,
+            # the PSNR of one picture against the converged one is about 3 dB above this
+            "noise_psnr_db": min(noise, PSNR_CAP_DB),
+            "second_seed_seconds": second.seconds,
+        },
+        "region_definition": REGION_DEFINITION,
+        "regions": {name: int(mask.sum()) for name, mask in regions.items()},
+        "models": {},
+    }
+    for name, (model, stats, seconds) in _model_renders(scene, camera, args).items():
+        report["models"][name] = {
+            "seconds": seconds,
+            "illumination_ms": stats.illumination_ms,
+            "frame_ms": stats.frame_ms,
+            "errors": region_errors(image, model, regions),
+        }
+        if args.model_images is not None:
+            write_output(args.model_images / f"{name}.png", lambda path, picture=model: iio.imwrite(path, picture))
+            write_output(
+                args.model_images / f"{name}_diff.png",
+                lambda path, picture=model: iio.imwrite(path, diff_image(image, picture)),
+            )
+    write_output(args.json, lambda path: path.write_text(json.dumps(report, indent=2) + "\n"))
+    print(f"truth noise (seeds {args.seed} and {args.seed + 1}): {noise:.2f} dB")
+    for name, model in report["models"].items():
+        whole = model["errors"]["image"]
+        print(
+            f"{name:<16} PSNR {whole['psnr_db']:6.2f} dB, mean luminance error {whole['mean_luminance_error']:+.4f} "
+            f"({model['seconds']:.2f} s)"
+        )
+    print(f"wrote {args.json}")
+    return 0
+
+
+def _render(scene, camera, args, seed: int):
+    with tqdm(total=args.spp, desc=f"path tracing (seed {seed})", unit="spp", disable=None, leave=False) as bar:
+        try:
+            return render_truth(
+                scene,
+                args.width,
+                args.height,
+                camera=camera,
+                time_of_day=args.time_of_day,
+                spp=args.spp,
+                seed=seed,
+                voxels_per_radius=args.voxels_per_radius,
+                variant=args.variant,
+                progress=lambda done, total: bar.update(done - bar.n),
+            )
+        except ValueError as error:
+            raise SceneError(args.scene, "truth", str(error)) from None
+
+
+#: the models compared with the truth: name -> (eye pass, illumination method)
+MODELS = {f"harris-{method}": ("harris", method) for method in METHODS} | {"saturated-exact": ("saturated", "exact")}
+
+
+def _model_renders(scene, camera, args) -> dict[str, tuple[np.ndarray, dict, float]]:
+    """Each model's full-3D picture of the truth's world (the sky; no terrain, no objects)."""
+    # headless: EGL must be chosen before OpenGL is first imported
+    os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
+    from cloudcore.gl import FrameRenderer
+    from cloudcore.settings import FULL_3D
+
+    world = dataclasses.replace(scene, terrain=None, objects=())
+    renders = {}
+    with FrameRenderer(args.width, args.height) as renderer:
+        for name, (eye_pass, method) in MODELS.items():
+            model_world = dataclasses.replace(world, shading=dataclasses.replace(world.shading, eye_pass=eye_pass))
+            start = time.perf_counter()
+            image, stats = renderer.render(
+                model_world, camera=camera, time_of_day=args.time_of_day, illumination_method=method, settings=FULL_3D
+            )
+            renders[name] = (image, stats, time.perf_counter() - start)
+    return renders

@@ -1,0 +1,585 @@
+"""Ground truth for the shading models: the clouds as a heterogeneous medium, path traced by Mitsuba 3.
+
+Each particle becomes a blob of extinction with the splat kernel's profile (`cloudcore.kernel`),
+
+    sigma_t(x) = c_i K(|x - p_i| / r_i),    c_i = tau_i / (r_i * KERNEL_DIAMETER_INTEGRAL),
+
+so that the optical depth along a diameter, the line integral through the centre, is the particle's
+tau (Harris's alpha = 1 - exp(-tau) is the opacity of a splat at its centre).  Overlapping particles
+add their extinction.  The extinction is sampled at voxel centres over boxes around the clouds (one
+box per set of clouds whose boxes overlap, so that empty air between clouds costs the path tracer
+nothing: Mitsuba's heterogeneous medium tracks free paths against the largest extinction of its
+grid); the albedo is the extinction-weighted mean of the particles' albedos, the phase function the
+scene's.
+
+The light is the model's: the sun and the skylight as directional emitters with the irradiance the
+model gives them, and the ambient term as a constant environment of that radiance (a cloud of albedo 1
+in it returns exactly the model's ambient * (1 - T)).  The emitters are hidden from camera rays; the
+background, the sky gradient the renderer draws (terrain left out), is added behind the clouds with
+their transmittance T, computed here by marching the same grid.  Mitsuba is imported only inside the
+functions that need it (`cloudview[truth]`), so importing this module never needs it.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from cloudcore.benchmark import PSNR_CAP_DB
+from cloudcore.camera import FAR_PLANE_M, NEAR_PLANE_M, camera_pose, pixel_rays
+from cloudcore.colour import srgb_decode
+from cloudcore.illumination import cloud_optics
+from cloudcore.imagecompare import compare
+from cloudcore.kernel import splat_kernel
+from cloudcore.lighting import active_lights, scene_hour, scene_lights, sky_colors, sky_gradient
+from cloudcore.phase import phase_function
+from cloudcore.scene import Camera, Scene
+from cloudcore.shading import concatenated_ranges
+
+
+def _kernel_diameter_integral(points: int = 64) -> float:
+    """The integral of K(|u|) over u in [-1, 1], by Gauss-Legendre on [0, 1] (K is smooth there: exact
+    to rounding at 64 points; tests/test_truth.py checks it against the closed form with erf)."""
+    nodes, weights = np.polynomial.legendre.leggauss(points)
+    return float(np.sum(weights * splat_kernel(0.5 * (nodes + 1.0))))  # 2 * (1/2) * sum over [0, 1]
+
+
+#: a particle's optical depth along a diameter is its centre's extinction times its radius times this
+KERNEL_DIAMETER_INTEGRAL = _kernel_diameter_integral()
+
+#: voxels across the scene's median particle radius: the line integral through a particle's centre is
+#: within 1% of its tau at 3 (tests/test_truth.py); the default scene then has about 10 million voxels
+DEFAULT_VOXELS_PER_RADIUS = 3.0
+#: (a, b) of `resolution_gain`, and the radius in voxels below which it stays constant
+RESOLUTION_GAIN_FIT = (1.46, 2.72)
+MIN_RADIUS_VOXELS = 1.5
+#: voxels along a side of one brick of the medium (`_bricks`)
+BRICK_VOXELS = 16
+#: more voxels than this is refused rather than filling the memory (float64 while built, float32 in Mitsuba)
+MAX_VOXELS = 60_000_000
+#: Mitsuba variants, the default first: the scalar one runs anywhere; the vectorised LLVM one needs
+#: libLLVM and, on this project's 2-core Xeon with Mesa's LLVM 15, aborts the process compiling its
+#: first kernel ("Cannot select"), which no exception can catch, so it is only taken when asked for
+VARIANTS = ("scalar_rgb", "llvm_ad_rgb")
+#: samples per pixel of one Mitsuba render call; the progress bar advances once per call
+SAMPLES_PER_PASS = 16
+#: a phase function Mitsuba lacks (Cornette-Shanks) goes in as a table over cos(theta) of this many points
+PHASE_TABLE_POINTS = 4097
+#: ray-marching step of the transmittance, in voxels (midpoint rule on the trilinear field)
+MARCH_STEP_VOXELS = 0.5
+
+
+def peak_extinction(optical_depth, radii) -> np.ndarray:
+    """c_i: the extinction (1/m) at a particle's centre that gives optical depth tau_i along its diameter."""
+    return np.asarray(optical_depth, dtype=np.float64) / (
+        np.asarray(radii, dtype=np.float64) * KERNEL_DIAMETER_INTEGRAL
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class MediumGrid:
+    """One brick of the medium: extinction and albedo at the centres of cubic voxels, voxel (i, j, k)
+    centred at low + (i + 0.5, j + 0.5, k + 0.5) * voxel, arrays indexed [z, y, x] as Mitsuba's
+    VolumeGrid.  The brick owns the box [box_low, box_high]; its arrays reach one voxel further on
+    each side where there is more grid, so that interpolation inside the box sees its neighbours."""
+
+    low: np.ndarray
+    voxel: float
+    extinction: np.ndarray
+    albedo: np.ndarray
+    box_low: np.ndarray
+    box_high: np.ndarray
+
+    @property
+    def shape_xyz(self) -> np.ndarray:
+        return np.array(self.extinction.shape[::-1])
+
+    @property
+    def high(self) -> np.ndarray:
+        return self.low + self.voxel * self.shape_xyz
+
+    def sample(self, points: np.ndarray) -> np.ndarray:
+        """Extinction at `points` (n, 3), trilinear between voxel centres and clamped at the faces, as
+        Mitsuba's gridvolume evaluates it (its texel centres are at (i + 0.5) / resolution)."""
+        u = np.clip((points - self.low) / self.voxel - 0.5, 0.0, self.shape_xyz - 1.0)
+        first = np.minimum(u.astype(np.int64), self.shape_xyz - 2)
+        f = u - first
+        nz, ny, nx = self.extinction.shape
+        flat = self.extinction.reshape(-1)
+        value = np.zeros(len(points))
+        for dx in (0, 1):
+            for dy in (0, 1):
+                for dz in (0, 1):
+                    weight = (
+                        (f[:, 0] if dx else 1.0 - f[:, 0])
+                        * (f[:, 1] if dy else 1.0 - f[:, 1])
+                        * (f[:, 2] if dz else 1.0 - f[:, 2])
+                    )
+                    index = ((first[:, 2] + dz) * ny + first[:, 1] + dy) * nx + first[:, 0] + dx
+                    value += weight * flat[index]
+        return value
+
+
+def medium_grids(
+    scene: Scene, voxels_per_radius: float = DEFAULT_VOXELS_PER_RADIUS, brick_voxels: int = BRICK_VOXELS
+) -> list[MediumGrid]:
+    """The scene's particles as one extinction grid, cut into bricks of `brick_voxels` a side, the empty
+    ones dropped.
+
+    Voxels are cubes of the scene's median particle radius / `voxels_per_radius`; the grid has one
+    empty voxel around the particles' reach, so it is zero where Mitsuba clamps at its faces.
+    """
+    if not voxels_per_radius > 0:
+        raise ValueError(f"voxels per radius must be > 0, got {voxels_per_radius}")
+    parts = []
+    for cloud in scene.clouds:
+        tau, albedo = cloud_optics(cloud, scene.shading)
+        keep = (cloud.radii > 0) & (tau > 0)
+        if keep.any():
+            parts.append((cloud.centres[keep], cloud.radii[keep], tau[keep], albedo[keep]))
+    if not parts:
+        return []
+    centres, radii, tau, albedo = (np.concatenate(column) for column in zip(*parts))
+    voxel = float(np.median(radii)) / voxels_per_radius
+    low = (centres - radii[:, None]).min(axis=0) - voxel
+    high = (centres + radii[:, None]).max(axis=0) + voxel
+    shape_xyz = np.maximum(np.ceil((high - low) / voxel).astype(np.int64), 2)
+    if int(np.prod(shape_xyz)) > MAX_VOXELS:
+        raise ValueError(
+            f"the medium would need {int(np.prod(shape_xyz)):,} voxels (at most {MAX_VOXELS:,}): "
+            "ask for fewer voxels per radius"
+        )
+    extinction, albedo_grid = _splatted(low, voxel, shape_xyz, centres, radii, tau, albedo)
+    return _bricks(low, voxel, extinction, albedo_grid, brick_voxels)
+
+
+def _bricks(low, voxel, extinction, albedo, brick_voxels: int) -> list[MediumGrid]:
+    """The grid's non-empty bricks, each with a one-voxel border of its neighbours' voxels.
+
+    Mitsuba tracks free paths in a medium against the largest extinction of its whole grid: one grid
+    over the scene would spend most of its steps in the clear air between the clouds.
+    """
+    bricks = []
+    shape_zyx = np.array(extinction.shape)
+    # Mitsuba starts a ray that leaves a surface (1 + |p|) * 9e-5 past it (float32): a neighbour's face
+    # closer than that would be skipped, and its medium with it.  So the boxes keep twice that apart,
+    # losing that sliver of cloud (0.4 m a brick at 2 km from the origin: 0.3% of a 160 m brick).
+    gap = 2.0 * (1.0 + float(np.abs(np.concatenate([low, low + voxel * shape_zyx[::-1]])).max())) * 9e-5
+    for z, y, x in np.ndindex(*(-(-shape_zyx // brick_voxels))):
+        start = np.array([z, y, x]) * brick_voxels
+        stop = np.minimum(start + brick_voxels, shape_zyx)
+        inner = tuple(slice(a, b) for a, b in zip(start, stop))
+        if not extinction[inner].any():
+            continue
+        border_start, border_stop = np.maximum(start - 1, 0), np.minimum(stop + 1, shape_zyx)
+        outer = tuple(slice(a, b) for a, b in zip(border_start, border_stop))
+        bricks.append(
+            MediumGrid(
+                low=low + border_start[::-1] * voxel,
+                voxel=voxel,
+                extinction=extinction[outer],
+                albedo=albedo[outer],
+                box_low=low + start[::-1] * voxel + 0.5 * gap,
+                box_high=low + stop[::-1] * voxel - 0.5 * gap,
+            )
+        )
+    return bricks
+
+
+def resolution_gain(radii_in_voxels) -> np.ndarray:
+    """What a particle's peak extinction is multiplied by on a grid of voxels a fraction of its radius.
+
+    Interpolating between voxel centres blurs the kernel across a ray, always a loss of optical depth
+    through the centre: measured over random centres and directions (tests/test_truth.py), 16.4% of tau
+    at 3 voxels a radius, 9.3% at 4, 4.2% at 6, 2.3% at 8.  1 + a / q^2 + b / q^4 in the radius in
+    voxels q, fitted to those four, gives the inverse within 0.5%; below 1.5 voxels a radius the grid
+    cannot hold a particle's shape and the gain stops growing.
+    """
+    q = np.maximum(np.asarray(radii_in_voxels, dtype=np.float64), MIN_RADIUS_VOXELS)
+    return 1.0 + RESOLUTION_GAIN_FIT[0] / q**2 + RESOLUTION_GAIN_FIT[1] / q**4
+
+
+def _splatted(
+    low, voxel, shape_xyz, centres, radii, tau, albedo, chunk_entries: int = 2_000_000
+) -> tuple[np.ndarray, np.ndarray]:
+    """(extinction, albedo) [z, y, x]: every particle's c_i K(d) summed at the voxel centres it reaches,
+    c_i times the resolution gain; the albedo weighted by extinction."""
+    count = int(np.prod(shape_xyz))
+    extinction = np.zeros(count)
+    scattering = np.zeros(count)
+    peak = peak_extinction(tau, radii) * resolution_gain(radii / voxel)
+    first = np.clip(np.floor((centres - radii[:, None] - low) / voxel - 0.5).astype(np.int64), 0, shape_xyz - 1)
+    last = np.clip(np.ceil((centres + radii[:, None] - low) / voxel - 0.5).astype(np.int64), 0, shape_xyz - 1)
+    spans = (last - first + 1).max(axis=1)
+    for span in np.unique(spans):
+        members = np.flatnonzero(spans == span)
+        offsets = np.stack(np.meshgrid(*[np.arange(span)] * 3, indexing="ij"), axis=-1).reshape(-1, 3)
+        step = max(1, chunk_entries // len(offsets))
+        for start in range(0, len(members), step):
+            part = members[start : start + step]
+            index = first[part, None, :] + offsets[None]
+            inside = np.all(index < shape_xyz, axis=2)
+            distance = np.linalg.norm(low + (index + 0.5) * voxel - centres[part, None, :], axis=2)
+            value = peak[part, None] * splat_kernel(distance / radii[part, None])
+            keep = inside & (value > 0)
+            flat = ((index[..., 2] * shape_xyz[1] + index[..., 1]) * shape_xyz[0] + index[..., 0])[keep]
+            extinction += np.bincount(flat, value[keep], count)
+            scattering += np.bincount(flat, (value * albedo[part, None])[keep], count)
+    # where nothing is, the albedo does not matter; the mean keeps interpolated edges from darkening
+    total = extinction.sum()
+    mean_albedo = float(scattering.sum() / total) if total > 0 else float(albedo.mean())
+    with np.errstate(invalid="ignore", divide="ignore"):
+        albedo_grid = np.where(extinction > 0, scattering / extinction, mean_albedo)
+    zyx = tuple(shape_xyz[::-1])
+    return extinction.reshape(zyx), albedo_grid.reshape(zyx)
+
+
+# ---------------------------------------------------------------- transmittance by marching the grid
+
+
+def optical_depths(
+    grids: list[MediumGrid], origins: np.ndarray, directions: np.ndarray, chunk_rays: int = 2048
+) -> tuple[np.ndarray, np.ndarray]:
+    """(total optical depth (n,), distance (n,) at which it first reaches 1, inf where it never does)
+    along rays from `origins` (n, 3) in unit `directions` (n, 3), marched through every grid.
+
+    Midpoint rule with a step of `MARCH_STEP_VOXELS` voxels on one lattice of distances shared by all
+    grids, so the depths of the grids a ray crosses add up in the order it meets them.
+    """
+    origins = np.asarray(origins, dtype=np.float64).reshape(-1, 3)
+    directions = np.asarray(directions, dtype=np.float64).reshape(-1, 3)
+    n = len(origins)
+    total, unit_distance = np.zeros(n), np.full(n, np.inf)
+    if not grids or n == 0:
+        return total, unit_distance
+    step = MARCH_STEP_VOXELS * min(grid.voxel for grid in grids)
+    for start in range(0, n, chunk_rays):
+        rays = slice(start, min(start + chunk_rays, n))
+        o, d = origins[rays], directions[rays]
+        segments = [_ray_box(o, d, grid.box_low, grid.box_high) for grid in grids]
+        far = max(float(np.max(np.where(t1 > t0, t1, 0.0))) for t0, t1 in segments)
+        columns = int(np.ceil(far / step)) + 1
+        depth = np.zeros((len(o), columns))
+        for grid, (t0, t1) in zip(grids, segments):
+            crossed = t1 > t0  # a missed box has t1 <= t0, possibly infinite
+            first = np.where(crossed, np.ceil(t0 / step - 0.5), 0).astype(np.int64)
+            last = np.where(crossed, np.floor(t1 / step - 0.5), -1).astype(np.int64)
+            counts = np.maximum(last - first + 1, 0)
+            if not counts.any():
+                continue
+            ray = np.repeat(np.arange(len(o)), counts)
+            column = concatenated_ranges(first[counts > 0], counts[counts > 0])
+            points = o[ray] + ((column + 0.5) * step)[:, None] * d[ray]
+            depth[ray, column] += grid.sample(points) * step
+        cumulative = np.cumsum(depth, axis=1)
+        total[rays] = cumulative[:, -1]
+        reached = cumulative[:, -1] >= 1.0
+        found = np.argmax(cumulative >= 1.0, axis=1)
+        unit_distance[start : start + len(o)] = np.where(reached, (found + 0.5) * step, np.inf)
+    return total, unit_distance
+
+
+def _ray_box(origins, directions, low, high) -> tuple[np.ndarray, np.ndarray]:
+    """Slab intersection: (entry, exit) distances of each ray with the box, entry clamped to 0."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inverse = 1.0 / directions
+        a, b = (low - origins) * inverse, (high - origins) * inverse
+    near = np.nan_to_num(np.minimum(a, b), nan=-np.inf).max(axis=1)
+    far = np.nan_to_num(np.maximum(a, b), nan=np.inf).min(axis=1)
+    return np.maximum(near, 0.0), far
+
+
+# ---------------------------------------------------------------- the Mitsuba scene
+
+
+def mitsuba_variant(preferred: str | None = None) -> str:
+    """Set and return `preferred`, or else the first of `VARIANTS` that loads here."""
+    import mitsuba as mi
+
+    errors = []
+    for variant in (preferred,) if preferred else VARIANTS:
+        try:
+            mi.set_variant(variant)
+            return variant
+        except (ImportError, AttributeError, RuntimeError, ValueError) as error:
+            errors.append(f"{variant}: {error}")
+    raise RuntimeError("no Mitsuba variant loads here (" + "; ".join(errors) + ")")
+
+
+def phase_description(phase: str, g: float) -> dict:
+    """The scene's phase function as a Mitsuba plugin: its own Rayleigh and Henyey-Greenstein, and
+    Cornette-Shanks (which it lacks) as a table; both normalise theirs to 1 / (4 pi) of our mean-1 form."""
+    if phase == "rayleigh":
+        return {"type": "rayleigh"}
+    if phase == "henyey-greenstein":
+        return {"type": "hg", "g": float(g)}
+    table = phase_function(np.linspace(-1.0, 1.0, PHASE_TABLE_POINTS), phase, g)
+    return {"type": "tabphase", "values": ",".join(f"{v:.9g}" for v in table)}
+
+
+def mitsuba_scene_description(
+    grids: list[MediumGrid],
+    scene: Scene,
+    camera: Camera,
+    width: int,
+    height: int,
+    *,
+    time_of_day: float | None = None,
+    max_depth: int = -1,
+) -> dict:
+    """The `mi.load_dict` description: the grids in null-bounded cubes, the model's lights, the camera.
+
+    Call `mitsuba_variant` first (the dictionary holds Mitsuba objects of that variant).
+    """
+    import mitsuba as mi
+
+    lighting = scene.lighting if time_of_day is None else dataclasses.replace(scene.lighting, time_of_day=time_of_day)
+    lights, ambient = scene_lights(lighting)
+    phase = phase_description(scene.shading.phase, scene.shading.g)
+    description = {
+        "type": "scene",
+        # emitters hidden from camera rays: the sky is composited behind the clouds with their transmittance
+        "integrator": {"type": "volpath", "max_depth": int(max_depth), "hide_emitters": True},
+        "sensor": _sensor(mi, camera, width, height, grids),
+        "ambient": {"type": "constant", "radiance": {"type": "rgb", "value": [float(v) for v in ambient]}},
+    }
+    for number, light in enumerate(active_lights(lights)):
+        description[f"light_{number}"] = {
+            "type": "directional",
+            "direction": [-float(v) for v in light.direction],  # Mitsuba's points the way the light travels
+            "irradiance": {"type": "rgb", "value": [float(c) * light.intensity for c in light.color]},
+        }
+    for number, grid in enumerate(grids):
+        description[f"cloud_{number}"] = {
+            "type": "cube",
+            "to_world": _box_transform(mi, grid, unit_cube=False),
+            "bsdf": {"type": "null"},
+            # named so that a sensor inside the box can start in it
+            "interior": _medium(mi, grid, phase) | {"id": f"cloud_{number}_medium"},
+        }
+    return description
+
+
+def _medium(mi, grid: MediumGrid, phase: dict) -> dict:
+    volume_to_world = _box_transform(mi, grid, unit_cube=True)
+    albedo = grid.albedo
+    uniform = float(albedo.min()) == float(albedo.max())
+    return {
+        "type": "heterogeneous",
+        "sigma_t": {
+            "type": "gridvolume",
+            "grid": mi.VolumeGrid(np.ascontiguousarray(grid.extinction, dtype=np.float32)),
+            "to_world": volume_to_world,
+        },
+        "albedo": float(albedo.flat[0])
+        if uniform
+        else {
+            "type": "gridvolume",
+            "grid": mi.VolumeGrid(np.ascontiguousarray(albedo, dtype=np.float32)),
+            "to_world": volume_to_world,
+        },
+        "phase": phase,
+    }
+
+
+def _box_transform(mi, grid: MediumGrid, *, unit_cube: bool):
+    """The brick's data from Mitsuba's unit cube [0, 1]^3 (volumes), or its box from the cube shape's
+    [-1, 1]^3."""
+    low, high = (grid.low, grid.high) if unit_cube else (grid.box_low, grid.box_high)
+    matrix = np.eye(4)
+    if unit_cube:
+        matrix[:3, :3], matrix[:3, 3] = np.diag(high - low), low
+    else:
+        matrix[:3, :3], matrix[:3, 3] = np.diag(0.5 * (high - low)), 0.5 * (low + high)
+    return mi.ScalarTransform4f(matrix.tolist())
+
+
+def _sensor(mi, camera: Camera, width: int, height: int, grids: list[MediumGrid]) -> dict:
+    """A perspective camera with `cloudcore.camera`'s pose and vertical field of view.
+
+    Mitsuba's camera looks down its +z with +y up and +x to the image's left (its look_at puts
+    cross(up, forward) there), so the pose's columns are (-right, up, forward, eye).
+    """
+    pose = camera_pose(camera)
+    matrix = np.eye(4)
+    matrix[:3, 0], matrix[:3, 1], matrix[:3, 2], matrix[:3, 3] = -pose[:3, 0], pose[:3, 1], -pose[:3, 2], pose[:3, 3]
+    sensor = {
+        "type": "perspective",
+        "fov": float(camera.fov_y_deg),
+        "fov_axis": "y",
+        "near_clip": NEAR_PLANE_M,
+        "far_clip": FAR_PLANE_M,
+        "to_world": mi.ScalarTransform4f(matrix.tolist()),
+        "film": {
+            "type": "hdrfilm",
+            "width": int(width),
+            "height": int(height),
+            "pixel_format": "rgb",
+            # one box per pixel, as the GL frame's one sample at each pixel centre covers its pixel
+            "rfilter": {"type": "box"},
+        },
+        "sampler": {"type": "independent", "sample_count": SAMPLES_PER_PASS},
+    }
+    eye = np.asarray(camera.position, dtype=np.float64)
+    inside = [i for i, grid in enumerate(grids) if np.all(eye > grid.box_low) and np.all(eye < grid.box_high)]
+    if inside:
+        # an eye inside a cloud's box starts in its medium (the box's faces are crossed only on the way out)
+        sensor["medium"] = {"type": "ref", "id": f"cloud_{inside[0]}_medium"}
+    return sensor
+
+
+# ---------------------------------------------------------------- the truth image
+
+
+@dataclass(frozen=True)
+class Truth:
+    """A path-traced picture: linear RGB (height, width, 3) with the sky behind, and what it was made of."""
+
+    linear: np.ndarray
+    #: (height, width, 3): the light the clouds send to the eye alone (the path-traced part of `linear`)
+    radiance: np.ndarray
+    #: (height, width): 1 - the transmittance of the clouds along each pixel's central ray
+    alpha: np.ndarray
+    #: (height, width): optical depth toward the sun from the point where the view ray's reaches 1
+    #: (inf where it never does, or without a sun)
+    sun_depth: np.ndarray
+    seconds: float
+    variant: str
+    voxels: int
+    spp: int
+    seed: int
+
+
+def render_truth(
+    scene: Scene,
+    width: int,
+    height: int,
+    *,
+    camera: Camera | None = None,
+    time_of_day: float | None = None,
+    spp: int = 64,
+    seed: int = 0,
+    voxels_per_radius: float = DEFAULT_VOXELS_PER_RADIUS,
+    variant: str | None = None,
+    max_depth: int = -1,
+    progress=None,
+) -> Truth:
+    """Path trace `scene` (its clouds and sky; no terrain, no objects) from `camera` (the scene's).
+
+    `spp` samples per pixel in passes of `SAMPLES_PER_PASS`, pass k seeded with (seed << 16) + k, so a
+    seed gives the same picture every time and two seeds share no samples.  `progress(done, total)`
+    is called after each pass.
+    """
+    if spp < 1:
+        raise ValueError(f"samples per pixel must be >= 1, got {spp}")
+    import mitsuba as mi
+
+    camera = scene.camera if camera is None else camera
+    start = time.perf_counter()
+    used_variant = mitsuba_variant(variant)
+    grids = medium_grids(scene, voxels_per_radius)
+    description = mitsuba_scene_description(
+        grids, scene, camera, width, height, time_of_day=time_of_day, max_depth=max_depth
+    )
+    mitsuba_scene = mi.load_dict(description)
+    passes = -(-spp // SAMPLES_PER_PASS)
+    radiance = np.zeros((height, width, 3))
+    done = 0
+    for number in range(passes):
+        samples = min(SAMPLES_PER_PASS, spp - done)
+        image = mi.render(mitsuba_scene, spp=samples, seed=(seed << 16) + number)
+        radiance += np.asarray(image, dtype=np.float64) * samples
+        done += samples
+        if progress is not None:
+            progress(done, spp)
+    radiance /= spp
+
+    lighting = scene.lighting if time_of_day is None else dataclasses.replace(scene.lighting, time_of_day=time_of_day)
+    rays = pixel_rays(camera, width, height).reshape(-1, 3)
+    eye = np.broadcast_to(np.asarray(camera.position, dtype=np.float64), rays.shape)
+    view_depth, unit_distance = optical_depths(grids, eye, rays)
+    transmittance = np.exp(-view_depth).reshape(height, width)
+    sky = sky_gradient(rays, *sky_colors(scene_hour(lighting))).reshape(height, width, 3)
+    radiance = np.nan_to_num(radiance, nan=0.0, posinf=0.0, neginf=0.0)
+    return Truth(
+        linear=radiance + transmittance[..., None] * sky,
+        radiance=radiance,
+        alpha=1.0 - transmittance,
+        sun_depth=_sun_depths(grids, eye, rays, unit_distance, lighting).reshape(height, width),
+        seconds=time.perf_counter() - start,
+        variant=used_variant,
+        voxels=sum(grid.extinction.size for grid in grids),
+        spp=spp,
+        seed=seed,
+    )
+
+
+def _sun_depths(grids, eye, rays, unit_distance, lighting) -> np.ndarray:
+    """Optical depth toward the sun (the first light) from each ray's unit-depth point (inf where none)."""
+    lights, _ = scene_lights(lighting)
+    lights = active_lights(lights)
+    depth = np.full(len(rays), np.inf)
+    seen = np.isfinite(unit_distance)
+    if lights and seen.any():
+        points = eye[seen] + unit_distance[seen, None] * rays[seen]
+        toward = np.broadcast_to(np.asarray(lights[0].direction, dtype=np.float64), points.shape)
+        depth[seen] = optical_depths(grids, points, toward)[0]
+    return depth
+
+
+# ---------------------------------------------------------------- comparing a model with the truth
+
+#: Rec. 709 weights of linear RGB in relative luminance
+LUMINANCE_WEIGHTS = np.array([0.2126, 0.7152, 0.0722])
+#: a pixel is cloud where the truth's alpha is at least the first, the cloud's body (no longer its
+#: silhouette) from the second: a view-ray optical depth of 2.3
+CLOUD_ALPHA, BODY_ALPHA = 0.02, 0.9
+REGIONS = ("image", "sky", "silhouette", "lit", "shadowed")
+
+
+def truth_regions(alpha: np.ndarray, sun_depth: np.ndarray) -> dict[str, np.ndarray]:
+    """Boolean masks (height, width) of the regions errors are split into, from the truth alone.
+
+    sky: alpha < CLOUD_ALPHA; silhouette: CLOUD_ALPHA <= alpha < BODY_ALPHA; the body splits into lit,
+    where the sun reaches the point the eye sees (where the view ray's optical depth reaches 1) through
+    an optical depth below 1, and shadowed, the rest (everything, without a sun).
+    """
+    cloud = alpha >= CLOUD_ALPHA
+    body = alpha >= BODY_ALPHA
+    lit = body & (sun_depth < 1.0)
+    return {
+        "image": np.ones(alpha.shape, dtype=bool),
+        "sky": ~cloud,
+        "silhouette": cloud & ~body,
+        "lit": lit,
+        "shadowed": body & ~lit,
+    }
+
+
+def luminance(srgb8: np.ndarray) -> np.ndarray:
+    """Relative luminance (linear) of 8-bit sRGB pixels (..., 3)."""
+    return srgb_decode(np.asarray(srgb8, dtype=np.float64) / 255.0) @ LUMINANCE_WEIGHTS
+
+
+def region_errors(truth8: np.ndarray, model8: np.ndarray, regions: dict[str, np.ndarray]) -> dict[str, dict]:
+    """Per region: pixels, PSNR of the 8-bit images (capped at PSNR_CAP_DB), the truth's mean luminance,
+    mean luminance error (model - truth, linear: negative is too dark) and mean absolute luminance error."""
+    truth_luminance = luminance(truth8)
+    difference = luminance(model8) - truth_luminance
+    errors = {}
+    for name, mask in regions.items():
+        pixels = int(mask.sum())
+        if pixels == 0:
+            errors[name] = {"pixels": 0}
+            continue
+        errors[name] = {
+            "pixels": pixels,
+            "psnr_db": min(compare(truth8[mask], model8[mask]).psnr_db, PSNR_CAP_DB),
+            "truth_luminance": float(truth_luminance[mask].mean()),
+            "mean_luminance_error": float(difference[mask].mean()),
+            "mean_abs_luminance_error": float(np.abs(difference[mask]).mean()),
+        }
+    return errors
