@@ -20,8 +20,8 @@ from pathlib import Path
 
 from cloudcore.editing import History, delete_cloud, delete_particles
 from cloudcore.errors import SceneError
-from cloudcore.frame_stats import FrameStats
 from cloudcore.limits import scene_limit_problems
+from cloudcore.measure.frame_stats import FrameStats
 from cloudcore.particle_files import particles_folder
 from cloudcore.paths import camera_on_path
 from cloudcore.scene import Camera, Lighting, Scene, Shading
@@ -59,7 +59,7 @@ class ShownFrame:
     picture_reused: bool  # nothing it is drawn from changed, or a newer light is on its way: not redrawn
     relighting: bool  # the light pass is running in the background
     shown_time_of_day: float
-    shown_illumination: str  # the shading method of the light shown (`cloudcore.relighting`)
+    shown_illumination: str  # the shading method of the light shown (`cloudcore.light.relighting`)
     frame_start_s: float  # perf_counter at the window frame's start
     viewport_ms: float
     viewport_width: int

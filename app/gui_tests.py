@@ -18,8 +18,8 @@ from imgui_bundle.imgui.test_engine_checks import CHECK
 
 from app.editor import discard_recovery, recovery_path
 from cloudcore.editing import add_cloud
+from cloudcore.measure.overlays import to_pixels
 from cloudcore.navigation import orbited
-from cloudcore.overlays import to_pixels
 from cloudcore.paths import camera_on_path
 from cloudcore.scenefile import save_scene
 

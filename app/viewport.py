@@ -8,8 +8,8 @@ drag turns the camera, the wheel flies forward.  Keys while the viewport is
 hovered: W/S forward/back, A/D sideways, Q/E down/up.
 
 Over the picture it outlines the impostors and ring segments of the frame plan
-(`cloudcore.overlays`) when asked, and shows the overdraw heat map
-(`cloudcore.heatmap`) in place of the frame when that is on.
+(`cloudcore.measure.overlays`) when asked, and shows the overdraw heat map
+(`cloudcore.measure.heatmap`) in place of the frame when that is on.
 """
 
 from __future__ import annotations
@@ -26,11 +26,11 @@ from cloudcore.editing import pick_ray
 from cloudcore.gl.context import WindowContext
 from cloudcore.gl.frame import FrameRenderer
 from cloudcore.gl.image_texture import ImageTexture
-from cloudcore.heatmap import heat_image, ramp_colours
-from cloudcore.illumination import IlluminationCache
+from cloudcore.light.illumination import IlluminationCache
+from cloudcore.light.relighting import EXACT_METHOD, PREVIEW_METHOD, LiveIllumination, Look
+from cloudcore.measure.heatmap import heat_image, ramp_colours
+from cloudcore.measure.overlays import impostor_outlines, ring_outlines, to_pixels
 from cloudcore.navigation import moved, turned
-from cloudcore.overlays import impostor_outlines, ring_outlines, to_pixels
-from cloudcore.relighting import EXACT_METHOD, PREVIEW_METHOD, LiveIllumination, Look
 
 TURN_DEG_PER_PIXEL = 0.2
 #: a frame that shows the picture again while the relighting worker runs waits this long first: the
@@ -55,7 +55,7 @@ class Viewport:
         self.show_ring_segments = False
         self.capture_next = False  # a GUI test asks for the next frame's pixels (as shown)
         self.captured: np.ndarray | None = None
-        self.outlines_drawn: list = []  # this frame's overlay outlines (`cloudcore.overlays.Outline`)
+        self.outlines_drawn: list = []  # this frame's overlay outlines (`cloudcore.measure.overlays.Outline`)
         self.regenerations_total = 0
         self.relighting = LiveIllumination(IlluminationCache())
         self.relighting.start()
@@ -150,7 +150,7 @@ class Viewport:
         """(the editor's scene in the look the viewport can show this frame, its illumination method).
 
         A dragged slider's look is lit by the coarse raster (`PREVIEW_METHOD`), the scene's own exactly;
-        until the worker has it, the last look shown stays (`cloudcore.relighting`)."""
+        until the worker has it, the last look shown stays (`cloudcore.light.relighting`)."""
         editor = self.editor
         shading, lighting = editor.look
         wanted = Look(shading, lighting, PREVIEW_METHOD if editor.dragged_look is not None else EXACT_METHOD)

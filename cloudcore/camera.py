@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cloudcore.kernel import SPLAT_REACH
+from cloudcore.light.kernel import SPLAT_REACH
 from cloudcore.scene import Camera
 
 #: metres; 1 m near and 100 km far keep 24-bit depth resolution near 0.5 m at 3 km.

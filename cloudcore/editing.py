@@ -16,8 +16,8 @@ import math
 
 import numpy as np
 
+from cloudcore.artist.cloudgen import box_fill, preset_cloud
 from cloudcore.camera import camera_pose
-from cloudcore.cloudgen import box_fill, preset_cloud
 from cloudcore.scene import Camera, Cloud, Scene
 
 DEFAULT_PARTICLE_RADIUS = 40.0

@@ -11,8 +11,8 @@ such a scene first.  docs/scene-format.md lists them.
 
 from __future__ import annotations
 
-from cloudcore.artist_shading import default_group_size, shading_grid_fits
-from cloudcore.lighting import active_lights
+from cloudcore.artist.artist_shading import default_group_size, shading_grid_fits
+from cloudcore.light.lighting import active_lights
 
 #: lights that shine on clouds at once: the compute shader keeps one incident term per light
 #: per particle (`incident[MAX_LIGHTS]` in gl/shaders/splat_shade.comp.glsl)

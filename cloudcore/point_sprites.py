@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cloudcore.particle_styles import FACING_SPLAT, ParticleStyles
+from cloudcore.artist.particle_styles import FACING_SPLAT, ParticleStyles
 
 #: a run of points costs two more draws (one each side) than drawing it with its neighbours as quads: on
 #: llvmpipe 3.4 us a draw against about 1 us saved a particle, even at 6-7 particles; twice that for

@@ -6,7 +6,7 @@
 renders the view `sunset` of the scene (a path relative to the test module)
 and compares it with `cloudview_goldens/<scene>/<view>.png` beside the test
 module, with the view's tolerance, else the one given, else 40 dB and 12
-levels (`cloudcore.screenshot_check`).  A failure says why in one line and
+levels (`cloudcore.measure.screenshot_check`).  A failure says why in one line and
 keeps the expected, actual and diff images.  Options:
 
 - `--cloudview-update-goldens`: write the goldens whose pixels changed
@@ -66,7 +66,7 @@ class _Session:
         if self._renderer is not None:
             self._renderer.close()
         if self.report is not None and self.entries:
-            from cloudcore.screenshot_check import write_report
+            from cloudcore.measure.screenshot_check import write_report
 
             write_report(self.report, self.entries, "cloudview screenshot tests")
 
@@ -83,9 +83,7 @@ def cloudview_check(request, _cloudview_session):
     """`cloudview_check(scene, view="default", *, size=(320, 240), tolerance_psnr=None, max_diff=None)`: render
     the view and fail the test unless it matches its golden; returns the `ViewCheck`."""
     from cloudcore.errors import SceneError
-    from cloudcore.scene import DEFAULT_VIEW_NAME
-    from cloudcore.scenefile import load_scene
-    from cloudcore.screenshot_check import (
+    from cloudcore.measure.screenshot_check import (
         DEFAULT_SIZE,
         Tolerance,
         check_view,
@@ -94,6 +92,8 @@ def cloudview_check(request, _cloudview_session):
         keep_images,
         update_golden,
     )
+    from cloudcore.scene import DEFAULT_VIEW_NAME
+    from cloudcore.scenefile import load_scene
 
     session, here = _cloudview_session, request.path.parent
 

@@ -12,9 +12,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from cloudcore.artist_shading import ArtistShading
-from cloudcore.formation import Formation
-from cloudcore.sprites import SpriteStyle
+from cloudcore.artist.artist_shading import ArtistShading
+from cloudcore.artist.formation import Formation
+from cloudcore.artist.sprites import SpriteStyle
 
 Vec3 = tuple[float, float, float]
 
@@ -72,7 +72,7 @@ class Lighting:
 @dataclass(frozen=True)
 class Shading:
     """Harris's defaults for every cloud; `eye_pass` chooses what a particle sends to the eye
-    (`cloudcore.shading.EYE_PASSES`: Harris's eq. 5, or its saturated form, closer to the path-traced
+    (`cloudcore.light.shading.EYE_PASSES`: Harris's eq. 5, or its saturated form, closer to the path-traced
     truth: docs/shading.md)."""
 
     albedo: float = 0.9

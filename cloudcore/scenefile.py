@@ -16,11 +16,13 @@ from pathlib import Path
 import numpy as np
 import tomlkit
 
-from cloudcore.artist_shading import ArtistShading
-from cloudcore.formation import FORMATION_KINDS, Formation
+from cloudcore.artist.artist_shading import ArtistShading
+from cloudcore.artist.formation import FORMATION_KINDS, Formation
+from cloudcore.artist.sprites import FACINGS, MAX_SEED, SpriteStyle
+from cloudcore.light.phase import MAX_ABS_G, PHASE_NAMES
+from cloudcore.light.shading import EYE_PASSES
 from cloudcore.limits import scene_limit_problems
 from cloudcore.particle_files import atomic_write, remove_unnamed_particle_files, store_particles
-from cloudcore.phase import MAX_ABS_G, PHASE_NAMES
 from cloudcore.scene import (
     DEFAULT_VIEW_NAME,
     Camera,
@@ -35,8 +37,6 @@ from cloudcore.scene import (
     View,
 )
 from cloudcore.settings import MODES, RenderSettings, setting_options
-from cloudcore.shading import EYE_PASSES
-from cloudcore.sprites import FACINGS, MAX_SEED, SpriteStyle
 from cloudcore.toml_table import Table, checked_matrix, field_error
 
 PRIMITIVES = ("box", "sphere", "aircraft")

@@ -3,7 +3,7 @@
 `mode` picks the representation: "full" draws every particle every frame (the
 reference picture), "impostor" draws every cloud from a cached texture, "auto"
 chooses per cloud, each frame, the representation predicted cheapest within
-the tolerance (`cloudcore.frameplan`, with the measured `cloudcore.lod_costs`),
+the tolerance (`cloudcore.lod.frameplan`, with the measured `cloudcore.lod.costs`),
 crossfading over `transition_frames` when it changes, and the ring beyond
 `ring_radius`.
 
@@ -19,7 +19,7 @@ import math
 from dataclasses import dataclass, field, fields
 
 MODES = ("auto", "full", "impostor")
-#: the names of `cloudcore.impostors.TRANSLATION_METRICS` (kept here so settings import no geometry)
+#: the names of `cloudcore.lod.impostors.TRANSLATION_METRICS` (kept here so settings import no geometry)
 TRANSLATION_METRICS = ("parallax", "centre")
 
 
@@ -148,7 +148,7 @@ class RenderSettings:
         high=60,
         display="%d",
     )
-    #: draw interpenetrating clouds as one unit (one impostor, one sort: `cloudcore.lod_units`); off, each
+    #: draw interpenetrating clouds as one unit (one impostor, one sort: `cloudcore.lod.units`); off, each
     #: cloud's impostor is sorted as a whole, Harris's approximation
     group_clouds: bool = _setting(
         True,

@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from cloudcore.benchmark import machine, write_report
+from cloudcore.measure.benchmark import machine, write_report
 from cloudcore.resources import DEFAULT_SCENE
 
 ROOT = Path(__file__).resolve().parents[1]

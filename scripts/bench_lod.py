@@ -3,7 +3,7 @@
     python scripts/bench_lod.py [--cases still,orbit,flythrough,field,untuned] [--quick]
                                 [--json out/bench_lod.json] [--plot docs/images/bench_lod.png]
 
-Each case is one run of `cloudcore.benchmark.bench_path` (one process, one context, the reference
+Each case is one run of `cloudcore.measure.benchmark.bench_path` (one process, one context, the reference
 and each mode over the same frames), default settings but for the mode:
 
 - still: the default view, camera still, 880x680 (the editor's viewport), after 20 unmeasured frames
@@ -36,7 +36,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from bench_many_particles import cloud_field  # noqa: E402  (a sibling script: the same 1.2M field)
 
-from cloudcore.benchmark import (  # noqa: E402
+from cloudcore.artist.cloudgen import preset_cloud  # noqa: E402
+from cloudcore.gl import FrameRenderer  # noqa: E402
+from cloudcore.measure.benchmark import (  # noqa: E402
     bench_path,
     headless_pyplot,
     machine,
@@ -46,8 +48,6 @@ from cloudcore.benchmark import (  # noqa: E402
     still_views,
     write_report,
 )
-from cloudcore.cloudgen import preset_cloud  # noqa: E402
-from cloudcore.gl import FrameRenderer  # noqa: E402
 from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
 from cloudcore.scene import CameraPath, Scene  # noqa: E402
 from cloudcore.scenefile import load_scene  # noqa: E402

@@ -25,8 +25,8 @@ import numpy as np
 
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 
-from cloudcore.benchmark import machine, path_views, resident_memory_bytes, write_report  # noqa: E402  (the GL imports need the platform)
 from cloudcore.gl import FrameRenderer  # noqa: E402
+from cloudcore.measure.benchmark import machine, path_views, resident_memory_bytes, write_report  # noqa: E402  (the GL imports need the platform)
 from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
 from cloudcore.scenefile import load_scene  # noqa: E402
 from cloudcore.settings import MODES, RenderSettings  # noqa: E402

@@ -4,7 +4,7 @@
                                            [--width 640 --height 480] [--json out/many_particles.json]
 
 The default scene's world (terrain, lighting, camera) under a field of
-cumulus clouds (`cloudcore.cloudgen.cumulus`) of the default scene's density,
+cumulus clouds (`cloudcore.artist.cloudgen.cumulus`) of the default scene's density,
 about 2,700 particles each, on a jittered grid filling the view up the valley
 and beyond.  The clouds' illumination is precomputed once (timed); then
 each mode renders --frames frames of the scene's camera: the first builds
@@ -27,9 +27,9 @@ import numpy as np
 
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 
-from cloudcore.benchmark import machine, resident_memory_bytes, write_report  # noqa: E402  (the GL imports need the platform)
-from cloudcore.cloudgen import cumulus  # noqa: E402
+from cloudcore.artist.cloudgen import cumulus  # noqa: E402
 from cloudcore.gl import FrameRenderer  # noqa: E402
+from cloudcore.measure.benchmark import machine, resident_memory_bytes, write_report  # noqa: E402  (the GL imports need the platform)
 from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
 from cloudcore.scene import Cloud, Scene  # noqa: E402
 from cloudcore.scenefile import load_scene  # noqa: E402

@@ -27,14 +27,14 @@ os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 from OpenGL import GL  # noqa: E402  (the GL imports need the platform above)
 
 import cloudcore.gl.splats as splats_module  # noqa: E402
-from cloudcore.benchmark import machine, write_report  # noqa: E402
 from cloudcore.camera import projection_matrix, view_matrix  # noqa: E402
-from cloudcore.eye_scattering import ParticleShading  # noqa: E402
 from cloudcore.gl.context import HeadlessContext  # noqa: E402
 from cloudcore.gl.splats import SplatPass, splat_batch  # noqa: E402
 from cloudcore.gl.targets import TextureTarget  # noqa: E402
-from cloudcore.impostors import impostor_view  # noqa: E402
-from cloudcore.lighting import scene_lights  # noqa: E402
+from cloudcore.light.eye_scattering import ParticleShading  # noqa: E402
+from cloudcore.light.lighting import scene_lights  # noqa: E402
+from cloudcore.lod.impostors import impostor_view  # noqa: E402
+from cloudcore.measure.benchmark import machine, write_report  # noqa: E402
 from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
 from cloudcore.scenefile import load_scene  # noqa: E402
 

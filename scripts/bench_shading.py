@@ -14,10 +14,10 @@ import argparse
 import platform
 from pathlib import Path
 
-from cloudcore.benchmark import machine, shading_comparison, write_report
+from cloudcore.light.shading import DEFAULT_RASTER_RESOLUTION
+from cloudcore.measure.benchmark import machine, shading_comparison, write_report
 from cloudcore.resources import DEFAULT_SCENE
 from cloudcore.scenefile import load_scene
-from cloudcore.shading import DEFAULT_RASTER_RESOLUTION
 
 
 def main() -> None:

@@ -9,7 +9,7 @@ and the right one thins from its edges until it is gone; the steady middle
 one shows the formation factor is per cloud.  The animations overlap in
 the middle of the path, both are done before its end, and every cloud stays
 inside the ring radius so each is drawn as itself.  The particles come from
-`cloudcore.cloudgen.preset_cloud` and are shipped as .npy beside the scene.
+`cloudcore.artist.cloudgen.preset_cloud` and are shipped as .npy beside the scene.
 """
 
 from __future__ import annotations
@@ -20,8 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
-from cloudcore.cloudgen import preset_cloud
-from cloudcore.formation import Formation
+from cloudcore.artist.cloudgen import preset_cloud
+from cloudcore.artist.formation import Formation
 from cloudcore.scene import Camera, CameraPath, Lighting, Scene, Shading, Terrain
 from cloudcore.scenefile import save_scene
 

@@ -3,8 +3,8 @@
     python scripts/make_sprite_atlas.py [--out cloudcore/resources/sprites/atlas.png] [--seed 2004]
 
 A 4x4 sheet of 256 px cells, one kind per row from the top: flat-bottom,
-foggy, puffy, wispy (`cloudcore.sprites.ROWS`), four variants each, drawn
-from hashed noise by `cloudcore.sprite_art`: the same file on every machine.
+foggy, puffy, wispy (`cloudcore.artist.sprites.ROWS`), four variants each, drawn
+from hashed noise by `cloudcore.artist.sprite_art`: the same file on every machine.
 RGBA, 8 bits: alpha is opacity, RGB brightness.
 """
 
@@ -16,8 +16,8 @@ from pathlib import Path
 import imageio.v3 as iio
 import numpy as np
 
-from cloudcore.sprite_art import ATLAS_SEED, render_atlas
-from cloudcore.sprites import ATLAS_PATH
+from cloudcore.artist.sprite_art import ATLAS_SEED, render_atlas
+from cloudcore.artist.sprites import ATLAS_PATH
 
 
 def main() -> None:

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from cloudcore.cloudgen import cumulus
+from cloudcore.artist.cloudgen import cumulus
 from cloudcore.scene import Camera, CameraPath, Cloud, Lighting, Scene, SceneObject, Shading, Terrain
 from cloudcore.scenefile import save_scene
 

@@ -5,10 +5,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from cloudcore.artist_shading import ArtistShading
+from cloudcore.artist.artist_shading import ArtistShading
+from cloudcore.artist.sprites import SpriteStyle
 from cloudcore.resources import DEFAULT_SCENE
 from cloudcore.scene import Camera, CameraPath, Cloud, Light, Lighting, Scene, SceneObject, Shading, Terrain, View
-from cloudcore.sprites import SpriteStyle
 
 ROOT = Path(__file__).resolve().parents[1]
 VALLEY = DEFAULT_SCENE

@@ -1,6 +1,6 @@
 """Comparing renders with committed golden PNGs (tests/golden/), shared by the golden-image tests.
 
-The comparison is `cloudview check`'s (`cloudcore.screenshot_check`), with its
+The comparison is `cloudview check`'s (`cloudcore.measure.screenshot_check`), with its
 default tolerance: PSNR >= 40 dB and no channel off by more than 12 levels of
 255, so llvmpipe builds and GPUs may differ by rounding but not by a visible
 change.  On failure the line says why and tests/_failures/golden/ gets the
@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from cloudcore.screenshot_check import Tolerance, check_view, keep_images, update_golden
+from cloudcore.measure.screenshot_check import Tolerance, check_view, keep_images, update_golden
 
 GOLDEN = Path(__file__).parent / "golden"
 FAILURES = Path(__file__).parent / "_failures"

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from cloudcore.artist_shading import (
+from cloudcore.artist.artist_shading import (
     DEFAULT_GROUP_RADII,
     ArtistShading,
     artist_colours,
@@ -14,9 +14,9 @@ from cloudcore.artist_shading import (
     shading_groups,
     vertical_colour,
 )
-from cloudcore.cloudgen import preset_cloud
+from cloudcore.artist.cloudgen import preset_cloud
 from cloudcore.errors import FieldError
-from cloudcore.lighting import sun_direction
+from cloudcore.light.lighting import sun_direction
 
 LEVELS = (
     (0.0, 0.2, 0.3, 0.4, 1.0),

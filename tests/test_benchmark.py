@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from conftest import VALLEY
 
-from cloudcore.benchmark import bench_path, pareto_front
-from cloudcore.frame_stats import FrameStats, PlanStats
+from cloudcore.measure.benchmark import bench_path, pareto_front
+from cloudcore.measure.frame_stats import FrameStats, PlanStats
 from cloudcore.scenefile import load_scene
 from cloudcore.settings import FULL_3D, RenderSettings
 

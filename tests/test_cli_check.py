@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 
 from cloudcore.cli import main
-from cloudcore.overlays import to_pixels
+from cloudcore.measure.overlays import to_pixels
+from cloudcore.measure.screenshot_check import Tolerance, check_view, encode_png, view_camera
 from cloudcore.resources import resource_path
 from cloudcore.scene import Camera, CameraPath, Cloud, Lighting, Scene, View
 from cloudcore.scenefile import load_scene, save_scene
-from cloudcore.screenshot_check import Tolerance, check_view, encode_png, view_camera
 
 pytestmark = pytest.mark.gl
 

@@ -11,7 +11,7 @@ import imageio_ffmpeg
 import pytest
 from conftest import VALLEY
 
-from cloudcore.recording import COLUMNS
+from cloudcore.measure.recording import COLUMNS
 
 pytestmark = pytest.mark.gl
 

@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
-from cloudcore.artist_shading import height_fractions
-from cloudcore.cloudgen import PRESETS, box_fill, cull_close, preset_cloud
+from cloudcore.artist.artist_shading import height_fractions
+from cloudcore.artist.cloudgen import PRESETS, box_fill, cull_close, preset_cloud
+from cloudcore.artist.sprites import ATLAS_GRID, FLAT_BOTTOM, FOGGY, WISPY, particle_sprites
 from cloudcore.scene import Cloud
-from cloudcore.sprites import ATLAS_GRID, FLAT_BOTTOM, FOGGY, WISPY, particle_sprites
 
 LOW, HIGH = np.array([-500.0, 1000.0, -300.0]), np.array([700.0, 1400.0, 500.0])
 

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from conftest import VALLEY
 
-from cloudcore.lighting import elevation_deg, sun_direction
+from cloudcore.light.lighting import elevation_deg, sun_direction
 from cloudcore.paths import sample
 from cloudcore.scenefile import load_scene
 from cloudcore.terrain import heightfield_mesh

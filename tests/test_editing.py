@@ -40,7 +40,7 @@ def test_edits_make_new_scenes_and_history_undoes_them():
 
 
 def test_navigation_keeps_distances_and_orbits_by_the_asked_angle():
-    from cloudcore.impostors import translation_error_deg
+    from cloudcore.lod.impostors import translation_error_deg
     from cloudcore.navigation import moved, orbited, turned
 
     camera = Camera((0.0, 100.0, 500.0), (0.0, 100.0, 0.0), 60.0)
@@ -164,7 +164,7 @@ def test_a_gesture_is_one_undo_step():
 
 
 def test_box_fill_and_presets_make_undoable_scenes():
-    from cloudcore.cloudgen import PRESETS, box_fill
+    from cloudcore.artist.cloudgen import PRESETS, box_fill
     from cloudcore.editing import add_preset_cloud, fill_box
 
     scene = Scene(clouds=(Cloud("a", [[0.0, 0.0, 0.0, 10.0]]),))

@@ -15,7 +15,7 @@ import imageio.v3 as iio
 import pytest
 from conftest import VALLEY
 
-from cloudcore.imagecompare import compare
+from cloudcore.measure.imagecompare import compare
 
 pytestmark = pytest.mark.gui
 

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from cloudcore.facing import (
+from cloudcore.artist.facing import (
     CORNERS,
     FALLBACK_NORMAL,
     HORIZONTAL_NORMAL,

@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
+from cloudcore.artist.formation import Formation, core_distances, formation_state, opacity_factor, progress
 from cloudcore.errors import SceneError
-from cloudcore.eye_scattering import ParticleShading
-from cloudcore.formation import Formation, core_distances, formation_state, opacity_factor, progress
+from cloudcore.light.eye_scattering import ParticleShading
 from cloudcore.scene import Cloud, Light, Shading
 from cloudcore.scenefile import load_scene, save_scene
 

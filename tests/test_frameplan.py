@@ -7,11 +7,11 @@ import numpy as np
 import pytest
 
 from cloudcore.camera import frustum_planes, projection_matrix, splats_in_frustum, view_matrix
-from cloudcore.frameplan import SWITCH_MARGIN, LodState, inside_runs, plan_frame
-from cloudcore.impostors import impostor_view, parallax_error_deg, translation_error_deg
-from cloudcore.lod_costs import CostModel
-from cloudcore.lod_units import LodUnits
-from cloudcore.ring import SEGMENTS, RingState
+from cloudcore.lod.costs import CostModel
+from cloudcore.lod.frameplan import SWITCH_MARGIN, LodState, inside_runs, plan_frame
+from cloudcore.lod.impostors import impostor_view, parallax_error_deg, translation_error_deg
+from cloudcore.lod.ring import SEGMENTS, RingState
+from cloudcore.lod.units import LodUnits
 from cloudcore.scene import Camera
 from cloudcore.settings import RenderSettings
 
@@ -140,7 +140,7 @@ QUARTER_OCTAVES_FROM_32 = (32, 40, 48, 56, 64, 80, 92, 108, 128, 156, 184, 216, 
 
 
 def test_texture_sides_are_quarter_octaves_so_they_overshoot_by_at_most_19_percent():
-    from cloudcore.impostors import required_size
+    from cloudcore.lod.impostors import required_size
 
     sides = [required_size(pixels, 32, 256) for pixels in np.linspace(1.0, 300.0, 3000)]
     assert sorted(set(sides)) == list(QUARTER_OCTAVES_FROM_32)

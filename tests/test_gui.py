@@ -13,7 +13,7 @@ import sys
 import pytest
 
 from app.gui_tests import GUI_TESTS
-from cloudcore.cloudgen import cumulus
+from cloudcore.artist.cloudgen import cumulus
 from cloudcore.resources import DEFAULT_SCENE
 from cloudcore.scene import Camera, CameraPath, Cloud, Lighting, Scene, Terrain
 from cloudcore.scenefile import save_scene

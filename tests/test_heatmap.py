@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from cloudcore.heatmap import RAMP, heat_image, legend_top, ramp_colours
+from cloudcore.measure.heatmap import RAMP, heat_image, legend_top, ramp_colours
 
 
 def test_the_ramp_runs_from_near_black_to_pale_yellow_always_getting_lighter():

@@ -1,9 +1,9 @@
-"""Time of day to sun, skylight and sky (cloudcore.lighting)."""
+"""Time of day to sun, skylight and sky (cloudcore.light.lighting)."""
 
 import numpy as np
 import pytest
 
-from cloudcore.lighting import active_lights, daylight, elevation_deg, scene_lights, sky_colors, sun_direction
+from cloudcore.light.lighting import active_lights, daylight, elevation_deg, scene_lights, sky_colors, sun_direction
 from cloudcore.scene import Light, Lighting
 
 

@@ -7,8 +7,7 @@ import numpy as np
 import pytest
 from test_frameplan import FILL_BOUND, FINEST, NO_RING, RADIUS, camera_at, plan
 
-from cloudcore.frameplan import LodState
-from cloudcore.lod_costs import (
+from cloudcore.lod.costs import (
     LLVMPIPE_COSTS,
     CostEstimator,
     CostModel,
@@ -18,6 +17,7 @@ from cloudcore.lod_costs import (
     regeneration_work,
     splat_fragments,
 )
+from cloudcore.lod.frameplan import LodState
 
 
 def test_splat_fragments_are_the_discs_areas_and_never_more_than_the_screen_each():

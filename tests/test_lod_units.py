@@ -4,8 +4,8 @@ import dataclasses
 
 import numpy as np
 
-from cloudcore.frameplan import LodState, plan_frame
-from cloudcore.lod_units import LodUnits, interpenetrating_groups, lod_units
+from cloudcore.lod.frameplan import LodState, plan_frame
+from cloudcore.lod.units import LodUnits, interpenetrating_groups, lod_units
 from cloudcore.scene import Camera, splats_bounding_sphere
 from cloudcore.settings import RenderSettings
 

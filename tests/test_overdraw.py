@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from cloudcore.camera import NEAR_PLANE_M, projection_matrix, view_matrix
-from cloudcore.overdraw import Overdraw, analytic_overdraw, overdraw_statistics
+from cloudcore.measure.overdraw import Overdraw, analytic_overdraw, overdraw_statistics
 from cloudcore.scene import Camera, Cloud, Scene
 from cloudcore.settings import FULL_3D
 

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from cloudcore.overdraw import WANG_BLOCK_SIZE_M, cloud_block_overdraw, cloud_block_overdraw_statistics
+from cloudcore.measure.overdraw import WANG_BLOCK_SIZE_M, cloud_block_overdraw, cloud_block_overdraw_statistics
 
 
 def test_a_hand_computed_case():

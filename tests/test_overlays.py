@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 from cloudcore.editing import pick_ray
-from cloudcore.frameplan import LodState, plan_frame
-from cloudcore.impostors import screen_size_px
-from cloudcore.lod_units import LodUnits
-from cloudcore.overlays import clip_to_near, impostor_outlines, ring_outlines, screen_polygon, to_pixels
+from cloudcore.lod.frameplan import LodState, plan_frame
+from cloudcore.lod.impostors import screen_size_px
+from cloudcore.lod.units import LodUnits
+from cloudcore.measure.overlays import clip_to_near, impostor_outlines, ring_outlines, screen_polygon, to_pixels
 from cloudcore.scene import Camera
 from cloudcore.settings import RenderSettings
 

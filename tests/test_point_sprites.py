@@ -3,10 +3,10 @@
 import numpy as np
 import pytest
 
+from cloudcore.artist.particle_styles import particle_styles
 from cloudcore.camera import projection_matrix, view_matrix
-from cloudcore.eye_scattering import ParticleShading
-from cloudcore.impostors import impostor_view
-from cloudcore.particle_styles import particle_styles
+from cloudcore.light.eye_scattering import ParticleShading
+from cloudcore.lod.impostors import impostor_view
 from cloudcore.point_sprites import draw_runs, plain_splats, point_sprite_mask
 from cloudcore.scene import Camera, Cloud, Light, Shading
 

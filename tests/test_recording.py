@@ -6,9 +6,9 @@ import math
 import numpy as np
 import pytest
 
-from cloudcore.frame_stats import FrameStats, PlanStats
-from cloudcore.overdraw import Overdraw
-from cloudcore.recording import COLUMNS, frame_row, frame_times
+from cloudcore.measure.frame_stats import FrameStats, PlanStats
+from cloudcore.measure.overdraw import Overdraw
+from cloudcore.measure.recording import COLUMNS, frame_row, frame_times
 
 
 def test_a_30_s_path_at_30_fps_is_901_frames_ending_on_the_last_key():

@@ -6,9 +6,9 @@ import time
 import numpy as np
 import pytest
 
-from cloudcore.illumination import IlluminationCache, illuminate_clouds
-from cloudcore.lighting import scene_lights
-from cloudcore.relighting import SYNCHRONOUS_PARTICLES, LiveIllumination, Look
+from cloudcore.light.illumination import IlluminationCache, illuminate_clouds
+from cloudcore.light.lighting import scene_lights
+from cloudcore.light.relighting import SYNCHRONOUS_PARTICLES, LiveIllumination, Look
 from cloudcore.scene import Cloud, Lighting, Scene, Shading
 
 SHADING = Shading()

@@ -9,10 +9,10 @@ the kernel altogether and must match the reference closely.
 import numpy as np
 import pytest
 
+from cloudcore.artist.formation import Formation
 from cloudcore.camera import projection_matrix, view_matrix
-from cloudcore.eye_scattering import ParticleShading
-from cloudcore.formation import Formation
-from cloudcore.kernel import splat_kernel
+from cloudcore.light.eye_scattering import ParticleShading
+from cloudcore.light.kernel import splat_kernel
 from cloudcore.scene import Camera, Cloud, Light, Shading
 
 WIDTH, HEIGHT = 160, 120
@@ -94,11 +94,11 @@ def test_the_shader_colours_particles_as_the_reference_does(renderer, phase, g, 
 def test_the_shader_colours_artist_clouds_as_the_reference_does(renderer):
     """Wang's model per corner (`artist_colours`); the quad's centre lies on the diagonal between
     its lower-right and upper-left corners, so it gets their mean."""
-    from cloudcore.artist_shading import ArtistShading, artist_colours
+    from cloudcore.artist.artist_shading import ArtistShading, artist_colours
+    from cloudcore.artist.particle_styles import particle_styles
     from cloudcore.gl.splats import SplatPass, splat_batch
     from cloudcore.gl.targets import TextureTarget
-    from cloudcore.lighting import sun_direction
-    from cloudcore.particle_styles import particle_styles
+    from cloudcore.light.lighting import sun_direction
     from cloudcore.scene import Lighting
 
     particles_xyzr = np.array([[0.0, -20.0, -100.0, 40.0], [0.0, 20.0, -100.0, 40.0], [30.0, 0.0, -160.0, 40.0]])
@@ -138,9 +138,9 @@ def test_a_sprite_the_eye_stands_in_keeps_its_facing_and_fades_as_the_eye_circle
     simply be gone: the near fade)."""
     import dataclasses
 
+    from cloudcore.artist.sprites import PUFFY, SpriteStyle
     from cloudcore.scene import Lighting, Scene
     from cloudcore.settings import FULL_3D
-    from cloudcore.sprites import PUFFY, SpriteStyle
 
     cloud = Cloud("sprite", [[0.0, 0.0, 0.0, 100.0]], sprite=SpriteStyle(rows=(PUFFY,), rotation_deg=(0.0, 0.0)))
     scene = Scene(lighting=Lighting(12.0), clouds=(cloud,))

@@ -11,8 +11,8 @@ import dataclasses
 import numpy as np
 import pytest
 
-from cloudcore.cloudgen import preset_cloud
-from cloudcore.formation import Formation
+from cloudcore.artist.cloudgen import preset_cloud
+from cloudcore.artist.formation import Formation
 from cloudcore.scene import Camera, Scene
 from cloudcore.settings import FULL_3D, RenderSettings
 

@@ -5,8 +5,8 @@ import pytest
 from conftest import VALLEY
 from goldens import MAX_ABS, MIN_PSNR_DB, check_golden
 
-from cloudcore.imagecompare import compare, diff_image
-from cloudcore.lighting import sun_direction
+from cloudcore.light.lighting import sun_direction
+from cloudcore.measure.imagecompare import compare, diff_image
 from cloudcore.paths import sample
 from cloudcore.scene import Camera, Scene
 from cloudcore.scenefile import load_scene

@@ -14,9 +14,9 @@ from conftest import VALLEY
 from test_frameplan import FILL_BOUND, UPKEEP_BOUND
 from test_render_golden import inside_a_cloud, into_the_sun
 
-from cloudcore.imagecompare import compare
+from cloudcore.lod.ring import SEGMENTS
+from cloudcore.measure.imagecompare import compare
 from cloudcore.navigation import orbited
-from cloudcore.ring import SEGMENTS
 from cloudcore.scene import Camera
 from cloudcore.scenefile import load_scene
 from cloudcore.settings import FULL_3D, RenderSettings

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from cloudcore.camera import screen_box
-from cloudcore.imagecompare import compare
+from cloudcore.measure.imagecompare import compare
 from cloudcore.objects import object_poses
 from cloudcore.resources import resource_path
 from cloudcore.scenefile import load_scene

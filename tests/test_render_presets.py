@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from goldens import check_golden
 
-from cloudcore.cloudgen import PRESETS, preset_cloud
+from cloudcore.artist.cloudgen import PRESETS, preset_cloud
 from cloudcore.scene import Camera, Lighting, Scene
 from cloudcore.settings import FULL_3D
 

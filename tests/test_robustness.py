@@ -22,12 +22,12 @@ from scipy.optimize import brentq
 
 from cloudcore.camera import NEAR_PLANE_M, frustum_planes, projection_matrix, splats_in_frustum, view_matrix
 from cloudcore.errors import SceneError
-from cloudcore.frame_stats import FrameStats
-from cloudcore.frameplan import TEXTURED
 from cloudcore.gl.context import WindowContext
 from cloudcore.gl.frame import FrameRenderer
-from cloudcore.lighting import elevation_deg, scene_lights, sun_direction
-from cloudcore.ring import SEGMENTS
+from cloudcore.light.lighting import elevation_deg, scene_lights, sun_direction
+from cloudcore.lod.frameplan import TEXTURED
+from cloudcore.lod.ring import SEGMENTS
+from cloudcore.measure.frame_stats import FrameStats
 from cloudcore.scene import Camera, Cloud, Light, Lighting, Scene, Terrain
 from cloudcore.scenefile import scene_from_dict
 from cloudcore.settings import FULL_3D, RenderSettings
@@ -202,7 +202,7 @@ def looking_from(eye, at=CLOUD_CENTRE + [0.0, 0.0, -500.0], fov: float = 55.0) -
 
 @pytest.mark.parametrize("mode", ["full", "auto"])
 def test_camera_inside_a_particle(renderer, mode):
-    """The particle holding the eye fades out (`cloudcore.eye_scattering`); the others in view are drawn."""
+    """The particle holding the eye fades out (`cloudcore.light.eye_scattering`); the others in view are drawn."""
     camera = looking_from(BASE.clouds[0].particles[0, :3])
     frame = render_checked(renderer, "camera at a particle's centre", BASE, MODES[mode], camera=camera)
     particles = BASE.clouds[0].particles
@@ -313,7 +313,7 @@ def test_sun_position(renderer, sun, mode):
 def test_phase_asymmetry(renderer, phase, g):
     """Looking straight into the light, where a g = 0.99 lobe peaks at (1 + g) / (1 - g)^2 ~ 2e4 times its mean.
 
-    The scattering cap (`cloudcore.shading.scattering_coefficient`) keeps every particle's colour within
+    The scattering cap (`cloudcore.light.shading.scattering_coefficient`) keeps every particle's colour within
     its opacity times (light + ambient), so the composited frame never exceeds light + ambient.
     """
     into_light = tuple((CLOUD_CENTRE - EYE) / np.linalg.norm(CLOUD_CENTRE - EYE))

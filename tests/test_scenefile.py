@@ -271,7 +271,7 @@ def test_sprites_and_artist_shading_round_trip(tmp_path):
     """Every preset's sprite style and artist model, and a shading group size, survive a save and load exactly."""
     from dataclasses import replace
 
-    from cloudcore.cloudgen import PRESETS, preset_cloud
+    from cloudcore.artist.cloudgen import PRESETS, preset_cloud
     from cloudcore.scene import Scene
 
     clouds = tuple(preset_cloud(name, name, (3000.0 * i, 1000.0, 0.0), seed=i) for i, name in enumerate(PRESETS))
@@ -300,8 +300,8 @@ def test_a_cloud_without_sprite_or_artist_keeps_splats_and_harris(tmp_path):
 
 
 def test_sprite_and_artist_tables_take_their_defaults(tmp_path):
-    from cloudcore.artist_shading import ArtistShading
-    from cloudcore.sprites import SpriteStyle
+    from cloudcore.artist.artist_shading import ArtistShading
+    from cloudcore.artist.sprites import SpriteStyle
 
     (tmp_path / "d.toml").write_text(BASE.replace('name = "a"', 'name = "a"\nsprite = {}\nartist = {}', 1))
     cloud = load_scene(tmp_path / "d.toml").clouds[0]

@@ -1,11 +1,11 @@
-"""The shading contract of cloudcore.shading.incident_light (issue: Foundation)."""
+"""The shading contract of cloudcore.light.shading.incident_light (issue: Foundation)."""
 
 import numpy as np
 import pytest
 from oracle import literal_incident_light
 
-from cloudcore.phase import phase_function
-from cloudcore.shading import eye_pass_coefficients, incident_light, scattering_coefficient
+from cloudcore.light.phase import phase_function
+from cloudcore.light.shading import eye_pass_coefficients, incident_light, scattering_coefficient
 
 RNG = np.random.default_rng(20021)
 
@@ -191,7 +191,7 @@ def test_the_saturated_eye_pass_is_harris_s_for_thin_particles_and_bounded_for_t
 
 
 def test_changing_the_eye_pass_shades_nothing_again():
-    from cloudcore.illumination import IlluminationCache
+    from cloudcore.light.illumination import IlluminationCache
     from cloudcore.scene import Cloud, Light, Shading
 
     cloud = Cloud("c", [[0.0, 0.0, 0.0, 10.0], [5.0, 5.0, 0.0, 10.0]])

@@ -6,13 +6,13 @@ import numpy as np
 import pytest
 from conftest import VALLEY
 
-from cloudcore.frameplan import LodState, plan_frame
-from cloudcore.lod_units import LodUnits
+from cloudcore.lod.frameplan import LodState, plan_frame
+from cloudcore.lod.splitting import layer_of
+from cloudcore.lod.units import LodUnits
 from cloudcore.objects import ObjectPose, object_poses
 from cloudcore.scene import Camera
 from cloudcore.scenefile import load_scene
 from cloudcore.settings import RenderSettings
-from cloudcore.splitting import layer_of
 
 VIEWPORT = (640, 480)
 RNG = np.random.default_rng(5)

@@ -3,9 +3,8 @@
 import numpy as np
 import pytest
 
-from cloudcore.errors import FieldError
-from cloudcore.sprite_art import render_atlas
-from cloudcore.sprites import (
+from cloudcore.artist.sprite_art import render_atlas
+from cloudcore.artist.sprites import (
     ATLAS_GRID,
     ATLAS_MAX_MIP_LEVEL,
     CELL_MARGIN_PIXELS,
@@ -21,6 +20,7 @@ from cloudcore.sprites import (
     particle_sprites,
     sprite_choices,
 )
+from cloudcore.errors import FieldError
 
 
 def cells(atlas: np.ndarray) -> np.ndarray:

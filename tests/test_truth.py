@@ -11,11 +11,10 @@ import pytest
 
 from cloudcore.camera import pixel_rays, projection_matrix, view_matrix
 from cloudcore.colour import srgb_decode, srgb_encode
-from cloudcore.kernel import SPLAT_SHARPNESS
-from cloudcore.lighting import sky_gradient
-from cloudcore.phase import phase_function
-from cloudcore.scene import Camera, Cloud, Scene, Shading
-from cloudcore.truth import (
+from cloudcore.light.kernel import SPLAT_SHARPNESS
+from cloudcore.light.lighting import sky_gradient
+from cloudcore.light.phase import phase_function
+from cloudcore.light.truth import (
     KERNEL_DIAMETER_INTEGRAL,
     luminance,
     medium_grids,
@@ -26,6 +25,7 @@ from cloudcore.truth import (
     resolution_gain,
     truth_regions,
 )
+from cloudcore.scene import Camera, Cloud, Scene, Shading
 
 
 def one_particle(tau, radius=50.0, centre=(0.0, 1000.0, 0.0), albedo=0.9) -> Scene:

@@ -7,11 +7,11 @@ import sys
 import numpy as np
 import pytest
 
-from cloudcore.phase import phase_function
+from cloudcore.light.phase import phase_function
+from cloudcore.light.shading import scattering_coefficient
+from cloudcore.light.truth import medium_grids, mitsuba_scene_description, mitsuba_variant, optical_depths, render_truth
 from cloudcore.scene import Camera, Cloud, Light, Lighting, Scene, Shading
 from cloudcore.scenefile import save_scene
-from cloudcore.shading import scattering_coefficient
-from cloudcore.truth import medium_grids, mitsuba_scene_description, mitsuba_variant, optical_depths, render_truth
 
 mi = pytest.importorskip("mitsuba")
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 from imgui_bundle import imgui
 
 from app.editor import Editor
-from cloudcore.cloudgen import PRESETS, TYPICAL_CULL_FRACTION
+from cloudcore.artist.cloudgen import PRESETS, TYPICAL_CULL_FRACTION
 from cloudcore.editing import add_preset_cloud, fill_box, pick_ray, point_at_altitude
 
 

@@ -8,8 +8,8 @@ from imgui_bundle import imgui
 
 from app.editor import Editor
 from app.panels.widgets import ReleasedSliders
-from cloudcore.phase import PHASE_NAMES
-from cloudcore.shading import EYE_PASSES
+from cloudcore.light.phase import PHASE_NAMES
+from cloudcore.light.shading import EYE_PASSES
 
 #: the shading sliders: label -> (`Shading` field, low, high)
 _SHADING_SLIDERS = {
@@ -35,7 +35,7 @@ class LightingPanel:
             field: self._sliders.slider(label, getattr(shading, field), low, high)
             for label, (field, low, high) in _SHADING_SLIDERS.items()
         }
-        # the viewport follows a slider being dragged (`cloudcore.relighting`); the edit is made on release
+        # the viewport follows a slider being dragged (`cloudcore.light.relighting`); the edit is made on release
         dragged = {
             field: self._sliders.dragged(label)
             for label, (field, _, _) in _SHADING_SLIDERS.items()

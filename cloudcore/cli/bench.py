@@ -1,7 +1,7 @@
 """`cloudview bench SCENE --camera-path NAME --json OUT.json`: error against run time along a camera path, headless.
 
 Each setting of the sweeps is rendered along the path beside the full-3D
-reference in the same run; the report is `cloudcore.benchmark.bench_path`'s,
+reference in the same run; the report is `cloudcore.measure.benchmark.bench_path`'s,
 plus the shading precompute (exact against raster).  With no --sweep, the
 default settings are run.
 """
@@ -14,7 +14,10 @@ import json
 import os
 from pathlib import Path
 
-from cloudcore.benchmark import (
+from cloudcore.cli.render import pixel_count
+from cloudcore.cli.settings_args import SWEEPABLE, add_settings_arguments, parse_sweep, settings_from
+from cloudcore.errors import SceneError
+from cloudcore.measure.benchmark import (
     bench_path,
     headless_pyplot,
     orbit_views,
@@ -23,9 +26,6 @@ from cloudcore.benchmark import (
     shading_comparison,
     still_views,
 )
-from cloudcore.cli.render import pixel_count
-from cloudcore.cli.settings_args import SWEEPABLE, add_settings_arguments, parse_sweep, settings_from
-from cloudcore.errors import SceneError
 from cloudcore.scenefile import load_scene
 from cloudcore.settings import setting_options
 

@@ -18,8 +18,7 @@ from pathlib import Path
 from cloudcore.cli.compare import decibels
 from cloudcore.cli.render import pixel_count
 from cloudcore.errors import SceneError
-from cloudcore.scenefile import load_scene
-from cloudcore.screenshot_check import (
+from cloudcore.measure.screenshot_check import (
     DEFAULT_MAX_DIFF,
     DEFAULT_MIN_PSNR_DB,
     DEFAULT_SIZE,
@@ -30,6 +29,7 @@ from cloudcore.screenshot_check import (
     update_golden,
     write_report,
 )
+from cloudcore.scenefile import load_scene
 
 
 def add_parser(commands) -> None:

@@ -14,7 +14,7 @@ import math
 from pathlib import Path
 
 from cloudcore.errors import SceneError
-from cloudcore.imagecompare import compare, diff_image, load_rgb8
+from cloudcore.measure.imagecompare import compare, diff_image, load_rgb8
 
 DEFAULT_TOLERANCE_DB = 40.0  # the golden render tests' threshold
 

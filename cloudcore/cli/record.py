@@ -1,7 +1,7 @@
 """`cloudview record SCENE --camera-path NAME --out F.mp4`: each frame of a camera path, headless, to H.264 and/or PNGs.
 
 Frame i shows the path at i / fps seconds; --stats writes one CSV row per
-frame (`cloudcore.recording.COLUMNS`).  Ctrl-C stops after the frame being
+frame (`cloudcore.measure.recording.COLUMNS`).  Ctrl-C stops after the frame being
 drawn: the video is finished properly, so it plays with the frames so far,
 and the exit status is 130.  The same arguments give the same frames.
 """
@@ -20,8 +20,8 @@ from types import SimpleNamespace
 from cloudcore.cli.render import add_scene_argument, pixel_count
 from cloudcore.cli.settings_args import add_settings_arguments, settings_from
 from cloudcore.errors import SceneError
+from cloudcore.measure.recording import COLUMNS, frame_row, frame_times
 from cloudcore.paths import camera_on_path
-from cloudcore.recording import COLUMNS, frame_row, frame_times
 from cloudcore.scenefile import load_scene
 
 

@@ -8,9 +8,9 @@ from pathlib import Path
 
 from cloudcore.cli.settings_args import add_settings_arguments, settings_from
 from cloudcore.errors import SceneError
-from cloudcore.heatmap import heat_image
 from cloudcore.limits import MAX_FRAME_SIDE
-from cloudcore.overdraw import scene_block_overdraw_statistics
+from cloudcore.measure.heatmap import heat_image
+from cloudcore.measure.overdraw import scene_block_overdraw_statistics
 from cloudcore.paths import camera_on_path
 from cloudcore.resources import DEFAULT_SCENE
 from cloudcore.scene import Camera

@@ -7,10 +7,10 @@ import time
 from tqdm import tqdm
 
 from cloudcore.cli.render import add_scene_argument
-from cloudcore.illumination import illuminate_clouds
-from cloudcore.lighting import active_lights, scene_lights
+from cloudcore.light.illumination import illuminate_clouds
+from cloudcore.light.lighting import active_lights, scene_lights
+from cloudcore.light.shading import METHODS
 from cloudcore.scenefile import load_scene
-from cloudcore.shading import METHODS
 
 
 def add_parser(commands) -> None:

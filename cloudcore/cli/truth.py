@@ -1,8 +1,8 @@
 """`cloudview truth SCENE --out T.png`: the path-traced reference (Mitsuba 3); with --json, the models against it.
 
-The models are Harris's with each illumination method of `cloudcore.shading` and the saturated eye
+The models are Harris's with each illumination method of `cloudcore.light.shading` and the saturated eye
 pass with the exact one.  The truth and the models both show the clouds over the sky, the terrain and objects left out
-(`cloudcore.truth` says what the medium and the lights are).  The report renders the truth again
+(`cloudcore.light.truth` says what the medium and the lights are).  The report renders the truth again
 with the next seed, for its own noise, and each model through the GL renderer in full 3D.
 """
 
@@ -17,15 +17,12 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from cloudcore.benchmark import PSNR_CAP_DB
 from cloudcore.cli.render import add_scene_argument, camera_argument, check_time_argument, pixel_count, write_output
 from cloudcore.colour import linear_to_srgb8
 from cloudcore.errors import SceneError
-from cloudcore.imagecompare import compare, diff_image
-from cloudcore.lighting import scene_hour
-from cloudcore.scenefile import load_scene
-from cloudcore.shading import METHODS
-from cloudcore.truth import (
+from cloudcore.light.lighting import scene_hour
+from cloudcore.light.shading import METHODS
+from cloudcore.light.truth import (
     BODY_ALPHA,
     CLOUD_ALPHA,
     DEFAULT_VOXELS_PER_RADIUS,
@@ -35,6 +32,9 @@ from cloudcore.truth import (
     render_truth,
     truth_regions,
 )
+from cloudcore.measure.benchmark import PSNR_CAP_DB
+from cloudcore.measure.imagecompare import compare, diff_image
+from cloudcore.scenefile import load_scene
 
 REGION_DEFINITION = (
     f"from the truth: sky where its alpha (1 - transmittance along the pixel's central ray) < {CLOUD_ALPHA}, "

@@ -5,8 +5,8 @@ sRGB happens on read-back.  `FrameRenderer` keeps its context, GL objects,
 terrain and precomputed cloud illumination between frames and rebuilds each
 only when what it came from changes; what the level of detail carries from
 frame to frame (impostor cache, ring, representations, the fitted costs) is
-the pure `cloudcore.frameplan.LodState` it holds.  Each frame it asks
-`cloudcore.frameplan.plan_frame` what to do, executes exactly that, and
+the pure `cloudcore.lod.frameplan.LodState` it holds.  Each frame it asks
+`cloudcore.lod.frameplan.plan_frame` what to do, executes exactly that, and
 folds the two timed passes into the state's cost fit:
 
 1. the world (terrain depth and colour over the sky), and the objects
@@ -29,13 +29,11 @@ from dataclasses import dataclass
 import numpy as np
 from OpenGL import GL
 
+from cloudcore.artist.facing import CloudFacings
+from cloudcore.artist.formation import formation_state
+from cloudcore.artist.particle_styles import particle_styles
 from cloudcore.camera import NEAR_PLANE_M, frustum_planes, projection_matrix, view_matrix
 from cloudcore.colour import linear_to_srgb8
-from cloudcore.eye_scattering import ParticleShading
-from cloudcore.facing import CloudFacings
-from cloudcore.formation import formation_state
-from cloudcore.frame_stats import FrameStats
-from cloudcore.frameplan import FramePlan, LodState, inside_runs, plan_frame
 from cloudcore.gl.context import HeadlessContext, WindowContext, check_frame_size
 from cloudcore.gl.impostor_store import ImpostorStore
 from cloudcore.gl.objects import ObjectPass
@@ -44,12 +42,14 @@ from cloudcore.gl.quads import SCREEN_CORNERS, QuadPass
 from cloudcore.gl.splats import SplatPass, splat_batch
 from cloudcore.gl.targets import TextureTarget, blit_depth, depth_renderbuffer
 from cloudcore.gl.world import WorldPass
-from cloudcore.illumination import IlluminationCache
-from cloudcore.lighting import scene_hour, scene_lights, sky_colors
-from cloudcore.lod_costs import CostModel
-from cloudcore.lod_units import LodUnits, lod_units
-from cloudcore.overdraw import analytic_overdraw, overdraw_statistics
-from cloudcore.particle_styles import particle_styles
+from cloudcore.light.eye_scattering import ParticleShading
+from cloudcore.light.illumination import IlluminationCache
+from cloudcore.light.lighting import scene_hour, scene_lights, sky_colors
+from cloudcore.lod.costs import CostModel
+from cloudcore.lod.frameplan import FramePlan, LodState, inside_runs, plan_frame
+from cloudcore.lod.units import LodUnits, lod_units
+from cloudcore.measure.frame_stats import FrameStats
+from cloudcore.measure.overdraw import analytic_overdraw, overdraw_statistics
 from cloudcore.scene import Camera, Lighting, Scene
 from cloudcore.settings import FULL_3D, RenderSettings
 
@@ -80,7 +80,7 @@ class FrameRenderer:
         """A headless renderer, or with `context` (a `WindowContext`) one inside the current window.
 
         `illumination` holds the clouds' precomputed light between frames; the editor passes one
-        that a worker fills in the background (`cloudcore.relighting`)."""
+        that a worker fills in the background (`cloudcore.light.relighting`)."""
         self.context = context if context is not None else HeadlessContext(width, height)
         self.context.make_current()
         self._splats = SplatPass()

@@ -1,10 +1,10 @@
 """The GL side of impostors: renders what the frame plan says to regenerate and keeps the textures.
 
 A unit's impostor (one cloud, or a group of interpenetrating clouds sorted
-together: `cloudcore.lod_units`) is rendered from the eye recorded in the
+together: `cloudcore.lod.units`) is rendered from the eye recorded in the
 plan's impostor cache, through the tight frustum of
-`cloudcore.impostors.impostor_view`; ring segments from their generation's
-eye (`cloudcore.ring`).  Textures come from one `TexturePool`; those of units
+`cloudcore.lod.impostors.impostor_view`; ring segments from their generation's
+eye (`cloudcore.lod.ring`).  Textures come from one `TexturePool`; those of units
 or ring generations the plan no longer holds go back to it.  A unit split
 around objects has one texture per layer, each holding the particles of its
 depth range seen from the impostor's eye.
@@ -14,16 +14,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from cloudcore.eye_scattering import ParticleShading
-from cloudcore.frameplan import FramePlan
 from cloudcore.gl.splats import SplatPass, splat_batch
 from cloudcore.gl.targets import TextureTarget
 from cloudcore.gl.texture_pool import TexturePool
-from cloudcore.impostors import ImpostorView, cropped_corners, impostor_view, particle_extent
-from cloudcore.lod_units import LodUnits
-from cloudcore.ring import RingGeneration, panel_corners, segment_camera
+from cloudcore.light.eye_scattering import ParticleShading
+from cloudcore.lod.frameplan import FramePlan
+from cloudcore.lod.impostors import ImpostorView, cropped_corners, impostor_view, particle_extent
+from cloudcore.lod.ring import RingGeneration, panel_corners, segment_camera
+from cloudcore.lod.splitting import layer_bounds
+from cloudcore.lod.units import LodUnits
 from cloudcore.settings import RenderSettings
-from cloudcore.splitting import layer_bounds
 
 
 class ImpostorStore:

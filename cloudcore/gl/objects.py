@@ -7,7 +7,7 @@ in front.  Objects outside clouds are composited once after the world with
 their depth written, so the clouds behind them are hidden; an object inside
 a split cloud is composited between its layers without writing depth, so
 the layers in front of it cover it whole and no billboard cuts through it
-(`cloudcore.splitting`).
+(`cloudcore.lod.splitting`).
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ from OpenGL import GL
 from cloudcore.camera import FAR_PLANE_M, NEAR_PLANE_M, camera_pose
 from cloudcore.gl.programs import build_program
 from cloudcore.gl.pyrender_compat import pyrender
-from cloudcore.lighting import active_lights
+from cloudcore.light.lighting import active_lights
 from cloudcore.objects import mesh_sphere, object_mesh, object_poses
 from cloudcore.scene import Camera
 

@@ -21,18 +21,18 @@ from dataclasses import dataclass
 import numpy as np
 from OpenGL import GL
 
+from cloudcore.artist.facing import FacingState
+from cloudcore.artist.particle_styles import ParticleStyles
+from cloudcore.artist.sprites import ATLAS_GRID, ATLAS_MAX_MIP_LEVEL, load_atlas
 from cloudcore.camera import splats_in_frustum
-from cloudcore.depth_order import far_to_near
-from cloudcore.eye_scattering import FADE_END_RADII, FADE_START_RADII, ParticleShading
-from cloudcore.facing import FacingState
 from cloudcore.gl.blending import cloud_blending
 from cloudcore.gl.programs import build_compute_program, build_program, set_matrix, set_vec3
-from cloudcore.kernel import SPLAT_SHARPNESS
+from cloudcore.light.eye_scattering import FADE_END_RADII, FADE_START_RADII, ParticleShading
+from cloudcore.light.kernel import SPLAT_SHARPNESS
+from cloudcore.light.phase import PHASE_NAMES
 from cloudcore.limits import MAX_LIGHTS
-from cloudcore.particle_styles import ParticleStyles
-from cloudcore.phase import PHASE_NAMES
+from cloudcore.lod.depth_order import far_to_near
 from cloudcore.point_sprites import draw_runs, guard_band, plain_splats, point_sprite_mask
-from cloudcore.sprites import ATLAS_GRID, ATLAS_MAX_MIP_LEVEL, load_atlas
 
 #: two triangles over a particle's four corners (lower left, lower right, upper left, upper right)
 _QUAD_TRIANGLES = np.array([0, 1, 2, 2, 1, 3], dtype=np.uint32)

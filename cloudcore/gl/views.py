@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from cloudcore.frameplan import LodState
 from cloudcore.gl.frame import FrameRenderer
-from cloudcore.lod_costs import LLVMPIPE_COSTS
+from cloudcore.lod.costs import LLVMPIPE_COSTS
+from cloudcore.lod.frameplan import LodState
+from cloudcore.measure.screenshot_check import view_camera, view_settings
 from cloudcore.scene import Scene, View
-from cloudcore.screenshot_check import view_camera, view_settings
 
 
 class ViewRenderer:

@@ -20,7 +20,7 @@ from cloudcore.colour import srgb_encode
 from cloudcore.gl.context import HeadlessContext
 from cloudcore.gl.programs import build_program, set_matrix, set_vec3
 from cloudcore.gl.pyrender_compat import pyrender
-from cloudcore.lighting import active_lights
+from cloudcore.light.lighting import active_lights
 from cloudcore.limits import DRAWN_TERRAIN_KINDS
 from cloudcore.scene import Camera, Terrain
 from cloudcore.terrain import heightfield_mesh

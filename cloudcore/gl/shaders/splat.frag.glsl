@@ -1,7 +1,7 @@
 #version 430 core
-// A Gaussian splat: the kernel of cloudcore.kernel, K(d) = (exp(-s d^2) - exp(-s)) / (1 - exp(-s))
+// A Gaussian splat: the kernel of cloudcore.light.kernel, K(d) = (exp(-s d^2) - exp(-s)) / (1 - exp(-s))
 // for d < 1, else 0, SPLAT_SHARPNESS (s) injected from Python.  Or an atlas sprite
-// (cloudcore.sprites): its cell's texture, alpha the sprite's opacity and rgb a
+// (cloudcore.artist.sprites): its cell's texture, alpha the sprite's opacity and rgb a
 // brightness that multiplies the colour.  Output is premultiplied for
 // glBlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA).  With COUNT_FRAGMENTS defined every
 // fragment kept writes 1, for additive blending into the overdraw counter.  With POINT_SPRITE

@@ -5,19 +5,19 @@
 // rather than at each corner in the vertex shader: on a software rasteriser
 // vertex work is the cost.
 //
-// Colour, Harris (reference cloudcore.eye_scattering.ParticleShading.seen_from):
+// Colour, Harris (reference cloudcore.light.eye_scattering.ParticleShading.seen_from):
 // per light, the incident light of the light pass times the phase function at
 // the angle between the view ray and the light, times the scattering
 // coefficient, plus ambient.  Colour, Wang's artist model (reference
-// cloudcore.artist_shading.artist_colours): the cloud's five vertical colour
+// cloudcore.artist.artist_shading.artist_colours): the cloud's five vertical colour
 // levels at each corner's height plus the directional term of its shading
 // group, per corner.  Opacity: splats fade out next to the eye; sprites lock
-// their facing there (cloudcore.facing) and fade by its angle; forming
-// clouds scale both (cloudcore.formation).
+// their facing there (cloudcore.artist.facing) and fade by its angle; forming
+// clouds scale both (cloudcore.artist.formation).
 //
-// Orientation (cloudcore.particle_styles): splats lie in the image plane;
+// Orientation (cloudcore.artist.particle_styles): splats lie in the image plane;
 // sprites face the eye (or their locked facing) with world up projected
-// into their plane (cloudcore.facing.sprite_axes), or lie flat; both turned
+// into their plane (cloudcore.artist.facing.sprite_axes), or lie flat; both turned
 // by their rotation.  Corners are written relative to the eye, so float32
 // keeps tiny particles far from the origin their size.
 
@@ -35,7 +35,7 @@ struct CloudStyle {
     vec4 level_colours[5];       // RGBA, RGB times the hour's percentage
     vec4 level_heights;          // the first four level heights (fractions of the cloud's height)
     vec4 last_height_extent;     // fifth level height, lowest and highest particle centre y, artist (0 or 1)
-    vec4 directional_colour;     // rgb, facing (FACING_* of cloudcore.particle_styles)
+    vec4 directional_colour;     // rgb, facing (FACING_* of cloudcore.artist.particle_styles)
     vec4 directional_range;      // min, median, max, unused
     vec4 sun;                    // toward the sun, unused
 };
@@ -57,7 +57,7 @@ uniform vec3 view_up;
 uniform int light_count;
 uniform vec3 light_direction[MAX_LIGHTS];  // toward the light
 uniform vec3 light_radiance[MAX_LIGHTS];
-uniform int phase_kind;  // cloudcore.phase.PHASE_NAMES order
+uniform int phase_kind;  // cloudcore.light.phase.PHASE_NAMES order
 uniform float g;
 
 const int FACING_SPLAT = 0;
@@ -89,7 +89,7 @@ vec4 harris_colour(Particle p, vec3 view_ray)
     return vec4(scattered * p.scattering_opacity.rgb + p.ambient.rgb, p.scattering_opacity.a);
 }
 
-// cloudcore.artist_shading.artist_colours at one vertex, premultiplied
+// cloudcore.artist.artist_shading.artist_colours at one vertex, premultiplied
 vec4 artist_colour(CloudStyle style, vec3 vertex, vec3 group_centre)
 {
     float bottom = style.last_height_extent.y, top = style.last_height_extent.z;

@@ -39,7 +39,7 @@ LEVEL_COUNT = 5
 DEFAULT_GROUP_RADII = 3.0
 
 #: percent of the level colours by hour; more keys around dawn and dusk, where it changes fastest
-#: (Wang: "we allow more samples around dawn and dusk").  The sun of cloudcore.lighting rises near
+#: (Wang: "we allow more samples around dawn and dusk").  The sun of cloudcore.light.lighting rises near
 #: 05:15 and sets near 18:45.
 DEFAULT_LEVEL_PERCENT_BY_HOUR = (
     (0.0, 10.0),
@@ -56,7 +56,7 @@ DEFAULT_LEVEL_PERCENT_BY_HOUR = (
     (19.0, 25.0),
     (19.5, 12.0),
 )
-#: the maximum directional colour by hour: cloudcore.lighting's sun beam at these hours (red low in the
+#: the maximum directional colour by hour: cloudcore.light.lighting's sun beam at these hours (red low in the
 #: sky, warm white by day, none at night), scaled to leave the levels room below white
 DEFAULT_DIRECTIONAL_COLOUR_BY_HOUR = (
     (0.0, 0.0, 0.0, 0.0),
@@ -272,7 +272,7 @@ def artist_colours(
     """Wang's vertex colour (n, 4) RGBA in [0, 1]: ambient + directional, before texture and formation.
 
     `cloud_bottom_y` and `cloud_top_y` bound the cloud's vertical extent: its
-    lowest and highest particle centre (as `cloudcore.sprites.particle_sprites`
+    lowest and highest particle centre (as `cloudcore.artist.sprites.particle_sprites`
     measures it); vertices beyond take the end levels.
 
     The reference the GLSL matches (Wang section 5.3, equation 3 without its

@@ -2,7 +2,7 @@
 
 The GL side counts blended fragments per pixel (`FrameRenderer.measure_overdraw`);
 this module turns those counts into the reported numbers (their heat map is
-`cloudcore.heatmap`) and gives the analytic estimate Harris and Wang reason with: the summed screen area
+`cloudcore.measure.heatmap`) and gives the analytic estimate Harris and Wang reason with: the summed screen area
 of the splats over the screen area.  The estimate clips each disc to the
 screen by its bounding square but ignores terrain in front, so it exceeds the
 measured mean where hills hide clouds.

@@ -1,6 +1,6 @@
 """Relighting without freezing the editor: the light pass in a worker process, the newest request winning.
 
-Harris's light pass (`cloudcore.illumination`) takes over a second exactly for
+Harris's light pass (`cloudcore.light.illumination`) takes over a second exactly for
 the default scene's 90,000 particles.  Run where the GUI runs, every step of
 the time-of-day or shading sliders would freeze the editor for that long.
 `LiveIllumination` says each frame which lighting the viewport can show now:
@@ -22,11 +22,11 @@ from concurrent.futures import Future, ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass
 
-from cloudcore.illumination import IlluminationCache, illuminate_direction
-from cloudcore.lighting import scene_lights
+from cloudcore.light.illumination import IlluminationCache, illuminate_direction
+from cloudcore.light.lighting import scene_lights
 from cloudcore.scene import Lighting, Scene, Shading
 
-#: the light pass while a slider is dragged (`cloudcore.shading`: a coarse raster), and once it is let go
+#: the light pass while a slider is dragged (`cloudcore.light.shading`: a coarse raster), and once it is let go
 PREVIEW_METHOD, EXACT_METHOD = "preview", "exact"
 #: a change that leaves at most this many particles to shade is shaded in the frame that needs it: about
 #: 30 ms exactly on this machine (one cloud of the default scene), less than a frame of the editor

@@ -2,7 +2,7 @@
 
 Harris shades each cloud on its own (clouds do not shadow each other) once per
 light; this module maps a scene's clouds, shading defaults and lights onto
-`cloudcore.shading.incident_light`.
+`cloudcore.light.shading.incident_light`.
 """
 
 from __future__ import annotations
@@ -11,9 +11,9 @@ import dataclasses
 
 import numpy as np
 
-from cloudcore.lighting import active_lights
+from cloudcore.light.lighting import active_lights
+from cloudcore.light.shading import DEFAULT_RASTER_RESOLUTION, incident_light
 from cloudcore.scene import Cloud, Shading
-from cloudcore.shading import DEFAULT_RASTER_RESOLUTION, incident_light
 
 
 def cloud_optics(cloud: Cloud, shading: Shading) -> tuple[np.ndarray, np.ndarray]:
@@ -83,7 +83,7 @@ class IlluminationCache:
     does, so the entries are per light direction: a new time of day moves the sun
     and recolours the skylight, and only the sun is shaded again.  `incident`
     keeps only what it was last asked for; `store` adds work done elsewhere
-    (`cloudcore.relighting`) beside it.
+    (`cloudcore.light.relighting`) beside it.
     """
 
     def __init__(self):

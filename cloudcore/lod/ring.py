@@ -21,7 +21,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from cloudcore.camera import camera_pose, frustum_planes, projection_matrix, spheres_in_frustum, view_matrix
-from cloudcore.impostors import SHRINK_FACTOR, required_size
+from cloudcore.lod.impostors import SHRINK_FACTOR, required_size
 from cloudcore.scene import Camera
 from cloudcore.settings import RenderSettings
 

@@ -5,7 +5,7 @@ flat-bottomed one for cumulus bases, foggy ones "used heavily in stratus",
 puffy ones for cumulus and wispy ones "used across all cloud types".  Here the
 sheet is `cloudcore/resources/sprites/atlas.png`, ATLAS_GRID x ATLAS_GRID cells of
 CELL_PIXELS, one kind per row (`ROWS`, top row first), four variants across;
-`scripts/make_sprite_atlas.py` draws it (`cloudcore.sprite_art`).
+`scripts/make_sprite_atlas.py` draws it (`cloudcore.artist.sprite_art`).
 
 Channels: alpha is the sprite's opacity (its density mask); RGB is a
 brightness texture that multiplies the shaded colour (Wang's final colour is
@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cloudcore.artist_shading import height_fractions
+from cloudcore.artist.artist_shading import height_fractions
 from cloudcore.errors import FieldError
 from cloudcore.noise import hash01
 from cloudcore.resources import ATLAS
@@ -61,7 +61,7 @@ class SpriteStyle:
     rotation_deg: (low, high) range of each sprite's rotation in its plane,
         counter-clockwise as seen by the viewer, 0 = upright; at most 360 wide.
     facing: "camera" (billboards turned toward the eye, locked near it:
-        `cloudcore.facing`) or "horizontal" (flat quads parallel to the ground,
+        `cloudcore.artist.facing`) or "horizontal" (flat quads parallel to the ground,
         Wang's cirrus: "flat textured rectangles").
     seed: the per-cloud seed of every choice.
     flat_bottom_fraction: particles whose centres lie in this lowest fraction
@@ -116,7 +116,7 @@ def sprite_choices(style: SpriteStyle, count: int, heights_fraction=None) -> tup
     Particle i's choice depends only on (style, i) and, with a flat bottom, on
     its own height: the same for any `count` and on any machine.
     `heights_fraction` (count,), 0 at the cloud's bottom and 1 at its top
-    (`cloudcore.artist_shading.height_fractions`), is needed only when
+    (`cloudcore.artist.artist_shading.height_fractions`), is needed only when
     `style.flat_bottom_fraction` > 0.
     """
     if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 0:
@@ -147,7 +147,7 @@ def sprite_choices(style: SpriteStyle, count: int, heights_fraction=None) -> tup
 
 def particle_sprites(style: SpriteStyle, centres) -> tuple[np.ndarray, np.ndarray]:
     """`sprite_choices` for a cloud's particle centres (n, 3), heights measured over the centres'
-    vertical extent (the same extent `cloudcore.artist_shading.artist_colours` is given)."""
+    vertical extent (the same extent `cloudcore.artist.artist_shading.artist_colours` is given)."""
     centres = np.asarray(centres, dtype=np.float64).reshape(-1, 3)
     y = centres[:, 1]
     heights = height_fractions(y, float(y.min()), float(y.max())) if len(y) else np.zeros(0)

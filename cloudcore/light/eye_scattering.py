@@ -1,7 +1,7 @@
 """What each cloud particle sends toward the eye: linear RGB and opacity (numpy, float64).
 
 Harris eq. 5: a particle scatters toward the eye the light that reached it
-(precomputed per light by `cloudcore.illumination`) times its scattering
+(precomputed per light by `cloudcore.light.illumination`) times its scattering
 coefficient times the phase function at the angle between the light and the
 view ray, plus ambient light in proportion to its opacity, all tinted by the
 cloud's colour (white by default).  A cloud that forms or dissipates has
@@ -19,22 +19,22 @@ dst = src + (1 - src_alpha) dst.
 splat_shade.comp.glsl`) evaluates the same sum per particle from the arrays
 kept here, so the CPU only sorts, and tests hold the two together.  Clouds
 shaded by Wang's artist model instead (`styles`) have their reference in
-`cloudcore.artist_shading.artist_colours`.
+`cloudcore.artist.artist_shading.artist_colours`.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from cloudcore.formation import core_distances, opacity_factor
-from cloudcore.illumination import IlluminationCache, cloud_optics, illuminate_clouds
-from cloudcore.lighting import active_lights
-from cloudcore.particle_styles import ParticleStyles, particle_styles
-from cloudcore.phase import phase_function
+from cloudcore.artist.formation import core_distances, opacity_factor
+from cloudcore.artist.particle_styles import ParticleStyles, particle_styles
+from cloudcore.artist.sprites import CELL_PIXELS
+from cloudcore.light.illumination import IlluminationCache, cloud_optics, illuminate_clouds
+from cloudcore.light.lighting import active_lights
+from cloudcore.light.phase import phase_function
+from cloudcore.light.shading import eye_pass_coefficients
 from cloudcore.ramps import smoothstep
 from cloudcore.scene import Lighting, Shading
-from cloudcore.shading import eye_pass_coefficients
-from cloudcore.sprites import CELL_PIXELS
 
 #: a particle fades out between these distances from the eye, in radii, so the
 #: camera inside one never gets a screen-filling quad.
@@ -56,7 +56,7 @@ class ParticleShading:
         styles: ParticleStyles | None = None,
     ):
         """`cache` keeps the illumination of unchanged clouds between instances (the editor);
-        `styles` (`cloudcore.particle_styles`, by default at the default hour) say which clouds
+        `styles` (`cloudcore.artist.particle_styles`, by default at the default hour) say which clouds
         are sprites or artist-shaded."""
         clouds = tuple(clouds)
         self.styles = styles if styles is not None else particle_styles(clouds, Lighting())
@@ -94,7 +94,7 @@ class ParticleShading:
         # a sprite's detail is its texture's texel, a splat's the splat itself (a smooth Gaussian)
         detail = np.where(self.styles.sprite_index >= 0, self.radii * (2.0 / CELL_PIXELS), self.radii)
         #: (clouds,) metres: the finest detail in each cloud (0 for an empty one), which bounds how
-        #: fine an impostor texture needs to be (`cloudcore.impostors.detail_size_px`)
+        #: fine an impostor texture needs to be (`cloudcore.lod.impostors.detail_size_px`)
         self.finest_radii = np.array(
             [
                 detail[start:stop].min() if stop > start else 0.0
@@ -116,7 +116,7 @@ class ParticleShading:
         """(linear RGB (n, 3), opacity (n,)) of particles `indices` seen from `eye`, near fade applied.
 
         Given `time_s` (the scene clock), clouds that form or dissipate are
-        scaled by their opacity factor at that time (`cloudcore.formation`).
+        scaled by their opacity factor at that time (`cloudcore.artist.formation`).
         """
         offset = self.centres[indices] - np.asarray(eye, dtype=np.float64)
         distance = np.linalg.norm(offset, axis=1)

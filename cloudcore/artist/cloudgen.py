@@ -10,8 +10,8 @@ distance to one already kept (`box_fill`, `cull_close`); a cull distance of a
 third of the sprite size suits typical clouds, a fifth to a sixth dense ones.
 `PRESETS` are cloud types built that way (`preset_cloud`), each with the
 per-type colour and transparency of his section 5.1 twice over: as Harris
-shading overrides and as an artist shading model (`cloudcore.artist_shading`),
-and with the atlas sprites it draws (`cloudcore.sprites`, section 3.2).
+shading overrides and as an artist shading model (`cloudcore.artist.artist_shading`),
+and with the atlas sprites it draws (`cloudcore.artist.sprites`, section 3.2).
 
 Same seed, same cloud (the shipped scenes also store the particles, so
 goldens never depend on numpy's generator streams).
@@ -26,9 +26,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from cloudcore.artist_shading import ArtistShading
+from cloudcore.artist.artist_shading import ArtistShading
+from cloudcore.artist.sprites import FOGGY, PUFFY, WISPY, SpriteStyle
 from cloudcore.scene import Cloud, Vec3
-from cloudcore.sprites import FOGGY, PUFFY, WISPY, SpriteStyle
 
 #: Wang's cull distance for typical clouds, as a fraction of the sprite size (its diameter)
 TYPICAL_CULL_FRACTION = 1.0 / 3.0

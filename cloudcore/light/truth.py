@@ -1,6 +1,6 @@
 """Ground truth for the shading models: the clouds as a heterogeneous medium, path traced by Mitsuba 3.
 
-Each particle becomes a blob of extinction with the splat kernel's profile (`cloudcore.kernel`),
+Each particle becomes a blob of extinction with the splat kernel's profile (`cloudcore.light.kernel`),
 
     sigma_t(x) = c_i K(|x - p_i| / r_i),    c_i = tau_i / (r_i * KERNEL_DIAMETER_INTEGRAL),
 
@@ -28,16 +28,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cloudcore.benchmark import PSNR_CAP_DB
 from cloudcore.camera import FAR_PLANE_M, NEAR_PLANE_M, camera_pose, pixel_rays
 from cloudcore.colour import srgb_decode
-from cloudcore.illumination import cloud_optics
-from cloudcore.imagecompare import compare
-from cloudcore.kernel import splat_kernel
-from cloudcore.lighting import active_lights, scene_hour, scene_lights, sky_colors, sky_gradient
-from cloudcore.phase import phase_function
+from cloudcore.light.illumination import cloud_optics
+from cloudcore.light.kernel import splat_kernel
+from cloudcore.light.lighting import active_lights, scene_hour, scene_lights, sky_colors, sky_gradient
+from cloudcore.light.phase import phase_function
+from cloudcore.light.shading import concatenated_ranges
+from cloudcore.measure.benchmark import PSNR_CAP_DB
+from cloudcore.measure.imagecompare import compare
 from cloudcore.scene import Camera, Scene
-from cloudcore.shading import concatenated_ranges
 
 
 def _kernel_diameter_integral(points: int = 64) -> float:

@@ -2,8 +2,8 @@
 
 A cloud is drawn as Gaussian splats in the image plane (the default), or
 with `Cloud.sprite` as atlas sprites that face the eye (locked near it,
-`cloudcore.facing`) or lie flat (cirrus); with `Cloud.artist` it is coloured
-by Wang's artist model (`cloudcore.artist_shading`) instead of Harris's
+`cloudcore.artist.facing`) or lie flat (cirrus); with `Cloud.artist` it is coloured
+by Wang's artist model (`cloudcore.artist.artist_shading`) instead of Harris's
 scattering.  `ParticleStyles` gathers what the renderer needs for that, for
 all clouds at once: per particle its cloud, shading-group centre, atlas cell
 and rotation; per cloud its facing and, for artist clouds, the model's
@@ -16,13 +16,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cloudcore.artist_shading import artist_uniforms, default_group_size, shading_groups
-from cloudcore.lighting import scene_hour, sun_direction
+from cloudcore.artist.artist_shading import artist_uniforms, default_group_size, shading_groups
+from cloudcore.artist.sprites import particle_sprites
+from cloudcore.light.lighting import scene_hour, sun_direction
 from cloudcore.scene import Lighting
-from cloudcore.sprites import particle_sprites
 
 #: how a cloud's quads are oriented: splats parallel to the image plane, sprites turned toward the
-#: eye (`cloudcore.facing.sprite_axes`), or sprites parallel to the ground
+#: eye (`cloudcore.artist.facing.sprite_axes`), or sprites parallel to the ground
 FACING_SPLAT, FACING_CAMERA, FACING_HORIZONTAL = 0, 1, 2
 _FACINGS = {"camera": FACING_CAMERA, "horizontal": FACING_HORIZONTAL}
 

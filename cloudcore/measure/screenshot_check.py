@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from cloudcore.errors import SceneError
-from cloudcore.imagecompare import Difference, compare, diff_image, load_rgb8
+from cloudcore.measure.imagecompare import Difference, compare, diff_image, load_rgb8
 from cloudcore.particle_files import atomic_write
 from cloudcore.paths import camera_on_path
 from cloudcore.scene import Camera, Scene, View

@@ -40,7 +40,7 @@ VERTICAL_TOLERANCE = 1e-6
 #: the normal of a "horizontal" sprite (Wang's cirrus quads, parallel to the ground)
 HORIZONTAL_NORMAL = (0.0, 1.0, 0.0)
 #: quad corners in (right, up) half-sizes, counter-clockwise as seen from the side the normal points to;
-#: texture coordinates (u0, v1), (u1, v1), (u1, v0), (u0, v0) of `cloudcore.sprites.atlas_cell_uv`
+#: texture coordinates (u0, v1), (u1, v1), (u1, v0), (u0, v0) of `cloudcore.artist.sprites.atlas_cell_uv`
 CORNERS = np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]])
 _FAR = 1e150
 
@@ -168,7 +168,7 @@ def sprite_corners(centres, radii, normals, rotations) -> np.ndarray:
 class CloudFacings:
     """The facing locks of every cloud of eye-facing sprites in a particle set, frame to frame.
 
-    `particles` is a `cloudcore.eye_scattering.ParticleShading`.  Only clouds
+    `particles` is a `cloudcore.light.eye_scattering.ParticleShading`.  Only clouds
     whose bounding sphere holds the eye, or that still have a sprite locked,
     are looked at: elsewhere no sprite is within its lock radius.
     """

@@ -14,8 +14,8 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass, field
 
-from cloudcore.lod_costs import CostModel
-from cloudcore.overdraw import Overdraw
+from cloudcore.lod.costs import CostModel
+from cloudcore.measure.overdraw import Overdraw
 
 
 @dataclass(frozen=True)

@@ -9,7 +9,7 @@ splatted with
     value = sigma_k * I_k * K_k(x) + (1 - alpha_k * K_k(x)) * value
 
 where alpha_k = 1 - exp(-tau_k), sigma_k = a_k tau_k p(0) / (4 pi) and K is the
-splat kernel (`cloudcore.kernel`).
+splat kernel (`cloudcore.light.kernel`).
 
 Stability.  Where sigma_k > alpha_k (tau above about 9.3 at albedo 0.9 with
 Rayleigh) the literal recurrence sends on more light than reached the particle.
@@ -40,11 +40,11 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
-from cloudcore.kernel import splat_kernel
-from cloudcore.phase import check_phase, phase_function
+from cloudcore.light.kernel import splat_kernel
+from cloudcore.light.phase import check_phase, phase_function
 
 METHODS = ("exact", "raster", "preview")
-#: what a particle sends toward the eye (`cloudcore.eye_scattering`): Harris's eq. 5 as printed, or
+#: what a particle sends toward the eye (`cloudcore.light.eye_scattering`): Harris's eq. 5 as printed, or
 #: "saturated", its scattering coefficient and ambient term made those of a thick medium
 EYE_PASSES = ("harris", "saturated")
 FOUR_PI = 4.0 * np.pi

@@ -18,9 +18,9 @@ from pathlib import Path
 
 import numpy as np
 
-from cloudcore.illumination import illuminate_clouds
-from cloudcore.imagecompare import compare
-from cloudcore.lighting import active_lights, scene_lights
+from cloudcore.light.illumination import illuminate_clouds
+from cloudcore.light.lighting import active_lights, scene_lights
+from cloudcore.measure.imagecompare import compare
 from cloudcore.navigation import orbited
 from cloudcore.paths import camera_on_path, frame_times
 from cloudcore.scene import Scene

@@ -19,9 +19,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from cloudcore.artist.sprites import ATLAS_GRID, CELL_MARGIN_PIXELS, CELL_PIXELS, FLAT_BOTTOM, FOGGY, PUFFY, WISPY
 from cloudcore.noise import hash01, value_noise
 from cloudcore.ramps import smoothstep
-from cloudcore.sprites import ATLAS_GRID, CELL_MARGIN_PIXELS, CELL_PIXELS, FLAT_BOTTOM, FOGGY, PUFFY, WISPY
 
 ATLAS_SEED = 2004
 #: where alpha has reached 0, as a fraction of the half cell: the margin starts there
@@ -35,7 +35,7 @@ FOGGY_TINT = np.array([0.92, 0.95, 1.0])
 def render_atlas(seed: int = ATLAS_SEED) -> np.ndarray:
     """The whole sheet, (ATLAS_GRID * CELL_PIXELS,) * 2 + (4,) RGBA float64 in [0, 1], rows top first.
 
-    Atlas row r (top to bottom) holds kind r of `cloudcore.sprites.ROWS`, four variants across.
+    Atlas row r (top to bottom) holds kind r of `cloudcore.artist.sprites.ROWS`, four variants across.
     """
     kinds = {FLAT_BOTTOM: _flat_bottom, FOGGY: _foggy, PUFFY: _puffy, WISPY: _wispy}
     rows = []

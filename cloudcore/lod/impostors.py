@@ -38,7 +38,7 @@ INSIDE_RADII = 1.05
 class ImpostorRecord:
     """What an impostor texture was made from: the eye, the texture side, the lighting, the layers.
 
-    A cloud split around objects (`cloudcore.splitting`) has one texture per layer: `splits`
+    A cloud split around objects (`cloudcore.lod.splitting`) has one texture per layer: `splits`
     are the objects' distances from `eye` when it was made and `layer_counts` its layers'
     particle counts.
     """

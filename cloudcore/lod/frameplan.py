@@ -2,7 +2,7 @@
 
 `plan_frame` turns (the LOD units, camera, viewport, settings, the state
 carried from the last frame, the lighting, measured costs) into a
-`FramePlan`.  A unit (`cloudcore.lod_units`) is a cloud, or a group of clouds
+`FramePlan`.  A unit (`cloudcore.lod.units`) is a cloud, or a group of clouds
 whose particles interpenetrate, drawn as one; per unit one of
 
 - ``empty``: no particles, nothing to draw;
@@ -23,13 +23,13 @@ and the `LodState` to carry into the next frame.  In auto mode the choice
 between full 3D and an impostor is by predicted cost within the tolerance:
 an impostor's error is bounded by the tolerance (it is remade past it) and
 full 3D is the reference, so both are admissible, and the plan prices each
-with the measured `CostModel` (`cloudcore.lod_costs`): full 3D its particles
+with the measured `CostModel` (`cloudcore.lod.costs`): full 3D its particles
 and fragments, the impostor its quad plus its regeneration spread over the
 frames it is predicted to last at the eye's current speed.  The GL side
 executes plans and nothing else; statistics come from the plan.
 
 Objects inside a drawn unit's bounds split it into layers
-(`cloudcore.splitting`); `draw_items` is then the frame's cloud pass far to
+(`cloudcore.lod.splitting`); `draw_items` is then the frame's cloud pass far to
 near: unit layers, and the objects between them.  Without objects in clouds
 no particle is looked at.
 """
@@ -51,8 +51,8 @@ from cloudcore.camera import (
     splats_in_frustum,
     view_matrix,
 )
-from cloudcore.frame_stats import PlanStats
-from cloudcore.impostors import (
+from cloudcore.lod.costs import CostEstimator, CostModel, Work, full_work, quad_work, regeneration_work
+from cloudcore.lod.impostors import (
     INSIDE_RADII,
     TRANSLATION_METRICS,
     ImpostorRecord,
@@ -65,13 +65,13 @@ from cloudcore.impostors import (
     screen_size_px,
     tolerance_deg_for,
 )
-from cloudcore.lod_costs import CostEstimator, CostModel, Work, full_work, quad_work, regeneration_work
-from cloudcore.lod_units import LodUnits
-from cloudcore.overdraw import analytic_overdraw
-from cloudcore.ring import RingPlan, RingState, plan_ring, segment_texture_size
+from cloudcore.lod.ring import RingPlan, RingState, plan_ring, segment_texture_size
+from cloudcore.lod.splitting import layer_bounds, layer_counts, layer_sort_key, objects_inside
+from cloudcore.lod.units import LodUnits
+from cloudcore.measure.frame_stats import PlanStats
+from cloudcore.measure.overdraw import analytic_overdraw
 from cloudcore.scene import Camera
 from cloudcore.settings import RenderSettings
-from cloudcore.splitting import layer_bounds, layer_counts, layer_sort_key, objects_inside
 
 KINDS = ("empty", "culled", "ring", "full", "crossfade", "impostor", "inside")
 #: kinds that draw from an impostor texture kept in the cache
@@ -84,7 +84,7 @@ LONGEST_LIFETIME_FRAMES = 120.0
 #: between the two, paying for a crossfade each time)
 SWITCH_MARGIN = 0.25
 #: bounding radii: a unit nearer than this has its full-3D fragments counted splat by splat, clipped to the
-#: screen (`cloudcore.overdraw.analytic_overdraw`); a ball of discs overestimates a near cloud tenfold, the
+#: screen (`cloudcore.measure.overdraw.analytic_overdraw`); a ball of discs overestimates a near cloud tenfold, the
 #: parts of it beside and behind the eye costing nothing
 NEAR_EXACT_RADII = 3.0
 #: a ring panel in view covers about this share of the screen (45 of ~75 degrees across, all the way up)
@@ -238,7 +238,7 @@ def plan_frame(
     costs: CostModel | None = None,
     cloud_splats=None,
 ) -> FramePlan:
-    """Plan one frame of `units` (`cloudcore.lod_units.LodUnits`) seen by `camera`.
+    """Plan one frame of `units` (`cloudcore.lod.units.LodUnits`) seen by `camera`.
 
     `lighting_key` identifies what the particles' colours were computed from: one key for
     all clouds, or a tuple with one per cloud (the editor changes one cloud at a time, and

@@ -1,8 +1,8 @@
 """Where the frame plan's impostors and ring panels fall on the screen, for the editor to outline (numpy).
 
 An impostor is a world-space quad through its cloud's centre, facing the eye
-it was made from (`cloudcore.impostors.impostor_view`); a ring segment is a
-panel of Wang's octagon (`cloudcore.ring.panel_corners`).  Each outline is
+it was made from (`cloudcore.lod.impostors.impostor_view`); a ring segment is a
+panel of Wang's octagon (`cloudcore.lod.ring.panel_corners`).  Each outline is
 that quad clipped to the camera's near plane (ring panels surround the eye,
 so some lie partly behind it) and projected to pixels: x right and y down
 from the viewport's top-left corner, as the GUI draws.
@@ -15,9 +15,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from cloudcore.camera import NEAR_PLANE_M, projection_matrix, view_matrix
-from cloudcore.frameplan import TEXTURED, FramePlan
-from cloudcore.impostors import impostor_view
-from cloudcore.ring import SEGMENTS, panel_corners
+from cloudcore.lod.frameplan import TEXTURED, FramePlan
+from cloudcore.lod.impostors import impostor_view
+from cloudcore.lod.ring import SEGMENTS, panel_corners
 from cloudcore.scene import Camera
 
 #: a quad's corners (lower left, lower right, upper left, upper right) in the order that walks its edges
@@ -64,7 +64,7 @@ def clip_to_near(polygon: np.ndarray, near: float) -> np.ndarray | None:
 
 
 def impostor_outlines(plan: FramePlan, units, camera: Camera, viewport: tuple[int, int]) -> list[Outline]:
-    """The quads of the units the plan draws from impostor textures; `units` (`cloudcore.lod_units.LodUnits`)
+    """The quads of the units the plan draws from impostor textures; `units` (`cloudcore.lod.units.LodUnits`)
     are those the plan was made with."""
     outlines = []
     for cloud in plan.of_kind(*TEXTURED):

@@ -1,0 +1,2 @@
+"""Measurement: frame statistics, overdraw, heat maps, image comparison, benchmarks, recordings,
+overlays, screenshot checks."""
