@@ -31,7 +31,7 @@ from cloudcore.camera import projection_matrix, view_matrix  # noqa: E402
 from cloudcore.gl.context import HeadlessContext  # noqa: E402
 from cloudcore.gl.splats import SplatPass, splat_batch  # noqa: E402
 from cloudcore.gl.targets import TextureTarget  # noqa: E402
-from cloudcore.light.eye_scattering import ParticleShading  # noqa: E402
+from cloudcore.light.eye_scattering import ParticleBuffer  # noqa: E402
 from cloudcore.light.lighting import scene_lights  # noqa: E402
 from cloudcore.lod.impostors import impostor_view  # noqa: E402
 from cloudcore.measure.benchmark import machine, write_report  # noqa: E402
@@ -72,7 +72,7 @@ def main() -> None:
     scene = load_scene(args.scene)
     cloud = max(scene.clouds, key=lambda c: len(c.particles))
     lights, ambient = scene_lights(scene.lighting)
-    particles = ParticleShading((cloud,), scene.shading, lights, ambient, "raster")
+    particles = ParticleBuffer((cloud,), scene.shading, lights, ambient, "raster")
     eye = np.asarray(scene.camera.position, dtype=np.float64)
     centre = cloud.centres.mean(axis=0)
     radius = float(np.max(np.linalg.norm(cloud.centres - centre, axis=1) + cloud.radii))

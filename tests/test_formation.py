@@ -9,7 +9,7 @@ import pytest
 
 from cloudcore.artist.formation import Formation, core_distances, formation_state, opacity_factor, progress
 from cloudcore.errors import SceneError
-from cloudcore.light.eye_scattering import ParticleShading
+from cloudcore.light.eye_scattering import ParticleBuffer
 from cloudcore.scene import Cloud, Light, Shading
 from cloudcore.scenefile import load_scene, save_scene
 
@@ -191,8 +191,8 @@ def test_bad_formation_names_file_field_and_problem(tmp_path, formation, field, 
 # ---------------------------------------------------------------- what the eye sees
 
 
-def shading_of(clouds) -> ParticleShading:
-    return ParticleShading(clouds, Shading(), [Light((0.0, 1.0, 0.0))], (0.1, 0.1, 0.1))
+def shading_of(clouds) -> ParticleBuffer:
+    return ParticleBuffer(clouds, Shading(), [Light((0.0, 1.0, 0.0))], (0.1, 0.1, 0.1))
 
 
 EYE = np.array([0.0, 900.0, 3000.0])

@@ -18,7 +18,7 @@ def blob(centre, count=300, spread=40.0, radius=12.0):
 
 
 class Packed:
-    """The parts of a `ParticleShading` that `lod_units` reads."""
+    """The parts of a `ParticleBuffer` that `lod_units` reads."""
 
     def __init__(self, blobs):
         self.centres = np.concatenate([b[0] for b in blobs])

@@ -5,7 +5,7 @@ import pytest
 
 from cloudcore.artist.particle_styles import particle_styles
 from cloudcore.camera import projection_matrix, view_matrix
-from cloudcore.light.eye_scattering import ParticleShading
+from cloudcore.light.eye_scattering import ParticleBuffer
 from cloudcore.lod.impostors import impostor_view
 from cloudcore.point_sprites import draw_runs, plain_splats, point_sprite_mask
 from cloudcore.scene import Camera, Cloud, Light, Shading
@@ -76,7 +76,7 @@ def test_an_impostor_drawn_with_points_is_the_one_drawn_with_quads(renderer, cou
     from cloudcore.gl.targets import TextureTarget
 
     particles_array = dense_cloud(np.random.default_rng(3), 400)
-    particles = ParticleShading((Cloud("cumulus", particles_array, optical_depth=1.5),), Shading(), LIGHTS, AMBIENT)
+    particles = ParticleBuffer((Cloud("cumulus", particles_array, optical_depth=1.5),), Shading(), LIGHTS, AMBIENT)
     eye = np.array([150.0, 40.0, 0.0])
     centre = particles_array[:, :3].mean(axis=0)
     radius = float(np.max(np.linalg.norm(particles_array[:, :3] - centre, axis=1) + particles_array[:, 3]))
@@ -128,7 +128,7 @@ def test_splats_around_the_eye_drawn_as_points_and_quads_together_match_quads_al
 
     rng = np.random.default_rng(8)
     around = np.column_stack([rng.uniform(-1500.0, 1500.0, (40000, 3)), rng.uniform(10.0, 60.0, 40000)])
-    particles = ParticleShading((Cloud("around the eye", around, optical_depth=0.5),), Shading(), LIGHTS, AMBIENT)
+    particles = ParticleBuffer((Cloud("around the eye", around, optical_depth=0.5),), Shading(), LIGHTS, AMBIENT)
     width, height = 160, 120
     view, projection = view_matrix(CAMERA), projection_matrix(CAMERA.fov_y_deg, width / height)
     batch = splat_batch(particles, [0], CAMERA.position, frustum=frustum_planes(projection @ view))

@@ -1,4 +1,4 @@
-"""The splat vertex shader colours particles as `ParticleShading.seen_from` does (the numpy reference).
+"""The splat vertex shader colours particles as `ParticleBuffer.seen_from` does (the numpy reference).
 
 Particles far apart on screen are drawn into a cleared float target; at each
 particle's centre pixel the kernel is nearly 1, so the pixel holds the
@@ -11,7 +11,7 @@ import pytest
 
 from cloudcore.artist.formation import Formation
 from cloudcore.camera import projection_matrix, view_matrix
-from cloudcore.light.eye_scattering import ParticleShading
+from cloudcore.light.eye_scattering import ParticleBuffer
 from cloudcore.light.kernel import splat_kernel
 from cloudcore.scene import Camera, Cloud, Light, Shading
 
@@ -52,7 +52,7 @@ def test_the_shader_colours_particles_as_the_reference_does(renderer, phase, g, 
             formation=Formation("form", 0.0, 10.0),
         ),
     )
-    particles = ParticleShading(clouds, Shading(albedo=0.85, phase=phase, g=g, eye_pass=eye_pass), LIGHTS, AMBIENT)
+    particles = ParticleBuffer(clouds, Shading(albedo=0.85, phase=phase, g=g, eye_pass=eye_pass), LIGHTS, AMBIENT)
     view, projection = view_matrix(CAMERA), projection_matrix(CAMERA.fov_y_deg, WIDTH / HEIGHT)
     time_s = 4.0  # the forming cloud's core is in, its edge not yet
     renderer.context.make_current()
@@ -105,7 +105,7 @@ def test_the_shader_colours_artist_clouds_as_the_reference_does(renderer):
     cloud = Cloud("artist", particles_xyzr, artist=ArtistShading(), shading_group_size=1000.0)
     hour = 17.0
     styles = particle_styles((cloud,), Lighting(hour))
-    particles = ParticleShading((cloud,), Shading(), LIGHTS, AMBIENT, styles=styles)
+    particles = ParticleBuffer((cloud,), Shading(), LIGHTS, AMBIENT, styles=styles)
     view, projection = view_matrix(CAMERA), projection_matrix(CAMERA.fov_y_deg, WIDTH / HEIGHT)
     renderer.context.make_current()
     splats, target = SplatPass(), TextureTarget(WIDTH, HEIGHT)
@@ -169,7 +169,7 @@ def test_splats_left_out_by_the_frustum_change_no_pixel(renderer):
 
     rng = np.random.default_rng(5)
     around = np.column_stack([rng.uniform(-300.0, 300.0, (2000, 3)), rng.uniform(4.0, 40.0, 2000)])
-    particles = ParticleShading((Cloud("around the eye", around, optical_depth=1.0),), Shading(), LIGHTS, AMBIENT)
+    particles = ParticleBuffer((Cloud("around the eye", around, optical_depth=1.0),), Shading(), LIGHTS, AMBIENT)
     view, projection = view_matrix(CAMERA), projection_matrix(CAMERA.fov_y_deg, WIDTH / HEIGHT)
     frustum = frustum_planes(projection @ view)
     renderer.context.make_current()

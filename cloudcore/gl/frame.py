@@ -42,7 +42,7 @@ from cloudcore.gl.quads import SCREEN_CORNERS, QuadPass
 from cloudcore.gl.splats import SplatPass, splat_batch
 from cloudcore.gl.targets import TextureTarget, blit_depth, depth_renderbuffer
 from cloudcore.gl.world import WorldPass
-from cloudcore.light.eye_scattering import ParticleShading
+from cloudcore.light.eye_scattering import ParticleBuffer
 from cloudcore.light.illumination import IlluminationCache
 from cloudcore.light.lighting import scene_hour, scene_lights, sky_colors
 from cloudcore.lod.costs import CostModel
@@ -59,7 +59,7 @@ class _CloudPassFrame:
     """What every draw of one frame's cloud pass shares."""
 
     plan: FramePlan
-    particles: ParticleShading
+    particles: ParticleBuffer
     camera: Camera
     view: np.ndarray
     projection: np.ndarray
@@ -275,7 +275,7 @@ class FrameRenderer:
         if particles_source == self._particles_source:
             return 0.0
         start = time.perf_counter()
-        self._particles = ParticleShading(
+        self._particles = ParticleBuffer(
             scene.clouds,
             scene.shading,
             lights,
@@ -305,7 +305,7 @@ class FrameRenderer:
     def _draw_clouds(
         self,
         plan: FramePlan,
-        particles: ParticleShading,
+        particles: ParticleBuffer,
         camera: Camera,
         view,
         projection,

@@ -17,7 +17,7 @@ import numpy as np
 from cloudcore.gl.splats import SplatPass, splat_batch
 from cloudcore.gl.targets import TextureTarget
 from cloudcore.gl.texture_pool import TexturePool
-from cloudcore.light.eye_scattering import ParticleShading
+from cloudcore.light.eye_scattering import ParticleBuffer
 from cloudcore.lod.frameplan import FramePlan
 from cloudcore.lod.impostors import ImpostorView, cropped_corners, impostor_view, particle_extent
 from cloudcore.lod.ring import RingGeneration, panel_corners, segment_camera
@@ -36,7 +36,7 @@ class ImpostorStore:
         self._ring: dict[tuple[RingGeneration, int], tuple[TextureTarget, tuple]] = {}  # (texture, extent)
 
     def update(
-        self, plan: FramePlan, units: LodUnits, particles: ParticleShading, settings: RenderSettings, time_s: float
+        self, plan: FramePlan, units: LodUnits, particles: ParticleBuffer, settings: RenderSettings, time_s: float
     ) -> int:
         """Render this frame's regenerations and ring segment at scene time `time_s`; returns the particles rendered."""
         rendered = 0
@@ -138,7 +138,7 @@ class ImpostorStore:
         self.pool.close()
 
 
-def _extent(particles: ParticleShading, clouds, view, projection, size) -> tuple:
+def _extent(particles: ParticleBuffer, clouds, view, projection, size) -> tuple:
     """The part of a texture rendered through (view, projection) that the particles of `clouds` can cover."""
     starts = particles.cloud_starts
     indices = np.concatenate([np.arange(starts[c], starts[c + 1]) for c in clouds]) if len(clouds) else []

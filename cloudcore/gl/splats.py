@@ -1,6 +1,6 @@
 """Splats: particles as instanced camera-facing billboards, blended back to front.
 
-The particles stay on the GPU: `SplatPass` uploads a `ParticleShading`'s
+The particles stay on the GPU: `SplatPass` uploads a `ParticleBuffer`'s
 per-particle terms (centre, radius, scattering, ambient, incident light per
 light) once, into a storage buffer, and a compute shader colours each
 particle of a draw for the eye (Harris eq. 5) into the instance attributes
@@ -27,7 +27,7 @@ from cloudcore.artist.sprites import ATLAS_GRID, ATLAS_MAX_MIP_LEVEL, load_atlas
 from cloudcore.camera import splats_in_frustum
 from cloudcore.gl.blending import cloud_blending
 from cloudcore.gl.programs import build_compute_program, build_program, set_matrix, set_vec3
-from cloudcore.light.eye_scattering import FADE_END_RADII, FADE_START_RADII, ParticleShading
+from cloudcore.light.eye_scattering import FADE_END_RADII, FADE_START_RADII, ParticleBuffer
 from cloudcore.light.kernel import SPLAT_SHARPNESS
 from cloudcore.light.phase import PHASE_NAMES
 from cloudcore.limits import MAX_LIGHTS
@@ -55,7 +55,7 @@ _SHADE_GROUP = 64
 class SplatBatch:
     """Particles of one draw, far to near from `eye`, as indices into `particles`."""
 
-    particles: ParticleShading
+    particles: ParticleBuffer
     order: np.ndarray  # (n,) uint32
     eye: np.ndarray
     time_s: float | None
@@ -74,7 +74,7 @@ class SplatBatch:
 
 
 def splat_batch(
-    particles: ParticleShading,
+    particles: ParticleBuffer,
     clouds,
     eye,
     depth_ranges=None,
@@ -85,7 +85,7 @@ def splat_batch(
 
     `depth_ranges`, one (near, far) per cloud, keeps only the particles with
     near < distance from `eye` <= far: one layer of a cloud split around objects.
-    `time_s`, the scene clock, fades forming and dissipating clouds (`ParticleShading.seen_from`).
+    `time_s`, the scene clock, fades forming and dissipating clouds (`ParticleBuffer.seen_from`).
     `frustum`, the draw's planes (`cloudcore.camera.frustum_planes`), leaves out the splats outside it.
     """
     starts = particles.cloud_starts
@@ -137,7 +137,7 @@ class SplatPass:
         self._atlas: int | None = None  # the sprite atlas texture, made when a cloud first needs it
         self._quads_indexed = 0
         self._instance_capacity = 0
-        self._resident: ParticleShading | None = None
+        self._resident: ParticleBuffer | None = None
         self._formation_time: float | None = None
 
     def draw(
@@ -216,7 +216,7 @@ class SplatPass:
         GL.glBufferData(GL.GL_ELEMENT_ARRAY_BUFFER, indices.nbytes, indices, GL.GL_STATIC_DRAW)
         self._quads_indexed = count
 
-    def update_facing(self, particles: ParticleShading, start: int, state: FacingState) -> None:
+    def update_facing(self, particles: ParticleBuffer, start: int, state: FacingState) -> None:
         """The facing lock of particles `start`, `start + 1`, ... (one cloud's) for the next draws."""
         self._make_resident(particles)
         records = np.empty((len(state.fade), 4), dtype=np.float32)
@@ -253,7 +253,7 @@ class SplatPass:
         GL.glDispatchCompute(-(-len(batch) // _SHADE_GROUP), 1, 1)
         GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT)
 
-    def _make_resident(self, particles: ParticleShading) -> None:
+    def _make_resident(self, particles: ParticleBuffer) -> None:
         """Upload the particles' shading terms, styles and unlocked facings when the particles change."""
         if particles is not self._resident:
             _store(self._particle_buffer, _particle_records(particles))
@@ -270,7 +270,7 @@ class SplatPass:
             _set_light_uniforms(self._shade_program, particles)
             self._resident, self._formation_time = particles, None
 
-    def _hold_formation(self, particles: ParticleShading, time_s: float | None) -> None:
+    def _hold_formation(self, particles: ParticleBuffer, time_s: float | None) -> None:
         """Upload the formation factors at `time_s` when they differ from those held."""
         factors = particles.formation_factors(time_s)
         held = None if factors is None else time_s  # the time the buffer's factors are for; None: all 1
@@ -292,7 +292,7 @@ class SplatPass:
         self._resident = None
 
 
-def _particle_records(particles: ParticleShading) -> np.ndarray:
+def _particle_records(particles: ParticleBuffer) -> np.ndarray:
     """The shader's `Particle` array (n, _PARTICLE_FLOATS) float32: the view-independent terms of `seen_from`."""
     lights = len(particles.light_directions)
     if lights > MAX_LIGHTS:  # the scene loader and the editor refuse these first (cloudcore.limits)
@@ -347,7 +347,7 @@ def _atlas_texture() -> int:
     return texture
 
 
-def _set_light_uniforms(program: int, particles: ParticleShading) -> None:
+def _set_light_uniforms(program: int, particles: ParticleBuffer) -> None:
     GL.glUseProgram(program)
     lights = len(particles.light_directions)
     GL.glUniform1i(GL.glGetUniformLocation(program, "light_count"), lights)

@@ -42,8 +42,10 @@ FADE_START_RADII = 0.5
 FADE_END_RADII = 1.5
 
 
-class ParticleShading:
-    """All particles of a scene's clouds, concatenated, with their illumination precomputed."""
+class ParticleBuffer:
+    """The scene's packed particle buffer: every cloud's particles concatenated, with what the splats are
+    drawn from (their incident light per light, scattering and ambient terms, styles, formation), and their
+    colour seen from an eye (`seen_from`, the reference of the GL side's eye pass)."""
 
     def __init__(
         self,

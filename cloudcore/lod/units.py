@@ -104,7 +104,7 @@ def interpenetrating_groups(
 
 
 def lod_units(particles, group: bool = True) -> LodUnits:
-    """The units of a `ParticleShading`: its clouds, interpenetrating ones grouped (`group`)."""
+    """The units of a `ParticleBuffer`: its clouds, interpenetrating ones grouped (`group`)."""
     starts = particles.cloud_starts
     sphere_centres, sphere_radii = particles.bounding_centres, particles.bounding_radii
     members = (
