@@ -39,8 +39,8 @@ def test_splats_inside_the_view_fit_and_a_centre_outside_it_does_not():
 
 def test_a_square_wider_than_the_largest_point_keeps_quads():
     view, projection = rotation_of(view_matrix(CAMERA)), projection_matrix(60.0, 1.0)
-    # side in pixels = r * focal * height / depth: 100 px here, 1000 px at ten times the height
-    centre, radius = np.array([[0.0, 0.0, -100.0]]), [100.0 / (projection[1, 1] * 100.0) * 100.0]
+    # side in pixels = r * focal * height / depth: 100 px at a height of 100, 1000 px at ten times it
+    centre, radius = np.array([[0.0, 0.0, -100.0]]), [100.0 / projection[1, 1]]
     assert points_fit(centre, radius, view, projection, (100, 100), POINT_SIZES_PX)
     assert not points_fit(centre, radius, view, projection, (1000, 1000), POINT_SIZES_PX)
 

@@ -67,6 +67,7 @@ class _CloudPassFrame:
     frustum: np.ndarray  # the view's planes (`cloudcore.camera.frustum_planes`)
     poses: tuple
     time_s: float
+    point_sprites: bool  # the setting: draw plain splats as points where the picture is the same
 
     @property
     def eye(self) -> np.ndarray:
@@ -317,9 +318,17 @@ class FrameRenderer:
         returns the particles drawn."""
         view_projection = projection @ view
         frame = _CloudPassFrame(
-            plan, particles, camera, view, projection, view_projection, frustum_planes(view_projection), poses, time_s
+            plan,
+            particles,
+            camera,
+            view,
+            projection,
+            view_projection,
+            frustum_planes(view_projection),
+            poses,
+            time_s,
+            settings.point_sprites,
         )
-        points = settings.point_sprites
         self._replay, self._screen_batches = [], []
         if plan.ring is not None:
             self._draw_ring(frame, settings.ring_elevation_deg)
@@ -334,23 +343,23 @@ class FrameRenderer:
                 full_run += [(member, (item.near, item.far)) for member in cloud.members]
                 continue
             if full_run:
-                drawn += self._draw_splats(frame, points, *zip(*full_run))
+                drawn += self._draw_splats(frame, *zip(*full_run))
                 full_run = []
             if cloud is None:
                 self._objects.draw(self.context, camera, poses, [item.index], write_depth=False)
             elif cloud.kind == "inside":
                 if id(item) in screen_impostors:  # the rest of its run is in the same screen impostor
-                    drawn += self._draw_inside(frame, points, screen_impostors[id(item)], cloud.full_weight)
+                    drawn += self._draw_inside(frame, screen_impostors[id(item)], cloud.full_weight)
             else:
-                drawn += kinds[cloud.kind](frame, points, item, cloud)
+                drawn += kinds[cloud.kind](frame, item, cloud)
         if full_run:
-            drawn += self._draw_splats(frame, points, *zip(*full_run))
+            drawn += self._draw_splats(frame, *zip(*full_run))
         return drawn
 
-    def _draw_splats(self, frame: _CloudPassFrame, points: bool, clouds, depth_ranges) -> int:
+    def _draw_splats(self, frame: _CloudPassFrame, clouds, depth_ranges) -> int:
         """Full 3D: the clouds' splats (each cloud's within its depth range) sorted together, on the screen."""
         batch = splat_batch(frame.particles, clouds, frame.eye, depth_ranges, frame.time_s, frame.frustum)
-        view, projection = frame.view, frame.projection
+        view, projection, points = frame.view, frame.projection, frame.point_sprites
         self._splats.draw(batch, view, projection, point_sprites=points)
         self._replay.append(lambda: self._splats.draw(batch, view, projection, counting=True, point_sprites=points))
         self._screen_batches.append(batch)
@@ -373,18 +382,18 @@ class FrameRenderer:
                 target, corners, extent = self._impostors.ring_panel(generation, segment, elevation_deg)
                 self._draw_quad(frame, corners, target.texture, weight, uv_rect=extent)
 
-    def _draw_impostor(self, frame: _CloudPassFrame, points: bool, item, cloud) -> int:
+    def _draw_impostor(self, frame: _CloudPassFrame, item, cloud) -> int:
         """A unit's impostor (one layer of it, when split around objects) as a quad."""
         target, corners, extent = self._impostors.cloud_impostor(cloud.members, item.layer)
         self._draw_quad(frame, corners, target.texture, cloud.impostor_weight, uv_rect=extent)
         return 0
 
-    def _draw_crossfade(self, frame: _CloudPassFrame, points: bool, item, cloud) -> int:
+    def _draw_crossfade(self, frame: _CloudPassFrame, item, cloud) -> int:
         """A unit between its impostor and full 3D: its splats into a screen layer, mixed with the impostor."""
         target, corners, extent = self._impostors.cloud_impostor(cloud.members, item.layer)
         layer = self._screen_layer()
         layer.bind_cleared()
-        drawn = self._draw_splats(frame, points, cloud.members, [(item.near, item.far)] * len(cloud.members))
+        drawn = self._draw_splats(frame, cloud.members, [(item.near, item.far)] * len(cloud.members))
         self.context.bind_target()
         self._draw_quad(
             frame,
@@ -397,7 +406,7 @@ class FrameRenderer:
         )
         return drawn
 
-    def _draw_inside(self, frame: _CloudPassFrame, points: bool, run, weight: float) -> int:
+    def _draw_inside(self, frame: _CloudPassFrame, run, weight: float) -> int:
         """Harris's screen impostor of the units the eye is in (`run`, consecutive draw items), their
         particles sorted together at the plan's reduced resolution, then laid over the screen."""
         target = self._inside_target(frame.plan.inside_size)
@@ -406,7 +415,7 @@ class FrameRenderer:
             *[(member, (item.near, item.far)) for item in run for member in frame.plan.clouds[item.index].members]
         )
         batch = splat_batch(frame.particles, members, frame.eye, depth_ranges, frame.time_s, frame.frustum)
-        self._splats.draw(batch, frame.view, frame.projection, point_sprites=points)
+        self._splats.draw(batch, frame.view, frame.projection, point_sprites=frame.point_sprites)
         self.context.bind_target()
         self._draw_quad(frame, SCREEN_CORNERS, target.texture, weight, screen=True)
         return len(batch)

@@ -161,11 +161,16 @@ class SplatPass:
         view_rotation = np.array(view, dtype=np.float64)
         view_rotation[:3, 3] = 0.0  # corners come relative to the batch's eye, the view's own
         pieces, target_viewport = [(0, len(batch), False)], None
-        if point_sprites and self._plain[batch.order].any():
+        plain = self._plain[batch.order] if point_sprites else None
+        if plain is not None and plain.any():
             # the same pixels through a clip volume wider than the target (cloudcore.point_sprites)
             target_viewport = GL.glGetIntegerv(GL.GL_VIEWPORT)
             projection, viewport = guard_band(projection, target_viewport[2:], self._point_sizes_px[1])
-            pieces = self._runs(batch, view_rotation, projection, viewport[2:])
+            size = (int(viewport[2]), int(viewport[3]))
+            fit = point_sprite_mask(
+                batch.centres - batch.eye, batch.radii, view_rotation, projection, size, self._point_sizes_px
+            )
+            pieces = draw_runs(plain & fit)
             GL.glViewport(*viewport)
         for as_points in {piece[2] for piece in pieces}:
             program = self._programs[as_points, counting]
@@ -196,15 +201,6 @@ class SplatPass:
         as_points = sum(stop - start for start, stop, as_points in pieces if as_points)
         self.particles_as_points += as_points
         return as_points
-
-    def _runs(self, batch: SplatBatch, view_rotation, projection, viewport) -> list[tuple[int, int, bool]]:
-        """The batch's runs of points and of quads (`cloudcore.point_sprites.draw_runs`) in a (width, height)
-        viewport."""
-        size = (int(viewport[0]), int(viewport[1]))
-        fit = point_sprite_mask(
-            batch.centres - batch.eye, batch.radii, view_rotation, projection, size, self._point_sizes_px
-        )
-        return draw_runs(self._plain[batch.order] & fit)
 
     def _index_quads(self, count: int) -> None:
         """Grow the (bound vertex array's) element buffer to hold the triangles of `count` particles."""
