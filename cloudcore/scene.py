@@ -12,9 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from cloudcore.artist.artist_shading import ArtistShading
-from cloudcore.artist.formation import Formation
-from cloudcore.artist.sprites import SpriteStyle
+from cloudcore.cloud_records import ArtistShading, Formation, SpriteStyle
 
 Vec3 = tuple[float, float, float]
 

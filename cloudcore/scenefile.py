@@ -16,9 +16,7 @@ from pathlib import Path
 import numpy as np
 import tomlkit
 
-from cloudcore.artist.artist_shading import ArtistShading
-from cloudcore.artist.formation import FORMATION_KINDS, Formation
-from cloudcore.artist.sprites import FACINGS, MAX_SEED, SpriteStyle
+from cloudcore.cloud_records import FACINGS, FORMATION_KINDS, MAX_SEED, ArtistShading, Formation, SpriteStyle
 from cloudcore.light.phase import MAX_ABS_G, PHASE_NAMES
 from cloudcore.light.shading import EYE_PASSES
 from cloudcore.limits import scene_limit_problems

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from cloudcore.artist.cloudgen import preset_cloud
-from cloudcore.artist.formation import Formation
+from cloudcore.cloud_records import Formation
 from cloudcore.scene import Camera, CameraPath, Lighting, Scene, Shading, Terrain
 from cloudcore.scenefile import save_scene
 

@@ -5,8 +5,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from cloudcore.artist.artist_shading import ArtistShading
-from cloudcore.artist.sprites import SpriteStyle
+from cloudcore.cloud_records import ArtistShading, SpriteStyle
 from cloudcore.resources import DEFAULT_SCENE
 from cloudcore.scene import Camera, CameraPath, Cloud, Light, Lighting, Scene, SceneObject, Shading, Terrain, View
 

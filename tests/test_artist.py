@@ -5,7 +5,6 @@ import pytest
 
 from cloudcore.artist.artist_shading import (
     DEFAULT_GROUP_RADII,
-    ArtistShading,
     artist_colours,
     artist_uniforms,
     default_group_size,
@@ -15,6 +14,7 @@ from cloudcore.artist.artist_shading import (
     vertical_colour,
 )
 from cloudcore.artist.cloudgen import preset_cloud
+from cloudcore.cloud_records import ArtistShading
 from cloudcore.errors import FieldError
 from cloudcore.light.lighting import sun_direction
 

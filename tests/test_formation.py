@@ -7,7 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from cloudcore.artist.formation import Formation, core_distances, formation_state, opacity_factor, progress
+from cloudcore.artist.formation import core_distances, formation_state, opacity_factor, progress
+from cloudcore.cloud_records import Formation
 from cloudcore.errors import SceneError
 from cloudcore.light.eye_scattering import ParticleBuffer
 from cloudcore.scene import Cloud, Light, Shading

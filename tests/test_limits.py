@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from app.editor import Editor
-from cloudcore.artist.artist_shading import ArtistShading
+from cloudcore.cloud_records import ArtistShading
 from cloudcore.editing import add_particle
 from cloudcore.errors import SceneError
 from cloudcore.limits import DRAWN_TERRAIN_KINDS, MAX_FRAME_SIDE, MAX_LIGHTS, scene_limit_problems

@@ -9,8 +9,8 @@ the kernel altogether and must match the reference closely.
 import numpy as np
 import pytest
 
-from cloudcore.artist.formation import Formation
 from cloudcore.camera import projection_matrix, view_matrix
+from cloudcore.cloud_records import Formation
 from cloudcore.light.eye_scattering import ParticleBuffer
 from cloudcore.light.kernel import splat_kernel
 from cloudcore.scene import Camera, Cloud, Light, Shading
@@ -94,8 +94,9 @@ def test_the_shader_colours_particles_as_the_reference_does(renderer, phase, g, 
 def test_the_shader_colours_artist_clouds_as_the_reference_does(renderer):
     """Wang's model per corner (`artist_colours`); the quad's centre lies on the diagonal between
     its lower-right and upper-left corners, so it gets their mean."""
-    from cloudcore.artist.artist_shading import ArtistShading, artist_colours
+    from cloudcore.artist.artist_shading import artist_colours
     from cloudcore.artist.particle_styles import particle_styles
+    from cloudcore.cloud_records import ArtistShading
     from cloudcore.gl.splats import SplatPass, splat_batch
     from cloudcore.gl.targets import TextureTarget
     from cloudcore.light.lighting import sun_direction
@@ -138,7 +139,7 @@ def test_a_sprite_the_eye_stands_in_keeps_its_facing_and_fades_as_the_eye_circle
     simply be gone: the near fade)."""
     import dataclasses
 
-    from cloudcore.artist.sprites import PUFFY, SpriteStyle
+    from cloudcore.cloud_records import PUFFY, SpriteStyle
     from cloudcore.scene import Lighting, Scene
     from cloudcore.settings import FULL_3D
 

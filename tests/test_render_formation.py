@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from cloudcore.artist.cloudgen import preset_cloud
-from cloudcore.artist.formation import Formation
+from cloudcore.cloud_records import Formation
 from cloudcore.scene import Camera, Scene
 from cloudcore.settings import FULL_3D, RenderSettings
 

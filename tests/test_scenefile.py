@@ -300,8 +300,7 @@ def test_a_cloud_without_sprite_or_artist_keeps_splats_and_harris(tmp_path):
 
 
 def test_sprite_and_artist_tables_take_their_defaults(tmp_path):
-    from cloudcore.artist.artist_shading import ArtistShading
-    from cloudcore.artist.sprites import SpriteStyle
+    from cloudcore.cloud_records import ArtistShading, SpriteStyle
 
     (tmp_path / "d.toml").write_text(BASE.replace('name = "a"', 'name = "a"\nsprite = {}\nartist = {}', 1))
     cloud = load_scene(tmp_path / "d.toml").clouds[0]

@@ -5,21 +5,15 @@ import pytest
 
 from cloudcore.artist.sprite_art import render_atlas
 from cloudcore.artist.sprites import (
-    ATLAS_GRID,
     ATLAS_MAX_MIP_LEVEL,
     CELL_MARGIN_PIXELS,
     CELL_PIXELS,
-    FLAT_BOTTOM,
-    FOGGY,
-    PUFFY,
-    ROWS,
-    WISPY,
-    SpriteStyle,
     atlas_cell_uv,
     load_atlas,
     particle_sprites,
     sprite_choices,
 )
+from cloudcore.cloud_records import ATLAS_GRID, FLAT_BOTTOM, FOGGY, PUFFY, ROWS, WISPY, SpriteStyle
 from cloudcore.errors import FieldError
 
 

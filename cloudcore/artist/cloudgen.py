@@ -26,8 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from cloudcore.artist.artist_shading import ArtistShading
-from cloudcore.artist.sprites import FOGGY, PUFFY, WISPY, SpriteStyle
+from cloudcore.cloud_records import FOGGY, PUFFY, WISPY, ArtistShading, SpriteStyle
 from cloudcore.scene import Cloud, Vec3
 
 #: Wang's cull distance for typical clouds, as a fraction of the sprite size (its diameter)

@@ -20,34 +20,14 @@ played backwards.  Outside the animation the factor is exactly 0 or 1.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
-FORMATION_KINDS = ("form", "dissipate")
+from cloudcore.cloud_records import Formation
 
 #: fraction of the animation by which the farthest particle lags the core:
 #: one half, so the edge starts when the core is fully opaque (Wang section 4)
 EDGE_LAG = 0.5
-
-
-@dataclass(frozen=True)
-class Formation:
-    """A cloud forming or dissipating over `duration_s` seconds from `start_s` on the scene clock."""
-
-    kind: str
-    start_s: float
-    duration_s: float
-
-    def __post_init__(self):
-        object.__setattr__(self, "start_s", float(self.start_s))
-        object.__setattr__(self, "duration_s", float(self.duration_s))
-        if self.kind not in FORMATION_KINDS:
-            raise ValueError(f"formation kind {self.kind!r} is not one of: {', '.join(FORMATION_KINDS)}")
-        if not math.isfinite(self.start_s):
-            raise ValueError(f"formation start_s must be finite, got {self.start_s}")
-        if not (math.isfinite(self.duration_s) and self.duration_s >= 0):
-            raise ValueError(f"formation duration_s must be finite and >= 0, got {self.duration_s}")
 
 
 def progress(formation: Formation, time_s: float) -> float:

@@ -19,7 +19,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from cloudcore.artist.sprites import ATLAS_GRID, CELL_MARGIN_PIXELS, CELL_PIXELS, FLAT_BOTTOM, FOGGY, PUFFY, WISPY
+from cloudcore.artist.sprites import CELL_MARGIN_PIXELS, CELL_PIXELS
+from cloudcore.cloud_records import ATLAS_GRID, FLAT_BOTTOM, FOGGY, PUFFY, WISPY
 from cloudcore.noise import hash01, value_noise
 from cloudcore.ramps import smoothstep
 
@@ -35,7 +36,7 @@ FOGGY_TINT = np.array([0.92, 0.95, 1.0])
 def render_atlas(seed: int = ATLAS_SEED) -> np.ndarray:
     """The whole sheet, (ATLAS_GRID * CELL_PIXELS,) * 2 + (4,) RGBA float64 in [0, 1], rows top first.
 
-    Atlas row r (top to bottom) holds kind r of `cloudcore.artist.sprites.ROWS`, four variants across.
+    Atlas row r (top to bottom) holds kind r of `cloudcore.cloud_records.ROWS`, four variants across.
     """
     kinds = {FLAT_BOTTOM: _flat_bottom, FOGGY: _foggy, PUFFY: _puffy, WISPY: _wispy}
     rows = []

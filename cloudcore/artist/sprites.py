@@ -25,89 +25,20 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
 from cloudcore.artist.artist_shading import height_fractions
-from cloudcore.errors import FieldError
+from cloudcore.cloud_records import ATLAS_GRID, FLAT_BOTTOM, SpriteStyle
 from cloudcore.noise import hash01
 from cloudcore.resources import ATLAS
 
 ATLAS_PATH = ATLAS
-ATLAS_GRID = 4
 CELL_PIXELS = 256
 #: empty border of each cell, in pixels at mip level 0
 CELL_MARGIN_PIXELS = 16
 #: the deepest mip level at which cells still keep an empty border (16 px -> 1 px): clamp the texture's levels here
 ATLAS_MAX_MIP_LEVEL = int(math.log2(CELL_MARGIN_PIXELS))
-#: atlas rows, top to bottom
-ROWS = ("flat_bottom", "foggy", "puffy", "wispy")
-FLAT_BOTTOM, FOGGY, PUFFY, WISPY = range(len(ROWS))
-FACINGS = ("camera", "horizontal")
-MAX_SEED = 2**31 - 1
-#: Wang: "all other sprites the full range of rotation (0 to 360 degrees)"
-FULL_CIRCLE_DEG = (0.0, 360.0)
-#: Wang: "cumulus cloud bottoms a narrow range" of about 5 degrees either way, so the flat edge stays down
-NARROW_DEG = (-5.0, 5.0)
-
-
-@dataclass(frozen=True)
-class SpriteStyle:
-    """How a cloud's particles draw from the atlas (Wang 2004, sections 3.2 and 7.1).
-
-    rows: atlas rows the sprites are drawn from, uniformly per entry (a row
-        listed twice is drawn twice as often).
-    rotation_deg: (low, high) range of each sprite's rotation in its plane,
-        counter-clockwise as seen by the viewer, 0 = upright; at most 360 wide.
-    facing: "camera" (billboards turned toward the eye, locked near it:
-        `cloudcore.artist.facing`) or "horizontal" (flat quads parallel to the ground,
-        Wang's cirrus: "flat textured rectangles").
-    seed: the per-cloud seed of every choice.
-    flat_bottom_fraction: particles whose centres lie in this lowest fraction
-        of the cloud's height draw the flat-bottom row instead, with rotations
-        in `flat_bottom_rotation_deg` (Wang: flat textures "create flat bottoms
-        in cumulus clouds", with a narrow rotation range); 0 = none.
-    """
-
-    rows: tuple[int, ...] = (PUFFY, WISPY)
-    rotation_deg: tuple[float, float] = FULL_CIRCLE_DEG
-    facing: str = "camera"
-    seed: int = 0
-    flat_bottom_fraction: float = 0.0
-    flat_bottom_rotation_deg: tuple[float, float] = NARROW_DEG
-
-    def __post_init__(self):
-        rows = tuple(self.rows)
-        if not rows or not all(
-            isinstance(r, (int, np.integer)) and not isinstance(r, bool) and 0 <= r < ATLAS_GRID for r in rows
-        ):
-            raise FieldError("rows", f"expected one or more atlas rows in 0..{ATLAS_GRID - 1}, got {list(rows)}")
-        object.__setattr__(self, "rows", tuple(int(r) for r in rows))
-        for name in ("rotation_deg", "flat_bottom_rotation_deg"):
-            object.__setattr__(self, name, _rotation_range(name, getattr(self, name)))
-        if self.facing not in FACINGS:
-            raise FieldError("facing", f"{self.facing!r} is not one of: {', '.join(FACINGS)}")
-        if (
-            isinstance(self.seed, bool)
-            or not isinstance(self.seed, (int, np.integer))
-            or not 0 <= self.seed <= MAX_SEED
-        ):
-            raise FieldError("seed", f"expected an integer in [0, {MAX_SEED}], got {self.seed!r}")
-        object.__setattr__(self, "seed", int(self.seed))
-        fraction = float(self.flat_bottom_fraction)
-        if not 0.0 <= fraction <= 1.0:
-            raise FieldError("flat_bottom_fraction", f"must be within [0, 1], got {fraction}")
-        object.__setattr__(self, "flat_bottom_fraction", fraction)
-
-
-def _rotation_range(name: str, value) -> tuple[float, float]:
-    low, high = (float(v) for v in value)
-    if not (math.isfinite(low) and math.isfinite(high)):
-        raise FieldError(name, f"must be finite, got [{low}, {high}]")
-    if not low <= high <= low + 360.0:
-        raise FieldError(name, f"expected [low, high] with low <= high <= low + 360, got [{low}, {high}]")
-    return low, high
 
 
 def sprite_choices(style: SpriteStyle, count: int, heights_fraction=None) -> tuple[np.ndarray, np.ndarray]:

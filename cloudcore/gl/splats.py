@@ -23,8 +23,9 @@ from OpenGL import GL
 
 from cloudcore.artist.facing import FacingState
 from cloudcore.artist.particle_styles import ParticleStyles
-from cloudcore.artist.sprites import ATLAS_GRID, ATLAS_MAX_MIP_LEVEL, load_atlas
+from cloudcore.artist.sprites import ATLAS_MAX_MIP_LEVEL, load_atlas
 from cloudcore.camera import splats_in_frustum
+from cloudcore.cloud_records import ATLAS_GRID
 from cloudcore.gl.blending import cloud_blending
 from cloudcore.gl.programs import build_compute_program, build_program, set_matrix, set_vec3
 from cloudcore.light.eye_scattering import FADE_END_RADII, FADE_START_RADII, ParticleBuffer
