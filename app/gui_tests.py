@@ -9,7 +9,9 @@ from __future__ import annotations
 
 import json
 import time
+from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from imgui_bundle import hello_imgui, imgui
@@ -23,489 +25,528 @@ from cloudcore.navigation import orbited
 from cloudcore.paths import camera_on_path
 from cloudcore.scenefile import save_scene
 
+if TYPE_CHECKING:
+    from app.editor import Editor
+    from app.panels import Panels
+    from app.viewport import Viewport
+
 #: frames to let the renderer catch up after an edit (illumination runs on the next frame)
 SETTLE = 4
 
 
-#: the GUI tests, in the order they run; `tests/test_gui.py` reads this list
-GUI_TESTS = (
-    "place_particles_by_clicking",
-    "time_of_day_changes_the_picture",
-    "the_saturated_eye_pass_darkens_the_clouds",
-    "dragging_the_time_of_day_relights_live",
-    "tolerance_drives_regeneration",
-    "save_and_reopen",
-    "malformed_scene_keeps_the_current_one",
-    "recovery_is_offered_and_restores_the_edits",
-    "place_on_the_cloud_surface",
-    "brush_stroke_is_one_undo_step",
-    "box_fill_adds_sprites",
-    "move_cloud_by_dragging",
-    "delete_key_and_statistics_toggle",
-    "heat_map_changes_the_picture",
-    "overlays_outline_impostors_and_the_ring",
-    "playing_a_camera_path_moves_the_camera",
-    "recording_runs_in_the_background",
-    "a_click_within_one_frame_is_not_lost",
-)
+@dataclass
+class EditorUnderTest:
+    """What a GUI test drives and reads: the editor, its viewport and panels, where the results go, and
+    `outcome`, the measurements a test reports beside its verdict (written into the results file)."""
 
+    editor: Editor
+    viewport: Viewport
+    panels: Panels
+    results_path: Path
+    outcome: dict
 
-def install(params, editor, viewport, panels, results_path: Path, outcome: dict, only=None) -> None:
-    """Register the GUI tests (those named in `only`, if given) to run in the editor, then exit."""
-    registered: list = []
-
-    def capture(ctx) -> np.ndarray:
-        viewport.capture_next = True
-        while viewport.capture_next:
+    def capture(self, ctx) -> np.ndarray:
+        """The viewport's next frame, as the artist sees it (RGB, uint8)."""
+        self.viewport.capture_next = True
+        while self.viewport.capture_next:
             ctx.yield_()
-        return viewport.captured
+        return self.viewport.captured
 
-    def use_window(ctx, name: str) -> None:
-        """Bring a panel's tab to the front (items in hidden tabs cannot be reached), then address it."""
-        hello_imgui.get_runner_params().docking_params.focus_dockable_window(name)
-        ctx.yield_(2)
-        ctx.set_ref(name)
-
-    def viewport_rect(ctx):
-        return ctx.item_info("//Viewport/canvas").rect_full
-
-    def to_viewport(ctx, x: float, y: float) -> imgui.ImVec2:
-        """The screen position of the viewport point (x, y) in [0, 1]^2."""
-        rect = viewport_rect(ctx)
-        return imgui.ImVec2(rect.min.x + x * (rect.max.x - rect.min.x), rect.min.y + y * (rect.max.y - rect.min.y))
-
-    def where_on_screen(ctx, point) -> imgui.ImVec2:
+    def where_on_screen(self, ctx, point) -> imgui.ImVec2:
         """The screen position at which the viewport shows the world point."""
         rect = viewport_rect(ctx)
         size = (rect.max.x - rect.min.x, rect.max.y - rect.min.y)
-        pixels, _ = to_pixels(point, editor.camera, size)
+        pixels, _ = to_pixels(point, self.editor.camera, size)
         x, y = pixels[0]
         return imgui.ImVec2(rect.min.x + x, rect.min.y + y)
 
-    def click_viewport(ctx, x: float, y: float) -> None:
-        ctx.mouse_move_to_pos(to_viewport(ctx, x, y))
-        ctx.mouse_click(0)
-        ctx.yield_(SETTLE)
-
-    def undo(ctx) -> None:
-        use_window(ctx, "Scene")
-        ctx.item_click("Undo")
-        ctx.yield_()
-
-    def place_particles_by_clicking(ctx):
-        use_window(ctx, "Clouds")
-        ctx.item_input_value("Altitude (m)", 900.0)
-        before = editor.scene.particle_count
-        click_viewport(ctx, 0.5, 0.35)
-        click_viewport(ctx, 0.6, 0.3)
-        CHECK(editor.scene.particle_count == before + 2)
-        use_window(ctx, "Scene")
-        ctx.item_click("Undo")
-        CHECK(editor.scene.particle_count == before + 1)
-        ctx.item_click("Undo")
-        CHECK(editor.scene.particle_count == before)
-        ctx.item_click("Redo")
-        CHECK(editor.scene.particle_count == before + 1)
-
-    def relit(ctx, frames: int = 600) -> None:
+    def relit(self, ctx, frames: int = 600) -> None:
         """Yield until the viewport shows the scene's own lighting, exactly shaded (the worker has it)."""
         for _ in range(frames):
-            shown = editor.last_stats
+            shown = self.editor.last_stats
             if (
                 shown is not None
                 and not shown.relighting
                 and shown.shown_illumination == "exact"
-                and shown.shown_time_of_day == editor.time_of_day
+                and shown.shown_time_of_day == self.editor.time_of_day
             ):
                 ctx.yield_(SETTLE)  # the impostors follow within the frame budget
                 return
             ctx.yield_()
         CHECK(False)
 
-    def time_of_day_changes_the_picture(ctx):
-        use_window(ctx, "Lighting")
-        ctx.item_input_value("Time of day", 12.0)
-        relit(ctx)
-        noon = capture(ctx)
-        ctx.item_input_value("Time of day", 19.0)
-        CHECK(abs(editor.time_of_day - 19.0) < 1e-3)
-        relit(ctx)
-        evening = capture(ctx)
-        changed = (np.abs(noon.astype(int) - evening.astype(int)).max(axis=2) > 20).mean()
-        outcome["time_of_day_changed_fraction"] = float(changed)
-        CHECK(bool(changed > 0.3))  # the sky and the clouds both change
 
-    def the_saturated_eye_pass_darkens_the_clouds(ctx):
-        use_window(ctx, "Lighting")
-        relit(ctx)
-        harris = capture(ctx)
-        ctx.combo_click("Eye pass/saturated")
-        CHECK(editor.scene.shading.eye_pass == "saturated")
-        ctx.yield_(SETTLE)
-        relit(ctx)
-        saturated = capture(ctx)
-        darker = (harris.astype(int).sum(axis=2) - saturated.astype(int).sum(axis=2) > 30).mean()
-        outcome["saturated_eye_pass_darker_fraction"] = float(darker)
-        CHECK(bool(darker > 0.05))  # the clouds, not the sky
-        undo(ctx)
-        CHECK(editor.scene.shading.eye_pass == "harris")
+def use_window(ctx, name: str) -> None:
+    """Bring a panel's tab to the front (items in hidden tabs cannot be reached), then address it."""
+    hello_imgui.get_runner_params().docking_params.focus_dockable_window(name)
+    ctx.yield_(2)
+    ctx.set_ref(name)
 
-    def dragging_the_time_of_day_relights_live(ctx):
-        """The viewport follows the slider while it moves, shaded in the worker; exact once let go."""
-        use_window(ctx, "Lighting")
-        ctx.item_input_value("Time of day", 9.0)
-        relit(ctx)
-        slider = ctx.item_info("Time of day").rect_full
-        middle_y = 0.5 * (slider.min.y + slider.max.y)
 
-        def at(hours: float) -> imgui.ImVec2:
-            return imgui.ImVec2(slider.min.x + (slider.max.x - slider.min.x) * hours / 24.0, middle_y)
+def viewport_rect(ctx):
+    return ctx.item_info("//Viewport/canvas").rect_full
 
-        ctx.mouse_move_to_pos(at(9.0))
-        ctx.mouse_down(0)
-        first = len(editor.frame_times)
-        started = time.perf_counter()
-        steps = max(20, int(slider.max.x - slider.min.x) // 4)  # 9 to 15 hours: a pixel and more a frame
-        for step in range(1, steps + 1):
-            ctx.mouse_teleport_to_pos(at(9.0 + 6.0 * step / steps))
-            ctx.yield_()
-        ctx.mouse_up(0)
-        dragged_s = time.perf_counter() - started
-        during = [stats for stats in list(editor.frame_times)[first:]]
-        shown = [frame.shown_time_of_day for frame in during]
-        relit_looks = len({hours for hours in shown}) - 1  # the looks shown after the first
-        gaps_ms = [1e3 * (b.frame_start_s - a.frame_start_s) for a, b in zip(during, during[1:])]
-        outcome["live_time_of_day"] = {
-            "drag_s": dragged_s,
-            "frames": len(during),
-            "relit_looks": relit_looks,
-            "relit_looks_per_s": relit_looks / dragged_s,
-            "longest_frame_gap_ms": max(gaps_ms, default=0.0),
-            "median_frame_gap_ms": float(np.median(gaps_ms)) if gaps_ms else 0.0,
-            "shading_ms_on_the_gui_thread_max": max(frame.frame.illumination_ms for frame in during),
-            "slowest": [
-                {
-                    "gap_ms": gap,
-                    "viewport_ms": during[i].viewport_ms,
-                    "illumination_ms": during[i].frame.illumination_ms,
-                    "impostors_regenerated": during[i].impostors_regenerated,
-                    "picture_reused": during[i].picture_reused,
-                    "frame_ms": during[i].frame.frame_ms,
-                }
-                for gap, i in sorted(((gap, i) for i, gap in enumerate(gaps_ms)), reverse=True)[:3]
-            ],
-        }
-        CHECK(relit_looks >= 3)  # the view followed the drag, not just its end
-        CHECK(all(frame.shown_illumination in ("preview", "exact") for frame in during))
-        # nothing like the exact light pass (about 2 s) ran where the GUI runs
-        CHECK(max(gaps_ms, default=0.0) < 1000.0)
-        relit(ctx)  # the released hour, exactly
-        outcome["live_time_of_day"]["released_hour"] = editor.time_of_day
-        CHECK(editor.time_of_day > 13.0)  # the drag moved the slider most of the way (the grab's padding aside)
 
-    def tolerance_drives_regeneration(ctx):
-        use_window(ctx, "LOD")
-        ctx.item_input_value("Tolerance (deg)", 5.0)
-        use_window(ctx, "Camera")
-        ctx.item_input_value("Orbit step (deg)", 0.5)
-        ctx.yield_(SETTLE)
-        before = viewport.regenerations_total
-        ctx.item_click("Orbit left")
-        ctx.yield_(SETTLE)
-        lenient = viewport.regenerations_total - before
-        use_window(ctx, "LOD")
-        ctx.item_input_value("Tolerance (deg)", 0.1)
-        ctx.yield_(SETTLE)
-        before = viewport.regenerations_total
-        use_window(ctx, "Camera")
-        ctx.item_click("Orbit left")
-        ctx.yield_(SETTLE)
-        strict = viewport.regenerations_total - before
-        # a budget of one spreads the same regenerations over frames, one a frame
-        use_window(ctx, "LOD")
-        ctx.item_input_value("Regeneration budget", 1)
-        CHECK(editor.settings.regeneration_budget == 1)
-        ctx.yield_(SETTLE)
-        before, marker = viewport.regenerations_total, editor.last_stats
-        use_window(ctx, "Camera")
-        ctx.item_click("Orbit left")
-        ctx.yield_(SETTLE)
-        history = list(editor.frame_times)
-        budgeted = history[next(i for i, s in enumerate(history) if s is marker) + 1 :]
-        per_frame = [s.impostors_regenerated for s in budgeted]
-        postponed = sum(s.frame.plan.regenerations_postponed for s in budgeted if not s.picture_reused)
-        use_window(ctx, "LOD")
-        ctx.item_input_value("Regeneration budget", 0)
-        outcome["regenerations"] = {
-            "tolerance 5": lenient,
-            "tolerance 0.1": strict,
-            "budget 1, most in a frame": max(per_frame, default=0),
-            "budget 1, postponed": postponed,
-        }
-        CHECK(lenient == 0 and strict > 0)
-        CHECK(max(per_frame, default=0) <= 1 and viewport.regenerations_total > before)
-        CHECK(postponed > 0)  # the orbit moves both clouds past the tolerance
+def to_viewport(ctx, x: float, y: float) -> imgui.ImVec2:
+    """The screen position of the viewport point (x, y) in [0, 1]^2."""
+    rect = viewport_rect(ctx)
+    return imgui.ImVec2(rect.min.x + x * (rect.max.x - rect.min.x), rect.min.y + y * (rect.max.y - rect.min.y))
 
-    def save_and_reopen(ctx):
-        target = results_path.with_name("saved_by_gui.toml")
-        use_window(ctx, "Scene")
-        ctx.item_input_value("File", str(target))
-        ctx.item_click("Save as")
-        CHECK(target.exists() and not editor.dirty)
-        saved = editor.scene
-        use_window(ctx, "Lighting")
-        ctx.item_input_value("Time of day", 6.0)
-        CHECK(editor.dirty)
-        use_window(ctx, "Scene")
-        ctx.item_click("Open")
-        CHECK(editor.scene == saved and not editor.dirty)
 
-    def malformed_scene_keeps_the_current_one(ctx):
-        bad = results_path.with_name("malformed.toml")
-        bad.write_text("[camera]\nposition = [0, 1]\n")
-        current = editor.scene
-        use_window(ctx, "Scene")
-        ctx.item_input_value("File", str(bad))
-        ctx.item_click("Open")
+def click_viewport(ctx, x: float, y: float) -> None:
+    ctx.mouse_move_to_pos(to_viewport(ctx, x, y))
+    ctx.mouse_click(0)
+    ctx.yield_(SETTLE)
+
+
+def undo(ctx) -> None:
+    use_window(ctx, "Scene")
+    ctx.item_click("Undo")
+    ctx.yield_()
+
+
+def place_particles_by_clicking(ctx, app: EditorUnderTest):
+    use_window(ctx, "Clouds")
+    ctx.item_input_value("Altitude (m)", 900.0)
+    before = app.editor.scene.particle_count
+    click_viewport(ctx, 0.5, 0.35)
+    click_viewport(ctx, 0.6, 0.3)
+    CHECK(app.editor.scene.particle_count == before + 2)
+    use_window(ctx, "Scene")
+    ctx.item_click("Undo")
+    CHECK(app.editor.scene.particle_count == before + 1)
+    ctx.item_click("Undo")
+    CHECK(app.editor.scene.particle_count == before)
+    ctx.item_click("Redo")
+    CHECK(app.editor.scene.particle_count == before + 1)
+
+
+def time_of_day_changes_the_picture(ctx, app: EditorUnderTest):
+    use_window(ctx, "Lighting")
+    ctx.item_input_value("Time of day", 12.0)
+    app.relit(ctx)
+    noon = app.capture(ctx)
+    ctx.item_input_value("Time of day", 19.0)
+    CHECK(abs(app.editor.time_of_day - 19.0) < 1e-3)
+    app.relit(ctx)
+    evening = app.capture(ctx)
+    changed = (np.abs(noon.astype(int) - evening.astype(int)).max(axis=2) > 20).mean()
+    app.outcome["time_of_day_changed_fraction"] = float(changed)
+    CHECK(bool(changed > 0.3))  # the sky and the clouds both change
+
+
+def the_saturated_eye_pass_darkens_the_clouds(ctx, app: EditorUnderTest):
+    use_window(ctx, "Lighting")
+    app.relit(ctx)
+    harris = app.capture(ctx)
+    ctx.combo_click("Eye pass/saturated")
+    CHECK(app.editor.scene.shading.eye_pass == "saturated")
+    ctx.yield_(SETTLE)
+    app.relit(ctx)
+    saturated = app.capture(ctx)
+    darker = (harris.astype(int).sum(axis=2) - saturated.astype(int).sum(axis=2) > 30).mean()
+    app.outcome["saturated_eye_pass_darker_fraction"] = float(darker)
+    CHECK(bool(darker > 0.05))  # the clouds, not the sky
+    undo(ctx)
+    CHECK(app.editor.scene.shading.eye_pass == "harris")
+
+
+def dragging_the_time_of_day_relights_live(ctx, app: EditorUnderTest):
+    """The viewport follows the slider while it moves, shaded in the worker; exact once let go."""
+    use_window(ctx, "Lighting")
+    ctx.item_input_value("Time of day", 9.0)
+    app.relit(ctx)
+    slider = ctx.item_info("Time of day").rect_full
+    middle_y = 0.5 * (slider.min.y + slider.max.y)
+
+    def at(hours: float) -> imgui.ImVec2:
+        return imgui.ImVec2(slider.min.x + (slider.max.x - slider.min.x) * hours / 24.0, middle_y)
+
+    ctx.mouse_move_to_pos(at(9.0))
+    ctx.mouse_down(0)
+    first = len(app.editor.frame_times)
+    started = time.perf_counter()
+    steps = max(20, int(slider.max.x - slider.min.x) // 4)  # 9 to 15 hours: a pixel and more a frame
+    for step in range(1, steps + 1):
+        ctx.mouse_teleport_to_pos(at(9.0 + 6.0 * step / steps))
         ctx.yield_()
-        CHECK(editor.scene is current)
-        CHECK(any("could not open" in m and "malformed.toml" in m for m in editor.messages))
+    ctx.mouse_up(0)
+    dragged_s = time.perf_counter() - started
+    during = [stats for stats in list(app.editor.frame_times)[first:]]
+    shown = [frame.shown_time_of_day for frame in during]
+    relit_looks = len({hours for hours in shown}) - 1  # the looks shown after the first
+    gaps_ms = [1e3 * (b.frame_start_s - a.frame_start_s) for a, b in zip(during, during[1:])]
+    app.outcome["live_time_of_day"] = {
+        "drag_s": dragged_s,
+        "frames": len(during),
+        "relit_looks": relit_looks,
+        "relit_looks_per_s": relit_looks / dragged_s,
+        "longest_frame_gap_ms": max(gaps_ms, default=0.0),
+        "median_frame_gap_ms": float(np.median(gaps_ms)) if gaps_ms else 0.0,
+        "shading_ms_on_the_gui_thread_max": max(frame.frame.illumination_ms for frame in during),
+        "slowest": [
+            {
+                "gap_ms": gap,
+                "viewport_ms": during[i].viewport_ms,
+                "illumination_ms": during[i].frame.illumination_ms,
+                "impostors_regenerated": during[i].impostors_regenerated,
+                "picture_reused": during[i].picture_reused,
+                "frame_ms": during[i].frame.frame_ms,
+            }
+            for gap, i in sorted(((gap, i) for i, gap in enumerate(gaps_ms)), reverse=True)[:3]
+        ],
+    }
+    CHECK(relit_looks >= 3)  # the view followed the drag, not just its end
+    CHECK(all(frame.shown_illumination in ("preview", "exact") for frame in during))
+    # nothing like the exact light pass (about 2 s) ran where the GUI runs
+    CHECK(max(gaps_ms, default=0.0) < 1000.0)
+    app.relit(ctx)  # the released hour, exactly
+    app.outcome["live_time_of_day"]["released_hour"] = app.editor.time_of_day
+    CHECK(app.editor.time_of_day > 13.0)  # the drag moved the slider most of the way (the grab's padding aside)
 
-    def recovery_is_offered_and_restores_the_edits(ctx):
-        """A recovery copy beside the scene (what a crashed session leaves) is offered and loads as one edit."""
-        before = editor.scene
-        save_scene(add_cloud(before, "recovered"), recovery_path(editor.path))
-        use_window(ctx, "Scene")
-        ctx.item_click("Recover unsaved edits")
-        CHECK([c.name for c in editor.scene.clouds] == [c.name for c in before.clouds] + ["recovered"])
-        ctx.item_click("Undo")
-        CHECK(editor.scene is before)
-        discard_recovery(editor.path)
 
-    def place_on_the_cloud_surface(ctx):
-        use_window(ctx, "Clouds")
-        ctx.item_click("Place")
-        ctx.item_click("On the cloud's surface")
-        cloud = editor.selected_cloud
-        before = editor.scene.clouds[cloud].particles
-        ctx.mouse_move_to_pos(where_on_screen(ctx, before[0, :3]))  # over a particle: the ray meets the cloud
-        ctx.mouse_click(0)
-        ctx.yield_(SETTLE)
-        after = editor.scene.clouds[cloud].particles
-        CHECK(len(after) == len(before) + 1)
-        gaps = np.linalg.norm(before[:, :3] - after[-1, :3], axis=1) - before[:, 3]
-        outcome["surface_gap_m"] = float(np.abs(gaps).min())
-        CHECK(bool(np.abs(gaps).min() < 1e-6) and bool(gaps.min() > -1e-6))  # on one sphere, inside none
-        undo(ctx)
-        use_window(ctx, "Clouds")
-        ctx.item_click("On the altitude plane")
+def tolerance_drives_regeneration(ctx, app: EditorUnderTest):
+    use_window(ctx, "LOD")
+    ctx.item_input_value("Tolerance (deg)", 5.0)
+    use_window(ctx, "Camera")
+    ctx.item_input_value("Orbit step (deg)", 0.5)
+    ctx.yield_(SETTLE)
+    before = app.viewport.regenerations_total
+    ctx.item_click("Orbit left")
+    ctx.yield_(SETTLE)
+    lenient = app.viewport.regenerations_total - before
+    use_window(ctx, "LOD")
+    ctx.item_input_value("Tolerance (deg)", 0.1)
+    ctx.yield_(SETTLE)
+    before = app.viewport.regenerations_total
+    use_window(ctx, "Camera")
+    ctx.item_click("Orbit left")
+    ctx.yield_(SETTLE)
+    strict = app.viewport.regenerations_total - before
+    # a budget of one spreads the same regenerations over frames, one a frame
+    use_window(ctx, "LOD")
+    ctx.item_input_value("Regeneration budget", 1)
+    CHECK(app.editor.settings.regeneration_budget == 1)
+    ctx.yield_(SETTLE)
+    before, marker = app.viewport.regenerations_total, app.editor.last_stats
+    use_window(ctx, "Camera")
+    ctx.item_click("Orbit left")
+    ctx.yield_(SETTLE)
+    history = list(app.editor.frame_times)
+    budgeted = history[next(i for i, s in enumerate(history) if s is marker) + 1 :]
+    per_frame = [s.impostors_regenerated for s in budgeted]
+    postponed = sum(s.frame.plan.regenerations_postponed for s in budgeted if not s.picture_reused)
+    use_window(ctx, "LOD")
+    ctx.item_input_value("Regeneration budget", 0)
+    app.outcome["regenerations"] = {
+        "tolerance 5": lenient,
+        "tolerance 0.1": strict,
+        "budget 1, most in a frame": max(per_frame, default=0),
+        "budget 1, postponed": postponed,
+    }
+    CHECK(lenient == 0 and strict > 0)
+    CHECK(max(per_frame, default=0) <= 1 and app.viewport.regenerations_total > before)
+    CHECK(postponed > 0)  # the orbit moves both clouds past the tolerance
 
-    def brush_stroke_is_one_undo_step(ctx):
-        use_window(ctx, "Clouds")
-        ctx.item_click("Brush")
-        ctx.item_click("Brush adds")
-        ctx.item_input_value("Altitude (m)", 900.0)
-        ctx.item_input_value("Brush radius (m)", 200.0)
-        ctx.item_input_value("Brush rate (per s)", 100.0)
-        before = editor.scene.particle_count
-        ctx.mouse_move_to_pos(to_viewport(ctx, 0.45, 0.35))
-        ctx.mouse_down(0)
-        for step in range(8):
-            ctx.mouse_move_to_pos(to_viewport(ctx, 0.45 + 0.01 * step, 0.35))
-            ctx.yield_(2)
-        ctx.mouse_up(0)
-        ctx.yield_(SETTLE)
-        added = editor.scene.particle_count - before
-        outcome["brush_stroke_added"] = added
-        CHECK(added >= 5)
-        undo(ctx)
-        CHECK(editor.scene.particle_count == before)
-        ctx.item_click("Redo")
-        CHECK(editor.scene.particle_count == before + added)
-        ctx.item_click("Undo")
-        use_window(ctx, "Clouds")
-        ctx.item_click("Place")
 
-    def box_fill_adds_sprites(ctx):
-        use_window(ctx, "Build")
-        ctx.item_input_value("Sprites", 150)
-        ctx.item_input_value("Sprite radius (m)", 40.0)
-        before = editor.scene.particle_count
-        ctx.item_click("Fill the selected cloud")
-        added = editor.scene.particle_count - before
-        outcome["box_fill_added"] = added
-        CHECK(0 < added <= 150)
-        undo(ctx)
-        CHECK(editor.scene.particle_count == before)
+def save_and_reopen(ctx, app: EditorUnderTest):
+    target = app.results_path.with_name("saved_by_gui.toml")
+    use_window(ctx, "Scene")
+    ctx.item_input_value("File", str(target))
+    ctx.item_click("Save as")
+    CHECK(target.exists() and not app.editor.dirty)
+    saved = app.editor.scene
+    use_window(ctx, "Lighting")
+    ctx.item_input_value("Time of day", 6.0)
+    CHECK(app.editor.dirty)
+    use_window(ctx, "Scene")
+    ctx.item_click("Open")
+    CHECK(app.editor.scene == saved and not app.editor.dirty)
 
-    def move_cloud_by_dragging(ctx):
-        use_window(ctx, "Clouds")
-        ctx.item_click("Move cloud")
-        scene = editor.scene
-        centre, _ = scene.clouds[editor.selected_cloud].bounding_sphere()
-        start = where_on_screen(ctx, centre)
-        ctx.mouse_move_to_pos(start)
-        ctx.mouse_down(0)
-        ctx.mouse_move_to_pos(imgui.ImVec2(start.x + 80.0, start.y))
+
+def malformed_scene_keeps_the_current_one(ctx, app: EditorUnderTest):
+    bad = app.results_path.with_name("malformed.toml")
+    bad.write_text("[camera]\nposition = [0, 1]\n")
+    current = app.editor.scene
+    use_window(ctx, "Scene")
+    ctx.item_input_value("File", str(bad))
+    ctx.item_click("Open")
+    ctx.yield_()
+    CHECK(app.editor.scene is current)
+    CHECK(any("could not open" in m and "malformed.toml" in m for m in app.editor.messages))
+
+
+def recovery_is_offered_and_restores_the_edits(ctx, app: EditorUnderTest):
+    """A recovery copy beside the scene (what a crashed session leaves) is offered and loads as one edit."""
+    before = app.editor.scene
+    save_scene(add_cloud(before, "recovered"), recovery_path(app.editor.path))
+    use_window(ctx, "Scene")
+    ctx.item_click("Recover unsaved edits")
+    CHECK([c.name for c in app.editor.scene.clouds] == [c.name for c in before.clouds] + ["recovered"])
+    ctx.item_click("Undo")
+    CHECK(app.editor.scene is before)
+    discard_recovery(app.editor.path)
+
+
+def place_on_the_cloud_surface(ctx, app: EditorUnderTest):
+    use_window(ctx, "Clouds")
+    ctx.item_click("Place")
+    ctx.item_click("On the cloud's surface")
+    cloud = app.editor.selected_cloud
+    before = app.editor.scene.clouds[cloud].particles
+    ctx.mouse_move_to_pos(app.where_on_screen(ctx, before[0, :3]))  # over a particle: the ray meets the cloud
+    ctx.mouse_click(0)
+    ctx.yield_(SETTLE)
+    after = app.editor.scene.clouds[cloud].particles
+    CHECK(len(after) == len(before) + 1)
+    gaps = np.linalg.norm(before[:, :3] - after[-1, :3], axis=1) - before[:, 3]
+    app.outcome["surface_gap_m"] = float(np.abs(gaps).min())
+    CHECK(bool(np.abs(gaps).min() < 1e-6) and bool(gaps.min() > -1e-6))  # on one sphere, inside none
+    undo(ctx)
+    use_window(ctx, "Clouds")
+    ctx.item_click("On the altitude plane")
+
+
+def brush_stroke_is_one_undo_step(ctx, app: EditorUnderTest):
+    use_window(ctx, "Clouds")
+    ctx.item_click("Brush")
+    ctx.item_click("Brush adds")
+    ctx.item_input_value("Altitude (m)", 900.0)
+    ctx.item_input_value("Brush radius (m)", 200.0)
+    ctx.item_input_value("Brush rate (per s)", 100.0)
+    before = app.editor.scene.particle_count
+    ctx.mouse_move_to_pos(to_viewport(ctx, 0.45, 0.35))
+    ctx.mouse_down(0)
+    for step in range(8):
+        ctx.mouse_move_to_pos(to_viewport(ctx, 0.45 + 0.01 * step, 0.35))
         ctx.yield_(2)
-        ctx.mouse_up(0)
-        ctx.yield_(SETTLE)
-        moved = [i for i, (a, b) in enumerate(zip(scene.clouds, editor.scene.clouds)) if a is not b]
-        CHECK(len(moved) == 1)
-        if len(moved) == 1:
-            offsets = editor.scene.clouds[moved[0]].centres - scene.clouds[moved[0]].centres
-            outcome["drag_offset_m"] = offsets[0].tolist()
-            # the whole cloud moves rigidly, sideways on a horizontal plane
-            CHECK(bool(np.allclose(offsets, offsets[0]) and abs(offsets[0, 1]) < 1e-6 and offsets[0, 0] > 1.0))
-        undo(ctx)
-        CHECK(editor.scene == scene)
-        use_window(ctx, "Clouds")
-        ctx.item_click("Place")
+    ctx.mouse_up(0)
+    ctx.yield_(SETTLE)
+    added = app.editor.scene.particle_count - before
+    app.outcome["brush_stroke_added"] = added
+    CHECK(added >= 5)
+    undo(ctx)
+    CHECK(app.editor.scene.particle_count == before)
+    ctx.item_click("Redo")
+    CHECK(app.editor.scene.particle_count == before + added)
+    ctx.item_click("Undo")
+    use_window(ctx, "Clouds")
+    ctx.item_click("Place")
 
-    def delete_key_and_statistics_toggle(ctx):
-        use_window(ctx, "Clouds")
-        ctx.item_click("Move particle")
-        cloud = editor.selected_cloud
-        before = editor.scene.clouds[cloud].particles
-        ctx.mouse_move_to_pos(where_on_screen(ctx, before[3, :3]))
-        ctx.mouse_click(0)  # a click picks without moving
-        ctx.yield_(SETTLE)
-        CHECK(editor.picked_particle is not None and editor.scene.clouds[cloud].particles is before)
-        ctx.key_press(imgui.Key.delete)
-        ctx.yield_(2)
-        CHECK(len(editor.scene.clouds[cloud].particles) == len(before) - 1)
-        undo(ctx)
-        CHECK(editor.scene.clouds[cloud].particles is before)
-        statistics = hello_imgui.get_runner_params().docking_params.dockable_window_of_name("Statistics")
-        ctx.key_press(imgui.Key.f3)
-        ctx.yield_(2)
-        CHECK(not statistics.is_visible)
-        ctx.key_press(imgui.Key.f3)
-        ctx.yield_(2)
-        CHECK(statistics.is_visible)
-        use_window(ctx, "Clouds")
-        ctx.item_click("Place")
 
-    def heat_map_changes_the_picture(ctx):
-        # in full 3D, where every splat counts: auto draws this still view from impostors, one a pixel
-        use_window(ctx, "LOD")
-        ctx.combo_click("Mode/full")
-        CHECK(editor.settings.mode == "full")
-        use_window(ctx, "Statistics")
-        ctx.yield_(SETTLE)
-        frame = capture(ctx)
-        ctx.item_check("Overdraw heat map")
-        ctx.yield_(SETTLE)
-        heat = capture(ctx)
-        ctx.item_uncheck("Overdraw heat map")
-        use_window(ctx, "LOD")
-        ctx.combo_click("Mode/auto")
-        changed = (np.abs(frame.astype(int) - heat.astype(int)).max(axis=2) > 20).mean()
-        outcome["heat_map_changed_fraction"] = float(changed)
-        CHECK(bool(changed > 0.5))  # the sky has no overdraw: black where it was blue
-        CHECK(len(np.unique(heat.reshape(-1, 3), axis=0)) > 3)  # and the clouds show as a ramp
+def box_fill_adds_sprites(ctx, app: EditorUnderTest):
+    use_window(ctx, "Build")
+    ctx.item_input_value("Sprites", 150)
+    ctx.item_input_value("Sprite radius (m)", 40.0)
+    before = app.editor.scene.particle_count
+    ctx.item_click("Fill the selected cloud")
+    added = app.editor.scene.particle_count - before
+    app.outcome["box_fill_added"] = added
+    CHECK(0 < added <= 150)
+    undo(ctx)
+    CHECK(app.editor.scene.particle_count == before)
 
-    def overlays_outline_impostors_and_the_ring(ctx):
-        use_window(ctx, "LOD")
-        ctx.item_check("Impostor outlines")
-        ctx.item_check("Ring segments")
-        ctx.yield_(SETTLE)
-        plan = viewport.renderer.last_plan
-        kinds = [outline.kind for outline in viewport.outlines_drawn]
-        outcome["outlines"] = {kind: kinds.count(kind) for kind in set(kinds)}
-        textured = len(plan.of_kind("impostor", "crossfade"))
-        CHECK(textured > 0 and kinds.count("impostor") + kinds.count("crossfade") == textured)
-        CHECK(plan.ring is not None and 0 < kinds.count("ring") <= 8)
-        ctx.item_uncheck("Impostor outlines")
-        ctx.item_uncheck("Ring segments")
+
+def move_cloud_by_dragging(ctx, app: EditorUnderTest):
+    use_window(ctx, "Clouds")
+    ctx.item_click("Move cloud")
+    scene = app.editor.scene
+    centre, _ = scene.clouds[app.editor.selected_cloud].bounding_sphere()
+    start = app.where_on_screen(ctx, centre)
+    ctx.mouse_move_to_pos(start)
+    ctx.mouse_down(0)
+    ctx.mouse_move_to_pos(imgui.ImVec2(start.x + 80.0, start.y))
+    ctx.yield_(2)
+    ctx.mouse_up(0)
+    ctx.yield_(SETTLE)
+    moved = [i for i, (a, b) in enumerate(zip(scene.clouds, app.editor.scene.clouds)) if a is not b]
+    CHECK(len(moved) == 1)
+    if len(moved) == 1:
+        offsets = app.editor.scene.clouds[moved[0]].centres - scene.clouds[moved[0]].centres
+        app.outcome["drag_offset_m"] = offsets[0].tolist()
+        # the whole cloud moves rigidly, sideways on a horizontal plane
+        CHECK(bool(np.allclose(offsets, offsets[0]) and abs(offsets[0, 1]) < 1e-6 and offsets[0, 0] > 1.0))
+    undo(ctx)
+    CHECK(app.editor.scene == scene)
+    use_window(ctx, "Clouds")
+    ctx.item_click("Place")
+
+
+def delete_key_and_statistics_toggle(ctx, app: EditorUnderTest):
+    use_window(ctx, "Clouds")
+    ctx.item_click("Move particle")
+    cloud = app.editor.selected_cloud
+    before = app.editor.scene.clouds[cloud].particles
+    ctx.mouse_move_to_pos(app.where_on_screen(ctx, before[3, :3]))
+    ctx.mouse_click(0)  # a click picks without moving
+    ctx.yield_(SETTLE)
+    CHECK(app.editor.picked_particle is not None and app.editor.scene.clouds[cloud].particles is before)
+    ctx.key_press(imgui.Key.delete)
+    ctx.yield_(2)
+    CHECK(len(app.editor.scene.clouds[cloud].particles) == len(before) - 1)
+    undo(ctx)
+    CHECK(app.editor.scene.clouds[cloud].particles is before)
+    statistics = hello_imgui.get_runner_params().docking_params.dockable_window_of_name("Statistics")
+    ctx.key_press(imgui.Key.f3)
+    ctx.yield_(2)
+    CHECK(not statistics.is_visible)
+    ctx.key_press(imgui.Key.f3)
+    ctx.yield_(2)
+    CHECK(statistics.is_visible)
+    use_window(ctx, "Clouds")
+    ctx.item_click("Place")
+
+
+def heat_map_changes_the_picture(ctx, app: EditorUnderTest):
+    # in full 3D, where every splat counts: auto draws this still view from impostors, one a pixel
+    use_window(ctx, "LOD")
+    ctx.combo_click("Mode/full")
+    CHECK(app.editor.settings.mode == "full")
+    use_window(ctx, "Statistics")
+    ctx.yield_(SETTLE)
+    frame = app.capture(ctx)
+    ctx.item_check("Overdraw heat map")
+    ctx.yield_(SETTLE)
+    heat = app.capture(ctx)
+    ctx.item_uncheck("Overdraw heat map")
+    use_window(ctx, "LOD")
+    ctx.combo_click("Mode/auto")
+    changed = (np.abs(frame.astype(int) - heat.astype(int)).max(axis=2) > 20).mean()
+    app.outcome["heat_map_changed_fraction"] = float(changed)
+    CHECK(bool(changed > 0.5))  # the sky has no overdraw: black where it was blue
+    CHECK(len(np.unique(heat.reshape(-1, 3), axis=0)) > 3)  # and the clouds show as a ramp
+
+
+def overlays_outline_impostors_and_the_ring(ctx, app: EditorUnderTest):
+    use_window(ctx, "LOD")
+    ctx.item_check("Impostor outlines")
+    ctx.item_check("Ring segments")
+    ctx.yield_(SETTLE)
+    plan = app.viewport.renderer.last_plan
+    kinds = [outline.kind for outline in app.viewport.outlines_drawn]
+    app.outcome["outlines"] = {kind: kinds.count(kind) for kind in set(kinds)}
+    textured = len(plan.of_kind("impostor", "crossfade"))
+    CHECK(textured > 0 and kinds.count("impostor") + kinds.count("crossfade") == textured)
+    CHECK(plan.ring is not None and 0 < kinds.count("ring") <= 8)
+    ctx.item_uncheck("Impostor outlines")
+    ctx.item_uncheck("Ring segments")
+    ctx.yield_()
+    CHECK(app.viewport.outlines_drawn == [])
+
+
+def playing_a_camera_path_moves_the_camera(ctx, app: EditorUnderTest):
+    use_window(ctx, "Camera")
+    path = app.editor.scene.camera_path(app.editor.camera_path_name)
+    start = app.editor.camera
+    ctx.item_click("Play")
+    ctx.yield_(6)
+    CHECK(app.editor.playing and app.editor.path_time_s > 0.0 and app.editor.camera != start)
+    ctx.item_click("Pause")
+    paused_at = app.editor.path_time_s
+    ctx.yield_(3)
+    CHECK(app.editor.path_time_s == paused_at)
+    CHECK(app.editor.camera == camera_on_path(path, paused_at, start.fov_y_deg))
+    ctx.item_input_value("Path time (s)", float(path.duration))
+    CHECK(bool(np.allclose(app.editor.camera.position, path.keys[-1, 1:4])))
+    ctx.item_click("Reset to the scene's camera")
+
+
+def recording_runs_in_the_background(ctx, app: EditorUnderTest):
+    use_window(ctx, "Camera")
+    video = app.results_path.with_name("pan.mp4")
+    ctx.item_input_value("Video", str(video))
+    ctx.item_input_value("Size (px)/$$0", 32)
+    ctx.item_input_value("Size (px)/$$1", 24)
+    ctx.item_input_value("Frames per second", 1.0)  # the 2 s path: 3 frames
+    ctx.item_click("Record the path to video")
+    started, deadline = imgui.get_frame_count(), time.monotonic() + 120.0
+    while app.panels.camera.record_job is not None and time.monotonic() < deadline:
         ctx.yield_()
-        CHECK(viewport.outlines_drawn == [])
+    app.outcome["frames_drawn_while_recording"] = imgui.get_frame_count() - started
+    CHECK(
+        app.panels.camera.record_job is None
+        and any(m.startswith("recorded: wrote 3 frames") for m in app.editor.messages)
+    )
+    CHECK(video.exists() and imgui.get_frame_count() - started > 10)  # the editor kept drawing meanwhile
 
-    def playing_a_camera_path_moves_the_camera(ctx):
-        use_window(ctx, "Camera")
-        path = editor.scene.camera_path(editor.camera_path_name)
-        start = editor.camera
-        ctx.item_click("Play")
-        ctx.yield_(6)
-        CHECK(editor.playing and editor.path_time_s > 0.0 and editor.camera != start)
-        ctx.item_click("Pause")
-        paused_at = editor.path_time_s
-        ctx.yield_(3)
-        CHECK(editor.path_time_s == paused_at)
-        CHECK(editor.camera == camera_on_path(path, paused_at, start.fov_y_deg))
-        ctx.item_input_value("Path time (s)", float(path.duration))
-        CHECK(bool(np.allclose(editor.camera.position, path.keys[-1, 1:4])))
-        ctx.item_click("Reset to the scene's camera")
 
-    def recording_runs_in_the_background(ctx):
-        use_window(ctx, "Camera")
-        video = results_path.with_name("pan.mp4")
-        ctx.item_input_value("Video", str(video))
-        ctx.item_input_value("Size (px)/$$0", 32)
-        ctx.item_input_value("Size (px)/$$1", 24)
-        ctx.item_input_value("Frames per second", 1.0)  # the 2 s path: 3 frames
-        ctx.item_click("Record the path to video")
-        started, deadline = imgui.get_frame_count(), time.monotonic() + 120.0
-        while panels.camera.record_job is not None and time.monotonic() < deadline:
-            ctx.yield_()
-        outcome["frames_drawn_while_recording"] = imgui.get_frame_count() - started
-        CHECK(
-            panels.camera.record_job is None and any(m.startswith("recorded: wrote 3 frames") for m in editor.messages)
-        )
-        CHECK(video.exists() and imgui.get_frame_count() - started > 10)  # the editor kept drawing meanwhile
-
-    def a_click_within_one_frame_is_not_lost(ctx):
-        """At a low frame rate a press and its release reach Dear ImGui in one frame: raw mouse events, a whole
-        click on the Camera tab (behind Lighting, in the same tab bar) and then one on "Orbit left", are all
-        queued before a single new frame.  Dear ImGui's input queue trickling (io.config_input_trickle_event_queue,
-        on by default; the editor never turns it off) spreads them over frames, so the tab and the button each
-        see their click; without it the frame would see the button up again at the end and no click at all."""
-        io = imgui.get_io()
-        CHECK(io.config_input_trickle_event_queue)
-        use_window(ctx, "Camera")
-        button = ctx.item_info("Orbit left").rect_full
-        use_window(ctx, "Lighting")
-        camera_window = imgui.internal.find_window_by_name("Camera")
-        tab_bar = camera_window.dock_node.tab_bar
-        tab = ctx.item_info(te.TestRef(camera_window.tab_id)).rect_full
-        CHECK(tab_bar.selected_tab_id != camera_window.tab_id)
-        start = editor.camera
-        raw = int(te.TestRunFlags_.enable_raw_inputs)
-        ctx.run_flags = int(ctx.run_flags) | raw  # the test engine submits none of its simulated input meanwhile
+def a_click_within_one_frame_is_not_lost(ctx, app: EditorUnderTest):
+    """At a low frame rate a press and its release reach Dear ImGui in one frame: raw mouse events, a whole
+    click on the Camera tab (behind Lighting, in the same tab bar) and then one on "Orbit left", are all
+    queued before a single new frame.  Dear ImGui's input queue trickling (io.config_input_trickle_event_queue,
+    on by default; the editor never turns it off) spreads them over frames, so the tab and the button each
+    see their click; without it the frame would see the button up again at the end and no click at all."""
+    io = imgui.get_io()
+    CHECK(io.config_input_trickle_event_queue)
+    use_window(ctx, "Camera")
+    button = ctx.item_info("Orbit left").rect_full
+    use_window(ctx, "Lighting")
+    camera_window = imgui.internal.find_window_by_name("Camera")
+    tab_bar = camera_window.dock_node.tab_bar
+    tab = ctx.item_info(te.TestRef(camera_window.tab_id)).rect_full
+    CHECK(tab_bar.selected_tab_id != camera_window.tab_id)
+    start = app.editor.camera
+    raw = int(te.TestRunFlags_.enable_raw_inputs)
+    ctx.run_flags = int(ctx.run_flags) | raw  # the test engine submits none of its simulated input meanwhile
+    ctx.yield_()
+    centre = {id(r): ((r.min.x + r.max.x) / 2, (r.min.y + r.max.y) / 2) for r in (tab, button)}
+    # the pointer rests on the tab first, as a real one does (a tab, like any item that allows overlap,
+    # takes a press only once it was hovered the frame before); then both whole clicks come in one frame
+    io.add_mouse_pos_event(*centre[id(tab)])
+    ctx.yield_()
+    for rect in (tab, button):
+        io.add_mouse_pos_event(*centre[id(rect)])
+        io.add_mouse_button_event(0, True)
+        io.add_mouse_button_event(0, False)
+    selected_after = moved_after = None
+    for frame in range(1, 11):
         ctx.yield_()
-        centre = {id(r): ((r.min.x + r.max.x) / 2, (r.min.y + r.max.y) / 2) for r in (tab, button)}
-        # the pointer rests on the tab first, as a real one does (a tab, like any item that allows overlap,
-        # takes a press only once it was hovered the frame before); then both whole clicks come in one frame
-        io.add_mouse_pos_event(*centre[id(tab)])
-        ctx.yield_()
-        for rect in (tab, button):
-            io.add_mouse_pos_event(*centre[id(rect)])
-            io.add_mouse_button_event(0, True)
-            io.add_mouse_button_event(0, False)
-        selected_after = moved_after = None
-        for frame in range(1, 11):
-            ctx.yield_()
-            if selected_after is None and tab_bar.selected_tab_id == camera_window.tab_id:
-                selected_after = frame
-            if moved_after is None and editor.camera != start:
-                moved_after = frame
-        ctx.run_flags = int(ctx.run_flags) & ~raw
-        ctx.yield_(SETTLE)
-        outcome["click_within_one_frame"] = {
-            "tab selected after frames": selected_after,
-            "camera orbited after frames": moved_after,
-        }
-        CHECK(selected_after is not None and camera_window.active)  # the Camera panel is the one drawn
-        CHECK(editor.camera == orbited(start, -panels.camera.orbit_step_deg))  # one orbit, not none and not two
-        use_window(ctx, "Camera")
-        ctx.item_click("Reset to the scene's camera")
+        if selected_after is None and tab_bar.selected_tab_id == camera_window.tab_id:
+            selected_after = frame
+        if moved_after is None and app.editor.camera != start:
+            moved_after = frame
+    ctx.run_flags = int(ctx.run_flags) & ~raw
+    ctx.yield_(SETTLE)
+    app.outcome["click_within_one_frame"] = {
+        "tab selected after frames": selected_after,
+        "camera orbited after frames": moved_after,
+    }
+    CHECK(selected_after is not None and camera_window.active)  # the Camera panel is the one drawn
+    CHECK(app.editor.camera == orbited(start, -app.panels.camera.orbit_step_deg))  # one orbit, not none and not two
+    use_window(ctx, "Camera")
+    ctx.item_click("Reset to the scene's camera")
 
-    defined = locals()
-    tests = [defined[name] for name in GUI_TESTS]  # a KeyError names a listed test not defined above
 
-    unknown = sorted(set(only or ()) - {function.__name__ for function in tests})
+#: the GUI tests, in the order they run; `tests/test_gui.py` reads their names here
+GUI_TESTS = (
+    place_particles_by_clicking,
+    time_of_day_changes_the_picture,
+    the_saturated_eye_pass_darkens_the_clouds,
+    dragging_the_time_of_day_relights_live,
+    tolerance_drives_regeneration,
+    save_and_reopen,
+    malformed_scene_keeps_the_current_one,
+    recovery_is_offered_and_restores_the_edits,
+    place_on_the_cloud_surface,
+    brush_stroke_is_one_undo_step,
+    box_fill_adds_sprites,
+    move_cloud_by_dragging,
+    delete_key_and_statistics_toggle,
+    heat_map_changes_the_picture,
+    overlays_outline_impostors_and_the_ring,
+    playing_a_camera_path_moves_the_camera,
+    recording_runs_in_the_background,
+    a_click_within_one_frame_is_not_lost,
+)
+
+
+def install(params, app: EditorUnderTest, only=None) -> None:
+    """Register the GUI tests (those named in `only`, if given) to run in the editor, then exit."""
+    unknown = sorted(set(only or ()) - {test.__name__ for test in GUI_TESTS})
     if unknown:
         raise SystemExit(f"cloudview: error: --tests: no GUI test named {', '.join(unknown)}")
+    chosen = [test for test in GUI_TESTS if only is None or test.__name__ in only]
+    registered: list = []
 
     def register():
         engine = hello_imgui.get_imgui_test_engine()
@@ -514,31 +555,29 @@ def install(params, editor, viewport, panels, results_path: Path, outcome: dict,
         io.config_log_to_tty = True
         io.config_saved_settings = False
         io.config_watchdog_kill_test = 120.0
-        for function in tests:
-            if only is not None and function.__name__ not in only:
-                continue
+        for function in chosen:
             test = te.register_test(engine, "editor", function.__name__)
-            test.test_func = function
+            test.test_func = lambda ctx, function=function: function(ctx, app)
             registered.append((function.__name__, test))
         te.queue_tests(engine, te.TestGroup.tests)
 
     def finish_when_done():
-        if outcome.get("done") or not registered:
+        if app.outcome.get("done") or not registered:
             return
         engine = hello_imgui.get_imgui_test_engine()
         pending = (te.TestStatus.queued, te.TestStatus.running, te.TestStatus.unknown)
         if not te.is_test_queue_empty(engine) or any(t.output.status in pending for _, t in registered):
             return
         statuses = {name: t.output.status.name for name, t in registered}
-        outcome.update(done=True, exit_code=0 if all(s == "success" for s in statuses.values()) else 1)
+        app.outcome.update(done=True, exit_code=0 if all(s == "success" for s in statuses.values()) else 1)
         report = {
             "tests": statuses,
-            **{k: v for k, v in outcome.items() if k not in ("done",)},
+            **{k: v for k, v in app.outcome.items() if k not in ("done",)},
             "logs": {
                 name: t.output.log.get_text() for name, t in registered if t.output.status != te.TestStatus.success
             },
         }
-        results_path.write_text(json.dumps(report, indent=2) + "\n")
+        app.results_path.write_text(json.dumps(report, indent=2) + "\n")
         hello_imgui.get_runner_params().app_shall_exit = True
 
     params.use_imgui_test_engine = True

@@ -137,15 +137,11 @@ def main(argv=None) -> int:
     params = runner_params(editor, viewport, panels, testing=args.self_test is not None, window_size=args.window_size)
     outcome = {}
     if args.self_test is not None:
-        from app.gui_tests import install
+        from app.gui_tests import EditorUnderTest, install
 
         install(
             params,
-            editor,
-            viewport,
-            panels,
-            args.self_test,
-            outcome,
+            EditorUnderTest(editor, viewport, panels, args.self_test, outcome),
             only=None if args.tests is None else args.tests.split(","),
         )
     if args.frames is not None:

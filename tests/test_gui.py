@@ -63,7 +63,7 @@ def run_editor(scene_path, folder, *options) -> tuple[subprocess.CompletedProces
     return result, json.loads(results_file.read_text())
 
 
-@pytest.mark.parametrize("name", GUI_TESTS)
+@pytest.mark.parametrize("name", [test.__name__ for test in GUI_TESTS])
 def test_gui(gui_results, name):
     result, report = gui_results
     assert report["tests"][name] == "success", report["logs"].get(name, "") + result.stdout[-2000:]
