@@ -49,7 +49,7 @@ from cloudcore.lod.costs import CostModel
 from cloudcore.lod.frameplan import FramePlan, LodState, inside_runs, plan_frame
 from cloudcore.lod.units import LodUnits, lod_units
 from cloudcore.measure.frame_stats import FrameStats
-from cloudcore.measure.overdraw import analytic_overdraw, overdraw_statistics
+from cloudcore.measure.overdraw import Overdraw, analytic_overdraw, overdraw_statistics
 from cloudcore.scene import Camera, Lighting, Scene
 from cloudcore.settings import FULL_3D, RenderSettings
 
@@ -127,7 +127,7 @@ class FrameRenderer:
         time_s: float = 0.0,
         read_back: bool = True,
         costs: CostModel | None = None,
-    ) -> tuple[np.ndarray | None, dict]:
+    ) -> tuple[np.ndarray | None, FrameStats]:
         """(sRGB uint8 (height, width, 3), stats); `time_of_day` and `camera` override the scene's.
 
         Auto mode prices its choices with the cost model fitted to the frames rendered so far, or
@@ -441,7 +441,7 @@ class FrameRenderer:
             GL.glDeleteRenderbuffers(1, [self._inside[1]])
             self._inside = None
 
-    def measure_overdraw(self) -> tuple[np.ndarray, dict]:
+    def measure_overdraw(self) -> tuple[np.ndarray, Overdraw]:
         """(fragments per pixel (height, width) float32, statistics) of the last rendered frame's clouds.
 
         Replays the last frame's screen-resolution cloud draws (splats, and one
@@ -507,7 +507,7 @@ def render_full(
     time_of_day: float | None = None,
     camera: Camera | None = None,
     illumination_method: str = "exact",
-) -> tuple[np.ndarray, dict]:
+) -> tuple[np.ndarray, FrameStats]:
     """Render one full-3D frame of `scene` in a context of its own; see `FrameRenderer.render`."""
     with FrameRenderer(width, height) as renderer:
         return renderer.render(
