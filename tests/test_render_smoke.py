@@ -43,6 +43,20 @@ def test_frame_is_a_valid_image_with_stats(afternoon, valley):
     assert 0 < stats.particles_drawn <= valley.particle_count
 
 
+def test_each_pass_is_timed_on_the_cpu_and_on_the_gpu_within_its_wall_time(afternoon):
+    _, stats = afternoon
+    passes = {
+        "world": (stats.world_ms, stats.world_gpu_ms),
+        "impostor updates": (stats.impostor_update_ms, stats.impostor_update_gpu_ms),
+        "clouds": (stats.cloud_ms, stats.cloud_gpu_ms),
+    }
+    # the GPU's time lies inside the pass's bracket on the wall clock (a millisecond for the clocks' grain)
+    for name, (wall_ms, gpu_ms) in passes.items():
+        assert 0.0 <= gpu_ms <= wall_ms + 1.0, (name, wall_ms, gpu_ms)
+    assert stats.cloud_gpu_ms > 0.0 and stats.world_gpu_ms > 0.0  # full 3D draws both
+    assert 0.0 < stats.cpu_ms
+
+
 def test_sky_at_the_top_is_blue(afternoon):
     r, g, b = afternoon[0][0, WIDTH // 2].astype(int)
     assert b > g > r and b > 150

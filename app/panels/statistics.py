@@ -23,6 +23,10 @@ class StatisticsPanel:
             f"{ms:6.1f} ms ({1000.0 / max(ms, 1e-3):5.1f} fps)  clouds {frame.cloud_ms:.1f}  "
             f"impostor updates {frame.impostor_update_ms:.1f}  world {frame.world_ms:.1f}"
         )
+        imgui.text(
+            f"GPU: clouds {frame.cloud_gpu_ms:.1f}  impostor updates {frame.impostor_update_gpu_ms:.1f}  "
+            f"world {frame.world_gpu_ms:.1f};  CPU {frame.cpu_ms:.1f} (planning and issuing the passes)"
+        )
         if shown.picture_reused:
             imgui.text("picture kept: nothing changed since it was drawn (clouds, updates, world: that frame's)")
         if shown.relighting:

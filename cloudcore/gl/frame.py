@@ -37,6 +37,7 @@ from cloudcore.colour import linear_to_srgb8
 from cloudcore.gl.context import HeadlessContext, WindowContext, check_frame_size
 from cloudcore.gl.impostor_store import ImpostorStore
 from cloudcore.gl.objects import ObjectPass
+from cloudcore.gl.pass_clock import PassClock
 from cloudcore.gl.programs import build_program
 from cloudcore.gl.quads import SCREEN_CORNERS, QuadPass
 from cloudcore.gl.splats import SplatPass, splat_batch
@@ -85,6 +86,7 @@ class FrameRenderer:
         self.context = context if context is not None else HeadlessContext(width, height)
         self.context.make_current()
         self._splats = SplatPass()
+        self._clock = PassClock()
         self._quads = QuadPass()
         self._impostors = ImpostorStore(self._splats)
         self._world, self._world_source = None, None
@@ -143,6 +145,7 @@ class FrameRenderer:
         )
         camera = scene.camera if camera is None else camera
         illumination_ms = self._prepare(scene, lighting, illumination_method)
+        planning_started = time.perf_counter()
         particles = self._particles
         poses = self._objects.poses(time_s) if self._objects is not None else ()
         starts = particles.cloud_starts
@@ -178,30 +181,31 @@ class FrameRenderer:
         GL.glDisable(GL.GL_SCISSOR_TEST)
         for start, facing in self._facings.update(camera.position):
             self._splats.update_facing(particles, start, facing)
-        start = time.perf_counter()
+        before_passes_ms = 1e3 * (time.perf_counter() - planning_started)
         self._splats.particles_as_points = 0
-        self._world.draw(self.context, camera, projection @ view)
-        if plan.objects_with_world:
-            self._objects.draw(self.context, camera, poses, plan.objects_with_world, write_depth=True)
-        GL.glFinish()
-        world_done = time.perf_counter()
-        rendered = self._impostors.update(plan, self._units, particles, settings, time_s)
-        GL.glFinish()
-        updates_done = time.perf_counter()
-        self.context.bind_target()
-        drawn = self._draw_clouds(plan, particles, camera, view, projection, settings, poses, time_s)
-        GL.glFinish()
-        done = time.perf_counter()
-        self.lod_state = plan.state.measured(
-            [(plan.update_work, 1e3 * (updates_done - world_done)), (plan.cloud_work, 1e3 * (done - updates_done))]
-        )
+        clock = self._clock
+        with clock.timed("world"):
+            self._world.draw(self.context, camera, projection @ view)
+            if plan.objects_with_world:
+                self._objects.draw(self.context, camera, poses, plan.objects_with_world, write_depth=True)
+        with clock.timed("impostor updates"):
+            rendered = self._impostors.update(plan, self._units, particles, settings, time_s)
+        with clock.timed("clouds"):
+            self.context.bind_target()
+            drawn = self._draw_clouds(plan, particles, camera, view, projection, settings, poses, time_s)
+        world, updates, clouds = (clock.times[name] for name in ("world", "impostor updates", "clouds"))
+        self.lod_state = plan.state.measured([(plan.update_work, updates.wall_ms), (plan.cloud_work, clouds.wall_ms)])
         stats = FrameStats(
             plan=plan.stats(),
             illumination_ms=illumination_ms,
-            frame_ms=1e3 * (done - start),
-            world_ms=1e3 * (world_done - start),
-            impostor_update_ms=1e3 * (updates_done - world_done),
-            cloud_ms=1e3 * (done - updates_done),
+            frame_ms=world.wall_ms + updates.wall_ms + clouds.wall_ms,
+            world_ms=world.wall_ms,
+            impostor_update_ms=updates.wall_ms,
+            cloud_ms=clouds.wall_ms,
+            cpu_ms=before_passes_ms + world.cpu_ms + updates.cpu_ms + clouds.cpu_ms,
+            world_gpu_ms=world.gpu_ms,
+            impostor_update_gpu_ms=updates.gpu_ms,
+            cloud_gpu_ms=clouds.gpu_ms,
             particles_drawn=drawn,
             particles_as_points=self._splats.particles_as_points,
             particles_to_impostors=rendered,
@@ -486,6 +490,7 @@ class FrameRenderer:
         self._impostors.close()
         self._quads.close()
         self._splats.close()
+        self._clock.close()
         if self._world is not None:
             self._world.close()
         if self._objects is not None:

@@ -43,15 +43,21 @@ class PlanStats:
 
 @dataclass(frozen=True)
 class FrameStats:
-    """One frame: the plan's choices, what the renderer drew, and the passes' times (to glFinish); the
-    defaults are an empty frame's."""
+    """One frame: the plan's choices, what the renderer drew, and the passes' times (to glFinish, on the
+    CPU, on the GPU); the defaults are an empty frame's."""
 
     plan: PlanStats = field(default_factory=PlanStats)
     illumination_ms: float = 0.0  # shading the particles' light, when the scene or its light changed
-    frame_ms: float = 0.0  # world, impostor updates and cloud pass
+    frame_ms: float = 0.0  # world, impostor updates and cloud pass, each to its glFinish
     world_ms: float = 0.0
     impostor_update_ms: float = 0.0
     cloud_ms: float = 0.0
+    #: the CPU's part: planning, then issuing the three passes (Python, numpy, driver calls), not waiting for them
+    cpu_ms: float = 0.0
+    #: the GPU's time on each pass (GL_TIME_ELAPSED queries: `cloudcore.gl.pass_clock`)
+    world_gpu_ms: float = 0.0
+    impostor_update_gpu_ms: float = 0.0
+    cloud_gpu_ms: float = 0.0
     particles_drawn: int = 0  # on the screen
     particles_as_points: int = 0  # of those and of the regenerations', drawn as point sprites
     particles_to_impostors: int = 0

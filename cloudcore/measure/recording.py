@@ -8,7 +8,8 @@ import numpy as np
 
 from cloudcore.measure.frame_stats import FrameStats
 
-#: the columns of `cloudview record --stats`, in order; other_ms is frame_ms less the cloud pass and impostor updates
+#: the columns of `cloudview record --stats`, in order; other_ms is frame_ms less the cloud pass and impostor updates,
+#: cpu_ms the CPU's part of the frame and gpu_ms the GPU's time on its passes (`FrameStats`)
 COLUMNS = (
     "frame",
     "time_s",
@@ -16,6 +17,8 @@ COLUMNS = (
     "cloud_ms",
     "impostor_update_ms",
     "other_ms",
+    "cpu_ms",
+    "gpu_ms",
     "particles_drawn",
     "clouds_drawn",
     "impostors_drawn",
@@ -54,6 +57,8 @@ def frame_row(frame: int, time_s: float, stats: FrameStats) -> dict:
         "cloud_ms": round(stats.cloud_ms, 3),
         "impostor_update_ms": round(stats.impostor_update_ms, 3),
         "other_ms": round(stats.frame_ms - stats.cloud_ms - stats.impostor_update_ms, 3),
+        "cpu_ms": round(stats.cpu_ms, 3),
+        "gpu_ms": round(stats.world_gpu_ms + stats.impostor_update_gpu_ms + stats.cloud_gpu_ms, 3),
         "particles_drawn": stats.particles_drawn,
         "clouds_drawn": stats.clouds_drawn,
         "impostors_drawn": stats.plan.impostors_drawn,
