@@ -92,3 +92,13 @@ def test_pyrender_bounds_work_under_numpy_2(renderer):
     scene = pyrender.Scene()
     scene.add(pyrender.Mesh([pyrender.Primitive(positions=np.eye(3, dtype=np.float32))]))
     np.testing.assert_allclose(scene.bounds, [[0, 0, 0], [1, 1, 1]])
+
+
+def test_an_antialiased_world_differs_only_along_the_terrains_edges(renderer, valley, afternoon):
+    plain, _ = afternoon
+    smooth, stats = renderer.render(
+        valley, time_of_day=15.5, settings=dataclasses.replace(FULL_3D, world_antialiasing=True)
+    )
+    changed = np.abs(smooth.astype(int) - plain.astype(int)).max(axis=2) > 8
+    assert 0.0 < changed.mean() < 0.01, changed.mean()  # the ridge line and nothing else
+    assert stats.world_ms > 0.0

@@ -3,16 +3,19 @@
 The frame is composed in linear light in an RGBA16F colour texture with a
 24-bit depth buffer (`RenderTargets`).  pyrender draws the world's colour
 (8 bits, sRGB-encoded) into `world_texture` and its depth into that same depth
-buffer, which the cloud passes then test against.  How pyrender gets there
-differs:
+buffer, which the cloud passes then test against.  In both contexts a
+`pyrender.Renderer` draws straight into our framebuffer, so the editor and the
+headless tools make the same picture:
 
 - `HeadlessContext` (tools, tests): pyrender's EGL `OffscreenRenderer` owns
-  the context and renders into its own framebuffer; we blit colour and depth
-  across (the depth formats must match, hence DEPTH_COMPONENT24).  Its
-  `render()` leaves the context un-current, so every raw-GL entry point calls
-  `make_current()` first.
-- `WindowContext` (the editor): the window's context is current already; a
-  `pyrender.Renderer` draws straight into our world framebuffer.
+  the context (we never call its `render`, which draws with 4x multisampling
+  and reads the result back to numpy every frame).  Every raw-GL entry point
+  calls `make_current()` first.
+- `WindowContext` (the editor): the window's context is current already.
+
+Multisampling the world is a choice per frame (`render_pyrender_scene`'s
+`antialiased`): on llvmpipe it makes the world pass 4 to 5.6 times slower for
+46.6-48.8 dB (docs/performance.md), so the frame's default is without.
 """
 
 from __future__ import annotations
@@ -21,6 +24,9 @@ import numpy as np
 from OpenGL import GL
 
 from cloudcore.gl.pyrender_compat import pyrender
+
+#: samples of an antialiased world: what pyrender's own offscreen renderer used, and what every GL 3.0+ must offer
+WORLD_SAMPLES = 4
 
 
 def check_frame_size(width: int, height: int) -> None:
@@ -42,6 +48,9 @@ class RenderTargets:
         self.framebuffer = _framebuffer(self.colour_texture, self.depth_renderbuffer)
         self.world_texture = _texture(self.width, self.height, GL.GL_RGBA8)
         self.world_framebuffer = _framebuffer(self.world_texture, self.depth_renderbuffer)
+        self._pyrender = _RendererIntoFramebuffer(self.width, self.height)
+        #: (framebuffer, colour and depth renderbuffers) with 4 samples, made by the first antialiased render
+        self._multisampled: tuple[int, list[int]] | None = None
 
     def make_current(self) -> None:
         """Make the GL context current (a no-op where the owner keeps it current)."""
@@ -63,6 +72,41 @@ class RenderTargets:
         GL.glClear(GL.GL_COLOR_BUFFER_BIT | GL.GL_DEPTH_BUFFER_BIT)
         self.bind_target()
 
+    def render_pyrender_scene(self, scene, flags, framebuffer: int | None = None, *, antialiased: bool = False):
+        """Render a pyrender scene: its depth into the target's depth, its colour into `world_texture`.
+
+        Or both into `framebuffer` (colour RGBA8, depth DEPTH_COMPONENT24), the objects' target.  With
+        `antialiased`, into a 4x multisampled framebuffer first, resolved into the destination (the
+        depth takes one sample per pixel, as a resolve of depth does).
+        """
+        self.make_current()
+        destination = self.world_framebuffer if framebuffer is None else framebuffer
+        drawn_into = self._multisampled_framebuffer() if antialiased else destination
+        self._pyrender.target_framebuffer = drawn_into
+        self._pyrender.render(scene, flags)
+        if antialiased:
+            GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, drawn_into)
+            GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, destination)
+            w, h = self.width, self.height
+            GL.glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL.GL_COLOR_BUFFER_BIT | GL.GL_DEPTH_BUFFER_BIT, GL.GL_NEAREST)
+        self.bind_target()
+
+    def _multisampled_framebuffer(self) -> int:
+        if self._multisampled is None:
+            renderbuffers = [int(r) for r in GL.glGenRenderbuffers(2)]
+            for renderbuffer, internal_format in zip(renderbuffers, (GL.GL_RGBA8, GL.GL_DEPTH_COMPONENT24)):
+                GL.glBindRenderbuffer(GL.GL_RENDERBUFFER, renderbuffer)
+                GL.glRenderbufferStorageMultisample(
+                    GL.GL_RENDERBUFFER, WORLD_SAMPLES, internal_format, self.width, self.height
+                )
+            framebuffer = GL.glGenFramebuffers(1)
+            GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, framebuffer)
+            for attachment, renderbuffer in zip((GL.GL_COLOR_ATTACHMENT0, GL.GL_DEPTH_ATTACHMENT), renderbuffers):
+                GL.glFramebufferRenderbuffer(GL.GL_FRAMEBUFFER, attachment, GL.GL_RENDERBUFFER, renderbuffer)
+            _check_complete("multisampled world")
+            self._multisampled = (framebuffer, renderbuffers)
+        return self._multisampled[0]
+
     def read_linear_rgb(self) -> np.ndarray:
         """The render target as float32 (height, width, 3), top row first."""
         self.make_current()
@@ -73,9 +117,15 @@ class RenderTargets:
         return pixels[::-1].copy()
 
     def close_targets(self) -> None:
+        self._pyrender.delete()
         GL.glDeleteFramebuffers(2, [self.framebuffer, self.world_framebuffer])
         GL.glDeleteRenderbuffers(1, [self.depth_renderbuffer])
         GL.glDeleteTextures([self.colour_texture, self.world_texture])
+        if self._multisampled is not None:
+            framebuffer, renderbuffers = self._multisampled
+            GL.glDeleteFramebuffers(1, [framebuffer])
+            GL.glDeleteRenderbuffers(len(renderbuffers), renderbuffers)
+            self._multisampled = None
 
 
 class HeadlessContext(RenderTargets):
@@ -93,22 +143,6 @@ class HeadlessContext(RenderTargets):
 
     def make_current(self) -> None:
         self.renderer._platform.make_current()
-
-    def render_pyrender_scene(self, scene, flags, framebuffer: int | None = None) -> None:
-        """Render a pyrender scene: its depth into the target's depth, its colour into `world_texture`.
-
-        Or both into `framebuffer` (colour RGBA8, depth DEPTH_COMPONENT24), the objects' target.
-        `OffscreenRenderer.render` always reads its result back to numpy; we copy
-        from the resolved framebuffer it leaves behind (pyrender 0.1.45 keeps it
-        in `Renderer._main_fb`), so colour and depth stay on the GPU.
-        """
-        self.renderer.render(scene, flags=flags)
-        self.make_current()
-        GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, self.renderer._renderer._main_fb)
-        GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, self.world_framebuffer if framebuffer is None else framebuffer)
-        w, h = self.width, self.height
-        GL.glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL.GL_COLOR_BUFFER_BIT | GL.GL_DEPTH_BUFFER_BIT, GL.GL_NEAREST)
-        self.bind_target()
 
     @property
     def closed(self) -> bool:
@@ -157,25 +191,15 @@ class _RendererIntoFramebuffer(pyrender.Renderer):
 class WindowContext(RenderTargets):
     """Our targets inside a context someone else made current (the editor's window)."""
 
-    def __init__(self, width: int, height: int):
-        super().__init__(width, height)
-        self._renderer = _RendererIntoFramebuffer(self.width, self.height)
-
-    def render_pyrender_scene(self, scene, flags, framebuffer: int | None = None) -> None:
-        self._renderer.target_framebuffer = self.world_framebuffer if framebuffer is None else framebuffer
-        self._renderer.render(scene, flags)
-        self.bind_target()
-
     @property
     def closed(self) -> bool:
-        return self._renderer is None
+        return self._pyrender is None
 
     def close(self) -> None:
-        if self._renderer is None:
+        if self._pyrender is None:
             return
         self.close_targets()
-        self._renderer.delete()
-        self._renderer = None
+        self._pyrender = None
 
 
 def _texture(width: int, height: int, internal_format) -> int:
@@ -192,7 +216,11 @@ def _framebuffer(colour_texture: int, depth_renderbuffer: int) -> int:
     GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, framebuffer)
     GL.glFramebufferTexture2D(GL.GL_FRAMEBUFFER, GL.GL_COLOR_ATTACHMENT0, GL.GL_TEXTURE_2D, colour_texture, 0)
     GL.glFramebufferRenderbuffer(GL.GL_FRAMEBUFFER, GL.GL_DEPTH_ATTACHMENT, GL.GL_RENDERBUFFER, depth_renderbuffer)
+    _check_complete("render target")
+    return framebuffer
+
+
+def _check_complete(what: str) -> None:
     status = GL.glCheckFramebufferStatus(GL.GL_FRAMEBUFFER)
     if status != GL.GL_FRAMEBUFFER_COMPLETE:
-        raise RuntimeError(f"framebuffer incomplete (status 0x{int(status):x})")
-    return framebuffer
+        raise RuntimeError(f"{what} framebuffer incomplete (status 0x{int(status):x})")

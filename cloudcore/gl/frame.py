@@ -185,9 +185,12 @@ class FrameRenderer:
         self._splats.particles_as_points = 0
         clock = self._clock
         with clock.timed("world"):
-            self._world.draw(self.context, camera, projection @ view)
+            antialiased = settings.world_antialiasing
+            self._world.draw(self.context, camera, projection @ view, antialiased=antialiased)
             if plan.objects_with_world:
-                self._objects.draw(self.context, camera, poses, plan.objects_with_world, write_depth=True)
+                self._objects.draw(
+                    self.context, camera, poses, plan.objects_with_world, write_depth=True, antialiased=antialiased
+                )
         with clock.timed("impostor updates"):
             rendered = self._impostors.update(plan, self._units, particles, settings, time_s)
         with clock.timed("clouds"):
@@ -350,7 +353,10 @@ class FrameRenderer:
                 drawn += self._draw_splats(frame, *zip(*full_run))
                 full_run = []
             if cloud is None:
-                self._objects.draw(self.context, camera, poses, [item.index], write_depth=False)
+                antialiased = settings.world_antialiasing
+                self._objects.draw(
+                    self.context, camera, poses, [item.index], write_depth=False, antialiased=antialiased
+                )
             elif cloud.kind == "inside":
                 if id(item) in screen_impostors:  # the rest of its run is in the same screen impostor
                     drawn += self._draw_inside(frame, screen_impostors[id(item)], cloud.full_weight)

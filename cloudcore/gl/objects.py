@@ -54,15 +54,18 @@ class ObjectPass:
     def poses(self, time_s: float):
         return object_poses(self.objects, time_s, self._spheres)
 
-    def draw(self, context, camera: Camera, poses, which, *, write_depth: bool) -> None:
-        """Composite the objects `which` (indices) at `poses` into the bound frame target."""
+    def draw(self, context, camera: Camera, poses, which, *, write_depth: bool, antialiased: bool = False) -> None:
+        """Composite the objects `which` (indices) at `poses` into the bound frame target (multisampled 4x
+        when `antialiased`)."""
         which = set(which)
         for index, (node, pose) in enumerate(zip(self._nodes, poses)):
             node.mesh.is_visible = index in which
             self._scene.set_pose(node, pose.model)
         self._camera_node.camera.yfov = math.radians(camera.fov_y_deg)
         self._scene.set_pose(self._camera_node, camera_pose(camera))
-        context.render_pyrender_scene(self._scene, pyrender.RenderFlags.NONE, self._framebuffer)
+        context.render_pyrender_scene(
+            self._scene, pyrender.RenderFlags.NONE, self._framebuffer, antialiased=antialiased
+        )
         GL.glUseProgram(self._program)
         for unit, (texture, name) in enumerate(((self._colour, "object_colour"), (self._depth, "object_depth"))):
             GL.glActiveTexture(GL.GL_TEXTURE0 + unit)

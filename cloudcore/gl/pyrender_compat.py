@@ -23,11 +23,9 @@ PRIVATE_API = (
     (
         "Renderer",
         "_configure_forward_pass_viewport",
-        "WindowContext overrides it to draw the world into our framebuffer (gl/context.py)",
+        "our renderer overrides it to draw the world into our framebuffer (gl/context.py)",
     ),
     ("OffscreenRenderer", "_platform", "its EGL context, made current before our own GL calls"),
-    ("OffscreenRenderer", "_renderer", "its Renderer, whose resolved framebuffer we blit from"),
-    ("Renderer", "_main_fb", "the resolved framebuffer a headless render leaves behind"),
     ("EGLPlatform", "_egl_display", "closing one headless context must not terminate the display (gl/context.py)"),
     ("EGLPlatform", "_egl_context", "the context destroyed alone while other headless contexts are open"),
 )

@@ -73,15 +73,18 @@ class WorldPass:
         camera = pyrender.PerspectiveCamera(yfov=np.radians(60.0), znear=NEAR_PLANE_M, zfar=FAR_PLANE_M)
         return scene, scene.add(camera)
 
-    def draw(self, context: HeadlessContext, camera: Camera, view_projection: np.ndarray) -> None:
-        """Fill the render target: terrain colour and depth where there is terrain, sky elsewhere."""
+    def draw(
+        self, context: HeadlessContext, camera: Camera, view_projection: np.ndarray, *, antialiased: bool = False
+    ) -> None:
+        """Fill the render target: terrain colour and depth where there is terrain, sky elsewhere (the terrain
+        multisampled 4x when `antialiased`)."""
         if self._scene is None:
             context.clear_world()
         else:
             # the aspect ratio comes from the viewport, as in our projection_matrix
             self._camera_node.camera.yfov = np.radians(camera.fov_y_deg)
             self._scene.set_pose(self._camera_node, camera_pose(camera))
-            context.render_pyrender_scene(self._scene, pyrender.RenderFlags.FLAT)
+            context.render_pyrender_scene(self._scene, pyrender.RenderFlags.FLAT, antialiased=antialiased)
         program = self._composite_program
         GL.glUseProgram(program)
         GL.glActiveTexture(GL.GL_TEXTURE0)
