@@ -216,6 +216,31 @@ class View:
 
 
 @dataclass(frozen=True)
+class CloudField:
+    """Clouds to the horizon as parameters: Yusov's camera-centred nested grid (2014, section 5.2).
+
+    The particles are generated around the eye, cell by cell, by
+    `cloudcore.field.cloud_field` (deterministic: the same cell is always the
+    same particles).  `coverage` in [0, 1] is how much of the sky is cloud;
+    `cell_size` (m) the side of the inner ring's cells, each ring's cells twice
+    the size of the ring inside it; `rings` the nested levels; `layers` the
+    particle layers of a cell between `altitude` = (bottom, top) in metres;
+    `cloud_type` a preset of `cloudcore.artist.cloudgen.PRESETS` (its optics and
+    colour); the field covers `extent` = (x, z) metres about `centre` = (x, z).
+    """
+
+    seed: int = 0
+    coverage: float = 0.4
+    cell_size: float = 1000.0
+    rings: int = 5
+    layers: int = 3
+    altitude: tuple[float, float] = (1200.0, 2600.0)
+    cloud_type: str = "cumulus_humilis"
+    extent: tuple[float, float] = (100000.0, 100000.0)
+    centre: tuple[float, float] = (0.0, 0.0)
+
+
+@dataclass(frozen=True)
 class Scene:
     camera: Camera = Camera()
     lighting: Lighting = Lighting()
@@ -227,6 +252,8 @@ class Scene:
     description: str = ""
     #: the named views of `[[views]]`; `all_views` adds the default one first
     views: tuple[View, ...] = ()
+    #: clouds generated around the eye to the horizon (`[cloud_field]`), besides the authored `clouds`
+    cloud_field: CloudField | None = None
 
     @property
     def particle_count(self) -> int:

@@ -17,8 +17,10 @@ import numpy as np
 import tomlkit
 
 from cloudcore.artist.artist_shading import ArtistShading
+from cloudcore.artist.cloudgen import PRESETS
 from cloudcore.artist.formation import FORMATION_KINDS, Formation
 from cloudcore.artist.sprites import FACINGS, MAX_SEED, SpriteStyle
+from cloudcore.field.grid import MAX_CELL_SIZE, MAX_CELLS_ACROSS, MAX_LAYERS, MAX_RINGS, MIN_CELL_SIZE
 from cloudcore.light.phase import MAX_ABS_G, PHASE_NAMES
 from cloudcore.light.shading import EYE_PASSES
 from cloudcore.limits import scene_limit_problems
@@ -28,6 +30,7 @@ from cloudcore.scene import (
     Camera,
     CameraPath,
     Cloud,
+    CloudField,
     Light,
     Lighting,
     Scene,
@@ -66,7 +69,18 @@ def load_scene(path) -> Scene:
 def scene_from_dict(data: dict, source: str = "<scene>", base_dir=Path(".")) -> Scene:
     root = Table(source, "", data)
     root.reject_unknown(
-        ("description", "camera", "lighting", "shading", "clouds", "terrain", "objects", "camera_paths", "views")
+        (
+            "description",
+            "camera",
+            "lighting",
+            "shading",
+            "clouds",
+            "cloud_field",
+            "terrain",
+            "objects",
+            "camera_paths",
+            "views",
+        )
     )
     clouds = tuple(_cloud(t, Path(base_dir)) for t in root.tables("clouds"))
     _unique_names(root, "clouds", clouds)
@@ -87,6 +101,7 @@ def scene_from_dict(data: dict, source: str = "<scene>", base_dir=Path(".")) -> 
         camera_paths=paths,
         description=root.string("description", ""),
         views=views,
+        cloud_field=root.table("cloud_field", _cloud_field),
     )
     # what every field allows, the renderer may still not draw: refuse that here, not in the GL code
     problems = scene_limit_problems(scene)
@@ -281,6 +296,37 @@ def _cloud(t: Table, base_dir: Path) -> Cloud:
     )
 
 
+#: the keys of [cloud_field], in the order a saved file writes them
+CLOUD_FIELD_KEYS = tuple(f.name for f in dataclasses.fields(CloudField))
+
+
+def _cloud_field(t: Table) -> CloudField:
+    """`[cloud_field]`: every limit the generator and the grid rely on checked here."""
+    t.reject_unknown(CLOUD_FIELD_KEYS)
+    d = CloudField()
+    cell_size = t.number("cell_size", d.cell_size, low=MIN_CELL_SIZE, high=MAX_CELL_SIZE)
+    altitude = t.row("altitude", 2, d.altitude)
+    if not altitude[0] < altitude[1]:
+        t.fail("altitude", f"expected [bottom, top] with bottom < top in metres, got {list(altitude)}")
+    extent = t.row("extent", 2, d.extent)
+    if not all(0.0 < side <= MAX_CELLS_ACROSS * cell_size for side in extent):
+        t.fail(
+            "extent",
+            f"expected [x, z] in metres, each > 0 and at most {MAX_CELLS_ACROSS} cells of cell_size, got {list(extent)}",
+        )
+    return CloudField(
+        seed=t.integer("seed", d.seed, low=0, high=2**31 - 1),
+        coverage=t.number("coverage", d.coverage, low=0.0, high=1.0),
+        cell_size=cell_size,
+        rings=t.integer("rings", d.rings, low=1, high=MAX_RINGS),
+        layers=t.integer("layers", d.layers, low=1, high=MAX_LAYERS),
+        altitude=altitude,
+        cloud_type=t.string("cloud_type", d.cloud_type, choices=tuple(PRESETS)),
+        extent=extent,
+        centre=t.row("centre", 2, d.centre),
+    )
+
+
 def _formation(t: Table) -> Formation:
     t.reject_unknown(("kind", "start_s", "duration_s"))
     return Formation(
@@ -448,6 +494,8 @@ def scene_to_dict(scene: Scene) -> dict:
             terrain["mesh"] = t.mesh
         data["terrain"] = terrain
     data["clouds"] = [_cloud_dict(cloud) for cloud in scene.clouds]
+    if scene.cloud_field is not None:
+        data["cloud_field"] = _record_dict(scene.cloud_field)
     data["objects"] = [_object_dict(o) for o in scene.objects]
     data["camera_paths"] = [{"name": p.name, "keys": _rows(p.keys)} for p in scene.camera_paths]
     data["views"] = [_view_dict(view) for view in scene.views]

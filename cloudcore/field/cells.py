@@ -1,0 +1,131 @@
+"""A cloud field's cells: the particles of cell (level, i, j), the same whenever it is made.
+
+Yusov (2014, section 5.2): "Each cell contains several particle layers.  The
+number of layers, as well as particle size and density, are determined by 2D
+noise.  Particles in higher layers are smaller to make cumulus-like cloud
+shapes with narrower tops and wider bottoms.  All particles are randomly
+rotated and displaced to break repetitive patterns."
+
+Here a cell holds `CANDIDATES_PER_SIDE`^2 candidate particles a layer on a
+jittered grid; a candidate is kept where the field's cloud density (2D value
+noise, `cloud_density`) exceeds the threshold that makes `coverage` of the
+plane cloudy, and in higher layers only where it exceeds it by more.  The
+candidate spacing, and with it the particle radius, follows the cell's side,
+so a coarser ring has a quarter as many particles per area, each twice as
+large: the same share of the sky covered.  Every random choice is an integer
+hash of (seed, level, layer, candidate), never a generator stream
+(`cloudcore.noise`), so a cell is the same on every machine and numpy.
+"""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+from cloudcore.artist.cloudgen import PRESETS
+from cloudcore.field.grid import cell_side
+from cloudcore.noise import hash01, value_noise
+from cloudcore.scene import Cloud, CloudField
+
+#: candidate particles along a cell's side, per layer
+CANDIDATES_PER_SIDE = 6
+#: the cloud density's largest wavelength, in inner cells: clouds about an inner cell across
+NOISE_WAVELENGTH_CELLS = 2.0
+#: a particle's radius over the candidate spacing: neighbours overlap, no gaps between splats
+RADIUS_SPACINGS = 1.1
+#: how much smaller a particle of the top layer is than one of the bottom layer
+TOP_SHRINK = 0.35
+#: the share of the density above the threshold that the top layer needs: narrower tops
+TOP_HEADROOM = 0.7
+#: octaves of the cloud density: (frequency, amplitude)
+_OCTAVES = ((1.0, 0.6), (2.03, 0.3), (4.11, 0.1))
+#: what the random choices are for, mixed into their hash seeds
+_JITTER_X, _JITTER_Z, _JITTER_Y, _SIZE = range(4)
+
+
+def cloud_density(field: CloudField, x, z) -> np.ndarray:
+    """The field's cloud density in [0, 1] at (x, z): fractal value noise, the same at every level."""
+    wavelength = NOISE_WAVELENGTH_CELLS * field.cell_size
+    u = (np.asarray(x, dtype=np.float64) - field.centre[0]) / wavelength
+    v = (np.asarray(z, dtype=np.float64) - field.centre[1]) / wavelength
+    total = sum(
+        amplitude * value_noise(frequency * u, frequency * v, field.seed + octave)
+        for octave, (frequency, amplitude) in enumerate(_OCTAVES)
+    )
+    return 0.5 * (total + 1.0)
+
+
+@functools.cache
+def _density_quantiles() -> np.ndarray:
+    """The density's quantiles 0, 0.001, ..., 1 over a large patch of plane (the same for every seed:
+    value noise is stationary)."""
+    u, v = np.meshgrid(np.linspace(0.0, 200.0, 400), np.linspace(0.0, 200.0, 400))
+    unit = CloudField(cell_size=1.0 / NOISE_WAVELENGTH_CELLS)
+    return np.quantile(cloud_density(unit, u, v), np.linspace(0.0, 1.0, 1001))
+
+
+def coverage_threshold(coverage: float) -> float:
+    """The density above which a point is cloudy, so that `coverage` of the plane is (0: none, 1: all)."""
+    if coverage <= 0.0:
+        return np.inf
+    if coverage >= 1.0:
+        return -np.inf
+    quantiles = _density_quantiles()
+    return float(np.interp(1.0 - coverage, np.linspace(0.0, 1.0, len(quantiles)), quantiles))
+
+
+def cell_cloud(field: CloudField, level: int, i: int, j: int) -> Cloud | None:
+    """The cloud of cell (level, i, j), or None where the cell is clear sky.
+
+    Its particles lie inside the cell's footprint and the field's extent,
+    between the altitudes of `field.altitude`; its optics and colour are
+    those of `field.cloud_type`.
+    """
+    side = cell_side(field, level)
+    spacing = side / CANDIDATES_PER_SIDE
+    steps = np.arange(CANDIDATES_PER_SIDE)
+    a, b = np.meshgrid(steps, steps, indexing="ij")
+    gx = (i * CANDIDATES_PER_SIDE + a).ravel()  # the candidates' indices on the level's plane
+    gz = (j * CANDIDATES_PER_SIDE + b).ravel()
+    threshold = coverage_threshold(field.coverage)
+    bottom, top = field.altitude
+    layer_depth = (top - bottom) / field.layers
+    rows = []
+    for layer in range(field.layers):
+
+        def chance(purpose: int) -> np.ndarray:
+            return hash01(gx, gz, _seed(field.seed, level, layer, purpose))
+
+        # displaced within their spacing, never out of the cell
+        x = field.centre[0] + (gx + 0.5 + 0.8 * (chance(_JITTER_X) - 0.5)) * spacing
+        z = field.centre[1] + (gz + 0.5 + 0.8 * (chance(_JITTER_Z) - 0.5)) * spacing
+        density = cloud_density(field, x, z)
+        headroom = (density - threshold) / max(1.0 - threshold, 1e-9) if np.isfinite(threshold) else density
+        height = layer / field.layers
+        kept = (density > threshold) & (headroom > TOP_HEADROOM * height)
+        kept &= (np.abs(x - field.centre[0]) <= 0.5 * field.extent[0]) & (
+            np.abs(z - field.centre[1]) <= 0.5 * field.extent[1]
+        )
+        if not kept.any():
+            continue
+        # the bottom layer sits flat on the condensation level; the others spread through their slab
+        spread = 0.15 if layer == 0 else 0.8
+        y = bottom + (layer + 0.5 + spread * (chance(_JITTER_Y) - 0.5)) * layer_depth
+        radius = RADIUS_SPACINGS * spacing * (1.0 - TOP_SHRINK * height) * (0.8 + 0.4 * chance(_SIZE))
+        rows.append(np.column_stack([x, y, z, radius])[kept])
+    if not rows:
+        return None
+    preset = PRESETS[field.cloud_type]
+    return Cloud(
+        f"field_{level}_{i}_{j}",
+        np.concatenate(rows),
+        optical_depth=preset.optical_depth,
+        albedo=preset.albedo,
+        color=preset.color,
+    )
+
+
+def _seed(seed: int, level: int, layer: int, purpose: int) -> int:
+    """One hash seed per (field seed, level, layer, purpose), within hash01's 64 bits."""
+    return (((seed * 1_000_003 + level) * 1_009 + layer) * 16 + purpose) & (2**64 - 1)
