@@ -312,7 +312,8 @@ def _cloud_field(t: Table) -> CloudField:
     if not all(0.0 < side <= MAX_CELLS_ACROSS * cell_size for side in extent):
         t.fail(
             "extent",
-            f"expected [x, z] in metres, each > 0 and at most {MAX_CELLS_ACROSS} cells of cell_size, got {list(extent)}",
+            f"expected [x, z] in metres, each > 0 and at most {MAX_CELLS_ACROSS} cells of cell_size, "
+            f"got {list(extent)}",
         )
     return CloudField(
         seed=t.integer("seed", d.seed, low=0, high=2**31 - 1),

@@ -93,10 +93,7 @@ def cell_cloud(field: CloudField, level: int, i: int, j: int) -> Cloud | None:
     layer_depth = (top - bottom) / field.layers
     rows = []
     for layer in range(field.layers):
-
-        def chance(purpose: int) -> np.ndarray:
-            return hash01(gx, gz, _seed(field.seed, level, layer, purpose))
-
+        chance = functools.partial(_chance, gx, gz, field.seed, level, layer)
         # displaced within their spacing, never out of the cell
         x = field.centre[0] + (gx + 0.5 + 0.8 * (chance(_JITTER_X) - 0.5)) * spacing
         z = field.centre[1] + (gz + 0.5 + 0.8 * (chance(_JITTER_Z) - 0.5)) * spacing
@@ -126,6 +123,7 @@ def cell_cloud(field: CloudField, level: int, i: int, j: int) -> Cloud | None:
     )
 
 
-def _seed(seed: int, level: int, layer: int, purpose: int) -> int:
-    """One hash seed per (field seed, level, layer, purpose), within hash01's 64 bits."""
-    return (((seed * 1_000_003 + level) * 1_009 + layer) * 16 + purpose) & (2**64 - 1)
+def _chance(gx: np.ndarray, gz: np.ndarray, seed: int, level: int, layer: int, purpose: int) -> np.ndarray:
+    """A value in [0, 1) per candidate (gx, gz) of a level's plane, one hash seed per (field seed, level, layer,
+    purpose) within hash01's 64 bits."""
+    return hash01(gx, gz, (((seed * 1_000_003 + level) * 1_009 + layer) * 16 + purpose) & (2**64 - 1))
