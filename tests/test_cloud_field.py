@@ -21,7 +21,7 @@ from cloudcore.field.grid import (
     level_support,
     level_weights,
 )
-from cloudcore.field.state import HOLE, FieldState, update_field
+from cloudcore.field.state import FADE_KEY_STEPS, HOLE, FieldState, update_field
 from cloudcore.resources import CUMULUS_FIELD, DEFAULT_SCENE
 from cloudcore.scene import CloudField, Scene
 from cloudcore.scenefile import CLOUD_FIELD_KEYS, load_scene, save_scene
@@ -55,11 +55,16 @@ def test_particles_stay_in_their_cell_and_altitude_band_and_coarser_cells_have_l
     radii = []
     for level in range(FIELD.rings):
         side = cell_side(FIELD, level)
-        clouds = [c for i in range(-2, 2) for j in range(-2, 2) if (c := cell_cloud(FIELD, level, i, j)) is not None]
-        for cloud, (i, j) in zip(clouds, [(i, j) for i in range(-2, 2) for j in range(-2, 2)]):
-            x, y, z = cloud.centres.T
-            assert np.all(x >= -2 * side) and np.all(x <= 2 * side)
-            assert np.all((y >= FIELD.altitude[0]) & (y <= FIELD.altitude[1]))
+        clouds = []
+        for i in range(-2, 2):
+            for j in range(-2, 2):
+                cloud = cell_cloud(FIELD, level, i, j)
+                if cloud is None:
+                    continue
+                x, y, z = cloud.centres.T
+                assert np.all((x >= i * side) & (x <= (i + 1) * side) & (z >= j * side) & (z <= (j + 1) * side))
+                assert np.all((y >= FIELD.altitude[0]) & (y <= FIELD.altitude[1]))
+                clouds.append(cloud)
         radii.append(np.median(np.concatenate([c.radii for c in clouds])))
     # Yusov: particle size follows the cell size (twice the cell, twice the particle)
     np.testing.assert_allclose(np.array(radii[1:]) / radii[:-1], 2.0, rtol=0.15)
@@ -220,12 +225,16 @@ def test_the_popping_test_can_fail_without_the_blend():
     assert (np.abs(np.diff(values)) / values.max()).max() > 0.1
 
 
-def test_fade_keys_change_only_while_a_cloud_blends():
-    frame, _ = update_field(FIELD, EYE)
-    for cloud, key, start in zip(frame.clouds, frame.fade_keys, range(len(frame.clouds))):
-        assert 0.0 <= key <= 1.0
-    solid = [k for k in frame.fade_keys if k == 1.0]
-    assert solid and len(solid) < len(frame.fade_keys)
+def test_a_cloud_s_fade_key_is_its_mean_weight_in_steps_and_exactly_1_when_it_does_not_blend():
+    frame, state = update_field(FIELD, EYE)
+    starts = state.cloud_starts
+    for index, key in enumerate(frame.fade_keys):
+        weights = frame.weights[starts[index] : starts[index + 1]]
+        if np.all(weights == 1.0):
+            assert key == 1.0
+        else:
+            assert abs(key - weights.mean()) <= 0.5 / FADE_KEY_STEPS + 1e-12
+    assert 1.0 in frame.fade_keys and min(frame.fade_keys) < 1.0
 
 
 # ---------------------------------------------------------------- the scene file
