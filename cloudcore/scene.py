@@ -8,6 +8,7 @@ input enters (`cloudcore.scenefile`); these types only normalise.
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -15,6 +16,7 @@ import numpy as np
 from cloudcore.artist.artist_shading import ArtistShading
 from cloudcore.artist.formation import Formation
 from cloudcore.artist.sprites import SpriteStyle
+from cloudcore.errors import FieldError
 
 Vec3 = tuple[float, float, float]
 
@@ -215,6 +217,16 @@ class View:
     max_diff: int | None = None
 
 
+#: the most rings a cloud field may have: the outermost's cells are 2^(MAX_RINGS - 1) inner cells across
+MAX_RINGS = 12
+#: the most particle layers a field's cell may hold
+MAX_LAYERS = 8
+#: an inner cell's side in metres, at least (smaller would be particles of a few metres) and at most
+MIN_CELL_SIZE, MAX_CELL_SIZE = 10.0, 1.0e6
+#: a field's extent in inner cells, at most: cell indices stay small integers
+MAX_CELLS_ACROSS = 2**31
+
+
 @dataclass(frozen=True)
 class CloudField:
     """Clouds to the horizon as parameters: Yusov's camera-centred nested grid (2014, section 5.2).
@@ -238,6 +250,36 @@ class CloudField:
     cloud_type: str = "cumulus_humilis"
     extent: tuple[float, float] = (100000.0, 100000.0)
     centre: tuple[float, float] = (0.0, 0.0)
+
+    def __post_init__(self):
+        for name in ("seed", "rings", "layers"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+                raise FieldError(name, f"expected an integer, got {value!r}")
+            object.__setattr__(self, name, int(value))
+        for name, low, high in (("seed", 0, 2**31 - 1), ("rings", 1, MAX_RINGS), ("layers", 1, MAX_LAYERS)):
+            if not low <= getattr(self, name) <= high:
+                raise FieldError(name, f"must be within [{low}, {high}], got {getattr(self, name)}")
+        for name, low, high in (("coverage", 0.0, 1.0), ("cell_size", MIN_CELL_SIZE, MAX_CELL_SIZE)):
+            value = float(getattr(self, name))
+            if not low <= value <= high:  # NaN fails too
+                raise FieldError(name, f"must be within [{low}, {high}], got {value}")
+            object.__setattr__(self, name, value)
+        for name in ("altitude", "extent", "centre"):
+            pair = tuple(float(v) for v in getattr(self, name))
+            if len(pair) != 2 or not all(math.isfinite(v) for v in pair):
+                raise FieldError(name, f"expected 2 finite numbers, got {list(pair)}")
+            object.__setattr__(self, name, pair)
+        if not self.altitude[0] < self.altitude[1]:
+            raise FieldError(
+                "altitude", f"expected [bottom, top] with bottom < top in metres, got {list(self.altitude)}"
+            )
+        if not all(0.0 < side <= MAX_CELLS_ACROSS * self.cell_size for side in self.extent):
+            raise FieldError(
+                "extent",
+                f"expected [x, z] in metres, each > 0 and at most {MAX_CELLS_ACROSS} cells of cell_size, "
+                f"got {list(self.extent)}",
+            )
 
 
 @dataclass(frozen=True)

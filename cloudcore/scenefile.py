@@ -20,13 +20,14 @@ from cloudcore.artist.artist_shading import ArtistShading
 from cloudcore.artist.cloudgen import PRESETS
 from cloudcore.artist.formation import FORMATION_KINDS, Formation
 from cloudcore.artist.sprites import FACINGS, MAX_SEED, SpriteStyle
-from cloudcore.field.grid import MAX_CELL_SIZE, MAX_CELLS_ACROSS, MAX_LAYERS, MAX_RINGS, MIN_CELL_SIZE
 from cloudcore.light.phase import MAX_ABS_G, PHASE_NAMES
 from cloudcore.light.shading import EYE_PASSES
 from cloudcore.limits import scene_limit_problems
 from cloudcore.particle_files import atomic_write, remove_unnamed_particle_files, store_particles
 from cloudcore.scene import (
     DEFAULT_VIEW_NAME,
+    MAX_LAYERS,
+    MAX_RINGS,
     Camera,
     CameraPath,
     Cloud,
@@ -301,29 +302,19 @@ CLOUD_FIELD_KEYS = tuple(f.name for f in dataclasses.fields(CloudField))
 
 
 def _cloud_field(t: Table) -> CloudField:
-    """`[cloud_field]`: every limit the generator and the grid rely on checked here."""
+    """`[cloud_field]`: types here, ranges by the record itself (the editor's panel edits it too)."""
     t.reject_unknown(CLOUD_FIELD_KEYS)
     d = CloudField()
-    cell_size = t.number("cell_size", d.cell_size, low=MIN_CELL_SIZE, high=MAX_CELL_SIZE)
-    altitude = t.row("altitude", 2, d.altitude)
-    if not altitude[0] < altitude[1]:
-        t.fail("altitude", f"expected [bottom, top] with bottom < top in metres, got {list(altitude)}")
-    extent = t.row("extent", 2, d.extent)
-    if not all(0.0 < side <= MAX_CELLS_ACROSS * cell_size for side in extent):
-        t.fail(
-            "extent",
-            f"expected [x, z] in metres, each > 0 and at most {MAX_CELLS_ACROSS} cells of cell_size, "
-            f"got {list(extent)}",
-        )
-    return CloudField(
+    return t.record(
+        CloudField,
         seed=t.integer("seed", d.seed, low=0, high=2**31 - 1),
-        coverage=t.number("coverage", d.coverage, low=0.0, high=1.0),
-        cell_size=cell_size,
+        coverage=t.number("coverage", d.coverage),
+        cell_size=t.number("cell_size", d.cell_size),
         rings=t.integer("rings", d.rings, low=1, high=MAX_RINGS),
         layers=t.integer("layers", d.layers, low=1, high=MAX_LAYERS),
-        altitude=altitude,
+        altitude=t.row("altitude", 2, d.altitude),
         cloud_type=t.string("cloud_type", d.cloud_type, choices=tuple(PRESETS)),
-        extent=extent,
+        extent=t.row("extent", 2, d.extent),
         centre=t.row("centre", 2, d.centre),
     )
 

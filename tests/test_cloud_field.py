@@ -9,11 +9,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from cloudcore.errors import SceneError
-from cloudcore.field.cells import cell_cloud, cloud_density, coverage_threshold
+from cloudcore.errors import FieldError, SceneError
+from cloudcore.field.cells import cell_cloud, cell_clouds, cloud_density, coverage_threshold
 from cloudcore.field.grid import (
-    MAX_LAYERS,
-    MAX_RINGS,
     RING_HALF_CELLS,
     cell_side,
     cells_in_reach,
@@ -23,7 +21,7 @@ from cloudcore.field.grid import (
 )
 from cloudcore.field.state import FADE_KEY_STEPS, HOLE, FieldState, update_field
 from cloudcore.resources import CUMULUS_FIELD, DEFAULT_SCENE
-from cloudcore.scene import CloudField, Scene
+from cloudcore.scene import MAX_LAYERS, MAX_RINGS, CloudField, Scene
 from cloudcore.scenefile import CLOUD_FIELD_KEYS, load_scene, save_scene
 
 FIELD = CloudField(seed=3, coverage=0.5, cell_size=500.0, rings=4, layers=3, extent=(60000.0, 60000.0))
@@ -43,6 +41,16 @@ def test_a_cell_is_the_same_particles_whenever_it_is_made():
         assert (a is None) == (b is None)
         if a is not None:
             np.testing.assert_array_equal(a.particles, b.particles)
+
+
+def test_a_cell_made_with_others_is_the_cell_made_alone():
+    cells = [(2, 0, 0), (0, 1, -1), (0, -3, 2), (1, 1, 1), (0, 0, 0)]
+    for cell, cloud in zip(cells, cell_clouds(FIELD, cells)):
+        alone = cell_cloud(FIELD, *cell)
+        assert (cloud is None) == (alone is None)
+        if cloud is not None:
+            np.testing.assert_array_equal(cloud.particles, alone.particles)
+            assert cloud.name == alone.name == "field_{}_{}_{}".format(*cell)
 
 
 def test_another_seed_makes_other_clouds():
@@ -329,3 +337,21 @@ def test_the_demo_scene_is_a_field_100_km_across_with_a_flight_at_2_km_and_is_no
     assert keys[0, 2] == 2000.0 and keys[:, 2].max() > scene.cloud_field.altitude[1]  # through, then above
     assert np.linalg.norm(np.diff(keys[:, 1:4], axis=0), axis=1).sum() >= 20000.0
     assert DEFAULT_SCENE != CUMULUS_FIELD
+
+
+@pytest.mark.parametrize(
+    "change, field",
+    [
+        ({"rings": 0}, "rings"),
+        ({"layers": True}, "layers"),
+        ({"coverage": float("nan")}, "coverage"),
+        ({"cell_size": 5.0}, "cell_size"),
+        ({"altitude": (1.0, 1.0)}, "altitude"),
+        ({"extent": (1e3, float("inf"))}, "extent"),
+        ({"centre": (0.0,)}, "centre"),
+    ],
+)
+def test_the_record_refuses_what_the_file_would_so_the_editor_s_edits_are_checked_too(change, field):
+    with pytest.raises(FieldError) as caught:
+        dataclasses.replace(FIELD, **change)
+    assert caught.value.field == field

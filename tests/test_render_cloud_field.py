@@ -41,7 +41,7 @@ def test_the_field_draws_beside_authored_clouds_and_lights_only_the_cells_that_e
     alone = renderer.render(dataclasses.replace(scene, cloud_field=None), settings=FULL_3D)[0]
     image, stats = renderer.render(scene, settings=FULL_3D)
     field_clouds = [c for c in renderer.field_state.cells.values() if c is not None]
-    assert stats.clouds_drawn > 1 + 0.5 * len(field_clouds)
+    assert stats.clouds_drawn > 20 and len(field_clouds) > 20
     assert np.abs(image.astype(int) - sky.astype(int)).mean() > np.abs(alone.astype(int) - sky.astype(int)).mean()
     # one inner cell further on: only the entering cells' clouds are lit, the others come from the cache
     moved = dataclasses.replace(ABOVE, position=(FIELD.cell_size, 5000.0, 0.0), look_at=(FIELD.cell_size, 1200.0, -3e3))

@@ -49,8 +49,13 @@ def cloud_density(field: CloudField, x, z) -> np.ndarray:
     wavelength = NOISE_WAVELENGTH_CELLS * field.cell_size
     u = (np.asarray(x, dtype=np.float64) - field.centre[0]) / wavelength
     v = (np.asarray(z, dtype=np.float64) - field.centre[1]) / wavelength
+    return _fractal_noise(u, v, field.seed)
+
+
+def _fractal_noise(u: np.ndarray, v: np.ndarray, seed: int) -> np.ndarray:
+    """Octaves of value noise at (u, v), in wavelengths of the first, mapped to [0, 1]."""
     total = sum(
-        amplitude * value_noise(frequency * u, frequency * v, field.seed + octave)
+        amplitude * value_noise(frequency * u, frequency * v, seed + octave)
         for octave, (frequency, amplitude) in enumerate(_OCTAVES)
     )
     return 0.5 * (total + 1.0)
@@ -58,11 +63,10 @@ def cloud_density(field: CloudField, x, z) -> np.ndarray:
 
 @functools.cache
 def _density_quantiles() -> np.ndarray:
-    """The density's quantiles 0, 0.001, ..., 1 over a large patch of plane (the same for every seed:
-    value noise is stationary)."""
+    """The density's quantiles 0, 0.001, ..., 1 over 200 x 200 wavelengths (the same for every seed: value noise
+    is stationary)."""
     u, v = np.meshgrid(np.linspace(0.0, 200.0, 400), np.linspace(0.0, 200.0, 400))
-    unit = CloudField(cell_size=1.0 / NOISE_WAVELENGTH_CELLS)
-    return np.quantile(cloud_density(unit, u, v), np.linspace(0.0, 1.0, 1001))
+    return np.quantile(_fractal_noise(u, v, 0), np.linspace(0.0, 1.0, 1001))
 
 
 def coverage_threshold(coverage: float) -> float:
@@ -76,51 +80,68 @@ def coverage_threshold(coverage: float) -> float:
 
 
 def cell_cloud(field: CloudField, level: int, i: int, j: int) -> Cloud | None:
-    """The cloud of cell (level, i, j), or None where the cell is clear sky.
+    """The cloud of cell (level, i, j), or None where the cell is clear sky (`cell_clouds` of one cell)."""
+    return cell_clouds(field, [(level, i, j)])[0]
 
-    Its particles lie inside the cell's footprint and the field's extent,
+
+def cell_clouds(field: CloudField, cells) -> list[Cloud | None]:
+    """The cloud of each cell (level, i, j) of `cells`, or None where a cell is clear sky; each cell's the same
+    whether it is made alone or with others (the work is done a level and a layer at a time, for all at once).
+
+    A cloud's particles lie inside its cell's footprint and the field's extent,
     between the altitudes of `field.altitude`; its optics and colour are
     those of `field.cloud_type`.
     """
-    side = cell_side(field, level)
-    spacing = side / CANDIDATES_PER_SIDE
-    steps = np.arange(CANDIDATES_PER_SIDE)
-    a, b = np.meshgrid(steps, steps, indexing="ij")
-    gx = (i * CANDIDATES_PER_SIDE + a).ravel()  # the candidates' indices on the level's plane
-    gz = (j * CANDIDATES_PER_SIDE + b).ravel()
+    cells = [tuple(int(v) for v in cell) for cell in cells]
+    rows: list[list[np.ndarray]] = [[] for _ in cells]
     threshold = coverage_threshold(field.coverage)
     bottom, top = field.altitude
     layer_depth = (top - bottom) / field.layers
-    rows = []
-    for layer in range(field.layers):
-        chance = functools.partial(_chance, gx, gz, field.seed, level, layer)
-        # displaced within their spacing, never out of the cell
-        x = field.centre[0] + (gx + 0.5 + 0.8 * (chance(_JITTER_X) - 0.5)) * spacing
-        z = field.centre[1] + (gz + 0.5 + 0.8 * (chance(_JITTER_Z) - 0.5)) * spacing
-        density = cloud_density(field, x, z)
-        headroom = (density - threshold) / max(1.0 - threshold, 1e-9) if np.isfinite(threshold) else density
-        height = layer / field.layers
-        kept = (density > threshold) & (headroom > TOP_HEADROOM * height)
-        kept &= (np.abs(x - field.centre[0]) <= 0.5 * field.extent[0]) & (
-            np.abs(z - field.centre[1]) <= 0.5 * field.extent[1]
-        )
-        if not kept.any():
-            continue
-        # the bottom layer sits flat on the condensation level; the others spread through their slab
-        spread = 0.15 if layer == 0 else 0.8
-        y = bottom + (layer + 0.5 + spread * (chance(_JITTER_Y) - 0.5)) * layer_depth
-        radius = RADIUS_SPACINGS * spacing * (1.0 - TOP_SHRINK * height) * (0.8 + 0.4 * chance(_SIZE))
-        rows.append(np.column_stack([x, y, z, radius])[kept])
-    if not rows:
-        return None
+    steps = np.arange(CANDIDATES_PER_SIDE)
+    a, b = (offset.ravel() for offset in np.meshgrid(steps, steps, indexing="ij"))
+    for level in sorted({cell[0] for cell in cells}):
+        of_level = [index for index, cell in enumerate(cells) if cell[0] == level]
+        spacing = cell_side(field, level) / CANDIDATES_PER_SIDE
+        # the candidates' indices on the level's plane, cell after cell
+        gx = (np.array([cells[index][1] for index in of_level])[:, None] * CANDIDATES_PER_SIDE + a).ravel()
+        gz = (np.array([cells[index][2] for index in of_level])[:, None] * CANDIDATES_PER_SIDE + b).ravel()
+        owner = np.repeat(of_level, len(a))
+        for layer in range(field.layers):
+            chance = functools.partial(_chance, gx, gz, field.seed, level, layer)
+            # displaced within their spacing, never out of the cell
+            x = field.centre[0] + (gx + 0.5 + 0.8 * (chance(_JITTER_X) - 0.5)) * spacing
+            z = field.centre[1] + (gz + 0.5 + 0.8 * (chance(_JITTER_Z) - 0.5)) * spacing
+            density = cloud_density(field, x, z)
+            headroom = (density - threshold) / max(1.0 - threshold, 1e-9) if np.isfinite(threshold) else density
+            height = layer / field.layers
+            kept = (density > threshold) & (headroom > TOP_HEADROOM * height)
+            kept &= (np.abs(x - field.centre[0]) <= 0.5 * field.extent[0]) & (
+                np.abs(z - field.centre[1]) <= 0.5 * field.extent[1]
+            )
+            if not kept.any():
+                continue
+            # the bottom layer sits flat on the condensation level; the others spread through their slab
+            spread = 0.15 if layer == 0 else 0.8
+            y = bottom + (layer + 0.5 + spread * (chance(_JITTER_Y) - 0.5)) * layer_depth
+            radius = RADIUS_SPACINGS * spacing * (1.0 - TOP_SHRINK * height) * (0.8 + 0.4 * chance(_SIZE))
+            particles = np.column_stack([x, y, z, radius])[kept]
+            owners = owner[kept]
+            bounds = np.flatnonzero(np.diff(owners)) + 1  # the candidates are cell after cell
+            for index, part in zip(owners[np.concatenate([[0], bounds])], np.split(particles, bounds)):
+                rows[index].append(part)
     preset = PRESETS[field.cloud_type]
-    return Cloud(
-        f"field_{level}_{i}_{j}",
-        np.concatenate(rows),
-        optical_depth=preset.optical_depth,
-        albedo=preset.albedo,
-        color=preset.color,
-    )
+    return [
+        Cloud(
+            f"field_{level}_{i}_{j}",
+            np.concatenate(parts),
+            optical_depth=preset.optical_depth,
+            albedo=preset.albedo,
+            color=preset.color,
+        )
+        if parts
+        else None
+        for (level, i, j), parts in zip(cells, rows)
+    ]
 
 
 def _chance(gx: np.ndarray, gz: np.ndarray, seed: int, level: int, layer: int, purpose: int) -> np.ndarray:

@@ -26,14 +26,6 @@ import numpy as np
 from cloudcore.ramps import smoothstep
 from cloudcore.scene import CloudField
 
-#: the most rings a field may have: the outermost's cells are 2^(MAX_RINGS - 1) inner cells across
-MAX_RINGS = 12
-#: the most particle layers a cell may hold
-MAX_LAYERS = 8
-#: an inner cell's side in metres, at least (smaller would be particles of a few metres) and at most
-MIN_CELL_SIZE, MAX_CELL_SIZE = 10.0, 1.0e6
-#: a field's extent in inner cells, at most: cell indices stay small integers
-MAX_CELLS_ACROSS = 2**31
 #: how many of its own cells a ring reaches from the eye (Chebyshev): each ring is 2 x 4 cells across, its
 #: inner part under the finer rings; 4 leaves a solid band of one cell between the two blend bands
 RING_HALF_CELLS = 4

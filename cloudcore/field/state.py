@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cloudcore.field.cells import cell_cloud
+from cloudcore.field.cells import cell_clouds
 from cloudcore.field.grid import cells_in_reach, level_weights
 from cloudcore.scene import Cloud, CloudField
 
@@ -71,7 +71,7 @@ def update_field(field: CloudField, eye, state: FieldState = FieldState()) -> tu
     wanted = {(level, i, j) for level in range(field.rings) for i, j in cells_in_reach(field, level, eye)}
     made = tuple(sorted(key for key in wanted if key not in state.cells))
     cells = {key: cloud for key, cloud in state.cells.items() if key in wanted}
-    cells.update((key, cell_cloud(field, *key)) for key in made)
+    cells.update(zip(made, cell_clouds(field, made)))
     dropped = len(state.cells) - (len(cells) - len(made))
     if made or dropped:
         state = _placed(field, cells, state.slots, made, dropped)
@@ -115,9 +115,13 @@ def _placed(field: CloudField, cells: dict, slots: tuple, made: tuple, dropped: 
 
 
 def _fade_keys(weights: np.ndarray, starts: np.ndarray) -> tuple:
-    """Per cloud, its mean weight in steps of 1 / FADE_KEY_STEPS (a cloud wholly at weight 1: exactly 1)."""
-    keys = []
-    for start, stop in zip(starts[:-1], starts[1:]):
-        part = weights[start:stop]
-        keys.append(1.0 if np.all(part == 1.0) else round(float(part.mean()) * FADE_KEY_STEPS) / FADE_KEY_STEPS)
-    return tuple(keys)
+    """Per cloud, its mean weight in steps of 1 / FADE_KEY_STEPS (a cloud wholly at weight 1, or empty: exactly 1)."""
+    counts = np.diff(starts)
+    keys = np.ones(len(counts))
+    filled = counts > 0
+    if filled.any():
+        firsts = starts[:-1][filled]
+        means = np.add.reduceat(weights, firsts) / counts[filled]
+        blending = np.minimum.reduceat(weights, firsts) < 1.0
+        keys[np.flatnonzero(filled)[blending]] = np.round(means[blending] * FADE_KEY_STEPS) / FADE_KEY_STEPS
+    return tuple(float(key) for key in keys)

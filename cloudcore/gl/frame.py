@@ -146,6 +146,7 @@ class FrameRenderer:
             scene.lighting if time_of_day is None else dataclasses.replace(scene.lighting, time_of_day=time_of_day)
         )
         camera = scene.camera if camera is None else camera
+        authored_clouds = len(scene.clouds)
         scene, fade_keys = self._with_field(scene, camera)
         illumination_ms = self._prepare(scene, lighting, illumination_method)
         particles = self._particles
@@ -160,7 +161,7 @@ class FrameRenderer:
         )
         # the units follow the particles' places and sizes, not their light: a relit scene keeps them
         if (scene.clouds, settings.group_clouds) != self._units_source:
-            self._units = lod_units(particles, settings.group_clouds)
+            self._units = lod_units(particles, settings.group_clouds, authored_clouds)
             self._units_source = (scene.clouds, settings.group_clouds)
         plan = plan_frame(
             self._units,
