@@ -7,6 +7,7 @@ editor under Xvfb and checks the results file.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import time
 from pathlib import Path
@@ -21,7 +22,8 @@ from cloudcore.editing import add_cloud
 from cloudcore.measure.overlays import to_pixels
 from cloudcore.navigation import orbited
 from cloudcore.paths import camera_on_path
-from cloudcore.scenefile import save_scene
+from cloudcore.scene import CloudField
+from cloudcore.scenefile import load_scene, save_scene
 
 #: frames to let the renderer catch up after an edit (illumination runs on the next frame)
 SETTLE = 4
@@ -47,6 +49,7 @@ GUI_TESTS = (
     "playing_a_camera_path_moves_the_camera",
     "recording_runs_in_the_background",
     "a_click_within_one_frame_is_not_lost",
+    "the_cloud_field_panel_edits_the_field",
 )
 
 
@@ -499,6 +502,45 @@ def install(params, editor, viewport, panels, results_path: Path, outcome: dict,
         CHECK(editor.camera == orbited(start, -panels.camera.orbit_step_deg))  # one orbit, not none and not two
         use_window(ctx, "Camera")
         ctx.item_click("Reset to the scene's camera")
+
+    def the_cloud_field_panel_edits_the_field(ctx):
+        """Add a field, change its parameters with the widgets (each one undo step), see it drawn, save it as
+        parameters, remove it."""
+        use_window(ctx, "Cloud field")
+        start = editor.scene
+        CHECK(start.cloud_field is None)
+        ctx.yield_(SETTLE)
+        without = capture(ctx)
+        ctx.item_click("Add cloud field")
+        CHECK(editor.scene.cloud_field == CloudField())
+        ctx.item_input_value("Rings", 2)  # a small field: the other tests stay quick
+        ctx.item_input_value("Coverage", 0.7)
+        ctx.item_input_value("Base (m)", 800.0)
+        ctx.combo_click("Cloud type/stratocumulus")
+        field = editor.scene.cloud_field
+        CHECK(abs(field.coverage - 0.7) < 1e-6)  # through a float32 slider
+        CHECK(
+            dataclasses.replace(field, coverage=0.7)
+            == CloudField(coverage=0.7, rings=2, altitude=(800.0, 2600.0), cloud_type="stratocumulus")
+        )
+        ctx.yield_(SETTLE)
+        with_field = capture(ctx)
+        changed = float((np.abs(with_field.astype(int) - without.astype(int)).max(axis=2) > 10).mean())
+        outcome["cloud_field_changed_fraction"] = changed
+        CHECK(changed > 0.05)
+        CHECK(len(viewport.renderer.field_state.cells) > 0)
+        ctx.item_input_value("Top (m)", 500.0)  # below the base: refused, the field kept
+        CHECK(editor.scene.cloud_field == field)
+        CHECK(any("altitude" in m for m in editor.messages))
+        target = results_path.with_name("field_saved_by_gui.toml")
+        CHECK(editor.save(target))
+        CHECK(load_scene(target).cloud_field == field and "[cloud_field]" in target.read_text())
+        undo(ctx)
+        CHECK(editor.scene.cloud_field.cloud_type == "cumulus_humilis")
+        use_window(ctx, "Cloud field")
+        ctx.item_click("Remove cloud field")
+        CHECK(editor.scene.cloud_field is None)
+        editor.edit(start)
 
     defined = locals()
     tests = [defined[name] for name in GUI_TESTS]  # a KeyError names a listed test not defined above
