@@ -119,8 +119,18 @@ class Cloud(_Record):
         return self.particles[:, 3]
 
     def bounding_sphere(self) -> tuple[np.ndarray, float]:
-        """Centre of the particles' box and the radius that encloses every splat."""
-        return splats_bounding_sphere(self.centres, self.radii)
+        """Centre of the particles' box and the radius that encloses every splat (read-only).
+
+        Worked out once: the particles never change, and a particle buffer with a cloud field's hundreds of
+        clouds asks every cloud again each time cells come or go.
+        """
+        held = self.__dict__.get("_bounding_sphere")
+        if held is None:
+            centre, radius = splats_bounding_sphere(self.centres, self.radii)
+            centre.flags.writeable = False
+            held = (centre, radius)
+            object.__setattr__(self, "_bounding_sphere", held)
+        return held
 
 
 def splats_bounding_sphere(centres: np.ndarray, radii: np.ndarray) -> tuple[np.ndarray, float]:
