@@ -3,7 +3,9 @@
 Everything is composed in linear light in a float target; the one transfer to
 sRGB happens on read-back.  `FrameRenderer` keeps its context, GL objects,
 terrain and precomputed cloud illumination between frames and rebuilds each
-only when what it came from changes; what the level of detail carries from
+only when what it came from changes (a scene's cloud field adds its clouds
+for the eye after the scene's own first: `cloudcore.field.state`, whose
+state it holds too); what the level of detail carries from
 frame to frame (impostor cache, ring, representations, the fitted costs) is
 the pure `cloudcore.lod.frameplan.LodState` it holds.  Each frame it asks
 `cloudcore.lod.frameplan.plan_frame` what to do, executes exactly that, and
