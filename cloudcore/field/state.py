@@ -76,9 +76,7 @@ def update_field(field: CloudField, eye, state: FieldState = FieldState()) -> tu
     if made or dropped:
         state = _placed(field, cells, state.slots, made, dropped)
     elif state.made or state.dropped:
-        state = FieldState(
-            field, cells, state.slots, (), 0, state.particle_xz, state.particle_levels, state.cloud_starts
-        )
+        state = dataclasses.replace(state, made=(), dropped=0)
     clouds = tuple(HOLE if key is None else state.cells[key] for key in state.slots)
     weights = level_weights(field, state.particle_levels, state.particle_xz[:, 0], state.particle_xz[:, 1], eye)
     return FieldFrame(clouds, weights, _fade_keys(weights, state.cloud_starts)), state
