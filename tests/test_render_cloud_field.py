@@ -9,7 +9,7 @@ from cloudcore.artist.cloudgen import preset_cloud
 from cloudcore.field.grid import level_reach
 from cloudcore.light.illumination import IlluminationCache
 from cloudcore.light.lighting import active_lights, scene_lights
-from cloudcore.scene import Camera, CloudField, Scene
+from cloudcore.scene import MAX_CELL_SIZE, MAX_LAYERS, MAX_RINGS, MIN_CELL_SIZE, Camera, CloudField, Scene
 from cloudcore.settings import FULL_3D, RenderSettings
 
 pytestmark = pytest.mark.gl
@@ -76,3 +76,28 @@ def test_flying_across_ring_boundaries_changes_the_picture_smoothly(own_renderer
     # auto mode draws the same field within a level of full 3D on the way
     auto = _flight_means(own_renderer[0], RenderSettings())
     assert np.abs(auto - full).max() < 1.0
+
+
+EXTREMES = {
+    "every limit at its largest": CloudField(
+        coverage=1.0, cell_size=MAX_CELL_SIZE, rings=MAX_RINGS, layers=MAX_LAYERS, extent=(1e12, 1e12)
+    ),
+    "the smallest cells": CloudField(coverage=1.0, cell_size=MIN_CELL_SIZE, rings=3, layers=1, extent=(100.0, 100.0)),
+    "an extent under one cell": CloudField(extent=(1.0, 1.0)),
+    "a band a millimetre thick": CloudField(coverage=1.0, altitude=(1000.0, 1000.001)),
+    "a field far away": CloudField(centre=(1e12, -1e12)),
+}
+
+
+@pytest.mark.parametrize("name", EXTREMES)
+def test_extreme_fields_render_in_every_mode(own_renderer, name):
+    renderer, _ = own_renderer
+    scene = Scene(camera=Camera((0.0, 1500.0, 0.0), (0.0, 1000.0, -3000.0), 60.0), cloud_field=EXTREMES[name])
+    sky = renderer.render(dataclasses.replace(scene, cloud_field=None), settings=FULL_3D)[0]
+    for settings in (FULL_3D, RenderSettings(), RenderSettings(mode="impostor")):
+        image, stats = renderer.render(scene, settings=settings)
+        assert image.shape == sky.shape and np.isfinite(stats.frame_ms)
+        if name in ("every limit at its largest", "a band a millimetre thick"):
+            assert stats.clouds_drawn > 0 and np.abs(image.astype(int) - sky.astype(int)).mean() > 1.0
+        if name == "a field far away":
+            assert not renderer.field_state.cells and np.array_equal(image, sky)

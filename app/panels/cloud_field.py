@@ -26,9 +26,11 @@ _SLIDERS = {
     "Top (m)": ("altitude", 1, 0.0, 12000.0, "%.0f"),
     "Extent x (km)": ("extent", 0, 1.0, 1000.0, "%.0f"),
     "Extent z (km)": ("extent", 1, 1.0, 1000.0, "%.0f"),
+    "Centre x (km)": ("centre", 0, -1000.0, 1000.0, "%.1f"),
+    "Centre z (km)": ("centre", 1, -1000.0, 1000.0, "%.1f"),
 }
 #: the sliders in kilometres, the record in metres
-_KM = ("Extent x (km)", "Extent z (km)")
+_KM = ("Extent x (km)", "Extent z (km)", "Centre x (km)", "Centre z (km)")
 _CLOUD_TYPES = tuple(PRESETS)
 
 
