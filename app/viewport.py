@@ -154,13 +154,21 @@ class Viewport:
         editor = self.editor
         shading, lighting = editor.look
         wanted = Look(shading, lighting, PREVIEW_METHOD if editor.dragged_look is not None else EXACT_METHOD)
-        look = self.relighting.look_for(editor.scene, wanted)
+        look = self.relighting.look_for(self._with_field_clouds(editor.scene), wanted)
         if self.relighting.failure is not None and self.relighting.failure not in editor.messages:
             editor.messages.append(self.relighting.failure)
         scene = editor.scene
         if (look.shading, look.lighting) != (scene.shading, scene.lighting):
             scene = dataclasses.replace(scene, shading=look.shading, lighting=look.lighting)
         return scene, look.method
+
+    def _with_field_clouds(self, scene):
+        """`scene` with the clouds its cloud field has made around the eye (the renderer holds them), so that
+        a new look lights them in the relighting worker too, not in the frame that shows it."""
+        state = self.renderer.field_state if self.renderer is not None else None
+        if state is None or scene.cloud_field is None or state.field != scene.cloud_field:
+            return scene
+        return dataclasses.replace(scene, clouds=scene.clouds + tuple(c for c in state.cells.values() if c is not None))
 
     def _use_tool(self, origin, size, clicked: bool, seconds: float) -> None:
         mouse, (width, height) = imgui.get_mouse_pos(), size

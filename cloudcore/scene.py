@@ -8,11 +8,13 @@ input enters (`cloudcore.scenefile`); these types only normalise.
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from cloudcore.cloud_records import ArtistShading, Formation, SpriteStyle
+from cloudcore.errors import FieldError
 
 Vec3 = tuple[float, float, float]
 
@@ -115,8 +117,18 @@ class Cloud(_Record):
         return self.particles[:, 3]
 
     def bounding_sphere(self) -> tuple[np.ndarray, float]:
-        """Centre of the particles' box and the radius that encloses every splat."""
-        return splats_bounding_sphere(self.centres, self.radii)
+        """Centre of the particles' box and the radius that encloses every splat (read-only).
+
+        Worked out once: the particles never change, and a particle buffer with a cloud field's hundreds of
+        clouds asks every cloud again each time cells come or go.
+        """
+        held = self.__dict__.get("_bounding_sphere")
+        if held is None:
+            centre, radius = splats_bounding_sphere(self.centres, self.radii)
+            centre.flags.writeable = False
+            held = (centre, radius)
+            object.__setattr__(self, "_bounding_sphere", held)
+        return held
 
 
 def splats_bounding_sphere(centres: np.ndarray, radii: np.ndarray) -> tuple[np.ndarray, float]:
@@ -213,6 +225,71 @@ class View:
     max_diff: int | None = None
 
 
+#: the most rings a cloud field may have: the outermost's cells are 2^(MAX_RINGS - 1) inner cells across
+MAX_RINGS = 12
+#: the most particle layers a field's cell may hold
+MAX_LAYERS = 8
+#: an inner cell's side in metres, at least (smaller would be particles of a few metres) and at most
+MIN_CELL_SIZE, MAX_CELL_SIZE = 10.0, 1.0e6
+#: a field's extent in inner cells, at most: cell indices stay small integers
+MAX_CELLS_ACROSS = 2**31
+
+
+@dataclass(frozen=True)
+class CloudField:
+    """Clouds to the horizon as parameters: Yusov's camera-centred nested grid (2014, section 5.2).
+
+    The particles are generated around the eye, cell by cell, by
+    `cloudcore.field.cloud_field` (deterministic: the same cell is always the
+    same particles).  `coverage` in [0, 1] is how much of the sky is cloud;
+    `cell_size` (m) the side of the inner ring's cells, each ring's cells twice
+    the size of the ring inside it; `rings` the nested levels; `layers` the
+    particle layers of a cell between `altitude` = (bottom, top) in metres;
+    `cloud_type` a preset of `cloudcore.artist.cloudgen.PRESETS` (its optics and
+    colour); the field covers `extent` = (x, z) metres about `centre` = (x, z).
+    """
+
+    seed: int = 0
+    coverage: float = 0.4
+    cell_size: float = 1000.0
+    rings: int = 5
+    layers: int = 3
+    altitude: tuple[float, float] = (1200.0, 2600.0)
+    cloud_type: str = "cumulus_humilis"
+    extent: tuple[float, float] = (100000.0, 100000.0)
+    centre: tuple[float, float] = (0.0, 0.0)
+
+    def __post_init__(self):
+        for name in ("seed", "rings", "layers"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+                raise FieldError(name, f"expected an integer, got {value!r}")
+            object.__setattr__(self, name, int(value))
+        for name, low, high in (("seed", 0, 2**31 - 1), ("rings", 1, MAX_RINGS), ("layers", 1, MAX_LAYERS)):
+            if not low <= getattr(self, name) <= high:
+                raise FieldError(name, f"must be within [{low}, {high}], got {getattr(self, name)}")
+        for name, low, high in (("coverage", 0.0, 1.0), ("cell_size", MIN_CELL_SIZE, MAX_CELL_SIZE)):
+            value = float(getattr(self, name))
+            if not low <= value <= high:  # NaN fails too
+                raise FieldError(name, f"must be within [{low}, {high}], got {value}")
+            object.__setattr__(self, name, value)
+        for name in ("altitude", "extent", "centre"):
+            pair = tuple(float(v) for v in getattr(self, name))
+            if len(pair) != 2 or not all(math.isfinite(v) for v in pair):
+                raise FieldError(name, f"expected 2 finite numbers, got {list(pair)}")
+            object.__setattr__(self, name, pair)
+        if not self.altitude[0] < self.altitude[1]:
+            raise FieldError(
+                "altitude", f"expected [bottom, top] with bottom < top in metres, got {list(self.altitude)}"
+            )
+        if not all(0.0 < side <= MAX_CELLS_ACROSS * self.cell_size for side in self.extent):
+            raise FieldError(
+                "extent",
+                f"expected [x, z] in metres, each > 0 and at most {MAX_CELLS_ACROSS} cells of cell_size, "
+                f"got {list(self.extent)}",
+            )
+
+
 @dataclass(frozen=True)
 class Scene:
     camera: Camera = Camera()
@@ -225,6 +302,8 @@ class Scene:
     description: str = ""
     #: the named views of `[[views]]`; `all_views` adds the default one first
     views: tuple[View, ...] = ()
+    #: clouds generated around the eye to the horizon (`[cloud_field]`), besides the authored `clouds`
+    cloud_field: CloudField | None = None
 
     @property
     def particle_count(self) -> int:

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 import tomlkit
 
+from cloudcore.artist.cloudgen import PRESETS
 from cloudcore.cloud_records import FACINGS, FORMATION_KINDS, MAX_SEED, ArtistShading, Formation, SpriteStyle
 from cloudcore.light.phase import MAX_ABS_G, PHASE_NAMES
 from cloudcore.light.shading import EYE_PASSES
@@ -23,9 +24,12 @@ from cloudcore.limits import scene_limit_problems
 from cloudcore.particle_files import atomic_write, remove_unnamed_particle_files, store_particles
 from cloudcore.scene import (
     DEFAULT_VIEW_NAME,
+    MAX_LAYERS,
+    MAX_RINGS,
     Camera,
     CameraPath,
     Cloud,
+    CloudField,
     Light,
     Lighting,
     Scene,
@@ -60,6 +64,7 @@ TABLE_KEYS = {
     "clouds.formation": record_keys(Formation),
     "clouds.sprite": record_keys(SpriteStyle),
     "clouds.artist": record_keys(ArtistShading),
+    "cloud_field": record_keys(CloudField),
     "terrain": record_keys(Terrain),
     # a mesh file's triangles are read from `mesh`, not written in the scene
     "objects": record_keys(SceneObject, leave_out=("vertices", "faces")),
@@ -108,6 +113,7 @@ def scene_from_dict(data: dict, source: str = "<scene>", base_dir=Path(".")) -> 
         camera_paths=paths,
         description=root.string("description", ""),
         views=views,
+        cloud_field=root.table("cloud_field", _cloud_field),
     )
     # what every field allows, the renderer may still not draw: refuse that here, not in the GL code
     problems = scene_limit_problems(scene)
@@ -271,6 +277,24 @@ def _cloud(t: Table, base_dir: Path) -> Cloud:
         shading_group_size=t.number("shading_group_size", None, low=0.0, low_open=True)
         if t.has("shading_group_size")
         else None,
+    )
+
+
+def _cloud_field(t: Table) -> CloudField:
+    """`[cloud_field]`: types here, ranges by the record itself (the editor's panel edits it too)."""
+    t.reject_unknown(TABLE_KEYS["cloud_field"])
+    d = CloudField()
+    return t.record(
+        CloudField,
+        seed=t.integer("seed", d.seed, low=0, high=2**31 - 1),
+        coverage=t.number("coverage", d.coverage),
+        cell_size=t.number("cell_size", d.cell_size),
+        rings=t.integer("rings", d.rings, low=1, high=MAX_RINGS),
+        layers=t.integer("layers", d.layers, low=1, high=MAX_LAYERS),
+        altitude=t.row("altitude", 2, d.altitude),
+        cloud_type=t.string("cloud_type", d.cloud_type, choices=tuple(PRESETS)),
+        extent=t.row("extent", 2, d.extent),
+        centre=t.row("centre", 2, d.centre),
     )
 
 
@@ -441,6 +465,8 @@ def scene_to_dict(scene: Scene) -> dict:
             terrain["mesh"] = t.mesh
         data["terrain"] = terrain
     data["clouds"] = [_cloud_dict(cloud) for cloud in scene.clouds]
+    if scene.cloud_field is not None:
+        data["cloud_field"] = _record_dict(scene.cloud_field)
     data["objects"] = [_object_dict(o) for o in scene.objects]
     data["camera_paths"] = [{"name": p.name, "keys": _rows(p.keys)} for p in scene.camera_paths]
     data["views"] = [_view_dict(view) for view in scene.views]

@@ -10,7 +10,7 @@ from conftest import VALLEY
 
 import cloudcore.scenefile as scenefile
 from cloudcore.errors import SceneError
-from cloudcore.scene import Scene, Shading
+from cloudcore.scene import MAX_LAYERS, MAX_RINGS, Scene, Shading
 from cloudcore.scenefile import load_scene, save_scene, scene_to_dict
 
 
@@ -173,6 +173,23 @@ MALFORMED = [
     ),
     ('name = "a"', 'name = "a"\nartist = { ambient = 1 }', "clouds[0].artist.ambient", "unknown key"),
     ('name = "a"', 'name = "a"\nshading_group_size = 0.0', "clouds[0].shading_group_size", "within"),
+    # [cloud_field]: every limit of the field, checked on load
+    ("[camera]", "[cloud_field]\nseed = -1\n[camera]", "cloud_field.seed", "within"),
+    ("[camera]", "[cloud_field]\ncoverage = 1.5\n[camera]", "cloud_field.coverage", "within"),
+    ("[camera]", "[cloud_field]\ncoverage = nan\n[camera]", "cloud_field.coverage", "finite"),
+    ("[camera]", "[cloud_field]\ncell_size = 0.0\n[camera]", "cloud_field.cell_size", "within"),
+    ("[camera]", "[cloud_field]\ncell_size = 1e9\n[camera]", "cloud_field.cell_size", "within"),
+    ("[camera]", "[cloud_field]\nrings = 0\n[camera]", "cloud_field.rings", "within"),
+    ("[camera]", f"[cloud_field]\nrings = {MAX_RINGS + 1}\n[camera]", "cloud_field.rings", "within"),
+    ("[camera]", "[cloud_field]\nrings = 2.5\n[camera]", "cloud_field.rings", "integer"),
+    ("[camera]", f"[cloud_field]\nlayers = {MAX_LAYERS + 1}\n[camera]", "cloud_field.layers", "within"),
+    ("[camera]", "[cloud_field]\naltitude = [2000.0, 1000.0]\n[camera]", "cloud_field.altitude", "bottom < top"),
+    ("[camera]", "[cloud_field]\naltitude = [1000.0]\n[camera]", "cloud_field.altitude", "rows of 2"),
+    ("[camera]", '[cloud_field]\ncloud_type = "cumulus"\n[camera]', "cloud_field.cloud_type", "not one of"),
+    ("[camera]", "[cloud_field]\nextent = [0.0, 40000.0]\n[camera]", "cloud_field.extent", "> 0"),
+    ("[camera]", "[cloud_field]\nextent = [1e300, 40000.0]\n[camera]", "cloud_field.extent", "cells of cell_size"),
+    ("[camera]", "[cloud_field]\ncentre = [inf, 0.0]\n[camera]", "cloud_field.centre", "not finite"),
+    ("[camera]", "[cloud_field]\nwind = 3.0\n[camera]", "cloud_field.wind", "unknown key"),
 ]
 
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 from app.editor import Editor
 from app.panels.build import BuildPanel
 from app.panels.camera import CameraPanel
+from app.panels.cloud_field import CloudFieldPanel
 from app.panels.clouds import CloudsPanel
 from app.panels.lighting import LightingPanel
 from app.panels.lod import LodPanel
@@ -24,6 +25,7 @@ class Panels:
         self.clouds = CloudsPanel(editor, sliders)
         self.build = BuildPanel(editor)
         self.lighting = LightingPanel(editor, sliders)
+        self.cloud_field = CloudFieldPanel(editor, viewport, sliders)
         self.lod = LodPanel(editor, viewport)
         self.camera = CameraPanel(editor, viewport)
         self.statistics = StatisticsPanel(editor, viewport)
@@ -35,6 +37,7 @@ class Panels:
             ("Clouds", "Left", self.clouds.draw),
             ("Build", "Left", self.build.draw),
             ("Lighting", "Left", self.lighting.draw),
+            ("Cloud field", "Left", self.cloud_field.draw),
             ("LOD", "Left", self.lod.draw),
             ("Camera", "Left", self.camera.draw),
             ("Statistics", "LeftBottom", self.statistics.draw),

@@ -16,6 +16,17 @@ class ReleasedSliders:
         """The slider `label`; returns the released value, or None."""
         shown = self._dragging.get(label, value)
         changed, shown = imgui.slider_float(label, shown, low, high, fmt)
+        return self._released(label, changed, shown)
+
+    def slider_int(self, label: str, value: int, low: int, high: int) -> int | None:
+        """The integer slider `label`; returns the released value, or None."""
+        shown = int(self._dragging.get(label, value))
+        changed, shown = imgui.slider_int(label, shown, low, high)
+        released = self._released(label, changed, shown)
+        return None if released is None else int(released)
+
+    def _released(self, label: str, changed: bool, shown):
+        """The value of the slider just drawn once it is let go after an edit, else None."""
         if changed:
             self._dragging[label] = shown
         if imgui.is_item_deactivated_after_edit():

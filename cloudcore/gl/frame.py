@@ -3,7 +3,9 @@
 Everything is composed in linear light in a float target; the one transfer to
 sRGB happens on read-back.  `FrameRenderer` keeps its context, GL objects,
 terrain and precomputed cloud illumination between frames and rebuilds each
-only when what it came from changes; what the level of detail carries from
+only when what it came from changes (a scene's cloud field adds its clouds
+for the eye after the scene's own first: `cloudcore.field.state`, whose
+state it holds too); what the level of detail carries from
 frame to frame (impostor cache, ring, representations, the fitted costs) is
 the pure `cloudcore.lod.frameplan.LodState` it holds.  Each frame it asks
 `cloudcore.lod.frameplan.plan_frame` what to do, executes exactly that, and
@@ -34,6 +36,7 @@ from cloudcore.artist.formation import formation_state
 from cloudcore.artist.particle_styles import particle_styles
 from cloudcore.camera import NEAR_PLANE_M, frustum_planes, projection_matrix, view_matrix
 from cloudcore.colour import linear_to_srgb8
+from cloudcore.field.state import FieldState, update_field
 from cloudcore.gl.context import HeadlessContext, WindowContext, check_frame_size
 from cloudcore.gl.impostor_store import ImpostorStore
 from cloudcore.gl.objects import ObjectPass
@@ -99,6 +102,9 @@ class FrameRenderer:
         self._key_serial = 0
         #: the level of detail's state between frames (impostor cache, ring, representations, costs)
         self.lod_state = LodState()
+        #: the cloud field's cells made for the last eye, and its particles' blend weights (None: no field)
+        self.field_state = FieldState()
+        self._field_weights: np.ndarray | None = None
         self._units: LodUnits | None = None
         self._units_source = None
         self._layer = None  # screen-sized, sharing the frame's depth: crossfading clouds' full-3D image
@@ -144,18 +150,23 @@ class FrameRenderer:
             scene.lighting if time_of_day is None else dataclasses.replace(scene.lighting, time_of_day=time_of_day)
         )
         camera = scene.camera if camera is None else camera
+        authored_clouds = len(scene.clouds)
+        scene, fade_keys = self._with_field(scene, camera)
         illumination_ms = self._prepare(scene, lighting, illumination_method)
         planning_started = time.perf_counter()
         particles = self._particles
+        particles.weigh(self._field_weights)
         poses = self._objects.poses(time_s) if self._objects is not None else ()
         starts = particles.cloud_starts
-        # a forming or dissipating cloud's colours change with the clock too: its impostor is stale meanwhile
+        # a forming or dissipating cloud's colours change with the clock too, a field's cloud's with its
+        # blend weights: its impostor is stale meanwhile
         cloud_keys = tuple(
-            (key, formation_state(cloud.formation, time_s)) for key, cloud in zip(self._lighting_keys, scene.clouds)
+            (key, formation_state(cloud.formation, time_s), fade)
+            for key, cloud, fade in zip(self._lighting_keys, scene.clouds, fade_keys)
         )
         # the units follow the particles' places and sizes, not their light: a relit scene keeps them
         if (scene.clouds, settings.group_clouds) != self._units_source:
-            self._units = lod_units(particles, settings.group_clouds)
+            self._units = lod_units(particles, settings.group_clouds, authored_clouds)
             self._units_source = (scene.clouds, settings.group_clouds)
         plan = plan_frame(
             self._units,
@@ -262,6 +273,20 @@ class FrameRenderer:
             held += target.nbytes if target is not None else 0
         return held
 
+    def _with_field(self, scene: Scene, camera: Camera) -> tuple[Scene, tuple]:
+        """The scene with its cloud field's clouds for this eye after its own (`cloudcore.field.state`), and
+        per cloud the key of its blend weights; the field's weights are held for the particle buffer."""
+        if scene.cloud_field is None:
+            self.field_state, self._field_weights = FieldState(), None
+            return scene, (1.0,) * len(scene.clouds)
+        frame, self.field_state = update_field(scene.cloud_field, camera.position, self.field_state)
+        authored = scene.particle_count
+        self._field_weights = np.concatenate([np.ones(authored), frame.weights])
+        return (
+            dataclasses.replace(scene, clouds=scene.clouds + frame.clouds),
+            (1.0,) * len(scene.clouds) + frame.fade_keys,
+        )
+
     def _prepare(self, scene: Scene, lighting: Lighting, illumination_method: str) -> float:
         """Rebuild the world pass and the particle illumination where their inputs changed; ms spent shading."""
         lights, ambient = scene_lights(lighting)
@@ -297,12 +322,9 @@ class FrameRenderer:
             ((), None) if self._particles_source is None else (self._particles_source[0], self._particles_source[1:])
         )
         same_lighting = old_lighting == particles_source[1:]
-        self._lighting_keys = tuple(
-            self._lighting_keys[i]
-            if same_lighting and i < len(old_clouds) and old_clouds[i] is cloud
-            else self._next_key()
-            for i, cloud in enumerate(scene.clouds)
-        )
+        # by identity, not place: a cloud field's clouds that stay keep their keys when others come and go
+        held = dict(zip(map(id, old_clouds), self._lighting_keys)) if same_lighting else {}
+        self._lighting_keys = tuple(held.get(id(cloud)) or self._next_key() for cloud in scene.clouds)
         self._particles_source = particles_source
         return 1e3 * (time.perf_counter() - start)
 

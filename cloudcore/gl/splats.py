@@ -86,7 +86,8 @@ def splat_batch(
 
     `depth_ranges`, one (near, far) per cloud, keeps only the particles with
     near < distance from `eye` <= far: one layer of a cloud split around objects.
-    `time_s`, the scene clock, fades forming and dissipating clouds (`ParticleBuffer.seen_from`).
+    `time_s`, the scene clock, fades forming and dissipating clouds (`ParticleBuffer.seen_from`), and
+    the buffer's blend weights fade a cloud field's rings.
     `frustum`, the draw's planes (`cloudcore.camera.frustum_planes`), leaves out the splats outside it.
     """
     starts = particles.cloud_starts
@@ -139,7 +140,7 @@ class SplatPass:
         self._quads_indexed = 0
         self._instance_capacity = 0
         self._resident: ParticleBuffer | None = None
-        self._formation_time: float | None = None
+        self._formation_time: tuple | None = None  # (time, weights serial) of the held opacity factors
 
     def draw(
         self,
@@ -268,9 +269,10 @@ class SplatPass:
             self._resident, self._formation_time = particles, None
 
     def _hold_formation(self, particles: ParticleBuffer, time_s: float | None) -> None:
-        """Upload the formation factors at `time_s` when they differ from those held."""
-        factors = particles.formation_factors(time_s)
-        held = None if factors is None else time_s  # the time the buffer's factors are for; None: all 1
+        """Upload the opacity factors (formation at `time_s`, blend weights) when they differ from those held."""
+        factors = particles.opacity_factors(time_s)
+        # what the buffer's factors are for: the time and the weights; None: all 1
+        held = None if factors is None else (time_s, particles.weights_serial)
         if held != self._formation_time:
             _store(
                 self._formation_buffer,

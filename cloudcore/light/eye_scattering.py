@@ -113,6 +113,10 @@ class ParticleBuffer:
             if c.formation is not None
         ]
         self._formation_memo: tuple[float, np.ndarray] | None = None
+        #: per particle, the blend weights of the eye's frame (a cloud field's rings), None: all 1
+        self._weights: np.ndarray | None = None
+        #: changes whenever the weights do, so the GL side uploads them only then
+        self.weights_serial = 0
 
     def seen_from(self, eye, indices: np.ndarray, *, time_s: float | None = None) -> tuple[np.ndarray, np.ndarray]:
         """(linear RGB (n, 3), opacity (n,)) of particles `indices` seen from `eye`, near fade applied.
@@ -133,7 +137,7 @@ class ParticleBuffer:
         colour = (scattered * self.scattering[indices, None] + ambient) * self.tint[indices]
         radii = self.radii[indices]
         fade = smoothstep(FADE_START_RADII * radii, FADE_END_RADII * radii, distance)
-        factors = self.formation_factors(time_s)
+        factors = self.opacity_factors(time_s)
         if factors is not None:
             fade = fade * factors[indices]
         return colour * fade[:, None], alpha * fade
@@ -147,8 +151,33 @@ class ParticleBuffer:
         kept = ((distances > FADE_START_RADII * self.radii[indices]) | ~self._near_faded[indices]) & self._opaque[
             indices
         ]
-        factors = self.formation_factors(time_s)
+        factors = self.opacity_factors(time_s)
         return kept if factors is None else kept & (factors[indices] > 0.0)
+
+    def weigh(self, weights: np.ndarray | None) -> None:
+        """Set every particle's blend weight in [0, 1] for the frames to come (None: all 1).
+
+        A cloud field's rings blend by these (`cloudcore.field.grid.level_weights`); they change as the eye moves,
+        the particles do not, so the buffer is kept and only its weights are replaced.
+        """
+        if weights is None and self._weights is None:
+            return
+        if weights is not None:
+            weights = np.asarray(weights, dtype=np.float64)
+            if weights.shape != self.radii.shape:
+                raise ValueError(f"expected {len(self.radii)} weights, got shape {weights.shape}")
+            if self._weights is not None and np.array_equal(weights, self._weights):
+                return
+        self._weights = weights
+        self.weights_serial += 1
+
+    def opacity_factors(self, time_s: float | None) -> np.ndarray | None:
+        """What multiplies each particle's colour and opacity: its formation factor at `time_s` times its blend
+        weight (`weigh`); None when both are 1 everywhere."""
+        factors = self.formation_factors(time_s)
+        if self._weights is None:
+            return factors
+        return self._weights if factors is None else factors * self._weights
 
     def formation_factors(self, time_s: float | None) -> np.ndarray | None:
         """Every particle's formation opacity factor at `time_s` (1 in clouds without a formation), or

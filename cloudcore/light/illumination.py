@@ -98,29 +98,24 @@ class IlluminationCache:
         for direction, stale in work:
             self.store(stale, shading, method, direction, illuminate_direction(stale, shading, direction, method))
         directions = light_directions(lights)
-        kept = {}
-        for cloud in clouds:
-            key = self._key(cloud, shading, method)
-            kept[key] = (cloud, {d: self._entries[key][1][d] for d in directions})
+        keys = self._keys(clouds, shading, method)
+        kept = {key: (cloud, {d: self._entries[key][1][d] for d in directions}) for key, cloud in zip(keys, clouds)}
         self._entries = kept
         self.last_recomputed = sum(len(stale) for _, stale in work)
         return [
-            np.column_stack([kept[self._key(c, shading, method)][1][d] for d in directions])
-            if directions
-            else np.zeros((len(c.particles), 0))
-            for c in clouds
+            np.column_stack([kept[key][1][d] for d in directions]) if directions else np.zeros((len(c.particles), 0))
+            for key, c in zip(keys, clouds)
         ]
 
     def missing(self, clouds, shading: Shading, lights, method: str = "exact") -> list[tuple[tuple, list[Cloud]]]:
         """(light direction, the clouds not held for it) for each direction some cloud lacks."""
         work = []
+        keys = self._keys(clouds, shading, method)
         for direction in light_directions(lights):
             stale = [
                 c
-                for c in clouds
-                if (hit := self._entries.get(self._key(c, shading, method))) is None
-                or hit[0] is not c
-                or direction not in hit[1]
+                for c, key in zip(clouds, keys)
+                if (hit := self._entries.get(key)) is None or hit[0] is not c or direction not in hit[1]
             ]
             if stale:
                 work.append((direction, stale))
@@ -129,13 +124,15 @@ class IlluminationCache:
     def store(self, clouds, shading: Shading, method: str, direction, incident) -> None:
         """Hold `incident` (`illuminate_direction` of `clouds` from `direction`, computed elsewhere)."""
         direction = tuple(float(v) for v in direction)
-        for cloud, light in zip(clouds, incident):
-            key = self._key(cloud, shading, method)
+        clouds = list(clouds)
+        for cloud, key, light in zip(clouds, self._keys(clouds, shading, method), incident):
             hit = self._entries.get(key)
             held = hit[1] if hit is not None and hit[0] is cloud else {}
             self._entries[key] = (cloud, held | {direction: light})
 
     @staticmethod
-    def _key(cloud: Cloud, shading: Shading, method: str) -> tuple:
+    def _keys(clouds, shading: Shading, method: str) -> list[tuple]:
+        """Each cloud's entry key (a scene field's hundreds of clouds share the one shading key, made once)."""
         # the light pass does not depend on what the eye pass makes of its result
-        return id(cloud), dataclasses.replace(shading, eye_pass=Shading().eye_pass), method
+        light_pass = dataclasses.replace(shading, eye_pass=Shading().eye_pass)
+        return [(id(cloud), light_pass, method) for cloud in clouds]

@@ -184,12 +184,17 @@ def plan_ring(
     mistake one cloud for another.  `texture_size` is the segment texture size the screen asks for
     (`segment_texture_size`).  A ring being built when its members' keys change
     is finished first and rebuilt after: a cloud forming in the ring, whose key changes every
-    frame, would otherwise keep the ring from ever completing.
+    frame, would otherwise keep the ring from ever completing; one whose members are no longer all
+    units (removed, regrouped) starts again.
     """
     if not settings.uses_ring:
         return None
     current, pending, built, fade_step = state.current, state.pending, state.built, state.fade_step
-    if pending is not None and (pending.radius != settings.ring_radius or _wrong_size(pending, texture_size)):
+    if pending is not None and (
+        pending.radius != settings.ring_radius
+        or _wrong_size(pending, texture_size)
+        or not pending.members <= set(ids)  # a member gone (a cloud field's cell left): nothing to render it from
+    ):
         pending = None  # the ring it was being built for is gone: start again
     keys = dict(zip(ids, lighting_keys))
     if pending is None and (current is None or _needs_rebuild(current, eye, settings, keys, texture_size)):

@@ -103,15 +103,24 @@ def interpenetrating_groups(
     return tuple(sorted((tuple(g) for g in groups.values()), key=lambda g: g[0]))
 
 
-def lod_units(particles, group: bool = True) -> LodUnits:
-    """The units of a `ParticleBuffer`: its clouds, interpenetrating ones grouped (`group`)."""
+def lod_units(particles, group: bool = True, groupable: int | None = None) -> LodUnits:
+    """The units of a `ParticleBuffer`: its clouds, interpenetrating ones grouped (`group`).
+
+    Only the first `groupable` clouds (None: all) are grouped; the others are units of their own: a cloud
+    field's cells, whose nested grid is their level of detail (grouping the touching cells of a field would
+    make it one unit to the horizon, beyond any impostor or ring).
+    """
     starts = particles.cloud_starts
     sphere_centres, sphere_radii = particles.bounding_centres, particles.bounding_radii
+    clouds = len(sphere_radii)
+    grouped = clouds if groupable is None else min(groupable, clouds)
     members = (
-        interpenetrating_groups(particles.centres, particles.radii, starts, sphere_centres, sphere_radii)
-        if group
-        else tuple((i,) for i in range(len(sphere_radii)))
-    )
+        interpenetrating_groups(
+            particles.centres, particles.radii, starts[: grouped + 1], sphere_centres[:grouped], sphere_radii[:grouped]
+        )
+        if group and grouped
+        else tuple((i,) for i in range(grouped))
+    ) + tuple((i,) for i in range(grouped, clouds))
     centres, radii, counts, squares, finest = [], [], [], [], []
     for clouds in members:
         ranges = [np.arange(starts[c], starts[c + 1]) for c in clouds]

@@ -24,3 +24,5 @@ def resource_path(*parts: str) -> Path:
 DEFAULT_SCENE = resource_path("scenes", "valley.toml")
 #: Wang's cloud sprite sheet (`scripts/make_sprite_atlas.py` regenerates it)
 ATLAS = resource_path("sprites", "atlas.png")
+#: a cumulus field 100 km across (`[cloud_field]`, Yusov's nested grid) with a flight through and above it
+CUMULUS_FIELD = resource_path("scenes", "cumulus_field.toml")

@@ -1,0 +1,83 @@
+"""The Cloud field panel: the scene's `[cloud_field]` (Yusov's nested grid to the horizon) as widgets.
+
+Each widget edits the scene through the editor's history, on release (a
+slider dragged does not remake the field every frame); the record refuses
+what the scene file would (`cloudcore.scene.CloudField`), and the refusal
+becomes a message.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+from imgui_bundle import imgui
+
+from app.editor import Editor
+from app.panels.widgets import ReleasedSliders
+from app.viewport import Viewport
+from cloudcore.artist.cloudgen import PRESETS
+from cloudcore.scene import MAX_LAYERS, MAX_RINGS, CloudField
+
+#: the float sliders: label -> (field, index in a pair or None, low, high, format)
+_SLIDERS = {
+    "Coverage": ("coverage", None, 0.0, 1.0, "%.2f"),
+    "Cell size (m)": ("cell_size", None, 100.0, 5000.0, "%.0f"),
+    "Base (m)": ("altitude", 0, 0.0, 10000.0, "%.0f"),
+    "Top (m)": ("altitude", 1, 0.0, 12000.0, "%.0f"),
+    "Extent x (km)": ("extent", 0, 1.0, 1000.0, "%.0f"),
+    "Extent z (km)": ("extent", 1, 1.0, 1000.0, "%.0f"),
+    "Centre x (km)": ("centre", 0, -1000.0, 1000.0, "%.1f"),
+    "Centre z (km)": ("centre", 1, -1000.0, 1000.0, "%.1f"),
+}
+#: the sliders in kilometres, the record in metres
+_KM = ("Extent x (km)", "Extent z (km)", "Centre x (km)", "Centre z (km)")
+_CLOUD_TYPES = tuple(PRESETS)
+
+
+class CloudFieldPanel:
+    def __init__(self, editor: Editor, viewport: Viewport, sliders: ReleasedSliders):
+        self.editor, self.viewport, self._sliders = editor, viewport, sliders
+
+    def draw(self) -> None:
+        editor = self.editor
+        field = editor.scene.cloud_field
+        if field is None:
+            imgui.text_wrapped("No cloud field: clouds generated around the camera to the horizon.")
+            if imgui.button("Add cloud field"):
+                editor.edit(dataclasses.replace(editor.scene, cloud_field=CloudField()))
+            return
+        changes: dict = {}
+        changed, seed = imgui.input_int("Seed", field.seed)
+        if changed:
+            changes["seed"] = seed
+        for label, (name, index, low, high, fmt) in _SLIDERS.items():
+            scale = 1e3 if label in _KM else 1.0
+            held = getattr(field, name)
+            value = self._sliders.slider(label, (held if index is None else held[index]) / scale, low, high, fmt)
+            if value is None:
+                continue
+            value *= scale
+            if index is None:
+                changes[name] = value
+            else:
+                pair = list(changes.get(name, held))
+                pair[index] = value
+                changes[name] = tuple(pair)
+        for label, name, high in (("Rings", "rings", MAX_RINGS), ("Layers", "layers", MAX_LAYERS)):
+            value = self._sliders.slider_int(label, getattr(field, name), 1, high)
+            if value is not None:
+                changes[name] = value
+        changed, type_index = imgui.combo("Cloud type", _CLOUD_TYPES.index(field.cloud_type), list(_CLOUD_TYPES))
+        if changed:
+            changes["cloud_type"] = _CLOUD_TYPES[type_index]
+        if changes:
+            scene = editor.scene
+            editor.change(lambda: dataclasses.replace(scene, cloud_field=dataclasses.replace(field, **changes)))
+        if self.viewport.renderer is not None:
+            cells = self.viewport.renderer.field_state.cells
+            clouds = [cloud for cloud in cells.values() if cloud is not None]
+            imgui.text(
+                f"{len(cells)} cells made, {len(clouds)} cloudy, {sum(len(c.particles) for c in clouds)} particles"
+            )
+        if imgui.button("Remove cloud field"):
+            editor.edit(dataclasses.replace(editor.scene, cloud_field=None))

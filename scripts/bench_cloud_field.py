@@ -1,0 +1,165 @@
+"""Frame time of a cloud field against its rings and against its extent: 20 km of the demo's flight in auto mode (JSON).
+
+    python scripts/bench_cloud_field.py [--stations 8] [--burst 16] [--warmup 6] [--width 320] [--height 240]
+                                        [--rings 2,3,4,5,6] [--json out/bench_cloud_field.json]
+
+The demo scene (`cloudcore/resources/scenes/cumulus_field.toml`: 100 km of cumulus, 5 rings) is flown over
+the first 20 km of its `flight` path (at 2 km through the clouds, then climbing above them) in auto mode
+with the default settings.  A CPU cannot draw the 3,000 frames of 20 km at 200 m/s and 30 fps, and frames
+kilometres apart would defeat what auto mode keeps between frames (Wang's ring lags its eye by its 16
+frames of rebuild and fade; impostors are remade every frame), so the flight is sampled: `--stations`
+places spread evenly over the 20 km, and at each a burst of `--burst` frames flown at 200 m/s and 30 fps
+(6.7 m a frame), of which the first `--warmup` (the jump from the last station: cells entering, the ring
+and impostors catching up) are reported apart.  Once per configuration: each number of `--rings` at the
+demo's extent, and the demo's rings at 4x its extent (400 km).  The configurations are interleaved frame
+by frame (one renderer each, all in this process), so a load on the machine slows them alike and the
+ratios hold.  Per configuration: the whole `render` call (`render_ms`: the field's update, lighting entering
+cells and rebuilding the particle buffer, the passes), the renderer's own frame time (`frame_ms`: the passes
+only), the cloud pass and impostor updates, the field's particles, the cells made per frame, what preparing
+the particles costs where cells entered (`illumination_ms`), and the pure field update on its own
+(`update_field`, timed beside the renderer).
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+
+os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
+
+from cloudcore.field.state import FieldState, update_field  # noqa: E402
+from cloudcore.gl import FrameRenderer  # noqa: E402
+from cloudcore.measure.benchmark import machine, write_report  # noqa: E402
+from cloudcore.paths import camera_on_path  # noqa: E402
+from cloudcore.resources import CUMULUS_FIELD  # noqa: E402
+from cloudcore.scenefile import load_scene  # noqa: E402
+from cloudcore.settings import RenderSettings  # noqa: E402
+
+#: how much of the flight is flown, metres (the issue's 20 km)
+FLOWN_M = 20000.0
+#: metres a frame at 200 m/s and 30 frames a second
+FRAME_STEP_M = 200.0 / 30.0
+
+
+def views_along(scene, path_name: str, distances_m) -> list:
+    """Cameras at `distances_m` metres along the path (by arc length)."""
+    path = scene.camera_path(path_name)
+    times = np.linspace(0.0, path.duration, 4001)
+    eyes = np.array([camera_on_path(path, t, scene.camera.fov_y_deg).position for t in times])
+    travelled = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(eyes, axis=0), axis=1))])
+    if travelled[-1] < max(distances_m):
+        raise SystemExit(f"the path is {travelled[-1]:.0f} m long, shorter than {max(distances_m):.0f} m")
+    return [camera_on_path(path, t, scene.camera.fov_y_deg) for t in np.interp(distances_m, travelled, times)]
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--stations", type=int, default=8)
+    parser.add_argument("--burst", type=int, default=16)
+    parser.add_argument("--warmup", type=int, default=6)
+    parser.add_argument("--width", type=int, default=320)
+    parser.add_argument("--height", type=int, default=240)
+    parser.add_argument(
+        "--rings", default="2,3,4,5,6", help="ring counts to fly at the demo's extent (its own is always flown)"
+    )
+    parser.add_argument("--json", type=Path)
+    args = parser.parse_args()
+
+    demo = load_scene(CUMULUS_FIELD)
+    field = demo.cloud_field
+    ring_counts = sorted({*map(int, args.rings.split(",")), field.rings})  # the demo's own: the reference
+    configurations = {f"rings={rings}": dataclasses.replace(field, rings=rings) for rings in ring_counts}
+    configurations[f"rings={field.rings} extent=4x"] = dataclasses.replace(
+        field, extent=tuple(4.0 * side for side in field.extent)
+    )
+    scenes = {name: dataclasses.replace(demo, cloud_field=f) for name, f in configurations.items()}
+    renderers = {name: FrameRenderer(args.width, args.height) for name in scenes}
+    states = dict.fromkeys(scenes, FieldState())
+    settings = RenderSettings()  # auto mode
+    rows = {name: [] for name in scenes}
+    stations = np.linspace(0.0, FLOWN_M - args.burst * FRAME_STEP_M, args.stations)
+    distances = (stations[:, None] + FRAME_STEP_M * np.arange(args.burst)).ravel()
+    for frame, camera in enumerate(views_along(demo, "flight", distances)):
+        for name, scene in scenes.items():
+            start = time.perf_counter()
+            field_frame, states[name] = update_field(scene.cloud_field, camera.position, states[name])
+            update_ms = 1e3 * (time.perf_counter() - start)
+            start = time.perf_counter()
+            _, stats = renderers[name].render(scene, camera=camera, settings=settings, read_back=False)
+            render_ms = 1e3 * (time.perf_counter() - start)
+            rows[name].append(
+                {
+                    "frame": frame,
+                    "distance_m": float(distances[frame]),
+                    "warmup": frame % args.burst < args.warmup,
+                    "render_ms": render_ms,
+                    "frame_ms": stats.frame_ms,
+                    "cloud_ms": stats.cloud_ms,
+                    "impostor_update_ms": stats.impostor_update_ms,
+                    "world_ms": stats.world_ms,
+                    "illumination_ms": stats.illumination_ms,
+                    "field_update_ms": update_ms,
+                    "field_particles": field_frame.particle_count,
+                    "cells_held": len(states[name].cells),
+                    "cells_made": len(states[name].made),
+                    "particles_drawn": stats.particles_drawn,
+                    "impostors_regenerated": stats.plan.impostors_regenerated,
+                }
+            )
+    for renderer in renderers.values():
+        renderer.close()
+
+    def summary(frames: list) -> dict:
+        flying = [f for f in frames if not f["warmup"]]
+        column = {key: np.array([f[key] for f in flying], dtype=np.float64) for key in flying[0]}
+        every = {key: np.array([f[key] for f in frames], dtype=np.float64) for key in ("cells_made", "illumination_ms")}
+        entering = every["cells_made"] > 0
+        return {
+            "median_render_ms": float(np.median(column["render_ms"])),
+            "mean_render_ms": float(column["render_ms"].mean()),
+            "p95_render_ms": float(np.percentile(column["render_ms"], 95)),
+            "median_frame_ms": float(np.median(column["frame_ms"])),
+            "mean_frame_ms": float(column["frame_ms"].mean()),
+            "median_cloud_ms": float(np.median(column["cloud_ms"])),
+            "mean_impostor_update_ms": float(column["impostor_update_ms"].mean()),
+            "median_world_ms": float(np.median(column["world_ms"])),
+            "mean_field_particles": float(column["field_particles"].mean()),
+            "max_cells_held": int(column["cells_held"].max()),
+            "flying_frames_with_cells_made": int(np.count_nonzero(column["cells_made"])),
+            "mean_field_update_ms": float(column["field_update_ms"].mean()),
+            "frames_with_cells_made": int(np.count_nonzero(entering)),
+            "mean_cells_made_where_any": float(every["cells_made"][entering].mean()) if entering.any() else 0.0,
+            "mean_illumination_ms_where_cells_made": float(every["illumination_ms"][entering].mean())
+            if entering.any()
+            else 0.0,
+            "first_frame": {
+                key: frames[0][key] for key in ("render_ms", "frame_ms", "illumination_ms", "field_update_ms")
+            },
+        }
+
+    summaries = {name: summary(frames) for name, frames in rows.items()}
+    reference = summaries[f"rings={field.rings}"]
+    for numbers in summaries.values():
+        for key in ("median_render_ms", "mean_render_ms", "p95_render_ms", "median_frame_ms"):
+            numbers[f"{key}_ratio_to_demo"] = numbers[key] / reference[key]
+    report = {
+        "command": "python scripts/bench_cloud_field.py "
+        f"--stations {args.stations} --burst {args.burst} --warmup {args.warmup} "
+        f"--width {args.width} --height {args.height} --rings {args.rings}",
+        "machine": machine(),
+        "date": time.strftime("%Y-%m-%d"),
+        "flown_m": FLOWN_M,
+        "frame_step_m": FRAME_STEP_M,
+        "summaries": summaries,
+        "frames_by_configuration": rows,
+    }
+    write_report(report, args.json, summary={"command": report["command"], "summaries": summaries})
+
+
+if __name__ == "__main__":
+    main()

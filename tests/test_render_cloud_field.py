@@ -1,0 +1,103 @@
+"""A cloud field in rendered frames: it joins the authored clouds, lights only entering cells, and does not pop."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from cloudcore.artist.cloudgen import preset_cloud
+from cloudcore.field.grid import level_reach
+from cloudcore.light.illumination import IlluminationCache
+from cloudcore.light.lighting import active_lights, scene_lights
+from cloudcore.scene import MAX_CELL_SIZE, MAX_LAYERS, MAX_RINGS, MIN_CELL_SIZE, Camera, CloudField, Scene
+from cloudcore.settings import FULL_3D, RenderSettings
+
+pytestmark = pytest.mark.gl
+
+FIELD = CloudField(seed=5, coverage=0.5, cell_size=400.0, rings=3, layers=2, altitude=(1000.0, 1600.0))
+#: high above the field, looking down and ahead: every ring in view
+ABOVE = Camera((0.0, 5000.0, 0.0), (0.0, 1200.0, -3000.0), 60.0)
+
+
+@pytest.fixture(scope="module")
+def own_renderer():
+    """A renderer of this module's own, with an illumination cache the tests can ask what it recomputed."""
+    from cloudcore.gl import FrameRenderer
+
+    cache = IlluminationCache()
+    try:
+        renderer = FrameRenderer(160, 120, illumination=cache)
+    except Exception as error:  # no libEGL or no Mesa driver
+        pytest.skip(f"no headless OpenGL (EGL) context: {error}")
+    yield renderer, cache
+    renderer.close()
+
+
+def test_the_field_draws_beside_authored_clouds_and_lights_only_the_cells_that_enter(own_renderer):
+    renderer, cache = own_renderer
+    authored = preset_cloud("cumulus_humilis", "authored", (0.0, 1000.0, -2500.0), seed=1)
+    scene = Scene(camera=ABOVE, clouds=(authored,), cloud_field=FIELD)
+    sky = renderer.render(dataclasses.replace(scene, clouds=(), cloud_field=None), settings=FULL_3D)[0]
+    alone = renderer.render(dataclasses.replace(scene, cloud_field=None), settings=FULL_3D)[0]
+    image, stats = renderer.render(scene, settings=FULL_3D)
+    field_clouds = [c for c in renderer.field_state.cells.values() if c is not None]
+    assert stats.clouds_drawn > 20 and len(field_clouds) > 20
+    assert np.abs(image.astype(int) - sky.astype(int)).mean() > np.abs(alone.astype(int) - sky.astype(int)).mean()
+    # one inner cell further on: only the entering cells' clouds are lit, the others come from the cache
+    moved = dataclasses.replace(ABOVE, position=(FIELD.cell_size, 5000.0, 0.0), look_at=(FIELD.cell_size, 1200.0, -3e3))
+    renderer.render(scene, camera=moved, settings=FULL_3D)
+    entering = [key for key in renderer.field_state.made if renderer.field_state.cells[key] is not None]
+    assert 0 < len(entering) < 0.3 * len(field_clouds)
+    # (cloud, light direction) pairs shaded: the sun and the skylights
+    assert cache.last_recomputed == len(entering) * len(active_lights(scene_lights(scene.lighting)[0]))
+    # and the authored cloud is the first cloud still: its index, and so its unit, never moves
+    assert renderer.units.members[0] == (0,) or 0 in renderer.units.members[0]
+
+
+def _flight_means(renderer, settings) -> np.ndarray:
+    """The frame's mean level as the eye moves 3 inner cells in steps of a twentieth of a cell, past the edges of the
+    inner and middle rings (cells enter and leave both)."""
+    scene = Scene(camera=ABOVE, cloud_field=FIELD)
+    means = []
+    for step in np.arange(0.0, 3.0, 0.05):
+        x = step * FIELD.cell_size
+        camera = dataclasses.replace(ABOVE, position=(x, 5000.0, 0.0), look_at=(x, 1200.0, -3000.0))
+        means.append(renderer.render(scene, camera=camera, settings=settings)[0].astype(float).mean())
+    assert level_reach(FIELD, 0) < 3.0 * FIELD.cell_size + level_reach(FIELD, 1)
+    return np.array(means)
+
+
+def test_flying_across_ring_boundaries_changes_the_picture_smoothly(own_renderer):
+    """The frame's mean brightness never steps.  The view itself slides by 20 m a frame; with the rings switched
+    hard instead of blended (weights rounded to 0 or 1) the largest change between frames was 0.054 levels here,
+    blended 0.009."""
+    full = _flight_means(own_renderer[0], FULL_3D)
+    assert np.abs(np.diff(full)).max() < 0.025
+    # auto mode draws the same field within a level of full 3D on the way
+    auto = _flight_means(own_renderer[0], RenderSettings())
+    assert np.abs(auto - full).max() < 1.0
+
+
+EXTREMES = {
+    "every limit at its largest": CloudField(
+        coverage=1.0, cell_size=MAX_CELL_SIZE, rings=MAX_RINGS, layers=MAX_LAYERS, extent=(1e12, 1e12)
+    ),
+    "the smallest cells": CloudField(coverage=1.0, cell_size=MIN_CELL_SIZE, rings=3, layers=1, extent=(100.0, 100.0)),
+    "an extent under one cell": CloudField(extent=(1.0, 1.0)),
+    "a band a millimetre thick": CloudField(coverage=1.0, altitude=(1000.0, 1000.001)),
+    "a field far away": CloudField(centre=(1e12, -1e12)),
+}
+
+
+@pytest.mark.parametrize("name", EXTREMES)
+def test_extreme_fields_render_in_every_mode(own_renderer, name):
+    renderer, _ = own_renderer
+    scene = Scene(camera=Camera((0.0, 1500.0, 0.0), (0.0, 1000.0, -3000.0), 60.0), cloud_field=EXTREMES[name])
+    sky = renderer.render(dataclasses.replace(scene, cloud_field=None), settings=FULL_3D)[0]
+    for settings in (FULL_3D, RenderSettings(), RenderSettings(mode="impostor")):
+        image, stats = renderer.render(scene, settings=settings)
+        assert image.shape == sky.shape and np.isfinite(stats.frame_ms)
+        if name in ("every limit at its largest", "a band a millimetre thick"):
+            assert stats.clouds_drawn > 0 and np.abs(image.astype(int) - sky.astype(int)).mean() > 1.0
+        if name == "a field far away":
+            assert not renderer.field_state.cells and np.array_equal(image, sky)
