@@ -29,7 +29,8 @@ def splats(centres, radii, colours, opacities) -> Splats:
     order = np.argsort(-np.linalg.norm(centres, axis=1), kind="stable")
     opacities = np.asarray(opacities, dtype=np.float64)
     colours = np.asarray(colours, dtype=np.float64) * opacities[:, None]
-    return Splats(centres[order], np.asarray(radii, dtype=np.float64)[order], colours[order], opacities[order], RIGHT, UP)
+    radii = np.asarray(radii, dtype=np.float64)
+    return Splats(centres[order], radii[order], colours[order], opacities[order], RIGHT, UP)
 
 
 RED_BLUE = ([[1.0, 0.1, 0.1], [0.1, 0.2, 1.0]], [0.9, 0.7])

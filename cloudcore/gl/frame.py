@@ -41,10 +41,12 @@ from cloudcore.gl.programs import build_program
 from cloudcore.gl.quads import SCREEN_CORNERS, QuadPass
 from cloudcore.gl.splats import SplatPass, splat_batch
 from cloudcore.gl.targets import TextureTarget, blit_depth, depth_renderbuffer
+from cloudcore.gl.volume_blending import VolumeBlendingPass
 from cloudcore.gl.world import WorldPass
 from cloudcore.light.eye_scattering import ParticleBuffer
 from cloudcore.light.illumination import IlluminationCache
 from cloudcore.light.lighting import scene_hour, scene_lights, sky_colors
+from cloudcore.light.volume_blending import blending_path, screen_tiles
 from cloudcore.lod.costs import CostModel
 from cloudcore.lod.frameplan import FramePlan, LodState, inside_runs, plan_frame
 from cloudcore.lod.units import LodUnits, lod_units
@@ -68,6 +70,7 @@ class _CloudPassFrame:
     poses: tuple
     time_s: float
     point_sprites: bool  # the setting: draw plain splats as points where the picture is the same
+    blending: str  # the setting: full-3D splats as billboards ("plain") or as volumes ("volume")
 
     @property
     def eye(self) -> np.ndarray:
@@ -85,6 +88,7 @@ class FrameRenderer:
         self.context = context if context is not None else HeadlessContext(width, height)
         self.context.make_current()
         self._splats = SplatPass()
+        self._volume = VolumeBlendingPass()
         self._quads = QuadPass()
         self._impostors = ImpostorStore(self._splats)
         self._world, self._world_source = None, None
@@ -111,6 +115,11 @@ class FrameRenderer:
     def units(self) -> LodUnits:
         """The units (clouds, or groups of interpenetrating clouds) the last frame was planned with."""
         return self._units
+
+    @property
+    def volume_features(self):
+        """What this GL offers volume-aware blending (`cloudcore.gl.volume_blending.GpuFeatures`)."""
+        return self._volume.features
 
     @property
     def size(self) -> tuple[int, int]:
@@ -328,6 +337,7 @@ class FrameRenderer:
             poses,
             time_s,
             settings.point_sprites,
+            settings.blending,
         )
         self._replay, self._screen_batches = [], []
         if plan.ring is not None:
@@ -356,11 +366,23 @@ class FrameRenderer:
             drawn += self._draw_splats(frame, *zip(*full_run))
         return drawn
 
-    def _draw_splats(self, frame: _CloudPassFrame, clouds, depth_ranges) -> int:
-        """Full 3D: the clouds' splats (each cloud's within its depth range) sorted together, on the screen."""
+    def _draw_splats(self, frame: _CloudPassFrame, clouds, depth_ranges, colour_texture: int | None = None) -> int:
+        """Full 3D: the clouds' splats (each cloud's within its depth range) sorted together, on the screen
+        (or the screen layer whose `colour_texture` is bound), as billboards or as volumes."""
         batch = splat_batch(frame.particles, clouds, frame.eye, depth_ranges, frame.time_s, frame.frustum)
         view, projection, points = frame.view, frame.projection, frame.point_sprites
-        self._splats.draw(batch, view, projection, point_sprites=points)
+        path = blending_path(
+            frame.blending,
+            compute_shaders=self._volume.features.compute_shaders,
+            plain_splats_only=bool(np.all(self._splats.plain_splats(batch))),
+        )
+        if path == "volume" and len(batch):
+            tiles = screen_tiles(batch.centres - batch.eye, batch.radii, view, projection, self.size, NEAR_PLANE_M)
+            instances = self._splats.shade(batch, view)
+            target = self.context.colour_texture if colour_texture is None else colour_texture
+            self._volume.draw(tiles, instances, view, projection, target, self.context.framebuffer)
+        else:
+            self._splats.draw(batch, view, projection, point_sprites=points)
         self._replay.append(lambda: self._splats.draw(batch, view, projection, counting=True, point_sprites=points))
         self._screen_batches.append(batch)
         return len(batch)
@@ -393,7 +415,7 @@ class FrameRenderer:
         target, corners, extent = self._impostors.cloud_impostor(cloud.members, item.layer)
         layer = self._screen_layer()
         layer.bind_cleared()
-        drawn = self._draw_splats(frame, cloud.members, [(item.near, item.far)] * len(cloud.members))
+        drawn = self._draw_splats(frame, cloud.members, [(item.near, item.far)] * len(cloud.members), layer.texture)
         self.context.bind_target()
         self._draw_quad(
             frame,
@@ -486,6 +508,7 @@ class FrameRenderer:
         self._impostors.close()
         self._quads.close()
         self._splats.close()
+        self._volume.close()
         if self._world is not None:
             self._world.close()
         if self._objects is not None:

@@ -31,12 +31,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from cloudcore.light.kernel import splat_kernel
+from cloudcore.settings import BLENDINGS
 
 #: optical depth a segment is capped at: e^-50 of light gets through, nothing a 16-bit target holds,
 #: and tau stays finite where a splat's opacity rounds to 1 (-ln 0)
 MAX_OPTICAL_DEPTH = 50.0
-#: names of the ways splats are composited, the `blending` setting's choices
-BLENDINGS = ("plain", "volume")
 _TINY = np.finfo(np.float64).tiny
 
 
@@ -244,3 +243,73 @@ def blending_path(requested: str, *, compute_shaders: bool, plain_splats_only: b
     if requested not in BLENDINGS:
         raise ValueError(f"blending must be one of {', '.join(BLENDINGS)}, got {requested!r}")
     return "volume" if requested == "volume" and compute_shaders and plain_splats_only else "plain"
+
+
+@dataclass(frozen=True)
+class ScreenTiles:
+    """Which particles of a batch can touch each screen tile: the compute pass's work, one group a tile.
+
+    Tiles are `TILE_PIXELS` square, counted from the lower left as GL counts pixels; tile i's particles
+    are `entries[starts[i]:starts[i + 1]]`, positions in the batch, in its far-to-near order."""
+
+    size: tuple[int, int]
+    across: int
+    up: int
+    starts: np.ndarray  # (across * up + 1,) uint32
+    entries: np.ndarray  # uint32
+
+    @property
+    def count(self) -> int:
+        return self.across * self.up
+
+
+#: pixels on a side of the compute pass's tiles (its work groups: 256 invocations)
+TILE_PIXELS = 16
+
+
+def screen_tiles(centres, radii, view: np.ndarray, projection: np.ndarray, size, near: float) -> ScreenTiles:
+    """Bin a batch's splats (`centres` relative to the eye, far to near) into the screen's tiles.
+
+    A splat lies in the image plane, so its image is the square (x +- r, y +- r) at its depth, projected;
+    a pixel is in it when its centre is (one pixel of margin, for rounding).  Splats not in front of the
+    `near` plane are in no tile, as the rasteriser clips them."""
+    width, height = int(size[0]), int(size[1])
+    across, up = -(-width // TILE_PIXELS), -(-height // TILE_PIXELS)
+    centres = np.asarray(centres, dtype=np.float64).reshape(-1, 3)
+    radii = np.asarray(radii, dtype=np.float64)
+    depth = centres @ -view[2, :3]
+    ahead = depth > near
+    safe_depth = np.where(ahead, depth, 1.0)
+    columns = _pixel_span(centres @ view[0, :3], radii, safe_depth, projection[0, 0], width)
+    rows = _pixel_span(centres @ view[1, :3], radii, safe_depth, projection[1, 1], height)
+    seen = ahead & (columns[1] >= columns[0]) & (rows[1] >= rows[0])
+    first_x, last_x = columns[0][seen] // TILE_PIXELS, columns[1][seen] // TILE_PIXELS
+    first_y, last_y = rows[0][seen] // TILE_PIXELS, rows[1][seen] // TILE_PIXELS
+    wide, tall = last_x - first_x + 1, last_y - first_y + 1
+    positions = np.repeat(np.flatnonzero(seen), wide * tall)
+    # the k-th tile of a splat's box, row by row
+    local = np.arange(len(positions)) - np.repeat(np.cumsum(wide * tall) - wide * tall, wide * tall)
+    box_wide = np.repeat(wide, wide * tall)
+    tile = (np.repeat(first_y, wide * tall) + local // box_wide) * across + np.repeat(first_x, wide * tall)
+    tile += local % box_wide
+    order = np.argsort(tile, kind="stable")  # stable: the batch's order within each tile
+    starts = np.concatenate([[0], np.cumsum(np.bincount(tile, minlength=across * up))])
+    return ScreenTiles((width, height), across, up, starts.astype(np.uint32), positions[order].astype(np.uint32))
+
+
+def _pixel_span(along, radii, depth, focal, pixels: int) -> tuple[np.ndarray, np.ndarray]:
+    """(first, last) pixel index, clipped to the screen, whose centres the spans along +- radii cover."""
+    low = ((along - radii) * focal / depth + 1.0) * 0.5 * pixels - 0.5
+    high = ((along + radii) * focal / depth + 1.0) * 0.5 * pixels - 0.5
+    first = np.clip(np.floor(low) - 1.0, 0, pixels)
+    last = np.clip(np.ceil(high) + 1.0, -1, pixels - 1)
+    return first.astype(np.int64), last.astype(np.int64)
+
+
+def ray_distances(window_depth: np.ndarray, rays: np.ndarray, view: np.ndarray, projection: np.ndarray) -> np.ndarray:
+    """Distances along unit `rays` to the world, from a frame's window depths (the same pixels, flat);
+    inf where the depth is cleared (1: nothing drawn).  The shader makes the same conversion."""
+    window_depth = np.asarray(window_depth, dtype=np.float64).ravel()
+    ndc = 2.0 * window_depth - 1.0
+    eye_depth = projection[2, 3] / np.where(window_depth < 1.0, ndc + projection[2, 2], -1.0)
+    return np.where(window_depth < 1.0, eye_depth / np.maximum(rays @ -view[2, :3], _TINY), np.inf)

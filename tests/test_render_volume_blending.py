@@ -1,0 +1,105 @@
+"""Volume-aware blending on the GL (the tiled compute pass) against its numpy reference, and a render of
+two interpenetrating clouds against the ray-marched reference: nearer than plain blending."""
+
+import dataclasses
+
+import numpy as np
+
+from cloudcore.artist.particle_styles import particle_styles
+from cloudcore.camera import NEAR_PLANE_M, pixel_rays, projection_matrix, view_matrix
+from cloudcore.light.eye_scattering import ParticleBuffer
+from cloudcore.light.lighting import scene_lights
+from cloudcore.light.volume_blending import plain_blend, ray_marched, screen_tiles, volume_blend
+from cloudcore.scene import Camera, Cloud, Light, Scene, Shading
+from cloudcore.settings import FULL_3D
+
+WIDTH, HEIGHT = 40, 30
+CAMERA = Camera((0.0, 0.0, 0.0), (0.0, 0.0, -1.0), 30.0)
+LIGHTS = (Light((0.3, 0.8, 0.5), (1.0, 0.9, 0.8), 1.2), Light((-0.6, -0.2, -0.7), (0.4, 0.5, 0.9), 0.6))
+AMBIENT = (0.05, 0.06, 0.09)
+
+
+def test_the_compute_pass_composites_as_the_reference_does(renderer):
+    from OpenGL import GL
+
+    from cloudcore.gl.splats import SplatPass, splat_batch
+    from cloudcore.gl.targets import TextureTarget
+    from cloudcore.gl.volume_blending import VolumeBlendingPass, batch_splats
+
+    clouds = (
+        Cloud("red", [[-1.5, 0.0, -100.0, 6.0]], optical_depth=3.0, color=(1.0, 0.3, 0.2)),
+        Cloud("blue", [[1.5, 0.8, -102.0, 5.0]], optical_depth=1.5, color=(0.2, 0.4, 1.0)),
+    )
+    particles = ParticleBuffer(clouds, Shading(), LIGHTS, AMBIENT)
+    view, projection = view_matrix(CAMERA), projection_matrix(CAMERA.fov_y_deg, WIDTH / HEIGHT)
+    renderer.context.make_current()
+    splats, volume, target = SplatPass(), VolumeBlendingPass(), TextureTarget(WIDTH, HEIGHT)
+    background = np.array([0.2, 0.3, 0.5, 1.0])
+    try:
+        assert volume.features.compute_shaders
+        batch = splat_batch(particles, [0, 1], CAMERA.position)
+        tiles = screen_tiles(batch.centres - batch.eye, batch.radii, view, projection, (WIDTH, HEIGHT), NEAR_PLANE_M)
+        target.bind_cleared()
+        GL.glClearColor(*background)
+        GL.glClear(GL.GL_COLOR_BUFFER_BIT)
+        # no depth attached: the frame's own depth, cleared to far, stands for "no world"
+        renderer.context.bind_target()
+        GL.glClear(GL.GL_DEPTH_BUFFER_BIT)
+        volume.draw(tiles, splats.shade(batch, view), view, projection, target.texture, renderer.context.framebuffer)
+        pixels = target.read()
+    finally:
+        splats.close(), volume.close(), target.close()
+    rays = pixel_rays(CAMERA, WIDTH, HEIGHT).reshape(-1, 3)
+    drawn = batch_splats(batch, view)
+    expected = volume_blend(drawn, rays, np.tile(background, (len(rays), 1))).reshape(pixels.shape)
+    plain = plain_blend(drawn, rays, np.tile(background, (len(rays), 1))).reshape(pixels.shape)
+    assert np.abs(expected - plain).max() > 0.02  # the particles do interpenetrate
+    np.testing.assert_allclose(pixels, expected, atol=4e-3)
+
+
+def interpenetrating_clouds(seed: int = 5) -> Scene:
+    """Two clouds of different colours and densities sharing one region of space, no terrain."""
+    generator = np.random.default_rng(seed)
+    made = []
+    for name, offset, colour, depth in (
+        ("warm", [-12.0, 0.0, 0.0], (1.0, 0.55, 0.35), 6.0),
+        ("cool", [12.0, 4.0, 6.0], (0.35, 0.55, 1.0), 3.0),
+    ):
+        centres = generator.normal(0.0, 14.0, (60, 3)) + offset + [0.0, 700.0, -300.0]
+        particles = np.column_stack([centres, generator.uniform(8.0, 14.0, 60)])
+        made.append(Cloud(name, particles, optical_depth=depth, color=colour))
+    return Scene(
+        clouds=tuple(made),
+        camera=Camera((0.0, 700.0, -150.0), (0.0, 700.0, -300.0), 40.0),
+        terrain=None,
+    )
+
+
+def test_two_interpenetrating_clouds_are_nearer_the_ray_march_than_plain_blending(renderer):
+    from cloudcore.camera import frustum_planes
+    from cloudcore.gl.splats import splat_batch
+    from cloudcore.gl.volume_blending import batch_splats
+
+    scene = interpenetrating_clouds()
+    width, height = renderer.size
+    images = {}
+    for blending in ("plain", "volume"):
+        renderer.render(scene, settings=dataclasses.replace(FULL_3D, blending=blending, point_sprites=False))
+        images[blending] = renderer.context.read_linear_rgb().reshape(-1, 3)
+    renderer.render(dataclasses.replace(scene, clouds=()), settings=FULL_3D)
+    background = np.column_stack([renderer.context.read_linear_rgb().reshape(-1, 3), np.zeros(width * height)])
+    lights, ambient = scene_lights(scene.lighting)
+    particles = ParticleBuffer(
+        scene.clouds, scene.shading, lights, ambient, styles=particle_styles(scene.clouds, scene.lighting)
+    )
+    view = view_matrix(scene.camera)
+    frustum = frustum_planes(projection_matrix(scene.camera.fov_y_deg, width / height) @ view)
+    batch = splat_batch(particles, range(len(scene.clouds)), scene.camera.position, time_s=0.0, frustum=frustum)
+    drawn, rays = batch_splats(batch, view), pixel_rays(scene.camera, width, height).reshape(-1, 3)
+    reference = ray_marched(drawn, rays, background, steps=512)[:, :3]
+    errors = {name: float(np.sqrt(np.mean((image - reference) ** 2))) for name, image in images.items()}
+    assert errors["volume"] < 0.85 * errors["plain"], errors
+    # each path draws its numpy reference's picture
+    for name, blend in (("plain", plain_blend), ("volume", volume_blend)):
+        difference = np.abs(images[name] - blend(drawn, rays, background)[:, :3]).max()
+        assert difference < 0.02, (name, difference)
