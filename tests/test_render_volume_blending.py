@@ -4,12 +4,13 @@ two interpenetrating clouds against the ray-marched reference: nearer than plain
 import dataclasses
 
 import numpy as np
+import pytest
 
 from cloudcore.artist.particle_styles import particle_styles
 from cloudcore.camera import NEAR_PLANE_M, pixel_rays, projection_matrix, view_matrix
 from cloudcore.light.eye_scattering import ParticleBuffer
 from cloudcore.light.lighting import scene_lights
-from cloudcore.light.volume_blending import plain_blend, ray_marched, screen_tiles, volume_blend
+from cloudcore.light.volume_blending import plain_blend, ray_distances, ray_marched, screen_tiles, volume_blend
 from cloudcore.scene import Camera, Cloud, Light, Scene, Shading
 from cloudcore.settings import FULL_3D
 
@@ -19,7 +20,10 @@ LIGHTS = (Light((0.3, 0.8, 0.5), (1.0, 0.9, 0.8), 1.2), Light((-0.6, -0.2, -0.7)
 AMBIENT = (0.05, 0.06, 0.09)
 
 
-def test_the_compute_pass_composites_as_the_reference_does(renderer):
+@pytest.mark.parametrize("wall_m", [None, 101.0])
+def test_the_compute_pass_composites_as_the_reference_does(renderer, wall_m):
+    """Two particles half inside each other, over a coloured background; with `wall_m`, the world's
+    depth is a wall that far ahead, between their centres, cutting their chords."""
     from OpenGL import GL
 
     from cloudcore.gl.splats import SplatPass, splat_batch
@@ -42,17 +46,22 @@ def test_the_compute_pass_composites_as_the_reference_does(renderer):
         target.bind_cleared()
         GL.glClearColor(*background)
         GL.glClear(GL.GL_COLOR_BUFFER_BIT)
-        # no depth attached: the frame's own depth, cleared to far, stands for "no world"
+        # the target has no depth: the pass reads the frame's, cleared to the wall (or to far: no world)
+        window_depth = 1.0 if wall_m is None else 0.5 * (projection[2, 2] * -wall_m + projection[2, 3]) / wall_m + 0.5
         renderer.context.bind_target()
+        GL.glDepthMask(GL.GL_TRUE)
+        GL.glClearDepth(window_depth)
         GL.glClear(GL.GL_DEPTH_BUFFER_BIT)
+        GL.glClearDepth(1.0)
         volume.draw(tiles, splats.shade(batch, view), view, projection, target.texture, renderer.context.framebuffer)
         pixels = target.read()
     finally:
         splats.close(), volume.close(), target.close()
     rays = pixel_rays(CAMERA, WIDTH, HEIGHT).reshape(-1, 3)
-    drawn = batch_splats(batch, view)
-    expected = volume_blend(drawn, rays, np.tile(background, (len(rays), 1))).reshape(pixels.shape)
-    plain = plain_blend(drawn, rays, np.tile(background, (len(rays), 1))).reshape(pixels.shape)
+    drawn, behind = batch_splats(batch, view), np.tile(background, (len(rays), 1))
+    opaque = ray_distances(np.full(len(rays), window_depth), rays, view, projection)
+    expected = volume_blend(drawn, rays, behind, opaque).reshape(pixels.shape)
+    plain = plain_blend(drawn, rays, behind, opaque).reshape(pixels.shape)
     assert np.abs(expected - plain).max() > 0.02  # the particles do interpenetrate
     np.testing.assert_allclose(pixels, expected, atol=4e-3)
 

@@ -4,14 +4,17 @@ reference where they interpenetrate, finite at the extremes."""
 import numpy as np
 import pytest
 
-from cloudcore.camera import pixel_rays
+from cloudcore.camera import NEAR_PLANE_M, pixel_rays, projection_matrix, view_matrix
 from cloudcore.light.volume_blending import (
     MAX_OPTICAL_DEPTH,
+    TILE_PIXELS,
     Splats,
     blending_path,
     particle_segments,
     plain_blend,
+    ray_distances,
     ray_marched,
+    screen_tiles,
     volume_blend,
 )
 from cloudcore.scene import Camera
@@ -134,3 +137,42 @@ def test_no_particles_leave_the_background():
 )
 def test_the_path_follows_the_setting_and_what_the_gl_can_do(requested, compute, plain_only, expected):
     assert blending_path(requested, compute_shaders=compute, plain_splats_only=plain_only) == expected
+
+
+def test_screen_tiles_list_every_splat_where_it_draws_in_the_batch_order():
+    camera = Camera((0.0, 0.0, 0.0), (0.0, 0.0, -1.0), 50.0)
+    width, height = 70, 45  # tiles that do not divide the screen
+    view, projection = view_matrix(camera), projection_matrix(camera.fov_y_deg, width / height)
+    generator = np.random.default_rng(8)
+    centres = generator.uniform([-60.0, -40.0, -120.0], [60.0, 40.0, -20.0], (50, 3))
+    centres[0] = [0.0, 0.0, 5.0]  # behind the eye: in no tile
+    radii = generator.uniform(1.0, 12.0, 50)
+    tiles = screen_tiles(centres, radii, view, projection, (width, height), NEAR_PLANE_M)
+    assert (tiles.across, tiles.up) == (5, 3) and len(tiles.starts) == 16
+    drawn = Splats(centres, radii, np.ones((50, 3)), np.ones(50), view[0, :3], view[1, :3])
+    rays = pixel_rays(camera, width, height).reshape(height, width, 3)[::-1].reshape(-1, 3)  # rows bottom first
+    for position in range(50):
+        reached = particle_segments(drawn, position, rays).optical_depth.reshape(height, width) > 0.0
+        for row, column in zip(*np.nonzero(reached)):
+            tile = (row // TILE_PIXELS) * tiles.across + column // TILE_PIXELS
+            assert position in tiles.entries[tiles.starts[tile] : tiles.starts[tile + 1]], (position, row, column)
+    assert 0 not in tiles.entries
+    for tile in range(tiles.count):
+        listed = tiles.entries[tiles.starts[tile] : tiles.starts[tile + 1]]
+        assert np.all(np.diff(listed.astype(np.int64)) > 0)  # far to near, as the batch
+
+
+def test_screen_tiles_of_no_splats_are_empty():
+    tiles = screen_tiles(np.zeros((0, 3)), np.zeros(0), np.eye(4), projection_matrix(60.0, 1.0), (16, 16), 0.1)
+    assert tiles.count == 1 and list(tiles.starts) == [0, 0] and len(tiles.entries) == 0
+
+
+def test_window_depth_becomes_distance_along_each_ray():
+    width, height = 8, 6
+    view, projection = view_matrix(CAMERA), projection_matrix(CAMERA.fov_y_deg, width / height)
+    rays = pixel_rays(CAMERA, width, height).reshape(-1, 3)
+    points = 250.0 * rays  # every pixel sees something 250 m away
+    clip = (projection @ view @ np.column_stack([points, np.ones(len(points))]).T).T
+    window = 0.5 * clip[:, 2] / clip[:, 3] + 0.5
+    np.testing.assert_allclose(ray_distances(np.append(window[:-1], 1.0), rays, view, projection)[:-1], 250.0)
+    assert ray_distances(np.ones(1), rays[:1], view, projection)[0] == np.inf

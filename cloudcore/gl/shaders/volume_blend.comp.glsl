@@ -5,7 +5,9 @@
 // segments along its ray as the numpy reference does (cloudcore.light.volume_blending.volume_blend):
 // one volume held (extent, optical depth, colour), the farther of two apart or the back part of two
 // overlapping into the frame, front and intersection merged.  A pixel is one invocation's alone,
-// so its read-modify-write of the target needs no interlock.
+// so its read-modify-write of the target needs no interlock.  The group gathers its tile's list a
+// chunk at a time into shared memory (as 3D Gaussian splatting rasterisers do), each particle's
+// plane and axes worked out once per tile rather than once per pixel.
 //
 // A particle's segment along the ray: the ray meets the splat's plane at d radii from its centre
 // (as splat.frag.glsl measures it); opacity alpha K(d) gives the optical depth -ln(1 - alpha K(d)),
@@ -60,42 +62,61 @@ float kernel(float d2)
     return max((exp(-SPLAT_SHARPNESS * d2) - floor_value) / (1.0 - floor_value), 0.0);
 }
 
-// the particle's segment along `ray`, cut at `opaque`; depth 0 where the ray misses it
-Segment segment_of(Instance p, vec3 ray, float opaque)
+// a particle as the pass reads it, gathered once per tile into shared memory with what every pixel
+// would otherwise recompute
+struct Splat {
+    vec4 centre_r2;      // relative to the eye, radius squared
+    vec4 u;              // the splat's right over its radius: offset . u is d's first coordinate
+    vec4 v;              // and up
+    vec4 normal_plane;   // the plane's normal, and its distance term centre . normal
+    vec4 colour;         // premultiplied rgb, opacity
+};
+shared Splat chunk[TILE_PIXELS * TILE_PIXELS];
+
+Splat splat_of(Instance p)
 {
-    Segment s = Segment(0.0, 0.0, 0.0, vec3(0.0));
     vec3 centre = 0.5 * (p.corners[0].xyz + p.corners[3].xyz);
     vec3 u = 0.5 * (p.corners[1].xyz - p.corners[0].xyz);  // radius times the splat's right
     vec3 v = 0.5 * (p.corners[2].xyz - p.corners[0].xyz);  // and up
     float r2 = dot(u, u);
-    float alpha = p.colours[0].a;
     vec3 normal = cross(u, v);
-    float facing = dot(ray, normal);
-    if (r2 <= 0.0 || alpha <= 0.0 || abs(facing) <= TINY)
+    float scale = r2 > 0.0 ? 1.0 / r2 : 0.0;
+    return Splat(vec4(centre, r2), vec4(u * scale, 0.0), vec4(v * scale, 0.0), vec4(normal, dot(centre, normal)),
+                 r2 > 0.0 ? p.colours[0] : vec4(0.0));
+}
+
+// the particle's segment along `ray`, cut at `opaque`; depth 0 where the ray misses it
+Segment segment_of(Splat p, vec3 ray, float opaque)
+{
+    Segment s = Segment(0.0, 0.0, 0.0, vec3(0.0));
+    float alpha = p.colour.a;
+    float facing = dot(ray, p.normal_plane.xyz);
+    if (alpha <= 0.0 || abs(facing) <= TINY)
         return s;
-    float plane = dot(centre, normal) / facing;
-    vec3 offset = plane * ray - centre;
-    float du = dot(offset, u), dv = dot(offset, v);
-    float d2 = (du * du + dv * dv) / (r2 * r2);
+    float plane = p.normal_plane.w / facing;
+    vec3 offset = plane * ray - p.centre_r2.xyz;
+    float du = dot(offset, p.u.xyz), dv = dot(offset, p.v.xyz);
+    float d2 = du * du + dv * dv;
     if (plane <= 0.0 || d2 >= 1.0)
         return s;
     float opacity = min(alpha * kernel(d2), 1.0);
     float depth = opacity < 1.0 ? min(-log(1.0 - opacity), MAX_OPTICAL_DEPTH) : MAX_OPTICAL_DEPTH;
-    float half_length = sqrt(r2 * max(1.0 - d2, 0.0));
-    float closest = dot(ray, centre);
+    float half_length = sqrt(p.centre_r2.w * max(1.0 - d2, 0.0));
+    float closest = dot(ray, p.centre_r2.xyz);
     s.near = closest - half_length;
     float whole_far = closest + half_length;
     s.far = clamp(opaque, s.near, whole_far);
     s.depth = half_length > 0.0 ? depth * (s.far - s.near) / max(whole_far - s.near, TINY) : 0.0;
-    s.colour = p.colours[0].rgb / alpha;
+    s.colour = p.colour.rgb / alpha;
     return s;
 }
 
 void main()
 {
     ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
-    if (any(greaterThanEqual(pixel, size)))
-        return;
+    // pixels past the screen's edge still gather their share of each chunk
+    bool on_screen = all(lessThan(pixel, size));
+    pixel = min(pixel, size - 1);
     uint tile = gl_WorkGroupID.y * uint(tiles_across) + gl_WorkGroupID.x;
     vec2 ndc = (vec2(pixel) + 0.5) / vec2(size) * 2.0 - 1.0;
     vec3 ray = normalize(ndc.x / focal.x * view_right + ndc.y / focal.y * view_up + view_forward);
@@ -104,43 +125,54 @@ void main()
     vec4 image = imageLoad(target, pixel);
 
     Segment held = Segment(0.0, 0.0, 0.0, vec3(0.0));
-    for (uint k = tile_starts[tile]; k < tile_starts[tile + 1u]; ++k) {
-        Segment s = segment_of(instances[tile_entries[k]], ray, opaque);
-        if (s.depth <= 0.0)
-            continue;
-        if (held.depth <= 0.0) {
-            held = s;
-            continue;
-        }
-        if (s.near >= held.far || s.far <= held.near) {  // apart: the farther goes into the frame
-            if (s.near < held.near) {
-                over_whole(image, held);
+    uint first = tile_starts[tile], end = tile_starts[tile + 1u];
+    const uint CHUNK = uint(TILE_PIXELS * TILE_PIXELS);
+    for (uint base = first; base < end; base += CHUNK) {
+        uint mine = base + gl_LocalInvocationIndex;
+        if (mine < end)
+            chunk[gl_LocalInvocationIndex] = splat_of(instances[tile_entries[mine]]);
+        barrier();
+        uint count = min(CHUNK, end - base);
+        for (uint k = 0u; k < count; ++k) {
+            Segment s = segment_of(chunk[k], ray, opaque);
+            if (s.depth <= 0.0)
+                continue;
+            if (held.depth <= 0.0) {
                 held = s;
-            } else {
-                over_whole(image, s);
+                continue;
             }
-            continue;
+            if (s.near >= held.far || s.far <= held.near) {  // apart: the farther goes into the frame
+                if (s.near < held.near) {
+                    over_whole(image, held);
+                    held = s;
+                } else {
+                    over_whole(image, s);
+                }
+                continue;
+            }
+            // overlapping (eq. 10-17): the back part into the frame, front and intersection held as one
+            float density0 = held.depth / max(held.far - held.near, TINY);
+            float density1 = s.depth / max(s.far - s.near, TINY);
+            float front_start = min(held.near, s.near), front_end = max(held.near, s.near);
+            float back_start = min(held.far, s.far), back_end = max(held.far, s.far);
+            bool held_first = held.near <= s.near, held_last = held.far >= s.far;
+            float front_depth = (held_first ? density0 : density1) * (front_end - front_start);  // eq. 10
+            float front_t = exp(-front_depth);
+            vec3 front_colour = (held_first ? held.colour : s.colour) * (1.0 - front_t);  // eq. 11
+            float inside_depth = (density0 + density1) * max(back_start - front_end, 0.0);  // eq. 14
+            float inside_t = exp(-inside_depth);
+            float weight0 = density0 / max(density0 + density1, TINY);
+            vec3 inside_colour = mix(s.colour, held.colour, weight0) * (1.0 - inside_t);  // eq. 15
+            float back_t = exp(-(held_last ? density0 : density1) * (back_end - back_start));  // eq. 12
+            over(image, (held_last ? held.colour : s.colour) * (1.0 - back_t), back_t);  // eq. 13
+            float merged_t = front_t * inside_t;  // eq. 16
+            vec3 merged = front_colour + front_t * inside_colour;  // eq. 17
+            held = Segment(front_start, back_start, front_depth + inside_depth, merged / max(1.0 - merged_t, TINY));
         }
-        // overlapping (eq. 10-17): the back part into the frame, front and intersection held as one
-        float density0 = held.depth / max(held.far - held.near, TINY);
-        float density1 = s.depth / max(s.far - s.near, TINY);
-        float front_start = min(held.near, s.near), front_end = max(held.near, s.near);
-        float back_start = min(held.far, s.far), back_end = max(held.far, s.far);
-        bool held_first = held.near <= s.near, held_last = held.far >= s.far;
-        float front_depth = (held_first ? density0 : density1) * (front_end - front_start);  // eq. 10
-        float front_t = exp(-front_depth);
-        vec3 front_colour = (held_first ? held.colour : s.colour) * (1.0 - front_t);  // eq. 11
-        float inside_depth = (density0 + density1) * max(back_start - front_end, 0.0);  // eq. 14
-        float inside_t = exp(-inside_depth);
-        float weight0 = density0 / max(density0 + density1, TINY);
-        vec3 inside_colour = mix(s.colour, held.colour, weight0) * (1.0 - inside_t);  // eq. 15
-        float back_t = exp(-(held_last ? density0 : density1) * (back_end - back_start));  // eq. 12
-        over(image, (held_last ? held.colour : s.colour) * (1.0 - back_t), back_t);  // eq. 13
-        float merged_t = front_t * inside_t;  // eq. 16
-        vec3 merged = front_colour + front_t * inside_colour;  // eq. 17
-        held = Segment(front_start, back_start, front_depth + inside_depth, merged / max(1.0 - merged_t, TINY));
+        barrier();  // the chunk is read by all before the next is gathered
     }
     if (held.depth > 0.0)
         over_whole(image, held);
-    imageStore(target, pixel, image);
+    if (on_screen)
+        imageStore(target, pixel, image);
 }
