@@ -148,7 +148,8 @@ def test_screen_tiles_list_every_splat_where_it_draws_in_the_batch_order():
     centres[0] = [0.0, 0.0, 5.0]  # behind the eye: in no tile
     radii = generator.uniform(1.0, 12.0, 50)
     tiles = screen_tiles(centres, radii, view, projection, (width, height), NEAR_PLANE_M)
-    assert (tiles.across, tiles.up) == (5, 3) and len(tiles.starts) == 16
+    across, up = -(-width // TILE_PIXELS), -(-height // TILE_PIXELS)
+    assert (tiles.across, tiles.up) == (across, up) and len(tiles.starts) == across * up + 1
     drawn = Splats(centres, radii, np.ones((50, 3)), np.ones(50), view[0, :3], view[1, :3])
     rays = pixel_rays(camera, width, height).reshape(height, width, 3)[::-1].reshape(-1, 3)  # rows bottom first
     for position in range(50):
@@ -163,7 +164,8 @@ def test_screen_tiles_list_every_splat_where_it_draws_in_the_batch_order():
 
 
 def test_screen_tiles_of_no_splats_are_empty():
-    tiles = screen_tiles(np.zeros((0, 3)), np.zeros(0), np.eye(4), projection_matrix(60.0, 1.0), (16, 16), 0.1)
+    size = (TILE_PIXELS, TILE_PIXELS)
+    tiles = screen_tiles(np.zeros((0, 3)), np.zeros(0), np.eye(4), projection_matrix(60.0, 1.0), size, 0.1)
     assert tiles.count == 1 and list(tiles.starts) == [0, 0] and len(tiles.entries) == 0
 
 
