@@ -158,6 +158,8 @@ def test_screen_tiles_list_every_splat_where_it_draws_in_the_batch_order():
             tile = (row // TILE_PIXELS) * tiles.across + column // TILE_PIXELS
             assert position in tiles.entries[tiles.starts[tile] : tiles.starts[tile + 1]], (position, row, column)
     assert 0 not in tiles.entries
+    listing = [tile for tile in range(tiles.count) if tiles.starts[tile + 1] > tiles.starts[tile]]
+    assert list(tiles.occupied) == listing and len(listing) < tiles.count
     for tile in range(tiles.count):
         listed = tiles.entries[tiles.starts[tile] : tiles.starts[tile + 1]]
         assert np.all(np.diff(listed.astype(np.int64)) > 0)  # far to near, as the batch
@@ -166,7 +168,7 @@ def test_screen_tiles_list_every_splat_where_it_draws_in_the_batch_order():
 def test_screen_tiles_of_no_splats_are_empty():
     size = (TILE_PIXELS, TILE_PIXELS)
     tiles = screen_tiles(np.zeros((0, 3)), np.zeros(0), np.eye(4), projection_matrix(60.0, 1.0), size, 0.1)
-    assert tiles.count == 1 and list(tiles.starts) == [0, 0] and len(tiles.entries) == 0
+    assert tiles.count == 1 and list(tiles.starts) == [0, 0] and len(tiles.entries) == len(tiles.occupied) == 0
 
 
 def test_window_depth_becomes_distance_along_each_ray():

@@ -23,7 +23,7 @@ from cloudcore.gl.targets import blit_depth
 from cloudcore.light.kernel import SPLAT_SHARPNESS
 from cloudcore.light.volume_blending import MAX_OPTICAL_DEPTH, TILE_PIXELS, ScreenTiles, Splats
 
-_TILE_STARTS_BINDING, _TILE_ENTRIES_BINDING = 6, 7
+_TILE_STARTS_BINDING, _TILE_ENTRIES_BINDING, _OCCUPIED_BINDING = 6, 7, 8
 #: the instances' binding, as `cloudcore.gl.splats` writes them
 _INSTANCES_BINDING = 3
 
@@ -58,7 +58,7 @@ class VolumeBlendingPass:
         if self.features.compute_shaders:
             constants = {"TILE_PIXELS": TILE_PIXELS, "SPLAT_SHARPNESS": SPLAT_SHARPNESS}
             self._program = build_compute_program("volume_blend", constants | {"MAX_OPTICAL_DEPTH": MAX_OPTICAL_DEPTH})
-        self._starts, self._entries = GL.glGenBuffers(2)
+        self._buffers = self._starts, self._entries, self._occupied = GL.glGenBuffers(3)
         self._depth: tuple[int, int, tuple[int, int]] | None = None  # (texture, framebuffer, size)
 
     def draw(
@@ -73,12 +73,16 @@ class VolumeBlendingPass:
         """Composite the splats binned in `tiles` (their instances in buffer `instances`) over
         `colour_texture` (RGBA16F, the size of `tiles`), cut by the depth of `depth_framebuffer`.
         Leaves the framebuffer that was bound bound."""
+        occupied = tiles.occupied
+        if not len(occupied):
+            return
         bound = GL.glGetIntegerv(GL.GL_DRAW_FRAMEBUFFER_BINDING)
         depth_texture = self._world_depth(depth_framebuffer, tiles.size)
         GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, int(bound))
         for binding, buffer, data in (
             (_TILE_STARTS_BINDING, self._starts, tiles.starts),
             (_TILE_ENTRIES_BINDING, self._entries, tiles.entries),
+            (_OCCUPIED_BINDING, self._occupied, occupied),
         ):
             data = data if len(data) else np.zeros(1, dtype=np.uint32)
             GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, buffer)
@@ -100,7 +104,7 @@ class VolumeBlendingPass:
         # what was drawn into the target before must be there to read
         GL.glMemoryBarrier(GL.GL_FRAMEBUFFER_BARRIER_BIT | GL.GL_SHADER_IMAGE_ACCESS_BARRIER_BIT)
         GL.glBindImageTexture(0, colour_texture, 0, GL.GL_FALSE, 0, GL.GL_READ_WRITE, GL.GL_RGBA16F)
-        GL.glDispatchCompute(tiles.across, tiles.up, 1)
+        GL.glDispatchCompute(len(occupied), 1, 1)
         # and what it wrote there, for the draws, blits and reads after it
         GL.glMemoryBarrier(
             GL.GL_FRAMEBUFFER_BARRIER_BIT | GL.GL_TEXTURE_FETCH_BARRIER_BIT | GL.GL_SHADER_IMAGE_ACCESS_BARRIER_BIT
@@ -135,7 +139,7 @@ class VolumeBlendingPass:
         self._close_depth()
         if self._program is not None:
             GL.glDeleteProgram(self._program)
-        GL.glDeleteBuffers(2, [self._starts, self._entries])
+        GL.glDeleteBuffers(len(self._buffers), list(self._buffers))
 
 
 def batch_splats(batch: SplatBatch, view: np.ndarray) -> Splats:

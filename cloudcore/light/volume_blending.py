@@ -262,6 +262,12 @@ class ScreenTiles:
     def count(self) -> int:
         return self.across * self.up
 
+    @property
+    def occupied(self) -> np.ndarray:
+        """(k,) uint32: the tiles some splat may touch, the only ones the pass runs on (the others keep
+        what the target holds)."""
+        return np.flatnonzero(np.diff(self.starts) > 0).astype(np.uint32)
+
 
 #: pixels on a side of the compute pass's tiles (its work groups).  Smaller tiles list fewer splats that
 #: miss a pixel, more tiles per splat: on llvmpipe, default view at 320x240, 8 took half the time of 16

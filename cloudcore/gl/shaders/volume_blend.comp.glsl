@@ -23,6 +23,7 @@ struct Instance {
 layout(std430, binding = 3) readonly buffer Instances { Instance instances[]; };
 layout(std430, binding = 6) readonly buffer TileStarts { uint tile_starts[]; };
 layout(std430, binding = 7) readonly buffer TileEntries { uint tile_entries[]; };
+layout(std430, binding = 8) readonly buffer Occupied { uint occupied[]; };  // one group each
 layout(rgba16f, binding = 0) uniform image2D target;  // premultiplied linear colour, what was drawn so far
 uniform sampler2D world_depth;  // the frame's depth, window coordinates in [0, 1]
 
@@ -113,11 +114,12 @@ Segment segment_of(Splat p, vec3 ray, float opaque)
 
 void main()
 {
-    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+    uint tile = occupied[gl_WorkGroupID.x];
+    ivec2 pixel = TILE_PIXELS * ivec2(tile % uint(tiles_across), tile / uint(tiles_across))
+                + ivec2(gl_LocalInvocationID.xy);
     // pixels past the screen's edge still gather their share of each chunk
     bool on_screen = all(lessThan(pixel, size));
     pixel = min(pixel, size - 1);
-    uint tile = gl_WorkGroupID.y * uint(tiles_across) + gl_WorkGroupID.x;
     vec2 ndc = (vec2(pixel) + 0.5) / vec2(size) * 2.0 - 1.0;
     vec3 ray = normalize(ndc.x / focal.x * view_right + ndc.y / focal.y * view_up + view_forward);
     float stored = texelFetch(world_depth, pixel, 0).r;
