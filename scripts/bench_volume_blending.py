@@ -19,6 +19,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import os
+import time
 from pathlib import Path
 
 import numpy as np
@@ -26,14 +27,14 @@ import numpy as np
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 
 from cloudcore.artist.particle_styles import particle_styles  # noqa: E402  (the GL imports need the platform)
-from cloudcore.camera import frustum_planes, pixel_rays, projection_matrix, view_matrix  # noqa: E402
+from cloudcore.camera import NEAR_PLANE_M, frustum_planes, pixel_rays, projection_matrix, view_matrix  # noqa: E402
 from cloudcore.colour import linear_to_srgb8  # noqa: E402
 from cloudcore.gl.frame import FrameRenderer  # noqa: E402
 from cloudcore.gl.splats import splat_batch  # noqa: E402
 from cloudcore.gl.volume_blending import batch_splats  # noqa: E402
 from cloudcore.light.eye_scattering import ParticleBuffer  # noqa: E402
 from cloudcore.light.lighting import scene_lights  # noqa: E402
-from cloudcore.light.volume_blending import ray_distances, ray_marched  # noqa: E402
+from cloudcore.light.volume_blending import ray_distances, ray_marched, screen_tiles  # noqa: E402
 from cloudcore.measure.benchmark import machine, write_report  # noqa: E402
 from cloudcore.measure.imagecompare import compare, diff_image  # noqa: E402
 from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
@@ -68,20 +69,37 @@ def two_clouds(seed: int = 5) -> Scene:
     return Scene(clouds=tuple(clouds), camera=Camera((0.0, 700.0, -150.0), (0.0, 700.0, -300.0), 40.0), terrain=None)
 
 
-def reference(renderer: FrameRenderer, scene: Scene, steps: int) -> np.ndarray:
-    """The ray-marched frame, linear (height, width, 3): the particles over the world the renderer draws."""
-    width, height = renderer.size
-    renderer.render(dataclasses.replace(scene, clouds=()), settings=FULL_3D)
-    world = renderer.context.read_linear_rgb().reshape(-1, 3)
+def scene_batch(scene: Scene, size):
+    """(every particle of the scene in one far-to-near batch seen from its camera, view, projection)."""
     camera = scene.camera
-    view, projection = view_matrix(camera), projection_matrix(camera.fov_y_deg, width / height)
-    rays = pixel_rays(camera, width, height).reshape(-1, 3)
-    opaque = ray_distances(renderer.context.read_depth(), rays, view, projection)
+    view, projection = view_matrix(camera), projection_matrix(camera.fov_y_deg, size[0] / size[1])
     lights, ambient = scene_lights(scene.lighting)
     styles = particle_styles(scene.clouds, scene.lighting)
     particles = ParticleBuffer(scene.clouds, scene.shading, lights, ambient, styles=styles)
     frustum = frustum_planes(projection @ view)
     batch = splat_batch(particles, range(len(scene.clouds)), camera.position, time_s=0.0, frustum=frustum)
+    return batch, view, projection
+
+
+def binning_ms(scene: Scene, size, repeat: int) -> float:
+    """Best time of the volume pass's CPU share: binning the scene's splats into screen tiles."""
+    batch, view, projection = scene_batch(scene, size)
+    best = np.inf
+    for _ in range(repeat):
+        start = time.perf_counter()
+        screen_tiles(batch.centres - batch.eye, batch.radii, view, projection, size, NEAR_PLANE_M)
+        best = min(best, time.perf_counter() - start)
+    return 1e3 * best
+
+
+def reference(renderer: FrameRenderer, scene: Scene, steps: int) -> np.ndarray:
+    """The ray-marched frame, linear (height, width, 3): the particles over the world the renderer draws."""
+    width, height = renderer.size
+    renderer.render(dataclasses.replace(scene, clouds=()), settings=FULL_3D)
+    world = renderer.context.read_linear_rgb().reshape(-1, 3)
+    batch, view, projection = scene_batch(scene, renderer.size)
+    rays = pixel_rays(scene.camera, width, height).reshape(-1, 3)
+    opaque = ray_distances(renderer.context.read_depth(), rays, view, projection)
     background = np.column_stack([world, np.zeros(len(world))])
     marched = ray_marched(batch_splats(batch, view), rays, background, opaque, steps=steps)
     return marched[:, :3].reshape(height, width, 3).astype(np.float32)
@@ -98,6 +116,7 @@ def measure(renderer: FrameRenderer, name: str, scene: Scene, repeat: int, steps
     for blending in BLENDINGS:
         row[f"{blending}_cloud_ms"] = float(np.median(cloud_ms[blending]))
     row["volume_over_plain_cost"] = row["volume_cloud_ms"] / max(row["plain_cloud_ms"], 1e-9)
+    row["volume_binning_ms"] = binning_ms(scene, renderer.size, repeat)
     volume_vs_plain = compare(frames["volume"], frames["plain"])
     row["volume_vs_plain_psnr_db"], row["volume_vs_plain_max"] = volume_vs_plain.psnr_db, volume_vs_plain.max_abs
     panels = [frames["plain"], frames["volume"]]

@@ -38,6 +38,7 @@ class GpuFeatures:
 
     compute_shaders: bool
     fragment_shader_interlock: bool
+    renderer: str  # GL_RENDERER: which GL this is (llvmpipe, a GPU)
 
     @classmethod
     def query(cls) -> GpuFeatures:
@@ -46,7 +47,9 @@ class GpuFeatures:
         }
         version = (int(GL.glGetIntegerv(GL.GL_MAJOR_VERSION)), int(GL.glGetIntegerv(GL.GL_MINOR_VERSION)))
         compute = version >= (4, 3) or {"GL_ARB_compute_shader", "GL_ARB_shader_image_load_store"} <= extensions
-        return cls(compute, "GL_ARB_fragment_shader_interlock" in extensions)
+        renderer = GL.glGetString(GL.GL_RENDERER)
+        renderer = renderer.decode() if isinstance(renderer, bytes) else str(renderer)
+        return cls(compute, "GL_ARB_fragment_shader_interlock" in extensions, renderer)
 
 
 class VolumeBlendingPass:

@@ -5,9 +5,9 @@
 // segments along its ray as the numpy reference does (cloudcore.light.volume_blending.volume_blend):
 // one volume held (extent, optical depth, colour), the farther of two apart or the back part of two
 // overlapping into the frame, front and intersection merged.  A pixel is one invocation's alone,
-// so its read-modify-write of the target needs no interlock.  The group gathers its tile's list a
-// chunk at a time into shared memory (as 3D Gaussian splatting rasterisers do), each particle's
-// plane and axes worked out once per tile rather than once per pixel.
+// so its read-modify-write of the target needs no interlock.  Each pixel reads its tile's splats
+// itself: gathering them into shared memory once per group (as 3D Gaussian splatting rasterisers
+// do on GPUs) was no faster on llvmpipe, whose barriers are costly (docs/shading.md).
 //
 // A particle's segment along the ray: the ray meets the splat's plane at d radii from its centre
 // (as splat.frag.glsl measures it); opacity alpha K(d) gives the optical depth -ln(1 - alpha K(d)),
@@ -63,8 +63,7 @@ float kernel(float d2)
     return max((exp(-SPLAT_SHARPNESS * d2) - floor_value) / (1.0 - floor_value), 0.0);
 }
 
-// a particle as the pass reads it, gathered once per tile into shared memory with what every pixel
-// would otherwise recompute
+// a particle as the pass reads it: its plane, and its axes scaled so that they measure d
 struct Splat {
     vec4 centre_r2;      // relative to the eye, radius squared
     vec4 u;              // the splat's right over its radius: offset . u is d's first coordinate
@@ -72,7 +71,6 @@ struct Splat {
     vec4 normal_plane;   // the plane's normal, and its distance term centre . normal
     vec4 colour;         // premultiplied rgb, opacity
 };
-shared Splat chunk[TILE_PIXELS * TILE_PIXELS];
 
 Splat splat_of(Instance p)
 {
@@ -117,9 +115,8 @@ void main()
     uint tile = occupied[gl_WorkGroupID.x];
     ivec2 pixel = TILE_PIXELS * ivec2(tile % uint(tiles_across), tile / uint(tiles_across))
                 + ivec2(gl_LocalInvocationID.xy);
-    // pixels past the screen's edge still gather their share of each chunk
-    bool on_screen = all(lessThan(pixel, size));
-    pixel = min(pixel, size - 1);
+    if (any(greaterThanEqual(pixel, size)))
+        return;
     vec2 ndc = (vec2(pixel) + 0.5) / vec2(size) * 2.0 - 1.0;
     vec3 ray = normalize(ndc.x / focal.x * view_right + ndc.y / focal.y * view_up + view_forward);
     float stored = texelFetch(world_depth, pixel, 0).r;
@@ -127,54 +124,43 @@ void main()
     vec4 image = imageLoad(target, pixel);
 
     Segment held = Segment(0.0, 0.0, 0.0, vec3(0.0));
-    uint first = tile_starts[tile], end = tile_starts[tile + 1u];
-    const uint CHUNK = uint(TILE_PIXELS * TILE_PIXELS);
-    for (uint base = first; base < end; base += CHUNK) {
-        uint mine = base + gl_LocalInvocationIndex;
-        if (mine < end)
-            chunk[gl_LocalInvocationIndex] = splat_of(instances[tile_entries[mine]]);
-        barrier();
-        uint count = min(CHUNK, end - base);
-        for (uint k = 0u; k < count; ++k) {
-            Segment s = segment_of(chunk[k], ray, opaque);
-            if (s.depth <= 0.0)
-                continue;
-            if (held.depth <= 0.0) {
-                held = s;
-                continue;
-            }
-            if (s.near >= held.far || s.far <= held.near) {  // apart: the farther goes into the frame
-                if (s.near < held.near) {
-                    over_whole(image, held);
-                    held = s;
-                } else {
-                    over_whole(image, s);
-                }
-                continue;
-            }
-            // overlapping (eq. 10-17): the back part into the frame, front and intersection held as one
-            float density0 = held.depth / max(held.far - held.near, TINY);
-            float density1 = s.depth / max(s.far - s.near, TINY);
-            float front_start = min(held.near, s.near), front_end = max(held.near, s.near);
-            float back_start = min(held.far, s.far), back_end = max(held.far, s.far);
-            bool held_first = held.near <= s.near, held_last = held.far >= s.far;
-            float front_depth = (held_first ? density0 : density1) * (front_end - front_start);  // eq. 10
-            float front_t = exp(-front_depth);
-            vec3 front_colour = (held_first ? held.colour : s.colour) * (1.0 - front_t);  // eq. 11
-            float inside_depth = (density0 + density1) * max(back_start - front_end, 0.0);  // eq. 14
-            float inside_t = exp(-inside_depth);
-            float weight0 = density0 / max(density0 + density1, TINY);
-            vec3 inside_colour = mix(s.colour, held.colour, weight0) * (1.0 - inside_t);  // eq. 15
-            float back_t = exp(-(held_last ? density0 : density1) * (back_end - back_start));  // eq. 12
-            over(image, (held_last ? held.colour : s.colour) * (1.0 - back_t), back_t);  // eq. 13
-            float merged_t = front_t * inside_t;  // eq. 16
-            vec3 merged = front_colour + front_t * inside_colour;  // eq. 17
-            held = Segment(front_start, back_start, front_depth + inside_depth, merged / max(1.0 - merged_t, TINY));
+    for (uint k = tile_starts[tile]; k < tile_starts[tile + 1u]; ++k) {
+        Segment s = segment_of(splat_of(instances[tile_entries[k]]), ray, opaque);
+        if (s.depth <= 0.0)
+            continue;
+        if (held.depth <= 0.0) {
+            held = s;
+            continue;
         }
-        barrier();  // the chunk is read by all before the next is gathered
+        if (s.near >= held.far || s.far <= held.near) {  // apart: the farther goes into the frame
+            if (s.near < held.near) {
+                over_whole(image, held);
+                held = s;
+            } else {
+                over_whole(image, s);
+            }
+            continue;
+        }
+        // overlapping (eq. 10-17): the back part into the frame, front and intersection held as one
+        float density0 = held.depth / max(held.far - held.near, TINY);
+        float density1 = s.depth / max(s.far - s.near, TINY);
+        float front_start = min(held.near, s.near), front_end = max(held.near, s.near);
+        float back_start = min(held.far, s.far), back_end = max(held.far, s.far);
+        bool held_first = held.near <= s.near, held_last = held.far >= s.far;
+        float front_depth = (held_first ? density0 : density1) * (front_end - front_start);  // eq. 10
+        float front_t = exp(-front_depth);
+        vec3 front_colour = (held_first ? held.colour : s.colour) * (1.0 - front_t);  // eq. 11
+        float inside_depth = (density0 + density1) * max(back_start - front_end, 0.0);  // eq. 14
+        float inside_t = exp(-inside_depth);
+        float weight0 = density0 / max(density0 + density1, TINY);
+        vec3 inside_colour = mix(s.colour, held.colour, weight0) * (1.0 - inside_t);  // eq. 15
+        float back_t = exp(-(held_last ? density0 : density1) * (back_end - back_start));  // eq. 12
+        over(image, (held_last ? held.colour : s.colour) * (1.0 - back_t), back_t);  // eq. 13
+        float merged_t = front_t * inside_t;  // eq. 16
+        vec3 merged = front_colour + front_t * inside_colour;  // eq. 17
+        held = Segment(front_start, back_start, front_depth + inside_depth, merged / max(1.0 - merged_t, TINY));
     }
     if (held.depth > 0.0)
         over_whole(image, held);
-    if (on_screen)
-        imageStore(target, pixel, image);
+    imageStore(target, pixel, image);
 }
