@@ -66,22 +66,14 @@ def test_the_compute_pass_composites_as_the_reference_does(renderer, wall_m):
     np.testing.assert_allclose(pixels, expected, atol=4e-3)
 
 
-def interpenetrating_clouds(seed: int = 5) -> Scene:
-    """Two clouds of different colours and densities sharing one region of space, no terrain."""
-    generator = np.random.default_rng(seed)
-    made = []
-    for name, offset, colour, depth in (
-        ("warm", [-12.0, 0.0, 0.0], (1.0, 0.55, 0.35), 6.0),
-        ("cool", [12.0, 4.0, 6.0], (0.35, 0.55, 1.0), 3.0),
-    ):
-        centres = generator.normal(0.0, 14.0, (60, 3)) + offset + [0.0, 700.0, -300.0]
-        particles = np.column_stack([centres, generator.uniform(8.0, 14.0, 60)])
-        made.append(Cloud(name, particles, optical_depth=depth, color=colour))
-    return Scene(
-        clouds=tuple(made),
-        camera=Camera((0.0, 700.0, -150.0), (0.0, 700.0, -300.0), 40.0),
-        terrain=None,
-    )
+def interpenetrating_clouds() -> Scene:
+    """Two balls of 50 particles each, of different colours and densities, half inside each other."""
+    generator = np.random.default_rng(5)
+    balls = generator.normal(0.0, 12.0, (2, 50, 3)) + [[[-10.0, 700.0, -300.0]], [[10.0, 703.0, -305.0]]]
+    radii = generator.uniform(8.0, 14.0, (2, 50, 1))
+    warm = Cloud("warm", np.concatenate([balls[0], radii[0]], axis=1), optical_depth=6.0, color=(1.0, 0.55, 0.35))
+    cool = Cloud("cool", np.concatenate([balls[1], radii[1]], axis=1), optical_depth=3.0, color=(0.35, 0.55, 1.0))
+    return Scene(clouds=(warm, cool), camera=Camera((0.0, 700.0, -160.0), (0.0, 700.0, -300.0), 40.0), terrain=None)
 
 
 def test_two_interpenetrating_clouds_are_nearer_the_ray_march_than_plain_blending(renderer):
