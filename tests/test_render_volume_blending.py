@@ -85,8 +85,9 @@ def test_two_interpenetrating_clouds_are_nearer_the_ray_march_than_plain_blendin
     width, height = renderer.size
     images = {}
     for blending in ("plain", "volume"):
-        renderer.render(scene, settings=dataclasses.replace(FULL_3D, blending=blending, point_sprites=False))
+        _, stats = renderer.render(scene, settings=dataclasses.replace(FULL_3D, blending=blending))
         images[blending] = renderer.context.read_linear_rgb().reshape(-1, 3)
+        assert stats.particles_as_volumes == (stats.particles_drawn if blending == "volume" else 0)
     renderer.render(dataclasses.replace(scene, clouds=()), settings=FULL_3D)
     background = np.column_stack([renderer.context.read_linear_rgb().reshape(-1, 3), np.zeros(width * height)])
     lights, ambient = scene_lights(scene.lighting)
@@ -104,3 +105,17 @@ def test_two_interpenetrating_clouds_are_nearer_the_ray_march_than_plain_blendin
     for name, blend in (("plain", plain_blend), ("volume", volume_blend)):
         difference = np.abs(images[name] - blend(drawn, rays, background)[:, :3]).max()
         assert difference < 0.02, (name, difference)
+
+
+def test_sprites_fall_back_to_billboards(renderer):
+    """The volume pass draws Gaussian splats of one colour: a batch with atlas sprites is drawn plain."""
+    from cloudcore.artist.sprites import SpriteStyle
+
+    scene = interpenetrating_clouds()
+    sprites = dataclasses.replace(scene.clouds[0], sprite=SpriteStyle())
+    scene = dataclasses.replace(scene, clouds=(sprites, scene.clouds[1]))
+    pictures = {}
+    for blending in ("plain", "volume"):
+        pictures[blending], stats = renderer.render(scene, settings=dataclasses.replace(FULL_3D, blending=blending))
+        assert stats.particles_drawn > 0 and stats.particles_as_volumes == 0
+    np.testing.assert_array_equal(pictures["plain"], pictures["volume"])

@@ -109,6 +109,7 @@ class FrameRenderer:
         self._display = None  # (RGBA8 target, program): the frame in sRGB for the editor
         # the last frame's draws into the screen, replayable as fragment counts, and its splat batches
         self._replay, self._screen_batches, self._last_matrices = [], [], None
+        self._particles_as_volumes = 0  # this frame's, for its statistics
         self.last_plan: FramePlan | None = None
 
     @property
@@ -189,6 +190,7 @@ class FrameRenderer:
             self._splats.update_facing(particles, start, facing)
         start = time.perf_counter()
         self._splats.particles_as_points = 0
+        self._particles_as_volumes = 0
         self._world.draw(self.context, camera, projection @ view)
         if plan.objects_with_world:
             self._objects.draw(self.context, camera, poses, plan.objects_with_world, write_depth=True)
@@ -213,6 +215,7 @@ class FrameRenderer:
             cloud_ms=1e3 * (done - updates_done),
             particles_drawn=drawn,
             particles_as_points=self._splats.particles_as_points,
+            particles_as_volumes=self._particles_as_volumes,
             particles_to_impostors=rendered,
             clouds_drawn=sum(len(plan.clouds[i].members) for i in plan.draw_order),
             texture_bytes=self.texture_bytes,
@@ -381,6 +384,7 @@ class FrameRenderer:
             instances = self._splats.shade(batch, view)
             target = self.context.colour_texture if colour_texture is None else colour_texture
             self._volume.draw(tiles, instances, view, projection, target, self.context.framebuffer)
+            self._particles_as_volumes += len(batch)
         else:
             self._splats.draw(batch, view, projection, point_sprites=points)
         self._replay.append(lambda: self._splats.draw(batch, view, projection, counting=True, point_sprites=points))
