@@ -4,9 +4,10 @@ cost of the cloud pass, side by side in one run. JSON out.
     python scripts/bench_volume_blending.py [--width 320 --height 240] [--repeat 5]
                                             [--json out/bench_volume_blending.json] [--images out/volume_blending]
 
-Three cases, each rendered in full 3D with blending "plain" and "volume" interleaved (--repeat times,
+Four cases, each rendered in full 3D with blending "plain" and "volume" interleaved (--repeat times,
 the median cloud pass kept): two interpenetrating particles, two interpenetrating clouds (120 particles
-of two colours and densities), and the default view of the default scene.  For the first two the
+of two colours and densities), a cloud lying on the terrain (the world's depth cuts it), and the
+default view of the default scene.  For the first three the
 reference is `cloudcore.light.volume_blending.ray_marched` of the same particles over the frame's own
 world (its colour and depth, rendered without the clouds); the default view's 75,000 particles are too
 many for it in numpy, so there the volume picture is compared with the plain one only.  Errors are on
@@ -38,9 +39,10 @@ from cloudcore.light.volume_blending import ray_distances, ray_marched, screen_t
 from cloudcore.measure.benchmark import machine, write_report  # noqa: E402
 from cloudcore.measure.imagecompare import compare, diff_image  # noqa: E402
 from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
-from cloudcore.scene import Camera, Cloud, Scene  # noqa: E402
+from cloudcore.scene import Camera, Cloud, Scene, Terrain  # noqa: E402
 from cloudcore.scenefile import load_scene  # noqa: E402
 from cloudcore.settings import FULL_3D  # noqa: E402
+from cloudcore.terrain import height_at  # noqa: E402
 
 BLENDINGS = ("plain", "volume")
 
@@ -67,6 +69,19 @@ def two_clouds(seed: int = 5) -> Scene:
             Cloud(name, np.column_stack([centres, generator.uniform(8.0, 14.0, 60)]), optical_depth=depth, color=colour)
         )
     return Scene(clouds=tuple(clouds), camera=Camera((0.0, 700.0, -150.0), (0.0, 700.0, -300.0), 40.0), terrain=None)
+
+
+def ground_fog(seed: int = 2) -> Scene:
+    """A flat cloud of 80 particles lying on the default terrain, seen from just above it: the world's
+    depth cuts the particles where they meet the ground."""
+    terrain = Terrain()
+    x, z = 0.0, -300.0
+    ground = float(height_at(terrain, np.array([x]), np.array([z]))[0])
+    generator = np.random.default_rng(seed)
+    centres = generator.normal(0.0, 12.0, (80, 3)) * [2.0, 0.6, 1.0] + [x, ground + 2.0, z]
+    fog = Cloud("fog", np.column_stack([centres, generator.uniform(10.0, 16.0, 80)]), optical_depth=2.0)
+    camera = Camera((x, ground + 25.0, z + 120.0), (x, ground, z), 40.0)
+    return Scene(clouds=(fog,), camera=camera, terrain=terrain)
 
 
 def scene_batch(scene: Scene, size):
@@ -150,6 +165,7 @@ def main(argv=None) -> None:
     cases = [
         ("two_particles", two_particles(), args.steps),
         ("two_clouds", two_clouds(), args.steps),
+        ("ground_fog", ground_fog(), args.steps),
         ("default_view", load_scene(args.scene), None),
     ]
     with FrameRenderer(args.width, args.height) as renderer:
