@@ -3,6 +3,7 @@ cost of the cloud pass, side by side in one run. JSON out.
 
     python scripts/bench_volume_blending.py [--width 320 --height 240] [--repeat 5]
                                             [--json out/bench_volume_blending.json] [--images out/volume_blending]
+                                            [--cases two_particles,two_clouds,ground_fog,default_view]
 
 Four cases, each rendered in full 3D with blending "plain" and "volume" interleaved (--repeat times,
 the median cloud pass kept): two interpenetrating particles, two interpenetrating clouds (120 particles
@@ -161,6 +162,7 @@ def main(argv=None) -> None:
     parser.add_argument("--steps", type=int, default=1024, help="ray-march intervals per pixel")
     parser.add_argument("--json", type=Path)
     parser.add_argument("--images", type=Path)
+    parser.add_argument("--cases", help="comma-separated names of the cases to run (default: all)")
     args = parser.parse_args(argv)
     cases = [
         ("two_particles", two_particles(), args.steps),
@@ -168,6 +170,8 @@ def main(argv=None) -> None:
         ("ground_fog", ground_fog(), args.steps),
         ("default_view", load_scene(args.scene), None),
     ]
+    if args.cases:
+        cases = [case for case in cases if case[0] in args.cases.split(",")]
     with FrameRenderer(args.width, args.height) as renderer:
         features = renderer.volume_features
         rows = [measure(renderer, name, scene, args.repeat, steps, args.images) for name, scene, steps in cases]
