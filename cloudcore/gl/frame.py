@@ -41,7 +41,7 @@ from cloudcore.gl.programs import build_program
 from cloudcore.gl.quads import SCREEN_CORNERS, QuadPass
 from cloudcore.gl.splats import SplatPass, splat_batch
 from cloudcore.gl.targets import TextureTarget, blit_depth, depth_renderbuffer
-from cloudcore.gl.volume_blending import VolumeBlendingPass
+from cloudcore.gl.volume_blending import GpuFeatures, VolumeBlendingPass
 from cloudcore.gl.world import WorldPass
 from cloudcore.light.eye_scattering import ParticleBuffer
 from cloudcore.light.illumination import IlluminationCache
@@ -118,8 +118,8 @@ class FrameRenderer:
         return self._units
 
     @property
-    def volume_features(self):
-        """What this GL offers volume-aware blending (`cloudcore.gl.volume_blending.GpuFeatures`)."""
+    def volume_features(self) -> GpuFeatures:
+        """What this GL offers volume-aware blending."""
         return self._volume.features
 
     @property
