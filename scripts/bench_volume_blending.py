@@ -36,7 +36,7 @@ from cloudcore.gl.splats import splat_batch  # noqa: E402
 from cloudcore.gl.volume_blending import batch_splats  # noqa: E402
 from cloudcore.light.eye_scattering import ParticleBuffer  # noqa: E402
 from cloudcore.light.lighting import scene_lights  # noqa: E402
-from cloudcore.light.volume_blending import ray_distances, ray_marched, screen_tiles  # noqa: E402
+from cloudcore.light.volume_blending import ray_distances, ray_marched_in_tiles, screen_tiles  # noqa: E402
 from cloudcore.measure.benchmark import machine, write_report  # noqa: E402
 from cloudcore.measure.imagecompare import compare, diff_image  # noqa: E402
 from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
@@ -117,7 +117,8 @@ def reference(renderer: FrameRenderer, scene: Scene, steps: int) -> np.ndarray:
     rays = pixel_rays(scene.camera, width, height).reshape(-1, 3)
     opaque = ray_distances(renderer.context.read_depth(), rays, view, projection)
     background = np.column_stack([world, np.zeros(len(world))])
-    marched = ray_marched(batch_splats(batch, view), rays, background, opaque, steps=steps)
+    tiles = screen_tiles(batch.centres - batch.eye, batch.radii, view, projection, renderer.size, NEAR_PLANE_M)
+    marched = ray_marched_in_tiles(batch_splats(batch, view), rays, background, opaque, tiles, steps)
     return marched[:, :3].reshape(height, width, 3).astype(np.float32)
 
 
@@ -168,7 +169,7 @@ def main(argv=None) -> None:
         ("two_particles", two_particles(), args.steps),
         ("two_clouds", two_clouds(), args.steps),
         ("ground_fog", ground_fog(), args.steps),
-        ("default_view", load_scene(args.scene), None),
+        ("default_view", load_scene(args.scene), args.steps),
     ]
     if args.cases:
         cases = [case for case in cases if case[0] in args.cases.split(",")]

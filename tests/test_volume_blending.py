@@ -14,6 +14,7 @@ from cloudcore.light.volume_blending import (
     plain_blend,
     ray_distances,
     ray_marched,
+    ray_marched_in_tiles,
     screen_tiles,
     volume_blend,
 )
@@ -67,10 +68,11 @@ def test_the_ray_march_converges_to_the_volume_compositing():
     assert errors[0] > errors[1] > errors[2], errors
 
 
-@pytest.mark.parametrize("spread, ratio", [(8.0, 0.5), (2.0, 0.9)])
+@pytest.mark.parametrize("spread, ratio", [(8.0, 0.5), (2.0, 0.97)])
 def test_a_cloud_of_interpenetrating_particles_is_nearer_the_ray_march_than_billboards(spread, ratio):
-    """Where neighbours overlap in pairs the one volume held per pixel is nearly exact; in a dense clump
-    (spread 2 m, radii 3-6 m) merging many into one homogeneous volume is Yusov's approximation."""
+    """Where neighbours overlap in pairs the one segment held per pixel is nearly exact; in a dense clump
+    (spread 2 m, radii 3-6 m), where many overlap one pixel, what is sent into the frame before the
+    nearer ones arrive is ordered as billboards are, and the gain is small."""
     generator = np.random.default_rng(3)
     count = 40
     centres = generator.normal(0.0, spread, (count, 3)) + [0.0, 0.0, -100.0]
@@ -180,3 +182,18 @@ def test_window_depth_becomes_distance_along_each_ray():
     window = 0.5 * clip[:, 2] / clip[:, 3] + 0.5
     np.testing.assert_allclose(ray_distances(np.append(window[:-1], 1.0), rays, view, projection)[:-1], 250.0)
     assert ray_distances(np.ones(1), rays[:1], view, projection)[0] == np.inf
+
+
+def test_the_ray_march_in_tiles_is_the_whole_ray_march():
+    camera = Camera((0.0, 0.0, 0.0), (0.0, 0.0, -1.0), 40.0)
+    width, height = 37, 21
+    view, projection = view_matrix(camera), projection_matrix(camera.fov_y_deg, width / height)
+    generator = np.random.default_rng(4)
+    centres = generator.uniform([-40.0, -20.0, -100.0], [40.0, 20.0, -60.0], (30, 3))
+    crowd = splats(centres, generator.uniform(3.0, 9.0, 30), generator.uniform(0.1, 1.0, (30, 3)), np.full(30, 0.8))
+    rays = pixel_rays(camera, width, height).reshape(-1, 3)
+    background = np.tile([0.2, 0.3, 0.5, 1.0], (len(rays), 1))
+    opaque = np.full(len(rays), 85.0)
+    tiles = screen_tiles(crowd.centres, crowd.radii, view, projection, (width, height), NEAR_PLANE_M)
+    whole = ray_marched(crowd, rays, background, opaque, steps=64)
+    np.testing.assert_allclose(ray_marched_in_tiles(crowd, rays, background, opaque, tiles, 64), whole, atol=1e-12)

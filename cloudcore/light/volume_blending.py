@@ -13,12 +13,19 @@ particle, so that a lone particle looks exactly as its splat does):
   premultiplied colour C (1 - T) is the splat's c K(d).
 
 Along one ray, segments overlap: `volume_blend` composites them as Yusov's pixel-shader-ordering pass
-does, particle by particle far to near, keeping per pixel one continuous volume (colour, density,
-extent) closest to the eye: a segment that misses it sends the farther of the two into the frame, one
-that overlaps it sends their back part (eq. 12-13) and merges front (eq. 10-11) and intersection
-(eq. 14-15) into the new volume.  `plain_blend` is what premultiplied billboards give, and
-`ray_marched` integrates the same densities and colours in fine steps: the reference both are measured
-against.  The opaque world cuts segments at its depth (a billboard is kept or not at its plane).
+does, particle by particle far to near, keeping per pixel one homogeneous volume (colour, density,
+extent) closest to the eye: a segment that misses it sends the farther of the two into the frame; one
+that overlaps it is split with it into back (eq. 12-13), intersection (eq. 14-15) and front (eq.
+10-11).  Yusov sends the back part into the frame and holds front and intersection merged as one
+homogeneous volume; here the intersection goes into the frame too and the front part alone is held.
+Two particles come out the same (eq. 16-17 either way); with many, a merged volume spreads the colour
+of the particles deep in it over its whole extent, toward the eye, and each merge spreads it further:
+on the default view's cumulus (thousands of splats a tile) that was four times plain blending's error
+against the ray march, where holding the front is below plain's (docs/shading.md).
+
+`plain_blend` is what premultiplied billboards give, and `ray_marched` integrates the same densities
+and colours in fine steps: the reference both are measured against.  The opaque world cuts segments
+at its depth (a billboard is kept or not at its plane).
 
 Images here are flat (pixels, 4) premultiplied linear RGBA over what the target held, alpha = 1 - T.
 The GL twin is `cloudcore/gl/shaders/volume_blend.comp.glsl` (`cloudcore.gl.volume_blending`).
@@ -123,7 +130,7 @@ def _cut(segments: Segments, opaque: np.ndarray) -> tuple[np.ndarray, np.ndarray
 
 
 def volume_blend(splats: Splats, rays: np.ndarray, background: np.ndarray, opaque: np.ndarray | None = None):
-    """Yusov's volume-aware blending (section 5.5), far to near; returns (pixels, 4) premultiplied."""
+    """Volume-aware blending (Yusov, section 5.5), far to near; returns (pixels, 4) premultiplied."""
     image = np.array(background, dtype=np.float64)
     pixels = len(rays)
     opaque = np.full(pixels, np.inf) if opaque is None else opaque
@@ -141,42 +148,41 @@ def volume_blend(splats: Splats, rays: np.ndarray, background: np.ndarray, opaqu
         _over(image, apart & ~new_nearer, *_homogeneous(new[3], new[2]))
         replace = arrives & (empty | (apart & new_nearer))
         overlap = arrives & ~empty & ~apart
-        *merged, back_colour, back_transmittance = _merge(held, new)
-        # the back part is behind everything still to come at this pixel: into the frame
-        _over(image, overlap, back_colour, back_transmittance)
-        for kept, arriving, joined in zip(held, new, merged):
+        front, intersection, back = _split(held, new)
+        # overlapping: the back part, then the intersection, are behind all still to come here (eq. 16-17
+        # are these "over"s); the front part is held, for the next particle to meet
+        _over(image, overlap, *back)
+        _over(image, overlap, *intersection)
+        for kept, arriving, part in zip(held, new, front):
             kept[replace] = arriving[replace]
-            kept[overlap] = joined[overlap]
+            kept[overlap] = part[overlap]
     _over(image, held[2] > 0.0, *_homogeneous(held[3], held[2]))
     return image
 
 
-def _merge(first, second):
-    """Two overlapping homogeneous segments, each (near, far, optical depth, colour) per pixel (eq. 10-17):
-    (near, far, optical depth, colour) of their front and intersection merged into one volume, then the
-    back part's (premultiplied colour, transmittance)."""
+def _split(first, second):
+    """Two overlapping homogeneous segments, each (near, far, optical depth, colour) per pixel, in their
+    three parts (eq. 10-15): the front as a segment (near, far, optical depth, colour) of the one that
+    starts first; the intersection and the back as (premultiplied colour, transmittance)."""
     near0, far0, depth0, colour0 = first
     near1, far1, depth1, colour1 = second
-    length0, length1 = np.maximum(far0 - near0, _TINY), np.maximum(far1 - near1, _TINY)
-    density0, density1 = depth0 / length0, depth1 / length1
+    density0 = depth0 / np.maximum(far0 - near0, _TINY)
+    density1 = depth1 / np.maximum(far1 - near1, _TINY)
     front_start, front_end = np.minimum(near0, near1), np.maximum(near0, near1)
     back_start, back_end = np.minimum(far0, far1), np.maximum(far0, far1)
-    starts_first = (near0 <= near1)[:, None]
+    starts_first = near0 <= near1
     ends_last = (far0 >= far1)[:, None]
     # eq. 10-11: the front part, of the segment that starts first
-    front_depth = np.where(starts_first[:, 0], density0, density1) * (front_end - front_start)
-    front_colour, front_t = _homogeneous(np.where(starts_first, colour0, colour1), front_depth)
+    front_depth = np.where(starts_first, density0, density1) * (front_end - front_start)
+    front = (front_start, front_end, front_depth, np.where(starts_first[:, None], colour0, colour1))
     # eq. 14-15: the intersection, densities adding, colours weighted by density
     inside_depth = (density0 + density1) * np.maximum(back_start - front_end, 0.0)
     weight0 = (density0 / np.maximum(density0 + density1, _TINY))[:, None]
-    inside_colour, inside_t = _homogeneous(weight0 * colour0 + (1.0 - weight0) * colour1, inside_depth)
+    intersection = _homogeneous(weight0 * colour0 + (1.0 - weight0) * colour1, inside_depth)
     # eq. 12-13: the back part, of the segment that ends last
     back_depth = np.where(ends_last[:, 0], density0, density1) * (back_end - back_start)
-    back_colour, back_t = _homogeneous(np.where(ends_last, colour0, colour1), back_depth)
-    # eq. 16-17 for what stays: front then intersection, held as one homogeneous volume of their extent
-    merged_t = front_t * inside_t
-    merged_colour = (front_colour + front_t[:, None] * inside_colour) / np.maximum(1.0 - merged_t, _TINY)[:, None]
-    return front_start, back_start, front_depth + inside_depth, merged_colour, back_colour, back_t
+    back = _homogeneous(np.where(ends_last, colour0, colour1), back_depth)
+    return front, intersection, back
 
 
 def ray_marched(
@@ -195,6 +201,32 @@ def ray_marched(
     for first in range(0, len(rays), chunk):
         part = slice(first, first + chunk)
         image[part] = _march(splats, rays[part], image[part], opaque[part], steps)
+    return image
+
+
+def ray_marched_in_tiles(
+    splats: Splats, rays: np.ndarray, background: np.ndarray, opaque: np.ndarray, tiles: ScreenTiles, steps: int
+):
+    """`ray_marched` of a whole frame (rays and images top row first, as `pixel_rays` gives them), each
+    screen tile with only the splats `tiles` lists for it: the same picture, for many particles at a
+    cost of the splats' pixels rather than particles times pixels."""
+    width, height = tiles.size
+    image = np.array(background, dtype=np.float64)
+    for tile in tiles.occupied:
+        columns = np.arange(TILE_PIXELS * (tile % tiles.across), TILE_PIXELS * (tile % tiles.across + 1))
+        rows = np.arange(TILE_PIXELS * (tile // tiles.across), TILE_PIXELS * (tile // tiles.across + 1))
+        columns, rows = columns[columns < width], rows[rows < height]
+        pixels = ((height - 1 - rows)[:, None] * width + columns[None, :]).ravel()  # GL rows count up
+        listed = tiles.entries[tiles.starts[tile] : tiles.starts[tile + 1]]
+        subset = Splats(
+            splats.centres[listed],
+            splats.radii[listed],
+            splats.colours[listed],
+            splats.opacities[listed],
+            splats.right,
+            splats.up,
+        )
+        image[pixels] = _march(subset, rays[pixels], image[pixels], opaque[pixels], steps)
     return image
 
 

@@ -3,8 +3,8 @@
 // one work group per screen tile, one invocation per pixel, each walking its tile's particles in the
 // batch's far-to-near order (cloudcore.light.volume_blending.screen_tiles) and compositing their
 // segments along its ray as the numpy reference does (cloudcore.light.volume_blending.volume_blend):
-// one volume held (extent, optical depth, colour), the farther of two apart or the back part of two
-// overlapping into the frame, front and intersection merged.  A pixel is one invocation's alone,
+// one segment held (extent, optical depth, colour), the farther of two apart into the frame, or of
+// two overlapping the back part and the intersection, the front part held.  A pixel is one invocation's alone,
 // so its read-modify-write of the target needs no interlock.  Each pixel reads its tile's splats
 // itself: gathering them into shared memory once per group (as 3D Gaussian splatting rasterisers
 // do on GPUs) was no faster on llvmpipe, whose barriers are costly (docs/shading.md).
@@ -141,24 +141,19 @@ void main()
             }
             continue;
         }
-        // overlapping (eq. 10-17): the back part into the frame, front and intersection held as one
+        // overlapping (eq. 10-17): the back part, then the intersection, into the frame; the front held
         float density0 = held.depth / max(held.far - held.near, TINY);
         float density1 = s.depth / max(s.far - s.near, TINY);
         float front_start = min(held.near, s.near), front_end = max(held.near, s.near);
         float back_start = min(held.far, s.far), back_end = max(held.far, s.far);
         bool held_first = held.near <= s.near, held_last = held.far >= s.far;
-        float front_depth = (held_first ? density0 : density1) * (front_end - front_start);  // eq. 10
-        float front_t = exp(-front_depth);
-        vec3 front_colour = (held_first ? held.colour : s.colour) * (1.0 - front_t);  // eq. 11
-        float inside_depth = (density0 + density1) * max(back_start - front_end, 0.0);  // eq. 14
-        float inside_t = exp(-inside_depth);
-        float weight0 = density0 / max(density0 + density1, TINY);
-        vec3 inside_colour = mix(s.colour, held.colour, weight0) * (1.0 - inside_t);  // eq. 15
         float back_t = exp(-(held_last ? density0 : density1) * (back_end - back_start));  // eq. 12
-        over(image, (held_last ? held.colour : s.colour) * (1.0 - back_t), back_t);  // eq. 13
-        float merged_t = front_t * inside_t;  // eq. 16
-        vec3 merged = front_colour + front_t * inside_colour;  // eq. 17
-        held = Segment(front_start, back_start, front_depth + inside_depth, merged / max(1.0 - merged_t, TINY));
+        over(image, (held_last ? held.colour : s.colour) * (1.0 - back_t), back_t);  // eq. 13, 16-17
+        float inside_t = exp(-(density0 + density1) * max(back_start - front_end, 0.0));  // eq. 14
+        float weight0 = density0 / max(density0 + density1, TINY);
+        over(image, mix(s.colour, held.colour, weight0) * (1.0 - inside_t), inside_t);  // eq. 15, 16-17
+        float front_depth = (held_first ? density0 : density1) * (front_end - front_start);  // eq. 10
+        held = Segment(front_start, front_end, front_depth, held_first ? held.colour : s.colour);
     }
     if (held.depth > 0.0)
         over_whole(image, held);
