@@ -36,7 +36,15 @@ from cloudcore.gl.splats import splat_batch  # noqa: E402
 from cloudcore.gl.volume_blending import batch_splats  # noqa: E402
 from cloudcore.light.eye_scattering import ParticleBuffer  # noqa: E402
 from cloudcore.light.lighting import scene_lights  # noqa: E402
-from cloudcore.light.volume_blending import ray_distances, ray_marched_in_tiles, screen_tiles  # noqa: E402
+from cloudcore.light.volume_blending import (  # noqa: E402
+    plain_blend,
+    ray_distances,
+    ray_marched,
+    ray_marched_in_tiles,
+    screen_tiles,
+    tile_pixels,
+    volume_blend,
+)
 from cloudcore.measure.benchmark import machine, write_report  # noqa: E402
 from cloudcore.measure.imagecompare import compare, diff_image  # noqa: E402
 from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
@@ -122,6 +130,34 @@ def reference(renderer: FrameRenderer, scene: Scene, steps: int) -> np.ndarray:
     return marched[:, :3].reshape(height, width, 3).astype(np.float32)
 
 
+def densest_tiles(renderer: FrameRenderer, scene: Scene, count: int, steps: int) -> list[dict]:
+    """RMS error (linear RGB) against the ray march on the `count` tiles listing the most splats, of
+    plain blending, the volume pass as built (holding the front part) and Yusov's merged volume."""
+    width, height = renderer.size
+    renderer.render(dataclasses.replace(scene, clouds=()), settings=FULL_3D)
+    world = np.column_stack([renderer.context.read_linear_rgb().reshape(-1, 3), np.zeros(width * height)])
+    batch, view, projection = scene_batch(scene, renderer.size)
+    rays = pixel_rays(scene.camera, width, height).reshape(-1, 3)
+    opaque = ray_distances(renderer.context.read_depth(), rays, view, projection)
+    tiles = screen_tiles(batch.centres - batch.eye, batch.radii, view, projection, renderer.size, NEAR_PLANE_M)
+    drawn = batch_splats(batch, view)
+    rows = []
+    for tile in np.argsort(-np.diff(tiles.starts.astype(np.int64)), kind="stable")[:count]:
+        listed = tiles.entries[tiles.starts[tile] : tiles.starts[tile + 1]]
+        subset, pixels = drawn.taken(listed), tile_pixels(tiles, int(tile))
+        truth = ray_marched(subset, rays[pixels], world[pixels], opaque[pixels], steps)[:, :3]
+        pictures = {
+            "plain": plain_blend(subset, rays[pixels], world[pixels], opaque[pixels]),
+            "volume": volume_blend(subset, rays[pixels], world[pixels], opaque[pixels]),
+            "yusov_merged": volume_blend(subset, rays[pixels], world[pixels], opaque[pixels], hold="merged"),
+        }
+        row = {"tile": int(tile), "splats": len(listed)}
+        row |= {f"{name}_rms": float(np.sqrt(np.mean((p[:, :3] - truth) ** 2))) for name, p in pictures.items()}
+        rows.append(row)
+        print(row)
+    return rows
+
+
 def measure(renderer: FrameRenderer, name: str, scene: Scene, repeat: int, steps: int | None, images: Path | None):
     frames, cloud_ms = {}, {blending: [] for blending in BLENDINGS}
     for _ in range(repeat):
@@ -164,6 +200,13 @@ def main(argv=None) -> None:
     parser.add_argument("--json", type=Path)
     parser.add_argument("--images", type=Path)
     parser.add_argument("--cases", help="comma-separated names of the cases to run (default: all)")
+    parser.add_argument(
+        "--densest-tiles",
+        type=int,
+        default=3,
+        help="on the default view, this many of the tiles listing the most splats: plain, volume and Yusov's "
+        "merged volume against the ray march (numpy, linear RGB)",
+    )
     args = parser.parse_args(argv)
     cases = [
         ("two_particles", two_particles(), args.steps),
@@ -176,11 +219,13 @@ def main(argv=None) -> None:
     with FrameRenderer(args.width, args.height) as renderer:
         features = renderer.volume_features
         rows = [measure(renderer, name, scene, args.repeat, steps, args.images) for name, scene, steps in cases]
+        dense = densest_tiles(renderer, load_scene(args.scene), args.densest_tiles, args.steps)
     report = {
         "machine": machine(),
         "size": [args.width, args.height],
         "gpu_features": dataclasses.asdict(features),
         "cases": rows,
+        "densest_tiles": dense,
     }
     write_report(report, args.json)
 

@@ -61,6 +61,14 @@ def test_interpenetrating_particles_match_the_ray_march_and_billboards_do_not(of
     assert plain_error > 0.03, (volume_error, plain_error)
 
 
+def test_holding_the_front_or_yusovs_merged_volume_is_the_same_for_two_particles():
+    pair = splats([[-1.0, 0.0, -100.0], [1.0, 0.5, -102.0]], [6.0, 5.0], *RED_BLUE)
+    front = volume_blend(pair, RAYS, BACKGROUND, hold="front")
+    np.testing.assert_allclose(volume_blend(pair, RAYS, BACKGROUND, hold="merged"), front, atol=1e-12)
+    with pytest.raises(ValueError, match="hold must be one of"):
+        volume_blend(pair, RAYS, BACKGROUND, hold="both")
+
+
 def test_the_ray_march_converges_to_the_volume_compositing():
     pair = splats([[-1.0, 0.0, -100.0], [1.0, 0.5, -102.0]], [6.0, 5.0], *RED_BLUE)
     volume = volume_blend(pair, RAYS, BACKGROUND)

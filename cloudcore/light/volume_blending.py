@@ -63,6 +63,17 @@ class Splats:
     def __len__(self) -> int:
         return len(self.radii)
 
+    def taken(self, positions: np.ndarray) -> Splats:
+        """The splats at `positions`, in that order."""
+        return Splats(
+            self.centres[positions],
+            self.radii[positions],
+            self.colours[positions],
+            self.opacities[positions],
+            self.right,
+            self.up,
+        )
+
 
 @dataclass(frozen=True)
 class Segments:
@@ -129,8 +140,17 @@ def _cut(segments: Segments, opaque: np.ndarray) -> tuple[np.ndarray, np.ndarray
     return segments.near, far, segments.optical_depth * kept
 
 
-def volume_blend(splats: Splats, rays: np.ndarray, background: np.ndarray, opaque: np.ndarray | None = None):
+#: what `volume_blend` holds of two overlapping segments: "front" (built, on the GL too), or Yusov's
+#: "merged" front and intersection (the paper's, kept here to measure the difference: docs/shading.md)
+HOLDS = ("front", "merged")
+
+
+def volume_blend(
+    splats: Splats, rays: np.ndarray, background: np.ndarray, opaque: np.ndarray | None = None, hold: str = "front"
+):
     """Volume-aware blending (Yusov, section 5.5), far to near; returns (pixels, 4) premultiplied."""
+    if hold not in HOLDS:
+        raise ValueError(f"hold must be one of {', '.join(HOLDS)}, got {hold!r}")
     image = np.array(background, dtype=np.float64)
     pixels = len(rays)
     opaque = np.full(pixels, np.inf) if opaque is None else opaque
@@ -151,8 +171,11 @@ def volume_blend(splats: Splats, rays: np.ndarray, background: np.ndarray, opaqu
         front, intersection, back = _split(held, new)
         # overlapping: the back part, then the intersection, are behind all still to come here (eq. 16-17
         # are these "over"s); the front part is held, for the next particle to meet
-        _over(image, overlap, *back)
-        _over(image, overlap, *intersection)
+        _over(image, overlap, *_homogeneous(back[3], back[2]))
+        if hold == "front":
+            _over(image, overlap, *_homogeneous(intersection[3], intersection[2]))
+        else:
+            front = _merged(front, intersection)
         for kept, arriving, part in zip(held, new, front):
             kept[replace] = arriving[replace]
             kept[overlap] = part[overlap]
@@ -162,8 +185,8 @@ def volume_blend(splats: Splats, rays: np.ndarray, background: np.ndarray, opaqu
 
 def _split(first, second):
     """Two overlapping homogeneous segments, each (near, far, optical depth, colour) per pixel, in their
-    three parts (eq. 10-15): the front as a segment (near, far, optical depth, colour) of the one that
-    starts first; the intersection and the back as (premultiplied colour, transmittance)."""
+    three parts, each a segment the same way (eq. 10-15): the front, of the one that starts first; the
+    intersection; the back, of the one that ends last."""
     near0, far0, depth0, colour0 = first
     near1, far1, depth1, colour1 = second
     density0 = depth0 / np.maximum(far0 - near0, _TINY)
@@ -171,18 +194,29 @@ def _split(first, second):
     front_start, front_end = np.minimum(near0, near1), np.maximum(near0, near1)
     back_start, back_end = np.minimum(far0, far1), np.maximum(far0, far1)
     starts_first = near0 <= near1
-    ends_last = (far0 >= far1)[:, None]
+    ends_last = far0 >= far1
     # eq. 10-11: the front part, of the segment that starts first
     front_depth = np.where(starts_first, density0, density1) * (front_end - front_start)
     front = (front_start, front_end, front_depth, np.where(starts_first[:, None], colour0, colour1))
     # eq. 14-15: the intersection, densities adding, colours weighted by density
-    inside_depth = (density0 + density1) * np.maximum(back_start - front_end, 0.0)
+    inside_end = np.maximum(back_start, front_end)
     weight0 = (density0 / np.maximum(density0 + density1, _TINY))[:, None]
-    intersection = _homogeneous(weight0 * colour0 + (1.0 - weight0) * colour1, inside_depth)
+    inside_colour = weight0 * colour0 + (1.0 - weight0) * colour1
+    intersection = (front_end, inside_end, (density0 + density1) * (inside_end - front_end), inside_colour)
     # eq. 12-13: the back part, of the segment that ends last
-    back_depth = np.where(ends_last[:, 0], density0, density1) * (back_end - back_start)
-    back = _homogeneous(np.where(ends_last, colour0, colour1), back_depth)
+    back_depth = np.where(ends_last, density0, density1) * (back_end - back_start)
+    back = (back_start, back_end, back_depth, np.where(ends_last[:, None], colour0, colour1))
     return front, intersection, back
+
+
+def _merged(front, intersection):
+    """Yusov's held volume: the front segment and the intersection behind it as one homogeneous
+    segment of their joint extent, its transmittance and colour eq. 16-17's."""
+    front_colour, front_t = _homogeneous(front[3], front[2])
+    inside_colour, inside_t = _homogeneous(intersection[3], intersection[2])
+    transmittance = front_t * inside_t
+    colour = (front_colour + front_t[:, None] * inside_colour) / np.maximum(1.0 - transmittance, _TINY)[:, None]
+    return front[0], intersection[1], front[2] + intersection[2], colour
 
 
 def ray_marched(
@@ -210,24 +244,22 @@ def ray_marched_in_tiles(
     """`ray_marched` of a whole frame (rays and images top row first, as `pixel_rays` gives them), each
     screen tile with only the splats `tiles` lists for it: the same picture, for many particles at a
     cost of the splats' pixels rather than particles times pixels."""
-    width, height = tiles.size
     image = np.array(background, dtype=np.float64)
     for tile in tiles.occupied:
-        columns = np.arange(TILE_PIXELS * (tile % tiles.across), TILE_PIXELS * (tile % tiles.across + 1))
-        rows = np.arange(TILE_PIXELS * (tile // tiles.across), TILE_PIXELS * (tile // tiles.across + 1))
-        columns, rows = columns[columns < width], rows[rows < height]
-        pixels = ((height - 1 - rows)[:, None] * width + columns[None, :]).ravel()  # GL rows count up
+        pixels = tile_pixels(tiles, int(tile))
         listed = tiles.entries[tiles.starts[tile] : tiles.starts[tile + 1]]
-        subset = Splats(
-            splats.centres[listed],
-            splats.radii[listed],
-            splats.colours[listed],
-            splats.opacities[listed],
-            splats.right,
-            splats.up,
-        )
-        image[pixels] = _march(subset, rays[pixels], image[pixels], opaque[pixels], steps)
+        image[pixels] = _march(splats.taken(listed), rays[pixels], image[pixels], opaque[pixels], steps)
     return image
+
+
+def tile_pixels(tiles: ScreenTiles, tile: int) -> np.ndarray:
+    """The flat indices, in an image whose top row is first, of the pixels of `tile` (on the screen)."""
+    width, height = tiles.size
+    across = tile % tiles.across
+    columns = np.arange(TILE_PIXELS * across, min(TILE_PIXELS * (across + 1), width))
+    up = tile // tiles.across
+    rows = np.arange(TILE_PIXELS * up, min(TILE_PIXELS * (up + 1), height))
+    return ((height - 1 - rows)[:, None] * width + columns[None, :]).ravel()  # GL counts rows up
 
 
 def _march(splats: Splats, rays, image, opaque, steps: int):
