@@ -137,3 +137,36 @@ def test_sprites_fall_back_to_billboards(renderer):
         pictures[blending], stats = renderer.render(scene, settings=dataclasses.replace(FULL_3D, blending=blending))
         assert stats.particles_drawn > 0 and stats.particles_as_volumes == 0
     np.testing.assert_array_equal(pictures["plain"], pictures["volume"])
+
+
+def test_a_crossfading_unit_composites_its_full_3d_layer_as_volumes(renderer):
+    """The full-3D image a unit fades in from its impostor goes through the volume pass too (into the
+    screen layer): mid-fade the frame is the plan's weighted mean of the volume picture and the impostor."""
+    from conftest import VALLEY
+    from test_frameplan import FILL_BOUND
+    from test_render_lod import FULL_CHEAP
+
+    from cloudcore.navigation import orbited
+    from cloudcore.scenefile import load_scene
+    from cloudcore.settings import RenderSettings
+
+    valley = load_scene(VALLEY)
+    cloud = valley.clouds[5]
+    centre, radius = cloud.bounding_sphere()
+    scene = dataclasses.replace(valley, clouds=(cloud,), terrain=None)
+    auto = RenderSettings(
+        ring_radius=np.inf, transition_frames=5, translation_metric="centre", tolerance_deg=1.0, blending="volume"
+    )
+    made_from = Camera(tuple(centre + [0.0, 0.0, 3.0 * radius]), tuple(centre), 60.0)
+    camera = orbited(made_from, 0.75)
+    renderer.render(scene, camera=made_from, settings=dataclasses.replace(auto, mode="impostor"))
+    full, impostor = (
+        renderer.render(scene, camera=camera, settings=dataclasses.replace(auto, mode=mode))[0].astype(float).mean()
+        for mode in ("full", "impostor")
+    )
+    for costs in (FILL_BOUND, FULL_CHEAP, FULL_CHEAP):
+        image, stats = renderer.render(scene, camera=camera, settings=auto, costs=costs)
+    weight = renderer.last_plan.clouds[0].full_weight
+    assert 0.0 < weight < 1.0 and renderer.last_plan.clouds[0].kind == "crossfade"
+    assert stats.particles_as_volumes == stats.particles_drawn > 0
+    assert image.astype(float).mean() == pytest.approx(weight * full + (1 - weight) * impostor, abs=0.01)
