@@ -419,6 +419,24 @@ def heat_map_changes_the_picture(ctx, app: EditorUnderTest):
     CHECK(len(np.unique(heat.reshape(-1, 3), axis=0)) > 3)  # and the clouds show as a ramp
 
 
+def volume_blending_composites_in_the_window(ctx, app: EditorUnderTest):
+    # the tiled compute pass in the window's own context, chosen in the LOD panel (full 3D: every unit)
+    use_window(ctx, "LOD")
+    ctx.combo_click("Mode/full")
+    ctx.yield_(SETTLE)
+    plain = app.capture(ctx)
+    ctx.combo_click("Blending/volume")
+    CHECK(app.editor.settings.blending == "volume")
+    ctx.yield_(SETTLE)
+    volume = app.capture(ctx)
+    shown = app.editor.last_stats.frame
+    app.outcome["volume_blended_particles"] = shown.particles_as_volumes
+    CHECK(shown.particles_as_volumes == shown.particles_drawn and shown.particles_drawn > 0)
+    CHECK(bool(np.abs(volume.astype(int) - plain.astype(int)).max() > 0))
+    ctx.combo_click("Blending/plain")
+    ctx.combo_click("Mode/auto")
+
+
 def overlays_outline_impostors_and_the_ring(ctx, app: EditorUnderTest):
     use_window(ctx, "LOD")
     ctx.item_check("Impostor outlines")
@@ -592,6 +610,7 @@ GUI_TESTS = (
     move_cloud_by_dragging,
     delete_key_and_statistics_toggle,
     heat_map_changes_the_picture,
+    volume_blending_composites_in_the_window,
     overlays_outline_impostors_and_the_ring,
     playing_a_camera_path_moves_the_camera,
     recording_runs_in_the_background,

@@ -21,6 +21,8 @@ from dataclasses import dataclass, field, fields
 MODES = ("auto", "full", "impostor")
 #: the names of `cloudcore.lod.impostors.TRANSLATION_METRICS` (kept here so settings import no geometry)
 TRANSLATION_METRICS = ("parallax", "centre")
+#: how full-3D splats are composited (`cloudcore.light.volume_blending`)
+BLENDINGS = ("plain", "volume")
 
 
 @dataclass(frozen=True)
@@ -195,11 +197,25 @@ class RenderSettings:
         help="multisample the terrain and objects 4x: smooth edges against the sky, at 4-6x the world pass's time",
         label="Antialiased world",
     )
+    #: "plain": premultiplied billboards (ONE, ONE_MINUS_SRC_ALPHA); "volume": Yusov's volume-aware
+    #: blending (HPG 2014, 5.5), intersecting particles composited as volumes by a tiled compute pass
+    #: where the GL has compute shaders (plain otherwise).  Plain by default: the goldens are its
+    #: pictures, and volume costs more on llvmpipe (docs/shading.md, "Volume-aware blending")
+    blending: str = _setting(
+        "plain",
+        flag="--blending",
+        help="plain: splats blended as billboards; volume: intersecting splats composited as volumes "
+        "(Yusov), full 3D only",
+        choices=BLENDINGS,
+        label="Blending",
+    )
 
     def __post_init__(self):
         problems = []
         if self.mode not in MODES:
             problems.append(f"mode must be one of {', '.join(MODES)}, got {self.mode!r}")
+        if self.blending not in BLENDINGS:
+            problems.append(f"blending must be one of {', '.join(BLENDINGS)}, got {self.blending!r}")
         if not 0.0 <= self.tolerance_deg <= 180.0:
             problems.append(f"tolerance_deg must be within [0, 180], got {self.tolerance_deg}")
         if self.translation_metric not in TRANSLATION_METRICS:

@@ -36,7 +36,7 @@ class StatisticsPanel:
             )
         imgui.text(
             f"particles drawn {frame.particles_drawn}, rendered to impostors {frame.particles_to_impostors}, "
-            f"as point sprites {frame.particles_as_points}"
+            f"as point sprites {frame.particles_as_points}, as volumes {frame.particles_as_volumes}"
         )
         imgui.text(
             f"impostors drawn {plan.impostors_drawn}, regenerated {shown.impostors_regenerated} "

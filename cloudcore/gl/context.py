@@ -116,6 +116,14 @@ class RenderTargets:
         pixels = np.frombuffer(data, dtype=np.float32).reshape(self.height, self.width, 3)
         return pixels[::-1].copy()
 
+    def read_depth(self) -> np.ndarray:
+        """The target's depth as float32 (height, width) window depths in [0, 1], top row first."""
+        self.make_current()
+        GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, self.framebuffer)
+        GL.glPixelStorei(GL.GL_PACK_ALIGNMENT, 1)
+        data = GL.glReadPixels(0, 0, self.width, self.height, GL.GL_DEPTH_COMPONENT, GL.GL_FLOAT)
+        return np.frombuffer(data, dtype=np.float32).reshape(self.height, self.width)[::-1].copy()
+
     def close_targets(self) -> None:
         self._pyrender.delete()
         GL.glDeleteFramebuffers(2, [self.framebuffer, self.world_framebuffer])

@@ -45,10 +45,12 @@ from cloudcore.gl.programs import build_program
 from cloudcore.gl.quads import SCREEN_CORNERS, QuadPass
 from cloudcore.gl.splats import SplatPass, splat_batch
 from cloudcore.gl.targets import TextureTarget, blit_depth, depth_renderbuffer
+from cloudcore.gl.volume_blending import GpuFeatures, VolumeBlendingPass
 from cloudcore.gl.world import WorldPass
 from cloudcore.light.eye_scattering import ParticleBuffer
 from cloudcore.light.illumination import IlluminationCache
 from cloudcore.light.lighting import scene_hour, scene_lights, sky_colors
+from cloudcore.light.volume_blending import blending_path, screen_tiles
 from cloudcore.lod.costs import CostModel
 from cloudcore.lod.frameplan import FramePlan, LodState, inside_runs, plan_frame
 from cloudcore.lod.units import LodUnits, lod_units
@@ -72,6 +74,7 @@ class _CloudPassFrame:
     poses: tuple
     time_s: float
     point_sprites: bool  # the setting: draw plain splats as points where the picture is the same
+    blending: str  # the setting: full-3D splats as billboards ("plain") or as volumes ("volume")
 
     @property
     def eye(self) -> np.ndarray:
@@ -90,6 +93,7 @@ class FrameRenderer:
         self.context.make_current()
         self._splats = SplatPass()
         self._clock = PassClock()
+        self._volume = VolumeBlendingPass()
         self._quads = QuadPass()
         self._impostors = ImpostorStore(self._splats)
         self._world, self._world_source = None, None
@@ -113,12 +117,18 @@ class FrameRenderer:
         self._display = None  # (RGBA8 target, program): the frame in sRGB for the editor
         # the last frame's draws into the screen, replayable as fragment counts, and its splat batches
         self._replay, self._screen_batches, self._last_matrices = [], [], None
+        self._particles_as_volumes = 0  # this frame's, for its statistics
         self.last_plan: FramePlan | None = None
 
     @property
     def units(self) -> LodUnits:
         """The units (clouds, or groups of interpenetrating clouds) the last frame was planned with."""
         return self._units
+
+    @property
+    def volume_features(self) -> GpuFeatures:
+        """What this GL offers volume-aware blending."""
+        return self._volume.features
 
     @property
     def size(self) -> tuple[int, int]:
@@ -194,6 +204,7 @@ class FrameRenderer:
             self._splats.update_facing(particles, start, facing)
         before_passes_ms = 1e3 * (time.perf_counter() - planning_started)
         self._splats.particles_as_points = 0
+        self._particles_as_volumes = 0
         clock = self._clock
         with clock.timed("world"):
             antialiased = settings.world_antialiasing
@@ -222,6 +233,7 @@ class FrameRenderer:
             cloud_gpu_ms=clouds.gpu_ms,
             particles_drawn=drawn,
             particles_as_points=self._splats.particles_as_points,
+            particles_as_volumes=self._particles_as_volumes,
             particles_to_impostors=rendered,
             clouds_drawn=sum(len(plan.clouds[i].members) for i in plan.draw_order),
             texture_bytes=self.texture_bytes,
@@ -357,6 +369,7 @@ class FrameRenderer:
             poses,
             time_s,
             settings.point_sprites,
+            settings.blending,
         )
         self._replay, self._screen_batches = [], []
         if plan.ring is not None:
@@ -388,11 +401,24 @@ class FrameRenderer:
             drawn += self._draw_splats(frame, *zip(*full_run))
         return drawn
 
-    def _draw_splats(self, frame: _CloudPassFrame, clouds, depth_ranges) -> int:
-        """Full 3D: the clouds' splats (each cloud's within its depth range) sorted together, on the screen."""
+    def _draw_splats(self, frame: _CloudPassFrame, clouds, depth_ranges, colour_texture: int | None = None) -> int:
+        """Full 3D: the clouds' splats (each cloud's within its depth range) sorted together, on the screen
+        (or the screen layer whose `colour_texture` is bound), as billboards or as volumes."""
         batch = splat_batch(frame.particles, clouds, frame.eye, depth_ranges, frame.time_s, frame.frustum)
         view, projection, points = frame.view, frame.projection, frame.point_sprites
-        self._splats.draw(batch, view, projection, point_sprites=points)
+        path = blending_path(
+            frame.blending,
+            compute_shaders=self._volume.features.compute_shaders,
+            plain_splats_only=bool(np.all(self._splats.plain_splats(batch))),
+        )
+        if path == "volume" and len(batch):
+            tiles = screen_tiles(batch.centres - batch.eye, batch.radii, view, projection, self.size, NEAR_PLANE_M)
+            instances = self._splats.shade(batch, view)
+            target = self.context.colour_texture if colour_texture is None else colour_texture
+            self._volume.draw(tiles, instances, view, projection, target, self.context.framebuffer)
+            self._particles_as_volumes += len(batch)
+        else:
+            self._splats.draw(batch, view, projection, point_sprites=points)
         self._replay.append(lambda: self._splats.draw(batch, view, projection, counting=True, point_sprites=points))
         self._screen_batches.append(batch)
         return len(batch)
@@ -425,7 +451,7 @@ class FrameRenderer:
         target, corners, extent = self._impostors.cloud_impostor(cloud.members, item.layer)
         layer = self._screen_layer()
         layer.bind_cleared()
-        drawn = self._draw_splats(frame, cloud.members, [(item.near, item.far)] * len(cloud.members))
+        drawn = self._draw_splats(frame, cloud.members, [(item.near, item.far)] * len(cloud.members), layer.texture)
         self.context.bind_target()
         self._draw_quad(
             frame,
@@ -519,6 +545,7 @@ class FrameRenderer:
         self._quads.close()
         self._splats.close()
         self._clock.close()
+        self._volume.close()
         if self._world is not None:
             self._world.close()
         if self._objects is not None:

@@ -159,11 +159,11 @@ class SplatPass:
         """
         if not len(batch):
             return 0
-        self._shade(batch, view)
+        self.shade(batch, view)
         view_rotation = np.array(view, dtype=np.float64)
         view_rotation[:3, 3] = 0.0  # corners come relative to the batch's eye, the view's own
         pieces, target_viewport = [(0, len(batch), False)], None
-        plain = self._plain[batch.order] if point_sprites else None
+        plain = self.plain_splats(batch) if point_sprites else None
         if plain is not None and plain.any():
             # the same pixels through a clip volume wider than the target (cloudcore.point_sprites)
             target_viewport = GL.glGetIntegerv(GL.GL_VIEWPORT)
@@ -204,6 +204,12 @@ class SplatPass:
         self.particles_as_points += as_points
         return as_points
 
+    def plain_splats(self, batch: SplatBatch) -> np.ndarray:
+        """(n,) bool: which of the batch's particles are plain Gaussian splats of one colour
+        (`cloudcore.point_sprites.plain_splats`)."""
+        self._make_resident(batch.particles)
+        return self._plain[batch.order]
+
     def _index_quads(self, count: int) -> None:
         """Grow the (bound vertex array's) element buffer to hold the triangles of `count` particles."""
         if count <= self._quads_indexed:
@@ -224,8 +230,9 @@ class SplatPass:
         GL.glBufferSubData(GL.GL_SHADER_STORAGE_BUFFER, start * records.itemsize * 4, records.nbytes, records)
         GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, 0)
 
-    def _shade(self, batch: SplatBatch, view: np.ndarray) -> None:
-        """Run the compute shader: the batch's quads and colours for its eye, in its order."""
+    def shade(self, batch: SplatBatch, view: np.ndarray) -> int:
+        """Run the compute shader: the batch's quads and colours for its eye, in its order; returns the
+        storage buffer holding them (the volume-aware blending pass reads them too)."""
         self._make_resident(batch.particles)
         self._hold_formation(batch.particles, batch.time_s)
         _store(self._order_buffer, batch.order, GL.GL_STREAM_DRAW)
@@ -250,6 +257,7 @@ class SplatPass:
         set_vec3(self._shade_program, "view_up", view[1, :3])
         GL.glDispatchCompute(-(-len(batch) // _SHADE_GROUP), 1, 1)
         GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT)
+        return self._instance_buffer
 
     def _make_resident(self, particles: ParticleBuffer) -> None:
         """Upload the particles' shading terms, styles and unlocked facings when the particles change."""

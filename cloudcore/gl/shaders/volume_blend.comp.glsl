@@ -1,0 +1,161 @@
+#version 430 core
+// Yusov's volume-aware blending (HPG 2014, section 5.5, eq. 10-17) without pixel-shader ordering:
+// one work group per screen tile, one invocation per pixel, each walking its tile's particles in the
+// batch's far-to-near order (cloudcore.light.volume_blending.screen_tiles) and compositing their
+// segments along its ray as the numpy reference does (cloudcore.light.volume_blending.volume_blend):
+// one segment held (extent, optical depth, colour), the farther of two apart into the frame, or of
+// two overlapping the back part and the intersection, the front part held.  A pixel is one invocation's alone,
+// so its read-modify-write of the target needs no interlock.  Each pixel reads its tile's splats
+// itself: gathering them into shared memory once per group (as 3D Gaussian splatting rasterisers
+// do on GPUs) was no faster on llvmpipe, whose barriers are costly (docs/shading.md).
+//
+// A particle's segment along the ray: the ray meets the splat's plane at d radii from its centre
+// (as splat.frag.glsl measures it); opacity alpha K(d) gives the optical depth -ln(1 - alpha K(d)),
+// spread over the chord of half length r sqrt(1 - d^2) around the ray's closest approach; the world's
+// depth cuts the chord.  Instances are those splat_shade.comp.glsl built: corners relative to the eye.
+
+layout(local_size_x = TILE_PIXELS, local_size_y = TILE_PIXELS) in;
+
+struct Instance {
+    vec4 corners[4];  // relative to the eye; w: atlas cell (-1: Gaussian splat)
+    vec4 colours[4];  // premultiplied linear rgb, opacity
+};
+layout(std430, binding = 3) readonly buffer Instances { Instance instances[]; };
+layout(std430, binding = 6) readonly buffer TileStarts { uint tile_starts[]; };
+layout(std430, binding = 7) readonly buffer TileEntries { uint tile_entries[]; };
+layout(std430, binding = 8) readonly buffer Occupied { uint occupied[]; };  // one group each
+layout(rgba16f, binding = 0) uniform image2D target;  // premultiplied linear colour, what was drawn so far
+uniform sampler2D world_depth;  // the frame's depth, window coordinates in [0, 1]
+
+uniform ivec2 size;
+uniform int tiles_across;
+uniform vec3 view_right;
+uniform vec3 view_up;
+uniform vec3 view_forward;
+uniform vec2 focal;        // projection[0][0], projection[1][1]
+uniform vec2 depth_terms;  // projection[2][2], projection[2][3]: window depth back to eye depth
+
+const float TINY = 1e-30;
+const float FAR = 3.0e38;  // no world along the ray
+
+struct Segment {
+    float near;
+    float far;
+    float depth;  // optical
+    vec3 colour;  // not premultiplied
+};
+
+void over(inout vec4 image, vec3 premultiplied, float transmittance)
+{
+    image.rgb = premultiplied + transmittance * image.rgb;
+    image.a = (1.0 - transmittance) + transmittance * image.a;
+}
+
+void over_whole(inout vec4 image, Segment s)
+{
+    float transmittance = exp(-s.depth);
+    over(image, s.colour * (1.0 - transmittance), transmittance);
+}
+
+float kernel(float d2)
+{
+    float floor_value = exp(-SPLAT_SHARPNESS);
+    return max((exp(-SPLAT_SHARPNESS * d2) - floor_value) / (1.0 - floor_value), 0.0);
+}
+
+// a particle as the pass reads it: its plane, and its axes scaled so that they measure d
+struct Splat {
+    vec4 centre_r2;      // relative to the eye, radius squared
+    vec4 u;              // the splat's right over its radius: offset . u is d's first coordinate
+    vec4 v;              // and up
+    vec4 normal_plane;   // the plane's normal, and its distance term centre . normal
+    vec4 colour;         // premultiplied rgb, opacity
+};
+
+Splat splat_of(Instance p)
+{
+    vec3 centre = 0.5 * (p.corners[0].xyz + p.corners[3].xyz);
+    vec3 u = 0.5 * (p.corners[1].xyz - p.corners[0].xyz);  // radius times the splat's right
+    vec3 v = 0.5 * (p.corners[2].xyz - p.corners[0].xyz);  // and up
+    float r2 = dot(u, u);
+    vec3 normal = cross(u, v);
+    float scale = r2 > 0.0 ? 1.0 / r2 : 0.0;
+    return Splat(vec4(centre, r2), vec4(u * scale, 0.0), vec4(v * scale, 0.0), vec4(normal, dot(centre, normal)),
+                 r2 > 0.0 ? p.colours[0] : vec4(0.0));
+}
+
+// the particle's segment along `ray`, cut at `opaque`; depth 0 where the ray misses it
+Segment segment_of(Splat p, vec3 ray, float opaque)
+{
+    Segment s = Segment(0.0, 0.0, 0.0, vec3(0.0));
+    float alpha = p.colour.a;
+    float facing = dot(ray, p.normal_plane.xyz);
+    if (alpha <= 0.0 || abs(facing) <= TINY)
+        return s;
+    float plane = p.normal_plane.w / facing;
+    vec3 offset = plane * ray - p.centre_r2.xyz;
+    float du = dot(offset, p.u.xyz), dv = dot(offset, p.v.xyz);
+    float d2 = du * du + dv * dv;
+    if (plane <= 0.0 || d2 >= 1.0)
+        return s;
+    float opacity = min(alpha * kernel(d2), 1.0);
+    float depth = opacity < 1.0 ? min(-log(1.0 - opacity), MAX_OPTICAL_DEPTH) : MAX_OPTICAL_DEPTH;
+    float half_length = sqrt(p.centre_r2.w * max(1.0 - d2, 0.0));
+    float closest = dot(ray, p.centre_r2.xyz);
+    s.near = closest - half_length;
+    float whole_far = closest + half_length;
+    s.far = clamp(opaque, s.near, whole_far);
+    s.depth = half_length > 0.0 ? depth * (s.far - s.near) / max(whole_far - s.near, TINY) : 0.0;
+    s.colour = p.colour.rgb / alpha;
+    return s;
+}
+
+void main()
+{
+    uint tile = occupied[gl_WorkGroupID.x];
+    ivec2 pixel = TILE_PIXELS * ivec2(tile % uint(tiles_across), tile / uint(tiles_across))
+                + ivec2(gl_LocalInvocationID.xy);
+    if (any(greaterThanEqual(pixel, size)))
+        return;
+    vec2 ndc = (vec2(pixel) + 0.5) / vec2(size) * 2.0 - 1.0;
+    vec3 ray = normalize(ndc.x / focal.x * view_right + ndc.y / focal.y * view_up + view_forward);
+    float stored = texelFetch(world_depth, pixel, 0).r;
+    float opaque = stored >= 1.0 ? FAR : depth_terms.y / ((2.0 * stored - 1.0) + depth_terms.x) / dot(ray, view_forward);
+    vec4 image = imageLoad(target, pixel);
+
+    Segment held = Segment(0.0, 0.0, 0.0, vec3(0.0));
+    for (uint k = tile_starts[tile]; k < tile_starts[tile + 1u]; ++k) {
+        Segment s = segment_of(splat_of(instances[tile_entries[k]]), ray, opaque);
+        if (s.depth <= 0.0)
+            continue;
+        if (held.depth <= 0.0) {
+            held = s;
+            continue;
+        }
+        if (s.near >= held.far || s.far <= held.near) {  // apart: the farther goes into the frame
+            if (s.near < held.near) {
+                over_whole(image, held);
+                held = s;
+            } else {
+                over_whole(image, s);
+            }
+            continue;
+        }
+        // overlapping (eq. 10-17): the back part, then the intersection, into the frame; the front held
+        float density0 = held.depth / max(held.far - held.near, TINY);
+        float density1 = s.depth / max(s.far - s.near, TINY);
+        float front_start = min(held.near, s.near), front_end = max(held.near, s.near);
+        float back_start = min(held.far, s.far), back_end = max(held.far, s.far);
+        bool held_first = held.near <= s.near, held_last = held.far >= s.far;
+        float back_t = exp(-(held_last ? density0 : density1) * (back_end - back_start));  // eq. 12
+        over(image, (held_last ? held.colour : s.colour) * (1.0 - back_t), back_t);  // eq. 13, 16-17
+        float inside_t = exp(-(density0 + density1) * max(back_start - front_end, 0.0));  // eq. 14
+        float weight0 = density0 / max(density0 + density1, TINY);
+        over(image, mix(s.colour, held.colour, weight0) * (1.0 - inside_t), inside_t);  // eq. 15, 16-17
+        float front_depth = (held_first ? density0 : density1) * (front_end - front_start);  // eq. 10
+        held = Segment(front_start, front_end, front_depth, held_first ? held.colour : s.colour);
+    }
+    if (held.depth > 0.0)
+        over_whole(image, held);
+    imageStore(target, pixel, image);
+}
