@@ -33,6 +33,9 @@ Two methods:
   order-independent compositing.  Faster and approximate; see `docs/shading.md`.
 * "preview": the raster method on a grid of `PREVIEW_RASTER_RESOLUTION` cells:
   what the editor lights with while a lighting slider is dragged.
+* "occlusion": not Harris's: Yusov's light-space occlusion estimate (`cloudcore.light.occlusion`), the
+  sunlight through the other particles with no light order, each particle losing the share
+  1 - sigma_eff / alpha of what it stops; the light pass of Yusov's model (eye pass "yusov").
 """
 
 from __future__ import annotations
@@ -41,9 +44,11 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from cloudcore.light.kernel import splat_kernel
+from cloudcore.light.occlusion import occlusion_estimate
 from cloudcore.light.phase import check_phase, phase_function
+from cloudcore.segments import concatenated_ranges
 
-METHODS = ("exact", "raster", "preview")
+METHODS = ("exact", "raster", "preview", "occlusion")
 #: what a particle sends toward the eye (`cloudcore.light.eye_scattering`): Harris's eq. 5 as printed, or
 #: "saturated", its scattering coefficient and ambient term made those of a thick medium
 EYE_PASSES = ("harris", "saturated")
@@ -139,6 +144,9 @@ def incident_light(
     sigma = scattering_coefficient(tau, albedo, phase, g) * float(phase_function(1.0, phase, g))
     if method == "exact":
         result = _incident_exact(plane, toward_light, radii, alpha, sigma, groups)
+    elif method == "occlusion":
+        lost = 1.0 - np.divide(sigma, alpha, out=np.zeros(n), where=alpha > 0.0)
+        result = occlusion_estimate(plane, toward_light, radii, tau, lost, groups)
     else:
         grid = PREVIEW_RASTER_RESOLUTION if method == "preview" else int(resolution)
         result = _incident_raster(plane, toward_light, radii, alpha, sigma, groups, grid)
@@ -274,16 +282,6 @@ def _incident_in_light_order(source, target, weight, alpha, sigma):
         np.subtract.at(waiting, released, 1)
         ready = np.unique(released[waiting[released] == 0])
     return incident
-
-
-def concatenated_ranges(starts: np.ndarray, counts: np.ndarray) -> np.ndarray:
-    """concatenate(arange(s, s + c) for s, c in zip(starts, counts)), vectorised."""
-    total = int(counts.sum())
-    if total == 0:
-        return np.zeros(0, dtype=np.int64)
-    ends = np.cumsum(counts)
-    offsets = np.repeat(starts - (ends - counts), counts)
-    return np.arange(total) + offsets
 
 
 def _compose_segments(through: np.ndarray, scattered: np.ndarray, lengths: np.ndarray):
