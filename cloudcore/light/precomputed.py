@@ -188,6 +188,40 @@ class ReferenceTables:
         return summed + tail
 
 
+@dataclass(frozen=True)
+class EyePassProfiles:
+    """What Yusov's eye pass needs per particle: each particle's row of `profiles`, (rows, 2, views): a x
+    single scattering and multiple scattering over the uniform mu grid from -1 to 1, one row per distinct
+    (tau, albedo); and the ambient response per particle (the light it returns in uniform light of
+    radiance 1, per unit opacity)."""
+
+    rows: np.ndarray
+    profiles: np.ndarray
+    ambient: np.ndarray
+
+    def at(self, indices: np.ndarray, mu: np.ndarray) -> np.ndarray:
+        """p-free part of the colour factor of particles `indices` at view-light cosines `mu`:
+        (single (n,), multiple (n,)) linear in mu between samples (the splat shader's look-up)."""
+        samples = self.profiles.shape[2]
+        position = (np.clip(mu, -1.0, 1.0) + 1.0) * 0.5 * (samples - 1)
+        below = np.minimum(position.astype(np.int64), samples - 2)
+        t = position - below
+        rows = self.profiles[self.rows[indices]]  # (n, 2, views)
+        low = np.take_along_axis(rows, below[:, None, None].repeat(2, 1), axis=2)[..., 0]
+        high = np.take_along_axis(rows, (below + 1)[:, None, None].repeat(2, 1), axis=2)[..., 0]
+        blended = (1.0 - t)[:, None] * low + t[:, None] * high
+        return blended[:, 0], blended[:, 1]
+
+
+def eye_pass_profiles(optical_depth, albedo, phase: str = "rayleigh", g: float = 0.0) -> EyePassProfiles:
+    """Yusov's eye pass for particles of `optical_depth` and `albedo` (n,) under `phase`, `g`."""
+    tau = np.asarray(optical_depth, dtype=np.float64)
+    albedo = np.broadcast_to(np.asarray(albedo, dtype=np.float64), tau.shape)
+    pairs, rows = np.unique(np.column_stack([tau, albedo]).reshape(-1, 2), axis=0, return_inverse=True)
+    single, multiple, ambient = reference_tables(phase, g).scattering_profiles(pairs[:, 0], pairs[:, 1])
+    return EyePassProfiles(rows.reshape(-1), np.stack([single, multiple], axis=1), ambient[rows.reshape(-1)])
+
+
 def reference_tables(
     phase: str = "rayleigh", g: float = 0.0, resolution: TableResolution = TableResolution()
 ) -> ReferenceTables:
