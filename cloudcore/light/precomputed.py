@@ -129,12 +129,6 @@ class ReferenceTables:
         arrays = (self.chord_depths, self.optical_depths, self.view_cosines, self.single, self.orders)
         return int(sum(a.nbytes for a in arrays) + self.tail_ratio.nbytes + self.last_order.nbytes)
 
-    def unit_optical_depth(self, points, directions) -> np.ndarray:
-        """Optical depth (for tau 1) from `points` (n, 3) in units of the radius, centre at 0, along unit
-        `directions` ((3,) or (n, 3)) to where the ray leaves the sphere: 0 for rays that miss it or have
-        left it, the whole chord for points before it."""
-        return chord_optical_depth(self.chord_depths, points, directions)
-
     def scattering_profiles(self, optical_depth, albedo) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Per particle: (a x single scattering (n, views), multiple scattering (n, views), ambient (n,)).
 
@@ -199,9 +193,9 @@ class EyePassProfiles:
     profiles: np.ndarray
     ambient: np.ndarray
 
-    def at(self, indices: np.ndarray, mu: np.ndarray) -> np.ndarray:
-        """p-free part of the colour factor of particles `indices` at view-light cosines `mu`:
-        (single (n,), multiple (n,)) linear in mu between samples (the splat shader's look-up)."""
+    def at(self, indices: np.ndarray, mu: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(a x single (n,), multiple (n,)) of particles `indices` at view-light cosines `mu` (n,), linear in
+        mu between samples, as the splat shader looks them up."""
         samples = self.profiles.shape[2]
         position = (np.clip(mu, -1.0, 1.0) + 1.0) * 0.5 * (samples - 1)
         below = np.minimum(position.astype(np.int64), samples - 2)
