@@ -32,12 +32,11 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from cloudcore.light.kernel import splat_kernel
-from cloudcore.light.precomputed import chord_depths, chord_optical_depth
+from cloudcore.light.precomputed import chord_depth, chord_depths
 from cloudcore.segments import concatenated_ranges
 
 #: tiles across a group's footprint in the light's view (the paper's typical grid is 64 x 64)
 TILES = 64
-_TOWARD_LIGHT = np.array([0.0, 0.0, 1.0])
 
 
 def occlusion_estimate(plane, toward_light, radii, optical_depth, xi, groups, *, smoothed: bool = True) -> np.ndarray:
@@ -57,11 +56,15 @@ def occlusion_estimate(plane, toward_light, radii, optical_depth, xi, groups, *,
     ahead = (toward_light[source] + radii[source] > toward_light[target]) & (target != source)
     target, source = target[ahead], source[ahead]
     gap = plane[target] - plane[source]
-    meets = np.einsum("ij,ij->i", gap, gap) < radii[source] ** 2
-    target, source, gap = target[meets], source[meets], gap[meets]
-    scale = np.maximum(radii[source], np.finfo(np.float64).tiny)[:, None]
-    offsets = np.column_stack([gap / scale, (toward_light[target] - toward_light[source]) / scale[:, 0]])
-    depth = optical_depth[source] * chord_optical_depth(chord_depths(), offsets, _TOWARD_LIGHT)
+    squared = np.einsum("ij,ij->i", gap, gap)
+    meets = squared < radii[source] ** 2
+    target, source, squared = target[meets], source[meets], squared[meets]
+    scale = np.maximum(radii[source], np.finfo(np.float64).tiny)
+    # the ray is the light's axis through the target's centre: its distance from the source's centre is
+    # the gap in the light's view, and the centre lies (toward_light difference) along it
+    depth = optical_depth[source] * chord_depth(
+        chord_depths(), np.sqrt(squared) / scale, (toward_light[target] - toward_light[source]) / scale
+    )
     passed = 1.0 - xi[source] * -np.expm1(-depth)
     # a product over each target's occluders, as a sum of logarithms (an opaque occluder passes 0)
     logs = np.bincount(target, np.log(np.maximum(passed, np.finfo(np.float64).tiny)), minlength=n)

@@ -299,18 +299,24 @@ def chord_optical_depth(table: np.ndarray, points, directions) -> np.ndarray:
     points = np.asarray(points, dtype=np.float64)
     directions = np.broadcast_to(np.asarray(directions, dtype=np.float64), points.shape)
     along = np.einsum("ij,ij->i", points, directions)
-    b = np.sqrt(np.maximum(np.einsum("ij,ij->i", points, points) - along * along, 0.0))
-    half = np.sqrt(np.maximum(1.0 - b * b, 0.0))
+    impact = np.sqrt(np.maximum(np.einsum("ij,ij->i", points, points) - along * along, 0.0))
+    return chord_depth(table, impact, along)
+
+
+def chord_depth(table: np.ndarray, impact: np.ndarray, along: np.ndarray) -> np.ndarray:
+    """`chord_table` at rays passing `impact` from the centre, from the point `along` the ray from its
+    closest approach (negative: before it), bilinear; 0 for rays that miss."""
+    half = np.sqrt(np.maximum(1.0 - impact * impact, 0.0))
     f = np.clip(np.divide(along + half, 2.0 * half, out=np.zeros_like(half), where=half > 0.0), 0.0, 1.0)
     impacts, positions = table.shape
-    bi, fi = np.minimum(b, 1.0) * (impacts - 1), f * (positions - 1)
+    bi, fi = np.minimum(impact, 1.0) * (impacts - 1), f * (positions - 1)
     i = np.minimum(bi.astype(np.int64), impacts - 2)
     j = np.minimum(fi.astype(np.int64), positions - 2)
     ti, tj = bi - i, fi - j
     value = (1 - ti) * ((1 - tj) * table[i, j] + tj * table[i, j + 1]) + ti * (
         (1 - tj) * table[i + 1, j] + tj * table[i + 1, j + 1]
     )
-    return np.where(b < 1.0, value, 0.0)
+    return np.where(impact < 1.0, value, 0.0)
 
 
 def _occluded_area(chords: np.ndarray, tau: float, nodes: int = 256) -> float:
