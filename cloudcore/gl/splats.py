@@ -272,11 +272,9 @@ class SplatPass:
             if self._atlas is None and np.any(particles.styles.sprite_index >= 0):
                 self._atlas = _atlas_texture()
             _store(self._formation_buffer, np.ones(max(len(particles.radii), 1), dtype=np.float32))
-            profiles = particles.profiles
-            _store(
-                self._profile_buffer,
-                np.zeros(1, np.float32) if profiles is None else profiles.profiles.astype(np.float32),
-            )
+            # Yusov's eye pass's profile rows; one float where there are none (no empty buffer is bound)
+            rows = np.zeros(0) if particles.profiles is None else particles.profiles.profiles.ravel()
+            _store(self._profile_buffer, (rows if rows.size else np.zeros(1)).astype(np.float32))
             _set_light_uniforms(self._shade_program, particles)
             self._resident, self._formation_time = particles, None
 
