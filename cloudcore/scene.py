@@ -72,8 +72,8 @@ class Lighting:
 @dataclass(frozen=True)
 class Shading:
     """Harris's defaults for every cloud; `eye_pass` chooses what a particle sends to the eye
-    (`cloudcore.light.shading.EYE_PASSES`: Harris's eq. 5, or its saturated form, closer to the path-traced
-    truth: docs/shading.md)."""
+    (`cloudcore.light.shading.EYE_PASSES`: Harris's eq. 5, its saturated form, closer to the path-traced
+    truth, or Yusov's precomputed reference particle: docs/shading.md)."""
 
     albedo: float = 0.9
     optical_depth: float = 8.0

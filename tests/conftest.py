@@ -17,6 +17,20 @@ RENDER_WIDTH, RENDER_HEIGHT = 160, 120
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 
 
+@pytest.fixture(scope="session", autouse=True)
+def cloudview_cache(request):
+    """cloudview's disk cache (Yusov's tables) in pytest's own cache folder, never the real home: built
+    once per checkout, kept between test runs."""
+    folder = request.config.cache.mkdir("cloudview-cache")
+    held = os.environ.get("XDG_CACHE_HOME")
+    os.environ["XDG_CACHE_HOME"] = str(folder)
+    yield folder
+    if held is None:
+        os.environ.pop("XDG_CACHE_HOME", None)
+    else:
+        os.environ["XDG_CACHE_HOME"] = held
+
+
 @pytest.fixture(scope="session")
 def renderer():
     """One headless renderer for all render tests; they skip where no EGL context can be made."""

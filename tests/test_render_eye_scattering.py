@@ -37,6 +37,7 @@ def particle_grid(z: float) -> np.ndarray:
         ("henyey-greenstein", 0.8, "harris"),
         ("cornette-shanks", -0.5, "harris"),
         ("rayleigh", 0.0, "saturated"),
+        ("rayleigh", 0.0, "yusov"),
     ],
 )
 def test_the_shader_colours_particles_as_the_reference_does(renderer, phase, g, eye_pass):

@@ -56,7 +56,9 @@ class LightingPanel:
         changed_eye_pass, eye_pass_index = imgui.combo("Eye pass", EYE_PASSES.index(shading.eye_pass), list(EYE_PASSES))
         imgui.set_item_tooltip(
             "harris: Harris's eye scattering; saturated: its scattering saturated for opaque particles and the "
-            "ambient light a thick medium's (closer to the path-traced truth: docs/shading.md)."
+            "ambient light a thick medium's (closer to the path-traced truth: docs/shading.md); yusov: the light "
+            "leaving Yusov's precomputed reference particle (its tables take about a minute to build once "
+            "per phase function and g, then come from the cache)."
         )
         changes = {key: value for key, value in changes.items() if value is not None}
         if changed_phase:

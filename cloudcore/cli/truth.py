@@ -1,7 +1,8 @@
 """`cloudview truth SCENE --out T.png`: the path-traced reference (Mitsuba 3); with --json, the models against it.
 
-The models are Harris's with each illumination method of `cloudcore.light.shading` and the saturated eye
-pass with the exact one.  The truth and the models both show the clouds over the sky, the terrain and objects left out
+The models are Harris's with each of his illumination methods of `cloudcore.light.shading` and the saturated
+eye pass with the exact one, or those --models names (any eye pass with any illumination method).  The
+truth and the models both show the clouds over the sky, the terrain and objects left out
 (`cloudcore.light.truth` says what the medium and the lights are).  The report renders the truth again
 with the next seed, for its own noise, and each model through the GL renderer in full 3D.
 """
@@ -21,7 +22,7 @@ from cloudcore.cli.render import add_scene_argument, camera_argument, check_time
 from cloudcore.colour import linear_to_srgb8
 from cloudcore.errors import SceneError
 from cloudcore.light.lighting import scene_hour
-from cloudcore.light.shading import METHODS
+from cloudcore.light.shading import EYE_PASSES, METHODS
 from cloudcore.light.truth import (
     BODY_ALPHA,
     CLOUD_ALPHA,
@@ -74,6 +75,13 @@ def add_parser(commands) -> None:
     parser.add_argument("--variant", choices=VARIANTS, help="Mitsuba variant (default: the first that loads)")
     parser.add_argument("--json", type=Path, help="compare the shading models with the truth; write the report here")
     parser.add_argument("--model-images", type=Path, help="with --json: write each model's picture and diff here")
+    parser.add_argument(
+        "--models",
+        type=model_names,
+        default=DEFAULT_MODELS,
+        help=f"with --json: the models compared, comma-separated (default {','.join(DEFAULT_MODELS)}; "
+        "any eye pass-illumination method: yusov-occlusion is Yusov's whole model)",
+    )
     parser.set_defaults(run=run)
 
 
@@ -172,8 +180,19 @@ def _render(scene, camera, args, seed: int):
             raise SceneError(args.scene, "truth", str(error)) from None
 
 
-#: the models compared with the truth: name -> (eye pass, illumination method)
-MODELS = {f"harris-{method}": ("harris", method) for method in METHODS} | {"saturated-exact": ("saturated", "exact")}
+#: the models that can be compared with the truth: name -> (eye pass, illumination method)
+MODELS = {f"{eye_pass}-{method}": (eye_pass, method) for eye_pass in EYE_PASSES for method in METHODS}
+#: those compared unless --models names others: Harris's light pass methods, the saturated eye pass
+DEFAULT_MODELS = ("harris-exact", "harris-raster", "harris-preview", "saturated-exact")
+
+
+def model_names(text: str) -> tuple[str, ...]:
+    """--models: names of `MODELS`, comma-separated."""
+    names = tuple(name.strip() for name in text.split(",") if name.strip())
+    unknown = [name for name in names if name not in MODELS]
+    if unknown or not names:
+        raise ValueError(f"unknown model {', '.join(unknown)}; valid: {', '.join(MODELS)}")
+    return names
 
 
 def _model_renders(scene, camera, args) -> dict[str, tuple[np.ndarray, dict, float]]:
@@ -186,7 +205,8 @@ def _model_renders(scene, camera, args) -> dict[str, tuple[np.ndarray, dict, flo
     world = dataclasses.replace(scene, terrain=None, objects=())
     renders = {}
     with FrameRenderer(args.width, args.height) as renderer:
-        for name, (eye_pass, method) in MODELS.items():
+        for name in args.models:
+            eye_pass, method = MODELS[name]
             model_world = dataclasses.replace(world, shading=dataclasses.replace(world.shading, eye_pass=eye_pass))
             start = time.perf_counter()
             image, stats = renderer.render(

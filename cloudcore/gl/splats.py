@@ -2,7 +2,8 @@
 
 The particles stay on the GPU: `SplatPass` uploads a `ParticleBuffer`'s
 per-particle terms (centre, radius, scattering, ambient, incident light per
-light) once, into a storage buffer, and a compute shader colours each
+light; for Yusov's eye pass, the row of its light-leaving profiles, which
+go in a buffer of their own) once, into storage buffers, and a compute shader colours each
 particle of a draw for the eye (Harris eq. 5) into the instance attributes
 the splats are drawn from.  Per draw the CPU only orders:
 `splat_batch` gathers the particles of some clouds (several together, since
@@ -45,9 +46,15 @@ _CLOUD_FLOATS = 40
 #: per particle, written by the compute shader: four corners and four colours (vec4 each)
 _INSTANCE_BYTES = 8 * 16
 _UNLOCKED = (0.0, 0.0, 0.0, -1.0)
-(_PARTICLES_BINDING, _FORMATION_BINDING, _ORDER_BINDING, _INSTANCES_BINDING, _CLOUDS_BINDING, _FACING_BINDING) = range(
-    6
-)
+(
+    _PARTICLES_BINDING,
+    _FORMATION_BINDING,
+    _ORDER_BINDING,
+    _INSTANCES_BINDING,
+    _CLOUDS_BINDING,
+    _FACING_BINDING,
+    _PROFILES_BINDING,
+) = range(7)
 #: the compute shader's local_size_x
 _SHADE_GROUP = 64
 
@@ -135,7 +142,8 @@ class SplatPass:
             self._formation_buffer,
             self._cloud_buffer,
             self._facing_buffer,
-        ) = self._buffers = GL.glGenBuffers(7)
+            self._profile_buffer,
+        ) = self._buffers = GL.glGenBuffers(8)
         self._atlas: int | None = None  # the sprite atlas texture, made when a cloud first needs it
         self._quads_indexed = 0
         self._instance_capacity = 0
@@ -248,6 +256,7 @@ class SplatPass:
             (_INSTANCES_BINDING, self._instance_buffer),
             (_CLOUDS_BINDING, self._cloud_buffer),
             (_FACING_BINDING, self._facing_buffer),
+            (_PROFILES_BINDING, self._profile_buffer),
         ):
             GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, binding, buffer)
         GL.glUseProgram(self._shade_program)
@@ -273,6 +282,9 @@ class SplatPass:
             if self._atlas is None and np.any(particles.styles.sprite_index >= 0):
                 self._atlas = _atlas_texture()
             _store(self._formation_buffer, np.ones(max(len(particles.radii), 1), dtype=np.float32))
+            # Yusov's eye pass's profile rows; one float where there are none (no empty buffer is bound)
+            rows = np.zeros(0) if particles.profiles is None else particles.profiles.profiles.ravel()
+            _store(self._profile_buffer, (rows if rows.size else np.zeros(1)).astype(np.float32))
             _set_light_uniforms(self._shade_program, particles)
             self._resident, self._formation_time = particles, None
 
@@ -316,6 +328,7 @@ def _particle_records(particles: ParticleBuffer) -> np.ndarray:
     records[:n, 15] = styles.cloud_index
     records[:n, 16] = styles.sprite_index
     records[:n, 17] = styles.rotation
+    records[:n, 18] = -1.0 if particles.profiles is None else particles.profiles.rows
     records[:n, 20 : 20 + lights] = particles.incident
     return records
 
@@ -356,6 +369,9 @@ def _atlas_texture() -> int:
 
 def _set_light_uniforms(program: int, particles: ParticleBuffer) -> None:
     GL.glUseProgram(program)
+    # Yusov's eye pass: samples per profile row (the rows are in the profiles buffer)
+    samples = 0 if particles.profiles is None else particles.profiles.profiles.shape[2]
+    GL.glUniform1i(GL.glGetUniformLocation(program, "profile_samples"), samples)
     lights = len(particles.light_directions)
     GL.glUniform1i(GL.glGetUniformLocation(program, "light_count"), lights)
     if lights:

@@ -4,7 +4,10 @@ Harris eq. 5: a particle scatters toward the eye the light that reached it
 (precomputed per light by `cloudcore.light.illumination`) times its scattering
 coefficient times the phase function at the angle between the light and the
 view ray, plus ambient light in proportion to its opacity, all tinted by the
-cloud's colour (white by default).  A cloud that forms or dissipates has
+cloud's colour (white by default).  Yusov's eye pass (HPG 2014, section 4.4)
+replaces scattering coefficient times phase by its opacity times the light
+leaving his precomputed reference particle toward the eye, p(mu) single(mu) +
+multiple(mu) (`cloudcore.light.precomputed`).  A cloud that forms or dissipates has
 both scaled by its opacity factor (Wang section 4 multiplies it into the
 sprite's alpha; the colour here is premultiplied).  `light.direction`
 points from the scene toward the light, so a view ray pointing at the light
@@ -32,6 +35,7 @@ from cloudcore.artist.sprites import CELL_PIXELS
 from cloudcore.light.illumination import IlluminationCache, cloud_optics, illuminate_clouds
 from cloudcore.light.lighting import active_lights
 from cloudcore.light.phase import phase_function
+from cloudcore.light.precomputed import eye_pass_profiles
 from cloudcore.light.shading import eye_pass_coefficients
 from cloudcore.ramps import smoothstep
 from cloudcore.scene import Lighting, Shading
@@ -84,6 +88,11 @@ class ParticleBuffer:
         self.scattering, self.ambient_weight = eye_pass_coefficients(
             tau, albedo, shading.phase, shading.g, shading.eye_pass
         )
+        #: Yusov's eye pass: the reference particle's light leaving toward the eye, per particle; None
+        #: for the others, whose light is the phase function times the scattering coefficient
+        self.profiles = (
+            eye_pass_profiles(tau, albedo, shading.phase, shading.g) if shading.eye_pass == "yusov" else None
+        )
         self.tint = np.repeat(np.array([c.color for c in clouds], dtype=np.float64).reshape(-1, 3), counts, axis=0)
         incident = (
             cache.incident(clouds, shading, lights, method)
@@ -130,7 +139,11 @@ class ParticleBuffer:
         view = offset / np.maximum(distance, np.finfo(np.float64).tiny)[:, None]
         scattered = np.zeros((len(indices), 3))
         for light, (direction, radiance) in enumerate(zip(self.light_directions, self.light_radiance)):
-            phase = phase_function(view @ direction, self.phase, self.g)
+            mu = view @ direction
+            phase = phase_function(mu, self.phase, self.g)
+            if self.profiles is not None:
+                single, multiple = self.profiles.at(indices, mu)
+                phase = phase * single + multiple
             scattered += (self.incident[indices, light] * phase)[:, None] * radiance
         alpha = self.alpha[indices]
         ambient = self.ambient * self.ambient_weight[indices, None]

@@ -23,3 +23,16 @@ def splat_kernel(d) -> np.ndarray:
     d = np.asarray(d, dtype=np.float64)
     k = (np.exp(-SPLAT_SHARPNESS * d * d) - _FLOOR) / (1.0 - _FLOOR)
     return np.where(d < 1.0, np.maximum(k, 0.0), 0.0)
+
+
+def _kernel_diameter_integral(points: int = 64) -> float:
+    """The integral of K(|u|) over u in [-1, 1], by Gauss-Legendre on [0, 1] (K is smooth there: exact
+    to rounding at 64 points; tests/test_truth.py checks it against the closed form with erf)."""
+    nodes, weights = np.polynomial.legendre.leggauss(points)
+    return float(np.sum(weights * splat_kernel(0.5 * (nodes + 1.0))))  # 2 * (1/2) * sum over [0, 1]
+
+
+#: a blob of extinction c K(|x - p| / r) has optical depth c r times this along a diameter (the
+#: path-traced truth's particles, `cloudcore.light.truth`, and Yusov's reference particle,
+#: `cloudcore.light.precomputed`)
+KERNEL_DIAMETER_INTEGRAL = _kernel_diameter_integral()

@@ -33,6 +33,9 @@ Two methods:
   order-independent compositing.  Faster and approximate; see `docs/shading.md`.
 * "preview": the raster method on a grid of `PREVIEW_RASTER_RESOLUTION` cells:
   what the editor lights with while a lighting slider is dragged.
+* "occlusion": not Harris's: Yusov's light-space occlusion estimate (`cloudcore.light.occlusion`), the
+  sunlight through the other particles with no light order, each particle losing the share
+  1 - sigma_eff / alpha of what it stops; the light pass of Yusov's model (eye pass "yusov").
 """
 
 from __future__ import annotations
@@ -41,12 +44,16 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from cloudcore.light.kernel import splat_kernel
+from cloudcore.light.occlusion import occlusion_estimate
 from cloudcore.light.phase import check_phase, phase_function
+from cloudcore.light.precomputed import eye_pass_profiles
+from cloudcore.segments import concatenated_ranges
 
-METHODS = ("exact", "raster", "preview")
-#: what a particle sends toward the eye (`cloudcore.light.eye_scattering`): Harris's eq. 5 as printed, or
-#: "saturated", its scattering coefficient and ambient term made those of a thick medium
-EYE_PASSES = ("harris", "saturated")
+METHODS = ("exact", "raster", "preview", "occlusion")
+#: what a particle sends toward the eye (`cloudcore.light.eye_scattering`): Harris's eq. 5 as printed,
+#: "saturated", its scattering coefficient and ambient term made those of a thick medium, or "yusov", the
+#: light leaving Yusov's precomputed reference particle (`cloudcore.light.precomputed`)
+EYE_PASSES = ("harris", "saturated", "yusov")
 FOUR_PI = 4.0 * np.pi
 
 #: raster grid cells across the widest axis of a cloud's light-plane footprint.
@@ -88,6 +95,10 @@ def eye_pass_coefficients(
     alpha times the reflectance of a thick medium (1 - s) / (1 + s), s = sqrt(1 - a) (two-stream; 1 at
     albedo 1, where Harris's ambient term is exact).  Against the path-traced truth of the default view
     at 160x120: 13.0 -> 23.6 dB at noon, 15.0 -> 24.0 dB at 18:15, at the same cost (docs/shading.md).
+
+    "yusov": the opacity alpha, which multiplies the reference particle's light leaving toward the eye
+    (its view-dependent profiles: `cloudcore.light.precomputed.eye_pass_profiles`, which stand in for
+    the phase function), and alpha times the particle's response to uniform light.
     """
     if eye_pass not in EYE_PASSES:
         raise ValueError(f"unknown eye pass {eye_pass!r}; valid: {', '.join(EYE_PASSES)}")
@@ -96,6 +107,8 @@ def eye_pass_coefficients(
     alpha = -np.expm1(-tau)
     if eye_pass == "harris":
         return scattering_coefficient(tau, albedo, phase, g), alpha
+    if eye_pass == "yusov":
+        return alpha, alpha * eye_pass_profiles(tau, albedo, phase, g).ambient
     s = np.sqrt(1.0 - albedo)
     # the same cap as Harris's: no particle sends more light forward than it stops
     p_forward = float(phase_function(1.0, phase, g))
@@ -139,6 +152,9 @@ def incident_light(
     sigma = scattering_coefficient(tau, albedo, phase, g) * float(phase_function(1.0, phase, g))
     if method == "exact":
         result = _incident_exact(plane, toward_light, radii, alpha, sigma, groups)
+    elif method == "occlusion":
+        lost = 1.0 - np.divide(sigma, alpha, out=np.zeros(n), where=alpha > 0.0)
+        result = occlusion_estimate(plane, toward_light, radii, tau, lost, groups)
     else:
         grid = PREVIEW_RASTER_RESOLUTION if method == "preview" else int(resolution)
         result = _incident_raster(plane, toward_light, radii, alpha, sigma, groups, grid)
@@ -274,16 +290,6 @@ def _incident_in_light_order(source, target, weight, alpha, sigma):
         np.subtract.at(waiting, released, 1)
         ready = np.unique(released[waiting[released] == 0])
     return incident
-
-
-def concatenated_ranges(starts: np.ndarray, counts: np.ndarray) -> np.ndarray:
-    """concatenate(arange(s, s + c) for s, c in zip(starts, counts)), vectorised."""
-    total = int(counts.sum())
-    if total == 0:
-        return np.zeros(0, dtype=np.int64)
-    ends = np.cumsum(counts)
-    offsets = np.repeat(starts - (ends - counts), counts)
-    return np.arange(total) + offsets
 
 
 def _compose_segments(through: np.ndarray, scattered: np.ndarray, lengths: np.ndarray):

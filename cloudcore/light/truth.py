@@ -31,24 +31,13 @@ import numpy as np
 from cloudcore.camera import FAR_PLANE_M, NEAR_PLANE_M, camera_pose, pixel_rays
 from cloudcore.colour import srgb_decode
 from cloudcore.light.illumination import cloud_optics
-from cloudcore.light.kernel import splat_kernel
+from cloudcore.light.kernel import KERNEL_DIAMETER_INTEGRAL, splat_kernel
 from cloudcore.light.lighting import active_lights, scene_hour, scene_lights, sky_colors, sky_gradient
 from cloudcore.light.phase import phase_function
-from cloudcore.light.shading import concatenated_ranges
 from cloudcore.measure.benchmark import PSNR_CAP_DB
 from cloudcore.measure.imagecompare import compare
 from cloudcore.scene import Camera, Scene
-
-
-def _kernel_diameter_integral(points: int = 64) -> float:
-    """The integral of K(|u|) over u in [-1, 1], by Gauss-Legendre on [0, 1] (K is smooth there: exact
-    to rounding at 64 points; tests/test_truth.py checks it against the closed form with erf)."""
-    nodes, weights = np.polynomial.legendre.leggauss(points)
-    return float(np.sum(weights * splat_kernel(0.5 * (nodes + 1.0))))  # 2 * (1/2) * sum over [0, 1]
-
-
-#: a particle's optical depth along a diameter is its centre's extinction times its radius times this
-KERNEL_DIAMETER_INTEGRAL = _kernel_diameter_integral()
+from cloudcore.segments import concatenated_ranges
 
 #: voxels across the scene's median particle radius: the line integral through a particle's centre is
 #: within 1% of its tau at 3 (tests/test_truth.py); the default scene then has about 10 million voxels

@@ -8,7 +8,11 @@
 // Colour, Harris (reference cloudcore.light.eye_scattering.ParticleShading.seen_from):
 // per light, the incident light of the light pass times the phase function at
 // the angle between the view ray and the light, times the scattering
-// coefficient, plus ambient.  Colour, Wang's artist model (reference
+// coefficient, plus ambient; for Yusov's eye pass (reference
+// cloudcore.light.precomputed.EyePassProfiles.at) the phase function times the
+// reference particle's single scattering plus its multiple scattering, both
+// read from the particle's profile row linearly in mu, stand in for the
+// phase function.  Colour, Wang's artist model (reference
 // cloudcore.artist.artist_shading.artist_colours): the cloud's five vertical colour
 // levels at each corner's height plus the directional term of its shading
 // group, per corner.  Opacity: splats fade out next to the eye; sprites lock
@@ -28,7 +32,7 @@ struct Particle {
     vec4 scattering_opacity;  // scattering coefficient x tint (rgb), opacity
     vec4 ambient;             // ambient x opacity x tint (rgb), unused
     vec4 group_cloud;         // shading group centre xyz, cloud index
-    vec4 sprite;              // atlas cell (-1: Gaussian splat), rotation (radians), unused, unused
+    vec4 sprite;              // atlas cell (-1: Gaussian splat), rotation (radians), profile row (-1: none), unused
     float incident[MAX_LIGHTS];
 };
 struct CloudStyle {
@@ -49,6 +53,8 @@ layout(std430, binding = 2) readonly buffer Order { uint order[]; };
 layout(std430, binding = 3) writeonly buffer Instances { Instance instances[]; };
 layout(std430, binding = 4) readonly buffer Clouds { CloudStyle clouds[]; };
 layout(std430, binding = 5) readonly buffer Facing { vec4 facing[]; };  // locked normal, fade (< 0: unlocked)
+// rows of Yusov's eye pass: single then multiple scattering at profile_samples mu from -1 to 1
+layout(std430, binding = 6) readonly buffer Profiles { float profiles[]; };
 
 uniform uint count;
 uniform vec3 eye;
@@ -59,6 +65,7 @@ uniform vec3 light_direction[MAX_LIGHTS];  // toward the light
 uniform vec3 light_radiance[MAX_LIGHTS];
 uniform int phase_kind;  // cloudcore.light.phase.PHASE_NAMES order
 uniform float g;
+uniform int profile_samples;
 
 const int FACING_SPLAT = 0;
 const int FACING_HORIZONTAL = 2;
@@ -81,11 +88,26 @@ float ramp(float edge0, float edge1, float x)
     return t * t * (3.0 - 2.0 * t);
 }
 
+// the row's profile `part` (0 single, 1 multiple) at mu, linear between samples
+float profile(int row, int part, float mu)
+{
+    float position = (clamp(mu, -1.0, 1.0) + 1.0) * 0.5 * float(profile_samples - 1);
+    int below = min(int(position), profile_samples - 2);
+    int start = (row * 2 + part) * profile_samples + below;
+    return mix(profiles[start], profiles[start + 1], position - float(below));
+}
+
 vec4 harris_colour(Particle p, vec3 view_ray)
 {
+    int row = int(p.sprite.z);
     vec3 scattered = vec3(0.0);
-    for (int light = 0; light < light_count; ++light)
-        scattered += p.incident[light] * phase(dot(view_ray, light_direction[light])) * light_radiance[light];
+    for (int light = 0; light < light_count; ++light) {
+        float mu = dot(view_ray, light_direction[light]);
+        float factor = phase(mu);
+        if (row >= 0)
+            factor = factor * profile(row, 0, mu) + profile(row, 1, mu);
+        scattered += p.incident[light] * factor * light_radiance[light];
+    }
     return vec4(scattered * p.scattering_opacity.rgb + p.ambient.rgb, p.scattering_opacity.a);
 }
 
