@@ -189,12 +189,12 @@ class RenderSettings:
         help="draw plain splats as point sprites (one vertex instead of four) where the picture is the same",
         label="Point sprites",
     )
-    #: multisample the world (terrain, objects) 4x: smooth ridge lines against the sky, for 4 times the world
-    #: pass at 640x480 and 5.6 at 1280x800 on llvmpipe (46.6 and 48.8 dB without it: docs/performance.md)
+    #: multisample the world (terrain, objects) 4x: smooth ridge lines against the sky, for twice the world
+    #: pass on llvmpipe (640x480 and 1280x800; without it 47.4 and 49.1 dB: docs/performance.md)
     world_antialiasing: bool = _setting(
         False,
         flag="--world-antialiasing",
-        help="multisample the terrain and objects 4x: smooth edges against the sky, at 4-6x the world pass's time",
+        help="multisample the terrain and objects 4x: smooth edges against the sky, for twice the world pass's time",
         label="Antialiased world",
     )
     #: "plain": premultiplied billboards (ONE, ONE_MINUS_SRC_ALPHA); "volume": Yusov's volume-aware

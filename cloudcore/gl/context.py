@@ -14,8 +14,8 @@ headless tools make the same picture:
 - `WindowContext` (the editor): the window's context is current already.
 
 Multisampling the world is a choice per frame (`render_pyrender_scene`'s
-`antialiased`): on llvmpipe it makes the world pass 4 to 5.6 times slower for
-46.6-48.8 dB (docs/performance.md), so the frame's default is without.
+`antialiased`): on llvmpipe it doubles the world pass for 47.4-49.1 dB
+(docs/performance.md), so the frame's default is without.
 """
 
 from __future__ import annotations
