@@ -5,6 +5,10 @@ hash of its key, and the key is also stored inside, so a hash collision, a file 
 version or a truncated or corrupt file reads as a miss and is rebuilt, never as a wrong answer or a
 crash.  Entries are written atomically (`cloudcore.particle_files.atomic_write`): a crash mid-write
 leaves the old entry or none.
+
+The package ships the entries nearly every scene needs (`cloudcore/resources/cache`, laid out as the
+cache is; `scripts/make_cache_entries.py` writes them), read before the user's cache: a fresh install
+never spends a minute building them.
 """
 
 from __future__ import annotations
@@ -18,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from cloudcore.particle_files import atomic_write
+from cloudcore.resources import resource_path
 
 _KEY_FIELD = "__cache_key__"
 
@@ -28,10 +33,16 @@ def cache_directory() -> Path:
     return Path(base) / "cloudview"
 
 
-def entry_path(kind: str, key: dict) -> Path:
-    """The file of `key` (a JSON-able dict naming every parameter the entry depends on) of `kind`."""
+def shipped_directory() -> Path:
+    """The entries that ship with the package, read-only."""
+    return resource_path("cache")
+
+
+def entry_path(kind: str, key: dict, directory: Path | None = None) -> Path:
+    """The file of `key` (a JSON-able dict naming every parameter the entry depends on) of `kind`, in
+    `directory` (the user's cache by default)."""
     digest = hashlib.sha256(_canonical(key).encode()).hexdigest()[:24]
-    return cache_directory() / kind / f"{digest}.npz"
+    return (cache_directory() if directory is None else directory) / kind / f"{digest}.npz"
 
 
 def load_or_build(kind: str, key: dict, build) -> tuple[dict[str, np.ndarray], bool]:
@@ -40,20 +51,27 @@ def load_or_build(kind: str, key: dict, build) -> tuple[dict[str, np.ndarray], b
     `build` returns a dict of numpy arrays.  A cache that cannot be written (a read-only home) costs the
     rebuild next time, not the result now.
     """
-    path = entry_path(kind, key)
-    held = _read(path, key)
-    if held is not None:
-        return held, True
+    for directory in (shipped_directory(), cache_directory()):
+        held = _read(entry_path(kind, key, directory), key)
+        if held is not None:
+            return held, True
     arrays = build()
+    try:
+        store(kind, key, arrays)
+    except OSError:
+        pass
+    return arrays, False
+
+
+def store(kind: str, key: dict, arrays: dict[str, np.ndarray], directory: Path | None = None) -> Path:
+    """Write the entry `key` of `kind` (atomically) into `directory` (the user's cache by default)."""
+    path = entry_path(kind, key, directory)
 
     def write(file):
         np.savez(file, **arrays, **{_KEY_FIELD: np.array(_canonical(key))})
 
-    try:
-        atomic_write(path, write)
-    except OSError:
-        pass
-    return arrays, False
+    atomic_write(path, write)
+    return path
 
 
 def _read(path: Path, key: dict) -> dict[str, np.ndarray] | None:

@@ -19,7 +19,9 @@ from cloudcore.light.precomputed import (
     reference_tables,
 )
 from cloudcore.light.shading import eye_pass_coefficients, incident_light
+from cloudcore.resources import resource_path
 from cloudcore.scene import Cloud, Light, Shading
+from cloudcore.scenefile import load_scene
 
 #: small enough to build in about a second: for the tests of the cache, not of accuracy
 TINY = TableResolution(
@@ -194,3 +196,27 @@ def test_the_estimate_keeps_groups_apart_and_its_extremes_finite():
     assert np.all(np.isfinite(extremes)) and np.all((extremes >= 0.0) & (extremes <= 1.0))
     coincident = incident_light(np.zeros((3, 3)), 1.0, 8.0, 0.9, [1, 0, 0], method="occlusion")
     assert np.all(np.isfinite(coincident))
+
+
+def test_the_tables_of_every_shipped_scenes_phase_function_ship_with_the_package(tmp_path, monkeypatch):
+    """A fresh install reads them (`scripts/make_cache_entries.py` writes them): nothing to build for a minute."""
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))  # an empty user cache
+    for scene_file in sorted(resource_path("scenes").glob("*.toml")):
+        shading = load_scene(scene_file).shading
+        g = 0.0 if shading.phase == "rayleigh" else shading.g
+        arrays, cached = disk_cache.load_or_build(
+            precomputed.CACHE_KIND, precomputed.cache_key(shading.phase, g), lambda: pytest.fail("built")
+        )
+        assert cached and arrays["single"].size, scene_file.name
+    assert not list(tmp_path.rglob("*.npz"))  # and nothing was written into the user's cache
+
+
+def test_a_shipped_entry_is_read_before_the_users_cache(tmp_path, monkeypatch):
+    shipped, users = tmp_path / "shipped", tmp_path / "users"
+    monkeypatch.setattr(disk_cache, "shipped_directory", lambda: shipped)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(users))
+    key = {"format": 1, "what": "a"}
+    disk_cache.store("kind", key, {"x": np.ones(2)}, shipped)
+    disk_cache.store("kind", key, {"x": np.zeros(2)})
+    arrays, cached = disk_cache.load_or_build("kind", key, lambda: pytest.fail("built"))
+    assert cached and arrays["x"].tolist() == [1.0, 1.0]

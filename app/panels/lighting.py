@@ -57,8 +57,8 @@ class LightingPanel:
         imgui.set_item_tooltip(
             "harris: Harris's eye scattering; saturated: its scattering saturated for opaque particles and the "
             "ambient light a thick medium's (closer to the path-traced truth: docs/shading.md); yusov: the light "
-            "leaving Yusov's precomputed reference particle (its tables take about a minute to build once "
-            "per phase function and g, then come from the cache)."
+            "leaving Yusov's precomputed reference particle (its tables ship for Rayleigh; another phase "
+            "function or g takes about a minute to build once, then comes from the cache)."
         )
         changes = {key: value for key, value in changes.items() if value is not None}
         if changed_phase:

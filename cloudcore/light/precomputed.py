@@ -231,10 +231,20 @@ def reference_tables(
 _held: dict[tuple, ReferenceTables] = {}
 
 
+#: the disk cache's name for the tables (`cloudcore.disk_cache`)
+CACHE_KIND = "reference-particle"
+
+
+def cache_key(phase: str, g: float, resolution: TableResolution = TableResolution()) -> dict:
+    """Every parameter the tables depend on, as the disk cache keys them."""
+    return {"format": FORMAT_VERSION, "phase": phase, "g": g, "resolution": dataclasses.asdict(resolution)}
+
+
 def _load_or_build(phase: str, g: float, resolution: TableResolution) -> ReferenceTables:
-    key = {"format": FORMAT_VERSION, "phase": phase, "g": g, "resolution": dataclasses.asdict(resolution)}
     start = time.perf_counter()
-    arrays, cached = disk_cache.load_or_build("reference-particle", key, lambda: build_tables(phase, g, resolution))
+    arrays, cached = disk_cache.load_or_build(
+        CACHE_KIND, cache_key(phase, g, resolution), lambda: build_tables(phase, g, resolution)
+    )
     return ReferenceTables(
         **arrays, phase=phase, g=g, build_s=0.0 if cached else time.perf_counter() - start, cached=cached
     )
