@@ -153,6 +153,23 @@ def the_saturated_eye_pass_darkens_the_clouds(ctx, app: EditorUnderTest):
     CHECK(app.editor.scene.shading.eye_pass == "harris")
 
 
+def the_occlusion_light_pass_relights_the_clouds(ctx, app: EditorUnderTest):
+    """Yusov's occlusion estimate, chosen in the Lighting panel, lights the clouds in the worker: a new picture."""
+    use_window(ctx, "Lighting")
+    app.relit(ctx)
+    harris = app.capture(ctx)
+    ctx.combo_click("Light pass/occlusion")
+    CHECK(app.editor.scene.shading.light_pass == "occlusion")
+    ctx.yield_(SETTLE)
+    app.relit(ctx)
+    occlusion = app.capture(ctx)
+    changed = (np.abs(harris.astype(int) - occlusion.astype(int)).max(axis=2) > 4).mean()
+    app.outcome["occlusion_light_pass_changed_fraction"] = float(changed)
+    CHECK(bool(changed > 0.02))  # the clouds, not the sky
+    undo(ctx)
+    CHECK(app.editor.scene.shading.light_pass == "harris")
+
+
 def dragging_the_time_of_day_relights_live(ctx, app: EditorUnderTest):
     """The viewport follows the slider while it moves, shaded in the worker; exact once let go."""
     use_window(ctx, "Lighting")
@@ -166,7 +183,6 @@ def dragging_the_time_of_day_relights_live(ctx, app: EditorUnderTest):
 
     ctx.mouse_move_to_pos(at(9.0))
     ctx.mouse_down(0)
-    first = len(app.editor.frame_times)
     started = time.perf_counter()
     steps = max(20, int(slider.max.x - slider.min.x) // 4)  # 9 to 15 hours: a pixel and more a frame
     for step in range(1, steps + 1):
@@ -174,7 +190,8 @@ def dragging_the_time_of_day_relights_live(ctx, app: EditorUnderTest):
         ctx.yield_()
     ctx.mouse_up(0)
     dragged_s = time.perf_counter() - started
-    during = [stats for stats in list(app.editor.frame_times)[first:]]
+    # by start time: editor.frame_times keeps the last frames only, so a count taken before the drag may be stale
+    during = [stats for stats in list(app.editor.frame_times) if stats.frame_start_s >= started]
     shown = [frame.shown_time_of_day for frame in during]
     relit_looks = len({hours for hours in shown}) - 1  # the looks shown after the first
     gaps_ms = [1e3 * (b.frame_start_s - a.frame_start_s) for a, b in zip(during, during[1:])]
@@ -599,6 +616,7 @@ GUI_TESTS = (
     place_particles_by_clicking,
     time_of_day_changes_the_picture,
     the_saturated_eye_pass_darkens_the_clouds,
+    the_occlusion_light_pass_relights_the_clouds,
     dragging_the_time_of_day_relights_live,
     tolerance_drives_regeneration,
     save_and_reopen,

@@ -73,13 +73,16 @@ class Lighting:
 class Shading:
     """Harris's defaults for every cloud; `eye_pass` chooses what a particle sends to the eye
     (`cloudcore.light.shading.EYE_PASSES`: Harris's eq. 5, its saturated form, closer to the path-traced
-    truth, or Yusov's precomputed reference particle: docs/shading.md)."""
+    truth, or Yusov's precomputed reference particle: docs/shading.md) and `light_pass` how the light
+    reaching it is found (`LIGHT_PASSES`: Harris's multiple forward scattering or Yusov's occlusion
+    estimate; "yusov" and "occlusion" together are Yusov's model)."""
 
     albedo: float = 0.9
     optical_depth: float = 8.0
     phase: str = "rayleigh"
     g: float = 0.0
     eye_pass: str = "harris"
+    light_pass: str = "harris"
 
 
 @dataclass(frozen=True, eq=False)

@@ -19,7 +19,7 @@ import tomlkit
 from cloudcore.artist.cloudgen import PRESETS
 from cloudcore.cloud_records import FACINGS, FORMATION_KINDS, MAX_SEED, ArtistShading, Formation, SpriteStyle
 from cloudcore.light.phase import MAX_ABS_G, PHASE_NAMES
-from cloudcore.light.shading import EYE_PASSES
+from cloudcore.light.shading import EYE_PASSES, LIGHT_PASSES
 from cloudcore.limits import scene_limit_problems
 from cloudcore.particle_files import atomic_write, remove_unnamed_particle_files, store_particles
 from cloudcore.scene import (
@@ -247,6 +247,7 @@ def _shading(t: Table) -> Shading:
         phase=t.string("phase", d.phase, choices=PHASE_NAMES),
         g=t.number("g", d.g, low=-MAX_ABS_G, high=MAX_ABS_G),
         eye_pass=t.string("eye_pass", d.eye_pass, choices=EYE_PASSES),
+        light_pass=t.string("light_pass", d.light_pass, choices=LIGHT_PASSES),
     )
 
 
@@ -449,8 +450,9 @@ def scene_to_dict(scene: Scene) -> dict:
         ]
     data["lighting"] = lighting
     data["shading"] = {"albedo": s.albedo, "optical_depth": s.optical_depth, "phase": s.phase, "g": s.g}
-    if s.eye_pass != Shading().eye_pass:  # files that keep Harris's eye pass stay as they were
-        data["shading"]["eye_pass"] = s.eye_pass
+    for key in ("eye_pass", "light_pass"):  # files that keep Harris's passes stay as they were
+        if getattr(s, key) != getattr(Shading(), key):
+            data["shading"][key] = getattr(s, key)
     if scene.terrain is not None:
         t = scene.terrain
         terrain = {

@@ -8,6 +8,7 @@ from scipy.integrate import quad
 from cloudcore import disk_cache
 from cloudcore.light import precomputed
 from cloudcore.light.eye_scattering import ParticleBuffer
+from cloudcore.light.illumination import illuminate_direction
 from cloudcore.light.kernel import KERNEL_DIAMETER_INTEGRAL, splat_kernel
 from cloudcore.light.occlusion import occlusion_estimate
 from cloudcore.light.phase import phase_function
@@ -20,8 +21,8 @@ from cloudcore.light.precomputed import (
 )
 from cloudcore.light.shading import eye_pass_coefficients, incident_light
 from cloudcore.resources import resource_path
-from cloudcore.scene import Cloud, Light, Shading
-from cloudcore.scenefile import load_scene
+from cloudcore.scene import Cloud, Light, Scene, Shading
+from cloudcore.scenefile import load_scene, save_scene
 
 #: small enough to build in about a second: for the tests of the cache, not of accuracy
 TINY = TableResolution(
@@ -220,3 +221,21 @@ def test_a_shipped_entry_is_read_before_the_users_cache(tmp_path, monkeypatch):
     disk_cache.store("kind", key, {"x": np.zeros(2)})
     arrays, cached = disk_cache.load_or_build("kind", key, lambda: pytest.fail("built"))
     assert cached and arrays["x"].tolist() == [1.0, 1.0]
+
+
+def test_a_scenes_occlusion_light_pass_runs_yusovs_estimate_where_harris_exact_would(tmp_path):
+    rng = np.random.default_rng(3)
+    clouds = [Cloud("c", np.column_stack([rng.normal(0.0, 60.0, (80, 3)), np.full(80, 30.0)]))]
+    sun = (0.3, 0.8, 0.5)
+    occlusion = Shading(light_pass="occlusion")
+    estimated = illuminate_direction(clouds, occlusion, sun, "exact")[0]
+    np.testing.assert_array_equal(estimated, illuminate_direction(clouds, Shading(), sun, "occlusion")[0])
+    assert np.abs(estimated - illuminate_direction(clouds, Shading(), sun, "exact")[0]).max() > 1e-3
+    # the editor's preview while a slider moves stays Harris's fast one
+    np.testing.assert_array_equal(
+        illuminate_direction(clouds, occlusion, sun, "preview")[0],
+        illuminate_direction(clouds, Shading(), sun, "preview")[0],
+    )
+    path = tmp_path / "s.toml"
+    save_scene(Scene(shading=occlusion, clouds=tuple(clouds)), path)
+    assert load_scene(path).shading.light_pass == "occlusion" and 'light_pass = "occlusion"' in path.read_text()

@@ -9,7 +9,7 @@ from imgui_bundle import imgui
 from app.editor import Editor
 from app.panels.widgets import ReleasedSliders
 from cloudcore.light.phase import PHASE_NAMES
-from cloudcore.light.shading import EYE_PASSES
+from cloudcore.light.shading import EYE_PASSES, LIGHT_PASSES
 
 #: the shading sliders: label -> (`Shading` field, low, high)
 _SHADING_SLIDERS = {
@@ -60,7 +60,16 @@ class LightingPanel:
             "leaving Yusov's precomputed reference particle (its tables ship for Rayleigh; another phase "
             "function or g takes about a minute to build once, then comes from the cache)."
         )
+        changed_light_pass, light_pass_index = imgui.combo(
+            "Light pass", LIGHT_PASSES.index(shading.light_pass), list(LIGHT_PASSES)
+        )
+        imgui.set_item_tooltip(
+            "harris: the light reaching each particle by Harris's multiple forward scattering; occlusion: by "
+            "Yusov's light-space occlusion estimate (with the yusov eye pass, Yusov's model)."
+        )
         changes = {key: value for key, value in changes.items() if value is not None}
+        if changed_light_pass:
+            changes["light_pass"] = LIGHT_PASSES[light_pass_index]
         if changed_phase:
             changes["phase"] = PHASE_NAMES[phase_index]
         if changed_eye_pass:

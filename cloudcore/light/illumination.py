@@ -53,6 +53,7 @@ def illuminate_direction(
     if sum(counts) == 0:
         return [np.zeros(n) for n in counts]
     optics = [cloud_optics(c, shading) for c in clouds]
+    method = light_pass_method(shading, method)
     incident = incident_light(
         np.concatenate([c.centres for c in clouds]),
         np.concatenate([c.radii for c in clouds]),
@@ -66,6 +67,13 @@ def illuminate_direction(
         resolution=resolution,
     )
     return np.split(incident, np.cumsum(counts)[:-1])
+
+
+def light_pass_method(shading: Shading, method: str) -> str:
+    """The incident-light method that runs when `method` is asked under `shading`: Yusov's occlusion
+    estimate in place of Harris's exact and raster passes where `shading.light_pass` says so; the
+    editor's preview (Harris's, fast while a slider moves) and an explicit method stay as asked."""
+    return "occlusion" if shading.light_pass == "occlusion" and method in ("exact", "raster") else method
 
 
 def light_directions(lights) -> tuple[tuple[float, ...], ...]:

@@ -54,6 +54,10 @@ METHODS = ("exact", "raster", "preview", "occlusion")
 #: "saturated", its scattering coefficient and ambient term made those of a thick medium, or "yusov", the
 #: light leaving Yusov's precomputed reference particle (`cloudcore.light.precomputed`)
 EYE_PASSES = ("harris", "saturated", "yusov")
+#: how the light reaching each particle is found (`[shading] light_pass`): Harris's multiple forward
+#: scattering (computed by the method asked: exact, raster or the editor's preview) or Yusov's
+#: light-space occlusion estimate (the method "occlusion" in place of exact and raster)
+LIGHT_PASSES = ("harris", "occlusion")
 FOUR_PI = 4.0 * np.pi
 
 #: raster grid cells across the widest axis of a cloud's light-plane footprint.
