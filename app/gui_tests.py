@@ -137,37 +137,35 @@ def time_of_day_changes_the_picture(ctx, app: EditorUnderTest):
     CHECK(bool(changed > 0.3))  # the sky and the clouds both change
 
 
-def the_saturated_eye_pass_darkens_the_clouds(ctx, app: EditorUnderTest):
+def shading_pictures(ctx, app: EditorUnderTest, field: str, choice: str) -> tuple[np.ndarray, np.ndarray]:
+    """The viewport relit with Harris's shading, then with `choice` picked in the Lighting panel's combo of
+    the `Shading` field `field` (the edit undone afterwards)."""
     use_window(ctx, "Lighting")
     app.relit(ctx)
-    harris = app.capture(ctx)
-    ctx.combo_click("Eye pass/saturated")
-    CHECK(app.editor.scene.shading.eye_pass == "saturated")
+    before = app.capture(ctx)
+    ctx.combo_click(f"{field.replace('_', ' ').capitalize()}/{choice}")
+    CHECK(getattr(app.editor.scene.shading, field) == choice)
     ctx.yield_(SETTLE)
     app.relit(ctx)
-    saturated = app.capture(ctx)
+    after = app.capture(ctx)
+    undo(ctx)
+    CHECK(getattr(app.editor.scene.shading, field) == "harris")
+    return before, after
+
+
+def the_saturated_eye_pass_darkens_the_clouds(ctx, app: EditorUnderTest):
+    harris, saturated = shading_pictures(ctx, app, "eye_pass", "saturated")
     darker = (harris.astype(int).sum(axis=2) - saturated.astype(int).sum(axis=2) > 30).mean()
     app.outcome["saturated_eye_pass_darker_fraction"] = float(darker)
     CHECK(bool(darker > 0.05))  # the clouds, not the sky
-    undo(ctx)
-    CHECK(app.editor.scene.shading.eye_pass == "harris")
 
 
 def the_occlusion_light_pass_relights_the_clouds(ctx, app: EditorUnderTest):
     """Yusov's occlusion estimate, chosen in the Lighting panel, lights the clouds in the worker: a new picture."""
-    use_window(ctx, "Lighting")
-    app.relit(ctx)
-    harris = app.capture(ctx)
-    ctx.combo_click("Light pass/occlusion")
-    CHECK(app.editor.scene.shading.light_pass == "occlusion")
-    ctx.yield_(SETTLE)
-    app.relit(ctx)
-    occlusion = app.capture(ctx)
+    harris, occlusion = shading_pictures(ctx, app, "light_pass", "occlusion")
     changed = (np.abs(harris.astype(int) - occlusion.astype(int)).max(axis=2) > 4).mean()
     app.outcome["occlusion_light_pass_changed_fraction"] = float(changed)
     CHECK(bool(changed > 0.02))  # the clouds, not the sky
-    undo(ctx)
-    CHECK(app.editor.scene.shading.light_pass == "harris")
 
 
 def dragging_the_time_of_day_relights_live(ctx, app: EditorUnderTest):
