@@ -224,6 +224,8 @@ def dragging_the_time_of_day_relights_live(ctx, app: EditorUnderTest):
 
 def tolerance_drives_regeneration(ctx, app: EditorUnderTest):
     use_window(ctx, "LOD")
+    # the small test scene is cheaper drawn all in full 3D, which auto mode finds by measuring: impostors only
+    ctx.combo_click("Mode/impostor")
     ctx.item_input_value("Tolerance (deg)", 5.0)
     use_window(ctx, "Camera")
     ctx.item_input_value("Orbit step (deg)", 0.5)
@@ -255,6 +257,7 @@ def tolerance_drives_regeneration(ctx, app: EditorUnderTest):
     postponed = sum(s.frame.plan.regenerations_postponed for s in budgeted if not s.picture_reused)
     use_window(ctx, "LOD")
     ctx.item_input_value("Regeneration budget", 0)
+    ctx.combo_click("Mode/auto")
     app.outcome["regenerations"] = {
         "tolerance 5": lenient,
         "tolerance 0.1": strict,
@@ -454,6 +457,7 @@ def volume_blending_composites_in_the_window(ctx, app: EditorUnderTest):
 
 def overlays_outline_impostors_and_the_ring(ctx, app: EditorUnderTest):
     use_window(ctx, "LOD")
+    ctx.combo_click("Mode/impostor")  # auto mode prices the ring, and the test scene's is dearer than its clouds
     ctx.item_check("Impostor outlines")
     ctx.item_check("Ring segments")
     ctx.yield_(SETTLE)
@@ -465,6 +469,7 @@ def overlays_outline_impostors_and_the_ring(ctx, app: EditorUnderTest):
     CHECK(plan.ring is not None and 0 < kinds.count("ring") <= 8)
     ctx.item_uncheck("Impostor outlines")
     ctx.item_uncheck("Ring segments")
+    ctx.combo_click("Mode/auto")
     ctx.yield_()
     CHECK(app.viewport.outlines_drawn == [])
 

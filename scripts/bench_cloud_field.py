@@ -1,7 +1,7 @@
 """Frame time of a cloud field against its rings and against its extent: 20 km of the demo's flight in auto mode (JSON).
 
     python scripts/bench_cloud_field.py [--stations 8] [--burst 16] [--warmup 6] [--width 320] [--height 240]
-                                        [--rings 2,3,4,5,6] [--json out/bench_cloud_field.json]
+                                        [--rings 2,3,4,5,6] [--modes full,impostor] [--json out/bench_cloud_field.json]
 
 The demo scene (`cloudcore/resources/scenes/cumulus_field.toml`: 100 km of cumulus, 5 rings) is flown over
 the first 20 km of its `flight` path (at 2 km through the clouds, then climbing above them) in auto mode
@@ -11,7 +11,9 @@ frames of rebuild and fade; impostors are remade every frame), so the flight is 
 places spread evenly over the 20 km, and at each a burst of `--burst` frames flown at 200 m/s and 30 fps
 (6.7 m a frame), of which the first `--warmup` (the jump from the last station: cells entering, the ring
 and impostors catching up) are reported apart.  Once per configuration: each number of `--rings` at the
-demo's extent, and the demo's rings at 4x its extent (400 km).  The configurations are interleaved frame
+demo's extent, the demo's rings at 4x its extent (400 km), and the demo in each of `--modes` (auto mode
+against full 3D and impostor mode: every frame of these and of the demo compared with full 3D's, PSNR).
+The configurations are interleaved frame
 by frame (one renderer each, all in this process), so a load on the machine slows them alike and the
 ratios hold.  Per configuration: the whole `render` call (`render_ms`: the field's update, lighting entering
 cells and rebuilding the particle buffer, the passes), the renderer's own frame time (`frame_ms`: the passes
@@ -35,6 +37,7 @@ os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 from cloudcore.field.state import FieldState, update_field  # noqa: E402
 from cloudcore.gl import FrameRenderer  # noqa: E402
 from cloudcore.measure.benchmark import machine, write_report  # noqa: E402
+from cloudcore.measure.imagecompare import compare  # noqa: E402
 from cloudcore.paths import camera_on_path  # noqa: E402
 from cloudcore.resources import CUMULUS_FIELD  # noqa: E402
 from cloudcore.scenefile import load_scene  # noqa: E402
@@ -67,6 +70,7 @@ def main() -> None:
     parser.add_argument(
         "--rings", default="2,3,4,5,6", help="ring counts to fly at the demo's extent (its own is always flown)"
     )
+    parser.add_argument("--modes", default="full,impostor", help="modes to fly the demo in beside auto ('' none)")
     parser.add_argument("--json", type=Path)
     args = parser.parse_args()
 
@@ -78,19 +82,27 @@ def main() -> None:
         field, extent=tuple(4.0 * side for side in field.extent)
     )
     scenes = {name: dataclasses.replace(demo, cloud_field=f) for name, f in configurations.items()}
+    demo_name = f"rings={field.rings}"
+    settings = dict.fromkeys(scenes, RenderSettings())  # auto mode
+    modes = [mode for mode in args.modes.split(",") if mode]
+    for mode in modes:
+        scenes[f"mode={mode}"], settings[f"mode={mode}"] = demo, RenderSettings(mode=mode)
+    compared = {demo_name, *(f"mode={mode}" for mode in modes)} if "full" in modes else set()
     renderers = {name: FrameRenderer(args.width, args.height) for name in scenes}
     states = dict.fromkeys(scenes, FieldState())
-    settings = RenderSettings()  # auto mode
     rows = {name: [] for name in scenes}
     stations = np.linspace(0.0, FLOWN_M - args.burst * FRAME_STEP_M, args.stations)
     distances = (stations[:, None] + FRAME_STEP_M * np.arange(args.burst)).ravel()
     for frame, camera in enumerate(views_along(demo, "flight", distances)):
+        images = {}
         for name, scene in scenes.items():
             start = time.perf_counter()
             field_frame, states[name] = update_field(scene.cloud_field, camera.position, states[name])
             update_ms = 1e3 * (time.perf_counter() - start)
             start = time.perf_counter()
-            _, stats = renderers[name].render(scene, camera=camera, settings=settings, read_back=False)
+            images[name], stats = renderers[name].render(
+                scene, camera=camera, settings=settings[name], read_back=name in compared
+            )
             render_ms = 1e3 * (time.perf_counter() - start)
             rows[name].append(
                 {
@@ -109,8 +121,12 @@ def main() -> None:
                     "cells_made": len(states[name].made),
                     "particles_drawn": stats.particles_drawn,
                     "impostors_regenerated": stats.plan.impostors_regenerated,
+                    "ring_panels_drawn": stats.plan.ring_panels_drawn,
+                    "clouds_inside": stats.plan.clouds_by_kind.get("inside", 0),
                 }
             )
+        for name in compared:
+            rows[name][-1]["psnr_db"] = min(compare(images[name], images["mode=full"]).psnr_db, 99.0)
     for renderer in renderers.values():
         renderer.close()
 
@@ -128,6 +144,14 @@ def main() -> None:
             "median_cloud_ms": float(np.median(column["cloud_ms"])),
             "mean_impostor_update_ms": float(column["impostor_update_ms"].mean()),
             "median_world_ms": float(np.median(column["world_ms"])),
+            "mean_cloud_and_update_ms": float((column["cloud_ms"] + column["impostor_update_ms"]).mean()),
+            "mean_ring_panels_drawn": float(column["ring_panels_drawn"].mean()),
+            "mean_clouds_inside": float(column["clouds_inside"].mean()),
+            **(
+                {"psnr_mean_db": float(column["psnr_db"].mean()), "psnr_min_db": float(column["psnr_db"].min())}
+                if "psnr_db" in column
+                else {}
+            ),
             "mean_field_particles": float(column["field_particles"].mean()),
             "max_cells_held": int(column["cells_held"].max()),
             "flying_frames_with_cells_made": int(np.count_nonzero(column["cells_made"])),
@@ -143,14 +167,14 @@ def main() -> None:
         }
 
     summaries = {name: summary(frames) for name, frames in rows.items()}
-    reference = summaries[f"rings={field.rings}"]
+    reference = summaries[demo_name]
     for numbers in summaries.values():
         for key in ("median_render_ms", "mean_render_ms", "p95_render_ms", "median_frame_ms"):
             numbers[f"{key}_ratio_to_demo"] = numbers[key] / reference[key]
     report = {
         "command": "python scripts/bench_cloud_field.py "
         f"--stations {args.stations} --burst {args.burst} --warmup {args.warmup} "
-        f"--width {args.width} --height {args.height} --rings {args.rings}",
+        f"--width {args.width} --height {args.height} --rings {args.rings} --modes {args.modes}",
         "machine": machine(),
         "date": time.strftime("%Y-%m-%d"),
         "flown_m": FLOWN_M,

@@ -51,7 +51,7 @@ from cloudcore.camera import (
     splats_in_frustum,
     view_matrix,
 )
-from cloudcore.lod.costs import CostEstimator, CostModel, Work, full_work, quad_work, regeneration_work
+from cloudcore.lod.costs import CostEstimator, CostModel, Work, quad_work, regeneration_work, splat_fragments
 from cloudcore.lod.impostors import (
     INSIDE_RADII,
     TRANSLATION_METRICS,
@@ -65,7 +65,7 @@ from cloudcore.lod.impostors import (
     screen_size_px,
     tolerance_deg_for,
 )
-from cloudcore.lod.ring import RingPlan, RingState, plan_ring, segment_texture_size
+from cloudcore.lod.ring import SEGMENT_DEG, RingPlan, RingState, plan_ring, ring_members, segment_texture_size
 from cloudcore.lod.splitting import layer_bounds, layer_counts, layer_sort_key, objects_inside
 from cloudcore.lod.units import LodUnits
 from cloudcore.measure.frame_stats import PlanStats
@@ -87,6 +87,17 @@ SWITCH_MARGIN = 0.25
 #: screen (`cloudcore.measure.overdraw.analytic_overdraw`); a ball of discs overestimates a near cloud tenfold, the
 #: parts of it beside and behind the eye costing nothing
 NEAR_EXACT_RADII = 3.0
+#: auto mode's choice between a frame of units each as priced and one all in full 3D is by the frames' measured
+#: times (the cost model, fitted to what is drawn, predicts the other poorly): the frames after a switch that do
+#: not count (crossfades and the ring's fade), the measured frames a choice needs, the age in frames after which
+#: the other's measurement is stale, and how close its predicted time must come for the other to be tried at all
+#: (a scene where full 3D is predicted four times dearer never stalls to find out)
+FRAME_SETTLE_FRAMES = 16
+PROBE_FRAMES = 8
+MEASUREMENT_AGE_FRAMES = 300
+PLAUSIBLE_RATIO = 1.5
+#: the running mean of a choice's frame times weighs each new frame at least this much
+FRAME_TIME_FORGETTING = 0.1
 #: a ring panel in view covers about this share of the screen (45 of ~75 degrees across, all the way up)
 RING_PANEL_SCREEN_SHARE = 0.6
 
@@ -142,10 +153,43 @@ class LodState:
     representations: Mapping = field(default_factory=dict)  # unit members -> Representation (auto mode)
     eye: tuple | None = None  # last frame's eye: the speed that predicts an impostor's lifetime
     costs: CostEstimator = CostEstimator()
+    #: auto mode draws a frame's units each as its price says ("units"), or every one in full 3D ("full"):
+    #: the choice for the next frame, the one this frame was drawn with and for how many frames in a row
+    frame_choice: str | None = None
+    drawn_as: str | None = None
+    frames_drawn_as: int = 0
+    frame_index: int = 0  # frames planned
+    frame_times: Mapping = field(default_factory=dict)  # choice -> FrameTime: how long its frames took, measured
 
     def measured(self, measurements) -> LodState:
-        """The state with this frame's (predicted work, measured ms) pairs folded into the cost fit."""
-        return dataclasses.replace(self, costs=self.costs.observe(measurements))
+        """The state with this frame's (predicted work, measured ms) pairs folded into the cost fit, and their
+        sum into the measured time of the way the frame was drawn (once the switch to it has settled)."""
+        frame_times = self.frame_times
+        total_ms = sum(ms for _, ms in measurements if math.isfinite(ms) and ms >= 0.0)
+        if self.drawn_as is not None and self.frames_drawn_as > FRAME_SETTLE_FRAMES:
+            held = frame_times.get(self.drawn_as)
+            running = held is not None and held.last_frame == self.frame_index - 1
+            frame_times = {
+                **frame_times,
+                self.drawn_as: FrameTime.after(held if running else None, total_ms, self.frame_index),
+            }
+        return dataclasses.replace(self, costs=self.costs.observe(measurements), frame_times=frame_times)
+
+
+@dataclass(frozen=True)
+class FrameTime:
+    """The measured time of the frames drawn one way, in a running mean over its last run of frames."""
+
+    mean_ms: float
+    frames: int
+    last_frame: int  # `LodState.frame_index` of the last frame measured
+
+    @staticmethod
+    def after(previous: FrameTime | None, ms: float, frame: int) -> FrameTime:
+        if previous is None:
+            return FrameTime(ms, 1, frame)
+        weight = max(1.0 / (previous.frames + 1), FRAME_TIME_FORGETTING)
+        return FrameTime((1.0 - weight) * previous.mean_ms + weight * ms, previous.frames + 1, frame)
 
 
 @dataclass(frozen=True)
@@ -258,16 +302,6 @@ def plan_frame(
     distances = np.linalg.norm(centres - eye, axis=1)
     cloud_keys = lighting_key if isinstance(lighting_key, tuple) else (lighting_key,) * sum(map(len, units.members))
     keys = tuple(tuple(cloud_keys[c] for c in members) for members in units.members)
-    ring = plan_ring(
-        state.ring,
-        centres,
-        radii,
-        eye,
-        settings,
-        keys,
-        units.members,
-        segment_texture_size(height, camera.fov_y_deg, settings),
-    )
     records = state.records
     present = set(units.members)
     next_records = {members: record for members, record in records.items() if members in present}
@@ -280,6 +314,56 @@ def plan_frame(
     focal_px = 0.5 * height / math.tan(math.radians(camera.fov_y_deg) / 2.0)
     screen_pixels = float(width * height)
     last_eye = None if state.eye is None else np.asarray(state.eye, dtype=np.float64)
+    # per unit, the translation error of one frame at the eye's current speed, and of the impostor held
+    rates = translation_error(centres, radii, last_eye, eye) if last_eye is not None else np.zeros(len(radii))
+    held_eyes = [records[members].eye if members in records else (math.nan,) * 3 for members in units.members]
+    held_errors = np.nan_to_num(
+        translation_error(centres, radii, np.array(held_eyes, dtype=np.float64).reshape(-1, 3), eye), nan=math.inf
+    )
+    # full 3D of every unit as a ball of discs (near units are counted splat by splat below)
+    ball_fragments = splat_fragments(
+        units.radius_squares, radii, distances, focal_px, units.particle_counts, screen_pixels
+    )
+    lifetimes = np.minimum(
+        np.divide(tolerance, rates, out=np.full(len(radii), math.inf), where=rates > 0.0), LONGEST_LIFETIME_FRAMES
+    )
+    # auto mode prices Wang's ring against drawing its clouds each as auto would (the cheaper of full 3D and
+    # an impostor): a sparse far field is cheaper drawn than its panels and their rebuilds
+    ring_ms = alone_ms = 0.0
+    candidates = np.zeros(len(radii), dtype=bool)
+    # auto mode found the last frame cheaper drawn all in full 3D (`_frame_choice`): every unit heads there
+    all_full = settings.mode == "auto" and state.frame_choice == "full"
+    in_view_of = {}  # unit index -> its full-3D work, splat by splat, for the ring's candidates in view
+    if settings.mode == "auto" and settings.uses_ring:
+        candidates = ring_members(centres, radii, eye, settings)
+        step = eye - last_eye if last_eye is not None else np.zeros(3)
+        ring_panels, ring_rebuild = _ring_work(
+            units, candidates, centres, eye, step, ball_fragments, screen_pixels, settings, state.ring
+        )
+        ring_ms = costs.ms(ring_panels + ring_rebuild)
+        alone = candidates & visible
+        in_view = (
+            _in_view_work(units, alone, cloud_splats, planes, eye, focal_px, screen_pixels)
+            if cloud_splats is not None
+            else (units.particle_counts[alone], ball_fragments[alone])
+        )
+        alone_ms = _alone_ms(
+            units, alone, in_view, distances, ball_fragments, lifetimes, focal_px, screen_pixels, settings, costs
+        )
+        in_view_of = {
+            int(i): Work(particles=float(p), fragments=float(f)) for i, p, f in zip(np.flatnonzero(alone), *in_view)
+        }
+    ring = plan_ring(
+        state.ring,
+        centres,
+        radii,
+        eye,
+        settings,
+        keys,
+        units.members,
+        segment_texture_size(height, camera.fov_y_deg, settings),
+        holds_clouds=settings.mode != "auto" or (not all_full and _ring_pays(state.ring, ring_ms, alone_ms)),
+    )
 
     def particles_of(index: int) -> np.ndarray:
         members = units.members[index]
@@ -322,9 +406,7 @@ def plan_frame(
         """The unit drawn in full 3D: a ball of discs far off; near, splat by splat, only the splats in the
         frustum (the renderer leaves out the rest), their discs clipped to the screen."""
         if cloud_splats is None or distance >= NEAR_EXACT_RADII * radius:
-            return full_work(
-                units.particle_counts[index], units.radius_squares[index], radius, distance, focal_px, screen_pixels
-            )
+            return Work(particles=float(units.particle_counts[index]), fragments=float(ball_fragments[index]))
         splats = [cloud_splats(c) for c in units.members[index]]
         splat_centres, splat_radii = np.concatenate([c for c, _ in splats]), np.concatenate([r for _, r in splats])
         seen = splats_in_frustum(planes, splat_centres, splat_radii)
@@ -335,10 +417,17 @@ def plan_frame(
 
     representations = {}
     update_work, cloud_work = Work(), Work()
+    # auto mode weighs the frame as planned unit by unit against every unit in full 3D in one sorted draw: splitting
+    # the particles into many draws between impostors costs what no unit's own price shows
+    everything_full, unit_prices = Work(batches=1.0), []
     clouds, wanted = [], []  # wanted: (index, priority, work) of the impostors past their tolerance
     for index, (centre, radius, distance) in enumerate(zip(centres, radii, distances)):
         distance, members = float(distance), units.members[index]
         individual = 1.0 - (ring.weight_of(members) if ring is not None else 0.0)
+        if individual <= 0.0 and radius > 0.0 and visible[index]:  # in the ring
+            everything_full += in_view_of.get(
+                index, Work(particles=float(units.particle_counts[index]), fragments=float(ball_fragments[index]))
+            )
         if radius <= 0.0 or individual <= 0.0 or not visible[index]:
             clouds.append(
                 CloudPlan(
@@ -353,7 +442,26 @@ def plan_frame(
         eye_inside = settings.mode != "full" and distance < INSIDE_RADII * radius
         # impostor mode draws no unit in full 3D but the one the eye is in: nothing else to price
         full = full_3d(index, radius, distance) if settings.mode != "impostor" or eye_inside else Work()
+        everything_full += full
         if eye_inside:
+            # a screen impostor has fewer fragments than the screen, not fewer particles; its composite
+            # over the screen is priced per run of inside units, below (here, for the choice, as one each)
+            screen_impostor = dataclasses.replace(full, fragments=full.fragments * settings.inside_resolution_scale**2)
+            full_ms, inside_ms = (
+                costs.ms(full),
+                costs.ms(screen_impostor + Work(quad_pixels=screen_pixels, quads=1, batches=1)),
+            )
+            if settings.mode == "auto" and individual == 1.0:
+                previous = state.representations.get(members)
+                held = previous.target if previous is not None and previous.full_weight == 1.0 else None
+                # the same particles either way
+                target = "full" if all_full else _cheapest(held, {"full": full_ms, "inside": inside_ms})
+                unit_prices.append((index, distance, full_ms, inside_ms))
+                representations[members] = Representation(target, 1.0)
+                if target == "full":
+                    clouds.append(in_full(index, distance, inside, splits, full_ms=full_ms, impostor_ms=inside_ms))
+                    cloud_work += full
+                    continue
             clouds.append(
                 CloudPlan(
                     index,
@@ -364,11 +472,11 @@ def plan_frame(
                     splits=splits,
                     layer_counts=counts(index, eye, splits),
                     members=members,
+                    full_ms=full_ms,
+                    impostor_ms=inside_ms,
                 )
             )
-            # a screen impostor has fewer fragments than the screen, not fewer particles; its composite
-            # over the screen is priced per run of inside units, below
-            cloud_work += dataclasses.replace(full, fragments=full.fragments * settings.inside_resolution_scale**2)
+            cloud_work += screen_impostor
             continue
         if settings.mode == "full":
             clouds.append(in_full(index, distance, inside, splits))
@@ -392,11 +500,9 @@ def plan_frame(
         # a unit fading into or out of the ring is drawn as an impostor: one layer scales exactly
         weight, full_ms, impostor_ms = 0.0, costs.ms(full), math.inf
         if settings.mode == "auto" and individual == 1.0:
-            rate = translation_error(centre, radius, last_eye, eye) if last_eye is not None else 0.0
-            lifetime = min(tolerance / rate, LONGEST_LIFETIME_FRAMES) if rate > 0.0 else LONGEST_LIFETIME_FRAMES
+            lifetime = float(lifetimes[index])
             impostor_ms = costs.ms(quad) + costs.ms(remake) / max(lifetime, 1.0)
-            held = records.get(members)
-            error = translation_error(centre, radius, held.eye, eye) if held is not None else math.inf
+            error = float(held_errors[index])
             budgeted = bool(settings.regeneration_budget or settings.frame_budget_ms)
             # an impostor within half its tolerance of the picture full 3D gives, or one remade from this very
             # eye, differs from it by less than a regeneration's own step: the switch needs no crossfade
@@ -405,8 +511,13 @@ def plan_frame(
                 "full": error <= 0.5 * tolerance,
             }
             representation = _represent(
-                state.representations.get(members), full_ms, impostor_ms, settings.transition_frames, close
+                state.representations.get(members),
+                full_ms,
+                math.inf if all_full else impostor_ms,
+                settings.transition_frames,
+                close,
             )
+            unit_prices.append((index, distance, full_ms, impostor_ms))
             representations[members] = representation
             weight = representation.full_weight
         if weight == 1.0:
@@ -440,11 +551,7 @@ def plan_frame(
         )
         cloud_work += quad + (full + Work(quad_pixels=screen_pixels) if weight > 0.0 else Work())  # the layer
         if reason is not None:
-            ratio = (
-                translation_error(centre, radius, record.eye, eye) / max(tolerance, 1e-300)
-                if record is not None
-                else math.inf
-            )
+            ratio = float(held_errors[index]) / max(tolerance, 1e-300)
             wanted.append(
                 (index, regeneration_priority(reason, ratio, bool(splits), pixels), remake.scaled(len(splits) + 1))
             )
@@ -460,9 +567,7 @@ def plan_frame(
             continue
         record = records.get(cloud.members)
         if index not in served and record is not None:
-            accepted = max(
-                accepted, translation_error(centres[index], radii[index], record.eye, eye) / max(tolerance, 1e-300)
-            )
+            accepted = max(accepted, float(held_errors[index]) / max(tolerance, 1e-300))
         if index in served:
             record = next_records[cloud.members] = ImpostorRecord(
                 tuple(float(v) for v in eye),
@@ -480,11 +585,8 @@ def plan_frame(
             layer_counts=record.layer_counts if cloud.splits else (0,),
         )
     if ring is not None:
-        cloud_work += Work(
-            quad_pixels=RING_PANEL_SCREEN_SHARE
-            * screen_pixels
-            * sum(len(generation.occupied_segments) for generation, _ in ring.draws)
-            / 2.0
+        cloud_work += _ring_panels_work(
+            sum(len(generation.occupied_segments) for generation, _ in ring.draws), screen_pixels
         )
         if ring.build_segment is not None and ring.state.pending is not None:
             segment = ring.state.pending.segment_members[ring.build_segment]
@@ -501,15 +603,29 @@ def plan_frame(
     cloud_work += Work(
         batches=float(_full_runs([clouds[i].kind for i in draw_order]) + screen_impostors),
         quad_pixels=screen_impostors * screen_pixels,
+        quads=float(screen_impostors),
     )
     between = {item.index for item in items if item.kind == "object"}
     with_world = tuple(i for i in range(len(object_radii)) if objects_visible[i] and i not in between)
+    drawn_as = frame_choice = None
+    if settings.mode == "auto":
+        drawn_as = "full" if all_full else "units"
+        predicted = {
+            "units": _units_ms(unit_prices, ring_ms, alone_ms, candidates, costs),
+            "full": costs.ms(everything_full),
+        }
+        frame_choice = _frame_choice(state, drawn_as, predicted)
     next_state = LodState(
         next_records,
         ring.state if ring is not None else RingState(),
         representations,
         tuple(float(v) for v in eye),
         state.costs,
+        frame_choice,
+        drawn_as,
+        state.frames_drawn_as + 1 if state.drawn_as == drawn_as else 1,
+        state.frame_index + 1,
+        state.frame_times,
     )
     return FramePlan(
         tuple(clouds),
@@ -525,6 +641,127 @@ def plan_frame(
         tolerance,
         accepted,
     )
+
+
+def _units_ms(unit_prices, ring_ms: float, alone_ms: float, candidates, costs: CostModel) -> float:
+    """The predicted time of a frame of units each in the representation its own price picks.
+
+    The units' prices (`unit_prices`: (index, distance, full 3D ms, the other's ms) of the units planned
+    on their own) miss that full units between impostors are drawn in as many batches as there are
+    runs; the ring's candidates in view (`candidates`) count as the cheaper of the ring (`ring_ms`)
+    and their own prices (`alone_ms`).
+    """
+    priced_ms, kinds = 0.0, []
+    for index, _, full_ms, other_ms in sorted(unit_prices, key=lambda price: -price[1]):
+        if not candidates[index]:
+            priced_ms += min(full_ms, other_ms)
+        kinds.append("full" if full_ms <= other_ms else "impostor")
+    ring_part = min(ring_ms, alone_ms) if candidates.any() else 0.0
+    return priced_ms + ring_part + costs.batches * _full_runs(kinds)
+
+
+def _frame_choice(state: LodState, drawn_as: str, predicted: dict) -> str:
+    """How auto mode draws the next frame: "units" or "full" (`LodState.frame_choice`), by the measured times
+    of both (`_cheapest`, within its margin), once both are measured and fresh; the way this frame was drawn
+    while it is being measured; the other, to measure it, where its `predicted` time is plausibly close.
+    The choice acts through each unit's representation and the ring, so a switch crossfades."""
+    other = "full" if drawn_as == "units" else "units"
+    frame = state.frame_index + 1
+
+    def known(choice: str) -> bool:
+        time = state.frame_times.get(choice)
+        return time is not None and time.frames >= PROBE_FRAMES and frame - time.last_frame <= MEASUREMENT_AGE_FRAMES
+
+    if not known(drawn_as):
+        return drawn_as
+    if known(other):
+        return _cheapest(drawn_as, {choice: state.frame_times[choice].mean_ms for choice in (drawn_as, other)})
+    return other if predicted[other] < PLAUSIBLE_RATIO * predicted[drawn_as] else drawn_as
+
+
+def _ring_panels_work(panels: int, screen_pixels: float) -> Work:
+    """Drawing `panels` ring panels (each a draw call): about half of them in view, each
+    `RING_PANEL_SCREEN_SHARE` of the screen."""
+    return Work(quad_pixels=RING_PANEL_SCREEN_SHARE * screen_pixels * panels / 2.0, quads=float(panels))
+
+
+def _ring_work(
+    units: LodUnits, candidates, centres, eye, step, ball_fragments, screen_pixels, settings, state: RingState
+) -> tuple[Work, Work]:
+    """(panels, rebuild): a frame of Wang's ring holding the units `candidates` (mask).  Its panels drawn, and its
+    rebuild (every candidate splatted into the segments, whose textures have the screen's pixel density)
+    spread over the frames until the eye's current `step` a frame carries it past a rebuild distance, or
+    over the frames the last ring lasted when that was shorter."""
+    offsets = centres[candidates] - eye
+    azimuths = np.degrees(np.arctan2(offsets[:, 0], -offsets[:, 2])) % 360.0
+    panels = len(np.unique(np.floor(azimuths / SEGMENT_DEG)))
+    horizontal, vertical = math.hypot(step[0], step[2]), abs(step[1])
+    lifetime = min(
+        LONGEST_LIFETIME_FRAMES,
+        state.rebuild_interval,
+        settings.ring_rebuild_horizontal * settings.ring_radius / max(horizontal, 1e-300),
+        settings.ring_rebuild_vertical * settings.ring_radius / max(vertical, 1e-300),
+    )
+    rebuild = Work(
+        particles=float(np.sum(units.particle_counts[candidates])),
+        texture_fragments=float(np.sum(ball_fragments[candidates])),
+        regenerations=float(panels),
+    )
+    return _ring_panels_work(panels, screen_pixels), rebuild.scaled(1.0 / max(lifetime, 1.0))
+
+
+def _in_view_work(units: LodUnits, chosen, cloud_splats, planes, eye, focal_px, screen_pixels):
+    """(particles, fragments) per unit of `chosen` (mask) drawn in full 3D far from the eye, splat by splat:
+    only the splats in the frustum (a cloud field's far units are kilometres across, and partly out of view),
+    each a disc of pi (f r / z)^2 at most the screen."""
+    indices = np.flatnonzero(chosen)
+    count = len(indices)
+    splats = [(owner, cloud_splats(cloud)) for owner, index in enumerate(indices) for cloud in units.members[index]]
+    if not splats:
+        return np.zeros(count), np.zeros(count)
+    owners = np.concatenate([np.full(len(radii), owner) for owner, (_, radii) in splats])
+    centres = np.concatenate([centres for _, (centres, _) in splats])
+    radii = np.concatenate([radii for _, (_, radii) in splats])
+    seen = splats_in_frustum(planes, centres, radii)
+    depths = np.maximum(np.linalg.norm(centres[seen] - eye, axis=1), radii[seen])
+    discs = np.minimum(math.pi * (focal_px * radii[seen] / depths) ** 2, screen_pixels)
+    return (
+        np.bincount(owners[seen], minlength=count).astype(np.float64),
+        np.bincount(owners[seen], weights=discs, minlength=count),
+    )
+
+
+def _alone_ms(
+    units: LodUnits, chosen, in_view, distances, ball_fragments, lifetimes, focal_px, screen_pixels, settings, costs
+):
+    """The units `chosen` (mask) drawn each on its own as auto mode would, far from the eye: per unit the
+    cheaper of full 3D (`in_view`: its particles and fragments in view) and an impostor (its quad, and its
+    regeneration over its predicted lifetime: every particle, into a texture)."""
+    particles, radii = units.particle_counts[chosen], units.radii[chosen]
+    distances, fragments = distances[chosen], ball_fragments[chosen]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        half_sides = radii * distances / np.sqrt(np.maximum((distances - radii) * (distances + radii), 1e-300))
+        sides = 2.0 * focal_px * half_sides / distances
+        detail = 2.0 * settings.impostor_detail_texels * half_sides / units.finest_radii[chosen]
+        detail = np.where(settings.impostor_detail_texels > 0.0, detail, np.inf)
+        texture = np.clip(np.minimum(sides, detail), settings.impostor_min_size, settings.impostor_max_size)
+        texture_fragments = fragments * np.nan_to_num((texture / sides) ** 2, nan=1.0)
+    full = costs.particles * in_view[0] + costs.fragments * in_view[1]
+    remake = costs.particles * particles + costs.texture_fragments * texture_fragments + costs.regenerations
+    impostor = (
+        costs.quad_pixels * np.minimum(sides * sides, screen_pixels)
+        + costs.quads
+        + remake / np.maximum(lifetimes[chosen], 1.0)
+    )
+    return float(np.sum(np.minimum(full, impostor)))
+
+
+def _ring_pays(state: RingState, ring_ms: float, alone_ms: float) -> bool:
+    """Whether the ring should hold its clouds: the cheaper of the two (`_cheapest`: each switch rebuilds
+    the ring and crossfades it)."""
+    newest = state.pending or state.current
+    held = None if newest is None else "ring" if newest.holds_clouds else "alone"
+    return _cheapest(held, {"ring": ring_ms, "alone": alone_ms}) == "ring"
 
 
 def _within_frame_budget(wanted, available_ms: float, costs: CostModel) -> set:
@@ -551,18 +788,28 @@ def _represent(
     does a switch to a representation that `close` says shows the same picture within half the
     tolerance: it is made at once, and only a switch that would show a step crossfades.
     """
-    cheaper = "full" if full_ms <= impostor_ms else "impostor"
+    prices = {"full": full_ms, "impostor": impostor_ms}
     if previous is None:
+        cheaper = _cheapest(None, prices)
         return Representation(cheaper, 1.0 if cheaper == "full" else 0.0)
-    target = previous.target
-    held, other = (full_ms, impostor_ms) if target == "full" else (impostor_ms, full_ms)
-    if other < (1.0 - SWITCH_MARGIN) * held:
-        target = "impostor" if target == "full" else "full"
-        if close[target] and previous.full_weight in (0.0, 1.0):
-            return Representation(target, 1.0 if target == "full" else 0.0)
+    if previous.target == "inside":  # the eye has left the unit: its particles were on screen
+        previous = Representation("full", 1.0)
+    target = _cheapest(previous.target, prices)
+    if target != previous.target and close[target] and previous.full_weight in (0.0, 1.0):
+        return Representation(target, 1.0 if target == "full" else 0.0)
     step = 1.0 / transition_frames
     weight = min(1.0, previous.full_weight + step) if target == "full" else max(0.0, previous.full_weight - step)
     return Representation(target, weight)
+
+
+def _cheapest(held: str | None, prices: dict) -> str:
+    """The name of the cheapest of `prices` (name -> ms; ties to the first), but the one `held` already
+    while no other is cheaper by `SWITCH_MARGIN`: costs measured frame to frame wobble, and a choice
+    near the break-even point would otherwise flicker, paying for a transition each time."""
+    cheapest = min(prices, key=prices.get)
+    if held in prices and prices[cheapest] >= (1.0 - SWITCH_MARGIN) * prices[held]:
+        return held
+    return cheapest
 
 
 def inside_runs(items, clouds) -> list[list]:

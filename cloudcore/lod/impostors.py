@@ -156,44 +156,60 @@ def required_size(pixels: float, smallest: int, largest: int) -> int:
     return int(min(4 * math.ceil(side / 4 - 1e-9), largest))
 
 
-def _angle_deg(a: np.ndarray, b: np.ndarray) -> float:
-    """Angle between two vectors; atan2 of |a x b| and a.b stays accurate for tiny angles, where acos does not."""
-    return math.degrees(math.atan2(float(np.linalg.norm(np.cross(a, b))), float(a @ b)))
+def _angles_deg(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Angles between the rows of two (n, 3) arrays; atan2 of |a x b| and a.b stays accurate for tiny angles,
+    where acos does not."""
+    return np.degrees(np.arctan2(np.linalg.norm(np.cross(a, b), axis=-1), np.einsum("ij,ij->i", a, b)))
+
+
+def centre_angles_deg(centres, radii, eyes_then, eye_now) -> np.ndarray:
+    """(n,) angles at each of `centres` between the directions to its eye then (one row each, or one eye
+    for all) and `eye_now` (0 when either coincides with it); `radii` are unused, for the metrics' one
+    signature."""
+    centres = np.asarray(centres, dtype=np.float64).reshape(-1, 3)
+    then = np.broadcast_to(np.asarray(eyes_then, dtype=np.float64), centres.shape)
+    return _angles_deg(then - centres, np.asarray(eye_now, dtype=np.float64) - centres)
+
+
+def parallax_errors_deg(centres, radii, eyes_then, eye_now) -> np.ndarray:
+    """Harris's translation error of n impostors at once: the angle at `eye_now` between each sphere's
+    near and far points as seen from its eye then (SkyWorks' `_vecNearPoint`, `_vecFarPoint`), exactly 0
+    at that eye (rounding in the rays would not give it), as SkyWorks.
+
+    Inf once the far point has come nearer than the near point (SkyWorks' "backwards impostor"):
+    the eye has passed the cloud's side and the quad shows it from behind; inf too for an eye then
+    inside its sphere, or a row of NaN (no impostor held).
+    """
+    centres = np.asarray(centres, dtype=np.float64).reshape(-1, 3)
+    radii = np.asarray(radii, dtype=np.float64).reshape(-1)
+    then = np.broadcast_to(np.asarray(eyes_then, dtype=np.float64), centres.shape)
+    now = np.asarray(eye_now, dtype=np.float64)
+    axis = centres - then
+    distances = np.linalg.norm(axis, axis=1)
+    outside = distances > radii  # False for NaN
+    with np.errstate(divide="ignore", invalid="ignore"):
+        axis = axis / np.where(outside, distances, 1.0)[:, None]
+    to_near = then + axis * (distances - radii)[:, None] - now
+    to_far = then + axis * (distances + radii)[:, None] - now
+    backwards = np.einsum("ij,ij->i", to_near, to_near) > np.einsum("ij,ij->i", to_far, to_far)
+    with np.errstate(invalid="ignore"):
+        errors = np.where(outside & ~backwards, _angles_deg(to_near, to_far), np.inf)
+    return np.where(np.all(then == now, axis=1), 0.0, errors)
 
 
 def translation_error_deg(centre, eye_then, eye_now) -> float:
     """Angle at `centre` between the directions to the two eyes (0 when either coincides with it)."""
-    centre = np.asarray(centre, dtype=np.float64)
-    return _angle_deg(np.asarray(eye_then, dtype=np.float64) - centre, np.asarray(eye_now, dtype=np.float64) - centre)
+    return float(centre_angles_deg(centre, None, eye_then, eye_now)[0])
 
 
 def parallax_error_deg(centre, radius: float, eye_then, eye_now) -> float:
-    """Harris's translation error: the angle at `eye_now` between the sphere's near and far points as seen
-    from `eye_then` (SkyWorks' `_vecNearPoint`, `_vecFarPoint`), 0 at `eye_then`.
-
-    Inf once the far point has come nearer than the near point (SkyWorks' "backwards impostor"):
-    the eye has passed the cloud's side and the quad shows it from behind.
-    """
-    centre, then = np.asarray(centre, dtype=np.float64), np.asarray(eye_then, dtype=np.float64)
-    now = np.asarray(eye_now, dtype=np.float64)
-    if np.array_equal(now, then):  # exactly 0 (rounding in the rays below would not give it), as SkyWorks
-        return 0.0
-    axis = centre - then
-    distance = float(np.linalg.norm(axis))
-    if not distance > radius:
-        return math.inf
-    axis /= distance
-    to_near, to_far = then + axis * (distance - radius) - now, then + axis * (distance + radius) - now
-    if to_near @ to_near > to_far @ to_far:
-        return math.inf
-    return _angle_deg(to_near, to_far)
+    """`parallax_errors_deg` of one sphere."""
+    return float(parallax_errors_deg(centre, radius, eye_then, eye_now)[0])
 
 
-#: translation metrics by name (`RenderSettings.translation_metric`): (centre, radius, eye then, eye now) -> degrees
-TRANSLATION_METRICS = {
-    "parallax": parallax_error_deg,
-    "centre": lambda centre, radius, eye_then, eye_now: translation_error_deg(centre, eye_then, eye_now),
-}
+#: translation metrics by name (`RenderSettings.translation_metric`), vectorised: (centres (n, 3), radii (n,),
+#: eyes then (n, 3) or (3,), eye now) -> (n,) degrees
+TRANSLATION_METRICS = {"parallax": parallax_errors_deg, "centre": centre_angles_deg}
 
 
 def tolerance_deg_for(settings, fov_y_deg: float, viewport_height: int) -> float:
@@ -262,7 +278,7 @@ def regeneration_reason(
         return "lights"
     if record.size < size or record.size >= SHRINK_FACTOR * size:
         return "resolution"
-    if TRANSLATION_METRICS[metric](centre, radius, record.eye, eye) > tolerance_deg:
+    if TRANSLATION_METRICS[metric](centre, radius, record.eye, eye)[0] > tolerance_deg:
         return "translation"
     if (layer_counts or (0,)) != (record.layer_counts if record.splits else (0,)):
         return "layers"

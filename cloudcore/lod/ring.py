@@ -41,6 +41,9 @@ class RingGeneration:
     members: frozenset  # the ids of the clouds (or units) it holds (`plan_ring`'s `ids`)
     segment_members: tuple  # SEGMENTS tuples of member ids
     texture_size: tuple = (0, 0)  # (width, height) of its segment textures
+    #: False: made while the ring did not pay for itself (`cloudcore.lod.frameplan`): it holds no cloud, and
+    #: fading it in hands the last ring's clouds back to the frame plan
+    holds_clouds: bool = True
 
     @property
     def occupied_segments(self) -> tuple[int, ...]:
@@ -56,6 +59,10 @@ class RingState:
     pending: RingGeneration | None = None
     built: int = 0
     fade_step: int = 0
+    #: frames since the last rebuild started, and between the last two starts (inf: fewer than two yet): how
+    #: long a ring lasts, measured (a cloud field's cells leaving it rebuild it long before the eye's motion does)
+    since_rebuild: int = 0
+    rebuild_interval: float = math.inf
 
 
 @dataclass(frozen=True)
@@ -123,9 +130,9 @@ def segment_texture_size(viewport_height: int, fov_y_deg: float, settings: Rende
 
 
 def new_generation(
-    centres, radii, eye, settings: RenderSettings, keys: dict, ids: tuple, texture_size: tuple
+    centres, radii, eye, settings: RenderSettings, keys: dict, ids: tuple, texture_size: tuple, holds_clouds=True
 ) -> RingGeneration:
-    in_ring = ring_members(centres, radii, eye, settings)
+    in_ring = ring_members(centres, radii, eye, settings) & holds_clouds
     members = frozenset(ids[i] for i in np.flatnonzero(in_ring))
     generation = RingGeneration(
         tuple(float(v) for v in eye),
@@ -134,6 +141,7 @@ def new_generation(
         members,
         (),
         tuple(texture_size),
+        holds_clouds,
     )
     per_segment = []
     for segment in range(SEGMENTS):
@@ -156,7 +164,13 @@ def _wrong_size(generation: RingGeneration, texture_size: tuple) -> bool:
     )
 
 
-def _needs_rebuild(generation: RingGeneration, eye, settings: RenderSettings, keys: dict, texture_size: tuple) -> bool:
+def _needs_rebuild(
+    generation: RingGeneration, eye, settings: RenderSettings, keys: dict, texture_size: tuple, holds_clouds: bool
+) -> bool:
+    if generation.holds_clouds != holds_clouds:
+        return True
+    if not holds_clouds:
+        return False  # holding nothing, nothing goes stale
     moved = np.asarray(eye, dtype=np.float64) - np.asarray(generation.eye)
     return (
         generation.lighting_key != _members_key(generation.members, keys)
@@ -176,29 +190,40 @@ def plan_ring(
     lighting_keys: tuple,
     ids: tuple,
     texture_size: tuple,
+    holds_clouds: bool = True,
 ) -> RingPlan | None:
     """Advance the ring by one frame: start a rebuild if needed, build one segment or step the fade.
 
     `lighting_keys` has one key per sphere, `ids` one identity (a unit's member clouds): the ring
     holds ids, so a scene whose spheres are renumbered (clouds regrouped, one removed) does not
     mistake one cloud for another.  `texture_size` is the segment texture size the screen asks for
-    (`segment_texture_size`).  A ring being built when its members' keys change
-    is finished first and rebuilt after: a cloud forming in the ring, whose key changes every
-    frame, would otherwise keep the ring from ever completing; one whose members are no longer all
-    units (removed, regrouped) starts again.
+    (`segment_texture_size`).  `holds_clouds` False asks for a ring of no clouds (it does not pay for
+    itself): the ring shown fades out as when it is rebuilt, with nothing to build.
+
+    A ring being built when its members' keys change is finished first and rebuilt after: a cloud
+    forming in the ring, whose key changes every frame, would otherwise keep the ring from ever
+    completing; one whose members are no longer all units (removed, regrouped) starts again.
     """
     if not settings.uses_ring:
         return None
     current, pending, built, fade_step = state.current, state.pending, state.built, state.fade_step
+    since_rebuild, rebuild_interval = state.since_rebuild + 1, state.rebuild_interval
     if pending is not None and (
         pending.radius != settings.ring_radius
         or _wrong_size(pending, texture_size)
         or not pending.members <= set(ids)  # a member gone (a cloud field's cell left): nothing to render it from
+        or pending.holds_clouds != holds_clouds
     ):
         pending = None  # the ring it was being built for is gone: start again
     keys = dict(zip(ids, lighting_keys))
-    if pending is None and (current is None or _needs_rebuild(current, eye, settings, keys, texture_size)):
-        pending, built, fade_step = new_generation(centres, radii, eye, settings, keys, ids, texture_size), 0, 0
+    if pending is None and (
+        (current is None and holds_clouds)
+        or (current is not None and _needs_rebuild(current, eye, settings, keys, texture_size, holds_clouds))
+    ):
+        if current is not None or state.pending is not None:
+            since_rebuild, rebuild_interval = 0, float(since_rebuild)
+        pending = new_generation(centres, radii, eye, settings, keys, ids, texture_size, holds_clouds)
+        built, fade_step = (0 if holds_clouds else SEGMENTS), 0  # a ring of nothing has nothing to build
     build_segment = None
     if pending is not None:
         if built < SEGMENTS:
@@ -213,4 +238,6 @@ def plan_ring(
         draws = ((pending, weight),) + (((current, 1.0 - weight),) if current is not None else ())
     elif current is not None:
         draws = ((current, 1.0),)
-    return RingPlan(build_segment, draws, RingState(current, pending, built, fade_step))
+    return RingPlan(
+        build_segment, draws, RingState(current, pending, built, fade_step, since_rebuild, rebuild_interval)
+    )
