@@ -7,8 +7,15 @@ import numpy as np
 import pytest
 
 from cloudcore.camera import frustum_planes, projection_matrix, splats_in_frustum, view_matrix
-from cloudcore.lod.costs import CostModel
-from cloudcore.lod.frameplan import SWITCH_MARGIN, LodState, inside_runs, plan_frame
+from cloudcore.lod.costs import CostModel, Work
+from cloudcore.lod.frameplan import (
+    FRAME_SETTLE_FRAMES,
+    PROBE_FRAMES,
+    SWITCH_MARGIN,
+    LodState,
+    inside_runs,
+    plan_frame,
+)
 from cloudcore.lod.impostors import impostor_view, parallax_error_deg, translation_error_deg
 from cloudcore.lod.ring import SEGMENTS, RingState
 from cloudcore.lod.units import LodUnits
@@ -704,3 +711,47 @@ def test_auto_mode_gives_the_unit_the_eye_is_in_a_screen_impostor_only_where_it_
     assert cloud.kind == kind and cloud.full_weight == 1.0
     if mode == "auto":
         assert (cloud.full_ms < cloud.impostor_ms) is (kind == "full")
+
+
+#: 40 small far clouds of 20 particles in view: full 3D of them all is predicted close to their impostors
+SPARSE_CENTRES = [(300.0 * (i % 8 - 3.5), 0.0, -3000.0 - 300.0 * (i // 8)) for i in range(40)]
+
+
+def fly_measured(frames: int, measured_ms: dict, centres=SPARSE_CENTRES, particles=20.0, state=None):
+    """Auto mode planned frame after frame from a still eye, each frame's passes 'measured' at
+    `measured_ms[the way it was drawn]` milliseconds; the plans and the last state."""
+    count = len(centres)
+    units = LodUnits.of_spheres(
+        np.array(centres), [RADIUS] * count, [RADIUS / 8.0] * count, [particles] * count, [particles * 150.0] * count
+    )
+    settings, state, plans = dataclasses.replace(NO_RING, mode="auto"), state or LodState(), []
+    for _ in range(frames):
+        frame = plan_frame(
+            units, camera_at((0.0, 0.0, 0.0), (0.0, 0.0, -1.0)), VIEWPORT, settings, state, 1, costs=CostModel()
+        )
+        plans.append(frame)
+        state = frame.state.measured([(Work(), measured_ms[frame.state.drawn_as])])
+    return plans, state
+
+
+def test_auto_mode_draws_a_frame_all_in_full_3d_where_that_measures_cheaper():
+    """The units are measured first, then full 3D is tried (predicted close), and kept: it measured cheaper."""
+    plans, state = fly_measured(80, {"units": 20.0, "full": 10.0})
+    drawn = [p.state.drawn_as for p in plans]
+    first_full = drawn.index("full")
+    assert FRAME_SETTLE_FRAMES + PROBE_FRAMES <= first_full and set(drawn[first_full:]) == {"full"}
+    assert {c.kind for c in plans[-1].clouds} == {"full"} and plans[-1].ring is None
+    assert state.frame_times["full"].mean_ms == pytest.approx(10.0)
+
+
+def test_auto_mode_goes_back_to_its_units_where_full_3d_measured_dearer():
+    plans, _ = fly_measured(100, {"units": 20.0, "full": 40.0})
+    drawn = [p.state.drawn_as for p in plans]
+    assert "full" in drawn and drawn[-1] == "units"
+    assert plans[-1].state.frame_times["units"].frames >= PROBE_FRAMES  # measured again since
+
+
+def test_auto_mode_never_tries_full_3d_where_it_is_predicted_far_dearer():
+    """Dense clouds: full 3D predicted several times the impostors' cost is never drawn to find out."""
+    plans, _ = fly_measured(120, {"units": 20.0, "full": 1.0}, centres=SPARSE_CENTRES[:8], particles=5000.0)
+    assert {p.state.drawn_as for p in plans} == {"units"}

@@ -218,8 +218,9 @@ def test_camera_inside_a_particle(renderer, mode):
 
 
 def kind_with_the_eye_inside(renderer, mode: str) -> str:
-    """How the one unit the eye is in is drawn, asked right after the frame: in full 3D in full mode, as a screen impostor in impostor mode, and
-    in auto mode as the cheaper of the two by the plan's own prices (a unit seen for the first time)."""
+    """How the one unit the eye is in is drawn, asked right after the frame: in full 3D in full mode, as a
+    screen impostor in impostor mode, and in auto mode as the cheaper of the two by the plan's own prices (a
+    unit seen for the first time)."""
     if mode != "auto":
         return {"full": "full", "impostor": "inside"}[mode]
     (cloud,) = renderer.last_plan.clouds

@@ -292,6 +292,31 @@ def plan_frame(
     by default the model `state.costs` has fitted to the frames so far.  `cloud_splats(i)` gives
     cloud i's (particle centres, radii), asked for units near the eye to count their fragments.
     """
+    if settings.mode == "auto" and _settled_in_full_3d(state):
+        # nothing to price: the choice is by measured times, and the units' measurement is fresh
+        in_full = plan_frame(
+            units,
+            camera,
+            viewport,
+            dataclasses.replace(settings, mode="full"),
+            state,
+            lighting_key,
+            objects,
+            cloud_particles,
+            costs,
+            cloud_splats,
+        )
+        drawn = {c.members: Representation("full", 1.0) for c in in_full.clouds if c.kind == "full"}
+        return dataclasses.replace(
+            in_full,
+            state=dataclasses.replace(
+                in_full.state,
+                representations=drawn,
+                frame_choice=_frame_choice(state, "full", {}),
+                drawn_as="full",
+                frames_drawn_as=state.frames_drawn_as + 1,
+            ),
+        )
     centres, radii = units.centres, units.radii
     width, height = viewport
     eye = np.asarray(camera.position, dtype=np.float64)
@@ -660,23 +685,34 @@ def _units_ms(unit_prices, ring_ms: float, alone_ms: float, candidates, costs: C
     return priced_ms + ring_part + costs.batches * _full_runs(kinds)
 
 
+def _known(state: LodState, choice: str) -> bool:
+    """Whether the frames drawn as `choice` have been measured for long enough, recently enough, to choose by."""
+    time = state.frame_times.get(choice)
+    frame = state.frame_index + 1  # the frame being planned
+    return time is not None and time.frames >= PROBE_FRAMES and frame - time.last_frame <= MEASUREMENT_AGE_FRAMES
+
+
+def _settled_in_full_3d(state: LodState) -> bool:
+    """Auto mode draws every unit in full 3D, settled there, and has measured the units' way freshly: the frame
+    can be planned as full mode plans it, without pricing a unit."""
+    return (
+        state.frame_choice == state.drawn_as == "full"
+        and state.frames_drawn_as > FRAME_SETTLE_FRAMES
+        and _known(state, "units")
+    )
+
+
 def _frame_choice(state: LodState, drawn_as: str, predicted: dict) -> str:
     """How auto mode draws the next frame: "units" or "full" (`LodState.frame_choice`), by the measured times
     of both (`_cheapest`, within its margin), once both are measured and fresh; the way this frame was drawn
     while it is being measured; the other, to measure it, where its `predicted` time is plausibly close.
     The choice acts through each unit's representation and the ring, so a switch crossfades."""
     other = "full" if drawn_as == "units" else "units"
-    frame = state.frame_index + 1
-
-    def known(choice: str) -> bool:
-        time = state.frame_times.get(choice)
-        return time is not None and time.frames >= PROBE_FRAMES and frame - time.last_frame <= MEASUREMENT_AGE_FRAMES
-
-    if not known(drawn_as):
+    if not _known(state, drawn_as):
         return drawn_as
-    if known(other):
+    if _known(state, other):
         return _cheapest(drawn_as, {choice: state.frame_times[choice].mean_ms for choice in (drawn_as, other)})
-    return other if predicted[other] < PLAUSIBLE_RATIO * predicted[drawn_as] else drawn_as
+    return other if predicted and predicted[other] < PLAUSIBLE_RATIO * predicted[drawn_as] else drawn_as
 
 
 def _ring_panels_work(panels: int, screen_pixels: float) -> Work:
