@@ -742,6 +742,8 @@ def test_auto_mode_draws_a_frame_all_in_full_3d_where_that_measures_cheaper():
     assert FRAME_SETTLE_FRAMES + PROBE_FRAMES <= first_full and set(drawn[first_full:]) == {"full"}
     assert {c.kind for c in plans[-1].clouds} == {"full"} and plans[-1].ring is None
     assert state.frame_times["full"].mean_ms == pytest.approx(10.0)
+    stats = plans[-1].stats()  # what the Statistics panel shows
+    assert (stats.drawn_as, stats.measured_units_ms, stats.measured_full_ms) == ("full", 20.0, pytest.approx(10.0))
 
 
 def test_auto_mode_goes_back_to_its_units_where_full_3d_measured_dearer():

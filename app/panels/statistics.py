@@ -53,6 +53,12 @@ class StatisticsPanel:
             f"measured; largest error drawn {plan.accepted_error_tolerances:.2f} x the tolerance "
             f"({plan.tolerance_deg:.3f} deg)"
         )
+        if plan.drawn_as:
+            way = {"units": "each unit as priced", "full": "every unit in full 3D, one draw"}[plan.drawn_as]
+            imgui.text(
+                f"auto drew {way}; measured: as priced {_measured(plan.measured_units_ms)}, "
+                f"all in full 3D {_measured(plan.measured_full_ms)}"
+            )
         imgui.text(
             f"objects in clouds {plan.objects_in_clouds}: layers drawn {plan.layers_drawn}, "
             f"rebuilt {plan.layers_rebuilt}"
@@ -79,3 +85,7 @@ class StatisticsPanel:
             ):
                 implot.plot_line(label, frames, np.array(times, dtype=np.float64))
             implot.end_plot()
+
+
+def _measured(ms: float) -> str:
+    return f"{ms:.1f} ms" if ms > 0.0 else "not yet"

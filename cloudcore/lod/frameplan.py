@@ -251,8 +251,15 @@ class FramePlan:
             predicted_ms=self.predicted_ms,
             tolerance_deg=self.tolerance_deg,
             accepted_error_tolerances=self.accepted_error,
+            drawn_as=self.state.drawn_as or "",
+            measured_units_ms=self._measured_ms("units"),
+            measured_full_ms=self._measured_ms("full"),
             costs=self.costs,
         )
+
+    def _measured_ms(self, choice: str) -> float:
+        time = self.state.frame_times.get(choice)
+        return time.mean_ms if time is not None else 0.0
 
     @property
     def settled(self) -> bool:

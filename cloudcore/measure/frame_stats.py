@@ -38,6 +38,11 @@ class PlanStats:
     predicted_ms: float = 0.0
     tolerance_deg: float = 0.0
     accepted_error_tolerances: float = 0.0  # the largest error drawn, in tolerances
+    #: auto mode: the frame drawn with its units each as priced ("units") or all in full 3D ("full"; "" in the
+    #: other modes), and the measured times of frames drawn each way (`lod.frameplan.FrameTime`; 0: not yet)
+    drawn_as: str = ""
+    measured_units_ms: float = 0.0
+    measured_full_ms: float = 0.0
     costs: CostModel = field(default_factory=CostModel)  # the coefficients the plan priced its choices with
 
 
