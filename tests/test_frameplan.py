@@ -757,3 +757,15 @@ def test_auto_mode_never_tries_full_3d_where_it_is_predicted_far_dearer():
     """Dense clouds: full 3D predicted several times the impostors' cost is never drawn to find out."""
     plans, _ = fly_measured(120, {"units": 20.0, "full": 1.0}, centres=SPARSE_CENTRES[:8], particles=5000.0)
     assert {p.state.drawn_as for p in plans} == {"units"}
+
+
+def test_another_scene_is_measured_afresh():
+    """Settled in full 3D on a sparse scene, auto mode forgets what it measured once the scene holds four times the
+    particles (clouds added, another scene opened) and measures again: the way it draws first, then the other where
+    that is plausibly cheaper."""
+    _, settled = fly_measured(80, {"units": 20.0, "full": 10.0})
+    assert settled.frame_choice == "full"
+    plans, _ = fly_measured(3, {"units": 20.0, "full": 10.0}, particles=80.0, state=settled)
+    assert plans[0].state.frame_times == {} and plans[0].state.drawn_as == "full"
+    assert plans[0].state.frame_choice == "full"  # drawn so until the frames drawn this way are measured
+    assert plans[-1].state.frame_times["full"].frames == 2  # measured again from the frame after

@@ -96,6 +96,9 @@ FRAME_SETTLE_FRAMES = 16
 PROBE_FRAMES = 8
 MEASUREMENT_AGE_FRAMES = 300
 PLAUSIBLE_RATIO = 1.5
+#: a scene whose particles changed by more than this factor (another scene opened, clouds added) is measured
+#: afresh
+SCENE_CHANGE_RATIO = 1.25
 #: the running mean of a choice's frame times weighs each new frame at least this much
 FRAME_TIME_FORGETTING = 0.1
 #: a ring panel in view covers about this share of the screen (45 of ~75 degrees across, all the way up)
@@ -160,6 +163,8 @@ class LodState:
     frames_drawn_as: int = 0
     frame_index: int = 0  # frames planned
     frame_times: Mapping = field(default_factory=dict)  # choice -> FrameTime: how long its frames took, measured
+    #: the units' particles when last planned: a scene changed past `SCENE_CHANGE_RATIO` forgets `frame_times`
+    particles: float = 0.0
 
     def measured(self, measurements) -> LodState:
         """The state with this frame's (predicted work, measured ms) pairs folded into the cost fit, and their
@@ -299,6 +304,9 @@ def plan_frame(
     by default the model `state.costs` has fitted to the frames so far.  `cloud_splats(i)` gives
     cloud i's (particle centres, radii), asked for units near the eye to count their fragments.
     """
+    scene_particles = float(np.sum(units.particle_counts))
+    if state.frame_times and not _comparable(state.particles, scene_particles):
+        state = dataclasses.replace(state, frame_times={})  # another scene: what was measured says nothing of it
     if settings.mode == "auto" and _settled_in_full_3d(state):
         # nothing to price: the choice is by measured times, and the units' measurement is fresh
         in_full = plan_frame(
@@ -658,6 +666,7 @@ def plan_frame(
         state.frames_drawn_as + 1 if state.drawn_as == drawn_as else 1,
         state.frame_index + 1,
         state.frame_times,
+        scene_particles,
     )
     return FramePlan(
         tuple(clouds),
@@ -690,6 +699,11 @@ def _units_ms(unit_prices, ring_ms: float, alone_ms: float, candidates, costs: C
         kinds.append("full" if full_ms <= other_ms else "impostor")
     ring_part = min(ring_ms, alone_ms) if candidates.any() else 0.0
     return priced_ms + ring_part + costs.batches * _full_runs(kinds)
+
+
+def _comparable(before: float, now: float) -> bool:
+    """Whether a scene of `now` particles is the one of `before` for what was measured of it."""
+    return before > 0.0 and now > 0.0 and max(before, now) <= SCENE_CHANGE_RATIO * min(before, now)
 
 
 def _known(state: LodState, choice: str) -> bool:
