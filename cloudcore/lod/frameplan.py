@@ -25,8 +25,13 @@ an impostor's error is bounded by the tolerance (it is remade past it) and
 full 3D is the reference, so both are admissible, and the plan prices each
 with the measured `CostModel` (`cloudcore.lod.costs`): full 3D its particles
 and fragments, the impostor its quad plus its regeneration spread over the
-frames it is predicted to last at the eye's current speed.  The GL side
-executes plans and nothing else; statistics come from the plan.
+frames it is predicted to last at the eye's current speed.  The screen
+impostor is priced the same way against the particles drawn on the screen,
+and Wang's ring against its clouds drawn each on its own (`_ring_pays`).  What
+per-unit prices miss (units drawn all in full 3D are one sorted draw) is
+settled by measurement: `_frame_choice` draws a frame all in full 3D where
+that measured cheaper.  The GL side executes plans and nothing else;
+statistics come from the plan.
 
 Objects inside a drawn unit's bounds split it into layers
 (`cloudcore.lod.splitting`); `draw_items` is then the frame's cloud pass far to
