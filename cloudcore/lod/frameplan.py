@@ -466,7 +466,7 @@ def plan_frame(
     # the particles into many draws between impostors costs what no unit's own price shows
     everything_full, unit_prices = Work(batches=1.0), []
     clouds, wanted = [], []  # wanted: (index, priority, work) of the impostors past their tolerance
-    for index, (centre, radius, distance) in enumerate(zip(centres, radii, distances)):
+    for index, (radius, distance) in enumerate(zip(radii, distances)):
         distance, members = float(distance), units.members[index]
         individual = 1.0 - (ring.weight_of(members) if ring is not None else 0.0)
         if individual <= 0.0 and radius > 0.0 and visible[index]:  # in the ring
@@ -574,9 +574,7 @@ def plan_frame(
         held_counts = (
             counts(index, record.eye, split_at(index, record.eye)[1]) if (record is not None and splits) else None
         )
-        reason = regeneration_reason(
-            record, centre, radius, eye, size, keys[index], tolerance, held_counts, settings.translation_metric
-        )
+        reason = regeneration_reason(record, size, keys[index], tolerance, float(held_errors[index]), held_counts)
         kind = "crossfade" if weight > 0.0 else "impostor"
         clouds.append(
             CloudPlan(

@@ -255,22 +255,19 @@ def budgeted_regenerations(wanted, budget: int) -> set:
 
 def regeneration_reason(
     record: ImpostorRecord | None,
-    centre,
-    radius: float,
-    eye,
     size: int,
     lighting_key: Hashable,
     tolerance_deg: float,
+    translation_error: float,
     layer_counts=None,
-    metric: str = "parallax",
 ) -> str | None:
     """Why the impostor must be remade this frame ("new", "lights", "resolution", "translation",
     "layers"), or None.
 
     `layer_counts` are the layers' particle counts the objects inside the cloud now give, seen
     from the record's eye (None: the cloud is not split); a change moves particles between
-    layer textures, so they are remade.  `metric` names the translation error
-    (`TRANSLATION_METRICS`).
+    layer textures, so they are remade.  `translation_error` is the held impostor's, in degrees, by the
+    metric in force (`TRANSLATION_METRICS`).
     """
     if record is None:
         return "new"
@@ -278,7 +275,7 @@ def regeneration_reason(
         return "lights"
     if record.size < size or record.size >= SHRINK_FACTOR * size:
         return "resolution"
-    if TRANSLATION_METRICS[metric](centre, radius, record.eye, eye)[0] > tolerance_deg:
+    if translation_error > tolerance_deg:
         return "translation"
     if (layer_counts or (0,)) != (record.layer_counts if record.splits else (0,)):
         return "layers"
