@@ -643,11 +643,11 @@ SETTLE = SEGMENTS + RING.ring_fade_frames + 1
 
 
 def test_auto_mode_keeps_the_ring_only_where_it_is_cheaper():
-    """Same scene, two cost models, two plans.  On llvmpipe's prior the clouds in view cost less as impostors
-    of their own than ring panels of the screen's size.  Where each regeneration's fixed cost dominates, the
-    ring's eight segments, remade from a still eye every `LONGEST_LIFETIME_FRAMES`, cost less than 24 impostors
-    remade as often (the ring renders the clouds out of view too: with 12 clouds it would not pay)."""
-    alone, _ = run_auto_ring(SETTLE, CostModel())
+    """Same scene, two cost models, two plans.  Where a regeneration's fixed cost is small against its particles,
+    the 24 clouds in view cost less as impostors of their own than a ring whose rebuilds render all 96; where it
+    dominates, the ring's eight segments, remade from a still eye every `LONGEST_LIFETIME_FRAMES`, cost less than
+    24 impostors remade as often."""
+    alone, _ = run_auto_ring(SETTLE, regeneration_heavy(10.0))
     assert alone[-1].ring.draws == () and alone[-1].stats().clouds_by_kind["ring"] == 0
     assert {c.kind for c in alone[-1].clouds} == {"impostor", "culled"}
     in_ring, _ = run_auto_ring(SETTLE, regeneration_heavy(200.0))
@@ -769,3 +769,35 @@ def test_another_scene_is_measured_afresh():
     assert plans[0].state.frame_times == {} and plans[0].state.drawn_as == "full"
     assert plans[0].state.frame_choice == "full"  # drawn so until the frames drawn this way are measured
     assert plans[-1].state.frame_times["full"].frames == 2  # measured again from the frame after
+
+
+@pytest.mark.parametrize(
+    "mode, across_m, rebuilds", [("auto", 300.0, False), ("auto", 500.0, True), ("impostor", 500.0, False)]
+)
+def test_auto_mode_rebuilds_a_ring_whose_clouds_passed_the_tolerance(mode, across_m, rebuilds):
+    """Wang's panels are impostors: in auto mode a ring cloud's parallax past the tolerance (0.5 degrees: about
+    390 m across for these clouds, 3 km off) rebuilds the ring, short of the ring's own rebuild distance (90% of
+    the radius here); impostor mode keeps Wang's rule alone.  The eye moves 25 m a frame."""
+    settings = dataclasses.replace(RING, mode=mode, ring_rebuild_horizontal=0.9)
+    costs = regeneration_heavy(200.0)
+
+    def at(x: float, state: LodState):
+        return plan(
+            camera_at((x, 100.0, 0.0), (x, 100.0, -1.0)),
+            settings,
+            centres=FAR_FIELD,
+            radii=(RADIUS,) * len(FAR_FIELD),
+            state=state,
+            costs=costs,
+        )
+
+    state = LodState()
+    for _ in range(SETTLE):
+        state = at(0.0, state).state
+    assert state.ring.current is not None and state.ring.current.holds_clouds
+    started = []
+    for x in np.arange(25.0, across_m + 1.0, 25.0):
+        frame = at(x, state)
+        started.append(frame.ring.build_segment == 0 and frame.ring.state.pending.holds_clouds)
+        state = frame.state
+    assert any(started) is rebuilds

@@ -106,8 +106,6 @@ PLAUSIBLE_RATIO = 1.5
 SCENE_CHANGE_RATIO = 1.25
 #: the running mean of a choice's frame times weighs each new frame at least this much
 FRAME_TIME_FORGETTING = 0.1
-#: a ring panel in view covers about this share of the screen (45 of ~75 degrees across, all the way up)
-RING_PANEL_SCREEN_SHARE = 0.6
 
 
 @dataclass(frozen=True)
@@ -369,6 +367,12 @@ def plan_frame(
     ball_fragments = splat_fragments(
         units.radius_squares, radii, distances, focal_px, units.particle_counts, screen_pixels
     )
+    # each unit's impostor quad: its half side in metres through the centre, and its pixels on the screen
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # the eye inside: the whole screen
+        half_sides = radii * distances / np.sqrt(np.maximum((distances - radii) * (distances + radii), 1e-300))
+        quad_pixels_of = np.nan_to_num(
+            np.minimum((2.0 * focal_px * half_sides / distances) ** 2, screen_pixels), nan=screen_pixels
+        )
     lifetimes = np.minimum(
         np.divide(tolerance, rates, out=np.full(len(radii), math.inf), where=rates > 0.0), LONGEST_LIFETIME_FRAMES
     )
@@ -382,18 +386,37 @@ def plan_frame(
     if settings.mode == "auto" and settings.uses_ring:
         candidates = ring_members(centres, radii, eye, settings)
         step = eye - last_eye if last_eye is not None else np.zeros(3)
+        alone = candidates & visible
         ring_panels, ring_rebuild = _ring_work(
-            units, candidates, centres, eye, step, ball_fragments, screen_pixels, settings, state.ring
+            units,
+            candidates,
+            centres,
+            eye,
+            step,
+            ball_fragments,
+            quad_pixels_of[alone],
+            lifetimes,
+            settings,
+            state.ring,
         )
         ring_ms = costs.ms(ring_panels + ring_rebuild)
-        alone = candidates & visible
         in_view = (
             _in_view_work(units, alone, cloud_splats, planes, eye, focal_px, screen_pixels)
             if cloud_splats is not None
             else (units.particle_counts[alone], ball_fragments[alone])
         )
         alone_ms = _alone_ms(
-            units, alone, in_view, distances, ball_fragments, lifetimes, focal_px, screen_pixels, settings, costs
+            units,
+            alone,
+            in_view,
+            distances,
+            half_sides,
+            ball_fragments,
+            lifetimes,
+            focal_px,
+            screen_pixels,
+            settings,
+            costs,
         )
         in_view_of = {
             int(i): Work(particles=float(p), fragments=float(f)) for i, p, f in zip(np.flatnonzero(alone), *in_view)
@@ -408,6 +431,8 @@ def plan_frame(
         units.members,
         segment_texture_size(height, camera.fov_y_deg, settings),
         holds_clouds=settings.mode != "auto" or (not all_full and _ring_pays(state.ring, ring_ms, alone_ms)),
+        past_tolerance=settings.mode == "auto"
+        and _ring_past_tolerance(state.ring.current, units, translation_error, eye, tolerance),
     )
 
     def particles_of(index: int) -> np.ndarray:
@@ -628,12 +653,12 @@ def plan_frame(
             layer_counts=record.layer_counts if cloud.splits else (0,),
         )
     if ring is not None:
-        cloud_work += _ring_panels_work(
-            sum(len(generation.occupied_segments) for generation, _ in ring.draws), screen_pixels
-        )
+        index_of = {members: index for index, members in enumerate(units.members)}
+        for generation, _ in ring.draws:
+            shown = [index_of[m] for m in generation.members if m in index_of and visible[index_of[m]]]
+            cloud_work += _ring_panels_work(len(generation.occupied_segments), quad_pixels_of[shown])
         if ring.build_segment is not None and ring.state.pending is not None:
             segment = ring.state.pending.segment_members[ring.build_segment]
-            index_of = {members: index for index, members in enumerate(units.members)}
             update_work += Work(
                 particles=float(sum(units.particle_counts[index_of[u]] for u in segment)),
                 regenerations=float(bool(segment)),
@@ -739,19 +764,22 @@ def _frame_choice(state: LodState, drawn_as: str, predicted: dict) -> str:
     return other if predicted and predicted[other] < PLAUSIBLE_RATIO * predicted[drawn_as] else drawn_as
 
 
-def _ring_panels_work(panels: int, screen_pixels: float) -> Work:
-    """Drawing `panels` ring panels (each a draw call): about half of them in view, each
-    `RING_PANEL_SCREEN_SHARE` of the screen."""
-    return Work(quad_pixels=RING_PANEL_SCREEN_SHARE * screen_pixels * panels / 2.0, quads=float(panels))
+def _ring_panels_work(panels: int, quad_pixels) -> Work:
+    """Drawing `panels` ring panels (each a draw call) holding clouds whose own impostor quads would fill
+    `quad_pixels` on the screen: a panel is cropped to its clouds' extent, so it fills about what they would."""
+    return Work(quad_pixels=float(np.sum(quad_pixels)), quads=float(panels))
 
 
 def _ring_work(
-    units: LodUnits, candidates, centres, eye, step, ball_fragments, screen_pixels, settings, state: RingState
+    units: LodUnits, candidates, centres, eye, step, ball_fragments, quad_pixels, lifetimes, settings, state: RingState
 ) -> tuple[Work, Work]:
-    """(panels, rebuild): a frame of Wang's ring holding the units `candidates` (mask).  Its panels drawn, and its
-    rebuild (every candidate splatted into the segments, whose textures have the screen's pixel density)
-    spread over the frames until the eye's current `step` a frame carries it past a rebuild distance, or
-    over the frames the last ring lasted when that was shorter."""
+    """(panels, rebuild): a frame of Wang's ring holding the units `candidates` (mask).
+
+    Its panels drawn (`quad_pixels`: the candidates in view's impostor quads), and its rebuild (every
+    candidate splatted into the segments, whose textures have the screen's pixel density) spread over
+    the frames until the eye's current `step` a frame carries it past a rebuild distance, or over the
+    frames the last ring lasted, or its clouds' impostors would (`lifetimes`), when shorter.
+    """
     offsets = centres[candidates] - eye
     azimuths = np.degrees(np.arctan2(offsets[:, 0], -offsets[:, 2])) % 360.0
     panels = len(np.unique(np.floor(azimuths / SEGMENT_DEG)))
@@ -759,6 +787,7 @@ def _ring_work(
     lifetime = min(
         LONGEST_LIFETIME_FRAMES,
         state.rebuild_interval,
+        float(np.min(lifetimes[candidates], initial=math.inf)),  # auto mode rebuilds it past the tolerance
         settings.ring_rebuild_horizontal * settings.ring_radius / max(horizontal, 1e-300),
         settings.ring_rebuild_vertical * settings.ring_radius / max(vertical, 1e-300),
     )
@@ -767,7 +796,7 @@ def _ring_work(
         texture_fragments=float(np.sum(ball_fragments[candidates])),
         regenerations=float(panels),
     )
-    return _ring_panels_work(panels, screen_pixels), rebuild.scaled(1.0 / max(lifetime, 1.0))
+    return _ring_panels_work(panels, quad_pixels), rebuild.scaled(1.0 / max(lifetime, 1.0))
 
 
 def _in_view_work(units: LodUnits, chosen, cloud_splats, planes, eye, focal_px, screen_pixels):
@@ -792,15 +821,24 @@ def _in_view_work(units: LodUnits, chosen, cloud_splats, planes, eye, focal_px, 
 
 
 def _alone_ms(
-    units: LodUnits, chosen, in_view, distances, ball_fragments, lifetimes, focal_px, screen_pixels, settings, costs
+    units: LodUnits,
+    chosen,
+    in_view,
+    distances,
+    half_sides,
+    ball_fragments,
+    lifetimes,
+    focal_px,
+    screen_pixels,
+    settings,
+    costs,
 ):
     """The units `chosen` (mask) drawn each on its own as auto mode would, far from the eye: per unit the
     cheaper of full 3D (`in_view`: its particles and fragments in view) and an impostor (its quad, and its
     regeneration over its predicted lifetime: every particle, into a texture)."""
-    particles, radii = units.particle_counts[chosen], units.radii[chosen]
+    particles, half_sides = units.particle_counts[chosen], half_sides[chosen]
     distances, fragments = distances[chosen], ball_fragments[chosen]
     with np.errstate(divide="ignore", invalid="ignore"):
-        half_sides = radii * distances / np.sqrt(np.maximum((distances - radii) * (distances + radii), 1e-300))
         sides = 2.0 * focal_px * half_sides / distances
         detail = 2.0 * settings.impostor_detail_texels * half_sides / units.finest_radii[chosen]
         detail = np.where(settings.impostor_detail_texels > 0.0, detail, np.inf)
@@ -814,6 +852,16 @@ def _alone_ms(
         + remake / np.maximum(lifetimes[chosen], 1.0)
     )
     return float(np.sum(np.minimum(full, impostor)))
+
+
+def _ring_past_tolerance(generation, units: LodUnits, translation_error, eye, tolerance: float) -> bool:
+    """Whether a cloud of the ring `generation` (None: no ring) has a translation error past the tolerance, seen
+    from its eye: Wang's panels are impostors too, and auto mode keeps every impostor within the tolerance."""
+    if generation is None or not generation.members:
+        return False
+    held = [index for index, members in enumerate(units.members) if members in generation.members]
+    errors = translation_error(units.centres[held], units.radii[held], generation.eye, eye)
+    return bool(np.any(errors > tolerance))
 
 
 def _ring_pays(state: RingState, ring_ms: float, alone_ms: float) -> bool:

@@ -165,7 +165,13 @@ def _wrong_size(generation: RingGeneration, texture_size: tuple) -> bool:
 
 
 def _needs_rebuild(
-    generation: RingGeneration, eye, settings: RenderSettings, keys: dict, texture_size: tuple, holds_clouds: bool
+    generation: RingGeneration,
+    eye,
+    settings: RenderSettings,
+    keys: dict,
+    texture_size: tuple,
+    holds_clouds: bool,
+    past_tolerance: bool,
 ) -> bool:
     if generation.holds_clouds != holds_clouds:
         return True
@@ -173,7 +179,8 @@ def _needs_rebuild(
         return False  # holding nothing, nothing goes stale
     moved = np.asarray(eye, dtype=np.float64) - np.asarray(generation.eye)
     return (
-        generation.lighting_key != _members_key(generation.members, keys)
+        past_tolerance
+        or generation.lighting_key != _members_key(generation.members, keys)
         or _wrong_size(generation, texture_size)
         or generation.radius != settings.ring_radius
         or math.hypot(moved[0], moved[2]) > settings.ring_rebuild_horizontal * settings.ring_radius
@@ -191,6 +198,7 @@ def plan_ring(
     ids: tuple,
     texture_size: tuple,
     holds_clouds: bool = True,
+    past_tolerance: bool = False,
 ) -> RingPlan | None:
     """Advance the ring by one frame: start a rebuild if needed, build one segment or step the fade.
 
@@ -198,7 +206,9 @@ def plan_ring(
     holds ids, so a scene whose spheres are renumbered (clouds regrouped, one removed) does not
     mistake one cloud for another.  `texture_size` is the segment texture size the screen asks for
     (`segment_texture_size`).  `holds_clouds` False asks for a ring of no clouds (it does not pay for
-    itself): the ring shown fades out as when it is rebuilt, with nothing to build.
+    itself): the ring shown fades out as when it is rebuilt, with nothing to build.  `past_tolerance`: the
+    ring shown holds a cloud whose translation error has passed the impostors' tolerance (auto mode keeps
+    every representation within it): it is rebuilt as when the eye has moved past the rebuild distance.
 
     A ring being built when its members' keys change is finished first and rebuilt after: a cloud
     forming in the ring, whose key changes every frame, would otherwise keep the ring from ever
@@ -218,7 +228,10 @@ def plan_ring(
     keys = dict(zip(ids, lighting_keys))
     if pending is None and (
         (current is None and holds_clouds)
-        or (current is not None and _needs_rebuild(current, eye, settings, keys, texture_size, holds_clouds))
+        or (
+            current is not None
+            and _needs_rebuild(current, eye, settings, keys, texture_size, holds_clouds, past_tolerance)
+        )
     ):
         if current is not None or state.pending is not None:
             since_rebuild, rebuild_interval = 0, float(since_rebuild)
