@@ -312,7 +312,7 @@ def plan_frame(
         state = dataclasses.replace(state, frame_times={})  # another scene: what was measured says nothing of it
     if settings.mode == "auto" and _settled_in_full_3d(state):
         # nothing to price: the choice is by measured times, and the units' measurement is fresh
-        in_full = plan_frame(
+        full_plan = plan_frame(
             units,
             camera,
             viewport,
@@ -324,13 +324,13 @@ def plan_frame(
             costs,
             cloud_splats,
         )
-        drawn = {c.members: Representation("full", 1.0) for c in in_full.clouds if c.kind == "full"}
+        drawn = {c.members: Representation("full", 1.0) for c in full_plan.clouds if c.kind == "full"}
         return dataclasses.replace(
-            in_full,
+            full_plan,
             state=dataclasses.replace(
-                in_full.state,
+                full_plan.state,
                 representations=drawn,
-                frame_choice=_frame_choice(state, "full", {}),
+                frame_choice=_frame_choice(state, "full", {}),  # the units are measured: no prediction is asked
                 drawn_as="full",
                 frames_drawn_as=state.frames_drawn_as + 1,
             ),
@@ -414,7 +414,7 @@ def plan_frame(
             ball_fragments,
             lifetimes,
             focal_px,
-            screen_pixels,
+            quad_pixels_of,
             settings,
             costs,
         )
@@ -761,7 +761,7 @@ def _frame_choice(state: LodState, drawn_as: str, predicted: dict) -> str:
         return drawn_as
     if _known(state, other):
         return _cheapest(drawn_as, {choice: state.frame_times[choice].mean_ms for choice in (drawn_as, other)})
-    return other if predicted and predicted[other] < PLAUSIBLE_RATIO * predicted[drawn_as] else drawn_as
+    return other if predicted[other] < PLAUSIBLE_RATIO * predicted[drawn_as] else drawn_as
 
 
 def _ring_panels_work(panels: int, quad_pixels) -> Work:
@@ -829,13 +829,13 @@ def _alone_ms(
     ball_fragments,
     lifetimes,
     focal_px,
-    screen_pixels,
+    quad_pixels,
     settings,
     costs,
 ):
     """The units `chosen` (mask) drawn each on its own as auto mode would, far from the eye: per unit the
     cheaper of full 3D (`in_view`: its particles and fragments in view) and an impostor (its quad, and its
-    regeneration over its predicted lifetime: every particle, into a texture)."""
+    regeneration over its predicted lifetime: every particle, into a texture); `quad_pixels` per unit, of all."""
     particles, half_sides = units.particle_counts[chosen], half_sides[chosen]
     distances, fragments = distances[chosen], ball_fragments[chosen]
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -846,11 +846,7 @@ def _alone_ms(
         texture_fragments = fragments * np.nan_to_num((texture / sides) ** 2, nan=1.0)
     full = costs.particles * in_view[0] + costs.fragments * in_view[1]
     remake = costs.particles * particles + costs.texture_fragments * texture_fragments + costs.regenerations
-    impostor = (
-        costs.quad_pixels * np.minimum(sides * sides, screen_pixels)
-        + costs.quads
-        + remake / np.maximum(lifetimes[chosen], 1.0)
-    )
+    impostor = costs.quad_pixels * quad_pixels[chosen] + costs.quads + remake / np.maximum(lifetimes[chosen], 1.0)
     return float(np.sum(np.minimum(full, impostor)))
 
 
