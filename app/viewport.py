@@ -186,7 +186,7 @@ class Viewport:
         draw = imgui.get_window_draw_list()
         outlines = []
         if plan is not None and self.show_impostor_outlines:
-            outlines += impostor_outlines(plan, self.renderer.units, editor.camera, size)
+            outlines += impostor_outlines(plan, editor.camera, size)
         if plan is not None and self.show_ring_segments:
             outlines += ring_outlines(plan, editor.camera, size, editor.settings.ring_elevation_deg)
         for outline in outlines:

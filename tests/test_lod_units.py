@@ -4,7 +4,9 @@ import dataclasses
 
 import numpy as np
 
+from cloudcore.lod.costs import CostModel
 from cloudcore.lod.frameplan import LodState, plan_frame
+from cloudcore.lod.impostors import parallax_errors_deg
 from cloudcore.lod.units import LodUnits, interpenetrating_groups, lod_units
 from cloudcore.scene import Camera, splats_bounding_sphere
 from cloudcore.settings import RenderSettings
@@ -84,3 +86,67 @@ def test_units_of_spheres_are_one_cloud_each():
     units = LodUnits.of_spheres(np.zeros((2, 3)), [1.0, 2.0])
     assert units.members == ((0,), (1,)) and len(units.radii) == 2
     assert dataclasses.is_dataclass(units)
+
+
+def fly(units, eyes, settings, costs=CostModel(), state=None):
+    """Plan a frame from each eye in turn (looking at the origin); the plans."""
+    plans, state = [], state or LodState()
+    for eye in eyes:
+        plan = plan_frame(units, Camera(tuple(eye), (0.0, 0.0, 0.0), 60.0), (640, 480), settings, state, 1, costs=costs)
+        plans.append(plan)
+        state = plan.state
+    return plans
+
+
+def sideways(start, step, frames):
+    return [np.add(start, (step * k, 0.0, 0.0)) for k in range(frames)]
+
+
+AUTO = RenderSettings(ring_radius=np.inf)
+
+
+def touching(gap: float) -> Packed:
+    """Two clouds `gap` apart whose splats meet halfway only, and one far off: one group twice a cloud's size."""
+    left, right = blob((0, 0, 0), spread=20.0), blob((gap, 0, 0), spread=20.0)
+    bridge = [np.array([[0.5 * gap - 4.0, 0.0, 0.0]]), np.array([[0.5 * gap + 4.0, 0.0, 0.0]])]
+    return Packed(
+        [
+            (np.concatenate([left[0], bridge[0]]), np.append(left[1], 12.0)),
+            (np.concatenate([right[0], bridge[1]]), np.append(right[1], 12.0)),
+            blob((3000, 0, 0)),
+        ]
+    )
+
+
+def test_a_moving_eye_plans_a_group_apart_where_its_clouds_impostors_cost_less():
+    units = lod_units(touching(240.0))
+    assert units.members[0] == (0, 1) and units.radii[0] > 1.7 * units.clouds.radii.max()
+    # moving, the group's larger sphere passes the tolerance sooner, and is remade every particle at a time
+    plans = fly(units, sideways((0.0, 0.0, 800.0), 6.0, 40), AUTO)
+    assert plans[0].units.members[0] == (0, 1)  # first seen: nothing moves yet, the group is the cheaper
+    apart = next(k for k, plan in enumerate(plans) if (0, 1) in plan.state.opened)
+    opening = plans[apart]
+    assert opening.units.members[:2] == ((0,), (1,))  # in place of the group
+    # it opened where the group's impostor was due anyway: past the tolerance, remade from this eye otherwise
+    assert plans[apart - 1].clouds[0].members == (0, 1)
+    held = plans[apart - 1].records[(0, 1)]
+    parallax = parallax_errors_deg(units.centres[:1], units.radii[:1], held.eye, np.asarray(opening.state.eye))
+    assert parallax[0] > opening.tolerance_deg
+    assert [c.regenerate for c in opening.clouds[:2]] == ["new", "new"]
+    assert (0, 1) not in opening.records  # its texture goes back to the pool
+    assert all((0, 1) in plan.state.opened for plan in plans[apart:])  # while it moves, it stays apart
+
+
+def test_a_group_apart_closes_once_the_eye_stops_and_only_auto_mode_opens_one():
+    units = lod_units(touching(240.0))
+    moving = fly(units, sideways((0.0, 0.0, 800.0), 6.0, 40), AUTO)
+    assert (0, 1) in moving[-1].state.opened
+    still = fly(units, [moving[-1].state.eye] * 3, AUTO, state=moving[-1].state)
+    assert (0, 1) not in still[-1].state.opened and still[-1].units.members[0] == (0, 1)
+    for settings in (
+        dataclasses.replace(AUTO, mode="impostor"),
+        dataclasses.replace(AUTO, groups_apart_in_motion=False),
+    ):
+        whole = fly(units, sideways((0.0, 0.0, 800.0), 6.0, 40), settings)
+        assert not any(plan.state.opened for plan in whole)
+        assert all(plan.units.members[0] == (0, 1) for plan in whole)

@@ -48,7 +48,7 @@ def test_an_impostor_outline_is_its_quad_on_screen():
     units = LodUnits.of_spheres(centres, radii, particle_counts=[3000, 0], radius_squares=[3000 * 40.0**2, 0.0])
     plan = plan_frame(units, CAMERA, VIEWPORT, RenderSettings(ring_radius=math.inf), LodState(), 1)
     assert [c.kind for c in plan.clouds] == ["impostor", "full"]
-    (outline,) = impostor_outlines(plan, units, CAMERA, VIEWPORT)  # the full cloud has none
+    (outline,) = impostor_outlines(plan, CAMERA, VIEWPORT)  # the full cloud has none
     assert (outline.kind, outline.index) == ("impostor", 0)
     side = screen_size_px(radius, distance, VIEWPORT[1], CAMERA.fov_y_deg)
     np.testing.assert_allclose(np.ptp(outline.points, axis=0), [side, side], rtol=1e-9)

@@ -122,7 +122,8 @@ class FrameRenderer:
 
     @property
     def units(self) -> LodUnits:
-        """The units (clouds, or groups of interpenetrating clouds) the last frame was planned with."""
+        """The units (clouds, or groups of interpenetrating clouds) of the scene last rendered; a frame opens
+        the groups the eye is in (`FramePlan.units`)."""
         return self._units
 
     @property
@@ -214,7 +215,7 @@ class FrameRenderer:
                     self.context, camera, poses, plan.objects_with_world, write_depth=True, antialiased=antialiased
                 )
         with clock.timed("impostor updates"):
-            rendered = self._impostors.update(plan, self._units, particles, settings, time_s)
+            rendered = self._impostors.update(plan, particles, settings, time_s)
         with clock.timed("clouds"):
             self.context.bind_target()
             drawn = self._draw_clouds(plan, particles, camera, view, projection, settings, poses, time_s)

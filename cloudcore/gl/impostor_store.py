@@ -22,7 +22,6 @@ from cloudcore.lod.frameplan import FramePlan
 from cloudcore.lod.impostors import ImpostorView, cropped_corners, impostor_view, particle_extent
 from cloudcore.lod.ring import RingGeneration, panel_corners, segment_camera
 from cloudcore.lod.splitting import layer_bounds
-from cloudcore.lod.units import LodUnits
 from cloudcore.settings import RenderSettings
 
 
@@ -35,11 +34,9 @@ class ImpostorStore:
         self._clouds: dict[tuple, tuple[list[TextureTarget], ImpostorView, tuple]] = {}
         self._ring: dict[tuple[RingGeneration, int], tuple[TextureTarget, tuple]] = {}  # (texture, extent)
 
-    def update(
-        self, plan: FramePlan, units: LodUnits, particles: ParticleBuffer, settings: RenderSettings, time_s: float
-    ) -> int:
+    def update(self, plan: FramePlan, particles: ParticleBuffer, settings: RenderSettings, time_s: float) -> int:
         """Render this frame's regenerations and ring segment at scene time `time_s`; returns the particles rendered."""
-        rendered = 0
+        rendered, units = 0, plan.units
         for cloud in plan.clouds:
             if cloud.regenerate is None:
                 continue

@@ -168,6 +168,7 @@ class LodState:
     frame_times: Mapping = field(default_factory=dict)  # choice -> FrameTime: how long its frames took, measured
     #: the units' particles when last planned: a scene changed past `SCENE_CHANGE_RATIO` forgets `frame_times`
     particles: float = 0.0
+    opened: frozenset = frozenset()  # the groups the eye is in, planned as their clouds (`LodUnits.seen_from`)
 
     def measured(self, measurements) -> LodState:
         """The state with this frame's (predicted work, measured ms) pairs folded into the cost fit, and their
@@ -214,6 +215,7 @@ class FramePlan:
     costs: CostModel = CostModel()  # the model the plan priced its choices with
     tolerance_deg: float = 0.0  # the translation tolerance in force
     accepted_error: float = 0.0  # the largest translation error drawn, in tolerances (> 1: a budget postponed it)
+    units: LodUnits | None = None  # the frame's units, which `clouds` index: the groups the eye is in opened
 
     @property
     def records(self) -> Mapping:
@@ -335,14 +337,57 @@ def plan_frame(
                 frames_drawn_as=state.frames_drawn_as + 1,
             ),
         )
-    centres, radii = units.centres, units.radii
-    width, height = viewport
+    arguments = (camera, viewport, settings, state, lighting_key, objects, cloud_particles, costs, cloud_splats)
+    if not (settings.mode == "auto" and settings.groups_apart_in_motion and units.clouds is not None):
+        return _plan_units(units, frozenset(), *arguments)
+    wanted = _groups_cheaper_apart(units, camera, viewport, settings, state, costs)
+    held = wanted & state.opened
+    plan = _plan_units(units, held, *arguments)
+    # a group opens only where its own impostor is due anyway, so the switch steps no more than a regeneration
+    due = frozenset(
+        cloud.members
+        for cloud in plan.clouds
+        if cloud.members in wanted - held and (cloud.kind == "inside" or cloud.regenerate or cloud.postponed)
+    )
+    return _plan_units(units, held | due, *arguments) if due else plan
+
+
+def _plan_units(
+    units: LodUnits,
+    opened: frozenset,
+    camera: Camera,
+    viewport: tuple[int, int],
+    settings: RenderSettings,
+    state: LodState,
+    lighting_key: Hashable,
+    objects,
+    cloud_particles,
+    costs: CostModel | None,
+    cloud_splats,
+) -> FramePlan:
+    """`plan_frame` with the groups `opened` planned apart, their clouds each a unit of its own."""
+    scene_particles = float(np.sum(units.particle_counts))
+    units = units.apart(opened)
     eye = np.asarray(camera.position, dtype=np.float64)
+    width, height = viewport
+    costs = state.costs.model() if costs is None else costs
+    tolerance = tolerance_deg_for(settings, camera.fov_y_deg, height)
+    translation_error = TRANSLATION_METRICS[settings.translation_metric]
+    focal_px = 0.5 * height / math.tan(math.radians(camera.fov_y_deg) / 2.0)
+    screen_pixels = float(width * height)
+    last_eye = None if state.eye is None else np.asarray(state.eye, dtype=np.float64)
+    centres, radii = units.centres, units.radii
     view, projection = view_matrix(camera), projection_matrix(camera.fov_y_deg, width / height)
     view_projection = projection @ view
     planes = frustum_planes(view_projection)
     visible = spheres_in_frustum(planes, centres, radii)
-    distances = np.linalg.norm(centres - eye, axis=1)
+    seen = _seen(units, eye, last_eye, translation_error, tolerance, focal_px, screen_pixels)
+    distances, ball_fragments, quad_pixels_of, lifetimes = (
+        seen.distances,
+        seen.ball_fragments,
+        seen.quad_pixels,
+        seen.lifetimes,
+    )
     cloud_keys = lighting_key if isinstance(lighting_key, tuple) else (lighting_key,) * sum(map(len, units.members))
     keys = tuple(tuple(cloud_keys[c] for c in members) for members in units.members)
     records = state.records
@@ -351,31 +396,7 @@ def plan_frame(
     object_centres = np.array([o.centre for o in objects], dtype=np.float64).reshape(-1, 3)
     object_radii = np.array([o.radius for o in objects], dtype=np.float64)
     objects_visible = spheres_in_frustum(planes, object_centres, object_radii)
-    costs = state.costs.model() if costs is None else costs
-    tolerance = tolerance_deg_for(settings, camera.fov_y_deg, height)
-    translation_error = TRANSLATION_METRICS[settings.translation_metric]
-    focal_px = 0.5 * height / math.tan(math.radians(camera.fov_y_deg) / 2.0)
-    screen_pixels = float(width * height)
-    last_eye = None if state.eye is None else np.asarray(state.eye, dtype=np.float64)
-    # per unit, the translation error of one frame at the eye's current speed, and of the impostor held
-    rates = translation_error(centres, radii, last_eye, eye) if last_eye is not None else np.zeros(len(radii))
-    held_eyes = [records[members].eye if members in records else (math.nan,) * 3 for members in units.members]
-    held_errors = np.nan_to_num(
-        translation_error(centres, radii, np.array(held_eyes, dtype=np.float64).reshape(-1, 3), eye), nan=math.inf
-    )
-    # full 3D of every unit as a ball of discs (near units are counted splat by splat below)
-    ball_fragments = splat_fragments(
-        units.radius_squares, radii, distances, focal_px, units.particle_counts, screen_pixels
-    )
-    # each unit's impostor quad: its half side in metres through the centre, and its pixels on the screen
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # the eye inside: the whole screen
-        half_sides = radii * distances / np.sqrt(np.maximum((distances - radii) * (distances + radii), 1e-300))
-        quad_pixels_of = np.nan_to_num(
-            np.minimum((2.0 * focal_px * half_sides / distances) ** 2, screen_pixels), nan=screen_pixels
-        )
-    lifetimes = np.minimum(
-        np.divide(tolerance, rates, out=np.full(len(radii), math.inf), where=rates > 0.0), LONGEST_LIFETIME_FRAMES
-    )
+    held_errors = _held_errors(units, records, translation_error, eye)
     # auto mode prices Wang's ring against drawing its clouds each as auto would (the cheaper of full 3D and
     # an impostor): a sparse far field is cheaper drawn than its panels and their rebuilds
     ring_ms = alone_ms = 0.0
@@ -405,19 +426,7 @@ def plan_frame(
             if cloud_splats is not None
             else (units.particle_counts[alone], ball_fragments[alone])
         )
-        alone_ms = _alone_ms(
-            units,
-            alone,
-            in_view,
-            distances,
-            half_sides,
-            ball_fragments,
-            lifetimes,
-            focal_px,
-            quad_pixels_of,
-            settings,
-            costs,
-        )
+        alone_ms = _alone_ms(units, seen, alone, in_view, focal_px, settings, costs)
         in_view_of = {
             int(i): Work(particles=float(p), fragments=float(f)) for i, p, f in zip(np.flatnonzero(alone), *in_view)
         }
@@ -695,6 +704,7 @@ def plan_frame(
         state.frame_index + 1,
         state.frame_times,
         scene_particles,
+        opened,
     )
     return FramePlan(
         tuple(clouds),
@@ -709,6 +719,7 @@ def plan_frame(
         costs,
         tolerance,
         accepted,
+        units,
     )
 
 
@@ -820,34 +831,111 @@ def _in_view_work(units: LodUnits, chosen, cloud_splats, planes, eye, focal_px, 
     )
 
 
-def _alone_ms(
-    units: LodUnits,
-    chosen,
-    in_view,
-    distances,
-    half_sides,
-    ball_fragments,
-    lifetimes,
-    focal_px,
-    quad_pixels,
-    settings,
-    costs,
-):
+def _alone_ms(units: LodUnits, seen: _Seen, chosen, in_view, focal_px, settings, costs) -> float:
     """The units `chosen` (mask) drawn each on its own as auto mode would, far from the eye: per unit the
-    cheaper of full 3D (`in_view`: its particles and fragments in view) and an impostor (its quad, and its
-    regeneration over its predicted lifetime: every particle, into a texture); `quad_pixels` per unit, of all."""
-    particles, half_sides = units.particle_counts[chosen], half_sides[chosen]
-    distances, fragments = distances[chosen], ball_fragments[chosen]
+    cheaper of full 3D (`in_view`: its particles and fragments in view) and an impostor (`_impostor_ms`)."""
+    full = costs.particles * in_view[0] + costs.fragments * in_view[1]
+    return float(np.sum(np.minimum(full, _impostor_ms(units, seen, chosen, focal_px, settings, costs))))
+
+
+@dataclass(frozen=True)
+class _Seen:
+    """What the plan prices units by, per unit, from this frame's eye."""
+
+    distances: np.ndarray  # of the centre from the eye
+    ball_fragments: np.ndarray  # of full 3D, its splats a ball of discs (`splat_fragments`)
+    half_sides: np.ndarray  # of the impostor quad through the centre, metres
+    quad_pixels: np.ndarray  # of the impostor quad on the screen (all of it with the eye inside)
+    lifetimes: np.ndarray  # frames an impostor made now lasts at the eye's speed, at most LONGEST_LIFETIME_FRAMES
+
+
+def _seen(units: LodUnits, eye, last_eye, translation_error, tolerance: float, focal_px, screen_pixels) -> _Seen:
+    centres, radii = units.centres, units.radii
+    distances = np.linalg.norm(centres - eye, axis=1)
+    # the translation error of one frame at the eye's current speed
+    rates = translation_error(centres, radii, last_eye, eye) if last_eye is not None else np.zeros(len(radii))
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # the eye inside: the whole screen
+        half_sides = radii * distances / np.sqrt(np.maximum((distances - radii) * (distances + radii), 1e-300))
+        quad_pixels = np.nan_to_num(
+            np.minimum((2.0 * focal_px * half_sides / distances) ** 2, screen_pixels), nan=screen_pixels
+        )
+    return _Seen(
+        distances,
+        splat_fragments(units.radius_squares, radii, distances, focal_px, units.particle_counts, screen_pixels),
+        half_sides,
+        quad_pixels,
+        np.minimum(
+            np.divide(tolerance, rates, out=np.full(len(radii), math.inf), where=rates > 0.0), LONGEST_LIFETIME_FRAMES
+        ),
+    )
+
+
+def _held_errors(units: LodUnits, records: Mapping, translation_error, eye) -> np.ndarray:
+    """Per unit, the translation error of the impostor held (inf: none)."""
+    eyes = [records[members].eye if members in records else (math.nan,) * 3 for members in units.members]
+    errors = translation_error(units.centres, units.radii, np.array(eyes, dtype=np.float64).reshape(-1, 3), eye)
+    return np.nan_to_num(errors, nan=math.inf)
+
+
+def _impostor_ms(units: LodUnits, seen: _Seen, chosen, focal_px, settings, costs: CostModel) -> np.ndarray:
+    """Per unit of `chosen` (a mask or indices), its impostor a frame: the quad, and the regeneration (every
+    particle, into a texture as fine as the screen or the unit's detail asks) over the impostor's lifetime."""
+    half_sides, distances, fragments = seen.half_sides[chosen], seen.distances[chosen], seen.ball_fragments[chosen]
     with np.errstate(divide="ignore", invalid="ignore"):
         sides = 2.0 * focal_px * half_sides / distances
         detail = 2.0 * settings.impostor_detail_texels * half_sides / units.finest_radii[chosen]
         detail = np.where(settings.impostor_detail_texels > 0.0, detail, np.inf)
         texture = np.clip(np.minimum(sides, detail), settings.impostor_min_size, settings.impostor_max_size)
         texture_fragments = fragments * np.nan_to_num((texture / sides) ** 2, nan=1.0)
-    full = costs.particles * in_view[0] + costs.fragments * in_view[1]
-    remake = costs.particles * particles + costs.texture_fragments * texture_fragments + costs.regenerations
-    impostor = costs.quad_pixels * quad_pixels[chosen] + costs.quads + remake / np.maximum(lifetimes[chosen], 1.0)
-    return float(np.sum(np.minimum(full, impostor)))
+    remake = (
+        costs.particles * units.particle_counts[chosen]
+        + costs.texture_fragments * texture_fragments
+        + costs.regenerations
+    )
+    return costs.quad_pixels * seen.quad_pixels[chosen] + costs.quads + remake / np.maximum(seen.lifetimes[chosen], 1.0)
+
+
+def _groups_cheaper_apart(units: LodUnits, camera: Camera, viewport, settings, state: LodState, costs) -> frozenset:
+    """The groups of interpenetrating clouds (their members) that auto mode would rather plan apart, each cloud a
+    unit of its own (`LodUnits.apart`): while the eye moves, those whose clouds' impostors cost less than the
+    group's (`_cheapest`, held apart while so).
+
+    A group's impostor is the picture without the blobs of clouds sorted whole (`cloudcore.lod.units`); a
+    moving eye remakes it every particle at a time, and sooner than its clouds' (its sphere is larger: more
+    parallax for the same step).  Moving, the blobs are the price of the time saved (`RenderSettings.
+    groups_apart_in_motion`); still (the group's impostor would outlast `LONGEST_LIFETIME_FRAMES`), a
+    group is whole, whatever the prices: it closes, remade from that very eye.  `plan_frame` opens a group
+    only where its own impostor is due anyway.
+    """
+    eye = np.asarray(camera.position, dtype=np.float64)
+    last_eye = None if state.eye is None else np.asarray(state.eye, dtype=np.float64)
+    costs = state.costs.model() if costs is None else costs
+    height = viewport[1]
+    tolerance = tolerance_deg_for(settings, camera.fov_y_deg, height)
+    pricing = (
+        eye,
+        last_eye,
+        TRANSLATION_METRICS[settings.translation_metric],
+        tolerance,
+        0.5 * height / math.tan(math.radians(camera.fov_y_deg) / 2.0),
+        float(viewport[0] * height),
+    )
+    focal_px = pricing[4]
+    groups = np.array([len(members) > 1 for members in units.members])
+    group_seen, part_seen = _seen(units, *pricing), _seen(units.clouds, *pricing)
+    # with the eye inside a group's sphere no impostor of it can be made: its screen impostor redraws it all
+    outside = groups & (group_seen.distances >= INSIDE_RADII * units.radii)
+    group_ms = np.full(len(groups), math.inf)
+    group_ms[outside] = _impostor_ms(units, group_seen, outside, focal_px, settings, costs)
+    part_prices = _impostor_ms(units.clouds, part_seen, slice(None), focal_px, settings, costs)
+    part_ms = dict(zip((members[0] for members in units.clouds.members), part_prices))
+    wanted = set()
+    for index in np.flatnonzero(groups & (group_seen.lifetimes < LONGEST_LIFETIME_FRAMES)):
+        members = units.members[index]
+        prices = {"group": float(group_ms[index]), "apart": sum(part_ms[cloud] for cloud in members)}
+        if _cheapest("apart" if members in state.opened else "group", prices) == "apart":
+            wanted.add(members)
+    return frozenset(wanted)
 
 
 def _ring_past_tolerance(generation, units: LodUnits, translation_error, eye, tolerance: float) -> bool:

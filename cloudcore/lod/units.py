@@ -14,12 +14,20 @@ times the sum of its radius and the other cloud's largest radius of a splat
 centre of the other: halfway, where each kernel exp(-4 (d/r)^2) is still
 above exp(-1) of its peak.  Splats that only graze (the default scene's
 bounding spheres nearly all meet) stay apart: grouping them would make
-needlessly large impostors for an error below 8-bit precision.  Pure numpy
-and scipy.
+needlessly large impostors for an error below 8-bit precision.
+
+A group costs motion: its sphere is larger than its clouds', so a moving eye
+remakes its impostor sooner, and every particle of it each time.  Auto mode
+plans a group apart, its clouds each a unit of its own, where their
+impostors cost less than the group's (`cloudcore.lod.frameplan`): along the
+default flythrough that is nearly always, and the picture's mean PSNR is the
+same (52.2 dB either way); with the eye still, the group's.  Pure numpy and
+scipy.
 """
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -43,6 +51,27 @@ class LodUnits:
     particle_counts: np.ndarray  # (units,) particles
     radius_squares: np.ndarray  # (units,) sum of the particles' squared radii, m^2: their splats' area
     finest_radii: np.ndarray  # (units,) metres: the finest detail in the unit (0: unknown)
+    #: a unit of its own for each cloud of a group, for a group planned apart (`apart`; None: no groups)
+    clouds: LodUnits | None = None
+
+    def apart(self, groups: frozenset) -> LodUnits:
+        """These units with each group of `groups` (their members) replaced, in place, by its clouds' own units."""
+        if not groups:
+            return self
+        row_of = {members[0]: row for row, members in enumerate(self.clouds.members)}
+        rows = [
+            (self.clouds, row_of[cloud]) if members in groups else (self, index)
+            for index, members in enumerate(self.members)
+            for cloud in (members if members in groups else members[:1])
+        ]
+        return LodUnits(
+            np.array([source.centres[row] for source, row in rows]).reshape(-1, 3),
+            np.array([source.radii[row] for source, row in rows]),
+            tuple(source.members[row] for source, row in rows),
+            np.array([source.particle_counts[row] for source, row in rows]),
+            np.array([source.radius_squares[row] for source, row in rows]),
+            np.array([source.finest_radii[row] for source, row in rows]),
+        )
 
     @staticmethod
     def of_spheres(centres, radii, finest_radii=None, particle_counts=None, radius_squares=None) -> LodUnits:
@@ -121,6 +150,15 @@ def lod_units(particles, group: bool = True, groupable: int | None = None) -> Lo
         if group and grouped
         else tuple((i,) for i in range(grouped))
     ) + tuple((i,) for i in range(grouped, clouds))
+    units = _units_of(particles, members)
+    in_groups = tuple((cloud,) for unit in members if len(unit) > 1 for cloud in unit)
+    return dataclasses.replace(units, clouds=_units_of(particles, in_groups)) if in_groups else units
+
+
+def _units_of(particles, members: tuple) -> LodUnits:
+    """The units of `particles` whose clouds are `members` (one tuple of cloud indices per unit)."""
+    starts = particles.cloud_starts
+    sphere_centres, sphere_radii = particles.bounding_centres, particles.bounding_radii
     centres, radii, counts, squares, finest = [], [], [], [], []
     for clouds in members:
         ranges = [np.arange(starts[c], starts[c + 1]) for c in clouds]

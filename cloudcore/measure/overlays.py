@@ -63,10 +63,9 @@ def clip_to_near(polygon: np.ndarray, near: float) -> np.ndarray | None:
     return np.array(kept) if len(kept) >= 3 else None
 
 
-def impostor_outlines(plan: FramePlan, units, camera: Camera, viewport: tuple[int, int]) -> list[Outline]:
-    """The quads of the units the plan draws from impostor textures; `units` (`cloudcore.lod.units.LodUnits`)
-    are those the plan was made with."""
-    outlines = []
+def impostor_outlines(plan: FramePlan, camera: Camera, viewport: tuple[int, int]) -> list[Outline]:
+    """The quads of the units the plan draws from impostor textures."""
+    units, outlines = plan.units, []
     for cloud in plan.of_kind(*TEXTURED):
         record = plan.records[cloud.members]
         corners = impostor_view(units.centres[cloud.index], units.radii[cloud.index], record.eye).corners[_AROUND]
