@@ -176,3 +176,24 @@ def test_no_frame_of_the_default_flythrough_has_a_layer_order_error():
         ]
     assert errors == []
     assert split_frames > 100, "the aircraft should cross a drawn cloud for seconds of the path"
+
+
+def test_auto_mode_prices_an_impostor_with_an_object_moving_inside_as_remade_each_frame_a_texture_a_layer():
+    units = LodUnits.of_spheres(
+        CENTRE, RADIUS, [10.0], particle_counts=[len(PARTICLES)], radius_squares=[len(PARTICLES) * 25.0]
+    )
+    camera = Camera((0.0, 0.0, 1500.0), (0.0, 0.0, 0.0), 60.0)
+    settings = RenderSettings(ring_radius=math.inf)
+
+    def prices(first, then):
+        """The unit's impostor price a frame, its object moving from `first` to `then` (the eye still)."""
+        state = plan_frame(units, camera, VIEWPORT, settings, LodState(), 1, [pose(first)], lambda _: PARTICLES).state
+        planned = plan_frame(units, camera, VIEWPORT, settings, state, 1, [pose(then)], lambda _: PARTICLES)
+        return planned.clouds[0].impostor_ms, planned.clouds[0].layers
+
+    still_ms, layers = prices((0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+    moving_ms, _ = prices((0.0, 0.0, 0.0), (3.0, 0.0, 0.0))
+    unsplit_ms, _ = prices((0.0, 0.0, 900.0), (0.0, 0.0, 900.0))  # the object outside the cloud
+    assert layers == 2
+    # still, its layers' impostor lasts as long as the eye lets it; moving, it is remade every frame, both layers
+    assert still_ms < 0.1 * moving_ms and unsplit_ms < 0.1 * moving_ms

@@ -168,7 +168,8 @@ class LodState:
     frame_times: Mapping = field(default_factory=dict)  # choice -> FrameTime: how long its frames took, measured
     #: the units' particles when last planned: a scene changed past `SCENE_CHANGE_RATIO` forgets `frame_times`
     particles: float = 0.0
-    opened: frozenset = frozenset()  # the groups the eye is in, planned as their clouds (`LodUnits.seen_from`)
+    opened: frozenset = frozenset()  # the groups of clouds planned apart (`_groups_cheaper_apart`)
+    object_centres: tuple = ()  # the objects' bounding-sphere centres: which of them move
 
     def measured(self, measurements) -> LodState:
         """The state with this frame's (predicted work, measured ms) pairs folded into the cost fit, and their
@@ -340,14 +341,14 @@ def plan_frame(
     arguments = (camera, viewport, settings, state, lighting_key, objects, cloud_particles, costs, cloud_splats)
     if not (settings.mode == "auto" and settings.groups_apart_in_motion and units.clouds is not None):
         return _plan_units(units, frozenset(), *arguments)
-    wanted = _groups_cheaper_apart(units, camera, viewport, settings, state, costs)
+    wanted = _groups_cheaper_apart(units, camera, viewport, settings, state, costs, objects)
     held = wanted & state.opened
     plan = _plan_units(units, held, *arguments)
     # a group opens only where its own impostor is due anyway, so the switch steps no more than a regeneration
     due = frozenset(
         cloud.members
         for cloud in plan.clouds
-        if cloud.members in wanted - held and (cloud.kind == "inside" or cloud.regenerate or cloud.postponed)
+        if cloud.members in wanted - held and (cloud.regenerate or cloud.postponed)
     )
     return _plan_units(units, held | due, *arguments) if due else plan
 
@@ -381,7 +382,10 @@ def _plan_units(
     view_projection = projection @ view
     planes = frustum_planes(view_projection)
     visible = spheres_in_frustum(planes, centres, radii)
-    seen = _seen(units, eye, last_eye, translation_error, tolerance, focal_px, screen_pixels)
+    object_centres = np.array([o.centre for o in objects], dtype=np.float64).reshape(-1, 3)
+    object_radii = np.array([o.radius for o in objects], dtype=np.float64)
+    split_by = _splitting_objects(object_centres, object_radii, state.object_centres, settings)
+    seen = _seen(units, eye, last_eye, translation_error, tolerance, focal_px, screen_pixels, split_by)
     distances, ball_fragments, quad_pixels_of, lifetimes = (
         seen.distances,
         seen.ball_fragments,
@@ -393,8 +397,6 @@ def _plan_units(
     records = state.records
     present = set(units.members)
     next_records = {members: record for members, record in records.items() if members in present}
-    object_centres = np.array([o.centre for o in objects], dtype=np.float64).reshape(-1, 3)
-    object_radii = np.array([o.radius for o in objects], dtype=np.float64)
     objects_visible = spheres_in_frustum(planes, object_centres, object_radii)
     held_errors = _held_errors(units, records, translation_error, eye)
     # auto mode prices Wang's ring against drawing its clouds each as auto would (the cheaper of full 3D and
@@ -580,7 +582,7 @@ def _plan_units(
         weight, full_ms, impostor_ms = 0.0, costs.ms(full), math.inf
         if settings.mode == "auto" and individual == 1.0:
             lifetime = float(lifetimes[index])
-            impostor_ms = costs.ms(quad) + costs.ms(remake) / max(lifetime, 1.0)
+            impostor_ms = costs.ms(quad) + costs.ms(remake.scaled(len(splits) + 1)) / max(lifetime, 1.0)
             error = float(held_errors[index])
             budgeted = bool(settings.regeneration_budget or settings.frame_budget_ms)
             # an impostor within half its tolerance of the picture full 3D gives, or one remade from this very
@@ -705,6 +707,7 @@ def _plan_units(
         state.frame_times,
         scene_particles,
         opened,
+        tuple(tuple(float(v) for v in centre) for centre in object_centres),
     )
     return FramePlan(
         tuple(clouds),
@@ -846,14 +849,25 @@ class _Seen:
     ball_fragments: np.ndarray  # of full 3D, its splats a ball of discs (`splat_fragments`)
     half_sides: np.ndarray  # of the impostor quad through the centre, metres
     quad_pixels: np.ndarray  # of the impostor quad on the screen (all of it with the eye inside)
-    lifetimes: np.ndarray  # frames an impostor made now lasts at the eye's speed, at most LONGEST_LIFETIME_FRAMES
+    #: frames an impostor made now lasts at the eye's speed (one with an object moving inside), at most
+    #: LONGEST_LIFETIME_FRAMES
+    lifetimes: np.ndarray
+    layers: np.ndarray  # textures of the impostor: one more than the objects inside
 
 
-def _seen(units: LodUnits, eye, last_eye, translation_error, tolerance: float, focal_px, screen_pixels) -> _Seen:
+def _seen(
+    units: LodUnits, eye, last_eye, translation_error, tolerance: float, focal_px, screen_pixels, objects
+) -> _Seen:
+    """`objects`: (centres, radii, moved) of the objects that split units into layers (none when not split)."""
     centres, radii = units.centres, units.radii
     distances = np.linalg.norm(centres - eye, axis=1)
     # the translation error of one frame at the eye's current speed
     rates = translation_error(centres, radii, last_eye, eye) if last_eye is not None else np.zeros(len(radii))
+    # an object moving inside a unit changes its layers' particles (`cloudcore.lod.splitting`): remade each frame
+    object_centres, object_radii, moved = objects
+    reach = np.linalg.norm(centres[:, None] - object_centres[None], axis=2) < radii[:, None] + object_radii[None]
+    reach &= (radii > 0.0)[:, None]
+    rates = np.where(np.any(reach & moved[None], axis=1), np.inf, rates)
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # the eye inside: the whole screen
         half_sides = radii * distances / np.sqrt(np.maximum((distances - radii) * (distances + radii), 1e-300))
         quad_pixels = np.nan_to_num(
@@ -867,7 +881,20 @@ def _seen(units: LodUnits, eye, last_eye, translation_error, tolerance: float, f
         np.minimum(
             np.divide(tolerance, rates, out=np.full(len(radii), math.inf), where=rates > 0.0), LONGEST_LIFETIME_FRAMES
         ),
+        1.0 + np.count_nonzero(reach, axis=1),
     )
+
+
+def _splitting_objects(centres: np.ndarray, radii: np.ndarray, last_centres: tuple, settings) -> tuple:
+    """(centres, radii, moved) of the objects that split units into layers (none unless `split_objects`): moved,
+    those not where they were last frame (or not there then)."""
+    if not settings.split_objects:
+        return np.zeros((0, 3)), np.zeros(0), np.zeros(0, dtype=bool)
+    last = np.array(last_centres, dtype=np.float64).reshape(-1, 3)
+    moved = np.ones(len(radii), dtype=bool)
+    if len(last) == len(radii):
+        moved = np.any(centres != last, axis=1)
+    return centres, radii, moved
 
 
 def _held_errors(units: LodUnits, records: Mapping, translation_error, eye) -> np.ndarray:
@@ -887,7 +914,7 @@ def _impostor_ms(units: LodUnits, seen: _Seen, chosen, focal_px, settings, costs
         detail = np.where(settings.impostor_detail_texels > 0.0, detail, np.inf)
         texture = np.clip(np.minimum(sides, detail), settings.impostor_min_size, settings.impostor_max_size)
         texture_fragments = fragments * np.nan_to_num((texture / sides) ** 2, nan=1.0)
-    remake = (
+    remake = seen.layers[chosen] * (
         costs.particles * units.particle_counts[chosen]
         + costs.texture_fragments * texture_fragments
         + costs.regenerations
@@ -895,7 +922,9 @@ def _impostor_ms(units: LodUnits, seen: _Seen, chosen, focal_px, settings, costs
     return costs.quad_pixels * seen.quad_pixels[chosen] + costs.quads + remake / np.maximum(seen.lifetimes[chosen], 1.0)
 
 
-def _groups_cheaper_apart(units: LodUnits, camera: Camera, viewport, settings, state: LodState, costs) -> frozenset:
+def _groups_cheaper_apart(
+    units: LodUnits, camera: Camera, viewport, settings, state: LodState, costs, objects
+) -> frozenset:
     """The groups of interpenetrating clouds (their members) that auto mode would rather plan apart, each cloud a
     unit of its own (`LodUnits.apart`): while the eye moves, those whose clouds' impostors cost less than the
     group's (`_cheapest`, held apart while so).
@@ -903,9 +932,9 @@ def _groups_cheaper_apart(units: LodUnits, camera: Camera, viewport, settings, s
     A group's impostor is the picture without the blobs of clouds sorted whole (`cloudcore.lod.units`); a
     moving eye remakes it every particle at a time, and sooner than its clouds' (its sphere is larger: more
     parallax for the same step).  Moving, the blobs are the price of the time saved (`RenderSettings.
-    groups_apart_in_motion`); still (the group's impostor would outlast `LONGEST_LIFETIME_FRAMES`), a
-    group is whole, whatever the prices: it closes, remade from that very eye.  `plan_frame` opens a group
-    only where its own impostor is due anyway.
+    groups_apart_in_motion`); still (the group's impostor would outlast `LONGEST_LIFETIME_FRAMES`), or with
+    the eye in its sphere, a group is whole, whatever the prices: it closes, remade from that very eye.
+    `plan_frame` opens a group only where its own impostor is due anyway.
     """
     eye = np.asarray(camera.position, dtype=np.float64)
     last_eye = None if state.eye is None else np.asarray(state.eye, dtype=np.float64)
@@ -919,18 +948,30 @@ def _groups_cheaper_apart(units: LodUnits, camera: Camera, viewport, settings, s
         tolerance,
         0.5 * height / math.tan(math.radians(camera.fov_y_deg) / 2.0),
         float(viewport[0] * height),
+        _splitting_objects(
+            np.array([o.centre for o in objects], dtype=np.float64).reshape(-1, 3),
+            np.array([o.radius for o in objects], dtype=np.float64),
+            state.object_centres,
+            settings,
+        ),
     )
     focal_px = pricing[4]
-    groups = np.array([len(members) > 1 for members in units.members])
     group_seen, part_seen = _seen(units, *pricing), _seen(units.clouds, *pricing)
-    # with the eye inside a group's sphere no impostor of it can be made: its screen impostor redraws it all
-    outside = groups & (group_seen.distances >= INSIDE_RADII * units.radii)
-    group_ms = np.full(len(groups), math.inf)
-    group_ms[outside] = _impostor_ms(units, group_seen, outside, focal_px, settings, costs)
+    # a group whose sphere holds the eye is whole: its screen impostor draws its particles sorted together, as
+    # full 3D does, and apart its clouds would cost as much (the particles near the eye are the screen
+    # impostor's cost, whatever holds them; under a stratocumulus deck apart was 1.7 times dearer)
+    outside = group_seen.distances >= INSIDE_RADII * units.radii
+    moving = group_seen.lifetimes < LONGEST_LIFETIME_FRAMES
+    candidates = np.array([len(members) > 1 for members in units.members]) & outside & moving
+    if not candidates.any():
+        return frozenset()
+    group_ms = np.zeros(len(candidates))
+    group_ms[candidates] = _impostor_ms(units, group_seen, candidates, focal_px, settings, costs)
+    # (a cloud whose own sphere holds the eye is priced as a quad over the whole screen: dear, so its group stays)
     part_prices = _impostor_ms(units.clouds, part_seen, slice(None), focal_px, settings, costs)
     part_ms = dict(zip((members[0] for members in units.clouds.members), part_prices))
     wanted = set()
-    for index in np.flatnonzero(groups & (group_seen.lifetimes < LONGEST_LIFETIME_FRAMES)):
+    for index in np.flatnonzero(candidates):
         members = units.members[index]
         prices = {"group": float(group_ms[index]), "apart": sum(part_ms[cloud] for cloud in members)}
         if _cheapest("apart" if members in state.opened else "group", prices) == "apart":
