@@ -216,7 +216,7 @@ class FramePlan:
     costs: CostModel = CostModel()  # the model the plan priced its choices with
     tolerance_deg: float = 0.0  # the translation tolerance in force
     accepted_error: float = 0.0  # the largest translation error drawn, in tolerances (> 1: a budget postponed it)
-    units: LodUnits | None = None  # the frame's units, which `clouds` index: the groups the eye is in opened
+    units: LodUnits | None = None  # the frame's units, which `clouds` index: the groups planned apart opened
 
     @property
     def records(self) -> Mapping:
@@ -369,14 +369,10 @@ def _plan_units(
     """`plan_frame` with the groups `opened` planned apart, their clouds each a unit of its own."""
     scene_particles = float(np.sum(units.particle_counts))
     units = units.apart(opened)
-    eye = np.asarray(camera.position, dtype=np.float64)
     width, height = viewport
     costs = state.costs.model() if costs is None else costs
-    tolerance = tolerance_deg_for(settings, camera.fov_y_deg, height)
-    translation_error = TRANSLATION_METRICS[settings.translation_metric]
-    focal_px = 0.5 * height / math.tan(math.radians(camera.fov_y_deg) / 2.0)
-    screen_pixels = float(width * height)
-    last_eye = None if state.eye is None else np.asarray(state.eye, dtype=np.float64)
+    pricing = _pricing(camera, viewport, settings, state, objects)
+    eye, last_eye, translation_error, tolerance, focal_px, screen_pixels, _ = pricing
     centres, radii = units.centres, units.radii
     view, projection = view_matrix(camera), projection_matrix(camera.fov_y_deg, width / height)
     view_projection = projection @ view
@@ -384,8 +380,7 @@ def _plan_units(
     visible = spheres_in_frustum(planes, centres, radii)
     object_centres = np.array([o.centre for o in objects], dtype=np.float64).reshape(-1, 3)
     object_radii = np.array([o.radius for o in objects], dtype=np.float64)
-    split_by = _splitting_objects(object_centres, object_radii, state.object_centres, settings)
-    seen = _seen(units, eye, last_eye, translation_error, tolerance, focal_px, screen_pixels, split_by)
+    seen = _seen(units, *pricing)
     distances, ball_fragments, quad_pixels_of, lifetimes = (
         seen.distances,
         seen.ball_fragments,
@@ -885,16 +880,25 @@ def _seen(
     )
 
 
-def _splitting_objects(centres: np.ndarray, radii: np.ndarray, last_centres: tuple, settings) -> tuple:
-    """(centres, radii, moved) of the objects that split units into layers (none unless `split_objects`): moved,
-    those not where they were last frame (or not there then)."""
-    if not settings.split_objects:
-        return np.zeros((0, 3)), np.zeros(0), np.zeros(0, dtype=bool)
-    last = np.array(last_centres, dtype=np.float64).reshape(-1, 3)
-    moved = np.ones(len(radii), dtype=bool)
-    if len(last) == len(radii):
-        moved = np.any(centres != last, axis=1)
-    return centres, radii, moved
+def _pricing(camera: Camera, viewport, settings, state: LodState, objects) -> tuple:
+    """What `_seen` prices units from this frame: (eye, last frame's eye or None, the translation metric, the
+    tolerance in degrees, the focal length in pixels, the screen's pixels, the objects that split units into
+    layers: (centres, radii, moved), none unless `split_objects`, moved those not where they were last frame)."""
+    width, height = viewport
+    centres = np.array([o.centre for o in objects], dtype=np.float64).reshape(-1, 3)
+    radii = np.array([o.radius for o in objects], dtype=np.float64)
+    last = np.array(state.object_centres, dtype=np.float64).reshape(-1, 3)
+    moved = np.any(centres != last, axis=1) if len(last) == len(radii) else np.ones(len(radii), dtype=bool)
+    splitting = (centres, radii, moved) if settings.split_objects else (np.zeros((0, 3)), np.zeros(0), moved[:0])
+    return (
+        np.asarray(camera.position, dtype=np.float64),
+        None if state.eye is None else np.asarray(state.eye, dtype=np.float64),
+        TRANSLATION_METRICS[settings.translation_metric],
+        tolerance_deg_for(settings, camera.fov_y_deg, height),
+        0.5 * height / math.tan(math.radians(camera.fov_y_deg) / 2.0),
+        float(width * height),
+        splitting,
+    )
 
 
 def _held_errors(units: LodUnits, records: Mapping, translation_error, eye) -> np.ndarray:
@@ -936,25 +940,8 @@ def _groups_cheaper_apart(
     the eye in its sphere, a group is whole, whatever the prices: it closes, remade from that very eye.
     `plan_frame` opens a group only where its own impostor is due anyway.
     """
-    eye = np.asarray(camera.position, dtype=np.float64)
-    last_eye = None if state.eye is None else np.asarray(state.eye, dtype=np.float64)
     costs = state.costs.model() if costs is None else costs
-    height = viewport[1]
-    tolerance = tolerance_deg_for(settings, camera.fov_y_deg, height)
-    pricing = (
-        eye,
-        last_eye,
-        TRANSLATION_METRICS[settings.translation_metric],
-        tolerance,
-        0.5 * height / math.tan(math.radians(camera.fov_y_deg) / 2.0),
-        float(viewport[0] * height),
-        _splitting_objects(
-            np.array([o.centre for o in objects], dtype=np.float64).reshape(-1, 3),
-            np.array([o.radius for o in objects], dtype=np.float64),
-            state.object_centres,
-            settings,
-        ),
-    )
+    pricing = _pricing(camera, viewport, settings, state, objects)
     focal_px = pricing[4]
     group_seen, part_seen = _seen(units, *pricing), _seen(units.clouds, *pricing)
     # a group whose sphere holds the eye is whole: its screen impostor draws its particles sorted together, as

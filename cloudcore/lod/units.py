@@ -17,12 +17,11 @@ bounding spheres nearly all meet) stay apart: grouping them would make
 needlessly large impostors for an error below 8-bit precision.
 
 A group costs motion: its sphere is larger than its clouds', so a moving eye
-remakes its impostor sooner, and every particle of it each time.  Auto mode
-plans a group apart, its clouds each a unit of its own, where their
-impostors cost less than the group's (`cloudcore.lod.frameplan`): along the
-default flythrough that is nearly always, and the picture's mean PSNR is the
-same (52.2 dB either way); with the eye still, the group's.  Pure numpy and
-scipy.
+remakes its impostor sooner, and every particle of it each time.  While the
+eye moves, auto mode plans a group apart (`LodUnits.apart`), its clouds each
+a unit of its own, where their impostors cost less than the group's
+(`cloudcore.lod.frameplan`, docs/lod.md); with the eye still, or inside its
+sphere, the group is whole.  Pure numpy and scipy.
 """
 
 from __future__ import annotations
