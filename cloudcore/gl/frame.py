@@ -122,8 +122,8 @@ class FrameRenderer:
 
     @property
     def units(self) -> LodUnits:
-        """The units (clouds, or groups of interpenetrating clouds) of the scene last rendered; a frame opens
-        the groups the eye is in (`FramePlan.units`)."""
+        """The units (clouds, or groups of interpenetrating clouds) of the scene last rendered; a frame may plan
+        some groups apart (`FramePlan.units`)."""
         return self._units
 
     @property
