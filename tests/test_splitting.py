@@ -90,18 +90,19 @@ def test_an_object_leaving_the_cloud_returns_it_to_one_impostor():
     assert again.clouds[0].regenerate is None and again.stats().layers_rebuilt == 0
 
 
-def test_layers_are_remade_when_the_object_moves_particles_between_them_and_not_before():
+def test_layers_stay_until_the_object_passes_in_depth_a_particle_it_covers():
     camera = Camera((0.0, 0.0, 700.0), (0.0, 0.0, 0.0), 50.0)
     impostor = RenderSettings(mode="impostor")
-    first = plan(camera, (pose((0.0, 0.0, 0.0)),), impostor)
-    distances = np.sort(np.linalg.norm(PARTICLES - camera.position, axis=1))
-    # the gap between the particles on either side of the split: moving within it changes no membership
-    at = np.searchsorted(distances, 700.0)
-    gap_near, gap_far = 700.0 - distances[at - 1], distances[at] - 700.0
-    within = plan(camera, (pose((0.0, 0.0, 0.5 * gap_near)),), impostor, first.records)
-    assert within.clouds[0].regenerate is None
-    across = plan(camera, (pose((0.0, 0.0, -2.0 * gap_far - 1.0)),), impostor, within.records)
-    assert across.clouds[0].regenerate == "layers" and across.stats().layers_rebuilt == 2
+    # behind the object on its line of sight, 10 m farther; and 50 m aside (4 degrees off, the object 0.4 wide)
+    behind, aside = (0.0, 0.0, -10.0), (50.0, 0.0, -4.0)
+    particles = np.array([behind, aside, (0.0, 40.0, 30.0)])
+    first = plan(camera, (pose((0.0, 0.0, 0.0)),), impostor, particles=lambda _: particles)
+    assert first.clouds[0].regenerate == "new" and first.clouds[0].layer_counts == (2, 1)
+    # 6 m back: past the particle aside (5.8 m farther than the object was), which it does not cover
+    past_aside = plan(camera, (pose((0.0, 0.0, -6.0)),), impostor, first.records, particles=lambda _: particles)
+    assert past_aside.clouds[0].regenerate is None
+    past_behind = plan(camera, (pose((0.0, 0.0, -12.0)),), impostor, past_aside.records, particles=lambda _: particles)
+    assert past_behind.clouds[0].regenerate == "layers" and past_behind.stats().layers_rebuilt == 2
 
 
 def test_a_scene_without_objects_in_clouds_looks_at_no_particle():
@@ -178,7 +179,7 @@ def test_no_frame_of_the_default_flythrough_has_a_layer_order_error():
     assert split_frames > 100, "the aircraft should cross a drawn cloud for seconds of the path"
 
 
-def test_auto_mode_prices_an_impostor_with_an_object_moving_inside_as_remade_each_frame_a_texture_a_layer():
+def test_auto_mode_prices_an_impostor_with_an_object_moving_inside_as_remade_as_often_as_it_passes_particles():
     units = LodUnits.of_spheres(
         CENTRE, RADIUS, [10.0], particle_counts=[len(PARTICLES)], radius_squares=[len(PARTICLES) * 25.0]
     )
@@ -192,8 +193,13 @@ def test_auto_mode_prices_an_impostor_with_an_object_moving_inside_as_remade_eac
         return planned.clouds[0].impostor_ms, planned.clouds[0].layers
 
     still_ms, layers = prices((0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
-    moving_ms, _ = prices((0.0, 0.0, 0.0), (3.0, 0.0, 0.0))
+    # the 5 m object covers particles about every 10 m in depth: past one every 3 frames, or every 40
+    fast_ms, _ = prices((0.0, 0.0, 0.0), (0.0, 0.0, 3.0))
+    slow_ms, _ = prices((0.0, 0.0, 0.0), (0.0, 0.0, 0.25))
+    aside_ms, _ = prices((0.0, 0.0, 0.0), (3.0, 0.0, 0.0))  # across the line of sight: 3 mm in depth
     unsplit_ms, _ = prices((0.0, 0.0, 900.0), (0.0, 0.0, 900.0))  # the object outside the cloud
     assert layers == 2
-    # still, its layers' impostor lasts as long as the eye lets it; moving, it is remade every frame, both layers
-    assert still_ms < 0.1 * moving_ms and unsplit_ms < 0.1 * moving_ms
+    # still (or moving across), its layers' impostor lasts as long as the eye lets it; moving in depth, until the
+    # object passes a particle it covers
+    assert still_ms < 0.2 * fast_ms and unsplit_ms < 0.2 * fast_ms and aside_ms < 0.2 * fast_ms
+    assert 1.2 * still_ms < slow_ms < 0.25 * fast_ms

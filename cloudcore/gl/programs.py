@@ -71,12 +71,24 @@ def _text(log) -> str:
     return log.decode(errors="replace") if isinstance(log, bytes) else str(log)
 
 
+def uniform_locations(program: int, names) -> dict[str, int]:
+    """The locations of a program's uniforms `names`, looked up once for a pass that sets them every draw."""
+    return {name: GL.glGetUniformLocation(program, name) for name in names}
+
+
 def set_matrix(program: int, name: str, matrix) -> None:
     """Upload a 4x4 numpy matrix (row-major, as numpy stores it) to a mat4 uniform."""
-    GL.glUniformMatrix4fv(
-        GL.glGetUniformLocation(program, name), 1, GL.GL_TRUE, np.ascontiguousarray(matrix, dtype=np.float32)
-    )
+    set_matrix_at(GL.glGetUniformLocation(program, name), matrix)
+
+
+def set_matrix_at(location: int, matrix) -> None:
+    """`set_matrix` for a uniform whose location is known (`uniform_locations`)."""
+    GL.glUniformMatrix4fv(location, 1, GL.GL_TRUE, np.ascontiguousarray(matrix, dtype=np.float32))
 
 
 def set_vec3(program: int, name: str, value) -> None:
-    GL.glUniform3f(GL.glGetUniformLocation(program, name), *(float(v) for v in value))
+    set_vec3_at(GL.glGetUniformLocation(program, name), value)
+
+
+def set_vec3_at(location: int, value) -> None:
+    GL.glUniform3f(location, *(float(v) for v in value))

@@ -6,7 +6,7 @@ import numpy as np
 from OpenGL import GL
 
 from cloudcore.gl.blending import cloud_blending
-from cloudcore.gl.programs import build_program, set_matrix
+from cloudcore.gl.programs import build_program, set_matrix_at, uniform_locations
 
 #: clip-space corners of the whole screen, for screen impostors
 SCREEN_CORNERS = np.array([[-1, -1, 0], [1, -1, 0], [-1, 1, 0], [1, 1, 0]], dtype=np.float64)
@@ -16,10 +16,15 @@ class QuadPass:
     def __init__(self):
         self._program = build_program("quad")
         self._counting_program = build_program("quad", {"COUNT_FRAGMENTS": 1})
+        #: per program, the locations of the uniforms every draw sets
+        self._uniforms = {}
         for program in (self._program, self._counting_program):
             GL.glUseProgram(program)
             GL.glUniform1i(GL.glGetUniformLocation(program, "impostor"), 0)
             GL.glUniform1i(GL.glGetUniformLocation(program, "layer"), 1)
+            self._uniforms[program] = uniform_locations(
+                program, ("corners", "uv_rect", "view_projection", "impostor_weight", "layer_weight")
+            )
         #: core profile draws nothing without a vertex array, even one with no attributes; shared
         #: with the other attribute-less passes
         self.vertex_array = GL.glGenVertexArrays(1)
@@ -40,14 +45,13 @@ class QuadPass:
         """Blend `texture` (premultiplied) over the bound target on the quad `corners` (4, 3), which show
         the part `uv_rect` (u0, v0, u1, v1) of the texture."""
         program = self._counting_program if counting else self._program
+        uniforms = self._uniforms[program]
         GL.glUseProgram(program)
-        GL.glUniform3fv(GL.glGetUniformLocation(program, "corners"), 4, np.ascontiguousarray(corners, dtype=np.float32))
-        set_matrix(program, "view_projection", view_projection)
-        GL.glUniform4f(GL.glGetUniformLocation(program, "uv_rect"), *map(float, uv_rect))
-        GL.glUniform1f(GL.glGetUniformLocation(program, "impostor_weight"), float(impostor_weight))
-        GL.glUniform1f(
-            GL.glGetUniformLocation(program, "layer_weight"), float(layer_weight) if layer_texture is not None else 0.0
-        )
+        GL.glUniform3fv(uniforms["corners"], 4, np.ascontiguousarray(corners, dtype=np.float32))
+        set_matrix_at(uniforms["view_projection"], view_projection)
+        GL.glUniform4f(uniforms["uv_rect"], *map(float, uv_rect))
+        GL.glUniform1f(uniforms["impostor_weight"], float(impostor_weight))
+        GL.glUniform1f(uniforms["layer_weight"], float(layer_weight) if layer_texture is not None else 0.0)
         GL.glActiveTexture(GL.GL_TEXTURE0)
         GL.glBindTexture(GL.GL_TEXTURE_2D, texture)
         if layer_texture is not None:

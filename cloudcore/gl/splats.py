@@ -28,7 +28,7 @@ from cloudcore.artist.sprites import ATLAS_MAX_MIP_LEVEL, load_atlas
 from cloudcore.camera import splats_in_frustum
 from cloudcore.cloud_records import ATLAS_GRID
 from cloudcore.gl.blending import cloud_blending
-from cloudcore.gl.programs import build_compute_program, build_program, set_matrix, set_vec3
+from cloudcore.gl.programs import build_compute_program, build_program, set_matrix_at, set_vec3_at, uniform_locations
 from cloudcore.light.eye_scattering import FADE_END_RADII, FADE_START_RADII, ParticleBuffer
 from cloudcore.light.kernel import SPLAT_SHARPNESS
 from cloudcore.light.phase import PHASE_NAMES
@@ -125,6 +125,11 @@ class SplatPass:
             (True, False): build_program("splat", defines | points),
             (True, True): build_program("splat", defines | points | counting),
         }
+        #: per program, the locations of the uniforms every draw sets
+        self._uniforms = {
+            program: uniform_locations(program, ("view_rotation", "projection", "viewport_height"))
+            for program in self._programs.values()
+        }
         self._point_sizes_px = tuple(float(size) for size in GL.glGetFloatv(GL.GL_POINT_SIZE_RANGE))
         self._plain: np.ndarray = np.zeros(0, dtype=bool)  # of the resident particles: `plain_splats`
         #: particles drawn as point sprites since the frame's renderer last set it to 0 (for its statistics)
@@ -133,6 +138,7 @@ class SplatPass:
             "splat_shade",
             {"MAX_LIGHTS": MAX_LIGHTS, "FADE_START_RADII": FADE_START_RADII, "FADE_END_RADII": FADE_END_RADII},
         )
+        self._shade_uniforms = uniform_locations(self._shade_program, ("count", "eye", "view_right", "view_up"))
         self._vertex_array = GL.glGenVertexArrays(1)
         (
             self._corner_index_buffer,
@@ -184,11 +190,12 @@ class SplatPass:
             GL.glViewport(*viewport)
         for as_points in {piece[2] for piece in pieces}:
             program = self._programs[as_points, counting]
+            uniforms = self._uniforms[program]
             GL.glUseProgram(program)
-            set_matrix(program, "view_rotation", view_rotation)
-            set_matrix(program, "projection", projection)
+            set_matrix_at(uniforms["view_rotation"], view_rotation)
+            set_matrix_at(uniforms["projection"], projection)
             if as_points:
-                GL.glUniform1f(GL.glGetUniformLocation(program, "viewport_height"), float(viewport[3]))
+                GL.glUniform1f(uniforms["viewport_height"], float(viewport[3]))
         if self._atlas is not None:
             GL.glActiveTexture(GL.GL_TEXTURE0)
             GL.glBindTexture(GL.GL_TEXTURE_2D, self._atlas)
@@ -259,11 +266,11 @@ class SplatPass:
             (_PROFILES_BINDING, self._profile_buffer),
         ):
             GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, binding, buffer)
+        uniforms = self._shade_uniforms
         GL.glUseProgram(self._shade_program)
-        GL.glUniform1ui(GL.glGetUniformLocation(self._shade_program, "count"), len(batch))
-        set_vec3(self._shade_program, "eye", batch.eye)
-        set_vec3(self._shade_program, "view_right", view[0, :3])
-        set_vec3(self._shade_program, "view_up", view[1, :3])
+        GL.glUniform1ui(uniforms["count"], len(batch))
+        for name, value in (("eye", batch.eye), ("view_right", view[0, :3]), ("view_up", view[1, :3])):
+            set_vec3_at(uniforms[name], value)
         GL.glDispatchCompute(-(-len(batch) // _SHADE_GROUP), 1, 1)
         GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT)
         return self._instance_buffer

@@ -71,7 +71,7 @@ from cloudcore.lod.impostors import (
     tolerance_deg_for,
 )
 from cloudcore.lod.ring import SEGMENT_DEG, RingPlan, RingState, plan_ring, ring_members, segment_texture_size
-from cloudcore.lod.splitting import layer_bounds, layer_counts, layer_sort_key, objects_inside
+from cloudcore.lod.splitting import layer_bounds, layer_counts, layer_sort_key, layers_hold, objects_inside
 from cloudcore.lod.units import LodUnits
 from cloudcore.measure.frame_stats import PlanStats
 from cloudcore.measure.overdraw import analytic_overdraw
@@ -460,6 +460,24 @@ def _plan_units(
         order = np.argsort(-gaps, kind="stable")
         return tuple(int(i) for i in inside[order]), tuple(float(g) for g in gaps[order])
 
+    def layers_changed(index: int, record: ImpostorRecord) -> bool:
+        """Whether the objects inside the unit would now cut the layers of its impostor `record` otherwise."""
+        inside, _ = split_at(index, record.eye)
+        if inside != record.split_objects:
+            return True
+        if not inside:
+            return False
+        if cloud_splats is None:  # only the particles' centres: points
+            particles = particles_of(index)
+            particle_radii = np.zeros(len(particles))
+        else:
+            splats = [cloud_splats(c) for c in units.members[index]]
+            particles, particle_radii = np.concatenate([c for c, _ in splats]), np.concatenate([r for _, r in splats])
+        cut = list(inside)
+        return not layers_hold(
+            particles, particle_radii, record.eye, object_centres[cut], object_radii[cut], record.splits
+        )
+
     def counts(index: int, from_eye, splits) -> tuple:
         """Particles per layer seen from `from_eye`; the particles are looked at only when there are splits."""
         return layer_counts(particles_of(index), from_eye, splits) if splits else (0,)
@@ -601,11 +619,14 @@ def _plan_units(
             cloud_work += full
             continue
         record = records.get(members)
-        # the layers the impostor's textures would hold now: split where the objects are, seen from its eye
-        held_counts = (
-            counts(index, record.eye, split_at(index, record.eye)[1]) if (record is not None and splits) else None
+        reason = regeneration_reason(
+            record,
+            size,
+            keys[index],
+            tolerance,
+            float(held_errors[index]),
+            record is not None and layers_changed(index, record),
         )
-        reason = regeneration_reason(record, size, keys[index], tolerance, float(held_errors[index]), held_counts)
         kind = "crossfade" if weight > 0.0 else "impostor"
         clouds.append(
             CloudPlan(
@@ -649,6 +670,7 @@ def _plan_units(
                 keys[index],
                 cloud.splits,
                 counts(index, eye, cloud.splits),
+                cloud.split_objects,
             )
         regenerate, postponed = (cloud.regenerate, None) if index in served else (None, cloud.regenerate)
         clouds[index] = dataclasses.replace(
@@ -844,7 +866,7 @@ class _Seen:
     ball_fragments: np.ndarray  # of full 3D, its splats a ball of discs (`splat_fragments`)
     half_sides: np.ndarray  # of the impostor quad through the centre, metres
     quad_pixels: np.ndarray  # of the impostor quad on the screen (all of it with the eye inside)
-    #: frames an impostor made now lasts at the eye's speed (one with an object moving inside), at most
+    #: frames an impostor made now lasts at the eye's speed (and an object's moving inside it), at most
     #: LONGEST_LIFETIME_FRAMES
     lifetimes: np.ndarray
     layers: np.ndarray  # textures of the impostor: one more than the objects inside
@@ -853,16 +875,24 @@ class _Seen:
 def _seen(
     units: LodUnits, eye, last_eye, translation_error, tolerance: float, focal_px, screen_pixels, objects
 ) -> _Seen:
-    """`objects`: (centres, radii, moved) of the objects that split units into layers (none when not split)."""
+    """`objects`: (centres, radii, depth steps) of the objects that split units into layers (none when not
+    split), the steps how far each moved in depth since last frame."""
     centres, radii = units.centres, units.radii
     distances = np.linalg.norm(centres - eye, axis=1)
     # the translation error of one frame at the eye's current speed
     rates = translation_error(centres, radii, last_eye, eye) if last_eye is not None else np.zeros(len(radii))
-    # an object moving inside a unit changes its layers' particles (`cloudcore.lod.splitting`): remade each frame
-    object_centres, object_radii, moved = objects
+    object_centres, object_radii, depth_steps = objects
     reach = np.linalg.norm(centres[:, None] - object_centres[None], axis=2) < radii[:, None] + object_radii[None]
     reach &= (radii > 0.0)[:, None]
-    rates = np.where(np.any(reach & moved[None], axis=1), np.inf, rates)
+    # an object moving in depth inside a unit remakes its layers once it passes a particle it covers
+    # (`cloudcore.lod.splitting.layers_hold`): about the unit's depth over the particles whose discs reach the
+    # object's, their share of the unit's disc those discs' sum over it
+    typical_radii = np.sqrt(units.radius_squares / np.maximum(units.particle_counts, 1.0))
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        covered_shares = np.minimum(((object_radii[None] + typical_radii[:, None]) / radii[:, None]) ** 2, 1.0)
+        spacings = 2.0 * radii[:, None] / np.maximum(units.particle_counts[:, None] * covered_shares, 1.0)
+        split_lifetimes = np.nan_to_num(spacings / depth_steps[None], nan=math.inf)
+    split_lifetimes = np.min(np.where(reach, split_lifetimes, math.inf), axis=1, initial=math.inf)
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # the eye inside: the whole screen
         half_sides = radii * distances / np.sqrt(np.maximum((distances - radii) * (distances + radii), 1e-300))
         quad_pixels = np.nan_to_num(
@@ -873,8 +903,12 @@ def _seen(
         splat_fragments(units.radius_squares, radii, distances, focal_px, units.particle_counts, screen_pixels),
         half_sides,
         quad_pixels,
-        np.minimum(
-            np.divide(tolerance, rates, out=np.full(len(radii), math.inf), where=rates > 0.0), LONGEST_LIFETIME_FRAMES
+        np.minimum.reduce(
+            [
+                np.divide(tolerance, rates, out=np.full(len(radii), math.inf), where=rates > 0.0),
+                split_lifetimes,
+                np.full(len(radii), LONGEST_LIFETIME_FRAMES),
+            ]
         ),
         1.0 + np.count_nonzero(reach, axis=1),
     )
@@ -883,15 +917,22 @@ def _seen(
 def _pricing(camera: Camera, viewport, settings, state: LodState, objects) -> tuple:
     """What `_seen` prices units from this frame: (eye, last frame's eye or None, the translation metric, the
     tolerance in degrees, the focal length in pixels, the screen's pixels, the objects that split units into
-    layers: (centres, radii, moved), none unless `split_objects`, moved those not where they were last frame)."""
+    layers: (centres, radii, depth steps; `_seen`), none unless `split_objects`)."""
     width, height = viewport
     centres = np.array([o.centre for o in objects], dtype=np.float64).reshape(-1, 3)
     radii = np.array([o.radius for o in objects], dtype=np.float64)
     last = np.array(state.object_centres, dtype=np.float64).reshape(-1, 3)
-    moved = np.any(centres != last, axis=1) if len(last) == len(radii) else np.ones(len(radii), dtype=bool)
-    splitting = (centres, radii, moved) if settings.split_objects else (np.zeros((0, 3)), np.zeros(0), moved[:0])
+    eye = np.asarray(camera.position, dtype=np.float64)
+    # how far each object moved in depth since last frame (inf with no last frame: as if it had jumped)
+    depth_steps = (
+        np.abs(np.linalg.norm(centres - eye, axis=1) - np.linalg.norm(last - eye, axis=1))
+        if len(last) == len(radii)
+        else np.full(len(radii), np.inf)
+    )
+    none = (np.zeros((0, 3)), np.zeros(0), np.zeros(0))
+    splitting = (centres, radii, depth_steps) if settings.split_objects else none
     return (
-        np.asarray(camera.position, dtype=np.float64),
+        eye,
         None if state.eye is None else np.asarray(state.eye, dtype=np.float64),
         TRANSLATION_METRICS[settings.translation_metric],
         tolerance_deg_for(settings, camera.fov_y_deg, height),

@@ -39,8 +39,8 @@ class ImpostorRecord:
     """What an impostor texture was made from: the eye, the texture side, the lighting, the layers.
 
     A cloud split around objects (`cloudcore.lod.splitting`) has one texture per layer: `splits`
-    are the objects' distances from `eye` when it was made and `layer_counts` its layers'
-    particle counts.
+    are the distances from `eye` of the objects `split_objects` (far to near) when it was made and
+    `layer_counts` its layers' particle counts.
     """
 
     eye: tuple[float, float, float]
@@ -48,6 +48,7 @@ class ImpostorRecord:
     lighting_key: Hashable
     splits: tuple[float, ...] = ()
     layer_counts: tuple[int, ...] = (0,)
+    split_objects: tuple[int, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -259,15 +260,14 @@ def regeneration_reason(
     lighting_key: Hashable,
     tolerance_deg: float,
     translation_error: float,
-    layer_counts=None,
+    layers_changed: bool = False,
 ) -> str | None:
     """Why the impostor must be remade this frame ("new", "lights", "resolution", "translation",
     "layers"), or None.
 
-    `layer_counts` are the layers' particle counts the objects inside the cloud now give, seen
-    from the record's eye (None: the cloud is not split); a change moves particles between
-    layer textures, so they are remade.  `translation_error` is the held impostor's, in degrees, by the
-    metric in force (`TRANSLATION_METRICS`).
+    `layers_changed`: the objects inside the cloud would cut its layers otherwise than its textures
+    are (`cloudcore.lod.splitting.layers_hold`).  `translation_error` is the held impostor's, in
+    degrees, by the metric in force (`TRANSLATION_METRICS`).
     """
     if record is None:
         return "new"
@@ -277,6 +277,6 @@ def regeneration_reason(
         return "resolution"
     if translation_error > tolerance_deg:
         return "translation"
-    if (layer_counts or (0,)) != (record.layer_counts if record.splits else (0,)):
+    if layers_changed:
         return "layers"
     return None

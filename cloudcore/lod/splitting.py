@@ -43,6 +43,39 @@ def layer_counts(centres: np.ndarray, eye, splits) -> tuple[int, ...]:
     return tuple(int(c) for c in np.bincount(layer_of(distances, splits), minlength=len(splits) + 1))
 
 
+def layers_hold(
+    centres: np.ndarray, radii: np.ndarray, eye, object_centres: np.ndarray, object_radii: np.ndarray, splits
+) -> bool:
+    """Whether a cloud's layers cut at `splits` (its objects' distances from `eye` then, far to near) show the
+    objects, now at `object_centres` (the same order), as layers cut where they are now would.
+
+    Moving a cut only moves the particles between the old and the new distance to the other side of
+    the object: the particles' order among themselves stays the far-to-near order either way, so a
+    particle the object does not cover, seen from `eye`, looks the same.  The layers hold while none
+    the object covers (their discs and its bounding sphere overlap seen from `eye`) lies between the
+    two cuts.  Particles are (n, 3) `centres` with `radii` (zeros: points).
+    """
+    eye = np.asarray(eye, dtype=np.float64)
+    offsets = np.asarray(centres, dtype=np.float64) - eye
+    distances = np.linalg.norm(offsets, axis=1)
+    radii = np.asarray(radii, dtype=np.float64)
+    tiny = np.finfo(np.float64).tiny
+    for centre, radius, split in zip(np.asarray(object_centres, dtype=np.float64), object_radii, splits):
+        towards = centre - eye
+        distance = float(np.linalg.norm(towards))
+        low, high = min(split, distance), max(split, distance)
+        between = (distances > low) & (distances <= high)
+        if not between.any():
+            continue
+        along = offsets[between] @ towards / np.maximum(distances[between] * distance, tiny)
+        angles = np.arccos(np.clip(along, -1.0, 1.0))
+        reach = np.arcsin(np.minimum(radii[between] / np.maximum(distances[between], tiny), 1.0))
+        reach += math.asin(min(radius / max(distance, tiny), 1.0))
+        if np.any(angles <= reach):
+            return False
+    return True
+
+
 def layer_bounds(splits, layer: int) -> tuple[float, float]:
     """(near, far): the layer holds particles with near < distance <= far."""
     far = math.inf if layer == 0 else splits[layer - 1]
