@@ -16,7 +16,7 @@ from cloudcore.lod.frameplan import (
     inside_runs,
     plan_frame,
 )
-from cloudcore.lod.impostors import impostor_view, parallax_error_deg, translation_error_deg
+from cloudcore.lod.impostors import content_depth, impostor_view, parallax_error_deg, translation_error_deg
 from cloudcore.lod.ring import SEGMENTS, RingState
 from cloudcore.lod.units import LodUnits
 from cloudcore.scene import Camera
@@ -118,6 +118,41 @@ def test_a_distant_cloud_tolerates_proportionally_more_motion():
         ("centre", 400.0): False,
         ("centre", 1200.0): False,
     }
+
+
+def test_a_flat_cloud_seen_face_on_tolerates_the_motion_its_particles_depth_allows_not_its_sphere_s():
+    """Parallax is of what the impostor holds: a pancake of particles 20 m deep in a sphere of 100 m keeps its
+    impostor through a step that remakes a ball of the same sphere."""
+    rng = np.random.default_rng(7)
+    disc = rng.uniform(-60.0, 60.0, size=(1000, 3)) * [1.0, 1.0, 0.0]
+    pancake = disc + rng.uniform(-5.0, 5.0, size=(1000, 3)) * [0.0, 0.0, 1.0]
+    ball = rng.normal(size=(1000, 3)) * 30.0
+    ball = ball[np.linalg.norm(ball, axis=1) < 90.0]
+    impostors = dataclasses.replace(NO_RING, mode="impostor", tolerance_deg=0.125)
+    kept = {}
+    for name, particles in (("pancake", pancake), ("ball", ball)):
+        splats = (particles, np.full(len(particles), 5.0))
+
+        def planned(eye, records=None, splats=splats):
+            state = LodState(records or {})
+            units = units_of(((0.0, 0.0, 0.0),), (RADIUS,))
+            return plan_frame(units, camera_at(eye), VIEWPORT, impostors, state, 1, (), None, None, lambda _: splats)
+
+        first = planned((0.0, 0.0, 400.0))
+        kept[name] = planned((3.0, 0.0, 400.0), first.records).clouds[0].regenerate is None
+    # 3 m sideways at 400 m: 0.22 degrees of parallax for the sphere, 0.04 for the pancake's 20 m (plus discs)
+    assert kept == {"pancake": True, "ball": False}
+
+
+def test_content_depth_is_the_splats_depth_along_the_axis_within_the_sphere():
+    eye = np.array([0.0, 0.0, 500.0])
+    centres = np.array([[0.0, 0.0, 10.0], [30.0, 0.0, -20.0]])
+    middle, half = content_depth((0.0, 0.0, 0.0), 100.0, eye, centres, np.array([5.0, 5.0]))
+    # depths along the axis from the eye: 490 - 5 and 520 + 5
+    assert np.allclose(middle, (0.0, 0.0, -5.0)) and half == pytest.approx(20.0)
+    assert content_depth((0.0, 0.0, 0.0), 100.0, eye, np.zeros((0, 3)), np.zeros(0)) == ((0.0, 0.0, 0.0), 100.0)
+    # discs reaching past the sphere are cut to it
+    assert content_depth((0.0, 0.0, 0.0), 10.0, eye, centres, np.array([50.0, 50.0]))[1] == pytest.approx(10.0)
 
 
 def test_a_tolerance_in_pixels_is_that_many_pixels_at_the_screen_s_centre():

@@ -62,7 +62,9 @@ from cloudcore.lod.impostors import (
     TRANSLATION_METRICS,
     ImpostorRecord,
     budgeted_regenerations,
+    content_depth,
     detail_size_px,
+    parallax_errors_deg,
     quad_half_side,
     regeneration_priority,
     regeneration_reason,
@@ -447,6 +449,11 @@ def _plan_units(
             return cloud_particles(members[0])
         return np.concatenate([cloud_particles(c) for c in members])
 
+    def splats_of(index: int) -> tuple[np.ndarray, np.ndarray]:
+        """The unit's particles' (centres, radii), of `cloud_splats`."""
+        splats = [cloud_splats(c) for c in units.members[index]]
+        return np.concatenate([c for c, _ in splats]), np.concatenate([r for _, r in splats])
+
     def split_at(index: int, from_eye) -> tuple[tuple, tuple]:
         """(objects inside the unit far to near from `from_eye`, their distances: the layers' boundaries)."""
         inside = (
@@ -471,8 +478,7 @@ def _plan_units(
             particles = particles_of(index)
             particle_radii = np.zeros(len(particles))
         else:
-            splats = [cloud_splats(c) for c in units.members[index]]
-            particles, particle_radii = np.concatenate([c for c, _ in splats]), np.concatenate([r for _, r in splats])
+            particles, particle_radii = splats_of(index)
         cut = list(inside)
         return not layers_hold(
             particles, particle_radii, record.eye, object_centres[cut], object_radii[cut], record.splits
@@ -671,6 +677,7 @@ def _plan_units(
                 cloud.splits,
                 counts(index, eye, cloud.splits),
                 cloud.split_objects,
+                content_depth(centres[index], radii[index], eye, *splats_of(index)) if cloud_splats else None,
             )
         regenerate, postponed = (cloud.regenerate, None) if index in served else (None, cloud.regenerate)
         clouds[index] = dataclasses.replace(
@@ -943,9 +950,15 @@ def _pricing(camera: Camera, viewport, settings, state: LodState, objects) -> tu
 
 
 def _held_errors(units: LodUnits, records: Mapping, translation_error, eye) -> np.ndarray:
-    """Per unit, the translation error of the impostor held (inf: none)."""
+    """Per unit, the translation error of the impostor held (inf: none); the parallax between the near and far
+    points of what it holds (`ImpostorRecord.content`) where the record has them."""
     eyes = [records[members].eye if members in records else (math.nan,) * 3 for members in units.members]
-    errors = translation_error(units.centres, units.radii, np.array(eyes, dtype=np.float64).reshape(-1, 3), eye)
+    centres, radii = units.centres, units.radii
+    if translation_error is parallax_errors_deg:
+        held = [records[members].content if members in records else None for members in units.members]
+        centres = np.array([c if h is None else h[0] for c, h in zip(centres, held)], dtype=np.float64).reshape(-1, 3)
+        radii = np.array([r if h is None else h[1] for r, h in zip(radii, held)], dtype=np.float64)
+    errors = translation_error(centres, radii, np.array(eyes, dtype=np.float64).reshape(-1, 3), eye)
     return np.nan_to_num(errors, nan=math.inf)
 
 

@@ -5,9 +5,10 @@ its bounding sphere from an eye, drawn afterwards as a quad through the
 sphere's centre facing that eye.  It is good while the eye stays close to that
 eye.  The *translation error* is, by default, Harris's own (SkyWorks,
 `SkyRenderableInstanceCloud::IsImpostorValid`): the impostor stores the
-nearest and farthest points of the bounding sphere along its view axis, and
-the error is the angle between the rays from the current eye to those two
-points, the parallax that a flat quad cannot show.  It is about 2R/D times
+nearest and farthest points of the bounding sphere along its view axis (here
+those of its particles' discs, `content_depth`), and the error is the angle
+between the rays from the current eye to those two points, the parallax that
+a flat quad cannot show.  It is about 2R/D times
 the angle the eye has turned around the centre, so a distant cloud tolerates
 proportionally more motion (`parallax_error_deg`).  The stricter angle seen
 from the centre is kept as the "centre" metric for comparison.  The
@@ -49,6 +50,9 @@ class ImpostorRecord:
     splits: tuple[float, ...] = ()
     layer_counts: tuple[int, ...] = (0,)
     split_objects: tuple[int, ...] = ()
+    #: the middle and half the depth, along the view axis from `eye`, of what the texture holds (its particles'
+    #: discs; `content_depth`): the near and far points of Harris's parallax (None: the bounding sphere's)
+    content: tuple[tuple[float, float, float], float] | None = None
 
 
 @dataclass(frozen=True)
@@ -161,6 +165,29 @@ def _angles_deg(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Angles between the rows of two (n, 3) arrays; atan2 of |a x b| and a.b stays accurate for tiny angles,
     where acos does not."""
     return np.degrees(np.arctan2(np.linalg.norm(np.cross(a, b), axis=-1), np.einsum("ij,ij->i", a, b)))
+
+
+def content_depth(centre, radius: float, eye, centres: np.ndarray, radii: np.ndarray) -> tuple[tuple, float]:
+    """(the point on the axis from `eye` through the bounding sphere (`centre`, `radius`) halfway through
+    the depth of the splats at `centres` with `radii`, half that depth): the near and far points of the
+    parallax metric for what an impostor made from `eye` holds.
+
+    Cumulus are flatter than their spheres: along the default flythrough their particles' depth is
+    0.78 of the sphere's diameter, and the parallax a flat quad cannot show is that depth's, not the
+    sphere's.  The sphere's own points when there are no splats.
+    """
+    centre, eye = np.asarray(centre, dtype=np.float64), np.asarray(eye, dtype=np.float64)
+    distance = float(np.linalg.norm(centre - eye))
+    if len(radii) == 0 or not distance > 0.0:
+        return tuple(float(v) for v in centre), float(radius)
+    axis = (centre - eye) / distance
+    depths = (np.asarray(centres, dtype=np.float64) - eye) @ axis
+    near = max(float(np.min(depths - radii)), distance - radius)
+    far = min(float(np.max(depths + radii)), distance + radius)
+    if not near < far:
+        return tuple(float(v) for v in centre), float(radius)
+    middle = eye + axis * (0.5 * (near + far))
+    return tuple(float(v) for v in middle), 0.5 * (far - near)
 
 
 def centre_angles_deg(centres, radii, eyes_then, eye_now) -> np.ndarray:
