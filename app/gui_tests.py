@@ -242,8 +242,10 @@ def tolerance_drives_regeneration(ctx, app: EditorUnderTest):
     ctx.item_click("Orbit left")
     ctx.yield_(SETTLE)
     strict = app.viewport.regenerations_total - before
-    # a budget of one spreads the same regenerations over frames, one a frame
+    # a budget of one spreads the regenerations over frames, one a frame; at 0.02 degrees the orbit takes every
+    # cloud past the tolerance (the parallax is of the clouds' particles' depth, less than their spheres')
     use_window(ctx, "LOD")
+    ctx.item_input_value("Tolerance (deg)", 0.02)
     ctx.item_input_value("Regeneration budget", 1)
     CHECK(app.editor.settings.regeneration_budget == 1)
     ctx.yield_(SETTLE)
@@ -257,6 +259,7 @@ def tolerance_drives_regeneration(ctx, app: EditorUnderTest):
     postponed = sum(s.frame.plan.regenerations_postponed for s in budgeted if not s.picture_reused)
     use_window(ctx, "LOD")
     ctx.item_input_value("Regeneration budget", 0)
+    ctx.item_input_value("Tolerance (deg)", 0.5)
     ctx.combo_click("Mode/auto")
     app.outcome["regenerations"] = {
         "tolerance 5": lenient,

@@ -98,18 +98,22 @@ def splat_batch(
     `frustum`, the draw's planes (`cloudcore.camera.frustum_planes`), leaves out the splats outside it.
     """
     starts = particles.cloud_starts
-    ranges = [np.arange(starts[c], starts[c + 1]) for c in clouds]
-    indices = np.concatenate(ranges) if ranges else np.zeros(0, dtype=np.int64)
+    # a cloud's particles are contiguous: slices gather them faster than an index array does
+    pieces = [slice(starts[c], starts[c + 1]) for c in clouds]
+    counts = [piece.stop - piece.start for piece in pieces]
+    indices = np.concatenate([np.arange(piece.start, piece.stop) for piece in pieces]) if pieces else np.zeros(0, int)
+    centres = np.concatenate([particles.centres[piece] for piece in pieces]) if pieces else np.zeros((0, 3))
     eye = np.asarray(eye, dtype=np.float64)
-    offsets = particles.centres[indices] - eye
+    offsets = centres - eye
     distances = np.sqrt(np.einsum("ij,ij->i", offsets, offsets))
     kept = particles.drawn(indices, distances, time_s)
     if depth_ranges is not None:
-        near = np.repeat([r[0] for r in depth_ranges], [len(r) for r in ranges])
-        far = np.repeat([r[1] for r in depth_ranges], [len(r) for r in ranges])
+        near = np.repeat([r[0] for r in depth_ranges], counts)
+        far = np.repeat([r[1] for r in depth_ranges], counts)
         kept &= (distances > near) & (distances <= far)
     if frustum is not None:
-        kept &= splats_in_frustum(frustum, particles.centres[indices], particles.radii[indices])
+        radii = np.concatenate([particles.radii[piece] for piece in pieces]) if pieces else np.zeros(0)
+        kept &= splats_in_frustum(frustum, centres, radii)
     indices, distances = indices[kept], distances[kept]
     return SplatBatch(particles, indices[far_to_near(distances)].astype(np.uint32), eye, time_s)
 
