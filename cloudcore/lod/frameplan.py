@@ -892,8 +892,8 @@ def _seen(
     reach = np.linalg.norm(centres[:, None] - object_centres[None], axis=2) < radii[:, None] + object_radii[None]
     reach &= (radii > 0.0)[:, None]
     # an object moving in depth inside a unit remakes its layers once it passes a particle it covers
-    # (`cloudcore.lod.splitting.layers_hold`): about the unit's depth over the particles whose discs reach the
-    # object's, their share of the unit's disc those discs' sum over it
+    # (`cloudcore.lod.splitting.layers_hold`): about every 2R / m metres of depth, m of the unit's particles
+    # overlapping it on screen, their share the area of a disc of its radius plus a typical particle's over the unit's
     typical_radii = np.sqrt(units.radius_squares / np.maximum(units.particle_counts, 1.0))
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         covered_shares = np.minimum(((object_radii[None] + typical_radii[:, None]) / radii[:, None]) ** 2, 1.0)
