@@ -26,6 +26,7 @@ from cloudcore.navigation import orbited
 from cloudcore.paths import camera_on_path
 from cloudcore.scene import CloudField
 from cloudcore.scenefile import load_scene, save_scene
+from cloudcore.settings import RenderSettings
 
 if TYPE_CHECKING:
     from app.editor import Editor
@@ -259,7 +260,7 @@ def tolerance_drives_regeneration(ctx, app: EditorUnderTest):
     postponed = sum(s.frame.plan.regenerations_postponed for s in budgeted if not s.picture_reused)
     use_window(ctx, "LOD")
     ctx.item_input_value("Regeneration budget", 0)
-    ctx.item_input_value("Tolerance (deg)", 0.5)
+    ctx.item_input_value("Tolerance (deg)", RenderSettings().tolerance_deg)
     ctx.combo_click("Mode/auto")
     app.outcome["regenerations"] = {
         "tolerance 5": lenient,

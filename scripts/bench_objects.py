@@ -167,8 +167,13 @@ def main() -> None:
         f"mean, {crossed['psnr_around_aircraft_min_db']:.2f} worst"
     )
     args.json.parent.mkdir(parents=True, exist_ok=True)
-    result = {"width": size[0], "height": size[1], "split_against_naive": rows, "flythrough": cost}
-    result["crossing"] = crossed
+    result = {
+        "width": size[0],
+        "height": size[1],
+        "split_against_naive": rows,
+        "flythrough": cost,
+        "crossing": crossed,
+    }
     args.json.write_text(json.dumps(result, indent=2) + "\n")
     if args.figure:
         write_figure(crops, rows, args.figure)
