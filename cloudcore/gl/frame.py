@@ -112,7 +112,7 @@ class FrameRenderer:
         self._units: LodUnits | None = None
         self._units_source = None
         self._layer = None  # screen-sized, sharing the frame's depth: crossfading clouds' full-3D image
-        self._inside = None  # (target, its depth renderbuffer) of the screen impostor
+        self._inside = []  # (target, its depth renderbuffer) per screen impostor of a frame, all of one size
         self._overdraw_target = None
         self._display = None  # (RGBA8 target, program): the frame in sRGB for the editor
         # the last frame's draws into the screen, replayable as fragment counts, and its splat batches
@@ -282,7 +282,7 @@ class FrameRenderer:
     def texture_bytes(self) -> int:
         """GPU memory of every impostor, ring, layer and screen-impostor texture held."""
         held = self._impostors.pool.bytes_total
-        for target in (self._layer, self._inside[0] if self._inside else None):
+        for target in (self._layer, *(target for target, _ in self._inside)):
             held += target.nbytes if target is not None else 0
         return held
 
@@ -376,8 +376,8 @@ class FrameRenderer:
         if plan.ring is not None:
             self._draw_ring(frame, settings.ring_elevation_deg)
         kinds = {"impostor": self._draw_impostor, "crossfade": self._draw_crossfade}
-        # units the eye is in, one after the other: one screen impostor, drawn where the run starts
-        screen_impostors = {id(run[0]): run for run in inside_runs(plan.draw_items, plan.clouds)}
+        # units the eye is in, one after the other: one screen impostor each run, laid where the run starts
+        screen_impostors = self._screen_impostors(frame, inside_runs(plan.draw_items, plan.clouds))
         full_run = []  # (cloud, (near, far)) of consecutive full-3D layers: they interpenetrate, sorted together
         drawn = 0
         for item in plan.draw_items:
@@ -395,7 +395,9 @@ class FrameRenderer:
                 )
             elif cloud.kind == "inside":
                 if id(item) in screen_impostors:  # the rest of its run is in the same screen impostor
-                    drawn += self._draw_inside(frame, screen_impostors[id(item)], cloud.full_weight)
+                    target, particles_drawn = screen_impostors[id(item)]
+                    self._draw_quad(frame, SCREEN_CORNERS, target.texture, cloud.full_weight, screen=True)
+                    drawn += particles_drawn
             else:
                 drawn += kinds[cloud.kind](frame, item, cloud)
         if full_run:
@@ -465,40 +467,47 @@ class FrameRenderer:
         )
         return drawn
 
-    def _draw_inside(self, frame: _CloudPassFrame, run, weight: float) -> int:
-        """Harris's screen impostor of the units the eye is in (`run`, consecutive draw items), their
-        particles sorted together at the plan's reduced resolution, then laid over the screen."""
-        target = self._inside_target(frame.plan.inside_size)
-        target.bind_cleared()
-        members, depth_ranges = zip(
-            *[(member, (item.near, item.far)) for item in run for member in frame.plan.clouds[item.index].members]
-        )
-        batch = splat_batch(frame.particles, members, frame.eye, depth_ranges, frame.time_s, frame.frustum)
-        self._splats.draw(batch, frame.view, frame.projection, point_sprites=frame.point_sprites)
+    def _screen_impostors(self, frame: _CloudPassFrame, runs) -> dict:
+        """Harris's screen impostors of the units the eye is in, before anything else of the cloud pass:
+        per run of consecutive draw items (keyed by id of its first), (target, particles drawn), their
+        particles sorted together at the plan's reduced resolution.
+
+        Their only input from the frame is the world's depth, which no cloud or object of the cloud pass
+        writes, so made first they are the same.  Made where they are laid, each stalled the frame twice
+        on llvmpipe: the depth blit waits for the frame's draws so far, the composite for the impostor's.
+        """
+        made = {}
+        for run, target in zip(runs, self._inside_targets(frame.plan.inside_size, len(runs))):
+            blit_depth(self.context.framebuffer, self.size, target.framebuffer, frame.plan.inside_size)
+            target.bind_cleared()
+            members, depth_ranges = zip(
+                *[(member, (item.near, item.far)) for item in run for member in frame.plan.clouds[item.index].members]
+            )
+            batch = splat_batch(frame.particles, members, frame.eye, depth_ranges, frame.time_s, frame.frustum)
+            self._splats.draw(batch, frame.view, frame.projection, point_sprites=frame.point_sprites)
+            made[id(run[0])] = (target, len(batch))
         self.context.bind_target()
-        self._draw_quad(frame, SCREEN_CORNERS, target.texture, weight, screen=True)
-        return len(batch)
+        return made
 
     def _screen_layer(self) -> TextureTarget:
         if self._layer is None:
             self._layer = TextureTarget(*self.size, depth_renderbuffer=self.context.depth_renderbuffer)
         return self._layer
 
-    def _inside_target(self, size) -> TextureTarget:
-        """The screen impostor's target, with the frame's depth scaled into its own depth buffer."""
-        if self._inside is None or (self._inside[0].width, self._inside[0].height) != tuple(size):
+    def _inside_targets(self, size, count: int) -> list[TextureTarget]:
+        """`count` screen impostor targets of `size`, each with its own depth buffer for the frame's."""
+        if self._inside and (self._inside[0][0].width, self._inside[0][0].height) != tuple(size):
             self._close_inside()
+        while len(self._inside) < count:
             depth = depth_renderbuffer(*size)
-            self._inside = (TextureTarget(*size, depth_renderbuffer=depth), depth)
-        target = self._inside[0]
-        blit_depth(self.context.framebuffer, self.size, target.framebuffer, size)
-        return target
+            self._inside.append((TextureTarget(*size, depth_renderbuffer=depth), depth))
+        return [target for target, _ in self._inside[:count]]
 
     def _close_inside(self) -> None:
-        if self._inside is not None:
-            self._inside[0].close()
-            GL.glDeleteRenderbuffers(1, [self._inside[1]])
-            self._inside = None
+        for target, depth in self._inside:
+            target.close()
+            GL.glDeleteRenderbuffers(1, [depth])
+        self._inside = []
 
     def measure_overdraw(self) -> tuple[np.ndarray, Overdraw]:
         """(fragments per pixel (height, width) float32, statistics) of the last rendered frame's clouds.
