@@ -15,10 +15,11 @@ SCREEN_CORNERS = np.array([[-1, -1, 0], [1, -1, 0], [-1, 1, 0], [1, 1, 0]], dtyp
 class QuadPass:
     def __init__(self):
         self._program = build_program("quad")
+        self._crossfade_program = build_program("quad", {"CROSSFADE": 1})
         self._counting_program = build_program("quad", {"COUNT_FRAGMENTS": 1})
         #: per program, the locations of the uniforms every draw sets
         self._uniforms = {}
-        for program in (self._program, self._counting_program):
+        for program in (self._program, self._crossfade_program, self._counting_program):
             GL.glUseProgram(program)
             GL.glUniform1i(GL.glGetUniformLocation(program, "impostor"), 0)
             GL.glUniform1i(GL.glGetUniformLocation(program, "layer"), 1)
@@ -44,14 +45,20 @@ class QuadPass:
     ) -> None:
         """Blend `texture` (premultiplied) over the bound target on the quad `corners` (4, 3), which show
         the part `uv_rect` (u0, v0, u1, v1) of the texture."""
-        program = self._counting_program if counting else self._program
+        program = (
+            self._counting_program
+            if counting
+            else self._crossfade_program
+            if layer_texture is not None
+            else self._program
+        )
         uniforms = self._uniforms[program]
         GL.glUseProgram(program)
         GL.glUniform3fv(uniforms["corners"], 4, np.ascontiguousarray(corners, dtype=np.float32))
         set_matrix_at(uniforms["view_projection"], view_projection)
         GL.glUniform4f(uniforms["uv_rect"], *map(float, uv_rect))
         GL.glUniform1f(uniforms["impostor_weight"], float(impostor_weight))
-        GL.glUniform1f(uniforms["layer_weight"], float(layer_weight) if layer_texture is not None else 0.0)
+        GL.glUniform1f(uniforms["layer_weight"], float(layer_weight))
         GL.glActiveTexture(GL.GL_TEXTURE0)
         GL.glBindTexture(GL.GL_TEXTURE_2D, texture)
         if layer_texture is not None:
@@ -64,6 +71,6 @@ class QuadPass:
             GL.glBindVertexArray(0)
 
     def close(self) -> None:
-        GL.glDeleteProgram(self._program)
-        GL.glDeleteProgram(self._counting_program)
+        for program in self._uniforms:
+            GL.glDeleteProgram(program)
         GL.glDeleteVertexArrays(1, [self.vertex_array])

@@ -3,7 +3,10 @@
 // cloud's opacity, plus (in a crossfade) the full-3D image of the same cloud
 // from a screen-sized layer scaled by the rest: a linear mix of two
 // premultiplied images is itself a correct premultiplied image, so the
-// crossfade neither brightens nor darkens.  COUNT_FRAGMENTS writes 1 instead.
+// crossfade neither brightens nor darkens.  Only the CROSSFADE variant reads the
+// layer: behind a branch on a uniform, llvmpipe paid for the fetch on every
+// quad that never took it (7% of the flythrough's clouds, docs/performance.md).
+// COUNT_FRAGMENTS writes 1 instead.
 
 uniform sampler2D impostor;
 uniform sampler2D layer;
@@ -19,8 +22,9 @@ void main()
     frag_colour = vec4(1.0);
 #else
     vec4 colour = impostor_weight * texture(impostor, uv);
-    if (layer_weight > 0.0)
-        colour += layer_weight * texelFetch(layer, ivec2(gl_FragCoord.xy), 0);
+#ifdef CROSSFADE
+    colour += layer_weight * texelFetch(layer, ivec2(gl_FragCoord.xy), 0);
+#endif
     frag_colour = colour;
 #endif
 }
