@@ -17,6 +17,7 @@ depth test on, terrain hides splats; splats never write depth.  Drawn with
 from __future__ import annotations
 
 import ctypes
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -121,13 +122,12 @@ def splat_batch(
 class SplatPass:
     def __init__(self):
         defines = {"SPLAT_SHARPNESS": SPLAT_SHARPNESS, "ATLAS_GRID": ATLAS_GRID}
-        counting, points = {"COUNT_FRAGMENTS": 1}, {"POINT_SPRITE": 1}
-        #: (points?, counting?) -> program
+        variants = {"POINT_SPRITE": (False, True), "COUNT_FRAGMENTS": (False, True), "ATLAS_SPRITES": (False, True)}
+        #: (points?, counting?, atlas sprites?) -> program; a point is never a sprite
         self._programs = {
-            (False, False): build_program("splat", defines),
-            (False, True): build_program("splat", defines | counting),
-            (True, False): build_program("splat", defines | points),
-            (True, True): build_program("splat", defines | points | counting),
+            key: build_program("splat", defines | {name: 1 for name, on in zip(variants, key) if on})
+            for key in itertools.product(*variants.values())
+            if not (key[0] and key[2])
         }
         #: per program, the locations of the uniforms every draw sets
         self._uniforms = {
@@ -136,6 +136,7 @@ class SplatPass:
         }
         self._point_sizes_px = tuple(float(size) for size in GL.glGetFloatv(GL.GL_POINT_SIZE_RANGE))
         self._plain: np.ndarray = np.zeros(0, dtype=bool)  # of the resident particles: `plain_splats`
+        self._sprites: np.ndarray = np.zeros(0, dtype=bool)  # of the resident particles: drawn from the atlas
         #: particles drawn as point sprites since the frame's renderer last set it to 0 (for its statistics)
         self.particles_as_points = 0
         self._shade_program = build_compute_program(
@@ -192,8 +193,10 @@ class SplatPass:
             )
             pieces = draw_runs(plain & fit)
             GL.glViewport(*viewport)
+        with_sprites = bool(self._sprites[batch.order].any())
+        programs = {points: self._programs[points, counting, with_sprites and not points] for points in (False, True)}
         for as_points in {piece[2] for piece in pieces}:
-            program = self._programs[as_points, counting]
+            program = programs[as_points]
             uniforms = self._uniforms[program]
             GL.glUseProgram(program)
             set_matrix_at(uniforms["view_rotation"], view_rotation)
@@ -209,7 +212,7 @@ class SplatPass:
         GL.glEnable(GL.GL_PROGRAM_POINT_SIZE)
         with cloud_blending(depth_test, counting):
             for start, stop, as_points in pieces:
-                GL.glUseProgram(self._programs[as_points, counting])
+                GL.glUseProgram(programs[as_points])
                 if as_points:
                     GL.glDrawArrays(GL.GL_POINTS, start, stop - start)
                 else:
@@ -290,6 +293,7 @@ class SplatPass:
                 GL.GL_DYNAMIC_DRAW,
             )
             self._plain = plain_splats(particles.styles)
+            self._sprites = particles.styles.sprite_index >= 0
             if self._atlas is None and np.any(particles.styles.sprite_index >= 0):
                 self._atlas = _atlas_texture()
             _store(self._formation_buffer, np.ones(max(len(particles.radii), 1), dtype=np.float32))
