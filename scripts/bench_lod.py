@@ -3,8 +3,8 @@
     python scripts/bench_lod.py [--cases still,orbit,flythrough,field,untuned] [--quick]
                                 [--json out/bench_lod.json] [--plot docs/images/bench_lod.png]
 
-Each case is one run of `cloudcore.measure.benchmark.bench_path` (one process, one context, the reference
-and each mode over the same frames), default settings but for the mode:
+Each case is one run of `cloudcore.measure.benchmark.bench_path` (one process, a renderer for the reference
+and one for each mode, taking turns frame by frame), default settings but for the mode:
 
 - still: the default view, camera still, 880x680 (the editor's viewport), after 20 unmeasured frames
   (the ring built and faded in); what remains is the static error floor;
@@ -23,6 +23,7 @@ case; the JSON holds every frame.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import os
 import sys
@@ -38,6 +39,7 @@ from bench_many_particles import cloud_field  # noqa: E402  (a sibling script: t
 
 from cloudcore.artist.cloudgen import preset_cloud  # noqa: E402
 from cloudcore.gl import FrameRenderer  # noqa: E402
+from cloudcore.light.illumination import IlluminationCache  # noqa: E402
 from cloudcore.measure.benchmark import (  # noqa: E402
     bench_path,
     headless_pyplot,
@@ -192,8 +194,12 @@ def main() -> None:
     }
     for name, scene, views, size, warmup in cases(names, args.quick):
         start = time.perf_counter()
-        with FrameRenderer(*size) as renderer:
-            report = bench_path(renderer, scene, "", len(views), MODES, size, views=views, warmup=warmup)
+        with contextlib.ExitStack() as stack:
+            illumination = IlluminationCache()
+            renderers = [
+                stack.enter_context(FrameRenderer(*size, illumination=illumination)) for _ in range(1 + len(MODES))
+            ]
+            report = bench_path(renderers, scene, "", len(views), MODES, size, views=views, warmup=warmup)
         report["seconds"] = time.perf_counter() - start
         result["cases"][name] = report
         rows = summary(name, report)

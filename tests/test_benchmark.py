@@ -33,12 +33,14 @@ def test_pareto_front_keeps_the_points_nothing_beats():
 
 
 class FakeRenderer:
-    """Full 3D is grey 100; every other mode adds `offset` levels: the bench must see exactly that error."""
+    """Full 3D is grey 100; every other mode adds `offset` levels: the bench must see exactly that error.
+    Every render is logged in `calls` as (renderer's name, camera position) in the order made."""
 
-    def __init__(self, offset):
-        self.offset = offset
+    def __init__(self, offset, name="", calls=None):
+        self.offset, self.name, self.calls = offset, name, calls if calls is not None else []
 
     def render(self, scene, camera=None, settings=None, time_s=0.0):
+        self.calls.append((self.name, tuple(camera.position)))
         level = 100 if settings == FULL_3D else 100 + self.offset
         stats = FrameStats(
             PlanStats(impostors_regenerated=1),
@@ -52,14 +54,32 @@ class FakeRenderer:
 
 def test_bench_path_reports_the_error_and_speedup_it_measured():
     scene = load_scene(VALLEY)
-    report = bench_path(FakeRenderer(offset=5), scene, "flythrough", 3, [RenderSettings()], (4, 4))
+    report = bench_path([FakeRenderer(offset=5) for _ in range(2)], scene, "flythrough", 3, [RenderSettings()], (4, 4))
     (run,) = report["runs"]
     assert CONTRACT_RUN_KEYS <= set(run)
     assert run["psnr_mean"] == pytest.approx(10 * np.log10(255**2 / 25))
     assert run["mad_mean"] == 5.0 and run["speedup_vs_full"] == 4.0 and run["regenerations"] == 3
     assert report["reference"]["mode"] == "full" and report["frames"] == 3
-    identical = bench_path(FakeRenderer(offset=0), scene, "flythrough", 2, [RenderSettings()], (4, 4))
+    twins = [FakeRenderer(offset=0) for _ in range(2)]
+    identical = bench_path(twins, scene, "flythrough", 2, [RenderSettings()], (4, 4))
     assert identical["runs"][0]["psnr_min"] == 100.0  # identical frames: the cap, JSON has no infinity
+
+
+def test_bench_path_renders_frame_by_frame_in_turn_alternating_the_order():
+    """Side by side: every renderer renders a frame before any renders the next, the order reversed on every
+    other frame, so a slower or faster spell of the machine falls on all runs alike."""
+    scene, calls = load_scene(VALLEY), []
+    renderers = [FakeRenderer(offset=1, name=name, calls=calls) for name in ("full", "a", "b")]
+    bench_path(renderers, scene, "flythrough", 3, [RenderSettings(), RenderSettings(mode="impostor")], (4, 4))
+    measured = calls[3:]  # after one unmeasured frame each: shading precompute, shader compiles
+    assert [name for name, _ in measured] == ["full", "a", "b", "b", "a", "full", "full", "a", "b"]
+    positions = [position for _, position in measured]
+    assert len(set(positions[0:3])) == len(set(positions[3:6])) == 1 and positions[0] != positions[3]
+
+
+def test_bench_path_wants_a_renderer_per_run():
+    with pytest.raises(ValueError, match="2 renderers for the reference and 2 settings"):
+        bench_path([FakeRenderer(0)] * 2, load_scene(VALLEY), "flythrough", 2, [RenderSettings()] * 2, (4, 4))
 
 
 def test_bench_cli_writes_the_contract(tmp_path):

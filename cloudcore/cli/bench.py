@@ -8,6 +8,7 @@ default settings are run.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import itertools
 import json
@@ -104,13 +105,18 @@ def run(args) -> int:
     from tqdm import tqdm
 
     from cloudcore.gl import FrameRenderer
+    from cloudcore.light.illumination import IlluminationCache
 
     with (
-        FrameRenderer(args.width, args.height) as renderer,
+        contextlib.ExitStack() as renderers,
         tqdm(total=(args.frames + args.warmup) * (1 + len(settings_list)), unit="frame", desc="bench") as bar,
     ):
+        illumination = IlluminationCache()  # the clouds' light, computed once for every run
         report = bench_path(
-            renderer,
+            [
+                renderers.enter_context(FrameRenderer(args.width, args.height, illumination=illumination))
+                for _ in range(1 + len(settings_list))
+            ],
             scene,
             args.camera_path,
             args.frames,

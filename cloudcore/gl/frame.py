@@ -157,6 +157,7 @@ class FrameRenderer:
         With `read_back=False` the image stays on the GPU (None is returned in its place): the
         editor shows it through `display_texture`.
         """
+        self.context.make_current()  # several renderers may share a thread (the benchmarks take turns)
         lighting = (
             scene.lighting if time_of_day is None else dataclasses.replace(scene.lighting, time_of_day=time_of_day)
         )
