@@ -24,7 +24,7 @@ import numpy as np
 from OpenGL import GL
 
 from cloudcore.artist.facing import FacingState
-from cloudcore.artist.particle_styles import ParticleStyles
+from cloudcore.artist.particle_styles import FACING_SPLAT, ParticleStyles
 from cloudcore.artist.sprites import ATLAS_MAX_MIP_LEVEL, load_atlas
 from cloudcore.camera import splats_in_frustum
 from cloudcore.cloud_records import ATLAS_GRID
@@ -119,6 +119,11 @@ def splat_batch(
     return SplatBatch(particles, indices[far_to_near(distances)].astype(np.uint32), eye, time_s)
 
 
+#: splat_shade.comp.glsl's optional code, in the order of a variant's key: sprites that do not lie in the
+#: image plane, Wang's artist colours, Yusov's eye-pass profiles
+_SHADE_FEATURES = ("FACING", "ARTIST", "PROFILES")
+
+
 class SplatPass:
     def __init__(self):
         defines = {"SPLAT_SHARPNESS": SPLAT_SHARPNESS, "ATLAS_GRID": ATLAS_GRID}
@@ -137,13 +142,14 @@ class SplatPass:
         self._point_sizes_px = tuple(float(size) for size in GL.glGetFloatv(GL.GL_POINT_SIZE_RANGE))
         self._plain: np.ndarray = np.zeros(0, dtype=bool)  # of the resident particles: `plain_splats`
         self._sprites: np.ndarray = np.zeros(0, dtype=bool)  # of the resident particles: drawn from the atlas
+        #: of the resident particles: per particle, (facing, artist) as bits; whether there are Yusov's profiles
+        self._feature_bits: np.ndarray = np.zeros(0, dtype=np.uint8)
+        self._profiled = False
         #: particles drawn as point sprites since the frame's renderer last set it to 0 (for its statistics)
         self.particles_as_points = 0
-        self._shade_program = build_compute_program(
-            "splat_shade",
-            {"MAX_LIGHTS": MAX_LIGHTS, "FADE_START_RADII": FADE_START_RADII, "FADE_END_RADII": FADE_END_RADII},
-        )
-        self._shade_uniforms = uniform_locations(self._shade_program, ("count", "eye", "view_right", "view_up"))
+        #: the compute shader's variants by the features a batch has (`_SHADE_FEATURES`), made when first
+        #: needed: (program, its uniforms' locations, the particles its light uniforms are of)
+        self._shade_programs: dict[tuple, list] = {}
         self._vertex_array = GL.glGenVertexArrays(1)
         (
             self._corner_index_buffer,
@@ -273,8 +279,8 @@ class SplatPass:
             (_PROFILES_BINDING, self._profile_buffer),
         ):
             GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, binding, buffer)
-        uniforms = self._shade_uniforms
-        GL.glUseProgram(self._shade_program)
+        program, uniforms = self._shade_program(batch)
+        GL.glUseProgram(program)
         GL.glUniform1ui(uniforms["count"], len(batch))
         for name, value in (("eye", batch.eye), ("view_right", view[0, :3]), ("view_up", view[1, :3])):
             set_vec3_at(uniforms[name], value)
@@ -300,8 +306,32 @@ class SplatPass:
             # Yusov's eye pass's profile rows; one float where there are none (no empty buffer is bound)
             rows = np.zeros(0) if particles.profiles is None else particles.profiles.profiles.ravel()
             _store(self._profile_buffer, (rows if rows.size else np.zeros(1)).astype(np.float32))
-            _set_light_uniforms(self._shade_program, particles)
+            per_cloud = [(s.facing != FACING_SPLAT) | (s.artist is not None) << 1 for s in particles.styles.clouds]
+            self._feature_bits = np.array(per_cloud + [0], dtype=np.uint8)[particles.styles.cloud_index]
+            self._profiled = particles.profiles is not None
             self._resident, self._formation_time = particles, None
+
+    def _shade_program(self, batch: SplatBatch) -> tuple[int, dict]:
+        """The compute shader variant with the features of `batch`'s particles, its light uniforms those of
+        the resident particles; and its uniforms' locations."""
+        bits = int(np.bitwise_or.reduce(self._feature_bits[batch.order])) if len(batch) else 0
+        features = (bool(bits & 1), bool(bits & 2), self._profiled)
+        if features not in self._shade_programs:
+            program = build_compute_program(
+                "splat_shade",
+                {"MAX_LIGHTS": MAX_LIGHTS, "FADE_START_RADII": FADE_START_RADII, "FADE_END_RADII": FADE_END_RADII}
+                | {name: 1 for name, on in zip(_SHADE_FEATURES, features) if on},
+            )
+            self._shade_programs[features] = [
+                program,
+                uniform_locations(program, ("count", "eye", "view_right", "view_up")),
+                None,
+            ]
+        held = self._shade_programs[features]
+        if held[2] is not self._resident:
+            _set_light_uniforms(held[0], self._resident)
+            held[2] = self._resident
+        return held[0], held[1]
 
     def _hold_formation(self, particles: ParticleBuffer, time_s: float | None) -> None:
         """Upload the opacity factors (formation at `time_s`, blend weights) when they differ from those held."""
@@ -317,7 +347,7 @@ class SplatPass:
 
     def close(self) -> None:
         """Free the GL objects (the context must be current)."""
-        for program in (*self._programs.values(), self._shade_program):
+        for program in (*self._programs.values(), *(held[0] for held in self._shade_programs.values())):
             GL.glDeleteProgram(program)
         if self._atlas is not None:
             GL.glDeleteTextures([self._atlas])

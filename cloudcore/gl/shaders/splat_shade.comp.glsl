@@ -24,6 +24,11 @@
 // into their plane (cloudcore.artist.facing.sprite_axes), or lie flat; both turned
 // by their rotation.  Corners are written relative to the eye, so float32
 // keeps tiny particles far from the origin their size.
+//
+// Variants: FACING (sprites not in the image plane), ARTIST (Wang's colours)
+// and PROFILES (Yusov's eye pass) compile their code in only for batches that
+// have them: llvmpipe paid for the code behind the branches, so a batch of Harris's
+// splats paid for the artist colours of every corner.
 
 layout(local_size_x = 64) in;
 
@@ -104,13 +109,16 @@ vec4 harris_colour(Particle p, vec3 view_ray)
     for (int light = 0; light < light_count; ++light) {
         float mu = dot(view_ray, light_direction[light]);
         float factor = phase(mu);
+#ifdef PROFILES
         if (row >= 0)
             factor = factor * profile(row, 0, mu) + profile(row, 1, mu);
+#endif
         scattered += p.incident[light] * factor * light_radiance[light];
     }
     return vec4(scattered * p.scattering_opacity.rgb + p.ambient.rgb, p.scattering_opacity.a);
 }
 
+#ifdef ARTIST
 // cloudcore.artist.artist_shading.artist_colours at one vertex, premultiplied
 vec4 artist_colour(CloudStyle style, vec3 vertex, vec3 group_centre)
 {
@@ -130,6 +138,7 @@ vec4 artist_colour(CloudStyle style, vec3 vertex, vec3 group_centre)
     vec4 colour = clamp(ambient + vec4(style.directional_colour.rgb * t, 0.0), 0.0, 1.0);
     return vec4(colour.rgb * colour.a, colour.a);
 }
+#endif
 
 void main()
 {
@@ -147,6 +156,7 @@ void main()
 
     vec3 right = view_right, up = view_up;
     float fade = ramp(FADE_START_RADII * radius, FADE_END_RADII * radius, distance);
+#ifdef FACING
     if (facing_kind != FACING_SPLAT) {
         vec4 lock = facing[index];
         vec3 normal = facing_kind == FACING_HORIZONTAL ? vec3(0.0, 1.0, 0.0)
@@ -159,14 +169,23 @@ void main()
         right = c * axis + s * up;
         up = cross(normal, right);
     }
+#endif
     fade *= formation[index];
 
+#ifdef ARTIST
     bool artist = style.last_height_extent.w > 0.5;
     vec4 colour = artist ? vec4(0.0) : harris_colour(p, view_ray) * fade;
+#else
+    vec4 colour = harris_colour(p, view_ray) * fade;
+#endif
     for (int k = 0; k < 4; ++k) {
         vec3 corner = offset + radius * (CORNERS[k].x * right + CORNERS[k].y * up);
         instances[slot].corners[k] = vec4(corner, p.sprite.x);
+#ifdef ARTIST
         instances[slot].colours[k] = artist ? artist_colour(style, corner + eye, p.group_cloud.xyz) * fade
                                             : colour;
+#else
+        instances[slot].colours[k] = colour;
+#endif
     }
 }
