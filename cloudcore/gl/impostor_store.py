@@ -138,5 +138,8 @@ class ImpostorStore:
 def _extent(particles: ParticleBuffer, clouds, view, projection, size) -> tuple:
     """The part of a texture rendered through (view, projection) that the particles of `clouds` can cover."""
     starts = particles.cloud_starts
-    indices = np.concatenate([np.arange(starts[c], starts[c + 1]) for c in clouds]) if len(clouds) else []
-    return particle_extent(view, projection, particles.centres[indices], particles.radii[indices], size)
+    pieces = [slice(starts[c], starts[c + 1]) for c in clouds]  # a cloud's particles are contiguous
+    if not pieces:
+        return particle_extent(view, projection, np.zeros((0, 3)), np.zeros(0), size)
+    centres = np.concatenate([particles.centres[piece] for piece in pieces])
+    return particle_extent(view, projection, centres, np.concatenate([particles.radii[p] for p in pieces]), size)

@@ -100,13 +100,17 @@ def particle_extent(
     depth = -eye_space[:, 2]
     if not np.all(depth - radii > 0.0):
         return (0.0, 0.0, 1.0, 1.0)
-    # a sphere's projection along each axis lies within (x +- r) / (depth - r)
-    low = (eye_space[:, :2] - radii[:, None]) / (depth - radii)[:, None]
-    high = (eye_space[:, :2] + radii[:, None]) / (depth - radii)[:, None]
+    # a sphere's projection along each axis lies within (x +- r) / (depth - r); axis by axis on contiguous
+    # columns, the projection's scale applied to the extremes: numpy loops over a row of two slowly, and a
+    # regeneration pays this for each of up to 10,000 splats (0.36 against 0.02 ms)
+    nearest = depth - radii
+    low = np.array([((eye_space[:, axis] - radii) / nearest).min() for axis in (0, 1)])
+    high = np.array([((eye_space[:, axis] + radii) / nearest).max() for axis in (0, 1)])
     scale = np.array([projection[0, 0], projection[1, 1]])
     margin = 2.0 * CROP_MARGIN_TEXELS / np.asarray(size, dtype=np.float64)
-    lower = np.clip(0.5 * (np.minimum(low * scale, high * scale).min(axis=0) + 1.0) - margin / 2, 0.0, 1.0)
-    upper = np.clip(0.5 * (np.maximum(low * scale, high * scale).max(axis=0) + 1.0) + margin / 2, 0.0, 1.0)
+    lowest, highest = np.minimum(low * scale, high * scale), np.maximum(low * scale, high * scale)
+    lower = np.clip(0.5 * (lowest + 1.0) - margin / 2, 0.0, 1.0)
+    upper = np.clip(0.5 * (highest + 1.0) + margin / 2, 0.0, 1.0)
     return (float(lower[0]), float(lower[1]), float(upper[0]), float(upper[1]))
 
 
