@@ -53,7 +53,14 @@ def test_the_compute_pass_composites_as_the_reference_does(renderer, wall_m):
         GL.glClearDepth(window_depth)
         GL.glClear(GL.GL_DEPTH_BUFFER_BIT)
         GL.glClearDepth(1.0)
-        volume.draw(tiles, splats.shade(batch, view), view, projection, target.texture, renderer.context.framebuffer)
+        volume.draw(
+            tiles,
+            (*splats.shade(batch, view), len(batch)),
+            view,
+            projection,
+            target.texture,
+            renderer.context.framebuffer,
+        )
         pixels = target.read()
     finally:
         splats.close(), volume.close(), target.close()

@@ -43,7 +43,7 @@ from cloudcore.gl.objects import ObjectPass
 from cloudcore.gl.pass_clock import PassClock
 from cloudcore.gl.programs import build_program
 from cloudcore.gl.quads import SCREEN_CORNERS, QuadPass
-from cloudcore.gl.splats import SplatPass, splat_batch
+from cloudcore.gl.splats import SplatBatch, SplatPass, splat_batch
 from cloudcore.gl.targets import TextureTarget, blit_depth, depth_renderbuffer
 from cloudcore.gl.volume_blending import GpuFeatures, VolumeBlendingPass
 from cloudcore.gl.world import WorldPass
@@ -374,41 +374,67 @@ class FrameRenderer:
             settings.blending,
         )
         self._replay, self._screen_batches = [], []
+        steps = self._cloud_pass_steps(frame)
+        runs = inside_runs(plan.draw_items, plan.clouds)
+        inside_batches = [self._batch_of(frame, run) for run in runs]
+        self._splats.shade_ahead(
+            [(batch, view) for batch in inside_batches]
+            + [(step[-1], view) for step in steps if step[0] in ("splats", "crossfade")]
+        )
+        # units the eye is in, one after the other: one screen impostor each run, laid where the run starts
+        screen_impostors = self._screen_impostors(frame, runs, inside_batches)
         if plan.ring is not None:
             self._draw_ring(frame, settings.ring_elevation_deg)
-        kinds = {"impostor": self._draw_impostor, "crossfade": self._draw_crossfade}
-        # units the eye is in, one after the other: one screen impostor each run, laid where the run starts
-        screen_impostors = self._screen_impostors(frame, inside_runs(plan.draw_items, plan.clouds))
-        full_run = []  # (cloud, (near, far)) of consecutive full-3D layers: they interpenetrate, sorted together
         drawn = 0
-        for item in plan.draw_items:
-            cloud = plan.clouds[item.index] if item.kind == "cloud" else None
-            if cloud is not None and cloud.kind == "full":
-                full_run += [(member, (item.near, item.far)) for member in cloud.members]
-                continue
-            if full_run:
-                drawn += self._draw_splats(frame, *zip(*full_run))
-                full_run = []
-            if cloud is None:
+        for kind, item, batch in steps:
+            if kind == "splats":
+                drawn += self._draw_splats(frame, batch)
+            elif kind == "object":
                 antialiased = settings.world_antialiasing
                 self._objects.draw(
                     self.context, camera, poses, [item.index], write_depth=False, antialiased=antialiased
                 )
-            elif cloud.kind == "inside":
+            elif kind == "inside":
                 if id(item) in screen_impostors:  # the rest of its run is in the same screen impostor
                     target, particles_drawn = screen_impostors[id(item)]
-                    self._draw_quad(frame, SCREEN_CORNERS, target.texture, cloud.full_weight, screen=True)
+                    weight = plan.clouds[item.index].full_weight
+                    self._draw_quad(frame, SCREEN_CORNERS, target.texture, weight, screen=True)
                     drawn += particles_drawn
+            elif kind == "impostor":
+                self._draw_impostor(frame, item, plan.clouds[item.index])
             else:
-                drawn += kinds[cloud.kind](frame, item, cloud)
-        if full_run:
-            drawn += self._draw_splats(frame, *zip(*full_run))
+                drawn += self._draw_crossfade(frame, item, plan.clouds[item.index], batch)
         return drawn
 
-    def _draw_splats(self, frame: _CloudPassFrame, clouds, depth_ranges, colour_texture: int | None = None) -> int:
-        """Full 3D: the clouds' splats (each cloud's within its depth range) sorted together, on the screen
-        (or the screen layer whose `colour_texture` is bound), as billboards or as volumes."""
-        batch = splat_batch(frame.particles, clouds, frame.eye, depth_ranges, frame.time_s, frame.frustum)
+    def _cloud_pass_steps(self, frame: _CloudPassFrame) -> list[tuple]:
+        """The cloud pass's draws in order, (kind, draw item, splat batch or None), kind one of "splats" (a run
+        of consecutive full-3D layers: they interpenetrate, sorted together), "object", "inside",
+        "impostor", "crossfade": sorted first, so that their splats are shaded before anything is drawn."""
+        steps, full_run = [], []  # full_run: draw items of consecutive full-3D layers
+        for item in frame.plan.draw_items:
+            cloud = frame.plan.clouds[item.index] if item.kind == "cloud" else None
+            if cloud is not None and cloud.kind == "full":
+                full_run.append(item)
+                continue
+            if full_run:
+                steps.append(("splats", None, self._batch_of(frame, full_run)))
+                full_run = []
+            kind = "object" if cloud is None else cloud.kind
+            steps.append((kind, item, self._batch_of(frame, [item]) if kind == "crossfade" else None))
+        if full_run:
+            steps.append(("splats", None, self._batch_of(frame, full_run)))
+        return steps
+
+    def _batch_of(self, frame: _CloudPassFrame, items) -> SplatBatch:
+        """The splats of the units of draw `items`, each within its item's depth range, sorted together."""
+        clouds, depth_ranges = zip(
+            *[(member, (item.near, item.far)) for item in items for member in frame.plan.clouds[item.index].members]
+        )
+        return splat_batch(frame.particles, clouds, frame.eye, depth_ranges, frame.time_s, frame.frustum)
+
+    def _draw_splats(self, frame: _CloudPassFrame, batch: SplatBatch, colour_texture: int | None = None) -> int:
+        """Full 3D: a batch of splats on the screen (or the screen layer whose `colour_texture` is bound), as
+        billboards or as volumes."""
         view, projection, points = frame.view, frame.projection, frame.point_sprites
         path = blending_path(
             frame.blending,
@@ -417,9 +443,9 @@ class FrameRenderer:
         )
         if path == "volume" and len(batch):
             tiles = screen_tiles(batch.centres - batch.eye, batch.radii, view, projection, self.size, NEAR_PLANE_M)
-            instances = self._splats.shade(batch, view)
+            buffer, first = self._splats.shade(batch, view)
             target = self.context.colour_texture if colour_texture is None else colour_texture
-            self._volume.draw(tiles, instances, view, projection, target, self.context.framebuffer)
+            self._volume.draw(tiles, (buffer, first, len(batch)), view, projection, target, self.context.framebuffer)
             self._particles_as_volumes += len(batch)
         else:
             self._splats.draw(batch, view, projection, point_sprites=points)
@@ -450,12 +476,13 @@ class FrameRenderer:
         self._draw_quad(frame, corners, target.texture, cloud.impostor_weight, uv_rect=extent)
         return 0
 
-    def _draw_crossfade(self, frame: _CloudPassFrame, item, cloud) -> int:
-        """A unit between its impostor and full 3D: its splats into a screen layer, mixed with the impostor."""
+    def _draw_crossfade(self, frame: _CloudPassFrame, item, cloud, batch: SplatBatch) -> int:
+        """A unit between its impostor and full 3D: its splats (`batch`) into a screen layer, mixed with the
+        impostor."""
         target, corners, extent = self._impostors.cloud_impostor(cloud.members, item.layer)
         layer = self._screen_layer()
         layer.bind_cleared()
-        drawn = self._draw_splats(frame, cloud.members, [(item.near, item.far)] * len(cloud.members), layer.texture)
+        drawn = self._draw_splats(frame, batch, layer.texture)
         self.context.bind_target()
         self._draw_quad(
             frame,
@@ -468,23 +495,19 @@ class FrameRenderer:
         )
         return drawn
 
-    def _screen_impostors(self, frame: _CloudPassFrame, runs) -> dict:
+    def _screen_impostors(self, frame: _CloudPassFrame, runs, batches) -> dict:
         """Harris's screen impostors of the units the eye is in, before anything else of the cloud pass:
         per run of consecutive draw items (keyed by id of its first), (target, particles drawn), their
-        particles sorted together at the plan's reduced resolution.
+        particles sorted together (`batches`, one a run) at the plan's reduced resolution.
 
         Their only input from the frame is the world's depth, which no cloud or object of the cloud pass
         writes, so made first they are the same.  Made where they are laid, each stalled the frame twice
         on llvmpipe: the depth blit waits for the frame's draws so far, the composite for the impostor's.
         """
         made = {}
-        for run, target in zip(runs, self._inside_targets(frame.plan.inside_size, len(runs))):
+        for run, batch, target in zip(runs, batches, self._inside_targets(frame.plan.inside_size, len(runs))):
             blit_depth(self.context.framebuffer, self.size, target.framebuffer, frame.plan.inside_size)
             target.bind_cleared()
-            members, depth_ranges = zip(
-                *[(member, (item.near, item.far)) for item in run for member in frame.plan.clouds[item.index].members]
-            )
-            batch = splat_batch(frame.particles, members, frame.eye, depth_ranges, frame.time_s, frame.frustum)
             self._splats.draw(batch, frame.view, frame.projection, point_sprites=frame.point_sprites)
             made[id(run[0])] = (target, len(batch))
         self.context.bind_target()

@@ -36,7 +36,8 @@ class ImpostorStore:
 
     def update(self, plan: FramePlan, particles: ParticleBuffer, settings: RenderSettings, time_s: float) -> int:
         """Render this frame's regenerations and ring segment at scene time `time_s`; returns the particles rendered."""
-        rendered, units = 0, plan.units
+        units = plan.units
+        renders = []  # (target, batch, view, projection): all sorted, then all shaded, then drawn
         for cloud in plan.clouds:
             if cloud.regenerate is None:
                 continue
@@ -49,18 +50,9 @@ class ImpostorStore:
                 _extent(particles, cloud.members, view.view, view.projection, (cloud.texture_size,) * 2),
             )
             for layer, target in enumerate(targets):
-                depth_range = layer_bounds(record.splits, layer)
-                rendered += self._render(
-                    target,
-                    particles,
-                    cloud.members,
-                    record.eye,
-                    view.view,
-                    view.projection,
-                    time_s,
-                    settings.point_sprites,
-                    [depth_range] * len(cloud.members),
-                )
+                depth_ranges = [layer_bounds(record.splits, layer)] * len(cloud.members)
+                batch = splat_batch(particles, cloud.members, record.eye, depth_ranges, time_s)
+                renders.append((target, batch, view.view, view.projection))
         for index in set(self._clouds) - set(plan.records):
             self._release(self._clouds.pop(index)[0])
 
@@ -74,13 +66,16 @@ class ImpostorStore:
             view, projection = segment_camera(generation, segment, settings.ring_elevation_deg)
             clouds = [cloud for unit in generation.segment_members[segment] for cloud in unit]
             self._ring[generation, segment] = (target, _extent(particles, clouds, view, projection, size))
-            rendered += self._render(
-                target, particles, clouds, generation.eye, view, projection, time_s, settings.point_sprites
-            )
+            renders.append((target, splat_batch(particles, clouds, generation.eye, None, time_s), view, projection))
+        self._splats.shade_ahead([(batch, view) for _, batch, view, _ in renders])
+        for target, batch, view, projection in renders:
+            # the clouds alone, no depth test: the texture holds their premultiplied colour and opacity
+            target.bind_cleared()
+            self._splats.draw(batch, view, projection, depth_test=False, point_sprites=settings.point_sprites)
         live = {plan.ring_state.current, plan.ring_state.pending}
         for key in [key for key in self._ring if key[0] not in live]:
             self.pool.release(self._ring.pop(key)[0])
-        return rendered
+        return sum(len(batch) for _, batch, _, _ in renders)
 
     def cloud_impostor(self, members: tuple, layer: int = 0) -> tuple[TextureTarget, np.ndarray, tuple]:
         """(texture of layer `layer` of the unit of clouds `members`, the world corners of the part of its
@@ -105,24 +100,6 @@ class ImpostorStore:
     def _release(self, targets) -> None:
         for target in targets:
             self.pool.release(target)
-
-    def _render(
-        self,
-        target: TextureTarget,
-        particles,
-        clouds,
-        eye,
-        view,
-        projection,
-        time_s: float,
-        point_sprites: bool,
-        depth_ranges=None,
-    ) -> int:
-        """The clouds alone, no depth test: the texture holds their premultiplied colour and opacity."""
-        batch = splat_batch(particles, clouds, eye, depth_ranges, time_s)
-        target.bind_cleared()
-        self._splats.draw(batch, view, projection, depth_test=False, point_sprites=point_sprites)
-        return len(batch)
 
     def close(self) -> None:
         for targets, _, _ in self._clouds.values():

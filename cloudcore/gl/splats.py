@@ -45,7 +45,7 @@ _PARTICLE_FLOATS = 20 + MAX_LIGHTS
 #: the shader's `CloudStyle`: ten vec4
 _CLOUD_FLOATS = 40
 #: per particle, written by the compute shader: four corners and four colours (vec4 each)
-_INSTANCE_BYTES = 8 * 16
+INSTANCE_BYTES = 8 * 16
 _UNLOCKED = (0.0, 0.0, 0.0, -1.0)
 (
     _PARTICLES_BINDING,
@@ -119,6 +119,16 @@ def splat_batch(
     return SplatBatch(particles, indices[far_to_near(distances)].astype(np.uint32), eye, time_s)
 
 
+#: a batch's instances start at a multiple of this many slots: 256 bytes, the largest offset alignment of a
+#: storage buffer range GL allows, so that any batch's can be bound alone
+_SLOT_ALIGNMENT = 256 // INSTANCE_BYTES
+
+
+def _slots(count: int) -> int:
+    """Slots a batch of `count` particles takes, its start aligned."""
+    return -(-count // _SLOT_ALIGNMENT) * _SLOT_ALIGNMENT
+
+
 #: splat_shade.comp.glsl's optional code, in the order of a variant's key: sprites that do not lie in the
 #: image plane, Wang's artist colours, Yusov's eye-pass profiles
 _SHADE_FEATURES = ("FACING", "ARTIST", "PROFILES")
@@ -163,7 +173,12 @@ class SplatPass:
         ) = self._buffers = GL.glGenBuffers(8)
         self._atlas: int | None = None  # the sprite atlas texture, made when a cloud first needs it
         self._quads_indexed = 0
-        self._instance_capacity = 0
+        self._instance_capacity = 0  # slots
+        #: the batches the pass shaded ahead (`shade_ahead`): id -> (first slot, the view they were shaded
+        #: for, the batch, kept so that its id stays its own); and the slots they fill, after which any
+        #: other batch is shaded as it is drawn
+        self._shaded: dict[int, tuple[int, np.ndarray, SplatBatch]] = {}
+        self._slots_ahead = 0
         self._resident: ParticleBuffer | None = None
         self._formation_time: tuple | None = None  # (time, weights serial) of the held opacity factors
 
@@ -184,7 +199,7 @@ class SplatPass:
         """
         if not len(batch):
             return 0
-        self.shade(batch, view)
+        _, first = self.shade(batch, view)
         view_rotation = np.array(view, dtype=np.float64)
         view_rotation[:3, 3] = 0.0  # corners come relative to the batch's eye, the view's own
         pieces, target_viewport = [(0, len(batch), False)], None
@@ -220,10 +235,12 @@ class SplatPass:
             for start, stop, as_points in pieces:
                 GL.glUseProgram(programs[as_points])
                 if as_points:
-                    GL.glDrawArrays(GL.GL_POINTS, start, stop - start)
+                    GL.glDrawArrays(GL.GL_POINTS, first + start, stop - start)
                 else:
-                    offset = ctypes.c_void_p(6 * 4 * start)  # six uint32 indices a particle
-                    GL.glDrawElements(GL.GL_TRIANGLES, 6 * (stop - start), GL.GL_UNSIGNED_INT, offset)
+                    offset = ctypes.c_void_p(6 * 4 * start)  # six uint32 indices a particle, four vertices
+                    GL.glDrawElementsBaseVertex(
+                        GL.GL_TRIANGLES, 6 * (stop - start), GL.GL_UNSIGNED_INT, offset, 4 * first
+                    )
         GL.glDisable(GL.GL_PROGRAM_POINT_SIZE)
         GL.glBindVertexArray(0)
         if target_viewport is not None:
@@ -258,17 +275,65 @@ class SplatPass:
         GL.glBufferSubData(GL.GL_SHADER_STORAGE_BUFFER, start * records.itemsize * 4, records.nbytes, records)
         GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, 0)
 
-    def shade(self, batch: SplatBatch, view: np.ndarray) -> int:
-        """Run the compute shader: the batch's quads and colours for its eye, in its order; returns the
-        storage buffer holding them (the volume-aware blending pass reads them too)."""
+    def shade_ahead(self, batches_and_views) -> None:
+        """Shade the (batch, view) pairs a pass will draw, one after the other before any of its draws, and
+        forget those shaded before: `draw` and `shade` then find them shaded.
+
+        The compute shader's results need a memory barrier before a draw reads them, and llvmpipe makes
+        each barrier a glFinish: shaded draw by draw, every batch waited for the draws before it.
+        """
+        self._shaded, self._slots_ahead = {}, 0
+        batches_and_views = [(batch, view) for batch, view in batches_and_views if len(batch)]
+        if not batches_and_views:
+            return
+        self._reserve(sum(_slots(len(batch)) for batch, _ in batches_and_views), keep=False)
+        for batch, view in batches_and_views:
+            self._dispatch(batch, view, self._slots_ahead)
+            self._shaded[id(batch)] = (self._slots_ahead, np.array(view, dtype=np.float64), batch)
+            self._slots_ahead += _slots(len(batch))
+        GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT)
+
+    def shade(self, batch: SplatBatch, view: np.ndarray) -> tuple[int, int]:
+        """(the storage buffer holding the batch's quads and colours for its eye, in its order, the slot of
+        its first): those `shade_ahead` made, else shaded now after them (the volume-aware blending pass
+        reads them too)."""
+        shaded = self._shaded.get(id(batch))
+        if shaded is not None and np.array_equal(shaded[1], view):
+            return self._instance_buffer, shaded[0]
+        self._reserve(self._slots_ahead + _slots(len(batch)), keep=True)
+        self._dispatch(batch, view, self._slots_ahead)
+        GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT)
+        return self._instance_buffer, self._slots_ahead
+
+    def _reserve(self, slots: int, keep: bool) -> None:
+        """Room for `slots` instances (and their order), growing geometrically; `keep`: with the instances
+        shaded so far, which draws to come may still read."""
+        if slots <= self._instance_capacity:
+            return
+        capacity = max(slots, 2 * self._instance_capacity)
+        grown = GL.glGenBuffers(1)
+        GL.glBindBuffer(GL.GL_COPY_WRITE_BUFFER, grown)
+        GL.glBufferData(GL.GL_COPY_WRITE_BUFFER, capacity * INSTANCE_BYTES, None, GL.GL_DYNAMIC_COPY)
+        if keep and self._slots_ahead:
+            GL.glBindBuffer(GL.GL_COPY_READ_BUFFER, self._instance_buffer)
+            GL.glCopyBufferSubData(
+                GL.GL_COPY_READ_BUFFER, GL.GL_COPY_WRITE_BUFFER, 0, 0, self._slots_ahead * INSTANCE_BYTES
+            )
+        GL.glDeleteBuffers(1, [self._instance_buffer])
+        self._instance_buffer = grown
+        self._buffers = (*self._buffers[:2], grown, *self._buffers[3:])
+        GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, self._order_buffer)
+        GL.glBufferData(GL.GL_SHADER_STORAGE_BUFFER, capacity * 4, None, GL.GL_STREAM_DRAW)
+        GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, 0)
+        self._instance_capacity = capacity
+
+    def _dispatch(self, batch: SplatBatch, view: np.ndarray, first: int) -> None:
+        """Shade `batch` for `view` into the slots from `first` on (room reserved)."""
         self._make_resident(batch.particles)
         self._hold_formation(batch.particles, batch.time_s)
-        _store(self._order_buffer, batch.order, GL.GL_STREAM_DRAW)
-        needed = len(batch) * _INSTANCE_BYTES
-        if needed > self._instance_capacity:
-            GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, self._instance_buffer)
-            GL.glBufferData(GL.GL_SHADER_STORAGE_BUFFER, needed, None, GL.GL_DYNAMIC_COPY)
-            self._instance_capacity = needed
+        GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, self._order_buffer)
+        GL.glBufferSubData(GL.GL_SHADER_STORAGE_BUFFER, first * 4, batch.order.nbytes, batch.order)
+        GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, 0)
         for binding, buffer in (
             (_PARTICLES_BINDING, self._particle_buffer),
             (_FORMATION_BINDING, self._formation_buffer),
@@ -281,12 +346,11 @@ class SplatPass:
             GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, binding, buffer)
         program, uniforms = self._shade_program(batch)
         GL.glUseProgram(program)
+        GL.glUniform1ui(uniforms["first"], first)
         GL.glUniform1ui(uniforms["count"], len(batch))
         for name, value in (("eye", batch.eye), ("view_right", view[0, :3]), ("view_up", view[1, :3])):
             set_vec3_at(uniforms[name], value)
         GL.glDispatchCompute(-(-len(batch) // _SHADE_GROUP), 1, 1)
-        GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT)
-        return self._instance_buffer
 
     def _make_resident(self, particles: ParticleBuffer) -> None:
         """Upload the particles' shading terms, styles and unlocked facings when the particles change."""
@@ -324,7 +388,7 @@ class SplatPass:
             )
             self._shade_programs[features] = [
                 program,
-                uniform_locations(program, ("count", "eye", "view_right", "view_up")),
+                uniform_locations(program, ("first", "count", "eye", "view_right", "view_up")),
                 None,
             ]
         held = self._shade_programs[features]

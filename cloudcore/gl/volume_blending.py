@@ -18,7 +18,7 @@ import numpy as np
 from OpenGL import GL
 
 from cloudcore.gl.programs import build_compute_program, set_vec3
-from cloudcore.gl.splats import SplatBatch
+from cloudcore.gl.splats import INSTANCE_BYTES, SplatBatch
 from cloudcore.gl.targets import blit_depth
 from cloudcore.light.kernel import SPLAT_SHARPNESS
 from cloudcore.light.volume_blending import MAX_OPTICAL_DEPTH, TILE_PIXELS, ScreenTiles, Splats
@@ -67,13 +67,13 @@ class VolumeBlendingPass:
     def draw(
         self,
         tiles: ScreenTiles,
-        instances: int,
+        instances: tuple[int, int, int],
         view: np.ndarray,
         projection: np.ndarray,
         colour_texture: int,
         depth_framebuffer: int,
     ) -> None:
-        """Composite the splats binned in `tiles` (their instances in buffer `instances`) over
+        """Composite the splats binned in `tiles` (their instances: (buffer, first slot, count)) over
         `colour_texture` (RGBA16F, the size of `tiles`), cut by the depth of `depth_framebuffer`.
         Leaves the framebuffer that was bound bound."""
         occupied = tiles.occupied
@@ -91,7 +91,10 @@ class VolumeBlendingPass:
             GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, buffer)
             GL.glBufferData(GL.GL_SHADER_STORAGE_BUFFER, data.nbytes, np.ascontiguousarray(data), GL.GL_STREAM_DRAW)
             GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, binding, buffer)
-        GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _INSTANCES_BINDING, instances)
+        buffer, first, count = instances
+        GL.glBindBufferRange(
+            GL.GL_SHADER_STORAGE_BUFFER, _INSTANCES_BINDING, buffer, first * INSTANCE_BYTES, count * INSTANCE_BYTES
+        )
         program = self._program
         GL.glUseProgram(program)
         GL.glUniform2i(GL.glGetUniformLocation(program, "size"), *tiles.size)

@@ -61,6 +61,7 @@ layout(std430, binding = 5) readonly buffer Facing { vec4 facing[]; };  // locke
 // rows of Yusov's eye pass: single then multiple scattering at profile_samples mu from -1 to 1
 layout(std430, binding = 6) readonly buffer Profiles { float profiles[]; };
 
+uniform uint first;  // the batch's first slot in the order and instance buffers (a pass shades its batches in one)
 uniform uint count;
 uniform vec3 eye;
 uniform vec3 view_right;  // the image plane's axes in the world, for splats
@@ -142,9 +143,9 @@ vec4 artist_colour(CloudStyle style, vec3 vertex, vec3 group_centre)
 
 void main()
 {
-    uint slot = gl_GlobalInvocationID.x;
-    if (slot >= count)
+    if (gl_GlobalInvocationID.x >= count)
         return;
+    uint slot = first + gl_GlobalInvocationID.x;
     uint index = order[slot];
     Particle p = particles[index];
     CloudStyle style = clouds[int(p.group_cloud.w)];
