@@ -137,3 +137,13 @@ def test_the_plan_predicts_the_work_it_schedules():
     assert p.cloud_work.particles == 1000 and p.update_work == Work()
     assert p.predicted_ms == pytest.approx(FILL_BOUND.ms(p.cloud_work))
     assert isinstance(p.state, LodState) and p.state.eye == (0.0, 0.0, 1000.0)
+
+
+def test_a_cost_model_prices_each_field_of_work_by_its_own_coefficient():
+    """`CostModel.ms` pairs coefficients and counts by name: the two classes must have the same fields."""
+    assert [f.name for f in dataclasses.fields(CostModel)] == [f.name for f in dataclasses.fields(Work)]
+    names = [f.name for f in dataclasses.fields(Work)]
+    for index, name in enumerate(names):
+        model = CostModel(**{n: 10.0 ** (k + 1) for k, n in enumerate(names)})
+        assert model.ms(Work(**{name: 2.0})) == 2.0 * 10.0 ** (index + 1)
+    assert (Work(particles=1.0, quads=2.0) + Work(quads=3.0)).scaled(2.0) == Work(particles=2.0, quads=10.0)
