@@ -311,17 +311,17 @@ class SplatPass:
         if slots <= self._instance_capacity:
             return
         capacity = max(slots, 2 * self._instance_capacity)
-        grown = GL.glGenBuffers(1)
-        GL.glBindBuffer(GL.GL_COPY_WRITE_BUFFER, grown)
-        GL.glBufferData(GL.GL_COPY_WRITE_BUFFER, capacity * INSTANCE_BYTES, None, GL.GL_DYNAMIC_COPY)
-        if keep and self._slots_ahead:
-            GL.glBindBuffer(GL.GL_COPY_READ_BUFFER, self._instance_buffer)
-            GL.glCopyBufferSubData(
-                GL.GL_COPY_READ_BUFFER, GL.GL_COPY_WRITE_BUFFER, 0, 0, self._slots_ahead * INSTANCE_BYTES
-            )
-        GL.glDeleteBuffers(1, [self._instance_buffer])
-        self._instance_buffer = grown
-        self._buffers = (*self._buffers[:2], grown, *self._buffers[3:])
+        kept = self._slots_ahead * INSTANCE_BYTES if keep else 0
+        # the buffer keeps its name (draws and the volume pass bind it by name): what is kept goes through a
+        # scratch copy while it is reallocated; growing happens a few times a session
+        scratch = GL.glGenBuffers(1) if kept else None
+        if kept:
+            _copy_buffer(self._instance_buffer, scratch, kept, allocate=True)
+        GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, self._instance_buffer)
+        GL.glBufferData(GL.GL_SHADER_STORAGE_BUFFER, capacity * INSTANCE_BYTES, None, GL.GL_DYNAMIC_COPY)
+        if kept:
+            _copy_buffer(scratch, self._instance_buffer, kept, allocate=False)
+            GL.glDeleteBuffers(1, [scratch])
         GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, self._order_buffer)
         GL.glBufferData(GL.GL_SHADER_STORAGE_BUFFER, capacity * 4, None, GL.GL_STREAM_DRAW)
         GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, 0)
@@ -496,6 +496,17 @@ def _set_light_uniforms(program: int, particles: ParticleBuffer) -> None:
         )
     GL.glUniform1i(GL.glGetUniformLocation(program, "phase_kind"), PHASE_NAMES.index(particles.phase))
     GL.glUniform1f(GL.glGetUniformLocation(program, "g"), float(particles.g))
+
+
+def _copy_buffer(source: int, destination: int, size: int, allocate: bool) -> None:
+    """Copy the first `size` bytes of buffer `source` into `destination` (first given that size: `allocate`)."""
+    GL.glBindBuffer(GL.GL_COPY_READ_BUFFER, source)
+    GL.glBindBuffer(GL.GL_COPY_WRITE_BUFFER, destination)
+    if allocate:
+        GL.glBufferData(GL.GL_COPY_WRITE_BUFFER, size, None, GL.GL_STREAM_COPY)
+    GL.glCopyBufferSubData(GL.GL_COPY_READ_BUFFER, GL.GL_COPY_WRITE_BUFFER, 0, 0, size)
+    GL.glBindBuffer(GL.GL_COPY_READ_BUFFER, 0)
+    GL.glBindBuffer(GL.GL_COPY_WRITE_BUFFER, 0)
 
 
 def _store(buffer: int, data: np.ndarray, usage=GL.GL_STATIC_DRAW) -> None:

@@ -507,8 +507,7 @@ def _plan_units(
         frustum (the renderer leaves out the rest), their discs clipped to the screen."""
         if cloud_splats is None or distance >= NEAR_EXACT_RADII * radius:
             return Work(particles=float(units.particle_counts[index]), fragments=float(ball_fragments[index]))
-        splats = [cloud_splats(c) for c in units.members[index]]
-        splat_centres, splat_radii = np.concatenate([c for c, _ in splats]), np.concatenate([r for _, r in splats])
+        splat_centres, splat_radii = splats_of(index)
         seen = splats_in_frustum(planes, splat_centres, splat_radii)
         fragments = screen_pixels * analytic_overdraw(
             splat_centres[seen], splat_radii[seen], view, projection, NEAR_PLANE_M
