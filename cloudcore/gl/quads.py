@@ -70,6 +70,25 @@ class QuadPass:
             GL.glDrawArrays(GL.GL_TRIANGLE_STRIP, 0, 4)
             GL.glBindVertexArray(0)
 
+    def draw_run(self, quads, view_projection: np.ndarray, *, counting: bool = False) -> None:
+        """`draw` for a run of depth-tested world-space quads, each (corners, texture, weight, uv_rect): the
+        program, the matrix and the blending set once for all."""
+        program = self._counting_program if counting else self._program
+        uniforms = self._uniforms[program]
+        GL.glUseProgram(program)
+        set_matrix_at(uniforms["view_projection"], view_projection)
+        GL.glActiveTexture(GL.GL_TEXTURE0)
+        corners_at, uv_at, weight_at = uniforms["corners"], uniforms["uv_rect"], uniforms["impostor_weight"]
+        with cloud_blending(True, counting):
+            GL.glBindVertexArray(self.vertex_array)
+            for corners, texture, weight, (u0, v0, u1, v1) in quads:
+                GL.glUniform3fv(corners_at, 4, corners)
+                GL.glUniform4f(uv_at, u0, v0, u1, v1)
+                GL.glUniform1f(weight_at, weight)
+                GL.glBindTexture(GL.GL_TEXTURE_2D, texture)
+                GL.glDrawArrays(GL.GL_TRIANGLE_STRIP, 0, 4)
+            GL.glBindVertexArray(0)
+
     def close(self) -> None:
         for program in self._uniforms:
             GL.glDeleteProgram(program)
