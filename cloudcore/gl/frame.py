@@ -472,10 +472,12 @@ class FrameRenderer:
 
     def _draw_ring(self, frame: _CloudPassFrame, elevation_deg: float) -> None:
         """Wang's ring: the panels of the generations drawn (two while a rebuilt one fades in)."""
+        quads = []
         for generation, weight in frame.plan.ring.draws:
             for segment in generation.occupied_segments:
                 target, corners, extent = self._impostors.ring_panel(generation, segment, elevation_deg)
-                self._draw_quad(frame, corners, target.texture, weight, uv_rect=extent)
+                quads.append((np.asarray(corners, dtype=np.float32), target.texture, float(weight), extent))
+        self._draw_quad_run(frame, quads)
 
     def _draw_impostors(self, frame: _CloudPassFrame, items) -> None:
         """Units' impostors (a layer each, when split around objects) as quads, consecutive in the pass."""
@@ -484,6 +486,10 @@ class FrameRenderer:
             cloud = frame.plan.clouds[item.index]
             target, corners, extent = self._impostors.cloud_impostor(cloud.members, item.layer)
             quads.append((np.asarray(corners, dtype=np.float32), target.texture, float(cloud.impostor_weight), extent))
+        self._draw_quad_run(frame, quads)
+
+    def _draw_quad_run(self, frame: _CloudPassFrame, quads) -> None:
+        """World-space quads (corners, texture, weight, uv_rect), depth-tested, one after the other."""
         self._quads.draw_run(quads, frame.view_projection)
         self._replay.append(lambda: self._quads.draw_run(quads, frame.view_projection, counting=True))
 
