@@ -44,14 +44,16 @@ def plain_splats(styles: ParticleStyles) -> np.ndarray:
     return per_cloud[styles.cloud_index] & (styles.sprite_index < 0)
 
 
-def guard_band(projection: np.ndarray, viewport: tuple[int, int], margin_px: float) -> tuple[np.ndarray, tuple]:
+def guard_band(
+    projection: np.ndarray, viewport: tuple[int, int, int, int], margin_px: float
+) -> tuple[np.ndarray, tuple]:
     """(projection, (x, y, width, height) viewport) mapping the world to the same pixels as `projection`
-    in a (width, height) target, with the clip volume `margin_px` wider on every side."""
-    width, height = viewport
+    in the viewport (x, y, width, height), with the clip volume `margin_px` wider on every side."""
+    x, y, width, height = map(int, viewport)
     margin = int(np.ceil(margin_px))
     wide, tall = width + 2 * margin, height + 2 * margin
     guarded = np.diag([width / wide, height / tall, 1.0, 1.0]) @ projection
-    return guarded, (-margin, -margin, wide, tall)
+    return guarded, (x - margin, y - margin, wide, tall)
 
 
 def point_sprite_mask(

@@ -282,7 +282,7 @@ class FrameRenderer:
     @property
     def texture_bytes(self) -> int:
         """GPU memory of every impostor, ring, layer and screen-impostor texture held."""
-        held = self._impostors.pool.bytes_total
+        held = self._impostors.texture_bytes
         for target in (self._layer, *(target for target, _ in self._inside)):
             held += target.nbytes if target is not None else 0
         return held
@@ -397,8 +397,7 @@ class FrameRenderer:
             elif kind == "inside":
                 if id(item) in screen_impostors:  # the rest of its run is in the same screen impostor
                     target, particles_drawn = screen_impostors[id(item)]
-                    weight = plan.clouds[item.index].full_weight
-                    self._draw_quad(frame, SCREEN_CORNERS, target.texture, weight, screen=True)
+                    self._draw_screen_quad(target.texture, plan.clouds[item.index].full_weight)
                     drawn += particles_drawn
             elif kind == "impostors":
                 self._draw_impostors(frame, item)
@@ -460,14 +459,11 @@ class FrameRenderer:
         self._screen_batches.append(batch)
         return len(batch)
 
-    def _draw_quad(
-        self, frame: _CloudPassFrame, corners, texture, weight, *, screen=False, uv_rect=(0.0, 0.0, 1.0, 1.0), **layer
-    ) -> None:
-        """A world-space quad, depth-tested; or with `screen`, clip-space corners over everything."""
-        matrix, depth_test = (np.eye(4), False) if screen else (frame.view_projection, True)
-        self._quads.draw(corners, matrix, texture, weight, depth_test=depth_test, uv_rect=uv_rect, **layer)
+    def _draw_screen_quad(self, texture, weight) -> None:
+        """A screen impostor: `texture` over the whole screen, over everything."""
+        self._quads.draw(SCREEN_CORNERS, np.eye(4), texture, weight, depth_test=False)
         self._replay.append(
-            lambda: self._quads.draw(corners, matrix, 0, 1.0, depth_test=depth_test, counting=True, uv_rect=uv_rect)
+            lambda: self._quads.draw(SCREEN_CORNERS, np.eye(4), 0, 1.0, depth_test=False, counting=True)
         )
 
     def _draw_ring(self, frame: _CloudPassFrame, elevation_deg: float) -> None:
@@ -480,13 +476,24 @@ class FrameRenderer:
         self._draw_quad_run(frame, quads)
 
     def _draw_impostors(self, frame: _CloudPassFrame, items) -> None:
-        """Units' impostors (a layer each, when split around objects) as quads, consecutive in the pass."""
-        quads = []
+        """Units' impostors (a layer each, when split around objects), consecutive in the pass: one instanced
+        draw from the atlas (two, where larger impostors than its layers' side need one of their own)."""
+        runs = []  # [atlas, instances]: consecutive quads from one atlas
         for item in items:
             cloud = frame.plan.clouds[item.index]
-            target, corners, extent = self._impostors.cloud_impostor(cloud.members, item.layer)
-            quads.append((np.asarray(corners, dtype=np.float32), target.texture, float(cloud.impostor_weight), extent))
-        self._draw_quad_run(frame, quads)
+            image, corners, extent = self._impostors.cloud_impostor(cloud.members, item.layer)
+            if not runs or runs[-1][0] is not image.atlas:
+                runs.append([image.atlas, []])
+            runs[-1][1].append(image.instance(corners, cloud.impostor_weight, extent))
+        for atlas, instances in runs:
+            self._draw_instanced(frame, atlas.texture, np.stack(instances))
+
+    def _draw_instanced(self, frame: _CloudPassFrame, atlas_texture: int, instances: np.ndarray, **crossfade) -> None:
+        """Quads from the atlas (`QuadPass.draw_instanced`), depth-tested, in one draw."""
+        self._quads.draw_instanced(instances, frame.view_projection, atlas_texture, **crossfade)
+        self._replay.append(
+            lambda: self._quads.draw_instanced(instances, frame.view_projection, atlas_texture, counting=True)
+        )
 
     def _draw_quad_run(self, frame: _CloudPassFrame, quads) -> None:
         """World-space quads (corners, texture, weight, uv_rect), depth-tested, one after the other."""
@@ -496,19 +503,14 @@ class FrameRenderer:
     def _draw_crossfade(self, frame: _CloudPassFrame, item, cloud, batch: SplatBatch) -> int:
         """A unit between its impostor and full 3D: its splats (`batch`) into a screen layer, mixed with the
         impostor."""
-        target, corners, extent = self._impostors.cloud_impostor(cloud.members, item.layer)
+        image, corners, extent = self._impostors.cloud_impostor(cloud.members, item.layer)
         layer = self._screen_layer()
         layer.bind_cleared()
         drawn = self._draw_splats(frame, batch, layer.texture)
         self.context.bind_target()
-        self._draw_quad(
-            frame,
-            corners,
-            target.texture,
-            cloud.impostor_weight,
-            uv_rect=extent,
-            layer_texture=layer.texture,
-            layer_weight=cloud.full_weight,
+        instance = image.instance(corners, cloud.impostor_weight, extent)[None]
+        self._draw_instanced(
+            frame, image.atlas.texture, instance, layer_texture=layer.texture, layer_weight=cloud.full_weight
         )
         return drawn
 

@@ -3,35 +3,44 @@
 A unit's impostor (one cloud, or a group of interpenetrating clouds sorted
 together: `cloudcore.lod.units`) is rendered from the eye recorded in the
 plan's impostor cache, through the tight frustum of
-`cloudcore.lod.impostors.impostor_view`; ring segments from their generation's
-eye (`cloudcore.lod.ring`).  Textures come from one `TexturePool`; those of units
-or ring generations the plan no longer holds go back to it.  A unit split
-around objects has one texture per layer, each holding the particles of its
+`cloudcore.lod.impostors.impostor_view`, into a cell of the impostor atlas
+(`cloudcore.gl.impostor_atlas`: a run of them is then one draw); ring segments
+from their generation's eye (`cloudcore.lod.ring`) into textures of their own
+from one `TexturePool`, few and wide.  The cells of units and the textures of
+ring generations the plan no longer holds are given back.  A unit split
+around objects has one image per layer, each holding the particles of its
 depth range seen from the impostor's eye.
 """
 
 from __future__ import annotations
 
 import numpy as np
+from OpenGL import GL
 
+from cloudcore.gl.impostor_atlas import AtlasImage, ImpostorAtlas
 from cloudcore.gl.splats import SplatPass, splat_batch
 from cloudcore.gl.targets import TextureTarget
 from cloudcore.gl.texture_pool import TexturePool
 from cloudcore.light.eye_scattering import ParticleBuffer
+from cloudcore.lod.atlas import power_of_two_at_least
 from cloudcore.lod.frameplan import FramePlan
 from cloudcore.lod.impostors import ImpostorView, cropped_corners, impostor_view, particle_extent
 from cloudcore.lod.ring import RingGeneration, panel_corners, segment_camera
 from cloudcore.lod.splitting import layer_bounds
 from cloudcore.settings import RenderSettings
 
+#: the atlas layers' side: the default largest impostor, one layer 2 MiB; larger impostors get an atlas of their side
+ATLAS_LAYER_SIDE = 512
+
 
 class ImpostorStore:
     def __init__(self, splats: SplatPass):
         self._splats = splats
         self.pool = TexturePool()
-        #: unit members -> (textures of its layers far to near, the view they were made with, the part of
-        #: the textures its particles can cover: only that part of the quad is drawn)
-        self._clouds: dict[tuple, tuple[list[TextureTarget], ImpostorView, tuple]] = {}
+        self._atlases: dict[int, ImpostorAtlas] = {}  # layer side -> atlas
+        #: unit members -> (images of its layers far to near, the view they were made with, the part of
+        #: the images its particles can cover: only that part of the quad is drawn)
+        self._clouds: dict[tuple, tuple[list[AtlasImage], ImpostorView, tuple]] = {}
         self._ring: dict[tuple[RingGeneration, int], tuple[TextureTarget, tuple]] = {}  # (texture, extent)
 
     def update(self, plan: FramePlan, particles: ParticleBuffer, settings: RenderSettings, time_s: float) -> int:
@@ -43,7 +52,7 @@ class ImpostorStore:
                 continue
             record = plan.records[cloud.members]
             view = impostor_view(units.centres[cloud.index], units.radii[cloud.index], record.eye)
-            targets = self._cloud_targets(cloud.members, cloud.texture_size, len(record.splits) + 1)
+            targets = self._cloud_images(cloud.members, cloud.texture_size, len(record.splits) + 1)
             self._clouds[cloud.members] = (
                 targets,
                 view,
@@ -72,14 +81,22 @@ class ImpostorStore:
             # the clouds alone, no depth test: the texture holds their premultiplied colour and opacity
             target.bind_cleared()
             self._splats.draw(batch, view, projection, depth_test=False, point_sprites=settings.point_sprites)
+        GL.glDisable(GL.GL_SCISSOR_TEST)  # an atlas cell's
+        for side in [side for side, atlas in self._atlases.items() if not atlas.in_use]:
+            self._atlases.pop(side).close()
         live = {plan.ring_state.current, plan.ring_state.pending}
         for key in [key for key in self._ring if key[0] not in live]:
             self.pool.release(self._ring.pop(key)[0])
         return sum(len(batch) for _, batch, _, _ in renders)
 
-    def cloud_impostor(self, members: tuple, layer: int = 0) -> tuple[TextureTarget, np.ndarray, tuple]:
-        """(texture of layer `layer` of the unit of clouds `members`, the world corners of the part of its
-        quad that can show particles, the part of the texture they cover (u0, v0, u1, v1))."""
+    @property
+    def texture_bytes(self) -> int:
+        """GPU memory of the atlases and of the ring's textures, in use and idle."""
+        return self.pool.bytes_total + sum(atlas.nbytes for atlas in self._atlases.values())
+
+    def cloud_impostor(self, members: tuple, layer: int = 0) -> tuple[AtlasImage, np.ndarray, tuple]:
+        """(image of layer `layer` of the unit of clouds `members`, the world corners of the part of its
+        quad that can show particles, the part of the image they cover (u0, v0, u1, v1))."""
         targets, view, extent = self._clouds[members]
         return targets[layer], cropped_corners(view.corners, extent), extent
 
@@ -90,25 +107,35 @@ class ImpostorStore:
         target, extent = self._ring[generation, segment]
         return target, cropped_corners(panel_corners(generation, segment, elevation_deg), extent), extent
 
-    def _cloud_targets(self, members: tuple, size: int, layers: int) -> list[TextureTarget]:
-        """`layers` textures of side `size`, reusing the unit's where they fit."""
+    def _cloud_images(self, members: tuple, size: int, layers: int) -> list[AtlasImage]:
+        """`layers` atlas images of side `size`, reusing the unit's cells where they are of the size it needs."""
         held = self._clouds.pop(members, ([], None))[0]
-        kept = [target for target in held if target.width == size][:layers]
-        self._release([target for target in held if target not in kept])
-        return kept + [self.pool.acquire(size, size) for _ in range(layers - len(kept))]
+        atlas = self._atlas_for(size)
+        cell_side = atlas.layout.cell_side(size)
+        kept = [image for image in held if image.atlas is atlas and image.cell.side == cell_side][:layers]
+        self._release([image for image in held if image not in kept])
+        kept = [AtlasImage(atlas, image.cell, size) for image in kept]
+        return kept + [atlas.allocate(size) for _ in range(layers - len(kept))]
 
-    def _release(self, targets) -> None:
-        for target in targets:
-            self.pool.release(target)
+    def _atlas_for(self, size: int) -> ImpostorAtlas:
+        side = power_of_two_at_least(size, ATLAS_LAYER_SIDE)
+        if side not in self._atlases:
+            self._atlases[side] = ImpostorAtlas(side)
+        return self._atlases[side]
+
+    @staticmethod
+    def _release(images) -> None:
+        for image in images:
+            image.atlas.release(image)
 
     def close(self) -> None:
-        for targets, _, _ in self._clouds.values():
-            for target in targets:
-                target.close()
         for target, _ in self._ring.values():
             target.close()
+        for atlas in self._atlases.values():
+            atlas.close()
         self._clouds.clear()
         self._ring.clear()
+        self._atlases.clear()
         self.pool.close()
 
 

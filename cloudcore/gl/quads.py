@@ -2,24 +2,35 @@
 
 from __future__ import annotations
 
+import ctypes
+
 import numpy as np
 from OpenGL import GL
 
 from cloudcore.gl.blending import cloud_blending
+from cloudcore.gl.impostor_atlas import INSTANCE_FLOATS
 from cloudcore.gl.programs import build_program, set_matrix_at, uniform_locations
 
 #: clip-space corners of the whole screen, for screen impostors
 SCREEN_CORNERS = np.array([[-1, -1, 0], [1, -1, 0], [-1, 1, 0], [1, 1, 0]], dtype=np.float64)
 
+#: (location, floats) of the instance attributes of quad.vert.glsl's ATLAS variant, in `INSTANCE_FLOATS` order
+_INSTANCE_ATTRIBUTES = ((0, 3), (1, 3), (2, 3), (3, 3), (4, 4), (5, 4), (6, 2))
+
 
 class QuadPass:
     def __init__(self):
         self._program = build_program("quad")
-        self._crossfade_program = build_program("quad", {"CROSSFADE": 1})
         self._counting_program = build_program("quad", {"COUNT_FRAGMENTS": 1})
+        #: (crossfade, counting) -> the program drawing instances from the atlas
+        self._atlas_programs = {
+            (False, False): build_program("quad", {"ATLAS": 1}),
+            (True, False): build_program("quad", {"ATLAS": 1, "CROSSFADE": 1}),
+            (False, True): build_program("quad", {"ATLAS": 1, "COUNT_FRAGMENTS": 1}),
+        }
         #: per program, the locations of the uniforms every draw sets
         self._uniforms = {}
-        for program in (self._program, self._crossfade_program, self._counting_program):
+        for program in (self._program, self._counting_program, *self._atlas_programs.values()):
             GL.glUseProgram(program)
             GL.glUniform1i(GL.glGetUniformLocation(program, "impostor"), 0)
             GL.glUniform1i(GL.glGetUniformLocation(program, "layer"), 1)
@@ -29,6 +40,18 @@ class QuadPass:
         #: core profile draws nothing without a vertex array, even one with no attributes; shared
         #: with the other attribute-less passes
         self.vertex_array = GL.glGenVertexArrays(1)
+        self._instance_array, self._instance_buffer = GL.glGenVertexArrays(1), GL.glGenBuffers(1)
+        GL.glBindVertexArray(self._instance_array)
+        GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self._instance_buffer)
+        offset = 0
+        for location, floats in _INSTANCE_ATTRIBUTES:
+            GL.glEnableVertexAttribArray(location)
+            GL.glVertexAttribPointer(
+                location, floats, GL.GL_FLOAT, GL.GL_FALSE, 4 * INSTANCE_FLOATS, ctypes.c_void_p(4 * offset)
+            )
+            GL.glVertexAttribDivisor(location, 1)
+            offset += floats
+        GL.glBindVertexArray(0)
 
     def draw(
         self,
@@ -37,59 +60,66 @@ class QuadPass:
         texture: int,
         impostor_weight: float,
         *,
-        layer_texture: int | None = None,
-        layer_weight: float = 0.0,
         depth_test: bool = True,
         counting: bool = False,
         uv_rect=(0.0, 0.0, 1.0, 1.0),
     ) -> None:
         """Blend `texture` (premultiplied) over the bound target on the quad `corners` (4, 3), which show
         the part `uv_rect` (u0, v0, u1, v1) of the texture."""
-        program = (
-            self._counting_program
-            if counting
-            else self._crossfade_program
-            if layer_texture is not None
-            else self._program
-        )
-        uniforms = self._uniforms[program]
-        GL.glUseProgram(program)
-        GL.glUniform3fv(uniforms["corners"], 4, np.ascontiguousarray(corners, dtype=np.float32))
-        set_matrix_at(uniforms["view_projection"], view_projection)
-        GL.glUniform4f(uniforms["uv_rect"], *map(float, uv_rect))
-        GL.glUniform1f(uniforms["impostor_weight"], float(impostor_weight))
-        GL.glUniform1f(uniforms["layer_weight"], float(layer_weight))
-        GL.glActiveTexture(GL.GL_TEXTURE0)
-        GL.glBindTexture(GL.GL_TEXTURE_2D, texture)
-        if layer_texture is not None:
-            GL.glActiveTexture(GL.GL_TEXTURE1)
-            GL.glBindTexture(GL.GL_TEXTURE_2D, layer_texture)
-            GL.glActiveTexture(GL.GL_TEXTURE0)
-        with cloud_blending(depth_test, counting):
-            GL.glBindVertexArray(self.vertex_array)
-            GL.glDrawArrays(GL.GL_TRIANGLE_STRIP, 0, 4)
-            GL.glBindVertexArray(0)
+        self.draw_run([(corners, texture, impostor_weight, uv_rect)], view_projection, depth_test, counting=counting)
 
-    def draw_run(self, quads, view_projection: np.ndarray, *, counting: bool = False) -> None:
-        """`draw` for a run of depth-tested world-space quads, each (corners, texture, weight, uv_rect): the
-        program, the matrix and the blending set once for all."""
+    def draw_run(self, quads, view_projection: np.ndarray, depth_test: bool = True, *, counting: bool = False) -> None:
+        """`draw` for a run of quads, each (corners, texture, weight, uv_rect): the program, the matrix and the
+        blending set once for all."""
         program = self._counting_program if counting else self._program
         uniforms = self._uniforms[program]
         GL.glUseProgram(program)
         set_matrix_at(uniforms["view_projection"], view_projection)
         GL.glActiveTexture(GL.GL_TEXTURE0)
         corners_at, uv_at, weight_at = uniforms["corners"], uniforms["uv_rect"], uniforms["impostor_weight"]
-        with cloud_blending(True, counting):
+        with cloud_blending(depth_test, counting):
             GL.glBindVertexArray(self.vertex_array)
             for corners, texture, weight, (u0, v0, u1, v1) in quads:
-                GL.glUniform3fv(corners_at, 4, corners)
+                GL.glUniform3fv(corners_at, 4, np.ascontiguousarray(corners, dtype=np.float32))
                 GL.glUniform4f(uv_at, u0, v0, u1, v1)
                 GL.glUniform1f(weight_at, weight)
                 GL.glBindTexture(GL.GL_TEXTURE_2D, texture)
                 GL.glDrawArrays(GL.GL_TRIANGLE_STRIP, 0, 4)
             GL.glBindVertexArray(0)
 
+    def draw_instanced(
+        self,
+        instances: np.ndarray,
+        view_projection: np.ndarray,
+        atlas_texture: int,
+        *,
+        counting: bool = False,
+        layer_texture: int | None = None,
+        layer_weight: float = 0.0,
+    ) -> None:
+        """Depth-tested world-space quads from the impostor atlas in one draw, one instance (`INSTANCE_FLOATS`
+        float32, `cloudcore.gl.impostor_atlas.AtlasImage.instance`) a row of `instances`, blended in row
+        order; with `layer_texture`, a crossfade: each adds `layer_weight` times that screen layer."""
+        program = self._atlas_programs[layer_texture is not None and not counting, counting]
+        uniforms = self._uniforms[program]
+        GL.glUseProgram(program)
+        set_matrix_at(uniforms["view_projection"], view_projection)
+        GL.glUniform1f(uniforms["layer_weight"], float(layer_weight))
+        if layer_texture is not None:
+            GL.glActiveTexture(GL.GL_TEXTURE1)
+            GL.glBindTexture(GL.GL_TEXTURE_2D, layer_texture)
+        GL.glActiveTexture(GL.GL_TEXTURE0)
+        GL.glBindTexture(GL.GL_TEXTURE_2D_ARRAY, atlas_texture)
+        data = np.ascontiguousarray(instances, dtype=np.float32)
+        GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self._instance_buffer)
+        GL.glBufferData(GL.GL_ARRAY_BUFFER, data.nbytes, data, GL.GL_STREAM_DRAW)
+        with cloud_blending(True, counting):
+            GL.glBindVertexArray(self._instance_array)
+            GL.glDrawArraysInstanced(GL.GL_TRIANGLE_STRIP, 0, 4, len(data))
+            GL.glBindVertexArray(0)
+
     def close(self) -> None:
         for program in self._uniforms:
             GL.glDeleteProgram(program)
-        GL.glDeleteVertexArrays(1, [self.vertex_array])
+        GL.glDeleteVertexArrays(2, [self.vertex_array, self._instance_array])
+        GL.glDeleteBuffers(1, [self._instance_buffer])

@@ -207,7 +207,7 @@ class SplatPass:
         if plain is not None and plain.any():
             # the same pixels through a clip volume wider than the target (cloudcore.point_sprites)
             target_viewport = GL.glGetIntegerv(GL.GL_VIEWPORT)
-            projection, viewport = guard_band(projection, target_viewport[2:], self._point_sizes_px[1])
+            projection, viewport = guard_band(projection, target_viewport, self._point_sizes_px[1])
             size = (int(viewport[2]), int(viewport[3]))
             fit = point_sprite_mask(
                 batch.centres - batch.eye, batch.radii, view_rotation, projection, size, self._point_sizes_px

@@ -34,7 +34,7 @@ class Work:
     fragments: float = 0.0  # splat fragments blended on the screen (estimated: `splat_fragments`)
     texture_fragments: float = 0.0  # splat fragments blended into impostor textures (estimated likewise)
     quad_pixels: float = 0.0  # pixels of impostor quads, ring panels and crossfade layers drawn
-    quads: float = 0.0  # those quads drawn: a draw call each, whatever its pixels
+    quads: float = 0.0  # those quads drawn, whatever their pixels: an instance of a run's draw, or a draw call
     regenerations: float = 0.0  # impostor textures (or ring segments) remade: target switch, clear, draw call
     batches: float = 0.0  # splat draws of the cloud pass: an upload of the order, a dispatch, a draw call
 

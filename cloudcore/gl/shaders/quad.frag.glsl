@@ -6,11 +6,18 @@
 // crossfade neither brightens nor darkens.  Only the CROSSFADE variant reads the
 // layer: behind a branch on a uniform, llvmpipe paid for the fetch on every
 // quad that never took it (7% of the flythrough's clouds, docs/performance.md).
-// COUNT_FRAGMENTS writes 1 instead.
+// ATLAS samples a layer of the impostor atlas within the instance's cell, its
+// weight per instance.  COUNT_FRAGMENTS writes 1 instead.
 
+#ifdef ATLAS
+uniform sampler2DArray impostor;
+flat in vec4 clamp_rect;
+flat in vec2 weight_layer;
+#else
 uniform sampler2D impostor;
-uniform sampler2D layer;
 uniform float impostor_weight;
+#endif
+uniform sampler2D layer;
 uniform float layer_weight;
 
 in vec2 uv;
@@ -21,7 +28,11 @@ void main()
 #ifdef COUNT_FRAGMENTS
     frag_colour = vec4(1.0);
 #else
+#ifdef ATLAS
+    vec4 colour = weight_layer.x * texture(impostor, vec3(clamp(uv, clamp_rect.xy, clamp_rect.zw), weight_layer.y));
+#else
     vec4 colour = impostor_weight * texture(impostor, uv);
+#endif
 #ifdef CROSSFADE
     colour += layer_weight * texelFetch(layer, ivec2(gl_FragCoord.xy), 0);
 #endif

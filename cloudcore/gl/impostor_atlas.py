@@ -1,0 +1,130 @@
+"""The impostors' array texture: cells of `cloudcore.lod.atlas` rendered into and drawn from one texture.
+
+One GL_TEXTURE_2D_ARRAY (RGBA16F, premultiplied linear colour) follows its
+layout's layer count, copying the layers it keeps when it is resized.  An
+impostor of side s lives in the lower left s x s texels of its cell; a quad
+drawn from it samples within those texels only, clamped half a texel inside
+them: exactly what CLAMP_TO_EDGE gave an impostor texture of its own, so the
+picture does not change and no neighbour bleeds in.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from OpenGL import GL
+
+from cloudcore.lod.atlas import AtlasLayout, Cell
+
+_TEXEL_BYTES = 8  # RGBA16F
+
+#: floats of one quad's instance in `QuadPass.draw_instanced`: four corners, uv and clamp rectangles, weight, layer
+INSTANCE_FLOATS = 22
+
+
+class ImpostorAtlas:
+    def __init__(self, layer_side: int):
+        self.layout = AtlasLayout(layer_side)
+        self.texture, self._layers = None, 0
+        self._framebuffer, self._copy_framebuffer = GL.glGenFramebuffers(2)
+        self._bound_layer = None
+
+    @property
+    def layer_side(self) -> int:
+        return self.layout.layer_side
+
+    @property
+    def nbytes(self) -> int:
+        return self._layers * self.layer_side**2 * _TEXEL_BYTES
+
+    @property
+    def in_use(self) -> bool:
+        return self.layout.texels_in_use > 0
+
+    def allocate(self, side: int) -> AtlasImage:
+        image = AtlasImage(self, self.layout.allocate(side), side)
+        self._fit()
+        return image
+
+    def release(self, image: AtlasImage) -> None:
+        self.layout.release(image.cell)
+        self._fit()
+
+    def bind_cleared(self, cell: Cell, side: int) -> None:
+        """Draw into the side x side texels of `cell` from now on (viewport and scissor), cleared to transparent.
+
+        The scissor stays on: a point sprite whose centre is in the viewport may reach beyond it."""
+        GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, self._framebuffer)
+        if self._bound_layer != cell.layer:  # consecutive cells of one layer keep the attachment
+            GL.glFramebufferTextureLayer(GL.GL_FRAMEBUFFER, GL.GL_COLOR_ATTACHMENT0, self.texture, 0, cell.layer)
+            self._bound_layer = cell.layer
+        GL.glViewport(cell.x, cell.y, side, side)
+        GL.glEnable(GL.GL_SCISSOR_TEST)
+        GL.glScissor(cell.x, cell.y, side, side)
+        GL.glClearColor(0.0, 0.0, 0.0, 0.0)
+        GL.glClear(GL.GL_COLOR_BUFFER_BIT)
+
+    def read(self, cell: Cell, side: int) -> np.ndarray:
+        """The side x side texels of `cell` as float32 (side, side, 4), top row first."""
+        GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, self._copy_framebuffer)
+        GL.glFramebufferTextureLayer(GL.GL_READ_FRAMEBUFFER, GL.GL_COLOR_ATTACHMENT0, self.texture, 0, cell.layer)
+        GL.glPixelStorei(GL.GL_PACK_ALIGNMENT, 1)
+        data = GL.glReadPixels(cell.x, cell.y, side, side, GL.GL_RGBA, GL.GL_FLOAT)
+        return np.frombuffer(data, dtype=np.float32).reshape(side, side, 4)[::-1].copy()
+
+    def _fit(self) -> None:
+        """Resize the texture to the layout's layers, copying the layers both hold."""
+        if self.layout.layers == self._layers:
+            return
+        texture = GL.glGenTextures(1)
+        GL.glBindTexture(GL.GL_TEXTURE_2D_ARRAY, texture)
+        side = self.layer_side
+        GL.glTexStorage3D(GL.GL_TEXTURE_2D_ARRAY, 1, GL.GL_RGBA16F, side, side, self.layout.layers)
+        for name in (GL.GL_TEXTURE_MIN_FILTER, GL.GL_TEXTURE_MAG_FILTER):
+            GL.glTexParameteri(GL.GL_TEXTURE_2D_ARRAY, name, GL.GL_LINEAR)
+        for name in (GL.GL_TEXTURE_WRAP_S, GL.GL_TEXTURE_WRAP_T):
+            GL.glTexParameteri(GL.GL_TEXTURE_2D_ARRAY, name, GL.GL_CLAMP_TO_EDGE)
+        GL.glDisable(GL.GL_SCISSOR_TEST)
+        for layer in range(min(self._layers, self.layout.layers)):
+            GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, self._copy_framebuffer)
+            GL.glFramebufferTextureLayer(GL.GL_READ_FRAMEBUFFER, GL.GL_COLOR_ATTACHMENT0, self.texture, 0, layer)
+            GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, self._framebuffer)
+            GL.glFramebufferTextureLayer(GL.GL_DRAW_FRAMEBUFFER, GL.GL_COLOR_ATTACHMENT0, texture, 0, layer)
+            GL.glBlitFramebuffer(0, 0, side, side, 0, 0, side, side, GL.GL_COLOR_BUFFER_BIT, GL.GL_NEAREST)
+        if self.texture is not None:
+            GL.glDeleteTextures([self.texture])
+        self.texture, self._layers, self._bound_layer = texture, self.layout.layers, None
+
+    def close(self) -> None:
+        GL.glDeleteFramebuffers(2, [self._framebuffer, self._copy_framebuffer])
+        if self.texture is not None:
+            GL.glDeleteTextures([self.texture])
+        self.texture, self._layers = None, 0
+
+
+@dataclass(frozen=True)
+class AtlasImage:
+    """One impostor texture of side `side` in `cell` of `atlas`."""
+
+    atlas: ImpostorAtlas
+    cell: Cell
+    side: int
+
+    def bind_cleared(self) -> None:
+        self.atlas.bind_cleared(self.cell, self.side)
+
+    def read(self) -> np.ndarray:
+        return self.atlas.read(self.cell, self.side)
+
+    def instance(self, corners: np.ndarray, weight: float, extent) -> np.ndarray:
+        """The quad of world `corners` (4, 3) showing the part `extent` (u0, v0, u1, v1) of this image at
+        `weight`, as one instance of `QuadPass.draw_instanced`."""
+        scale, (x, y) = self.side / self.atlas.layer_side, (self.cell.x, self.cell.y)
+        origin = np.array([x, y, x, y], dtype=np.float64) / self.atlas.layer_side
+        uv_rect = origin + scale * np.asarray(extent, dtype=np.float64)
+        half = 0.5 / self.atlas.layer_side
+        clamp_rect = origin + np.array([half, half, scale - half, scale - half])
+        return np.concatenate(
+            [np.asarray(corners, dtype=np.float64).ravel(), uv_rect, clamp_rect, [weight, self.cell.layer]]
+        ).astype(np.float32)

@@ -1,0 +1,70 @@
+"""The impostor atlas on the GPU: cells keep their texels when the texture grows and shrinks, quads sample only
+their own cell, and a frame's impostors share it."""
+
+import types
+
+import numpy as np
+from conftest import VALLEY
+from OpenGL import GL
+
+from cloudcore.gl.impostor_atlas import INSTANCE_FLOATS, AtlasImage, ImpostorAtlas
+from cloudcore.lod.atlas import Cell
+from cloudcore.scenefile import load_scene
+from cloudcore.settings import RenderSettings
+
+
+def fill(image: AtlasImage, colour) -> None:
+    image.bind_cleared()
+    GL.glClearColor(*colour)
+    GL.glClear(GL.GL_COLOR_BUFFER_BIT)
+    GL.glDisable(GL.GL_SCISSOR_TEST)
+
+
+def test_cells_keep_their_texels_while_the_atlas_grows_and_shrinks(renderer):
+    renderer.context.make_current()
+    atlas = ImpostorAtlas(64)
+    try:
+        colours = [(0.1 * i, 0.2, 1.0 - 0.1 * i, 0.5) for i in range(5)]
+        images = []
+        for colour, side in zip(colours, (64, 20, 40, 64, 20)):
+            images.append(atlas.allocate(side))  # layers 1, 2, 4, 4, 4: two copies on the way
+            fill(images[-1], colour)
+        assert [image.cell.layer for image in images] == [0, 1, 2, 3, 1]
+        assert atlas.layout.layers == 4 and atlas.nbytes == 4 * 64 * 64 * 8
+        for image, colour in zip(images, colours):
+            np.testing.assert_allclose(image.read(), np.broadcast_to(colour, (image.side, image.side, 4)), atol=1e-3)
+        for image in (images[0], images[2], images[3]):
+            atlas.release(image)
+        assert atlas.layout.layers == 2  # the top half free, a quarter in use at most: halved, copied
+        for image, colour in zip((images[1], images[4]), (colours[1], colours[4])):
+            np.testing.assert_allclose(image.read(), np.broadcast_to(colour, (image.side, image.side, 4)), atol=1e-3)
+    finally:
+        atlas.close()
+
+
+def test_an_instance_samples_its_own_texels_clamped_half_a_texel_inside_them():
+    atlas = types.SimpleNamespace(layer_side=512)
+    image = AtlasImage(atlas, Cell(layer=3, y=256, x=128, side=128), side=100)
+    corners = np.arange(12.0).reshape(4, 3)
+    instance = image.instance(corners, 0.75, (0.0, 0.5, 1.0, 1.0))
+    assert instance.shape == (INSTANCE_FLOATS,) and instance.dtype == np.float32
+    np.testing.assert_array_equal(instance[:12], corners.ravel())
+    np.testing.assert_allclose(instance[12:16], np.array([128, 306, 228, 356]) / 512, rtol=1e-6)
+    np.testing.assert_allclose(instance[16:20], np.array([128.5, 256.5, 227.5, 355.5]) / 512, rtol=1e-6)
+    assert tuple(instance[20:]) == (0.75, 3.0)
+
+
+def test_a_frames_impostors_lie_in_separate_cells_of_one_atlas(renderer):
+    renderer.lod_state = type(renderer.lod_state)()
+    renderer.render(load_scene(VALLEY), settings=RenderSettings(mode="impostor"), read_back=False)
+    plan, store = renderer.last_plan, renderer._impostors  # the store's lookups are public, not its handle
+    images = [store.cloud_impostor(cloud.members)[0] for cloud in plan.of_kind("impostor")]
+    assert len(images) > 10 and len({id(image.atlas) for image in images}) == 1
+    cells = [image.cell for image in images]
+    assert len(set(cells)) == len(cells)
+    for a in cells:
+        for b in cells:
+            if a != b and a.layer == b.layer:
+                assert a.x >= b.x + b.side or b.x >= a.x + a.side or a.y >= b.y + b.side or b.y >= a.y + a.side
+    assert all(image.side <= image.cell.side for image in images)
+    assert renderer.texture_bytes >= images[0].atlas.nbytes > 0
