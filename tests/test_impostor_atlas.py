@@ -8,6 +8,7 @@ from conftest import VALLEY
 from OpenGL import GL
 
 from cloudcore.gl.impostor_atlas import INSTANCE_FLOATS, AtlasImage, ImpostorAtlas
+from cloudcore.gl.targets import TextureTarget
 from cloudcore.lod.atlas import Cell
 from cloudcore.scenefile import load_scene
 from cloudcore.settings import RenderSettings
@@ -68,3 +69,19 @@ def test_a_frames_impostors_lie_in_separate_cells_of_one_atlas(renderer):
                 assert a.x >= b.x + b.side or b.x >= a.x + a.side or a.y >= b.y + b.side or b.y >= a.y + a.side
     assert all(image.side <= image.cell.side for image in images)
     assert renderer.texture_bytes >= images[0].atlas.nbytes > 0
+
+
+def test_a_target_drawn_after_an_atlas_cell_is_not_clipped_to_the_cell(renderer):
+    """A cell's scissor stays on for its splats; the ring's segment targets rendered after it in the same
+    update must still be cleared and drawn whole (they were clipped to the last cell once)."""
+    renderer.context.make_current()
+    atlas, target = ImpostorAtlas(64), TextureTarget(48, 32)
+    try:
+        atlas.allocate(16).bind_cleared()
+        target.bind_cleared()
+        GL.glClearColor(0.25, 0.5, 0.75, 1.0)
+        GL.glClear(GL.GL_COLOR_BUFFER_BIT)
+        np.testing.assert_allclose(target.read(), np.broadcast_to((0.25, 0.5, 0.75, 1.0), (32, 48, 4)), atol=1e-3)
+    finally:
+        atlas.close()
+        target.close()

@@ -46,6 +46,7 @@ class TextureTarget:
         """Draw into this target from now on, starting from transparent black (depth untouched)."""
         GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, self.framebuffer)
         GL.glViewport(0, 0, self.width, self.height)
+        GL.glDisable(GL.GL_SCISSOR_TEST)  # an atlas cell's, or the GUI's, would clip it
         GL.glClearColor(0.0, 0.0, 0.0, 0.0)
         GL.glClear(GL.GL_COLOR_BUFFER_BIT)
 
