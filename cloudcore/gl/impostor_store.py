@@ -81,7 +81,7 @@ class ImpostorStore:
             # the clouds alone, no depth test: the texture holds their premultiplied colour and opacity
             target.bind_cleared()
             self._splats.draw(batch, view, projection, depth_test=False, point_sprites=settings.point_sprites)
-            GL.glDisable(GL.GL_SCISSOR_TEST)  # an atlas cell's: it would clip the ring's targets after it
+        GL.glDisable(GL.GL_SCISSOR_TEST)  # the last atlas cell's: it would clip the cloud pass
         for side in [side for side, atlas in self._atlases.items() if not atlas.in_use]:
             self._atlases.pop(side).close()
         live = {plan.ring_state.current, plan.ring_state.pending}
