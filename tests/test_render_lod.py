@@ -123,3 +123,22 @@ def test_orbiting_draws_groups_apart_and_the_still_eye_whole_again(renderer, val
     worst = min(compare(image, reference).psnr_db for image, reference in zip(images, references))
     assert worst >= 35.5, f"orbiting: {worst:.1f} dB"
     assert compare(still, references[-1]).psnr_db >= 38.0
+
+
+def test_the_screen_impostor_of_a_cloud_at_the_side_of_the_view_is_composited_where_its_particles_are(renderer, valley):
+    """The eye just inside a unit's sphere, the unit off to the right: its screen impostor's composite is
+    cropped to the part of the screen its particles can cover (here about a quarter of it), its texture
+    rectangle and corners alike (that the crop holds every particle, tests/test_particle_extent.py)."""
+    renderer.render(valley, camera=inside_a_cloud(valley), settings=RenderSettings(mode="impostor"))
+    plan = renderer.last_plan
+    (unit,) = plan.of_kind("inside")
+    centre, radius = plan.units.centres[unit.index], plan.units.radii[unit.index]
+    eye = centre + np.array([radius * 1.02, 0.0, 0.0])
+    # looking 40 degrees off the direction back to the centre, horizontally: the cloud fills the right
+    aside = np.radians(40.0)
+    camera = Camera(tuple(eye), tuple(eye + 100.0 * np.array([-np.cos(aside), 0.0, np.sin(aside)])), 60.0)
+    reference, _ = renderer.render(valley, camera=camera, settings=FULL_3D)
+    image, _ = renderer.render(valley, camera=camera, settings=RenderSettings(mode="impostor"))
+    assert renderer.last_plan.of_kind("inside")
+    difference = compare(image, reference)
+    assert difference.psnr_db >= 42.0, difference  # measured 45.3; a texture rectangle off its corners: far less

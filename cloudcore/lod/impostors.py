@@ -100,12 +100,16 @@ def particle_extent(
     depth = -eye_space[:, 2]
     if not np.all(depth - radii > 0.0):
         return (0.0, 0.0, 1.0, 1.0)
-    # a sphere's projection along each axis lies within (x +- r) / (depth - r); axis by axis on contiguous
+    # a sphere lies in its bounding box, whose projection along each axis runs from (x - r) over the box's
+    # nearest depth (x - r < 0) or its farthest (x - r >= 0) to the same for x + r; axis by axis on contiguous
     # columns, the projection's scale applied to the extremes: numpy loops over a row of two slowly, and a
     # regeneration pays this for each of up to 10,000 splats (0.36 against 0.02 ms)
-    nearest = depth - radii
-    low = np.array([((eye_space[:, axis] - radii) / nearest).min() for axis in (0, 1)])
-    high = np.array([((eye_space[:, axis] + radii) / nearest).max() for axis in (0, 1)])
+    nearest, farthest = depth - radii, depth + radii
+    low, high = np.empty(2), np.empty(2)
+    for axis in (0, 1):
+        left, right = eye_space[:, axis] - radii, eye_space[:, axis] + radii
+        low[axis] = (left / np.where(left < 0.0, nearest, farthest)).min()
+        high[axis] = (right / np.where(right > 0.0, nearest, farthest)).max()
     scale = np.array([projection[0, 0], projection[1, 1]])
     margin = 2.0 * CROP_MARGIN_TEXELS / np.asarray(size, dtype=np.float64)
     lowest, highest = np.minimum(low * scale, high * scale), np.maximum(low * scale, high * scale)
