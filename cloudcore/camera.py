@@ -101,6 +101,12 @@ def spheres_in_frustum(planes: np.ndarray, centres: np.ndarray, radii: np.ndarra
     return np.all(distances >= -np.asarray(radii, dtype=np.float64), axis=0)
 
 
+def spheres_within_frustum(planes: np.ndarray, centres: np.ndarray, radii: np.ndarray) -> np.ndarray:
+    """Boolean (N,): which spheres lie wholly inside the frustum."""
+    distances = planes[:, :3] @ np.asarray(centres, dtype=np.float64).reshape(-1, 3).T + planes[:, 3:]
+    return np.all(distances >= np.asarray(radii, dtype=np.float64), axis=0)
+
+
 def splats_in_frustum(planes: np.ndarray, centres: np.ndarray, radii: np.ndarray) -> np.ndarray:
     """Boolean (N,): which splats (billboards of half side `radii`, facing any way) can touch the frustum.
 

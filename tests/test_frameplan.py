@@ -13,6 +13,7 @@ from cloudcore.lod.frameplan import (
     PROBE_FRAMES,
     SWITCH_MARGIN,
     LodState,
+    _in_view_work,
     inside_runs,
     plan_frame,
 )
@@ -460,6 +461,33 @@ def test_full_3d_near_the_eye_counts_only_the_splats_in_the_frustum():
         cloud_splats=lambda cloud: (splat_centres, splat_radii),
     )
     assert full.cloud_work.particles == np.count_nonzero(seen) < 400
+
+
+def test_a_far_unit_the_frustum_cuts_is_priced_by_its_splats_in_view_one_wholly_in_view_by_all():
+    """Wang's ring's candidates are priced drawn alone in full 3D: a field's far units are kilometres across."""
+    rng = np.random.default_rng(5)
+    eye = camera_at((0.0, 0.0, 0.0), look_at=(0.0, 0.0, -5000.0))
+    planes = frustum_planes(projection_matrix(60.0, VIEWPORT[0] / VIEWPORT[1]) @ view_matrix(eye))
+    edge_x = -5000.0 * math.tan(math.radians(30.0)) * VIEWPORT[0] / VIEWPORT[1]
+    splats = [
+        (rng.normal(size=(3000, 3)) * 150.0 + centre, np.full(3000, 20.0))
+        for centre in ((0, 0, -5000), (edge_x, 0, -5000))
+    ]
+    units = LodUnits.of_spheres(
+        [(0.0, 0.0, -5000.0), (edge_x, 0.0, -5000.0)], [800.0, 800.0], None, [3000, 3000], [3000 * 400.0] * 2
+    )
+    focal_px, screen = 0.5 * VIEWPORT[1] / math.tan(math.radians(30.0)), float(VIEWPORT[0] * VIEWPORT[1])
+    ball = np.array([1234.0, 5678.0])
+    particles, fragments = _in_view_work(
+        units, np.array([True, True]), lambda cloud: splats[cloud], planes, np.zeros(3), focal_px, screen, ball
+    )
+    assert particles[0] == 3000 and fragments[0] == ball[0]  # wholly in view: every splat, a ball of discs
+    centres, radii = splats[1]
+    seen = splats_in_frustum(planes, centres, radii)
+    discs = math.pi * (focal_px * radii[seen] / np.linalg.norm(centres[seen], axis=1)) ** 2
+    assert 1000 < np.count_nonzero(seen) < 2000  # the left plane cuts it about in half
+    assert particles[1] == pytest.approx(np.count_nonzero(seen), rel=0.05)
+    assert fragments[1] == pytest.approx(discs.sum(), rel=0.05)
 
 
 def test_a_still_eye_settles_once_its_impostors_are_made_and_the_ring_is_in():

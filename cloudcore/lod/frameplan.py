@@ -53,6 +53,7 @@ from cloudcore.camera import (
     frustum_planes,
     projection_matrix,
     spheres_in_frustum,
+    spheres_within_frustum,
     splats_in_frustum,
     view_matrix,
 )
@@ -94,6 +95,9 @@ SWITCH_MARGIN = 0.25
 #: screen (`cloudcore.measure.overdraw.analytic_overdraw`); a ball of discs overestimates a near cloud tenfold, the
 #: parts of it beside and behind the eye costing nothing
 NEAR_EXACT_RADII = 3.0
+#: splats per cloud that count a far unit the frustum cuts (`_in_view_work`): the share of them in view, a
+#: binomial estimate, is within 3% (one standard deviation) of the count of every splat
+IN_VIEW_SAMPLE = 256
 #: auto mode's choice between a frame of units each as priced and one all in full 3D is by the frames' measured
 #: times (the cost model, fitted to what is drawn, predicts the other poorly): the frames after a switch that do
 #: not count (crossfades and the ring's fade), the measured frames a choice needs, the age in frames after which
@@ -421,7 +425,7 @@ def _plan_units(
         )
         ring_ms = costs.ms(ring_panels + ring_rebuild)
         in_view = (
-            _in_view_work(units, alone, cloud_splats, planes, eye, focal_px, screen_pixels)
+            _in_view_work(units, alone, cloud_splats, planes, eye, focal_px, screen_pixels, ball_fragments)
             if cloud_splats is not None
             else (units.particle_counts[alone], ball_fragments[alone])
         )
@@ -836,25 +840,40 @@ def _ring_work(
     return _ring_panels_work(panels, quad_pixels), rebuild.scaled(1.0 / max(lifetime, 1.0))
 
 
-def _in_view_work(units: LodUnits, chosen, cloud_splats, planes, eye, focal_px, screen_pixels):
-    """(particles, fragments) per unit of `chosen` (mask) drawn in full 3D far from the eye, splat by splat:
-    only the splats in the frustum (a cloud field's far units are kilometres across, and partly out of view),
-    each a disc of pi (f r / z)^2 at most the screen."""
+def _in_view_work(units: LodUnits, chosen, cloud_splats, planes, eye, focal_px, screen_pixels, ball_fragments):
+    """(particles, fragments) per unit of `chosen` (mask) drawn in full 3D far from the eye.
+
+    A unit wholly in the frustum has all its splats in view, a ball of discs (`ball_fragments`); one its
+    planes cut (a cloud field's far units are kilometres across, and partly out of view) is counted splat by
+    splat, only the splats in the frustum, each a disc of pi (f r / z)^2 at most the screen, over a strided
+    sample of `IN_VIEW_SAMPLE` splats per cloud scaled to the cloud's count: the 1.2M-particle field's 416
+    candidates took 65 ms a frame counted splat by splat, every one, 1.2 with the sample and the shortcut.
+    """
     indices = np.flatnonzero(chosen)
-    count = len(indices)
-    splats = [(owner, cloud_splats(cloud)) for owner, index in enumerate(indices) for cloud in units.members[index]]
-    if not splats:
-        return np.zeros(count), np.zeros(count)
-    owners = np.concatenate([np.full(len(radii), owner) for owner, (_, radii) in splats])
-    centres = np.concatenate([centres for _, (centres, _) in splats])
-    radii = np.concatenate([radii for _, (_, radii) in splats])
+    particles = units.particle_counts[indices].astype(np.float64)
+    fragments = np.asarray(ball_fragments, dtype=np.float64)[indices]
+    cut = np.flatnonzero(~spheres_within_frustum(planes, units.centres[indices], units.radii[indices]))
+    samples = []  # (owner, centres, radii, splats each sampled one stands for)
+    for owner in cut:
+        for cloud in units.members[indices[owner]]:
+            centres, radii = cloud_splats(cloud)
+            stride = max(1, len(radii) // IN_VIEW_SAMPLE)
+            if len(radii):
+                samples.append((owner, centres[::stride], radii[::stride], len(radii) / len(radii[::stride])))
+    particles[cut] = fragments[cut] = 0.0
+    if not samples:
+        return particles, fragments
+    owners = np.concatenate([np.full(len(radii), owner) for owner, _, radii, _ in samples])
+    weights = np.concatenate([np.full(len(radii), weight) for _, _, radii, weight in samples])
+    centres = np.concatenate([centres for _, centres, _, _ in samples])
+    radii = np.concatenate([radii for _, _, radii, _ in samples])
     seen = splats_in_frustum(planes, centres, radii)
     depths = np.maximum(np.linalg.norm(centres[seen] - eye, axis=1), radii[seen])
     discs = np.minimum(math.pi * (focal_px * radii[seen] / depths) ** 2, screen_pixels)
-    return (
-        np.bincount(owners[seen], minlength=count).astype(np.float64),
-        np.bincount(owners[seen], weights=discs, minlength=count),
-    )
+    count = len(indices)
+    particles += np.bincount(owners[seen], weights=weights[seen], minlength=count)
+    fragments += np.bincount(owners[seen], weights=weights[seen] * discs, minlength=count)
+    return particles, fragments
 
 
 def _alone_ms(units: LodUnits, seen: _Seen, chosen, in_view, focal_px, settings, costs) -> float:
