@@ -131,6 +131,7 @@ def summary(name: str, report: dict) -> list[dict]:
             "mode": "full",
             "frame_ms": reference["frame_ms_mean"],
             "cloud_ms": reference["cloud_ms_mean"],
+            "plan_ms": reference["plan_ms_mean"],
             "fps": 1e3 / reference["frame_ms_mean"],
         }
     ]
@@ -141,6 +142,7 @@ def summary(name: str, report: dict) -> list[dict]:
                 "mode": run["settings"]["mode"],
                 "frame_ms": run["frame_ms_mean"],
                 "cloud_ms": run["cloud_ms_mean"],
+                "plan_ms": run["plan_ms_mean"],
                 "fps": 1e3 / run["frame_ms_mean"],
                 "cloud_speedup": run["cloud_speedup_vs_full"],
                 "frame_speedup": run["speedup_vs_full"],

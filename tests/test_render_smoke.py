@@ -57,6 +57,12 @@ def test_each_pass_is_timed_on_the_cpu_and_on_the_gpu_within_its_wall_time(after
     assert 0.0 < stats.cpu_ms
 
 
+def test_the_frame_time_holds_the_planning_and_the_passes(afternoon):
+    _, stats = afternoon
+    assert 0.0 < stats.plan_ms <= stats.cpu_ms
+    assert stats.frame_ms == pytest.approx(stats.plan_ms + stats.world_ms + stats.impostor_update_ms + stats.cloud_ms)
+
+
 def test_sky_at_the_top_is_blue(afternoon):
     r, g, b = afternoon[0][0, WIDTH // 2].astype(int)
     assert b > g > r and b > 150

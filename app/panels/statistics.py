@@ -21,7 +21,7 @@ class StatisticsPanel:
         ms = shown.viewport_ms
         imgui.text(
             f"{ms:6.1f} ms ({1000.0 / max(ms, 1e-3):5.1f} fps)  clouds {frame.cloud_ms:.1f}  "
-            f"impostor updates {frame.impostor_update_ms:.1f}  world {frame.world_ms:.1f}"
+            f"impostor updates {frame.impostor_update_ms:.1f}  world {frame.world_ms:.1f}  plan {frame.plan_ms:.1f}"
         )
         imgui.text(
             f"GPU: clouds {frame.cloud_gpu_ms:.1f}  impostor updates {frame.impostor_update_gpu_ms:.1f}  "

@@ -91,7 +91,7 @@ def run(args) -> int:
         write_output(args.stats, lambda path: path.write_text(json.dumps(report, indent=2) + "\n"))
     print(
         f"wrote {args.out} ({args.width}x{args.height}): frame {stats.frame_ms:.1f} ms "
-        f"(world {stats.world_ms:.1f}, clouds {stats.cloud_ms:.1f}; CPU {stats.cpu_ms:.1f}, "
+        f"(plan {stats.plan_ms:.1f}, world {stats.world_ms:.1f}, clouds {stats.cloud_ms:.1f}; CPU {stats.cpu_ms:.1f}, "
         f"GPU {stats.world_gpu_ms + stats.impostor_update_gpu_ms + stats.cloud_gpu_ms:.1f}), "
         f"{stats.particles_drawn} particles, {stats.clouds_drawn} clouds drawn, "
         f"{stats.clouds_culled} culled"

@@ -226,7 +226,8 @@ class FrameRenderer:
         stats = FrameStats(
             plan=plan.stats(),
             illumination_ms=illumination_ms,
-            frame_ms=world.wall_ms + updates.wall_ms + clouds.wall_ms,
+            frame_ms=before_passes_ms + world.wall_ms + updates.wall_ms + clouds.wall_ms,
+            plan_ms=before_passes_ms,
             world_ms=world.wall_ms,
             impostor_update_ms=updates.wall_ms,
             cloud_ms=clouds.wall_ms,

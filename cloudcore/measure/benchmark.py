@@ -96,6 +96,7 @@ def _summary(rows) -> dict:
         "frame_ms_p95": float(np.percentile(times, 95)),
         "cloud_ms_mean": float(np.mean([r["cloud_ms"] + r.get("impostor_update_ms", 0.0) for r in rows])),
         "world_ms_mean": float(np.mean([r["world_ms"] for r in rows])),
+        "plan_ms_mean": float(np.mean([r.get("plan_ms", 0.0) for r in rows])),
         "cpu_ms_mean": float(np.mean([r["cpu_ms"] for r in rows])),
         "gpu_ms_mean": float(
             np.mean([r["world_gpu_ms"] + r["impostor_update_gpu_ms"] + r["cloud_gpu_ms"] for r in rows])

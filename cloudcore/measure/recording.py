@@ -8,7 +8,8 @@ import numpy as np
 
 from cloudcore.measure.frame_stats import FrameStats
 
-#: the columns of `cloudview record --stats`, in order; other_ms is frame_ms less the cloud pass and impostor updates,
+#: the columns of `cloudview record --stats`, in order; other_ms is frame_ms less the cloud pass and impostor updates
+#: (the plan and the world),
 #: cpu_ms the CPU's part of the frame and gpu_ms the GPU's time on its passes (`FrameStats`)
 COLUMNS = (
     "frame",
