@@ -55,14 +55,17 @@ def analytic_overdraw(
     eye_space = centres @ view[:3, :3].T + view[:3, 3]
     depth = -eye_space[:, 2]
     drawn = depth > near
-    centre_ndc = (
-        np.column_stack([projection[0, 0] * eye_space[drawn, 0], projection[1, 1] * eye_space[drawn, 1]])
-        / depth[drawn, None]
-    )
-    semi_axes = radii[drawn, None] * np.array([projection[0, 0], projection[1, 1]]) / depth[drawn, None]
-    inside = np.clip(centre_ndc + semi_axes, -1.0, 1.0) - np.clip(centre_ndc - semi_axes, -1.0, 1.0)
-    on_screen = np.prod(inside / (2.0 * semi_axes), axis=1)
-    return float(np.sum(np.pi * np.prod(semi_axes, axis=1) * on_screen) / 4.0)
+    inverse_depth = 1.0 / depth[drawn]
+    # per axis the disc's bounding box on screen, 2 a wide, and the width w of its part in [-1, 1]; the
+    # disc's area pi a_x a_y times the share w_x w_y / (4 a_x a_y) of its box on screen is pi w_x w_y / 4, over
+    # the screen's 4: one array per axis, no division by a (the auto mode's planner runs this on every near
+    # cloud's splats, every frame: 0.84 ms for 7,600 splats with the area and the share apart, against 0.20)
+    area = np.ones(len(inverse_depth))
+    for axis in (0, 1):
+        scale = projection[axis, axis] * inverse_depth
+        centre, semi_axis = scale * eye_space[drawn, axis], scale * radii[drawn]
+        area *= np.clip(centre + semi_axis, -1.0, 1.0) - np.clip(centre - semi_axis, -1.0, 1.0)
+    return float(np.pi / 16.0 * np.sum(area))
 
 
 #: Wang's cloud blocks are 16 square kilometres: 4 km on a side
