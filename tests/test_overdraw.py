@@ -29,6 +29,13 @@ def test_splats_behind_the_near_plane_are_not_estimated():
     assert analytic_overdraw(behind, np.array([10.0]), view, projection, NEAR_PLANE_M) == 0.0
 
 
+def test_a_splat_of_no_radius_adds_nothing_to_the_estimate():
+    view, projection = view_matrix(CAMERA), projection_matrix(60.0, 4 / 3)
+    one = analytic_overdraw(np.zeros((1, 3)), np.array([100.0]), view, projection, NEAR_PLANE_M)
+    both = analytic_overdraw(np.zeros((2, 3)), np.array([100.0, 0.0]), view, projection, NEAR_PLANE_M)
+    assert both == one  # not NaN: the share on screen of a point is not asked
+
+
 def test_statistics_of_known_counts():
     counts = np.array([[0.0, 2.0], [4.0, 0.0]], dtype=np.float32)
     assert overdraw_statistics(counts, 2.0) == Overdraw(mean=1.5, mean_covered=3.0, max=4.0, analytic=2.0)
