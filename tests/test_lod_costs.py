@@ -147,3 +147,4 @@ def test_a_cost_model_prices_each_field_of_work_by_its_own_coefficient():
         model = CostModel(**{n: 10.0 ** (k + 1) for k, n in enumerate(names)})
         assert model.ms(Work(**{name: 2.0})) == 2.0 * 10.0 ** (index + 1)
     assert (Work(particles=1.0, quads=2.0) + Work(quads=3.0)).scaled(2.0) == Work(particles=2.0, quads=10.0)
+    assert Work(**{n: float(k) for k, n in enumerate(names)}).values() == tuple(map(float, range(len(names))))
