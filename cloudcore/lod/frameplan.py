@@ -114,7 +114,7 @@ SCENE_CHANGE_RATIO = 1.25
 FRAME_TIME_FORGETTING = 0.1
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)  # hundreds a frame on a cloud field
 class CloudPlan:
     index: int  # the unit's
     kind: str
@@ -406,7 +406,8 @@ def _plan_units(
     candidates = np.zeros(len(radii), dtype=bool)
     # auto mode found the last frame cheaper drawn all in full 3D (`_frame_choice`): every unit heads there
     all_full = settings.mode == "auto" and state.frame_choice == "full"
-    in_view_of = {}  # unit index -> its full-3D work, splat by splat, for the ring's candidates in view
+    # per unit, its full-3D work far off (particles, fragments): splat by splat for the ring's candidates in view
+    in_view_particles, in_view_fragments = units.particle_counts.astype(np.float64), ball_fragments.copy()
     if settings.mode == "auto" and settings.uses_ring:
         candidates = ring_members(centres, radii, eye, settings)
         step = eye - last_eye if last_eye is not None else np.zeros(3)
@@ -424,15 +425,12 @@ def _plan_units(
             state.ring,
         )
         ring_ms = costs.ms(ring_panels + ring_rebuild)
-        in_view = (
-            _in_view_work(units, alone, cloud_splats, planes, eye, focal_px, screen_pixels, ball_fragments)
-            if cloud_splats is not None
-            else (units.particle_counts[alone], ball_fragments[alone])
-        )
+        if cloud_splats is not None:
+            in_view_particles[alone], in_view_fragments[alone] = _in_view_work(
+                units, alone, cloud_splats, planes, eye, focal_px, screen_pixels, ball_fragments
+            )
+        in_view = (in_view_particles[alone], in_view_fragments[alone])
         alone_ms = _alone_ms(units, seen, alone, in_view, focal_px, settings, costs)
-        in_view_of = {
-            int(i): Work(particles=float(p), fragments=float(f)) for i, p, f in zip(np.flatnonzero(alone), *in_view)
-        }
     ring = plan_ring(
         state.ring,
         centres,
@@ -522,15 +520,18 @@ def _plan_units(
     update_work, cloud_work = Work(), Work()
     # auto mode weighs the frame as planned unit by unit against every unit in full 3D in one sorted draw: splitting
     # the particles into many draws between impostors costs what no unit's own price shows
-    everything_full, unit_prices = Work(batches=1.0), []
+    shown_by_ring = ring.weights() if ring is not None else {}
+    individuals = np.array([1.0 - shown_by_ring.get(members, 0.0) for members in units.members]).reshape(-1)
+    in_ring = (individuals <= 0.0) & (radii > 0.0) & visible
+    everything_full = Work(
+        particles=float(np.sum(in_view_particles[in_ring])),
+        fragments=float(np.sum(in_view_fragments[in_ring])),
+        batches=1.0,
+    )
+    unit_prices = []
     clouds, wanted = [], []  # wanted: (index, priority, work) of the impostors past their tolerance
-    for index, (radius, distance) in enumerate(zip(radii, distances)):
-        distance, members = float(distance), units.members[index]
-        individual = 1.0 - (ring.weight_of(members) if ring is not None else 0.0)
-        if individual <= 0.0 and radius > 0.0 and visible[index]:  # in the ring
-            everything_full += in_view_of.get(
-                index, Work(particles=float(units.particle_counts[index]), fragments=float(ball_fragments[index]))
-            )
+    for index, (radius, distance, individual) in enumerate(zip(radii, distances, individuals)):
+        distance, members, individual = float(distance), units.members[index], float(individual)
         if radius <= 0.0 or individual <= 0.0 or not visible[index]:
             clouds.append(
                 CloudPlan(

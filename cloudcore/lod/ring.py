@@ -75,7 +75,15 @@ class RingPlan:
 
     def weight_of(self, cloud: Hashable) -> float:
         """The share of the opacity of the cloud (or unit) of id `cloud` the ring shows this frame."""
-        return sum(weight for generation, weight in self.draws if cloud in generation.members)
+        return self.weights().get(cloud, 0.0)
+
+    def weights(self) -> dict:
+        """`weight_of` of every cloud (or unit) the ring shows, at once (a field's hundreds)."""
+        shown: dict = {}
+        for generation, weight in self.draws:
+            for member in generation.members:
+                shown[member] = shown.get(member, 0.0) + weight
+        return shown
 
 
 def segment_direction(segment: int) -> np.ndarray:
