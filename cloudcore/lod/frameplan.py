@@ -1013,18 +1013,19 @@ def _groups_cheaper_apart(
     the eye in its sphere, a group is whole, whatever the prices: it closes, remade from that very eye.
     `plan_frame` opens a group only where its own impostor is due anyway.
     """
-    costs = state.costs.model() if costs is None else costs
     pricing = _pricing(camera, viewport, settings, state, objects)
     focal_px = pricing[4]
-    group_seen, part_seen = _seen(units, *pricing), _seen(units.clouds, *pricing)
+    group_seen = _seen(units, *pricing)
     # a group whose sphere holds the eye is whole: its screen impostor draws its particles sorted together, as
     # full 3D does, and apart its clouds would cost as much (the particles near the eye are the screen
     # impostor's cost, whatever holds them; under a stratocumulus deck apart was 1.7 times dearer)
     outside = group_seen.distances >= INSIDE_RADII * units.radii
     moving = group_seen.lifetimes < LONGEST_LIFETIME_FRAMES
     candidates = np.array([len(members) > 1 for members in units.members]) & outside & moving
-    if not candidates.any():
+    if not candidates.any():  # a still eye: nothing more to price
         return frozenset()
+    costs = state.costs.model() if costs is None else costs
+    part_seen = _seen(units.clouds, *pricing)
     group_ms = np.zeros(len(candidates))
     group_ms[candidates] = _impostor_ms(units, group_seen, candidates, focal_px, settings, costs)
     # (a cloud whose own sphere holds the eye is priced as a quad over the whole screen: dear, so its group stays)
