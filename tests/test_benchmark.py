@@ -3,12 +3,13 @@
 import json
 import subprocess
 import sys
+from collections import Counter
 
 import numpy as np
 import pytest
 from conftest import VALLEY
 
-from cloudcore.measure.benchmark import bench_path, pareto_front
+from cloudcore.measure.benchmark import bench_path, pareto_front, turns
 from cloudcore.measure.frame_stats import FrameStats, PlanStats
 from cloudcore.scenefile import load_scene
 from cloudcore.settings import FULL_3D, RenderSettings
@@ -65,16 +66,30 @@ def test_bench_path_reports_the_error_and_speedup_it_measured():
     assert identical["runs"][0]["psnr_min"] == 100.0  # identical frames: the cap, JSON has no infinity
 
 
-def test_bench_path_renders_frame_by_frame_in_turn_alternating_the_order():
-    """Side by side: every renderer renders a frame before any renders the next, the order reversed on every
-    other frame, so a slower or faster spell of the machine falls on all runs alike."""
+def test_bench_path_renders_frame_by_frame_in_turn_in_the_balanced_order():
+    """Side by side: every renderer renders a frame before any renders the next, so a slower or faster spell of
+    the machine falls on all runs alike; in the order of `turns`."""
     scene, calls = load_scene(VALLEY), []
     renderers = [FakeRenderer(offset=1, name=name, calls=calls) for name in ("full", "a", "b")]
-    bench_path(renderers, scene, "flythrough", 3, [RenderSettings(), RenderSettings(mode="impostor")], (4, 4))
+    bench_path(renderers, scene, "flythrough", 4, [RenderSettings(), RenderSettings(mode="impostor")], (4, 4))
     measured = calls[3:]  # after one unmeasured frame each: shading precompute, shader compiles
-    assert [name for name, _ in measured] == ["full", "a", "b", "b", "a", "full", "full", "a", "b"]
+    names = ("full", "a", "b")
+    assert [name for name, _ in measured] == [names[run] for frame in turns(3, 4) for run in frame]
     positions = [position for _, position in measured]
-    assert len(set(positions[0:3])) == len(set(positions[3:6])) == 1 and positions[0] != positions[3]
+    assert all(len(set(positions[i : i + 3])) == 1 for i in range(0, 12, 3)) and positions[0] != positions[3]
+
+
+@pytest.mark.parametrize("runs", [3, 4, 5])
+def test_each_run_follows_each_other_equally_often_never_itself_and_takes_each_place_alike(runs):
+    order = turns(runs, 60 * runs)
+    assert all(sorted(frame) == list(range(runs)) for frame in order)
+    sequence = [run for frame in order for run in frame]
+    follows = Counter(zip(sequence, sequence[1:]))
+    assert not any(follows[run, run] for run in range(runs))
+    others = [follows[a, b] for a in range(runs) for b in range(runs) if a != b]
+    assert max(others) - min(others) <= 2
+    places = Counter((run, place) for frame in order for place, run in enumerate(frame))
+    assert max(places.values()) - min(places.values()) <= 0.1 * len(order) / runs + 2
 
 
 def test_bench_path_wants_a_renderer_per_run():
