@@ -463,6 +463,29 @@ def test_full_3d_near_the_eye_counts_only_the_splats_in_the_frustum():
     assert full.cloud_work.particles == np.count_nonzero(seen) < 400
 
 
+def test_a_still_eye_prices_a_unit_near_it_splat_by_splat_once():
+    rng = np.random.default_rng(4)
+    splat_centres, splat_radii = rng.uniform(-RADIUS, RADIUS, (1000, 3)), np.full(1000, 5.0)
+    asked = []
+
+    def splats(cloud):
+        asked.append(cloud)
+        return splat_centres, splat_radii
+
+    units, eye = units_of([(0.0, 0.0, 0.0)], [RADIUS]), camera_at((0.0, 0.0, 2.5 * RADIUS))
+
+    def priced(camera, state, key=1):
+        before = len(asked)
+        p = plan_frame(units, camera, VIEWPORT, NO_RING, state, key, cloud_splats=splats)
+        return p, len(asked) - before
+
+    first, first_asks = priced(eye, LodState())
+    again, again_asks = priced(eye, first.state)
+    assert first_asks > 0 and again_asks == 0 and again.clouds[0].full_ms == first.clouds[0].full_ms
+    assert priced(camera_at((0.0, 0.0, 2.5 * RADIUS + 1.0)), again.state)[1] > 0  # the eye moved
+    assert priced(eye, again.state, key=2)[1] > 0  # the cloud changed (its light, its formation)
+
+
 def test_a_far_unit_the_frustum_cuts_is_priced_by_its_splats_in_view_one_wholly_in_view_by_all():
     """Wang's ring's candidates are priced drawn alone in full 3D: a field's far units are kilometres across."""
     rng = np.random.default_rng(5)
