@@ -35,6 +35,7 @@ from imgui_bundle import hello_imgui, imgui, immapp  # noqa: E402
 from app.editor import Editor  # noqa: E402
 from app.panels import Panels  # noqa: E402
 from app.viewport import Viewport  # noqa: E402
+from cloudcore.collector import freeze_what_is_set_up  # noqa: E402
 from cloudcore.errors import SceneError  # noqa: E402
 from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
 
@@ -67,7 +68,13 @@ def runner_params(
         windows.append(window)
     params.docking_params.dockable_windows = windows
 
+    frames = 0
+
     def every_frame():
+        nonlocal frames
+        frames += 1
+        if frames == 3:  # the viewport's renderer made and drawn: its setup out of the collector's full passes
+            freeze_what_is_set_up()
         shortcuts(editor)
         panels.poll_recording()
         editor.autosave()

@@ -201,7 +201,7 @@ def main() -> None:
             renderers = [
                 stack.enter_context(FrameRenderer(*size, illumination=illumination)) for _ in range(1 + len(MODES))
             ]
-            report = bench_path(renderers, scene, "", len(views), MODES, size, views=views, warmup=warmup)
+            report = bench_path(renderers, scene, "", len(views), MODES, size, views=views, warmup=warmup, freeze=True)
         report["seconds"] = time.perf_counter() - start
         result["cases"][name] = report
         rows = summary(name, report)

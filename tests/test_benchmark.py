@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from conftest import VALLEY
 
+from cloudcore.measure import benchmark
 from cloudcore.measure.benchmark import bench_path, pareto_front, turns
 from cloudcore.measure.frame_stats import FrameStats, PlanStats
 from cloudcore.scenefile import load_scene
@@ -90,6 +91,18 @@ def test_each_run_follows_each_other_equally_often_never_itself_and_takes_each_p
     assert max(others) - min(others) <= 2
     places = Counter((run, place) for frame in order for place, run in enumerate(frame))
     assert max(places.values()) - min(places.values()) <= 0.1 * len(order) / runs + 2
+
+
+def test_a_benchmark_freezes_what_is_set_up_after_the_warm_up_and_before_the_measured_frames(monkeypatch):
+    """A full collection is a 70 ms stall (`cloudcore.collector`): it must not fall in a measured frame."""
+    scene, calls = load_scene(VALLEY), []
+    monkeypatch.setattr(benchmark, "freeze_what_is_set_up", lambda: calls.append(("frozen", None)))
+    renderers = [FakeRenderer(offset=1, name=name, calls=calls) for name in ("full", "a")]
+    bench_path(renderers, scene, "flythrough", 2, [RenderSettings()], (4, 4), warmup=3, freeze=True)
+    assert [name for name, _ in calls].index("frozen") == 2 + 2 * 3  # first frames, warm-up, then frozen
+    calls.clear()
+    bench_path(renderers, scene, "flythrough", 2, [RenderSettings()], (4, 4), warmup=3)
+    assert ("frozen", None) not in calls  # a test's process is not frozen
 
 
 def test_bench_path_wants_a_renderer_per_run():

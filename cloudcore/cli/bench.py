@@ -125,6 +125,7 @@ def run(args) -> int:
             progress=bar.update,
             views=views,
             warmup=args.warmup,
+            freeze=True,
         )
     report["path"] = motion
     report["scene"] = str(args.scene)

@@ -19,6 +19,7 @@ from types import SimpleNamespace
 
 from cloudcore.cli.render import add_scene_argument, pixel_count
 from cloudcore.cli.settings_args import add_settings_arguments, settings_from
+from cloudcore.collector import freeze_what_is_set_up
 from cloudcore.errors import SceneError
 from cloudcore.measure.recording import COLUMNS, frame_row, frame_times
 from cloudcore.paths import camera_on_path
@@ -111,6 +112,8 @@ def run(args) -> int:
                 rows.writerow(frame_row(index, t, stats))
                 table.flush()  # a run cut short, even by a kill, keeps its rows
             frame_ms.append(stats.frame_ms)
+            if index == 0:  # the renderer set up: out of the collector's full passes (`cloudcore.collector`)
+                freeze_what_is_set_up()
             bar.update()
             if stop.requested:
                 break

@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
+from cloudcore.collector import freeze_what_is_set_up
 from cloudcore.light.illumination import illuminate_clouds
 from cloudcore.light.lighting import active_lights, scene_lights
 from cloudcore.measure.imagecompare import compare
@@ -87,7 +88,9 @@ def turns(runs: int, frames: int) -> list[list[int]]:
     return order
 
 
-def _interleaved_rows(renderers, scene: Scene, views, settings_list, progress=None, warmup: int = 0) -> list:
+def _interleaved_rows(
+    renderers, scene: Scene, views, settings_list, progress=None, warmup: int = 0, freeze: bool = False
+) -> list:
     """Per renderer (the reference's first, in full 3D), one row a frame: its statistics and, but for the
     reference's, its error against the reference's image of that frame."""
     runs = list(zip(renderers, [FULL_3D, *settings_list]))
@@ -96,6 +99,8 @@ def _interleaved_rows(renderers, scene: Scene, views, settings_list, progress=No
             renderer.render(scene, camera=views[0][1], settings=settings, time_s=views[0][0])
             if progress is not None:
                 progress()
+    if freeze:  # a full collection is a 70 ms stall in whichever run's frame sets it off
+        freeze_what_is_set_up()
     rows = [[] for _ in runs]
     for frame, ((time_s, camera), order) in enumerate(zip(views, turns(len(runs), len(views)))):
         images = [None] * len(runs)
@@ -138,19 +143,22 @@ def bench_path(
     progress=None,
     views=None,
     warmup: int = 0,
+    freeze: bool = False,
 ) -> dict:
     """The report: reference (full 3D) and one run per settings object, errors per frame and overall.
 
     `renderers`: one for the reference, then one per settings object, each with its own caches; they
     render frame by frame in turn.  The frames are `views` ((scene clock, camera) pairs) when given,
     else `frames` along the path; each run first renders `warmup` unmeasured frames of the first view.
+    `freeze`: after those, leave what is set up out of the garbage collector's full passes, for the rest of the
+    process (`cloudcore.collector`; a benchmark's own process, not a test's).
     """
     if len(renderers) != 1 + len(settings_list):
         raise ValueError(f"{len(renderers)} renderers for the reference and {len(settings_list)} settings")
     views = path_views(scene, path_name, frames) if views is None else views
     for renderer in renderers:  # shading precompute, shader compiles; in full 3D, no impostor made ahead
         renderer.render(scene, camera=views[0][1], settings=FULL_3D)
-    reference_rows, *rows_of_runs = _interleaved_rows(renderers, scene, views, settings_list, progress, warmup)
+    reference_rows, *rows_of_runs = _interleaved_rows(renderers, scene, views, settings_list, progress, warmup, freeze)
     reference = {"mode": "full", **_summary(reference_rows), "per_frame": reference_rows}
     runs = []
     for settings, rows in zip(settings_list, rows_of_runs):
