@@ -461,9 +461,10 @@ def _plan_units(
 
     def split_at(index: int, from_eye) -> tuple[tuple, tuple]:
         """(objects inside the unit far to near from `from_eye`, their distances: the layers' boundaries)."""
+        # most scenes have no objects: asked for every unit drawn, hundreds as a field's ring fades
         inside = (
             objects_inside(centres[index], radii[index], object_centres, object_radii)
-            if (settings.split_objects)
+            if settings.split_objects and len(object_radii)
             else ()
         )
         if not len(inside):
