@@ -95,16 +95,19 @@ def frustum_planes(view_projection: np.ndarray) -> np.ndarray:
 
 def spheres_in_frustum(planes: np.ndarray, centres: np.ndarray, radii: np.ndarray) -> np.ndarray:
     """Boolean (N,): which spheres are at least partly inside the frustum (conservative)."""
-    # plane by plane, each a contiguous row: numpy reduces rows of six slowly (0.67 against 0.04 ms for
-    # 10,000 splats, which every draw near the eye tests)
-    distances = planes[:, :3] @ np.asarray(centres, dtype=np.float64).reshape(-1, 3).T + planes[:, 3:]
-    return np.all(distances >= -np.asarray(radii, dtype=np.float64), axis=0)
+    return np.all(_plane_distances(planes, centres) >= -np.asarray(radii, dtype=np.float64), axis=0)
 
 
 def spheres_within_frustum(planes: np.ndarray, centres: np.ndarray, radii: np.ndarray) -> np.ndarray:
     """Boolean (N,): which spheres lie wholly inside the frustum."""
-    distances = planes[:, :3] @ np.asarray(centres, dtype=np.float64).reshape(-1, 3).T + planes[:, 3:]
-    return np.all(distances >= np.asarray(radii, dtype=np.float64), axis=0)
+    return np.all(_plane_distances(planes, centres) >= np.asarray(radii, dtype=np.float64), axis=0)
+
+
+def _plane_distances(planes: np.ndarray, centres: np.ndarray) -> np.ndarray:
+    """(6, N): each centre's signed distance from each plane, positive inside."""
+    # plane by plane, each a contiguous row: numpy reduces rows of six slowly (0.67 against 0.04 ms for
+    # 10,000 splats, which every draw near the eye tests)
+    return planes[:, :3] @ np.asarray(centres, dtype=np.float64).reshape(-1, 3).T + planes[:, 3:]
 
 
 def splats_in_frustum(planes: np.ndarray, centres: np.ndarray, radii: np.ndarray) -> np.ndarray:

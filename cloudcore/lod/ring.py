@@ -73,12 +73,9 @@ class RingPlan:
     draws: tuple = field(default_factory=tuple)  # ((generation, weight), ...)
     state: RingState = RingState()
 
-    def weight_of(self, cloud: Hashable) -> float:
-        """The share of the opacity of the cloud (or unit) of id `cloud` the ring shows this frame."""
-        return self.weights().get(cloud, 0.0)
-
     def weights(self) -> dict:
-        """`weight_of` of every cloud (or unit) the ring shows, at once (a field's hundreds)."""
+        """The share of the opacity of each cloud (or unit) the ring shows this frame, by its id; at once, for a
+        field's hundreds."""
         shown: dict = {}
         for generation, weight in self.draws:
             for member in generation.members:
