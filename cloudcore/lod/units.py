@@ -18,7 +18,7 @@ needlessly large impostors for an error below 8-bit precision.
 
 A group costs motion: its sphere is larger than its clouds', so a moving eye
 remakes its impostor sooner, and every particle of it each time.  While the
-eye moves, auto mode plans a group apart (`LodUnits.apart`), its clouds each
+eye moves, auto mode plans a group apart (`LodUnits.apart_rows`), its clouds each
 a unit of its own, where their impostors cost less than the group's
 (`cloudcore.lod.frameplan`, docs/lod.md); with the eye still, or inside its
 sphere, the group is whole.  Pure numpy and scipy.
@@ -27,6 +27,7 @@ sphere, the group is whole.  Pure numpy and scipy.
 from __future__ import annotations
 
 import dataclasses
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -53,23 +54,49 @@ class LodUnits:
     #: a unit of its own for each cloud of a group, for a group planned apart (`apart`; None: no groups)
     clouds: LodUnits | None = None
 
-    def apart(self, groups: frozenset) -> LodUnits:
-        """These units with each group of `groups` (their members) replaced, in place, by its clouds' own units."""
-        if not groups:
+    @functools.cached_property
+    def and_clouds(self) -> LodUnits:
+        """These units, then `clouds`: what a frame with groups planned apart takes its units from (`apart_rows`),
+        priced in one pass."""
+        if self.clouds is None:
             return self
-        row_of = {members[0]: row for row, members in enumerate(self.clouds.members)}
-        rows = [
-            (self.clouds, row_of[cloud]) if members in groups else (self, index)
-            for index, members in enumerate(self.members)
-            for cloud in (members if members in groups else members[:1])
-        ]
+        parts = (self, self.clouds)
         return LodUnits(
-            np.array([source.centres[row] for source, row in rows]).reshape(-1, 3),
-            np.array([source.radii[row] for source, row in rows]),
-            tuple(source.members[row] for source, row in rows),
-            np.array([source.particle_counts[row] for source, row in rows]),
-            np.array([source.radius_squares[row] for source, row in rows]),
-            np.array([source.finest_radii[row] for source, row in rows]),
+            np.concatenate([u.centres for u in parts]),
+            np.concatenate([u.radii for u in parts]),
+            self.members + self.clouds.members,
+            np.concatenate([u.particle_counts for u in parts]),
+            np.concatenate([u.radius_squares for u in parts]),
+            np.concatenate([u.finest_radii for u in parts]),
+        )
+
+    @functools.cached_property
+    def group_rows(self) -> np.ndarray:
+        """The rows of the units of more than one cloud."""
+        return np.array([row for row, members in enumerate(self.members) if len(members) > 1], dtype=np.int64)
+
+    def apart_rows(self, groups: frozenset) -> np.ndarray:
+        """The rows of `and_clouds` of these units with each group of `groups` (their members) replaced, in
+        place, by its clouds' own units."""
+        row_of = {members[0]: len(self.members) + row for row, members in enumerate(self.clouds.members)}
+        return np.array(
+            [
+                row_of[cloud] if members in groups else index
+                for index, members in enumerate(self.members)
+                for cloud in (members if members in groups else members[:1])
+            ],
+            dtype=np.int64,
+        )
+
+    def take(self, rows) -> LodUnits:
+        """The units at `rows` (an array of indices), on their own (without `clouds`)."""
+        return LodUnits(
+            self.centres[rows],
+            self.radii[rows],
+            tuple(self.members[row] for row in rows),
+            self.particle_counts[rows],
+            self.radius_squares[rows],
+            self.finest_radii[rows],
         )
 
     @staticmethod
