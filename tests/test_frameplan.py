@@ -19,7 +19,7 @@ from cloudcore.lod.frameplan import (
 )
 from cloudcore.lod.impostors import content_depth, impostor_view, parallax_error_deg, translation_error_deg
 from cloudcore.lod.ring import SEGMENTS, RingState
-from cloudcore.lod.units import LodUnits
+from cloudcore.lod.units import LodUnits, SplatSample
 from cloudcore.scene import Camera
 from cloudcore.settings import RenderSettings
 
@@ -496,14 +496,15 @@ def test_a_far_unit_the_frustum_cuts_is_priced_by_its_splats_in_view_one_wholly_
         (rng.normal(size=(3000, 3)) * 150.0 + centre, np.full(3000, 20.0))
         for centre in ((0, 0, -5000), (edge_x, 0, -5000))
     ]
-    units = LodUnits.of_spheres(
-        [(0.0, 0.0, -5000.0), (edge_x, 0.0, -5000.0)], [800.0, 800.0], None, [3000, 3000], [3000 * 400.0] * 2
+    units = dataclasses.replace(
+        LodUnits.of_spheres(
+            [(0.0, 0.0, -5000.0), (edge_x, 0.0, -5000.0)], [800.0, 800.0], None, [3000, 3000], [3000 * 400.0] * 2
+        ),
+        sample=SplatSample.of(*(np.concatenate(column) for column in zip(*splats)), [0, 3000, 6000]),
     )
     focal_px, screen = 0.5 * VIEWPORT[1] / math.tan(math.radians(30.0)), float(VIEWPORT[0] * VIEWPORT[1])
     ball = np.array([1234.0, 5678.0])
-    particles, fragments = _in_view_work(
-        units, np.array([True, True]), lambda cloud: splats[cloud], planes, np.zeros(3), focal_px, screen, ball
-    )
+    particles, fragments = _in_view_work(units, np.array([True, True]), planes, np.zeros(3), focal_px, screen, ball)
     assert particles[0] == 3000 and fragments[0] == ball[0]  # wholly in view: every splat, a ball of discs
     centres, radii = splats[1]
     seen = splats_in_frustum(planes, centres, radii)

@@ -3,11 +3,12 @@
 import dataclasses
 
 import numpy as np
+import pytest
 
 from cloudcore.lod.costs import CostModel
 from cloudcore.lod.frameplan import LodState, plan_frame
 from cloudcore.lod.impostors import parallax_errors_deg
-from cloudcore.lod.units import LodUnits, interpenetrating_groups, lod_units
+from cloudcore.lod.units import SAMPLE_PER_CLOUD, LodUnits, SplatSample, interpenetrating_groups, lod_units
 from cloudcore.scene import Camera, splats_bounding_sphere
 from cloudcore.settings import RenderSettings
 
@@ -150,3 +151,28 @@ def test_a_group_apart_closes_once_the_eye_stops_and_only_auto_mode_opens_one():
         whole = fly(units, sideways((0.0, 0.0, 800.0), 6.0, 40), settings)
         assert not any(plan.state.opened for plan in whole)
         assert all(plan.units.members[0] == (0, 1) for plan in whole)
+
+
+def test_the_splat_sample_takes_every_kth_splat_of_each_cloud_each_standing_for_k():
+    counts = [0, 5, 64, 127, 128, 1000]
+    centres = RNG.normal(size=(sum(counts), 3))
+    radii = RNG.uniform(1.0, 2.0, sum(counts))
+    starts = np.concatenate([[0], np.cumsum(counts)])
+    sample = SplatSample.of(centres, radii, starts)
+    for cloud, count in enumerate(counts):
+        rows = slice(sample.cloud_starts[cloud], sample.cloud_starts[cloud + 1])
+        stride = max(1, count // SAMPLE_PER_CLOUD)
+        expected = centres[starts[cloud] : starts[cloud + 1]][::stride]
+        np.testing.assert_array_equal(sample.centres[rows], expected)
+        np.testing.assert_array_equal(sample.radii[rows], radii[starts[cloud] : starts[cloud + 1]][::stride])
+        assert np.sum(sample.weights[rows]) == pytest.approx(count, rel=1e-12)
+    owners, got, _, weights = sample.of_clouds([5, 2], [7, 3])
+    assert list(np.unique(owners)) == [3, 7] and np.sum(weights[owners == 7]) == pytest.approx(1000.0, rel=1e-12)
+    np.testing.assert_array_equal(got[owners == 3], sample.centres[sample.cloud_starts[2] : sample.cloud_starts[3]])
+
+
+def test_the_units_of_a_buffer_carry_its_sample_into_their_groups_clouds_and_rows():
+    units = lod_units(CLOUDS)
+    assert units.sample is not None and units.clouds.sample is units.sample
+    assert units.and_clouds.take([0]).sample is units.sample
+    assert np.sum(units.sample.weights) == pytest.approx(len(CLOUDS.radii), rel=1e-12)

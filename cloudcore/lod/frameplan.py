@@ -95,11 +95,6 @@ SWITCH_MARGIN = 0.25
 #: screen (`cloudcore.measure.overdraw.analytic_overdraw`); a ball of discs overestimates a near cloud tenfold, the
 #: parts of it beside and behind the eye costing nothing
 NEAR_EXACT_RADII = 3.0
-#: splats per cloud that count a far unit the frustum cuts (`_in_view_work`): the share of them in view, a
-#: binomial estimate, is within 6% (one standard deviation) of the count of every splat, and a frame's sum over
-#: its cut units far closer: over the 1.2M-particle field's 30 bench frames 0.5% at most, over the cumulus
-#: field's 989 frames 0.3% on average and 4.4% at most (256 splats: 0.1% and 1.2%, at twice the time)
-IN_VIEW_SAMPLE = 64
 #: auto mode's choice between a frame of units each as priced and one all in full 3D is by the frames' measured
 #: times (the cost model, fitted to what is drawn, predicts the other poorly): the frames after a switch that do
 #: not count (crossfades and the ring's fade), the measured frames a choice needs, the age in frames after which
@@ -441,9 +436,9 @@ def _plan_units(
             state.ring,
         )
         ring_ms = costs.ms(ring_panels + ring_rebuild)
-        if cloud_splats is not None:
+        if units.sample is not None:
             in_view_particles[alone], in_view_fragments[alone] = _in_view_work(
-                units, alone, cloud_splats, planes, eye, focal_px, screen_pixels, ball_fragments
+                units, alone, planes, eye, focal_px, screen_pixels, ball_fragments
             )
         in_view = (in_view_particles[alone], in_view_fragments[alone])
         alone_ms = _alone_ms(units, seen, alone, in_view, focal_px, settings, costs)
@@ -873,35 +868,24 @@ def _ring_work(
     return _ring_panels_work(panels, quad_pixels), rebuild.scaled(1.0 / max(lifetime, 1.0))
 
 
-def _in_view_work(units: LodUnits, chosen, cloud_splats, planes, eye, focal_px, screen_pixels, ball_fragments):
+def _in_view_work(units: LodUnits, chosen, planes, eye, focal_px, screen_pixels, ball_fragments):
     """(particles, fragments) per unit of `chosen` (mask) drawn in full 3D far from the eye.
 
     A unit wholly in the frustum has all its splats in view, a ball of discs (`ball_fragments`); one its
     planes cut (a cloud field's far units are kilometres across, and partly out of view) is counted splat by
-    splat, only the splats in the frustum, each a disc of pi (f r / z)^2 at most the screen, over a strided
-    sample of `IN_VIEW_SAMPLE` splats per cloud scaled to the cloud's count: the 1.2M-particle field's 416
-    candidates took 65 ms a frame counted splat by splat, every one, 0.55 with the sample and the shortcut.
+    splat, only the splats in the frustum, each a disc of pi (f r / z)^2 at most the screen, over the units'
+    `SplatSample`: the 1.2M-particle field's 416 candidates took 65 ms a frame counted splat by splat, every
+    one, 0.3 with the sample and the shortcut.
     """
     indices = np.flatnonzero(chosen)
     particles = units.particle_counts[indices].astype(np.float64)
     fragments = np.asarray(ball_fragments, dtype=np.float64)[indices]
     cut = np.flatnonzero(~spheres_within_frustum(planes, units.centres[indices], units.radii[indices]))
     particles[cut] = fragments[cut] = 0.0
-    owners, samples = [], []  # per cloud of a cut unit: its unit's row, its strided sample (centres, radii)
-    for owner in cut:
-        for cloud in units.members[indices[owner]]:
-            centres, radii = cloud_splats(cloud)
-            stride = max(1, len(radii) // IN_VIEW_SAMPLE)
-            owners.append(owner)
-            samples.append((centres[::stride], radii[::stride], len(radii)))
-    sampled = np.array([len(radii) for _, radii, _ in samples], dtype=np.int64)
-    if not sampled.any():
+    clouds = [(owner, cloud) for owner in cut for cloud in units.members[indices[owner]]]
+    if not clouds:
         return particles, fragments
-    owners = np.repeat(owners, sampled)
-    # each sampled splat stands for its cloud's splats over those sampled
-    weights = np.repeat([count / max(taken, 1) for (_, _, count), taken in zip(samples, sampled)], sampled)
-    centres = np.concatenate([centres for centres, _, _ in samples])
-    radii = np.concatenate([radii for _, radii, _ in samples])
+    owners, centres, radii, weights = units.sample.of_clouds([c for _, c in clouds], [o for o, _ in clouds])
     seen = splats_in_frustum(planes, centres, radii)
     offsets = centres[seen] - eye
     depths = np.maximum(np.sqrt(np.einsum("ij,ij->i", offsets, offsets)), radii[seen])

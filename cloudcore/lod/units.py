@@ -39,6 +39,53 @@ from cloudcore.scene import splats_bounding_sphere
 
 #: two splats interpenetrate when their centres are closer than this times the sum of their radii
 TOUCH_RADII = 0.5
+#: splats per cloud (`SplatSample`) that count a far unit the frustum cuts: the share of them in view, a
+#: binomial estimate, is within 6% (one standard deviation) of the count of every splat, and a frame's sum over
+#: its cut units far closer: over the 1.2M-particle field's 30 bench frames 0.5% at most, over the cumulus
+#: field's 989 frames 0.3% on average and 4.4% at most (256 splats: 0.1% and 1.2%, at twice the time)
+SAMPLE_PER_CLOUD = 64
+
+
+def concatenated_ranges(firsts: np.ndarray, counts: np.ndarray) -> np.ndarray:
+    """The integers firsts[i] .. firsts[i] + counts[i] - 1, for each i in turn, without a Python loop."""
+    firsts, counts = np.asarray(firsts, dtype=np.int64), np.asarray(counts, dtype=np.int64)
+    offsets = np.cumsum(counts) - counts
+    return np.arange(int(np.sum(counts)), dtype=np.int64) + np.repeat(firsts - offsets, counts)
+
+
+@dataclass(frozen=True, eq=False)
+class SplatSample:
+    """Every k-th splat of each cloud, about `SAMPLE_PER_CLOUD` of them, each standing for k: what the plan
+    counts the splats in view of a far unit the frustum cuts by, copied once when the units are made (the
+    1.2M-particle field's: 29,000 splats, 1.2 MB, 1.4 ms) so that a frame gathers them without a loop over clouds."""
+
+    centres: np.ndarray  # (samples, 3)
+    radii: np.ndarray  # (samples,)
+    weights: np.ndarray  # (samples,) the cloud's splats each stands for
+    cloud_starts: np.ndarray  # (clouds + 1,) cloud c's samples are cloud_starts[c]:cloud_starts[c + 1]
+
+    @staticmethod
+    def of(centres: np.ndarray, radii: np.ndarray, cloud_starts: np.ndarray) -> SplatSample:
+        """The sample of splats (`centres`, `radii`) whose cloud c is cloud_starts[c]:cloud_starts[c + 1]."""
+        starts = np.asarray(cloud_starts, dtype=np.int64)
+        counts = np.diff(starts)
+        strides = np.maximum(1, counts // SAMPLE_PER_CLOUD)
+        taken = -(-counts // strides)  # ceil: the strided slice's length
+        steps = concatenated_ranges(np.zeros(len(counts)), taken)
+        rows = np.repeat(starts[:-1], taken) + np.repeat(strides, taken) * steps
+        return SplatSample(
+            np.asarray(centres, dtype=np.float64)[rows].reshape(-1, 3),
+            np.asarray(radii, dtype=np.float64)[rows],
+            np.repeat(counts / np.maximum(taken, 1), taken),
+            np.concatenate([[0], np.cumsum(taken)]),
+        )
+
+    def of_clouds(self, clouds, owners) -> tuple:
+        """(owners, centres, radii, weights) of the samples of `clouds`, each sample's owner that of its cloud."""
+        clouds = np.asarray(clouds, dtype=np.int64)
+        firsts, counts = self.cloud_starts[clouds], np.diff(self.cloud_starts)[clouds]
+        rows = concatenated_ranges(firsts, counts)
+        return np.repeat(owners, counts), self.centres[rows], self.radii[rows], self.weights[rows]
 
 
 @dataclass(frozen=True, eq=False)
@@ -51,8 +98,9 @@ class LodUnits:
     particle_counts: np.ndarray  # (units,) particles
     radius_squares: np.ndarray  # (units,) sum of the particles' squared radii, m^2: their splats' area
     finest_radii: np.ndarray  # (units,) metres: the finest detail in the unit (0: unknown)
-    #: a unit of its own for each cloud of a group, for a group planned apart (`apart`; None: no groups)
+    #: a unit of its own for each cloud of a group, for a group planned apart (`apart_rows`; None: no groups)
     clouds: LodUnits | None = None
+    sample: SplatSample | None = None  # of every cloud's splats (None: only the spheres are known)
 
     @functools.cached_property
     def and_clouds(self) -> LodUnits:
@@ -68,6 +116,7 @@ class LodUnits:
             np.concatenate([u.particle_counts for u in parts]),
             np.concatenate([u.radius_squares for u in parts]),
             np.concatenate([u.finest_radii for u in parts]),
+            sample=self.sample,
         )
 
     @functools.cached_property
@@ -97,6 +146,7 @@ class LodUnits:
             self.particle_counts[rows],
             self.radius_squares[rows],
             self.finest_radii[rows],
+            sample=self.sample,
         )
 
     @staticmethod
@@ -176,9 +226,12 @@ def lod_units(particles, group: bool = True, groupable: int | None = None) -> Lo
         if group and grouped
         else tuple((i,) for i in range(grouped))
     ) + tuple((i,) for i in range(grouped, clouds))
-    units = _units_of(particles, members)
+    sample = SplatSample.of(particles.centres, particles.radii, starts)
+    units = dataclasses.replace(_units_of(particles, members), sample=sample)
     in_groups = tuple((cloud,) for unit in members if len(unit) > 1 for cloud in unit)
-    return dataclasses.replace(units, clouds=_units_of(particles, in_groups)) if in_groups else units
+    if not in_groups:
+        return units
+    return dataclasses.replace(units, clouds=dataclasses.replace(_units_of(particles, in_groups), sample=sample))
 
 
 def _units_of(particles, members: tuple) -> LodUnits:
