@@ -14,7 +14,7 @@ from cloudcore.lod.costs import (
     Work,
     inverse_square_depth,
     quad_work,
-    regeneration_work,
+    regeneration_fragments,
     splat_fragments,
 )
 from cloudcore.lod.frameplan import SWITCH_MARGIN, LodState
@@ -40,9 +40,10 @@ def test_the_inverse_square_depth_of_a_ball_against_sampling_it(distance):
 
 
 def test_remaking_an_impostor_costs_its_particles_and_a_fill_that_grows_with_the_texture():
-    small, large = (regeneration_work(1000, 1000 * 25.0, 100.0, 1000.0, 200.0, size) for size in (64, 256))
-    assert small.particles == large.particles == 1000 and small.regenerations == 1
-    assert large.texture_fragments == pytest.approx(16 * small.texture_fragments) and small.fragments == 0
+    small, large = regeneration_fragments(1000, 1000 * 25.0, 100.0, 1000.0, 200.0, np.array([64, 256]))
+    assert large == pytest.approx(16 * small)
+    # one pixel-sized texture: each splat fills it at most
+    assert regeneration_fragments(1000, 1000 * 25.0, 100.0, 101.0, 1e-300, 1) == pytest.approx(1000.0)
     assert quad_work(1e5, 640 * 480).quad_pixels == 640 * 480  # a quad past the screen fills the screen
 
 

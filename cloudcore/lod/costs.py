@@ -129,23 +129,18 @@ def splat_fragments(radius_squares, radius, distance, focal_px: float, particles
     """Fragments of a unit's splats seen from `distance`: their disc areas pi (f r / z)^2 summed, z spread
     over the unit's bounding ball (`inverse_square_depth`); each disc at most the screen (scalars, or
     arrays of units)."""
-    area = math.pi * focal_px * focal_px * np.asarray(radius_squares) * inverse_square_depth(radius, distance)
+    with np.errstate(over="ignore"):  # a disc past any float is capped to the screen all the same
+        area = math.pi * np.square(focal_px) * np.asarray(radius_squares) * inverse_square_depth(radius, distance)
     result = np.minimum(area, np.asarray(particles) * screen_pixels)
     return float(result) if np.ndim(result) == 0 else result
 
 
-def regeneration_work(
-    particles: float, radius_squares: float, radius: float, distance: float, quad_half_side: float, texture_size: int
-) -> Work:
-    """Remaking a unit's impostor: its particles splatted into a texture whose side spans the quad
-    (`quad_half_side` at the centre's `distance`)."""
-    focal_texels = texture_size * distance / (2.0 * max(quad_half_side, np.finfo(float).tiny))
-    texels = float(texture_size) ** 2
-    return Work(
-        particles=particles,
-        texture_fragments=splat_fragments(radius_squares, radius, distance, focal_texels, particles, texels),
-        regenerations=1.0,
-    )
+def regeneration_fragments(particles, radius_squares, radius, distance, quad_half_side, texture_size):
+    """Remaking units' impostors: the fragments of their particles splatted into textures whose side spans
+    the quad (`quad_half_side` at the centre's `distance`); arrays of units (or scalars)."""
+    size = np.asarray(texture_size, dtype=np.float64)
+    focal_texels = size * distance / (2.0 * np.maximum(quad_half_side, np.finfo(float).tiny))
+    return splat_fragments(radius_squares, radius, distance, focal_texels, particles, size * size)
 
 
 def quad_work(side_px: float, screen_pixels: float) -> Work:

@@ -57,7 +57,7 @@ from cloudcore.camera import (
     splats_in_frustum,
     view_matrix,
 )
-from cloudcore.lod.costs import CostEstimator, CostModel, Work, quad_work, regeneration_work, splat_fragments
+from cloudcore.lod.costs import CostEstimator, CostModel, Work, quad_work, regeneration_fragments, splat_fragments
 from cloudcore.lod.impostors import (
     INSIDE_RADII,
     TRANSLATION_METRICS,
@@ -556,6 +556,12 @@ def _plan_units(
     )
     unit_prices = []
     clouds, wanted = [], []  # wanted: (index, priority, work) of the impostors past their tolerance
+    may_be_textured = visible & (radii > 0.0) & (individuals > 0.0) & (distances >= INSIDE_RADII * radii)
+    textured = (
+        _impostor_textures(units, np.flatnonzero(may_be_textured), distances, height, camera.fov_y_deg, settings)
+        if settings.mode != "full"
+        else {}
+    )
     for index, (radius, distance, individual) in enumerate(zip(radii, distances, individuals)):
         distance, members, individual = float(distance), units.members[index], float(individual)
         if radius <= 0.0 or individual <= 0.0 or not visible[index]:
@@ -612,21 +618,8 @@ def _plan_units(
             clouds.append(in_full(index, distance, inside, splits))
             cloud_work += full
             continue
-        pixels = screen_size_px(radius, distance, height, camera.fov_y_deg)
-        size = required_size(
-            min(pixels, detail_size_px(radius, distance, units.finest_radii[index], settings.impostor_detail_texels)),
-            settings.impostor_min_size,
-            settings.impostor_max_size,
-        )
+        pixels, size, remake = textured[index]
         quad = quad_work(pixels, screen_pixels)
-        remake = regeneration_work(
-            units.particle_counts[index],
-            units.radius_squares[index],
-            radius,
-            distance,
-            quad_half_side(radius, distance),
-            size,
-        )
         # a unit fading into or out of the ring is drawn as an impostor: one layer scales exactly
         weight, full_ms, impostor_ms = 0.0, costs.ms(full), math.inf
         if settings.mode == "auto" and individual == 1.0:
@@ -779,6 +772,28 @@ def _plan_units(
         accepted,
         units,
     )
+
+
+def _impostor_textures(units: LodUnits, rows, distances, height: int, fov_y_deg: float, settings) -> dict:
+    """Per unit of `rows`, (its quad's side on the screen in pixels, its impostor texture's side, the `Work` of
+    remaking it: every particle splatted into that texture), the fragments in one numpy pass (the planner's
+    numpy calls cost 20 us each whatever their size, and a field has hundreds of units)."""
+    pixels, sizes, half_sides = [], [], []
+    for index in rows:
+        radius, distance = float(units.radii[index]), float(distances[index])
+        side = screen_size_px(radius, distance, height, fov_y_deg)
+        detail = detail_size_px(radius, distance, units.finest_radii[index], settings.impostor_detail_texels)
+        pixels.append(side)
+        sizes.append(required_size(min(side, detail), settings.impostor_min_size, settings.impostor_max_size))
+        half_sides.append(quad_half_side(radius, distance))
+    counts = units.particle_counts[rows]
+    fragments = regeneration_fragments(
+        counts, units.radius_squares[rows], units.radii[rows], distances[rows], np.array(half_sides), np.array(sizes)
+    )
+    return {
+        int(index): (side, size, Work(particles=float(count), texture_fragments=float(f), regenerations=1.0))
+        for index, side, size, count, f in zip(rows, pixels, sizes, counts, np.reshape(fragments, -1))
+    }
 
 
 def _units_ms(unit_prices, ring_ms: float, alone_ms: float, candidates, costs: CostModel) -> float:
