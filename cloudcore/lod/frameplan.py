@@ -901,13 +901,14 @@ def _in_view_work(units: LodUnits, chosen, planes, eye, focal_px, screen_pixels,
     if not clouds:
         return particles, fragments
     owners, centres, radii, weights = units.sample.of_clouds([c for _, c in clouds], [o for o, _ in clouds])
-    seen = splats_in_frustum(planes, centres, radii)
-    offsets = centres[seen] - eye
-    depths = np.maximum(np.sqrt(np.einsum("ij,ij->i", offsets, offsets)), radii[seen])
-    discs = np.minimum(math.pi * (focal_px * radii[seen] / depths) ** 2, screen_pixels)
+    seen = np.flatnonzero(splats_in_frustum(planes, centres, radii))
+    owners, centres, radii, weights = owners[seen], centres[seen], radii[seen], weights[seen]
+    offsets = centres - eye
+    depths = np.maximum(np.sqrt(np.einsum("ij,ij->i", offsets, offsets)), radii)
+    discs = np.minimum(math.pi * np.square(focal_px * radii / depths), screen_pixels)
     count = len(indices)
-    particles += np.bincount(owners[seen], weights=weights[seen], minlength=count)
-    fragments += np.bincount(owners[seen], weights=weights[seen] * discs, minlength=count)
+    particles += np.bincount(owners, weights=weights, minlength=count)
+    fragments += np.bincount(owners, weights=weights * discs, minlength=count)
     return particles, fragments
 
 

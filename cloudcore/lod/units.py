@@ -83,7 +83,8 @@ class SplatSample:
     def of_clouds(self, clouds, owners) -> tuple:
         """(owners, centres, radii, weights) of the samples of `clouds`, each sample's owner that of its cloud."""
         clouds = np.asarray(clouds, dtype=np.int64)
-        firsts, counts = self.cloud_starts[clouds], np.diff(self.cloud_starts)[clouds]
+        firsts = self.cloud_starts[clouds]
+        counts = self.cloud_starts[clouds + 1] - firsts
         rows = concatenated_ranges(firsts, counts)
         return np.repeat(owners, counts), self.centres[rows], self.radii[rows], self.weights[rows]
 
