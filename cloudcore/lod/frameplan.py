@@ -387,8 +387,8 @@ def _plan_units(
     if opened:
         rows = units.apart_rows(opened)
         units, seen = units.and_clouds.take(rows), seen.take(rows)
-    elif len(seen.distances) > len(units.radii):
-        seen = seen.take(slice(0, len(units.radii)))
+    else:
+        seen = seen.take(slice(0, len(units.radii)))  # views: the units' own rows, first in `and_clouds`
     width, height = viewport
     eye, last_eye, translation_error, tolerance, focal_px, screen_pixels, _ = pricing
     centres, radii = units.centres, units.radii
@@ -897,10 +897,11 @@ def _in_view_work(units: LodUnits, chosen, planes, eye, focal_px, screen_pixels,
     fragments = np.asarray(ball_fragments, dtype=np.float64)[indices]
     cut = np.flatnonzero(~spheres_within_frustum(planes, units.centres[indices], units.radii[indices]))
     particles[cut] = fragments[cut] = 0.0
-    clouds = [(owner, cloud) for owner in cut for cloud in units.members[indices[owner]]]
+    clouds = [cloud for owner in cut for cloud in units.members[indices[owner]]]
     if not clouds:
         return particles, fragments
-    owners, centres, radii, weights = units.sample.of_clouds([c for _, c in clouds], [o for o, _ in clouds])
+    owners = [owner for owner in cut for _ in units.members[indices[owner]]]
+    owners, centres, radii, weights = units.sample.of_clouds(clouds, owners)
     seen = np.flatnonzero(splats_in_frustum(planes, centres, radii))
     owners, centres, radii, weights = owners[seen], centres[seen], radii[seen], weights[seen]
     offsets = centres - eye
