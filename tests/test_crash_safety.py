@@ -136,7 +136,9 @@ class Child:
         self.lines += remaining.strip().splitlines()
 
     def numbers(self, word: str) -> list[int]:
-        return [int(line.split()[1]) for line in self.lines if line.split()[0] == word]
+        """The N of each "word N" line; the kill can cut the last line short ("edi", "autosaved"): it says nothing."""
+        lines = [line.split() for line in self.lines]
+        return [int(parts[1]) for parts in lines if len(parts) == 2 and parts[0] == word and parts[1].isdigit()]
 
 
 # ---------------------------------------------------------------- killed mid-save
