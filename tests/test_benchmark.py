@@ -10,7 +10,7 @@ import pytest
 from conftest import VALLEY
 
 from cloudcore.measure import benchmark
-from cloudcore.measure.benchmark import bench_path, pareto_front, turns
+from cloudcore.measure.benchmark import bench_path, pareto_front, ratio_interval, turns
 from cloudcore.measure.frame_stats import FrameStats, PlanStats
 from cloudcore.scenefile import load_scene
 from cloudcore.settings import FULL_3D, RenderSettings
@@ -32,6 +32,36 @@ def test_pareto_front_keeps_the_points_nothing_beats():
     seconds = [10.0, 20.0, 15.0, 30.0, 15.0]
     errors = [5.0, 1.0, 6.0, 0.5, 2.0]
     assert pareto_front(seconds, errors) == [0, 1, 3, 4]
+
+
+def test_a_ratio_of_proportional_frames_is_exact_and_its_interval_has_no_width():
+    frames = np.random.default_rng(3).uniform(20.0, 40.0, size=60)
+    assert ratio_interval(1.05 * frames, [frames]) == pytest.approx((1.05, 1.05, 1.05))
+
+
+def test_a_ratio_is_against_the_lowest_mean_of_its_denominators():
+    frames = np.full(30, 10.0)
+    ratio, low, high = ratio_interval(frames, [2.0 * frames, 0.8 * frames, 4.0 * frames])
+    assert (ratio, low, high) == pytest.approx((1.25, 1.25, 1.25))
+
+
+def test_a_ratio_interval_pairs_the_frames_so_the_machines_slow_phases_cancel():
+    # slow phases of several frames, shared by both runs, each run with its own small noise: the ratio is 1.1
+    rng = np.random.default_rng(7)
+    phases = np.repeat(rng.uniform(15.0, 35.0, size=12), 10)
+    auto, faster = 1.1 * phases + rng.normal(0.0, 0.5, 120), phases + rng.normal(0.0, 0.5, 120)
+    ratio, low, high = ratio_interval(auto, [faster])
+    assert low < 1.1 < high and high - low < 0.02, (ratio, low, high)
+    # the same frames taken apart (the faster run's reversed) no longer share the phases: far wider
+    _, apart_low, apart_high = ratio_interval(auto, [faster[::-1]])
+    assert apart_high - apart_low > 5.0 * (high - low)
+
+
+def test_a_ratio_interval_wants_runs_of_the_same_frames():
+    with pytest.raises(ValueError):
+        ratio_interval([1.0, 2.0, 3.0], [[1.0, 2.0]])
+    with pytest.raises(ValueError):
+        ratio_interval([1.0, 2.0], [])
 
 
 class FakeRenderer:

@@ -244,6 +244,35 @@ def pareto_front(seconds, errors) -> list[int]:
     ]
 
 
+#: frames per block of `ratio_interval`'s bootstrap: llvmpipe's slow phases last several frames (a still view's
+#: identical frames measured 15 to 32 ms of world pass in runs of a few), so single frames are not independent
+BOOTSTRAP_BLOCK_FRAMES = 10
+
+
+def ratio_interval(numerator, denominators, resamples: int = 4000, seed: int = 0) -> tuple[float, float, float]:
+    """(ratio, low, high): the mean of `numerator` over the lowest mean of `denominators` (per-frame times of
+    runs measured side by side, frame i of each in the same turn), and its 95% interval.
+
+    The interval is a circular moving-block bootstrap (blocks of `BOOTSTRAP_BLOCK_FRAMES`) that resamples the
+    same frames of every run, so what the machine did to a frame falls on both sides of the ratio; which
+    denominator is the lowest is chosen again in each resample, as the comparison "against the faster" asks.
+    """
+    if not denominators or len({len(run) for run in (numerator, *denominators)}) != 1 or not len(numerator):
+        raise ValueError("a ratio needs a numerator and at least one denominator, each of the same frames")
+    runs = np.array([numerator, *denominators], dtype=np.float64)
+    frames = runs.shape[1]
+
+    def ratios(sums):
+        return sums[0] / np.maximum(np.min(sums[1:], axis=0), 1e-300)
+
+    block = min(BOOTSTRAP_BLOCK_FRAMES, frames)
+    starts = np.random.default_rng(seed).integers(0, frames, size=(resamples, -(-frames // block)))
+    picked = ((starts[:, :, None] + np.arange(block)) % frames).reshape(resamples, -1)[:, :frames]
+    sampled = ratios(runs[:, picked].sum(axis=2))
+    low, high = np.percentile(sampled, [2.5, 97.5])
+    return float(ratios(runs.sum(axis=1))), float(low), float(high)
+
+
 def machine() -> str:
     """The processor the numbers were measured on, for a report."""
     return platform.processor() or platform.machine()
