@@ -669,6 +669,9 @@ def test_clouds_far_above_or_within_the_radius_stay_out_of_the_ring():
         )
         state = p.ring_state
     assert [c.kind for c in p.clouds] == ["ring", "impostor", "impostor"]
+    # the ring keeps the spheres it rendered, its members' alone: what its translation error is measured from
+    centres, radii = state.current.spheres
+    assert centres.tolist() == [[0.0, 100.0, -3000.0]] and radii.tolist() == [RADIUS]
 
 
 def test_full_mode_and_an_infinite_radius_have_no_ring():
@@ -728,7 +731,45 @@ def run_auto_ring(frames, costs, state=None):
     return plans, state
 
 
-SETTLE = SEGMENTS + RING.ring_fade_frames + 1
+#: frames for the far field's ring to be built and faded in: each cloud is 12 ms of splats, past `PIECE_MS`, so a
+#: segment is built a cloud a frame (a cloud on a segment's edge in both)
+SETTLE = 2 * len(FAR_FIELD) + RING.ring_fade_frames + 1
+
+
+@pytest.mark.parametrize("particle_ms, clouds_a_piece", [(4e-3, 2), (1e-6, None)])
+def test_a_segment_dearer_than_a_frame_s_share_is_built_in_pieces_far_to_near(particle_ms, clouds_a_piece):
+    """At 4 ms of splats a cloud, a piece holds 2 clouds (8 ms, a third would pass `PIECE_MS`); at 1 ns a particle
+    a segment is one piece, a frame each.  Every member of a segment is drawn once, far to near from the ring's eye,
+    each piece after the last, and the ring fades in only once all eight are built."""
+    eye = np.array([0.0, 100.0, 0.0])
+    # the far field and, behind it in the first segment, nearer clouds: distances that are not in the ids' order
+    centres = FAR_FIELD + [(150.0 * k, 100.0, -1500.0 - 90.0 * k) for k in range(1, 4)]
+    costs = CostModel(particles=particle_ms)
+    state, pieces, drawn_before_built = LodState(), [], False
+    for _ in range(4 * len(centres)):
+        frame = plan(
+            camera_at(tuple(eye)), RING, centres=centres, radii=(RADIUS,) * len(centres), state=state, costs=costs
+        )
+        state = frame.state
+        if frame.ring.build_segment is not None:
+            pieces.append((frame.ring.build_segment, frame.ring.build_piece, frame.ring.build_members))
+            drawn_before_built |= bool(frame.ring.draws)
+        if frame.ring.state.current is not None:
+            break
+    generation = state.ring.current
+    assert generation is not None and not drawn_before_built
+    for segment in range(SEGMENTS):
+        members = generation.segment_members[segment]
+        distances = [float(np.linalg.norm(np.array(centres[m[0]]) - eye)) for m in members]
+        assert np.all(np.diff(distances) <= 1e-9 * 3000.0)  # far to near (the far field's all at 3 km)
+        its = [(piece, drawn) for s, piece, drawn in pieces if s == segment]
+        assert [m for _, drawn in its for m in drawn] == list(members)  # each once, in order
+        assert [piece[0] for piece, _ in its][1:] == [piece[1] for piece, _ in its][:-1]  # each after the last
+        sizes = {len(drawn) for _, drawn in its if drawn}
+        if clouds_a_piece is None:
+            assert len(its) == 1
+        elif members:
+            assert max(sizes) == clouds_a_piece and len(its) == -(-len(members) // clouds_a_piece)
 
 
 def test_auto_mode_keeps_the_ring_only_where_it_is_cheaper():

@@ -15,6 +15,8 @@ from conftest import VALLEY
 from test_frameplan import FILL_BOUND, UPKEEP_BOUND
 from test_render_golden import inside_a_cloud, into_the_sun
 
+from cloudcore.lod.costs import CostModel
+from cloudcore.lod.frameplan import LodState
 from cloudcore.lod.ring import SEGMENTS
 from cloudcore.measure.imagecompare import compare
 from cloudcore.navigation import orbited
@@ -104,6 +106,27 @@ def test_textures_of_a_dropped_ring_are_reused_not_added(renderer, valley):
     with_ring = renderer.texture_bytes
     _, stats = settled(renderer, valley, None, dataclasses.replace(RenderSettings(), ring_radius=np.inf))
     assert stats.plan.ring_panels_drawn == 0 and stats.texture_bytes <= with_ring
+
+
+def test_a_ring_built_in_pieces_shows_what_one_built_whole_does(renderer, valley):
+    """A particle priced at 1 ms makes every cloud a piece of its own (past `PIECE_MS`): each drawn over the last,
+    far to near, into its segment's texture, the ring is the picture of the ring rendered a segment at a time."""
+    settings = RenderSettings(mode="impostor")
+    renderer.lod_state = LodState()
+    whole, _ = settled(renderer, valley, None, settings)
+    renderer.lod_state = LodState()
+    pieces = []
+    for _ in range(400):
+        image, _ = renderer.render(valley, settings=settings, costs=CostModel(particles=1.0))
+        ring = renderer.last_plan.ring
+        pieces += [ring.build_piece] if ring.build_members else []
+        if ring.state.current is not None and ring.state.pending is None and ring.draws[0][1] == 1.0:
+            break
+    generation = renderer.last_plan.ring.state.current
+    members = sum(len(segment) for segment in generation.segment_members)
+    assert len(pieces) == members > len(generation.occupied_segments), pieces  # a cloud a piece, several a segment
+    difference = compare(image, whole)
+    assert difference.psnr_db >= 50.0, difference
 
 
 def test_orbiting_draws_groups_apart_and_the_still_eye_whole_again(renderer, valley):

@@ -46,7 +46,7 @@ class ImpostorStore:
     def update(self, plan: FramePlan, particles: ParticleBuffer, settings: RenderSettings, time_s: float) -> int:
         """Render this frame's regenerations and ring segment at scene time `time_s`; returns the particles rendered."""
         units = plan.units
-        renders = []  # (target, batch, view, projection): all sorted, then all shaded, then drawn
+        renders = []  # (target, batch, view, projection, cleared first): all sorted, then all shaded, then drawn
         for cloud in plan.clouds:
             if cloud.regenerate is None:
                 continue
@@ -61,25 +61,31 @@ class ImpostorStore:
             for layer, target in enumerate(targets):
                 depth_ranges = [layer_bounds(record.splits, layer)] * len(cloud.members)
                 batch = splat_batch(particles, cloud.members, record.eye, depth_ranges, time_s)
-                renders.append((target, batch, view.view, view.projection))
+                renders.append((target, batch, view.view, view.projection, True))
         for index in set(self._clouds) - set(plan.records):
             self._release(self._clouds.pop(index)[0])
 
         ring = plan.ring
-        if ring is not None and ring.build_segment in (
-            ring.state.pending.occupied_segments if ring.state.pending else ()
-        ):
-            generation, segment = ring.state.pending, ring.build_segment
+        if ring is not None and ring.build_members:
+            # a piece of the segment, its clouds far to near (`cloudcore.lod.ring`): the first clears the texture,
+            # the next are drawn over it
+            generation, segment, first = ring.state.pending, ring.build_segment, ring.build_piece[0] == 0
             size = generation.texture_size
-            target = self.pool.acquire(*size)
             view, projection = segment_camera(generation, segment, settings.ring_elevation_deg)
-            clouds = [cloud for unit in generation.segment_members[segment] for cloud in unit]
-            self._ring[generation, segment] = (target, _extent(particles, clouds, view, projection, size))
-            renders.append((target, splat_batch(particles, clouds, generation.eye, None, time_s), view, projection))
-        self._splats.shade_ahead([(batch, view) for _, batch, view, _ in renders])
-        for target, batch, view, projection in renders:
+            clouds = [cloud for unit in ring.build_members for cloud in unit]
+            extent = _extent(particles, clouds, view, projection, size)
+            if first:
+                target = self.pool.acquire(*size)
+            else:
+                target, held = self._ring[generation, segment]
+                extent = _union(held, extent)
+            self._ring[generation, segment] = (target, extent)
+            batch = splat_batch(particles, clouds, generation.eye, None, time_s)
+            renders.append((target, batch, view, projection, first))
+        self._splats.shade_ahead([(batch, view) for _, batch, view, _, _ in renders])
+        for target, batch, view, projection, cleared in renders:
             # the clouds alone, no depth test: the texture holds their premultiplied colour and opacity
-            target.bind_cleared()
+            target.bind_cleared() if cleared else target.bind()
             self._splats.draw(batch, view, projection, depth_test=False, point_sprites=settings.point_sprites)
         GL.glDisable(GL.GL_SCISSOR_TEST)  # the last atlas cell's: it would clip the cloud pass
         for side in [side for side, atlas in self._atlases.items() if not atlas.in_use]:
@@ -87,7 +93,7 @@ class ImpostorStore:
         live = {plan.ring_state.current, plan.ring_state.pending}
         for key in [key for key in self._ring if key[0] not in live]:
             self.pool.release(self._ring.pop(key)[0])
-        return sum(len(batch) for _, batch, _, _ in renders)
+        return sum(len(batch) for _, batch, _, _, _ in renders)
 
     @property
     def texture_bytes(self) -> int:
@@ -137,6 +143,15 @@ class ImpostorStore:
         self._ring.clear()
         self._atlases.clear()
         self.pool.close()
+
+
+def _union(extent: tuple, other: tuple) -> tuple:
+    """The part of a texture two extents (u0, v0, u1, v1) cover together (an empty one, u1 <= u0, covers none)."""
+    if other[2] <= other[0]:
+        return extent
+    if extent[2] <= extent[0]:
+        return other
+    return (min(extent[0], other[0]), min(extent[1], other[1]), max(extent[2], other[2]), max(extent[3], other[3]))
 
 
 def _extent(particles: ParticleBuffer, clouds, view, projection, size) -> tuple:

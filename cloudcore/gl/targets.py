@@ -42,11 +42,15 @@ class TextureTarget:
     def nbytes(self) -> int:
         return self.width * self.height * _TEXEL_BYTES[self.internal_format]
 
-    def bind_cleared(self) -> None:
-        """Draw into this target from now on, starting from transparent black (depth untouched)."""
+    def bind(self) -> None:
+        """Draw into this target from now on, over what it holds."""
         GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, self.framebuffer)
         GL.glViewport(0, 0, self.width, self.height)
         GL.glDisable(GL.GL_SCISSOR_TEST)  # an atlas cell's, or the GUI's, would clip it
+
+    def bind_cleared(self) -> None:
+        """Draw into this target from now on, starting from transparent black (depth untouched)."""
+        self.bind()
         GL.glClearColor(0.0, 0.0, 0.0, 0.0)
         GL.glClear(GL.GL_COLOR_BUFFER_BIT)
 
