@@ -108,23 +108,32 @@ def test_textures_of_a_dropped_ring_are_reused_not_added(renderer, valley):
     assert stats.plan.ring_panels_drawn == 0 and stats.texture_bytes <= with_ring
 
 
-def test_a_ring_built_in_pieces_shows_what_one_built_whole_does(renderer, valley):
-    """A particle priced at 1 ms makes every cloud a piece of its own (past `PIECE_MS`): each drawn over the last,
-    far to near, into its segment's texture, the ring is the picture of the ring rendered a segment at a time."""
-    settings = RenderSettings(mode="impostor")
+def test_a_ring_rebuilt_in_pieces_shows_what_one_built_whole_does(renderer, valley):
+    """Relit, the ring is rebuilt; a particle priced at 1 ms makes every cloud a piece of its own (past
+    `RING_FRAME_MS`), each drawn over the last, far to near, into its segment's texture: the rebuilt ring is the
+    picture of the first ring at that hour, built a segment a frame."""
+    settings, later = RenderSettings(mode="impostor"), valley.lighting.time_of_day + 1.0
+
+    def render(frames, **options):
+        for _ in range(frames):
+            image, _ = renderer.render(valley, settings=settings, time_of_day=later, **options)
+            yield image, renderer.last_plan.ring
+
     renderer.lod_state = LodState()
-    whole, _ = settled(renderer, valley, None, settings)
-    renderer.lod_state = LodState()
+    settled(renderer, valley, None, settings)
+    first = renderer.last_plan.ring.state.current
     pieces = []
-    for _ in range(400):
-        image, _ = renderer.render(valley, settings=settings, costs=CostModel(particles=1.0))
-        ring = renderer.last_plan.ring
+    for frame in render(400, costs=CostModel(particles=1.0)):
+        image, ring = frame
         pieces += [ring.build_piece] if ring.build_members else []
-        if ring.state.current is not None and ring.state.pending is None and ring.draws[0][1] == 1.0:
+        if ring.state.current is not first and ring.state.pending is None:
             break
-    generation = renderer.last_plan.ring.state.current
-    members = sum(len(segment) for segment in generation.segment_members)
-    assert len(pieces) == members > len(generation.occupied_segments), pieces  # a cloud a piece, several a segment
+    rebuilt = ring.state.current
+    assert rebuilt is not first and len(pieces) == sum(map(len, rebuilt.segment_members)) > len(
+        rebuilt.occupied_segments
+    )
+    renderer.lod_state = LodState()
+    *_, (whole, _) = render(SETTLE_FRAMES)
     difference = compare(image, whole)
     assert difference.psnr_db >= 50.0, difference
 

@@ -73,7 +73,15 @@ from cloudcore.lod.impostors import (
     screen_size_px,
     tolerance_deg_for,
 )
-from cloudcore.lod.ring import SEGMENT_DEG, RingPlan, RingState, plan_ring, ring_members, segment_texture_size
+from cloudcore.lod.ring import (
+    RING_FRAME_MS,
+    SEGMENT_DEG,
+    RingPlan,
+    RingState,
+    plan_ring,
+    ring_members,
+    segment_texture_size,
+)
 from cloudcore.lod.splitting import layer_bounds, layer_counts, layer_sort_key, layers_hold, objects_inside
 from cloudcore.lod.units import LodUnits
 from cloudcore.measure.frame_stats import PlanStats
@@ -413,7 +421,8 @@ def _plan_units(
     held_errors = _held_errors(units, records, translation_error, eye)
     # auto mode prices Wang's ring against drawing its clouds each as auto would (the cheaper of full 3D and
     # an impostor): a sparse far field is cheaper drawn than its panels and their rebuilds
-    ring_ms = alone_ms = 0.0
+    ring_ms = alone_ms = ring_error = 0.0
+    chases_tolerance = False
     candidates = np.zeros(len(radii), dtype=bool)
     # auto mode found the last frame cheaper drawn all in full 3D (`_frame_choice`): every unit heads there
     all_full = settings.mode == "auto" and state.frame_choice == "full"
@@ -423,7 +432,7 @@ def _plan_units(
         candidates = ring_members(centres, radii, eye, settings)
         step = eye - last_eye if last_eye is not None else np.zeros(3)
         alone = candidates & visible
-        ring_panels, ring_rebuild = _ring_work(
+        ring_panels, ring_rebuild, moved_lifetime, tolerance_lifetime = _ring_work(
             units,
             candidates,
             centres,
@@ -435,7 +444,14 @@ def _plan_units(
             settings,
             state.ring,
         )
-        ring_ms = costs.ms(ring_panels + ring_rebuild)
+        # the ring is kept within the tolerance (rebuilt once a cloud of it passes it: Wang's panels are impostors
+        # too) while that costs at most its share of a frame; past it, only by Wang's own rules, as impostor mode
+        # does, and the error it then shows is the plan's accepted error (the 1.2M field orbiting 0.05 degrees a
+        # frame: 18 ms a frame of rebuilds to keep it so, a 400 ms rebuild every 60 frames, for 1.2 dB)
+        chases_tolerance = costs.ms(ring_rebuild) / max(tolerance_lifetime, 1.0) <= RING_FRAME_MS
+        ring_lifetime = tolerance_lifetime if chases_tolerance else moved_lifetime
+        ring_ms = costs.ms(ring_panels + ring_rebuild.scaled(1.0 / max(ring_lifetime, 1.0)))
+        ring_error = _ring_error(state.ring.current, translation_error, eye)
         if units.sample is not None:
             in_view_particles[alone], in_view_fragments[alone] = _in_view_work(
                 units, alone, planes, eye, focal_px, screen_pixels, ball_fragments
@@ -453,8 +469,7 @@ def _plan_units(
         units.members,
         segment_texture_size(height, camera.fov_y_deg, settings),
         holds_clouds=settings.mode != "auto" or (not all_full and _ring_pays(state.ring, ring_ms, alone_ms)),
-        past_tolerance=settings.mode == "auto"
-        and _ring_past_tolerance(state.ring.current, translation_error, eye, tolerance),
+        past_tolerance=chases_tolerance and ring_error > tolerance,
         # a segment is priced as its update is (below), by its particles: what the segment's render takes on
         # llvmpipe (478,000 particles of the 1.2M field, 368 ms: 0.77 us a particle, the fit's prior 0.85)
         build_ms=lambda members: costs.particles * float(units.particle_counts[index_of[members]]),
@@ -689,7 +704,8 @@ def _plan_units(
     for index, _, remake in wanted:
         if index in served:
             update_work += remake
-    accepted = 0.0  # the largest translation error drawn, over the tolerance
+    # the largest translation error drawn, over the tolerance
+    accepted = 0.0 if chases_tolerance or ring is None or not ring.draws else ring_error / max(tolerance, 1e-300)
     for index, cloud in enumerate(clouds):
         if cloud.kind not in TEXTURED:
             continue
@@ -857,22 +873,22 @@ def _ring_panels_work(panels: int, quad_pixels) -> Work:
 
 def _ring_work(
     units: LodUnits, candidates, centres, eye, step, ball_fragments, quad_pixels, lifetimes, settings, state: RingState
-) -> tuple[Work, Work]:
-    """(panels, rebuild): a frame of Wang's ring holding the units `candidates` (mask).
+) -> tuple[Work, Work, float, float]:
+    """(panels, rebuild, moved, tolerated): Wang's ring holding the units `candidates` (mask).
 
-    Its panels drawn (`quad_pixels`: the candidates in view's impostor quads), and its rebuild (every
-    candidate splatted into the segments, whose textures have the screen's pixel density) spread over
-    the frames until the eye's current `step` a frame carries it past a rebuild distance, or over the
-    frames the last ring lasted, or its clouds' impostors would (`lifetimes`), when shorter.
+    Its panels drawn a frame (`quad_pixels`: the candidates in view's impostor quads), its rebuild (every
+    candidate splatted into the segments, whose textures have the screen's pixel density), and the frames
+    it lasts: until the eye's current `step` a frame carries it past a rebuild distance, or the frames the
+    last ring lasted when shorter (moved); and that or the frames its clouds' impostors would (`lifetimes`),
+    when shorter still (tolerated).
     """
     offsets = centres[candidates] - eye
     azimuths = np.degrees(np.arctan2(offsets[:, 0], -offsets[:, 2])) % 360.0
     panels = len(np.unique(np.floor(azimuths / SEGMENT_DEG)))
     horizontal, vertical = math.hypot(step[0], step[2]), abs(step[1])
-    lifetime = min(
+    moved = min(
         LONGEST_LIFETIME_FRAMES,
         state.rebuild_interval,
-        float(np.min(lifetimes[candidates], initial=math.inf)),  # auto mode rebuilds it past the tolerance
         settings.ring_rebuild_horizontal * settings.ring_radius / max(horizontal, 1e-300),
         settings.ring_rebuild_vertical * settings.ring_radius / max(vertical, 1e-300),
     )
@@ -881,7 +897,8 @@ def _ring_work(
         texture_fragments=float(np.sum(ball_fragments[candidates])),
         regenerations=float(panels),
     )
-    return _ring_panels_work(panels, quad_pixels), rebuild.scaled(1.0 / max(lifetime, 1.0))
+    tolerated = min(moved, float(np.min(lifetimes[candidates], initial=math.inf)))
+    return _ring_panels_work(panels, quad_pixels), rebuild, moved, tolerated
 
 
 def _in_view_work(units: LodUnits, chosen, planes, eye, focal_px, screen_pixels, ball_fragments):
@@ -1077,13 +1094,13 @@ def _groups_cheaper_apart(units: LodUnits, seen: _Seen, settings, state: LodStat
     return frozenset(wanted)
 
 
-def _ring_past_tolerance(generation, translation_error, eye, tolerance: float) -> bool:
-    """Whether a cloud of the ring `generation` (None: no ring) has a translation error past the tolerance, seen
-    from its eye: Wang's panels are impostors too, and auto mode keeps every impostor within the tolerance."""
+def _ring_error(generation, translation_error, eye) -> float:
+    """The largest translation error of a cloud of the ring `generation` (None: no ring; 0: none) seen from
+    `eye`: Wang's panels are impostors too."""
     if generation is None or not generation.members:
-        return False
+        return 0.0
     centres, radii = generation.spheres
-    return bool(np.any(translation_error(centres, radii, generation.eye, eye) > tolerance))
+    return float(np.max(translation_error(centres, radii, generation.eye, eye), initial=0.0))
 
 
 def _ring_pays(state: RingState, ring_ms: float, alone_ms: float) -> bool:

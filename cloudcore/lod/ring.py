@@ -8,10 +8,12 @@ the radius (15% horizontally, 2% vertically, as in the paper), the lights
 changed, or the screen now asks for finer (or far coarser) segment textures
 than the ring was made with (a window grown from its first, tiny frame): one
 segment a frame, then the new ring crossfades in over a few frames while the
-old one fades out.  A segment dearer than the frame's share for the ring
-(`plan_ring`'s budget) is built in pieces over several frames, its clouds
-far to near, each piece drawn over the last: the 1.2M-particle field's
-segments took 115 to 418 ms each, a stall in one frame.  Pure numpy; the GL
+old one fades out.  Rebuilt, a segment dearer than the ring's share of a
+frame (`RING_FRAME_MS`) is built in pieces over several frames, its clouds
+far to near, each piece drawn over the last, while the last ring shows: the
+1.2M-particle field's segments took 115 to 418 ms each, a stall in one
+frame.  The first ring is built a segment a frame: until it is in, its
+clouds are drawn on their own, at twice the field's frame.  Pure numpy; the GL
 side renders what `RingPlan` says.
 """
 
@@ -30,10 +32,11 @@ from cloudcore.settings import RenderSettings
 
 SEGMENTS = 8
 SEGMENT_DEG = 360.0 / SEGMENTS
-#: ms of a frame the ring's build may take, by the cost model (`plan_ring`'s `build_ms`): a dearer segment is built
-#: in pieces, a member at least each.  A third of a 30 fps frame on llvmpipe: the 1.2M-particle field's segments,
-#: 115 to 418 ms each, then take 12 to 42 frames (its ring, rebuilt, lasts about 60)
-PIECE_MS = 10.0
+#: the ring's share of a frame, ms by the cost model: what its build may take (`plan_ring`'s `build_ms`: a dearer
+#: segment is built in pieces, a member at least each) and, in auto mode, what keeping it within the impostors'
+#: tolerance may cost a frame (`cloudcore.lod.frameplan`).  A third of a 30 fps frame on llvmpipe: the
+#: 1.2M-particle field's segments, 115 to 418 ms each, then take 12 to 42 frames
+RING_FRAME_MS = 10.0
 #: metres: the panels never come nearer than this, so a zero ring radius still has a drawable octagon
 MIN_PANEL_DISTANCE = 10.0
 
@@ -238,8 +241,9 @@ def plan_ring(
     itself): the ring shown fades out as when it is rebuilt, with nothing to build.  `past_tolerance`: the
     ring shown holds a cloud whose translation error has passed the impostors' tolerance (auto mode keeps
     every representation within it): it is rebuilt as when the eye has moved past the rebuild distance.
-    `build_ms`: per id, the predicted ms of drawing it into a segment; a segment's members are then drawn far to
-    near in pieces of at most `PIECE_MS` (one member at least), each over the last.  None: a segment a frame.
+    `build_ms`: per id, the predicted ms of drawing it into a segment; a ring rebuilt while one holding clouds
+    shows draws a segment's members far to near in pieces of at most `RING_FRAME_MS` (one member at least), each
+    over the last.  None, or no such ring shown: a segment a frame.
 
     A ring being built when its members' keys change is finished first and rebuilt after: a cloud
     forming in the ring, whose key changes every frame, would otherwise keep the ring from ever
@@ -273,7 +277,8 @@ def plan_ring(
     if pending is not None:
         if built < SEGMENTS:
             members = pending.segment_members[built]
-            stop = _piece_end(members, built_of_segment, build_ms)
+            shown = current is not None and current.holds_clouds  # else the clouds cost more until it is in
+            stop = _piece_end(members, built_of_segment, build_ms if shown else None)
             build_segment, build_piece = built, (built_of_segment, stop)
             built, built_of_segment = (built + 1, 0) if stop == len(members) else (built, stop)
         else:
@@ -296,13 +301,13 @@ def plan_ring(
 
 def _piece_end(members: tuple, start: int, build_ms: Callable[[Hashable], float] | None) -> int:
     """Where the piece of a segment's `members` drawn this frame from `start` ends: as many as fit in
-    `PIECE_MS` together, one at least."""
+    `RING_FRAME_MS` together, one at least."""
     if build_ms is None:
         return len(members)
     stop, spent = start, 0.0
     while stop < len(members):
         spent += build_ms(members[stop])
-        if stop > start and spent > PIECE_MS:
+        if stop > start and spent > RING_FRAME_MS:
             break
         stop += 1
     return stop
