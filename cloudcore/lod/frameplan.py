@@ -229,7 +229,9 @@ class FramePlan:
     cloud_work: Work = Work()  # predicted work of the cloud pass
     costs: CostModel = CostModel()  # the model the plan priced its choices with
     tolerance_deg: float = 0.0  # the translation tolerance in force
-    accepted_error: float = 0.0  # the largest translation error drawn, in tolerances (> 1: a budget postponed it)
+    #: the largest translation error drawn, in tolerances (> 1: a budget postponed it, or auto kept Wang's ring by
+    #: Wang's rules, its upkeep within the tolerance past `RING_FRAME_MS`)
+    accepted_error: float = 0.0
     units: LodUnits | None = None  # the frame's units, which `clouds` index: the groups planned apart opened
 
     @property
@@ -447,7 +449,7 @@ def _plan_units(
         # the ring is kept within the tolerance (rebuilt once a cloud of it passes it: Wang's panels are impostors
         # too) while that costs at most its share of a frame; past it, only by Wang's own rules, as impostor mode
         # does, and the error it then shows is the plan's accepted error (the 1.2M field orbiting 0.05 degrees a
-        # frame: 18 ms a frame of rebuilds to keep it so, a 400 ms rebuild every 60 frames, for 1.2 dB)
+        # frame: 18 ms a frame of rebuilds to keep it so, 1.1 s every 60 frames, for 1.2 dB)
         chases_tolerance = costs.ms(ring_rebuild) / max(tolerance_lifetime, 1.0) <= RING_FRAME_MS
         ring_lifetime = tolerance_lifetime if chases_tolerance else moved_lifetime
         ring_ms = costs.ms(ring_panels + ring_rebuild.scaled(1.0 / max(ring_lifetime, 1.0)))

@@ -239,8 +239,9 @@ def plan_ring(
     mistake one cloud for another.  `texture_size` is the segment texture size the screen asks for
     (`segment_texture_size`).  `holds_clouds` False asks for a ring of no clouds (it does not pay for
     itself): the ring shown fades out as when it is rebuilt, with nothing to build.  `past_tolerance`: the
-    ring shown holds a cloud whose translation error has passed the impostors' tolerance (auto mode keeps
-    every representation within it): it is rebuilt as when the eye has moved past the rebuild distance.
+    ring shown holds a cloud whose translation error has passed the impostors' tolerance (auto mode keeps it
+    within it where that costs at most `RING_FRAME_MS` a frame): it is rebuilt as when the eye has moved past
+    the rebuild distance.
     `build_ms`: per id, the predicted ms of drawing it into a segment; a ring rebuilt while one holding clouds
     shows draws a segment's members far to near in pieces of at most `RING_FRAME_MS` (one member at least), each
     over the last.  None, or no such ring shown: a segment a frame.
