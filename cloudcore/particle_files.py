@@ -55,10 +55,32 @@ def store_particles(cloud: Cloud, path: Path) -> str:
     return relative
 
 
+def open_particle_array(file: Path) -> np.ndarray:
+    """The array a .npy holds, memory-mapped (a header that claims more data than the file holds fails here
+    instead of allocating it); ValueError where its header describes none numpy can map safely.
+
+    The header is read and checked before numpy maps the file: a forged one of zero-byte items and a negative
+    dimension ('V0', (-1,)) killed the process with SIGFPE inside numpy's memmap (found by the fuzz tests).
+    Only versions 1.0 and 2.0 are read: numpy writes 3.0 only for field names outside latin-1, which a plain
+    numeric array has none of.
+    """
+    readers = {(1, 0): np.lib.format.read_array_header_1_0, (2, 0): np.lib.format.read_array_header_2_0}
+    with open(file, "rb") as stream:
+        version = np.lib.format.read_magic(stream)
+        if version not in readers:
+            raise ValueError(f"version {version[0]}.{version[1]} holds no plain numeric array")
+        shape, _, dtype = readers[version](stream)  # numpy's own header size limit, as np.load
+    if dtype.itemsize == 0:
+        raise ValueError(f"items of {dtype} hold no bytes")
+    if any(side < 0 for side in shape):
+        raise ValueError(f"a negative dimension in its shape {shape}")
+    return np.load(file, mmap_mode="r", allow_pickle=False)
+
+
 def _holds(file: Path, particles: np.ndarray) -> bool:
     """Whether `file` is a .npy of exactly `particles` (float64, bit for bit)."""
     try:
-        stored = np.load(file, mmap_mode="r", allow_pickle=False)
+        stored = open_particle_array(file)
     except Exception:  # missing, unreadable or corrupt (np.load raises many kinds): it does not hold them
         return False
     return stored.dtype == np.float64 and stored.shape == particles.shape and np.array_equal(stored, particles)

@@ -21,7 +21,12 @@ from cloudcore.cloud_records import FACINGS, FORMATION_KINDS, MAX_SEED, ArtistSh
 from cloudcore.light.phase import MAX_ABS_G, PHASE_NAMES
 from cloudcore.light.shading import EYE_PASSES, LIGHT_PASSES
 from cloudcore.limits import scene_limit_problems
-from cloudcore.particle_files import atomic_write, remove_unnamed_particle_files, store_particles
+from cloudcore.particle_files import (
+    atomic_write,
+    open_particle_array,
+    remove_unnamed_particle_files,
+    store_particles,
+)
 from cloudcore.scene import (
     DEFAULT_VIEW_NAME,
     MAX_LAYERS,
@@ -340,9 +345,7 @@ def _artist(t: Table) -> ArtistShading:
 
 def _read_particles(t: Table, file: Path) -> np.ndarray:
     try:
-        # mmap_mode: a header that claims more data than the file holds fails here instead of
-        # allocating it; checked_matrix copies the data out of the map
-        array = np.load(file, mmap_mode="r", allow_pickle=False)
+        array = open_particle_array(file)  # memory-mapped: checked_matrix copies the data out of the map
     except FileNotFoundError:
         t.fail("particles_file", f"{file}: no such file")
     except Exception as error:  # a forged header raises ValueError, OverflowError, TokenError, BadZipFile...

@@ -22,11 +22,14 @@ import io
 import math
 import os
 import pickle
+import subprocess
+import sys
 import tomllib
 
 import numpy as np
 import pytest
 import tomlkit
+from conftest import ROOT
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
@@ -673,6 +676,33 @@ def test_forged_npy_headers_load_or_are_refused(saved, header, version, drop, pa
     outcome = load_with_npy(saved, content + payload)
     if isinstance(outcome, SceneError):
         assert outcome.field == NPY_FIELD
+
+
+@pytest.mark.parametrize("descr, shape", [("'V0'", "(-1,)"), ("'S0'", "(-2, 4)"), ("'<f8'", "(-1, 4)")])
+def test_a_header_of_empty_items_or_a_negative_dimension_is_refused_not_a_crash(saved, descr, shape):
+    """'V0' of shape (-1,) killed the process with SIGFPE inside numpy's memmap (the fuzz test above found it):
+    the header is checked before the file is mapped, in a child so that a crash fails this test, not the run."""
+    text = f"{{'descr': {descr}, 'fortran_order': False, 'shape': {shape}, }}".encode("latin1")
+    body = text + b" " * ((64 - (10 + len(text) + 1) % 64) % 64) + b"\n"
+    npy_of(saved).write_bytes(b"\x93NUMPY\x01\x00" + len(body).to_bytes(2, "little") + body + b"\x00" * 64)
+    child = subprocess.run(
+        [sys.executable, "-c", LOAD_AND_SAY, str(saved)], capture_output=True, text=True, timeout=120, cwd=ROOT
+    )
+    assert child.returncode == 0, f"the load died ({child.returncode}): {child.stderr}"
+    field, message = child.stdout.strip().split("\t")
+    assert field == NPY_FIELD and "not a readable .npy" in message, message
+
+
+#: a child's load of a scene: the field and message of its refusal, tab-separated
+LOAD_AND_SAY = """
+import sys
+from cloudcore.errors import SceneError
+from cloudcore.scenefile import load_scene
+try:
+    load_scene(sys.argv[1])
+except SceneError as error:
+    print(error.field, str(error), sep="\\t")
+"""
 
 
 @pytest.mark.parametrize(
