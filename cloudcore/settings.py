@@ -23,6 +23,8 @@ MODES = ("auto", "full", "impostor")
 TRANSLATION_METRICS = ("parallax", "centre")
 #: how full-3D splats are composited (`cloudcore.light.volume_blending`)
 BLENDINGS = ("plain", "volume")
+#: where full-3D draws choose and order their particles (`cloudcore.gl.splats`)
+SPLAT_ORDERS = ("cpu", "gpu")
 
 
 @dataclass(frozen=True)
@@ -223,12 +225,27 @@ class RenderSettings:
         label="Blending",
     )
 
+    #: "cpu": a draw's particles are chosen and sorted far to near in numpy and their order uploaded; "gpu":
+    #: chosen, sorted and counted by compute shaders, drawn as quads by an indirect draw, so that the CPU's
+    #: work for a draw does not grow with its particles.  CPU by default: on llvmpipe the GPU's sort is
+    #: two orders of magnitude slower than numpy's (docs/performance.md, "The GPU's order")
+    splat_order: str = _setting(
+        "cpu",
+        flag="--splat-order",
+        help="cpu: full-3D splats chosen and sorted far to near on the CPU; gpu: by compute shaders, "
+        "drawn indirectly (for GPUs: slower on llvmpipe)",
+        choices=SPLAT_ORDERS,
+        label="Splat order",
+    )
+
     def __post_init__(self):
         problems = []
         if self.mode not in MODES:
             problems.append(f"mode must be one of {', '.join(MODES)}, got {self.mode!r}")
         if self.blending not in BLENDINGS:
             problems.append(f"blending must be one of {', '.join(BLENDINGS)}, got {self.blending!r}")
+        if self.splat_order not in SPLAT_ORDERS:
+            problems.append(f"splat_order must be one of {', '.join(SPLAT_ORDERS)}, got {self.splat_order!r}")
         if not 0.0 <= self.tolerance_deg <= 180.0:
             problems.append(f"tolerance_deg must be within [0, 180], got {self.tolerance_deg}")
         if self.translation_metric not in TRANSLATION_METRICS:

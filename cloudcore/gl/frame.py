@@ -43,7 +43,7 @@ from cloudcore.gl.objects import ObjectPass
 from cloudcore.gl.pass_clock import PassClock
 from cloudcore.gl.programs import build_program
 from cloudcore.gl.quads import SCREEN_CORNERS, QuadPass
-from cloudcore.gl.splats import SplatBatch, SplatPass, splat_batch
+from cloudcore.gl.splats import SplatBatch, SplatPass, SplatSelection, splat_batch
 from cloudcore.gl.targets import TextureTarget, blit_depth, depth_renderbuffer
 from cloudcore.gl.volume_blending import GpuFeatures, VolumeBlendingPass
 from cloudcore.gl.world import WorldPass
@@ -76,6 +76,7 @@ class _CloudPassFrame:
     time_s: float
     point_sprites: bool  # the setting: draw plain splats as points where the picture is the same
     blending: str  # the setting: full-3D splats as billboards ("plain") or as volumes ("volume")
+    splat_order: str  # the setting: full-3D splats chosen and sorted on the "cpu" or the "gpu"
 
     @property
     def eye(self) -> np.ndarray:
@@ -221,6 +222,7 @@ class FrameRenderer:
         with clock.timed("clouds"):
             self.context.bind_target()
             drawn = self._draw_clouds(plan, particles, camera, view, projection, settings, poses, time_s)
+        drawn += self._splats.take_selected()
         world, updates, clouds = (clock.times[name] for name in ("world", "impostor updates", "clouds"))
         self.lod_state = plan.state.measured([(plan.update_work, updates.wall_ms), (plan.cloud_work, clouds.wall_ms)])
         stats = FrameStats(
@@ -374,6 +376,7 @@ class FrameRenderer:
             time_s,
             settings.point_sprites,
             settings.blending,
+            settings.splat_order,
         )
         self._replay, self._screen_batches = [], []
         steps = self._cloud_pass_steps(frame)
@@ -420,7 +423,7 @@ class FrameRenderer:
                 full_run.append(item)
                 continue
             if full_run:
-                steps.append(("splats", None, self._batch_of(frame, full_run)))
+                steps.append(("splats", None, self._full_3d_batch(frame, full_run)))
                 full_run = []
             kind = "object" if cloud is None else cloud.kind
             if kind == "impostor" and steps and steps[-1][0] == "impostors":
@@ -430,20 +433,40 @@ class FrameRenderer:
             else:
                 steps.append((kind, item, self._batch_of(frame, [item]) if kind == "crossfade" else None))
         if full_run:
-            steps.append(("splats", None, self._batch_of(frame, full_run)))
+            steps.append(("splats", None, self._full_3d_batch(frame, full_run)))
         return steps
+
+    def _full_3d_batch(self, frame: _CloudPassFrame, items) -> SplatBatch | SplatSelection:
+        """`_batch_of` for a run of full-3D layers; chosen and sorted on the GPU with that setting, where they
+        are blended as billboards (volume blending reads its batch on the CPU)."""
+        if frame.splat_order == "gpu" and frame.blending == "plain":
+            clouds, depth_ranges = self._members_and_ranges(frame, items)
+            return SplatSelection(frame.particles, clouds, frame.eye, depth_ranges, frame.time_s, frame.frustum)
+        return self._batch_of(frame, items)
 
     def _batch_of(self, frame: _CloudPassFrame, items) -> SplatBatch:
         """The splats of the units of draw `items`, each within its item's depth range, sorted together."""
-        clouds, depth_ranges = zip(
-            *[(member, (item.near, item.far)) for item in items for member in frame.plan.clouds[item.index].members]
-        )
+        clouds, depth_ranges = self._members_and_ranges(frame, items)
         return splat_batch(frame.particles, clouds, frame.eye, depth_ranges, frame.time_s, frame.frustum)
 
-    def _draw_splats(self, frame: _CloudPassFrame, batch: SplatBatch, colour_texture: int | None = None) -> int:
+    @staticmethod
+    def _members_and_ranges(frame: _CloudPassFrame, items) -> tuple[tuple, tuple]:
+        """(the clouds of draw `items`, the depth range of each: its item's)."""
+        pairs = [(member, (item.near, item.far)) for item in items for member in frame.plan.clouds[item.index].members]
+        return tuple(zip(*pairs))
+
+    def _draw_splats(
+        self, frame: _CloudPassFrame, batch: SplatBatch | SplatSelection, colour_texture: int | None = None
+    ) -> int:
         """Full 3D: a batch of splats on the screen (or the screen layer whose `colour_texture` is bound), as
-        billboards or as volumes."""
+        billboards or as volumes; returns the particles drawn, but 0 for a selection: the GPU counts those
+        (`SplatPass.take_selected`)."""
         view, projection, points = frame.view, frame.projection, frame.point_sprites
+        if isinstance(batch, SplatSelection):
+            self._splats.draw(batch, view, projection)
+            self._replay.append(lambda: self._splats.draw(batch, view, projection, counting=True))
+            self._screen_batches.append(batch)
+            return 0
         path = blending_path(
             frame.blending,
             compute_shaders=self._volume.features.compute_shaders,
@@ -580,7 +603,7 @@ class FrameRenderer:
         view, projection = self._last_matrices
         analytic = sum(
             analytic_overdraw(batch.centres, batch.radii, view, projection, NEAR_PLANE_M)
-            for batch in self._screen_batches
+            for batch in (batch.on_cpu() for batch in self._screen_batches)
         )
         counts = self._overdraw_target.read()
         self.context.bind_target()

@@ -9,9 +9,12 @@ the splats are drawn from.  Per draw the CPU only orders:
 `splat_batch` gathers the particles of some clouds (several together, since
 clouds interpenetrate in depth), leaves out those the near fade or a
 formation makes fully transparent, and sorts the rest far to near from the
-eye; the batch uploads just those indices (4 bytes a particle).  With the
-depth test on, terrain hides splats; splats never write depth.  Drawn with
-`counting=True`, every fragment adds 1 instead (overdraw).
+eye; the batch uploads just those indices (4 bytes a particle).  Or, for
+a `SplatSelection`, the GPU does that too (`splat_select.comp.glsl`, then
+`cloudcore.gl.depth_sort`) and the quads are drawn by an indirect draw whose
+count the GPU wrote: the CPU's work for the draw no longer grows with its
+particles.  With the depth test on, terrain hides splats; splats never write
+depth.  Drawn with `counting=True`, every fragment adds 1 instead (overdraw).
 """
 
 from __future__ import annotations
@@ -29,9 +32,10 @@ from cloudcore.artist.sprites import ATLAS_MAX_MIP_LEVEL, load_atlas
 from cloudcore.camera import splats_in_frustum
 from cloudcore.cloud_records import ATLAS_GRID
 from cloudcore.gl.blending import cloud_blending
+from cloudcore.gl.depth_sort import GpuDepthSort
 from cloudcore.gl.programs import build_compute_program, build_program, set_matrix_at, set_vec3_at, uniform_locations
 from cloudcore.light.eye_scattering import FADE_END_RADII, FADE_START_RADII, ParticleBuffer
-from cloudcore.light.kernel import SPLAT_SHARPNESS
+from cloudcore.light.kernel import SPLAT_REACH, SPLAT_SHARPNESS
 from cloudcore.light.phase import PHASE_NAMES
 from cloudcore.limits import MAX_LIGHTS
 from cloudcore.lod.depth_order import far_to_near
@@ -56,8 +60,20 @@ _UNLOCKED = (0.0, 0.0, 0.0, -1.0)
     _FACING_BINDING,
     _PROFILES_BINDING,
 ) = range(7)
-#: the compute shader's local_size_x
-_SHADE_GROUP = 64
+#: splat_select.comp.glsl's buffers
+(
+    _SELECT_PARTICLES,
+    _SELECT_FORMATION,
+    _SELECT_BITS,
+    _SELECT_RANGES,
+    _SELECT_KEYS,
+    _SELECT_VALUES,
+    _SELECT_COMMAND,
+) = range(7)
+#: the compute shaders' local_size_x
+_SHADE_GROUP = _SELECT_GROUP = 64
+#: uints of a DrawElementsIndirectCommand: count, instance count, first index, base vertex, base instance
+_COMMAND_UINTS = 5
 
 
 @dataclass(frozen=True)
@@ -73,6 +89,15 @@ class SplatBatch:
         return len(self.order)
 
     @property
+    def slots(self) -> int:
+        """Instances its shading fills."""
+        return len(self.order)
+
+    def on_cpu(self) -> SplatBatch:
+        """The batch (its particles are known on the CPU): as `SplatSelection.on_cpu`."""
+        return self
+
+    @property
     def centres(self) -> np.ndarray:
         """(n, 3) world centres, for the analytic overdraw estimate."""
         return self.particles.centres[self.order]
@@ -80,6 +105,29 @@ class SplatBatch:
     @property
     def radii(self) -> np.ndarray:
         return self.particles.radii[self.order]
+
+
+@dataclass(frozen=True, eq=False)
+class SplatSelection:
+    """The particles of one draw as `splat_batch` chooses them (its arguments), chosen and ordered by the GPU
+    when `SplatPass` shades it: how many there are is known there only (`SplatPass.take_selected`)."""
+
+    particles: ParticleBuffer
+    clouds: tuple
+    eye: np.ndarray
+    depth_ranges: tuple | None
+    time_s: float | None
+    frustum: np.ndarray | None
+
+    @property
+    def slots(self) -> int:
+        """Instances its shading fills: one per particle of its clouds, chosen or not."""
+        starts = self.particles.cloud_starts
+        return int(sum(starts[c + 1] - starts[c] for c in self.clouds))
+
+    def on_cpu(self) -> SplatBatch:
+        """The same particles chosen and sorted on the CPU, for what reads them there (overdraw's estimate)."""
+        return splat_batch(self.particles, self.clouds, self.eye, self.depth_ranges, self.time_s, self.frustum)
 
 
 def splat_batch(
@@ -181,6 +229,24 @@ class SplatPass:
         self._slots_ahead = 0
         self._resident: ParticleBuffer | None = None
         self._formation_time: tuple | None = None  # (time, weights serial) of the held opacity factors
+        #: of the resident particles' clouds: (facing, artist) as bits, whether any is an atlas sprite; what a
+        #: `SplatSelection`'s shading and drawing go by, its particles unknown to the CPU
+        self._cloud_feature_bits: np.ndarray = np.zeros(1, dtype=np.uint8)
+        self._cloud_sprites: np.ndarray = np.zeros(1, dtype=bool)
+        #: choosing and sorting on the GPU, made when a selection first needs it: (splat_select's program,
+        #: its uniforms' locations, the sort)
+        self._selecting: tuple | None = None
+        (
+            self._drawn_bits_buffer,
+            self._ranges_buffer,
+            self._keys_buffer,
+            self._values_buffer,
+            self._command_buffer,
+        ) = self._selection_buffers = GL.glGenBuffers(5)
+        self._keys_capacity = self._command_capacity = 0
+        #: the selections shaded since `shade_ahead` last began a pass: id -> their indirect command's index
+        self._commands: dict[int, int] = {}
+        self._drawn_commands: list[int] = []  # those drawn (not counting fragments) since `take_selected`
 
     def draw(
         self,
@@ -196,12 +262,14 @@ class SplatPass:
 
         With `point_sprites`, the runs of the batch that `cloudcore.point_sprites` allows are drawn as
         points, the rest as quads, in the batch's order; returns the particles drawn as points.
+        A `SplatSelection` is drawn as quads, by one indirect draw.
         """
+        if isinstance(batch, SplatSelection):
+            return self._draw_selection(batch, view, projection, depth_test, counting)
         if not len(batch):
             return 0
         _, first = self.shade(batch, view)
-        view_rotation = np.array(view, dtype=np.float64)
-        view_rotation[:3, 3] = 0.0  # corners come relative to the batch's eye, the view's own
+        view_rotation = _rotation(view)
         pieces, target_viewport = [(0, len(batch), False)], None
         plain = self.plain_splats(batch) if point_sprites else None
         if plain is not None and plain.any():
@@ -217,19 +285,8 @@ class SplatPass:
         with_sprites = bool(self._sprites[batch.order].any())
         programs = {points: self._programs[points, counting, with_sprites and not points] for points in (False, True)}
         for as_points in {piece[2] for piece in pieces}:
-            program = programs[as_points]
-            uniforms = self._uniforms[program]
-            GL.glUseProgram(program)
-            set_matrix_at(uniforms["view_rotation"], view_rotation)
-            set_matrix_at(uniforms["projection"], projection)
-            if as_points:
-                GL.glUniform1f(uniforms["viewport_height"], float(viewport[3]))
-        if self._atlas is not None:
-            GL.glActiveTexture(GL.GL_TEXTURE0)
-            GL.glBindTexture(GL.GL_TEXTURE_2D, self._atlas)
-        GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _INSTANCES_BINDING, self._instance_buffer)
-        GL.glBindVertexArray(self._vertex_array)
-        self._index_quads(len(batch))
+            self._use(programs[as_points], view_rotation, projection, float(viewport[3]) if as_points else None)
+        self._bind_quads(len(batch))
         GL.glEnable(GL.GL_PROGRAM_POINT_SIZE)
         with cloud_blending(depth_test, counting):
             for start, stop, as_points in pieces:
@@ -248,6 +305,74 @@ class SplatPass:
         as_points = sum(stop - start for start, stop, as_points in pieces if as_points)
         self.particles_as_points += as_points
         return as_points
+
+    def _draw_selection(
+        self, selection: SplatSelection, view: np.ndarray, projection: np.ndarray, depth_test: bool, counting: bool
+    ) -> int:
+        """`draw` for particles chosen and ordered on the GPU: as quads, as many as its command counted."""
+        if not selection.slots:
+            return 0
+        self.shade(selection, view)
+        command = self._commands[id(selection)]
+        with_sprites = bool(self._cloud_sprites[list(selection.clouds)].any())
+        self._use(self._programs[False, counting, with_sprites], _rotation(view), projection, None)
+        self._bind_quads(selection.slots)
+        GL.glBindBuffer(GL.GL_DRAW_INDIRECT_BUFFER, self._command_buffer)
+        with cloud_blending(depth_test, counting):
+            GL.glDrawElementsIndirect(
+                GL.GL_TRIANGLES, GL.GL_UNSIGNED_INT, ctypes.c_void_p(4 * _COMMAND_UINTS * command)
+            )
+        GL.glBindBuffer(GL.GL_DRAW_INDIRECT_BUFFER, 0)
+        GL.glBindVertexArray(0)
+        if not counting:
+            self._drawn_commands.append(command)
+        return 0
+
+    def take_selected(self) -> int:
+        """The particles that the selections drawn since the last call chose, read from their commands
+        (after the draws finished, this waits for nothing)."""
+        if not self._drawn_commands:
+            return 0
+        GL.glMemoryBarrier(GL.GL_BUFFER_UPDATE_BARRIER_BIT)
+        GL.glBindBuffer(GL.GL_COPY_READ_BUFFER, self._command_buffer)
+        size = 4 * _COMMAND_UINTS * (max(self._drawn_commands) + 1)
+        commands = np.frombuffer(GL.glGetBufferSubData(GL.GL_COPY_READ_BUFFER, 0, size), dtype=np.uint32)
+        GL.glBindBuffer(GL.GL_COPY_READ_BUFFER, 0)
+        indices = commands.reshape(-1, _COMMAND_UINTS)[self._drawn_commands, 0]
+        self._drawn_commands = []
+        return int(indices.sum()) // 6
+
+    def read_order(self, selection: SplatSelection, view: np.ndarray) -> np.ndarray:
+        """The particles `selection` chose for `view`'s eye, far to near, read back from the GPU (to verify it
+        against `splat_batch`: it waits for the GPU)."""
+        _, first = self.shade(selection, view)
+        command = self._commands[id(selection)]
+        GL.glMemoryBarrier(GL.GL_BUFFER_UPDATE_BARRIER_BIT)
+        GL.glBindBuffer(GL.GL_COPY_READ_BUFFER, self._command_buffer)
+        record = GL.glGetBufferSubData(GL.GL_COPY_READ_BUFFER, 4 * _COMMAND_UINTS * command, 4 * _COMMAND_UINTS)
+        count = int(np.frombuffer(record, dtype=np.uint32)[0]) // 6
+        GL.glBindBuffer(GL.GL_COPY_READ_BUFFER, self._order_buffer)
+        order = GL.glGetBufferSubData(GL.GL_COPY_READ_BUFFER, 4 * first, 4 * count) if count else b""
+        GL.glBindBuffer(GL.GL_COPY_READ_BUFFER, 0)
+        return np.frombuffer(order, dtype=np.uint32).copy()
+
+    def _use(self, program: int, view_rotation: np.ndarray, projection: np.ndarray, viewport_height) -> None:
+        """Make `program` current with a draw's matrices (and, for points, the viewport's height in pixels)."""
+        uniforms = self._uniforms[program]
+        GL.glUseProgram(program)
+        set_matrix_at(uniforms["view_rotation"], view_rotation)
+        set_matrix_at(uniforms["projection"], projection)
+        if viewport_height is not None:
+            GL.glUniform1f(uniforms["viewport_height"], viewport_height)
+
+    def _bind_quads(self, count: int) -> None:
+        """Bind what drawing `count` particles' quads reads: the atlas, the instances, the triangles."""
+        if self._atlas is not None:
+            GL.glActiveTexture(GL.GL_TEXTURE0)
+            GL.glBindTexture(GL.GL_TEXTURE_2D, self._atlas)
+        GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _INSTANCES_BINDING, self._instance_buffer)
+        GL.glBindVertexArray(self._vertex_array)
+        self._index_quads(count)
 
     def plain_splats(self, batch: SplatBatch) -> np.ndarray:
         """(n,) bool: which of the batch's particles are plain Gaussian splats of one colour
@@ -282,16 +407,16 @@ class SplatPass:
         The compute shader's results need a memory barrier before a draw reads them, and llvmpipe makes
         each barrier a glFinish: shaded draw by draw, every batch waited for the draws before it.
         """
-        self._shaded, self._slots_ahead = {}, 0
-        batches_and_views = [(batch, view) for batch, view in batches_and_views if len(batch)]
+        self._shaded, self._slots_ahead, self._commands = {}, 0, {}
+        batches_and_views = [(batch, view) for batch, view in batches_and_views if batch.slots]
         if not batches_and_views:
             return
-        self._reserve(sum(_slots(len(batch)) for batch, _ in batches_and_views), keep=False)
+        self._reserve(sum(_slots(batch.slots) for batch, _ in batches_and_views), keep=False)
         for batch, view in batches_and_views:
             self._dispatch(batch, view, self._slots_ahead)
             self._shaded[id(batch)] = (self._slots_ahead, np.array(view, dtype=np.float64), batch)
-            self._slots_ahead += _slots(len(batch))
-        GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT)
+            self._slots_ahead += _slots(batch.slots)
+        GL.glMemoryBarrier(_SHADED_BARRIERS)
 
     def shade(self, batch: SplatBatch, view: np.ndarray) -> tuple[int, int]:
         """(the storage buffer holding the batch's quads and colours for its eye, in its order, the slot of
@@ -300,9 +425,9 @@ class SplatPass:
         shaded = self._shaded.get(id(batch))
         if shaded is not None and np.array_equal(shaded[1], view):
             return self._instance_buffer, shaded[0]
-        self._reserve(self._slots_ahead + _slots(len(batch)), keep=True)
+        self._reserve(self._slots_ahead + _slots(batch.slots), keep=True)
         self._dispatch(batch, view, self._slots_ahead)
-        GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT)
+        GL.glMemoryBarrier(_SHADED_BARRIERS)
         return self._instance_buffer, self._slots_ahead
 
     def _reserve(self, slots: int, keep: bool) -> None:
@@ -331,9 +456,12 @@ class SplatPass:
         """Shade `batch` for `view` into the slots from `first` on (room reserved)."""
         self._make_resident(batch.particles)
         self._hold_formation(batch.particles, batch.time_s)
-        GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, self._order_buffer)
-        GL.glBufferSubData(GL.GL_SHADER_STORAGE_BUFFER, first * 4, batch.order.nbytes, batch.order)
-        GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, 0)
+        if isinstance(batch, SplatSelection):
+            self._select(batch, first)
+        else:
+            GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, self._order_buffer)
+            GL.glBufferSubData(GL.GL_SHADER_STORAGE_BUFFER, first * 4, batch.order.nbytes, batch.order)
+            GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, 0)
         for binding, buffer in (
             (_PARTICLES_BINDING, self._particle_buffer),
             (_FORMATION_BINDING, self._formation_buffer),
@@ -347,10 +475,89 @@ class SplatPass:
         program, uniforms = self._shade_program(batch)
         GL.glUseProgram(program)
         GL.glUniform1ui(uniforms["first"], first)
-        GL.glUniform1ui(uniforms["count"], len(batch))
+        GL.glUniform1ui(uniforms["count"], batch.slots)
         for name, value in (("eye", batch.eye), ("view_right", view[0, :3]), ("view_up", view[1, :3])):
             set_vec3_at(uniforms[name], value)
-        GL.glDispatchCompute(-(-len(batch) // _SHADE_GROUP), 1, 1)
+        GL.glDispatchCompute(-(-batch.slots // _SHADE_GROUP), 1, 1)
+
+    def _select(self, selection: SplatSelection, first: int) -> None:
+        """Choose and sort `selection`'s particles on the GPU into the order's slots from `first` on, the chosen
+        first, far to near, and count them into a new indirect command of quads from slot `first`."""
+        if self._selecting is None:
+            program = build_compute_program(
+                "splat_select",
+                {"PARTICLE_FLOATS": _PARTICLE_FLOATS, "FADE_START_RADII": FADE_START_RADII, "SPLAT_REACH": SPLAT_REACH},
+            )
+            names = ("count", "range_count", "command_at", "eye", "planes", "cull_to_frustum")
+            self._selecting = (program, uniform_locations(program, names), GpuDepthSort())
+        program, uniforms, sort = self._selecting
+        slots, command = selection.slots, len(self._commands)
+        self._reserve_selection(slots, command + 1)
+        self._commands[id(selection)] = command
+        starts = selection.particles.cloud_starts
+        clouds = np.asarray(selection.clouds, dtype=np.int64)
+        counts = starts[clouds + 1] - starts[clouds]
+        ranges = np.zeros((len(clouds), 4), dtype=np.uint32)  # the shader's Range: start, before, near, far
+        ranges[:, 0] = starts[clouds]
+        ranges[:, 1] = np.cumsum(counts) - counts
+        everything = [(-1.0, np.inf)] * len(clouds)
+        depth = np.array(everything if selection.depth_ranges is None else selection.depth_ranges, dtype=np.float64)
+        ranges[:, 2:].view(np.float32)[:] = np.clip(depth, -1.0, np.finfo(np.float32).max)
+        _store(self._ranges_buffer, ranges, GL.GL_STREAM_DRAW)
+        GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, self._command_buffer)
+        record = np.array([0, 1, 0, 4 * first, 0], dtype=np.uint32)  # its count is the GPU's to add to
+        GL.glBufferSubData(GL.GL_SHADER_STORAGE_BUFFER, record.nbytes * command, record.nbytes, record)
+        for binding, buffer in (
+            (_SELECT_PARTICLES, self._particle_buffer),
+            (_SELECT_FORMATION, self._formation_buffer),
+            (_SELECT_BITS, self._drawn_bits_buffer),
+            (_SELECT_RANGES, self._ranges_buffer),
+            (_SELECT_KEYS, self._keys_buffer),
+            (_SELECT_VALUES, self._values_buffer),
+            (_SELECT_COMMAND, self._command_buffer),
+        ):
+            GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, binding, buffer)
+        GL.glUseProgram(program)
+        GL.glUniform1ui(uniforms["count"], slots)
+        GL.glUniform1ui(uniforms["range_count"], len(clouds))
+        GL.glUniform1ui(uniforms["command_at"], _COMMAND_UINTS * command)
+        eye = np.asarray(selection.eye, dtype=np.float64)
+        set_vec3_at(uniforms["eye"], eye)
+        GL.glUniform1i(uniforms["cull_to_frustum"], selection.frustum is not None)
+        if selection.frustum is not None:
+            planes = np.array(selection.frustum, dtype=np.float64)
+            planes[:, 3] += planes[:, :3] @ eye  # relative to the eye: float32 keeps their precision there
+            GL.glUniform4fv(uniforms["planes"], 6, np.ascontiguousarray(planes, dtype=np.float32))
+        GL.glDispatchCompute(-(-slots // _SELECT_GROUP), 1, 1)
+        GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT)
+        sort.sort(self._keys_buffer, self._values_buffer, slots)
+        GL.glMemoryBarrier(GL.GL_BUFFER_UPDATE_BARRIER_BIT)
+        GL.glBindBuffer(GL.GL_COPY_READ_BUFFER, self._values_buffer)
+        GL.glBindBuffer(GL.GL_COPY_WRITE_BUFFER, self._order_buffer)
+        GL.glCopyBufferSubData(GL.GL_COPY_READ_BUFFER, GL.GL_COPY_WRITE_BUFFER, 0, 4 * first, 4 * slots)
+        GL.glBindBuffer(GL.GL_COPY_READ_BUFFER, 0)
+        GL.glBindBuffer(GL.GL_COPY_WRITE_BUFFER, 0)
+
+    def _reserve_selection(self, slots: int, commands: int) -> None:
+        """Room for choosing `slots` particles and for `commands` indirect commands, keeping those made."""
+        if slots > self._keys_capacity:
+            self._keys_capacity = max(slots, 2 * self._keys_capacity)
+            for buffer in (self._keys_buffer, self._values_buffer):
+                GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, buffer)
+                GL.glBufferData(GL.GL_SHADER_STORAGE_BUFFER, 4 * self._keys_capacity, None, GL.GL_DYNAMIC_COPY)
+            GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, 0)
+        if commands > self._command_capacity:
+            capacity, size = max(commands, 2 * self._command_capacity, 16), 4 * _COMMAND_UINTS
+            scratch = GL.glGenBuffers(1)
+            if self._command_capacity:
+                _copy_buffer(self._command_buffer, scratch, size * self._command_capacity, allocate=True)
+            GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, self._command_buffer)
+            GL.glBufferData(GL.GL_SHADER_STORAGE_BUFFER, size * capacity, None, GL.GL_DYNAMIC_COPY)
+            GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, 0)
+            if self._command_capacity:
+                _copy_buffer(scratch, self._command_buffer, size * self._command_capacity, allocate=False)
+            GL.glDeleteBuffers(1, [scratch])
+            self._command_capacity = capacity
 
     def _make_resident(self, particles: ParticleBuffer) -> None:
         """Upload the particles' shading terms, styles and unlocked facings when the particles change."""
@@ -373,12 +580,21 @@ class SplatPass:
             per_cloud = [(s.facing != FACING_SPLAT) | (s.artist is not None) << 1 for s in particles.styles.clouds]
             self._feature_bits = np.array(per_cloud + [0], dtype=np.uint8)[particles.styles.cloud_index]
             self._profiled = particles.profiles is not None
+            self._cloud_feature_bits = np.array(per_cloud + [0], dtype=np.uint8)
+            self._cloud_sprites = np.array(
+                [np.any(self._sprites[a:b]) for a, b in zip(particles.cloud_starts[:-1], particles.cloud_starts[1:])]
+                + [False]
+            )
+            _store(self._drawn_bits_buffer, np.append(particles.drawn_bits, np.uint32(0)))
             self._resident, self._formation_time = particles, None
 
     def _shade_program(self, batch: SplatBatch) -> tuple[int, dict]:
         """The compute shader variant with the features of `batch`'s particles, its light uniforms those of
         the resident particles; and its uniforms' locations."""
-        bits = int(np.bitwise_or.reduce(self._feature_bits[batch.order])) if len(batch) else 0
+        if isinstance(batch, SplatSelection):
+            bits = int(np.bitwise_or.reduce(self._cloud_feature_bits[list(batch.clouds)]))
+        else:
+            bits = int(np.bitwise_or.reduce(self._feature_bits[batch.order])) if len(batch) else 0
         features = (bool(bits & 1), bool(bits & 2), self._profiled)
         if features not in self._shade_programs:
             program = build_compute_program(
@@ -413,9 +629,13 @@ class SplatPass:
         """Free the GL objects (the context must be current)."""
         for program in (*self._programs.values(), *(held[0] for held in self._shade_programs.values())):
             GL.glDeleteProgram(program)
+        if self._selecting is not None:
+            GL.glDeleteProgram(self._selecting[0])
+            self._selecting[2].close()
         if self._atlas is not None:
             GL.glDeleteTextures([self._atlas])
         GL.glDeleteBuffers(len(self._buffers), list(self._buffers))
+        GL.glDeleteBuffers(len(self._selection_buffers), list(self._selection_buffers))
         GL.glDeleteVertexArrays(1, [self._vertex_array])
         self._resident = None
 
@@ -496,6 +716,17 @@ def _set_light_uniforms(program: int, particles: ParticleBuffer) -> None:
         )
     GL.glUniform1i(GL.glGetUniformLocation(program, "phase_kind"), PHASE_NAMES.index(particles.phase))
     GL.glUniform1f(GL.glGetUniformLocation(program, "g"), float(particles.g))
+
+
+#: what a draw after shading waits for: the instances (and a selection's indirect command)
+_SHADED_BARRIERS = GL.GL_SHADER_STORAGE_BARRIER_BIT | GL.GL_COMMAND_BARRIER_BIT
+
+
+def _rotation(view: np.ndarray) -> np.ndarray:
+    """The view matrix without its translation: corners come relative to the batch's eye, the view's own."""
+    rotation = np.array(view, dtype=np.float64)
+    rotation[:3, 3] = 0.0
+    return rotation
 
 
 def _copy_buffer(source: int, destination: int, size: int, allocate: bool) -> None:

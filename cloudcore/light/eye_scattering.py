@@ -167,6 +167,13 @@ class ParticleBuffer:
         factors = self.opacity_factors(time_s)
         return kept if factors is None else kept & (factors[indices] > 0.0)
 
+    @property
+    def drawn_bits(self) -> np.ndarray:
+        """(n,) uint32, what `drawn` tests of each particle besides its distance and opacity factors: bit 0 its
+        near fade (a splat's; sprites lock instead), bit 1 any opacity at all; for the GPU's own test
+        (`cloudcore/gl/shaders/splat_select.comp.glsl`)."""
+        return self._near_faded.astype(np.uint32) | self._opaque.astype(np.uint32) << 1
+
     def weigh(self, weights: np.ndarray | None) -> None:
         """Set every particle's blend weight in [0, 1] for the frames to come (None: all 1).
 

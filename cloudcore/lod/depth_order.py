@@ -20,6 +20,15 @@ def far_to_near(distances: np.ndarray) -> np.ndarray:
 
     Equal distances (at float32 precision) keep their input order.
     """
-    keys = ~np.asarray(distances, dtype=np.float32).view(np.uint32)
+    keys = distance_keys(distances)
     by_low = np.argsort((keys & 0xFFFF).astype(np.uint16), kind="stable")
     return by_low[np.argsort((keys[by_low] >> 16).astype(np.uint16), kind="stable")]
+
+
+def distance_keys(distances: np.ndarray) -> np.ndarray:
+    """(n,) uint32 keys that order `distances` (finite, >= 0) far to near when sorted ascending.
+
+    Positive IEEE floats order like their bit patterns read as unsigned integers; inverting the bits turns
+    ascending into descending.
+    """
+    return ~np.asarray(distances, dtype=np.float32).view(np.uint32)

@@ -1,0 +1,82 @@
+"""A stable radix sort on the GPU of (key, value) uint32 pairs held in storage buffers.
+
+The GPU counterpart of `cloudcore.lod.depth_order.far_to_near`: given keys
+that are the inverted bit patterns of float32 distances, sorting them
+ascending orders the values (particle indices) far to near, equal distances
+in their input order, exactly as the CPU does.  Eight passes of four bits,
+each three dispatches (`shaders/depth_sort.comp.glsl`), ping-ponging between
+the caller's buffers and two of its own, so the sorted pairs end where they
+began.  No data comes back to the CPU: what draws from the order reads it
+where it is.
+"""
+
+from __future__ import annotations
+
+from OpenGL import GL
+
+from cloudcore.gl.programs import build_compute_program, uniform_locations
+
+#: bits of the key a pass sorts by; see the shader for why four
+DIGIT_BITS = 4
+#: keys one invocation takes; 256 invocations a workgroup make a tile of 2048
+ITEMS = 8
+TILE = 256 * ITEMS
+_PASSES = 32 // DIGIT_BITS
+_STAGES = ("COUNT", "SCAN", "SCATTER")
+_KEYS_IN, _VALUES_IN, _KEYS_OUT, _VALUES_OUT, _TILE_COUNTS = range(5)
+
+
+class GpuDepthSort:
+    def __init__(self):
+        defines = {"DIGIT_BITS": DIGIT_BITS, "ITEMS": ITEMS}
+        self._programs = {stage: build_compute_program("depth_sort", defines | {stage: 1}) for stage in _STAGES}
+        self._uniforms = {
+            stage: uniform_locations(program, ("count", "shift", "tiles")) for stage, program in self._programs.items()
+        }
+        self._scratch_keys, self._scratch_values, self._tile_counts = self._buffers = GL.glGenBuffers(3)
+        self._capacity = 0  # pairs the scratch buffers hold
+
+    def sort(self, keys: int, values: int, count: int) -> None:
+        """Sort the first `count` pairs of buffers `keys` and `values` by key, in place, stably.
+
+        The caller orders its writes to the buffers before this with a storage barrier, and its reads after
+        it with the barrier its reads need; between the passes this issues its own."""
+        if count <= 1:
+            return
+        self._reserve(count)
+        tiles = -(-count // TILE)
+        sources, targets = (keys, values), (self._scratch_keys, self._scratch_values)
+        for sort_pass in range(_PASSES):
+            for binding, buffer in zip((_KEYS_IN, _VALUES_IN, _KEYS_OUT, _VALUES_OUT), sources + targets):
+                GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, binding, buffer)
+            GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _TILE_COUNTS, self._tile_counts)
+            for stage, groups in zip(_STAGES, (tiles, 1, tiles)):
+                GL.glUseProgram(self._programs[stage])
+                uniforms = self._uniforms[stage]
+                GL.glUniform1ui(uniforms["count"], count)
+                GL.glUniform1ui(uniforms["shift"], sort_pass * DIGIT_BITS)
+                GL.glUniform1ui(uniforms["tiles"], tiles)
+                GL.glDispatchCompute(groups, 1, 1)
+                GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT)
+            sources, targets = targets, sources
+
+    def _reserve(self, count: int) -> None:
+        if count <= self._capacity:
+            return
+        capacity = max(count, 2 * self._capacity)
+        tiles = -(-capacity // TILE)
+        for buffer, size in (
+            (self._scratch_keys, 4 * capacity),
+            (self._scratch_values, 4 * capacity),
+            (self._tile_counts, 4 * tiles << DIGIT_BITS),
+        ):
+            GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, buffer)
+            GL.glBufferData(GL.GL_SHADER_STORAGE_BUFFER, size, None, GL.GL_DYNAMIC_COPY)
+        GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, 0)
+        self._capacity = capacity
+
+    def close(self) -> None:
+        """Free the GL objects (the context must be current)."""
+        for program in self._programs.values():
+            GL.glDeleteProgram(program)
+        GL.glDeleteBuffers(len(self._buffers), list(self._buffers))

@@ -1,0 +1,128 @@
+#version 430 core
+// One pass of a stable least-significant-digit radix sort of (key, value)
+// pairs of uint32, ascending by key, on DIGIT_BITS bits of the key from
+// `shift` (reference: cloudcore.lod.depth_order.far_to_near, whose keys are
+// the inverted bit patterns of float32 distances).  A pass is three
+// dispatches, chosen by the stage defined:
+//   COUNT    one workgroup a tile: how many of its keys have each digit;
+//   SCAN     one workgroup: where each (digit, tile) run starts in the output,
+//            digit-major so that all of digit 0 comes first, tile by tile;
+//   SCATTER  one workgroup a tile: each key to its run's start plus the keys
+//            of its digit before it in the tile.
+// Stable because each invocation takes ITEMS consecutive keys in order and
+// ranks them after those of every invocation before it in the tile, so equal
+// keys keep their input order, pass after pass.  Four-bit digits keep the
+// scatter's per-invocation counts (16) in registers and its prefix table
+// (16 x 256 uints) in shared memory.
+
+#define GROUP 256
+#define DIGITS (1 << DIGIT_BITS)
+#define TILE (GROUP * ITEMS)
+
+layout(local_size_x = GROUP) in;
+
+layout(std430, binding = 0) readonly buffer KeysIn { uint keys_in[]; };
+layout(std430, binding = 1) readonly buffer ValuesIn { uint values_in[]; };
+layout(std430, binding = 2) writeonly buffer KeysOut { uint keys_out[]; };
+layout(std430, binding = 3) writeonly buffer ValuesOut { uint values_out[]; };
+// per (digit, tile), digit-major: COUNT writes the counts, SCAN turns them into output starts
+layout(std430, binding = 4) buffer TileCounts { uint tile_counts[]; };
+
+uniform uint count;  // pairs to sort
+uniform uint shift;  // the digit's lowest bit
+uniform uint tiles;
+
+uint digit_of(uint key)
+{
+    return (key >> shift) & uint(DIGITS - 1);
+}
+
+#ifdef COUNT
+shared uint histogram[DIGITS];
+
+void main()
+{
+    uint tile = gl_WorkGroupID.x, thread = gl_LocalInvocationID.x;
+    if (thread < DIGITS)
+        histogram[thread] = 0u;
+    barrier();
+    uint first = tile * TILE + thread * ITEMS;
+    for (uint i = 0u; i < ITEMS; ++i)
+        if (first + i < count)
+            atomicAdd(histogram[digit_of(keys_in[first + i])], 1u);
+    barrier();
+    if (thread < DIGITS)
+        tile_counts[thread * tiles + tile] = histogram[thread];
+}
+#endif
+
+#ifdef SCAN
+shared uint sums[GROUP];
+
+void main()
+{
+    uint thread = gl_LocalInvocationID.x;
+    uint total = uint(DIGITS) * tiles;
+    uint chunk = (total + GROUP - 1u) / GROUP;
+    uint first = min(thread * chunk, total), last = min(first + chunk, total);
+    uint sum = 0u;
+    for (uint i = first; i < last; ++i)
+        sum += tile_counts[i];
+    sums[thread] = sum;
+    barrier();
+    // inclusive Hillis-Steele scan of the chunks' sums
+    for (uint offset = 1u; offset < GROUP; offset <<= 1) {
+        uint before = thread >= offset ? sums[thread - offset] : 0u;
+        barrier();
+        sums[thread] += before;
+        barrier();
+    }
+    uint start = sums[thread] - sum;
+    for (uint i = first; i < last; ++i) {
+        uint counted = tile_counts[i];
+        tile_counts[i] = start;
+        start += counted;
+    }
+}
+#endif
+
+#ifdef SCATTER
+// per digit, per invocation: its keys of that digit, then (scanned) those of the invocations before it
+shared uint prefix[DIGITS][GROUP];
+
+void main()
+{
+    uint tile = gl_WorkGroupID.x, thread = gl_LocalInvocationID.x;
+    uint first = tile * TILE + thread * ITEMS;
+    uint own[DIGITS];
+    for (int d = 0; d < DIGITS; ++d)
+        own[d] = 0u;
+    for (uint i = 0u; i < ITEMS; ++i)
+        if (first + i < count)
+            own[digit_of(keys_in[first + i])] += 1u;
+    for (int d = 0; d < DIGITS; ++d)
+        prefix[d][thread] = own[d];
+    barrier();
+    for (uint offset = 1u; offset < GROUP; offset <<= 1) {
+        uint before[DIGITS];
+        for (int d = 0; d < DIGITS; ++d)
+            before[d] = thread >= offset ? prefix[d][thread - offset] : 0u;
+        barrier();
+        for (int d = 0; d < DIGITS; ++d)
+            prefix[d][thread] += before[d];
+        barrier();
+    }
+    uint next[DIGITS];  // where this invocation's next key of each digit goes
+    for (int d = 0; d < DIGITS; ++d)
+        next[d] = tile_counts[uint(d) * tiles + tile] + prefix[d][thread] - own[d];
+    for (uint i = 0u; i < ITEMS; ++i) {
+        if (first + i >= count)
+            break;
+        uint key = keys_in[first + i];
+        uint d = digit_of(key);
+        keys_out[next[d]] = key;
+        values_out[next[d]] = values_in[first + i];
+        next[d] += 1u;
+    }
+}
+#endif
