@@ -8,6 +8,8 @@ world pass and by our own passes compare correctly.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from cloudcore.light.kernel import SPLAT_REACH
@@ -16,28 +18,37 @@ from cloudcore.scene import Camera
 #: metres; 1 m near and 100 km far keep 24-bit depth resolution near 0.5 m at 3 km.
 NEAR_PLANE_M = 1.0
 FAR_PLANE_M = 1.0e5
-_WORLD_UP = np.array([0.0, 1.0, 0.0])
 
 
 def camera_pose(camera: Camera) -> np.ndarray:
-    """Camera-to-world 4x4: columns are the camera's right, up and back axes and its position."""
-    eye = np.asarray(camera.position, dtype=np.float64)
-    forward = np.asarray(camera.look_at, dtype=np.float64) - eye
-    forward /= np.linalg.norm(forward)
-    right = np.cross(forward, _WORLD_UP)
-    if np.linalg.norm(right) < 1e-9:
+    """Camera-to-world 4x4: columns are the camera's right, up and back axes and its position.
+
+    Written out in scalars: every impostor regeneration makes a pose, and numpy's `cross` and `norm` on
+    3-vectors cost 0.25 ms of each (40 regenerations a frame, docs/performance.md).
+    """
+    ex, ey, ez = (float(value) for value in camera.position)
+    fx, fy, fz = (float(target) - origin for target, origin in zip(camera.look_at, (ex, ey, ez)))
+    length = math.sqrt(fx * fx + fy * fy + fz * fz)
+    fx, fy, fz = fx / length, fy / length, fz / length
+    # right = forward x world up (0, 1, 0), horizontal
+    rx, rz = -fz, fx
+    horizontal = math.sqrt(rx * rx + rz * rz)
+    if horizontal < 1e-9:
         # looking straight up or down: any horizontal right axis will do; take east
-        right = np.array([1.0, 0.0, 0.0])
-    right /= np.linalg.norm(right)
-    up = np.cross(right, forward)
-    pose = np.eye(4)
-    pose[:3, 0], pose[:3, 1], pose[:3, 2], pose[:3, 3] = right, up, -forward, eye
-    return pose
+        rx, rz, horizontal = 1.0, 0.0, 1.0
+    rx, rz = rx / horizontal, rz / horizontal
+    # up = right x forward
+    ux, uy, uz = -rz * fy, rz * fx - rx * fz, rx * fy
+    return np.array([[rx, ux, -fx, ex], [0.0, uy, -fy, ey], [rz, uz, -fz, ez], [0.0, 0.0, 0.0, 1.0]])
 
 
 def view_matrix(camera: Camera) -> np.ndarray:
     """World-to-eye 4x4 (the inverse of `camera_pose`, computed without a general inverse)."""
-    pose = camera_pose(camera)
+    return pose_to_view(camera_pose(camera))
+
+
+def pose_to_view(pose: np.ndarray) -> np.ndarray:
+    """The view matrix of a camera-to-world `pose` of orthonormal axes: its inverse."""
     rotation = pose[:3, :3].T
     view = np.eye(4)
     view[:3, :3] = rotation

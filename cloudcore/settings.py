@@ -228,7 +228,7 @@ class RenderSettings:
     #: "cpu": a draw's particles are chosen and sorted far to near in numpy and their order uploaded; "gpu":
     #: chosen, sorted and counted by compute shaders, drawn as quads by an indirect draw, so that the CPU's
     #: work for a draw does not grow with its particles.  CPU by default: on llvmpipe the GPU's sort is
-    #: two orders of magnitude slower than numpy's (docs/performance.md, "The GPU's order")
+    #: 30-40 times slower than numpy's, the frame 1.65 times (docs/performance.md, "The GPU's order")
     splat_order: str = _setting(
         "cpu",
         flag="--splat-order",

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cloudcore.camera import camera_pose, projection_matrix, view_matrix
+from cloudcore.camera import camera_pose, pose_to_view, projection_matrix
 from cloudcore.scene import Camera
 
 #: an impostor texture at least this many times finer than needed is remade smaller (saves memory;
@@ -77,7 +77,7 @@ def impostor_view(centre, radius: float, eye) -> ImpostorView:
     corners = np.array([centre - right - up, centre + right - up, centre - right + up, centre + right + up])
     near = max(distance - radius, distance * 1e-6)
     projection = projection_matrix(camera.fov_y_deg, 1.0, near=near, far=distance + radius)
-    return ImpostorView(view_matrix(camera), projection, corners)
+    return ImpostorView(pose_to_view(pose), projection, corners)
 
 
 #: texels of margin around the particles' extent (bilinear filtering reads one beyond the edge)

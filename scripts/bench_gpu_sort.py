@@ -1,0 +1,99 @@
+"""The far-to-near sort on the CPU (`cloudcore.lod.depth_order.far_to_near`) against the GPU's radix sort
+(`cloudcore.gl.depth_sort.GpuDepthSort`), side by side in one run, with their orders compared. JSON out.
+
+    python scripts/bench_gpu_sort.py [--counts 10000,100000,1000000] [--repeat 7] [--json out/bench_gpu_sort.json]
+
+Per count: the distances of particles of a random cloud field from an eye inside it; the CPU sorts them
+from float64 distances (what `splat_batch` does), the GPU sorts the same keys already in its buffers (what a
+`SplatSelection` does after choosing).  Times are the median of --repeat, the GPU's to glFinish and on its
+own clock (GL_TIMESTAMP), the first run (compiling, allocating) left out.  `equal` says whether the GPU's
+order is the CPU's, exactly.
+"""
+
+from __future__ import annotations
+
+import argparse
+import ctypes
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+
+os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
+
+from OpenGL import GL  # noqa: E402  (the GL imports need the platform)
+
+from cloudcore.gl.context import HeadlessContext  # noqa: E402
+from cloudcore.gl.depth_sort import GpuDepthSort  # noqa: E402
+from cloudcore.lod.depth_order import distance_keys, far_to_near  # noqa: E402
+from cloudcore.measure.benchmark import machine, write_report  # noqa: E402
+
+
+def _timestamp_ns(query: int) -> int:
+    value = ctypes.c_uint64()
+    GL.glGetQueryObjectui64v(query, GL.GL_QUERY_RESULT, ctypes.byref(value))
+    return value.value
+
+
+def bench(count: int, repeat: int, sort: GpuDepthSort, buffers, queries) -> dict:
+    rng = np.random.default_rng(count)
+    distances = np.linalg.norm(rng.normal(size=(count, 3)) * [3000.0, 400.0, 3000.0], axis=1)
+    cpu_ms, gpu_wall_ms, gpu_ms = [], [], []
+    for _ in range(repeat + 1):
+        started = time.perf_counter()
+        cpu_order = far_to_near(distances)
+        cpu_ms.append(1e3 * (time.perf_counter() - started))
+        for buffer, data in zip(buffers, (distance_keys(distances), np.arange(count, dtype=np.uint32))):
+            GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, buffer)
+            GL.glBufferData(GL.GL_SHADER_STORAGE_BUFFER, data.nbytes, data, GL.GL_DYNAMIC_COPY)
+        GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT)
+        GL.glFinish()
+        started = time.perf_counter()
+        GL.glQueryCounter(queries[0], GL.GL_TIMESTAMP)
+        sort.sort(*buffers, count)
+        GL.glQueryCounter(queries[1], GL.GL_TIMESTAMP)
+        GL.glFinish()
+        gpu_wall_ms.append(1e3 * (time.perf_counter() - started))
+        gpu_ms.append(1e-6 * (_timestamp_ns(queries[1]) - _timestamp_ns(queries[0])))
+    GL.glMemoryBarrier(GL.GL_BUFFER_UPDATE_BARRIER_BIT)
+    GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, buffers[1])
+    gpu_order = np.frombuffer(GL.glGetBufferSubData(GL.GL_SHADER_STORAGE_BUFFER, 0, 4 * count), dtype=np.uint32)
+    median = lambda times: float(np.median(times[1:]))  # noqa: E731
+    row = {
+        "count": count,
+        "cpu_ms": median(cpu_ms),
+        "gpu_wall_ms": median(gpu_wall_ms),
+        "gpu_ms": median(gpu_ms),
+        "equal": bool(np.array_equal(gpu_order, cpu_order)),
+    }
+    row["gpu_over_cpu"] = row["gpu_wall_ms"] / row["cpu_ms"]
+    return row
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--counts", default="10000,100000,1000000")
+    parser.add_argument("--repeat", type=int, default=7)
+    parser.add_argument("--json", type=Path, default=Path("out/bench_gpu_sort.json"))
+    args = parser.parse_args()
+    context = HeadlessContext(64, 64)
+    context.make_current()
+    sort, buffers, queries = GpuDepthSort(), GL.glGenBuffers(2), GL.glGenQueries(2)
+    rows = []
+    for count in (int(text) for text in args.counts.split(",")):
+        rows.append(bench(count, args.repeat, sort, buffers, queries))
+        row = rows[-1]
+        print(
+            f"{row['count']:>9,} keys: CPU {row['cpu_ms']:8.2f} ms, GPU {row['gpu_wall_ms']:8.2f} ms to glFinish "
+            f"({row['gpu_ms']:.2f} on its clock), x{row['gpu_over_cpu']:.1f}, same order: {row['equal']}"
+        )
+    sort.close()
+    GL.glDeleteBuffers(2, list(buffers))
+    GL.glDeleteQueries(2, list(queries))
+    context.close()
+    write_report({"machine": machine(), "counts": rows}, args.json)
+
+
+if __name__ == "__main__":
+    main()
