@@ -59,7 +59,10 @@ _UNLOCKED = (0.0, 0.0, 0.0, -1.0)
     _CLOUDS_BINDING,
     _FACING_BINDING,
     _PROFILES_BINDING,
-) = range(7)
+    _BATCHES_BINDING,
+) = range(8)
+#: floats of splat_shade.comp.glsl's `Batch`: first slot and count (as uints), eye, image plane's right and up
+_BATCH_FLOATS = 16
 #: splat_select.comp.glsl's buffers
 (
     _SELECT_PARTICLES,
@@ -218,7 +221,8 @@ class SplatPass:
             self._cloud_buffer,
             self._facing_buffer,
             self._profile_buffer,
-        ) = self._buffers = GL.glGenBuffers(8)
+            self._batch_buffer,
+        ) = self._buffers = GL.glGenBuffers(9)
         self._atlas: int | None = None  # the sprite atlas texture, made when a cloud first needs it
         self._quads_indexed = 0
         self._instance_capacity = 0  # slots
@@ -412,10 +416,10 @@ class SplatPass:
         if not batches_and_views:
             return
         self._reserve(sum(_slots(batch.slots) for batch, _ in batches_and_views), keep=False)
-        for batch, view in batches_and_views:
-            self._dispatch(batch, view, self._slots_ahead)
-            self._shaded[id(batch)] = (self._slots_ahead, np.array(view, dtype=np.float64), batch)
-            self._slots_ahead += _slots(batch.slots)
+        firsts = self._shade_all(batches_and_views, 0)
+        for (batch, view), first in zip(batches_and_views, firsts):
+            self._shaded[id(batch)] = (first, np.array(view, dtype=np.float64), batch)
+        self._slots_ahead = sum(_slots(batch.slots) for batch, _ in batches_and_views)
         GL.glMemoryBarrier(_SHADED_BARRIERS)
 
     def shade(self, batch: SplatBatch, view: np.ndarray) -> tuple[int, int]:
@@ -426,7 +430,7 @@ class SplatPass:
         if shaded is not None and np.array_equal(shaded[1], view):
             return self._instance_buffer, shaded[0]
         self._reserve(self._slots_ahead + _slots(batch.slots), keep=True)
-        self._dispatch(batch, view, self._slots_ahead)
+        self._shade_all([(batch, view)], self._slots_ahead)
         GL.glMemoryBarrier(_SHADED_BARRIERS)
         return self._instance_buffer, self._slots_ahead
 
@@ -452,16 +456,46 @@ class SplatPass:
         GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, 0)
         self._instance_capacity = capacity
 
-    def _dispatch(self, batch: SplatBatch, view: np.ndarray, first: int) -> None:
-        """Shade `batch` for `view` into the slots from `first` on (room reserved)."""
-        self._make_resident(batch.particles)
-        self._hold_formation(batch.particles, batch.time_s)
-        if isinstance(batch, SplatSelection):
-            self._select(batch, first)
-        else:
-            GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, self._order_buffer)
-            GL.glBufferSubData(GL.GL_SHADER_STORAGE_BUFFER, first * 4, batch.order.nbytes, batch.order)
-            GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, 0)
+    def _shade_all(self, batches_and_views, first: int) -> list[int]:
+        """Shade the (batch, view) pairs (room reserved) into the slots from `first` on, each batch's start
+        aligned; returns each one's first slot.  All the CPU's orders go up in one upload, and each run of
+        batches with the same particles, scene time and shader variant is one dispatch."""
+        runs: dict[tuple, list] = {}  # key -> [[batch, view, first slot]], slots contiguous within a run
+        for batch, view in batches_and_views:
+            runs.setdefault((id(batch.particles), batch.time_s, self._features(batch)), []).append([batch, view])
+        firsts, end = {}, first
+        for run in runs.values():
+            for entry in run:
+                entry.append(end)
+                firsts[id(entry[0])] = end
+                end += _slots(entry[0].slots)
+        orders = np.zeros(end - first, dtype=np.uint32)
+        for run in runs.values():
+            for batch, _, slot in run:
+                if isinstance(batch, SplatBatch):
+                    orders[slot - first : slot - first + len(batch)] = batch.order
+        GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, self._order_buffer)
+        GL.glBufferSubData(GL.GL_SHADER_STORAGE_BUFFER, first * 4, orders.nbytes, orders)
+        GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, 0)
+        for (_, _, features), run in runs.items():
+            self._dispatch(run, features)
+        return [firsts[id(batch)] for batch, _ in batches_and_views]
+
+    def _dispatch(self, run: list, features: tuple) -> None:
+        """Shade a run of (batch, view, first slot), their order uploaded, in one dispatch of the variant with
+        `features` (selections are chosen and sorted first)."""
+        particles, time_s = run[0][0].particles, run[0][0].time_s
+        self._make_resident(particles)
+        self._hold_formation(particles, time_s)
+        for batch, _, slot in run:
+            if isinstance(batch, SplatSelection):
+                self._select(batch, slot)
+        table = np.zeros((len(run), _BATCH_FLOATS), dtype=np.float32)
+        slots = table.view(np.uint32)
+        for row, (batch, view, slot) in enumerate(run):
+            slots[row, 0:2] = slot, batch.slots
+            table[row, 4:7], table[row, 8:11], table[row, 12:15] = batch.eye, view[0, :3], view[1, :3]
+        _store(self._batch_buffer, table, GL.GL_STREAM_DRAW)
         for binding, buffer in (
             (_PARTICLES_BINDING, self._particle_buffer),
             (_FORMATION_BINDING, self._formation_buffer),
@@ -470,15 +504,16 @@ class SplatPass:
             (_CLOUDS_BINDING, self._cloud_buffer),
             (_FACING_BINDING, self._facing_buffer),
             (_PROFILES_BINDING, self._profile_buffer),
+            (_BATCHES_BINDING, self._batch_buffer),
         ):
             GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, binding, buffer)
-        program, uniforms = self._shade_program(batch)
+        program, uniforms = self._shade_program(features)
+        first, end = run[0][2], run[-1][2] + run[-1][0].slots
         GL.glUseProgram(program)
         GL.glUniform1ui(uniforms["first"], first)
-        GL.glUniform1ui(uniforms["count"], batch.slots)
-        for name, value in (("eye", batch.eye), ("view_right", view[0, :3]), ("view_up", view[1, :3])):
-            set_vec3_at(uniforms[name], value)
-        GL.glDispatchCompute(-(-batch.slots // _SHADE_GROUP), 1, 1)
+        GL.glUniform1ui(uniforms["slot_count"], end - first)
+        GL.glUniform1ui(uniforms["batch_count"], len(run))
+        GL.glDispatchCompute(-(-(end - first) // _SHADE_GROUP), 1, 1)
 
     def _select(self, selection: SplatSelection, first: int) -> None:
         """Choose and sort `selection`'s particles on the GPU into the order's slots from `first` on, the chosen
@@ -588,14 +623,18 @@ class SplatPass:
             _store(self._drawn_bits_buffer, np.append(particles.drawn_bits, np.uint32(0)))
             self._resident, self._formation_time = particles, None
 
-    def _shade_program(self, batch: SplatBatch) -> tuple[int, dict]:
-        """The compute shader variant with the features of `batch`'s particles, its light uniforms those of
-        the resident particles; and its uniforms' locations."""
+    def _features(self, batch: SplatBatch | SplatSelection) -> tuple[bool, bool, bool]:
+        """The shader features (`_SHADE_FEATURES`) `batch`'s particles need."""
+        self._make_resident(batch.particles)
         if isinstance(batch, SplatSelection):
             bits = int(np.bitwise_or.reduce(self._cloud_feature_bits[list(batch.clouds)]))
         else:
             bits = int(np.bitwise_or.reduce(self._feature_bits[batch.order])) if len(batch) else 0
-        features = (bool(bits & 1), bool(bits & 2), self._profiled)
+        return bool(bits & 1), bool(bits & 2), self._profiled
+
+    def _shade_program(self, features: tuple[bool, bool, bool]) -> tuple[int, dict]:
+        """The compute shader variant with `features`, its light uniforms those of the resident particles; and
+        its uniforms' locations."""
         if features not in self._shade_programs:
             program = build_compute_program(
                 "splat_shade",
@@ -604,7 +643,7 @@ class SplatPass:
             )
             self._shade_programs[features] = [
                 program,
-                uniform_locations(program, ("first", "count", "eye", "view_right", "view_up")),
+                uniform_locations(program, ("first", "slot_count", "batch_count")),
                 None,
             ]
         held = self._shade_programs[features]
