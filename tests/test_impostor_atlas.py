@@ -83,3 +83,64 @@ def test_a_target_drawn_after_an_atlas_cell_is_not_clipped_to_the_cell(renderer)
     finally:
         atlas.close()
         target.close()
+
+
+def test_cells_drawn_in_one_multi_draw_hold_what_each_drawn_alone_holds(renderer):
+    """A frame's regenerations all of point sprites go into the atlas in one multi-draw a 16 cells, each through
+    its own viewport, scissor and layer (`SplatPass.draw_point_cells`): the texels must be those of drawing each
+    cell by itself, none spilling into a neighbour; a cloud of sprites still needs quads, so a draw of its own."""
+    from cloudcore.cloud_records import SpriteStyle
+    from cloudcore.gl.splats import SplatPass, splat_batch
+    from cloudcore.light.eye_scattering import ParticleBuffer
+    from cloudcore.lod.impostors import impostor_view
+    from cloudcore.scene import Cloud, Light, Shading
+
+    rng = np.random.default_rng(11)
+    clouds = []
+    for index in range(20):
+        centre = [(index % 5 - 2) * 150.0, (index // 5) * 80.0, -700.0 - 40.0 * index]
+        centres = rng.normal(size=(60, 3)) * [30.0, 12.0, 30.0] + centre
+        style = {"sprite": SpriteStyle(rows=(0,))} if index == 7 else {}
+        clouds.append(Cloud(f"c{index}", np.column_stack([centres, rng.uniform(6.0, 14.0, 60)]), **style))
+    light = Light((0.0, 0.6, -0.8), (1.0, 0.95, 0.9), 1.0)
+    particles = ParticleBuffer(clouds, Shading(), (light,), (0.05, 0.06, 0.09))
+    eye = np.zeros(3)
+    renderer.context.make_current()
+    atlas, splats = ImpostorAtlas(128), SplatPass()
+    try:
+        images = [atlas.allocate(int(side)) for side in rng.choice([16, 24, 40, 64], len(clouds))]
+        renders = []
+        for index, image in enumerate(images):
+            start, stop = particles.cloud_starts[index : index + 2]
+            centre = particles.centres[start:stop].mean(axis=0)
+            reach = np.linalg.norm(particles.centres[start:stop] - centre, axis=1) + particles.radii[start:stop]
+            view = impostor_view(centre, reach.max(), eye)
+            renders.append((image, splat_batch(particles, [index], eye), view.view, view.projection))
+        splats.shade_ahead([(batch, view) for _, batch, view, _ in renders])
+        alone = []
+        for image, batch, view, projection in renders:
+            image.bind_cleared()
+            splats.draw(batch, view, projection, depth_test=False)
+            alone.append(image.read())
+        as_points, drawn = [], []
+        for index, (image, batch, view, projection) in enumerate(renders):
+            image.bind_cleared()
+            points = splats.as_points_in(batch, view, projection, image.viewport)
+            if points is not None:
+                as_points.append((batch, view, *points, image.viewport, image.cell.layer))
+                drawn.append(index)
+        # the sprites need quads, as do clouds with splats under a pixel in the smallest cells: two multi-draws
+        assert 7 not in drawn and len(drawn) > 16
+        atlas.bind_layers()
+        splats.draw_point_cells(as_points)
+        GL.glDisable(GL.GL_SCISSOR_TEST)
+        for index, (image, expected) in enumerate(zip(images, alone)):
+            held = image.read()
+            if index not in drawn:
+                assert not held.any()  # cleared, not drawn: nothing spilled in from a neighbour
+                continue
+            assert expected[..., 3].max() > 0.1, index
+            np.testing.assert_allclose(held, expected, atol=2e-3, err_msg=f"cell {index}")
+    finally:
+        splats.close()
+        atlas.close()

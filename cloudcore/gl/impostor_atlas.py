@@ -27,8 +27,9 @@ class ImpostorAtlas:
     def __init__(self, layer_side: int):
         self.layout = AtlasLayout(layer_side)
         self.texture, self._layers = None, 0
-        self._framebuffer, self._copy_framebuffer = GL.glGenFramebuffers(2)
+        self._framebuffer, self._copy_framebuffer, self._layered_framebuffer = GL.glGenFramebuffers(3)
         self._bound_layer = None
+        self._layered_texture = None  # the texture the layered framebuffer has attached
 
     @property
     def layer_side(self) -> int:
@@ -55,6 +56,12 @@ class ImpostorAtlas:
         """Draw into the side x side texels of `cell` from now on (viewport and scissor), cleared to transparent.
 
         The scissor stays on: a point sprite whose centre is in the viewport may reach beyond it."""
+        self.bind(cell, side)
+        GL.glClearColor(0.0, 0.0, 0.0, 0.0)
+        GL.glClear(GL.GL_COLOR_BUFFER_BIT)
+
+    def bind(self, cell: Cell, side: int) -> None:
+        """`bind_cleared` without the clearing."""
         GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, self._framebuffer)
         if self._bound_layer != cell.layer:  # consecutive cells of one layer keep the attachment
             GL.glFramebufferTextureLayer(GL.GL_FRAMEBUFFER, GL.GL_COLOR_ATTACHMENT0, self.texture, 0, cell.layer)
@@ -62,8 +69,15 @@ class ImpostorAtlas:
         GL.glViewport(cell.x, cell.y, side, side)
         GL.glEnable(GL.GL_SCISSOR_TEST)
         GL.glScissor(cell.x, cell.y, side, side)
-        GL.glClearColor(0.0, 0.0, 0.0, 0.0)
-        GL.glClear(GL.GL_COLOR_BUFFER_BIT)
+
+    def bind_layers(self) -> None:
+        """Draw into every layer at once from now on (a draw's vertices pick theirs: gl_Layer), with the scissor
+        test on; the viewports and scissors are the caller's to set per index."""
+        GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, self._layered_framebuffer)
+        if self._layered_texture != self.texture:
+            GL.glFramebufferTexture(GL.GL_FRAMEBUFFER, GL.GL_COLOR_ATTACHMENT0, self.texture, 0)
+            self._layered_texture = self.texture
+        GL.glEnable(GL.GL_SCISSOR_TEST)
 
     def read(self, cell: Cell, side: int) -> np.ndarray:
         """The side x side texels of `cell` as float32 (side, side, 4), top row first."""
@@ -94,10 +108,11 @@ class ImpostorAtlas:
             GL.glBlitFramebuffer(0, 0, side, side, 0, 0, side, side, GL.GL_COLOR_BUFFER_BIT, GL.GL_NEAREST)
         if self.texture is not None:
             GL.glDeleteTextures([self.texture])
-        self.texture, self._layers, self._bound_layer = texture, self.layout.layers, None
+        # the framebuffers are attached again when next bound: a new texture may take a deleted one's name
+        self.texture, self._layers, self._bound_layer, self._layered_texture = texture, self.layout.layers, None, None
 
     def close(self) -> None:
-        GL.glDeleteFramebuffers(2, [self._framebuffer, self._copy_framebuffer])
+        GL.glDeleteFramebuffers(3, [self._framebuffer, self._copy_framebuffer, self._layered_framebuffer])
         if self.texture is not None:
             GL.glDeleteTextures([self.texture])
         self.texture, self._layers = None, 0
@@ -113,6 +128,14 @@ class AtlasImage:
 
     def bind_cleared(self) -> None:
         self.atlas.bind_cleared(self.cell, self.side)
+
+    def bind(self) -> None:
+        self.atlas.bind(self.cell, self.side)
+
+    @property
+    def viewport(self) -> tuple[int, int, int, int]:
+        """(x, y, width, height) of its texels in its layer."""
+        return self.cell.x, self.cell.y, self.side, self.side
 
     def read(self) -> np.ndarray:
         return self.atlas.read(self.cell, self.side)

@@ -83,10 +83,12 @@ class ImpostorStore:
             batch = splat_batch(particles, clouds, generation.eye, None, time_s)
             renders.append((target, batch, view, projection, first))
         self._splats.shade_ahead([(batch, view) for _, batch, view, _, _ in renders])
+        self._draw_cells([render[:4] for render in renders if isinstance(render[0], AtlasImage)], settings)
         for target, batch, view, projection, cleared in renders:
-            # the clouds alone, no depth test: the texture holds their premultiplied colour and opacity
-            target.bind_cleared() if cleared else target.bind()
-            self._splats.draw(batch, view, projection, depth_test=False, point_sprites=settings.point_sprites)
+            if not isinstance(target, AtlasImage):
+                # the clouds alone, no depth test: the texture holds their premultiplied colour and opacity
+                target.bind_cleared() if cleared else target.bind()
+                self._splats.draw(batch, view, projection, depth_test=False, point_sprites=settings.point_sprites)
         GL.glDisable(GL.GL_SCISSOR_TEST)  # the last atlas cell's: it would clip the cloud pass
         for side in [side for side, atlas in self._atlases.items() if not atlas.in_use]:
             self._atlases.pop(side).close()
@@ -94,6 +96,33 @@ class ImpostorStore:
         for key in [key for key in self._ring if key[0] not in live]:
             self.pool.release(self._ring.pop(key)[0])
         return sum(len(batch) for _, batch, _, _, _ in renders)
+
+    def _draw_cells(self, renders, settings: RenderSettings) -> None:
+        """Render (atlas image, batch, view, projection) into their cells, cleared first: per atlas, those all of
+        point sprites in one multi-draw (`SplatPass.draw_point_cells`: 0.3 ms a regeneration of CPU and driver
+        work less on llvmpipe), the others one by one."""
+        by_atlas: dict[int, list] = {}
+        for render in renders:
+            by_atlas.setdefault(id(render[0].atlas), []).append(render)
+        for group in by_atlas.values():
+            atlas, as_points, alone = group[0][0].atlas, [], []
+            for image, batch, view, projection in group:
+                image.bind_cleared()  # glClearTexSubImage cost llvmpipe more: 1.58 against 1.30 ms a regeneration
+                points = (
+                    self._splats.as_points_in(batch, view, projection, image.viewport)
+                    if settings.point_sprites
+                    else None
+                )
+                if points is None:
+                    alone.append((image, batch, view, projection))
+                else:
+                    as_points.append((batch, view, *points, image.viewport, image.cell.layer))
+            if as_points:
+                atlas.bind_layers()
+                self._splats.draw_point_cells(as_points)
+            for image, batch, view, projection in alone:
+                image.bind()
+                self._splats.draw(batch, view, projection, depth_test=False, point_sprites=settings.point_sprites)
 
     @property
     def texture_bytes(self) -> int:

@@ -63,6 +63,11 @@ _UNLOCKED = (0.0, 0.0, 0.0, -1.0)
 ) = range(8)
 #: floats of splat_shade.comp.glsl's `Batch`: first slot and count (as uints), eye, image plane's right and up
 _BATCH_FLOATS = 16
+#: splat.vert.glsl's `Cell` (CELLS): view rotation, projection, viewport height and layer; its binding
+_CELL_FLOATS = 36
+_CELLS_BINDING = 8
+#: viewports (and scissors) a multi-draw of cells can address: what GL 4.1 guarantees, llvmpipe's and NVIDIA's
+_MAX_VIEWPORTS = 16
 #: splat_select.comp.glsl's buffers
 (
     _SELECT_PARTICLES,
@@ -222,7 +227,8 @@ class SplatPass:
             self._facing_buffer,
             self._profile_buffer,
             self._batch_buffer,
-        ) = self._buffers = GL.glGenBuffers(9)
+            self._cell_buffer,
+        ) = self._buffers = GL.glGenBuffers(10)
         self._atlas: int | None = None  # the sprite atlas texture, made when a cloud first needs it
         self._quads_indexed = 0
         self._instance_capacity = 0  # slots
@@ -251,6 +257,9 @@ class SplatPass:
         #: the selections shaded since `shade_ahead` last began a pass: id -> their indirect command's index
         self._commands: dict[int, int] = {}
         self._drawn_commands: list[int] = []  # those drawn (not counting fragments) since `take_selected`
+        #: `draw_point_cells`'s program (made when first needed) and its first cell's uniform
+        self._cell_points: int | None = None
+        self._cell_points_first = -1
 
     def draw(
         self,
@@ -274,17 +283,9 @@ class SplatPass:
             return 0
         _, first = self.shade(batch, view)
         view_rotation = _rotation(view)
-        pieces, target_viewport = [(0, len(batch), False)], None
-        plain = self.plain_splats(batch) if point_sprites else None
-        if plain is not None and plain.any():
-            # the same pixels through a clip volume wider than the target (cloudcore.point_sprites)
-            target_viewport = GL.glGetIntegerv(GL.GL_VIEWPORT)
-            projection, viewport = guard_band(projection, target_viewport, self._point_sizes_px[1])
-            size = (int(viewport[2]), int(viewport[3]))
-            fit = point_sprite_mask(
-                batch.centres - batch.eye, batch.radii, view_rotation, projection, size, self._point_sizes_px
-            )
-            pieces = draw_runs(plain & fit)
+        target_viewport = GL.glGetIntegerv(GL.GL_VIEWPORT) if point_sprites else None
+        pieces, projection, viewport = self._pieces(batch, view_rotation, projection, target_viewport)
+        if viewport is not None:
             GL.glViewport(*viewport)
         with_sprites = bool(self._sprites[batch.order].any())
         programs = {points: self._programs[points, counting, with_sprites and not points] for points in (False, True)}
@@ -304,11 +305,75 @@ class SplatPass:
                     )
         GL.glDisable(GL.GL_PROGRAM_POINT_SIZE)
         GL.glBindVertexArray(0)
-        if target_viewport is not None:
+        if viewport is not None:
             GL.glViewport(*target_viewport)
         as_points = sum(stop - start for start, stop, as_points in pieces if as_points)
         self.particles_as_points += as_points
         return as_points
+
+    def _pieces(self, batch: SplatBatch, view_rotation: np.ndarray, projection: np.ndarray, target_viewport):
+        """(the batch's draws, (start, stop, as points), the projection and the viewport they are drawn
+        through): with a `target_viewport` (x, y, width, height), the runs of points that
+        `cloudcore.point_sprites` allows, through a clip volume wider than the target, the same pixels; without
+        one, or when none can be points, the whole batch as quads through `projection` (viewport None)."""
+        plain = self.plain_splats(batch) if target_viewport is not None else None
+        if plain is None or not plain.any():
+            return [(0, len(batch), False)], projection, None
+        projection, viewport = guard_band(projection, target_viewport, self._point_sizes_px[1])
+        size = (int(viewport[2]), int(viewport[3]))
+        fit = point_sprite_mask(
+            batch.centres - batch.eye, batch.radii, view_rotation, projection, size, self._point_sizes_px
+        )
+        return draw_runs(plain & fit), projection, viewport
+
+    def as_points_in(self, batch: SplatBatch, view: np.ndarray, projection: np.ndarray, viewport) -> tuple | None:
+        """(the projection, the viewport) through which all of `batch` is drawn as point sprites into a target
+        at `viewport` (x, y, width, height) with its scissor, as `draw` would draw it; None when `draw` would
+        draw some of it as quads."""
+        if not len(batch):
+            return None
+        pieces, projection, guarded = self._pieces(batch, _rotation(view), projection, viewport)
+        return (projection, guarded) if pieces == [(0, len(batch), True)] else None
+
+    def draw_point_cells(self, cells) -> None:
+        """Draw batches all of point sprites (`as_points_in`), each into its own rectangle of a layered target,
+        blended over it without a depth test, as `draw` would one by one: one multi-draw for each
+        MAX_VIEWPORTS of them.  `cells`: (batch, view, its projection and viewport from `as_points_in`, the
+        scissor rectangle (x, y, width, height), the layer); the layered target is bound, its scissor on."""
+        if not cells:
+            return
+        if self._cell_points is None:
+            self._cell_points = build_program(
+                "splat",
+                {"SPLAT_SHARPNESS": SPLAT_SHARPNESS, "ATLAS_GRID": ATLAS_GRID, "POINT_SPRITE": 1, "CELLS": 1},
+            )
+            self._cell_points_first = GL.glGetUniformLocation(self._cell_points, "first_cell")
+        firsts = np.array([self.shade(batch, view)[1] for batch, view, *_ in cells], dtype=np.int32)
+        counts = np.array([len(batch) for batch, *_ in cells], dtype=np.int32)
+        table = np.zeros((len(cells), _CELL_FLOATS), dtype=np.float32)
+        for row, (_, view, projection, viewport, _, layer) in enumerate(cells):
+            # GLSL reads matrices by columns
+            table[row, 0:16], table[row, 16:32] = _rotation(view).T.ravel(), np.asarray(projection).T.ravel()
+            table[row, 32:34] = viewport[3], layer
+        _store(self._cell_buffer, table, GL.GL_STREAM_DRAW)
+        GL.glUseProgram(self._cell_points)
+        GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _INSTANCES_BINDING, self._instance_buffer)
+        GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _CELLS_BINDING, self._cell_buffer)
+        GL.glBindVertexArray(self._vertex_array)
+        GL.glEnable(GL.GL_PROGRAM_POINT_SIZE)
+        with cloud_blending(depth_test=False, counting=False):
+            for start in range(0, len(cells), _MAX_VIEWPORTS):
+                group = cells[start : start + _MAX_VIEWPORTS]
+                viewports = np.array([cell[3] for cell in group], dtype=np.float32)
+                scissors = np.array([cell[4] for cell in group], dtype=np.int32)
+                GL.glViewportArrayv(0, len(group), viewports)
+                GL.glScissorArrayv(0, len(group), scissors)
+                GL.glUniform1i(self._cell_points_first, start)
+                stop = start + len(group)
+                GL.glMultiDrawArrays(GL.GL_POINTS, firsts[start:stop], counts[start:stop], len(group))
+        GL.glDisable(GL.GL_PROGRAM_POINT_SIZE)
+        GL.glBindVertexArray(0)
+        self.particles_as_points += int(counts.sum())
 
     def _draw_selection(
         self, selection: SplatSelection, view: np.ndarray, projection: np.ndarray, depth_test: bool, counting: bool
@@ -668,6 +733,8 @@ class SplatPass:
         """Free the GL objects (the context must be current)."""
         for program in (*self._programs.values(), *(held[0] for held in self._shade_programs.values())):
             GL.glDeleteProgram(program)
+        if self._cell_points is not None:
+            GL.glDeleteProgram(self._cell_points)
         if self._selecting is not None:
             GL.glDeleteProgram(self._selecting[0])
             self._selecting[2].close()

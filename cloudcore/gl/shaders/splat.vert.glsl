@@ -1,4 +1,8 @@
 #version 430 core
+#ifdef CELLS
+#extension GL_ARB_shader_viewport_layer_array : require
+#extension GL_ARB_shader_draw_parameters : require
+#endif
 // Draws the quads splat_shade.comp.glsl built: four vertices per particle,
 // as indexed triangles rather than instances (a software rasteriser runs its
 // vertex pipeline once per instance).  Corners come relative to the eye,
@@ -6,7 +10,10 @@
 // defined, one vertex per particle instead, a point sprite of the quad's
 // square (cloudcore.point_sprites says when the picture is the same); its
 // centre and radius come back from the corners, so that one compute shader
-// serves both ways of drawing.
+// serves both ways of drawing.  With CELLS defined too, the points of many
+// impostors at once, one multi-draw's draw each: its cell's view, projection,
+// viewport and atlas layer come from a table (a frame's regenerations into the
+// atlas in one call; the viewports and scissors are the cells', set per index).
 
 struct Instance {
     vec4 corners[4];  // relative to the eye; w: atlas cell (-1: Gaussian splat)
@@ -22,16 +29,35 @@ flat out int sprite;      // atlas cell, -1 for a Gaussian splat
 
 #ifdef POINT_SPRITE
 uniform float viewport_height;  // pixels
+#ifdef CELLS
+struct Cell {
+    mat4 view_rotation;
+    mat4 projection;
+    vec4 viewport_height_layer;  // the cell's (guard-banded) viewport height in pixels, its atlas layer
+};
+layout(std430, binding = 8) readonly buffer Cells { Cell cells[]; };
+uniform int first_cell;  // the cell of the multi-draw's first draw
+#endif
 
 void main()
 {
+#ifdef CELLS
+    Cell cell = cells[first_cell + gl_DrawIDARB];
+    mat4 rotation = cell.view_rotation, clip = cell.projection;
+    float height = cell.viewport_height_layer.x;
+    gl_ViewportIndex = gl_DrawIDARB;
+    gl_Layer = int(cell.viewport_height_layer.y);
+#else
+    mat4 rotation = view_rotation, clip = projection;
+    float height = viewport_height;
+#endif
     Instance instance = instances[gl_VertexID];
     // corners 0 and 3 are opposite, (-1, -1) and (1, 1); 0 and 1 are 2r apart along the image's right
     vec3 centre = 0.5 * (instance.corners[0].xyz + instance.corners[3].xyz);
     float radius = 0.5 * length(instance.corners[1].xyz - instance.corners[0].xyz);
-    gl_Position = projection * (view_rotation * vec4(centre, 1.0));
-    // the square's side in pixels: 2r * projection[1][1] / w of the 2 that viewport_height spans
-    gl_PointSize = radius * projection[1][1] * viewport_height / gl_Position.w;
+    gl_Position = clip * (rotation * vec4(centre, 1.0));
+    // the square's side in pixels: 2r * projection[1][1] / w of the 2 that the viewport's height spans
+    gl_PointSize = radius * clip[1][1] * height / gl_Position.w;
     colour = instance.colours[0];
     sprite = -1;
 }
