@@ -23,8 +23,8 @@ MODES = ("auto", "full", "impostor")
 TRANSLATION_METRICS = ("parallax", "centre")
 #: how full-3D splats are composited (`cloudcore.light.volume_blending`)
 BLENDINGS = ("plain", "volume")
-#: where full-3D draws choose and order their particles (`cloudcore.gl.splats`)
-SPLAT_ORDERS = ("cpu", "gpu")
+#: where full-3D draws choose and order their particles (`cloudcore.gl.splats`; "auto": `cloudcore.lod.splat_order`)
+SPLAT_ORDERS = ("auto", "cpu", "gpu")
 
 
 @dataclass(frozen=True)
@@ -227,13 +227,13 @@ class RenderSettings:
 
     #: "cpu": a draw's particles are chosen and sorted far to near in numpy and their order uploaded; "gpu":
     #: chosen, sorted and counted by compute shaders, drawn as quads by an indirect draw, so that the CPU's
-    #: work for a draw does not grow with its particles.  CPU by default: on llvmpipe the GPU's sort is
-    #: 30-40 times slower than numpy's, the frame 1.65 times (docs/performance.md, "The GPU's order")
+    #: work for a draw does not grow with its particles; "auto": the one measured faster on this GL
+    #: (`cloudcore.lod.splat_order`: on llvmpipe the CPU's, whose sort is 30-40 times faster, the frame 1.65)
     splat_order: str = _setting(
-        "cpu",
+        "auto",
         flag="--splat-order",
         help="cpu: full-3D splats chosen and sorted far to near on the CPU; gpu: by compute shaders, "
-        "drawn indirectly (for GPUs: slower on llvmpipe)",
+        "drawn indirectly; auto: the one measured faster here (the CPU on llvmpipe)",
         choices=SPLAT_ORDERS,
         label="Splat order",
     )

@@ -126,5 +126,6 @@ def test_a_frame_drawn_from_gpu_selections_shows_the_cpus_picture_and_counts(ren
     difference = compare(cpu_image, gpu_image)
     assert difference.within(min_psnr_db=60.0, max_abs=4), str(difference)
     assert gpu_stats.particles_drawn == cpu_stats.particles_drawn > 0
+    assert (cpu_stats.splat_order, gpu_stats.splat_order) == ("cpu", "gpu")  # "auto" on llvmpipe: the CPU
     assert gpu_overdraw.mean == pytest.approx(cpu_overdraw.mean, rel=1e-4)
     assert gpu_overdraw.analytic == pytest.approx(cpu_overdraw.analytic, rel=1e-9)

@@ -36,7 +36,8 @@ class StatisticsPanel:
             )
         imgui.text(
             f"particles drawn {frame.particles_drawn}, rendered to impostors {frame.particles_to_impostors}, "
-            f"as point sprites {frame.particles_as_points}, as volumes {frame.particles_as_volumes}"
+            f"as point sprites {frame.particles_as_points}, as volumes {frame.particles_as_volumes}; "
+            f"sorted on the {frame.splat_order.upper()}"
         )
         imgui.text(
             f"impostors drawn {plan.impostors_drawn}, regenerated {shown.impostors_regenerated} "

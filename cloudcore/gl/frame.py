@@ -54,6 +54,7 @@ from cloudcore.light.volume_blending import blending_path, screen_tiles
 from cloudcore.lod.costs import CostModel
 from cloudcore.lod.frameplan import FramePlan, LodState, inside_runs, plan_frame
 from cloudcore.lod.impostors import cropped_corners, particle_extent
+from cloudcore.lod.splat_order import SplatOrderChoice
 from cloudcore.lod.units import LodUnits, lod_units
 from cloudcore.measure.frame_stats import FrameStats
 from cloudcore.measure.overdraw import Overdraw, analytic_overdraw, overdraw_statistics
@@ -76,7 +77,7 @@ class _CloudPassFrame:
     time_s: float
     point_sprites: bool  # the setting: draw plain splats as points where the picture is the same
     blending: str  # the setting: full-3D splats as billboards ("plain") or as volumes ("volume")
-    splat_order: str  # the setting: full-3D splats chosen and sorted on the "cpu" or the "gpu"
+    splat_order: str  # full-3D splats chosen and sorted on the "cpu" or the "gpu" (the setting, "auto" resolved)
 
     @property
     def eye(self) -> np.ndarray:
@@ -108,6 +109,7 @@ class FrameRenderer:
         self._key_serial = 0
         #: the level of detail's state between frames (impostor cache, ring, representations, costs)
         self.lod_state = LodState()
+        self.splat_order = SplatOrderChoice()  # where full-3D draws sort, measured (settings' "auto")
         #: the cloud field's cells made for the last eye, and its particles' blend weights (None: no field)
         self.field_state = FieldState()
         self._field_weights: np.ndarray | None = None
@@ -219,12 +221,14 @@ class FrameRenderer:
                 )
         with clock.timed("impostor updates"):
             rendered = self._impostors.update(plan, particles, settings, time_s)
+        way = self.splat_order.way(settings.splat_order, self._volume.features.renderer)
         with clock.timed("clouds"):
             self.context.bind_target()
-            drawn = self._draw_clouds(plan, particles, camera, view, projection, settings, poses, time_s)
+            drawn = self._draw_clouds(plan, particles, camera, view, projection, settings, poses, time_s, way)
         drawn += self._splats.take_selected()
         world, updates, clouds = (clock.times[name] for name in ("world", "impostor updates", "clouds"))
         self.lod_state = plan.state.measured([(plan.update_work, updates.wall_ms), (plan.cloud_work, clouds.wall_ms)])
+        self.splat_order = self.splat_order.observe(way, clouds.wall_ms, drawn)
         stats = FrameStats(
             plan=plan.stats(),
             illumination_ms=illumination_ms,
@@ -240,6 +244,7 @@ class FrameRenderer:
             particles_drawn=drawn,
             particles_as_points=self._splats.particles_as_points,
             particles_as_volumes=self._particles_as_volumes,
+            splat_order=way,
             particles_to_impostors=rendered,
             clouds_drawn=sum(len(plan.clouds[i].members) for i in plan.draw_order),
             texture_bytes=self.texture_bytes,
@@ -360,9 +365,10 @@ class FrameRenderer:
         settings: RenderSettings,
         poses,
         time_s: float,
+        splat_order: str,
     ) -> int:
-        """Execute the plan's cloud pass into the frame target at scene time `time_s`, one method per draw kind;
-        returns the particles drawn."""
+        """Execute the plan's cloud pass into the frame target at scene time `time_s`, one method per draw kind,
+        full-3D draws sorted the way `splat_order` ("cpu" or "gpu"); returns the particles drawn."""
         view_projection = projection @ view
         frame = _CloudPassFrame(
             plan,
@@ -376,7 +382,7 @@ class FrameRenderer:
             time_s,
             settings.point_sprites,
             settings.blending,
-            settings.splat_order,
+            splat_order,
         )
         self._replay, self._screen_batches = [], []
         steps = self._cloud_pass_steps(frame)
