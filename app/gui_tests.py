@@ -21,6 +21,7 @@ from imgui_bundle.imgui.test_engine_checks import CHECK
 
 from app.editor import discard_recovery, recovery_path
 from cloudcore.editing import add_cloud
+from cloudcore.measure.imagecompare import compare
 from cloudcore.measure.overlays import to_pixels
 from cloudcore.navigation import orbited
 from cloudcore.paths import camera_on_path
@@ -459,6 +460,28 @@ def volume_blending_composites_in_the_window(ctx, app: EditorUnderTest):
     ctx.combo_click("Mode/auto")
 
 
+def the_gpu_sorts_the_splats_in_the_window(ctx, app: EditorUnderTest):
+    # "Splat order/gpu": the compute shaders choose, sort and count in the window's own context, the indirect
+    # draw shows the CPU's picture; "auto" goes back to the CPU on llvmpipe
+    use_window(ctx, "LOD")
+    ctx.combo_click("Mode/full")
+    ctx.yield_(SETTLE)
+    on_cpu, cpu_stats = app.capture(ctx), app.editor.last_stats.frame
+    ctx.combo_click("Splat order/gpu")
+    CHECK(app.editor.settings.splat_order == "gpu")
+    ctx.yield_(SETTLE)
+    on_gpu, gpu_stats = app.capture(ctx), app.editor.last_stats.frame
+    difference = compare(on_cpu, on_gpu)
+    app.outcome["gpu_order_psnr_db"] = difference.psnr_db
+    CHECK((cpu_stats.splat_order, gpu_stats.splat_order) == ("cpu", "gpu"))
+    CHECK(gpu_stats.particles_drawn == cpu_stats.particles_drawn and gpu_stats.particles_drawn > 0)
+    CHECK(bool(difference.psnr_db > 50.0))
+    ctx.combo_click("Splat order/auto")
+    ctx.yield_(SETTLE)
+    CHECK(app.editor.last_stats.frame.splat_order == "cpu")
+    ctx.combo_click("Mode/auto")
+
+
 def overlays_outline_impostors_and_the_ring(ctx, app: EditorUnderTest):
     use_window(ctx, "LOD")
     ctx.combo_click("Mode/impostor")  # auto mode prices the ring, and the test scene's is dearer than its clouds
@@ -636,6 +659,7 @@ GUI_TESTS = (
     delete_key_and_statistics_toggle,
     heat_map_changes_the_picture,
     volume_blending_composites_in_the_window,
+    the_gpu_sorts_the_splats_in_the_window,
     overlays_outline_impostors_and_the_ring,
     playing_a_camera_path_moves_the_camera,
     recording_runs_in_the_background,

@@ -339,16 +339,20 @@ class SplatPass:
         """Draw batches all of point sprites (`as_points_in`), each into its own rectangle of a layered target,
         blended over it without a depth test, as `draw` would one by one: one multi-draw for each
         MAX_VIEWPORTS of them.  `cells`: (batch, view, its projection and viewport from `as_points_in`, the
-        scissor rectangle (x, y, width, height), the layer); the layered target is bound, its scissor on."""
+        scissor rectangle (x, y, width, height), the layer), each shaded ahead (`shade_ahead`) for its view;
+        the layered target is bound, its scissor on."""
         if not cells:
             return
+        shaded = [self._shaded.get(id(batch)) for batch, *_ in cells]
+        if any(held is None or not np.array_equal(held[1], view) for held, (_, view, *_) in zip(shaded, cells)):
+            raise ValueError("cells drawn together must be shaded ahead for their views (SplatPass.shade_ahead)")
         if self._cell_points is None:
             self._cell_points = build_program(
                 "splat",
                 {"SPLAT_SHARPNESS": SPLAT_SHARPNESS, "ATLAS_GRID": ATLAS_GRID, "POINT_SPRITE": 1, "CELLS": 1},
             )
             self._cell_points_first = GL.glGetUniformLocation(self._cell_points, "first_cell")
-        firsts = np.array([self.shade(batch, view)[1] for batch, view, *_ in cells], dtype=np.int32)
+        firsts = np.array([held[0] for held in shaded], dtype=np.int32)
         counts = np.array([len(batch) for batch, *_ in cells], dtype=np.int32)
         table = np.zeros((len(cells), _CELL_FLOATS), dtype=np.float32)
         for row, (_, view, projection, viewport, _, layer) in enumerate(cells):
@@ -561,7 +565,7 @@ class SplatPass:
             slots[row, 0:2] = slot, batch.slots
             table[row, 4:7], table[row, 8:11], table[row, 12:15] = batch.eye, view[0, :3], view[1, :3]
         _store(self._batch_buffer, table, GL.GL_STREAM_DRAW)
-        for binding, buffer in (
+        _bind_storage(
             (_PARTICLES_BINDING, self._particle_buffer),
             (_FORMATION_BINDING, self._formation_buffer),
             (_ORDER_BINDING, self._order_buffer),
@@ -570,8 +574,7 @@ class SplatPass:
             (_FACING_BINDING, self._facing_buffer),
             (_PROFILES_BINDING, self._profile_buffer),
             (_BATCHES_BINDING, self._batch_buffer),
-        ):
-            GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, binding, buffer)
+        )
         program, uniforms = self._shade_program(features)
         first, end = run[0][2], run[-1][2] + run[-1][0].slots
         GL.glUseProgram(program)
@@ -607,7 +610,7 @@ class SplatPass:
         GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, self._command_buffer)
         record = np.array([0, 1, 0, 4 * first, 0], dtype=np.uint32)  # its count is the GPU's to add to
         GL.glBufferSubData(GL.GL_SHADER_STORAGE_BUFFER, record.nbytes * command, record.nbytes, record)
-        for binding, buffer in (
+        _bind_storage(
             (_SELECT_PARTICLES, self._particle_buffer),
             (_SELECT_FORMATION, self._formation_buffer),
             (_SELECT_BITS, self._drawn_bits_buffer),
@@ -615,8 +618,7 @@ class SplatPass:
             (_SELECT_KEYS, self._keys_buffer),
             (_SELECT_VALUES, self._values_buffer),
             (_SELECT_COMMAND, self._command_buffer),
-        ):
-            GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, binding, buffer)
+        )
         GL.glUseProgram(program)
         GL.glUniform1ui(uniforms["count"], slots)
         GL.glUniform1ui(uniforms["range_count"], len(clouds))
@@ -833,6 +835,12 @@ def _rotation(view: np.ndarray) -> np.ndarray:
     rotation = np.array(view, dtype=np.float64)
     rotation[:3, 3] = 0.0
     return rotation
+
+
+def _bind_storage(*bindings) -> None:
+    """Bind each (binding point, buffer) pair as a shader storage buffer."""
+    for binding, buffer in bindings:
+        GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, binding, buffer)
 
 
 def _copy_buffer(source: int, destination: int, size: int, allocate: bool) -> None:
