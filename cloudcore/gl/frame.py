@@ -443,8 +443,8 @@ class FrameRenderer:
         return steps
 
     def _full_3d_batch(self, frame: _CloudPassFrame, items) -> SplatBatch | SplatSelection:
-        """`_batch_of` for a run of full-3D layers; chosen and sorted on the GPU with that setting, where they
-        are blended as billboards (volume blending reads its batch on the CPU)."""
+        """`_batch_of` for a run of full-3D layers; chosen and sorted on the GPU when that is the frame's way
+        and they are blended as billboards (volume blending reads its batch on the CPU)."""
         if frame.splat_order == "gpu" and frame.blending == "plain":
             clouds, depth_ranges = self._members_and_ranges(frame, items)
             return SplatSelection(frame.particles, clouds, frame.eye, depth_ranges, frame.time_s, frame.frustum)
