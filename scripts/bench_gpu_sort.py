@@ -13,7 +13,6 @@ order is the CPU's, exactly.
 from __future__ import annotations
 
 import argparse
-import ctypes
 import os
 import time
 from pathlib import Path
@@ -26,17 +25,12 @@ from OpenGL import GL  # noqa: E402  (the GL imports need the platform)
 
 from cloudcore.gl.context import HeadlessContext  # noqa: E402
 from cloudcore.gl.depth_sort import GpuDepthSort  # noqa: E402
+from cloudcore.gl.pass_clock import PassClock  # noqa: E402
 from cloudcore.lod.depth_order import distance_keys, far_to_near  # noqa: E402
 from cloudcore.measure.benchmark import machine, write_report  # noqa: E402
 
 
-def _timestamp_ns(query: int) -> int:
-    value = ctypes.c_uint64()
-    GL.glGetQueryObjectui64v(query, GL.GL_QUERY_RESULT, ctypes.byref(value))
-    return value.value
-
-
-def bench(count: int, repeat: int, sort: GpuDepthSort, buffers, queries) -> dict:
+def bench(count: int, repeat: int, sort: GpuDepthSort, buffers, clock: PassClock) -> dict:
     rng = np.random.default_rng(count)
     distances = np.linalg.norm(rng.normal(size=(count, 3)) * [3000.0, 400.0, 3000.0], axis=1)
     cpu_ms, gpu_wall_ms, gpu_ms = [], [], []
@@ -49,13 +43,10 @@ def bench(count: int, repeat: int, sort: GpuDepthSort, buffers, queries) -> dict
             GL.glBufferData(GL.GL_SHADER_STORAGE_BUFFER, data.nbytes, data, GL.GL_DYNAMIC_COPY)
         GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT)
         GL.glFinish()
-        started = time.perf_counter()
-        GL.glQueryCounter(queries[0], GL.GL_TIMESTAMP)
-        sort.sort(*buffers, count)
-        GL.glQueryCounter(queries[1], GL.GL_TIMESTAMP)
-        GL.glFinish()
-        gpu_wall_ms.append(1e3 * (time.perf_counter() - started))
-        gpu_ms.append(1e-6 * (_timestamp_ns(queries[1]) - _timestamp_ns(queries[0])))
+        with clock.timed("sort"):
+            sort.sort(*buffers, count)
+        gpu_wall_ms.append(clock.times["sort"].wall_ms)
+        gpu_ms.append(clock.times["sort"].gpu_ms)
     GL.glMemoryBarrier(GL.GL_BUFFER_UPDATE_BARRIER_BIT)
     GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, buffers[1])
     gpu_order = np.frombuffer(GL.glGetBufferSubData(GL.GL_SHADER_STORAGE_BUFFER, 0, 4 * count), dtype=np.uint32)
@@ -79,10 +70,10 @@ def main() -> None:
     args = parser.parse_args()
     context = HeadlessContext(64, 64)
     context.make_current()
-    sort, buffers, queries = GpuDepthSort(), GL.glGenBuffers(2), GL.glGenQueries(2)
+    sort, buffers, clock = GpuDepthSort(), GL.glGenBuffers(2), PassClock()
     rows = []
     for count in (int(text) for text in args.counts.split(",")):
-        rows.append(bench(count, args.repeat, sort, buffers, queries))
+        rows.append(bench(count, args.repeat, sort, buffers, clock))
         row = rows[-1]
         print(
             f"{row['count']:>9,} keys: CPU {row['cpu_ms']:8.2f} ms, GPU {row['gpu_wall_ms']:8.2f} ms to glFinish "
@@ -90,7 +81,7 @@ def main() -> None:
         )
     sort.close()
     GL.glDeleteBuffers(2, list(buffers))
-    GL.glDeleteQueries(2, list(queries))
+    clock.close()
     context.close()
     write_report({"machine": machine(), "counts": rows}, args.json)
 
