@@ -80,6 +80,9 @@ class FakeRenderer:
             world_ms=5.0,
             cloud_ms=30.0,
             texture_bytes=1024,
+            world_gpu_ms=2.0,
+            impostor_update_gpu_ms=0.0 if settings == FULL_3D else 3.0,
+            cloud_gpu_ms=7.0,
         )
         return np.full((4, 4, 3), level, dtype=np.uint8), stats
 
@@ -92,6 +95,8 @@ def test_bench_path_reports_the_error_and_speedup_it_measured():
     assert run["psnr_mean"] == pytest.approx(10 * np.log10(255**2 / 25))
     assert run["mad_mean"] == 5.0 and run["speedup_vs_full"] == 4.0 and run["regenerations"] == 3
     assert report["reference"]["mode"] == "full" and report["frames"] == 3
+    assert run["gpu_ms_by_pass"] == {"clouds": 7.0, "impostor_updates": 3.0, "world": 2.0}
+    assert run["gpu_ms_mean"] == 12.0 and report["reference"]["gpu_ms_by_pass"]["impostor_updates"] == 0.0
     twins = [FakeRenderer(offset=0) for _ in range(2)]
     identical = bench_path(twins, scene, "flythrough", 2, [RenderSettings()], (4, 4))
     assert identical["runs"][0]["psnr_min"] == 100.0  # identical frames: the cap, JSON has no infinity

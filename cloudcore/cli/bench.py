@@ -134,14 +134,17 @@ def run(args) -> int:
     args.json.parent.mkdir(parents=True, exist_ok=True)
     args.json.write_text(json.dumps(report, indent=2) + "\n")
     reference = report["reference"]
-    print(f"full 3D: {reference['frame_ms_mean']:.1f} ms mean, {reference['frame_ms_p95']:.1f} ms p95")
+    print(
+        f"full 3D: {reference['frame_ms_mean']:.1f} ms mean, {reference['frame_ms_p95']:.1f} ms p95, "
+        + _cpu_and_gpu(reference)
+    )
     for run_ in report["runs"]:
         changed = {k: v for k, v in run_["settings"].items() if v != dataclasses.asdict(base)[k]}
         print(
             f"{changed or run_['settings']['mode']}: {run_['frame_ms_mean']:.1f} ms "
             f"(x{run_['speedup_vs_full']:.2f} frame, x{run_['cloud_speedup_vs_full']:.2f} clouds), "
             f"PSNR mean {run_['psnr_mean']:.2f} dB, min {run_['psnr_min']:.2f} dB, "
-            f"{run_['regenerations_per_frame']:.2f} regenerations a frame"
+            f"{run_['regenerations_per_frame']:.2f} regenerations a frame, " + _cpu_and_gpu(run_)
         )
     if args.plot:
         plot_error_against_time(report, args.plot)
@@ -186,3 +189,9 @@ def plot_error_against_time(report: dict, path: Path) -> None:
     axes.set_title(f"{Path(report['scene']).name}, path {report['path']}, {report['width']}x{report['height']}")
     axes.legend(fontsize=7)
     save_figure(figure, path)
+
+
+def _cpu_and_gpu(summary: dict) -> str:
+    """A run's mean CPU time a frame and its GPU time per pass, as the bench prints them."""
+    passes = ", ".join(f"{name.replace('_', ' ')} {ms:.1f}" for name, ms in summary["gpu_ms_by_pass"].items())
+    return f"CPU {summary['cpu_ms_mean']:.1f} ms, GPU {summary['gpu_ms_mean']:.1f} ms ({passes})"

@@ -130,6 +130,15 @@ def _summary(rows) -> dict:
         "gpu_ms_mean": float(
             np.mean([r["world_gpu_ms"] + r["impostor_update_gpu_ms"] + r["cloud_gpu_ms"] for r in rows])
         ),
+        # the GPU's own clock per pass (GL_TIMESTAMP, `cloudcore.gl.pass_clock`): where a GPU spends the frame
+        "gpu_ms_by_pass": {
+            name: float(np.mean([r[key] for r in rows]))
+            for name, key in (
+                ("clouds", "cloud_gpu_ms"),
+                ("impostor_updates", "impostor_update_gpu_ms"),
+                ("world", "world_gpu_ms"),
+            )
+        },
     }
 
 
