@@ -23,7 +23,8 @@ MODES = ("auto", "full", "impostor")
 TRANSLATION_METRICS = ("parallax", "centre")
 #: how full-3D splats are composited (`cloudcore.light.volume_blending`)
 BLENDINGS = ("plain", "volume")
-#: where full-3D draws choose and order their particles (`cloudcore.gl.splats`; "auto": `cloudcore.lod.splat_order`)
+#: where full-3D draws and impostor regenerations choose and order their particles (`cloudcore.gl.splats`; "auto":
+#: `cloudcore.lod.splat_order`)
 SPLAT_ORDERS = ("auto", "cpu", "gpu")
 
 
@@ -232,8 +233,8 @@ class RenderSettings:
     splat_order: str = _setting(
         "auto",
         flag="--splat-order",
-        help="cpu: full-3D splats chosen and sorted far to near on the CPU; gpu: by compute shaders, "
-        "drawn indirectly; auto: the one measured faster here (the CPU on llvmpipe)",
+        help="cpu: splats (full 3D and impostor regenerations) chosen and sorted far to near on the CPU; "
+        "gpu: by compute shaders, drawn indirectly; auto: the one measured faster here (the CPU on llvmpipe)",
         choices=SPLAT_ORDERS,
         label="Splat order",
     )

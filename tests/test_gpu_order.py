@@ -27,14 +27,17 @@ LIGHTS = (Light((0.0, 0.6, -0.8), (1.0, 0.95, 0.9), 1.0),)
 AMBIENT = (0.05, 0.06, 0.09)
 
 
-@pytest.mark.parametrize("count", [0, 1, 2, 2047, 2048, 2049, 30000])
-def test_the_gpu_radix_sort_orders_as_a_stable_sort(renderer, count):
+@pytest.mark.parametrize(
+    "count, key_bits", [(0, 32), (1, 32), (2, 32), (2047, 32), (2048, 32), (2049, 32), (30000, 32), (5000, 8)]
+)
+def test_the_gpu_radix_sort_orders_as_a_stable_sort(renderer, count, key_bits):
+    """8-bit keys (a selection's cells) need only two passes."""
     from OpenGL import GL
 
     from cloudcore.gl.depth_sort import GpuDepthSort
 
     rng = np.random.default_rng(count)
-    keys = rng.integers(0, 2**32, count, dtype=np.uint64).astype(np.uint32)
+    keys = rng.integers(0, 2**key_bits, count, dtype=np.uint64).astype(np.uint32)
     keys[::5] = keys[count // 2] if count else 0  # many equal keys: their input order must stay
     keys[1::7] = rng.integers(0, 4, len(keys[1::7]))  # and keys differing only in the lowest digits
     values = rng.permutation(count).astype(np.uint32)
@@ -47,7 +50,7 @@ def test_the_gpu_radix_sort_orders_as_a_stable_sort(renderer, count):
                 GL.GL_SHADER_STORAGE_BUFFER, max(data.nbytes, 4), data if count else None, GL.GL_DYNAMIC_COPY
             )
         GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT)
-        sort.sort(*buffers, count)
+        sort.sort(*buffers, count, key_bits)
         GL.glMemoryBarrier(GL.GL_BUFFER_UPDATE_BARRIER_BIT)
         sorted_pairs = []
         for buffer in buffers:
@@ -100,7 +103,7 @@ def test_a_selection_chooses_and_orders_the_particles_splat_batch_does(renderer)
         ):
             expected = splat_batch(particles, members, eye, depth_ranges, time_s, frustum).order
             selection = SplatSelection(particles, members, eye, depth_ranges, time_s, frustum)
-            chosen = splats.read_order(selection, view)
+            (chosen,) = splats.read_orders(selection, view)
             # the CPU's float64 and the GPU's float32 may disagree on particles right on a boundary: none here
             assert set(chosen.tolist()) == set(expected.tolist()), (members, depth_ranges, time_s)
             _far_to_near_up_to_ties(chosen, particles, eye)
@@ -113,7 +116,19 @@ def test_a_selection_chooses_and_orders_the_particles_splat_batch_does(renderer)
         splats.close()
 
 
-@pytest.mark.parametrize("mode", ["full", "auto"])
+def test_the_gpu_radix_sort_takes_keys_of_whole_bytes(renderer):
+    from cloudcore.gl.depth_sort import GpuDepthSort
+
+    renderer.context.make_current()
+    sort = GpuDepthSort()
+    try:
+        with pytest.raises(ValueError, match="8, 16, 24 or 32 bits, not 12"):
+            sort.sort(0, 0, 10, key_bits=12)
+    finally:
+        sort.close()
+
+
+@pytest.mark.parametrize("mode", ["full", "auto", "impostor"])
 def test_a_frame_drawn_from_gpu_selections_shows_the_cpus_picture_and_counts(renderer, valley, mode):
     cpu_settings = RenderSettings(mode=mode)
     gpu_settings = dataclasses.replace(cpu_settings, splat_order="gpu")
@@ -125,7 +140,10 @@ def test_a_frame_drawn_from_gpu_selections_shows_the_cpus_picture_and_counts(ren
     _, gpu_overdraw = renderer.measure_overdraw()
     difference = compare(cpu_image, gpu_image)
     assert difference.within(min_psnr_db=60.0, max_abs=4), str(difference)
-    assert gpu_stats.particles_drawn == cpu_stats.particles_drawn > 0
+    assert gpu_stats.particles_drawn == cpu_stats.particles_drawn
+    # the regenerations too are chosen on the GPU: the same particles, counted from their commands
+    assert gpu_stats.particles_to_impostors == cpu_stats.particles_to_impostors
+    assert cpu_stats.particles_drawn + cpu_stats.particles_to_impostors > 0
     assert (cpu_stats.splat_order, gpu_stats.splat_order) == ("cpu", "gpu")  # "auto" on llvmpipe: the CPU
     assert gpu_overdraw.mean == pytest.approx(cpu_overdraw.mean, rel=1e-4)
     assert gpu_overdraw.analytic == pytest.approx(cpu_overdraw.analytic, rel=1e-9)

@@ -85,17 +85,12 @@ def test_a_target_drawn_after_an_atlas_cell_is_not_clipped_to_the_cell(renderer)
         target.close()
 
 
-def test_cells_drawn_in_one_multi_draw_hold_what_each_drawn_alone_holds(renderer):
-    """A frame's regenerations all of point sprites go into the atlas in one multi-draw a 16 cells, each through
-    its own viewport, scissor and layer (`SplatPass.draw_point_cells`): the texels must be those of drawing each
-    cell by itself, none spilling into a neighbour; a cloud of sprites still needs quads, so a draw of its own."""
+def _twenty_clouds(rng):
+    """Twenty small clouds ahead of the eye at the origin, the eighth of sprites, as a `ParticleBuffer`."""
     from cloudcore.cloud_records import SpriteStyle
-    from cloudcore.gl.splats import SplatPass, splat_batch
     from cloudcore.light.eye_scattering import ParticleBuffer
-    from cloudcore.lod.impostors import impostor_view
     from cloudcore.scene import Cloud, Light, Shading
 
-    rng = np.random.default_rng(11)
     clouds = []
     for index in range(20):
         centre = [(index % 5 - 2) * 150.0, (index // 5) * 80.0, -700.0 - 40.0 * index]
@@ -103,7 +98,27 @@ def test_cells_drawn_in_one_multi_draw_hold_what_each_drawn_alone_holds(renderer
         style = {"sprite": SpriteStyle(rows=(0,))} if index == 7 else {}
         clouds.append(Cloud(f"c{index}", np.column_stack([centres, rng.uniform(6.0, 14.0, 60)]), **style))
     light = Light((0.0, 0.6, -0.8), (1.0, 0.95, 0.9), 1.0)
-    particles = ParticleBuffer(clouds, Shading(), (light,), (0.05, 0.06, 0.09))
+    return ParticleBuffer(clouds, Shading(), (light,), (0.05, 0.06, 0.09))
+
+
+def _impostor_view_of(particles, cloud: int, eye):
+    from cloudcore.lod.impostors import impostor_view
+
+    start, stop = particles.cloud_starts[cloud : cloud + 2]
+    centre = particles.centres[start:stop].mean(axis=0)
+    reach = np.linalg.norm(particles.centres[start:stop] - centre, axis=1) + particles.radii[start:stop]
+    return impostor_view(centre, reach.max(), eye)
+
+
+def test_cells_drawn_in_one_multi_draw_hold_what_each_drawn_alone_holds(renderer):
+    """A frame's regenerations all of point sprites go into the atlas in one multi-draw a 16 cells, each through
+    its own viewport, scissor and layer (`SplatPass.draw_point_cells`): the texels must be those of drawing each
+    cell by itself, none spilling into a neighbour; a cloud of sprites still needs quads, so a draw of its own."""
+    from cloudcore.gl.splats import SplatPass, splat_batch
+
+    rng = np.random.default_rng(11)
+    particles = _twenty_clouds(rng)
+    clouds = range(20)
     eye = np.zeros(3)
     renderer.context.make_current()
     atlas, splats = ImpostorAtlas(128), SplatPass()
@@ -111,10 +126,7 @@ def test_cells_drawn_in_one_multi_draw_hold_what_each_drawn_alone_holds(renderer
         images = [atlas.allocate(int(side)) for side in rng.choice([16, 24, 40, 64], len(clouds))]
         renders = []
         for index, image in enumerate(images):
-            start, stop = particles.cloud_starts[index : index + 2]
-            centre = particles.centres[start:stop].mean(axis=0)
-            reach = np.linalg.norm(particles.centres[start:stop] - centre, axis=1) + particles.radii[start:stop]
-            view = impostor_view(centre, reach.max(), eye)
+            view = _impostor_view_of(particles, index, eye)
             renders.append((image, splat_batch(particles, [index], eye), view.view, view.projection))
         splats.shade_ahead([(batch, view) for _, batch, view, _ in renders])
         alone = []
@@ -141,6 +153,60 @@ def test_cells_drawn_in_one_multi_draw_hold_what_each_drawn_alone_holds(renderer
                 continue
             assert expected[..., 3].max() > 0.1, index
             np.testing.assert_allclose(held, expected, atol=2e-3, err_msg=f"cell {index}")
+    finally:
+        splats.close()
+        atlas.close()
+
+
+def test_cells_chosen_and_sorted_on_the_gpu_hold_what_each_drawn_alone_holds(renderer):
+    """The GPU's way for a frame's regenerations (`splat_order = "gpu"`): one selection of every cell, one
+    sort, one multi-draw of quads a 16 cells (`SplatPass.draw_cells`).  Each cell must hold the particles
+    `splat_batch` chooses for it, far to near, and the texels of drawing it alone as quads; a cloud split in two
+    layers is in two cells, and the sprites' cell shares the draw."""
+    from cloudcore.gl.splats import SplatPass, SplatSelection, splat_batch
+
+    rng = np.random.default_rng(12)
+    particles = _twenty_clouds(rng)
+    eye = np.zeros(3)
+    middle = float(
+        np.median(np.linalg.norm(particles.centres[particles.cloud_starts[3] : particles.cloud_starts[4]], axis=1))
+    )
+    # (cloud, depth range): the fourth in two layers, 21 cells in all
+    cells = [(3, (-1.0, middle)), (3, (middle, np.inf))] + [
+        (cloud, (-1.0, np.inf)) for cloud in range(20) if cloud != 3
+    ]
+    renderer.context.make_current()
+    atlas, splats = ImpostorAtlas(128), SplatPass()
+    try:
+        images = [atlas.allocate(int(side)) for side in rng.choice([24, 40, 64], len(cells))]
+        views = [_impostor_view_of(particles, cloud, eye) for cloud, _ in cells]
+        batches = [splat_batch(particles, [cloud], eye, [depth]) for cloud, depth in cells]
+        selection = SplatSelection(
+            particles, tuple(c for c, _ in cells), eye, tuple(d for _, d in cells), None, None, tuple(range(len(cells)))
+        )
+        stacked = np.array([view.view for view in views])
+        for index, (chosen, batch) in enumerate(zip(splats.read_orders(selection, stacked), batches)):
+            assert len(batch) > 20 and set(chosen.tolist()) == set(batch.order.tolist()), index
+            distances = np.linalg.norm(particles.centres[chosen] - eye, axis=1)
+            assert np.all(distances[1:] <= distances[:-1] * (1.0 + 4e-7) + 1e-4), index
+        alone = []
+        for image, batch, view in zip(images, batches, views):
+            image.bind_cleared()
+            splats.draw(batch, view.view, view.projection, depth_test=False, point_sprites=False)
+            alone.append(image.read())
+        for image in images:
+            image.bind_cleared()
+        atlas.bind_layers()
+        splats.draw_cells(
+            selection,
+            stacked,
+            [(view.projection, image.viewport, image.cell.layer) for view, image in zip(views, images)],
+        )
+        GL.glDisable(GL.GL_SCISSOR_TEST)
+        for index, (image, expected) in enumerate(zip(images, alone)):
+            assert expected[..., 3].max() > 0.1, index
+            np.testing.assert_allclose(image.read(), expected, atol=2e-3, err_msg=f"cell {index}")
+        assert splats.take_selected() == (0, sum(len(batch) for batch in batches))
     finally:
         splats.close()
         atlas.close()

@@ -3,8 +3,8 @@
 The GPU counterpart of `cloudcore.lod.depth_order.far_to_near`: given keys
 that are the inverted bit patterns of float32 distances, sorting them
 ascending orders the values (particle indices) far to near, equal distances
-in their input order, exactly as the CPU does.  Eight passes of four bits,
-each three dispatches (`shaders/depth_sort.comp.glsl`), ping-ponging between
+in their input order, exactly as the CPU does.  Eight passes of four bits
+(fewer for shorter keys), each three dispatches (`shaders/depth_sort.comp.glsl`), ping-ponging between
 the caller's buffers and two of its own, so the sorted pairs end where they
 began.  No data comes back to the CPU: what draws from the order reads it
 where it is.
@@ -21,7 +21,6 @@ DIGIT_BITS = 4
 #: keys one invocation takes; 256 invocations a workgroup make a tile of 2048
 ITEMS = 8
 TILE = 256 * ITEMS
-_PASSES = 32 // DIGIT_BITS
 _STAGES = ("COUNT", "SCAN", "SCATTER")
 _KEYS_IN, _VALUES_IN, _KEYS_OUT, _VALUES_OUT, _TILE_COUNTS = range(5)
 
@@ -36,17 +35,21 @@ class GpuDepthSort:
         self._scratch_keys, self._scratch_values, self._tile_counts = self._buffers = GL.glGenBuffers(3)
         self._capacity = 0  # pairs the scratch buffers hold
 
-    def sort(self, keys: int, values: int, count: int) -> None:
-        """Sort the first `count` pairs of buffers `keys` and `values` by key, in place, stably.
+    def sort(self, keys: int, values: int, count: int, key_bits: int = 32) -> None:
+        """Sort the first `count` pairs of buffers `keys` and `values` by key, in place, stably; keys below
+        2**`key_bits` need only that many bits sorted (a multiple of 8: the pairs end where they began
+        after an even count of passes).
 
         The caller orders its writes to the buffers before this with a storage barrier, and its reads after
         it with the barrier its reads need; between the passes this issues its own."""
+        if key_bits % (2 * DIGIT_BITS) or not 0 < key_bits <= 32:
+            raise ValueError(f"the sort takes keys of 8, 16, 24 or 32 bits, not {key_bits}")
         if count <= 1:
             return
         self._reserve(count)
         tiles = -(-count // TILE)
         sources, targets = (keys, values), (self._scratch_keys, self._scratch_values)
-        for sort_pass in range(_PASSES):
+        for sort_pass in range(key_bits // DIGIT_BITS):
             for binding, buffer in zip((_KEYS_IN, _VALUES_IN, _KEYS_OUT, _VALUES_OUT), sources + targets):
                 GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, binding, buffer)
             GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _TILE_COUNTS, self._tile_counts)

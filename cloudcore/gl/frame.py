@@ -77,7 +77,7 @@ class _CloudPassFrame:
     time_s: float
     point_sprites: bool  # the setting: draw plain splats as points where the picture is the same
     blending: str  # the setting: full-3D splats as billboards ("plain") or as volumes ("volume")
-    splat_order: str  # full-3D splats chosen and sorted on the "cpu" or the "gpu" (the setting, "auto" resolved)
+    splat_order: str  # splats chosen and sorted on the "cpu" or the "gpu" (the setting, "auto" resolved)
 
     @property
     def eye(self) -> np.ndarray:
@@ -109,7 +109,7 @@ class FrameRenderer:
         self._key_serial = 0
         #: the level of detail's state between frames (impostor cache, ring, representations, costs)
         self.lod_state = LodState()
-        self.splat_order = SplatOrderChoice()  # where full-3D draws sort, measured (settings' "auto")
+        self.splat_order = SplatOrderChoice()  # where draws and regenerations sort, measured (settings' "auto")
         #: the cloud field's cells made for the last eye, and its particles' blend weights (None: no field)
         self.field_state = FieldState()
         self._field_weights: np.ndarray | None = None
@@ -219,16 +219,17 @@ class FrameRenderer:
                 self._objects.draw(
                     self.context, camera, poses, plan.objects_with_world, write_depth=True, antialiased=antialiased
                 )
-        with clock.timed("impostor updates"):
-            rendered = self._impostors.update(plan, particles, settings, time_s)
         way = self.splat_order.way(settings.splat_order, self._volume.features.renderer)
+        with clock.timed("impostor updates"):
+            rendered = self._impostors.update(plan, particles, settings, time_s, way)
         with clock.timed("clouds"):
             self.context.bind_target()
             drawn = self._draw_clouds(plan, particles, camera, view, projection, settings, poses, time_s, way)
-        drawn += self._splats.take_selected()
+        drawn_by_gpu, rendered_by_gpu = self._splats.take_selected()
+        drawn, rendered = drawn + drawn_by_gpu, rendered + rendered_by_gpu
         world, updates, clouds = (clock.times[name] for name in ("world", "impostor updates", "clouds"))
         self.lod_state = plan.state.measured([(plan.update_work, updates.wall_ms), (plan.cloud_work, clouds.wall_ms)])
-        self.splat_order = self.splat_order.observe(way, clouds.wall_ms, drawn)
+        self.splat_order = self.splat_order.observe(way, updates.wall_ms + clouds.wall_ms, drawn + rendered)
         stats = FrameStats(
             plan=plan.stats(),
             illumination_ms=illumination_ms,

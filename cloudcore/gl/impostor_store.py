@@ -9,7 +9,11 @@ from their generation's eye (`cloudcore.lod.ring`) into textures of their own
 from one `TexturePool`, few and wide.  The cells of units and the textures of
 ring generations the plan no longer holds are given back.  A unit split
 around objects has one image per layer, each holding the particles of its
-depth range seen from the impostor's eye.
+depth range seen from the impostor's eye.  The CPU's way (`splat_order`)
+sorts each image's particles in numpy; the GPU's chooses and sorts all of an
+atlas's images in one selection of cells and draws them in one indirect
+multi-draw a 16 (`SplatPass.draw_cells`), the CPU's work independent of
+their particles.
 """
 
 from __future__ import annotations
@@ -18,7 +22,7 @@ import numpy as np
 from OpenGL import GL
 
 from cloudcore.gl.impostor_atlas import AtlasImage, ImpostorAtlas
-from cloudcore.gl.splats import SplatPass, splat_batch
+from cloudcore.gl.splats import SplatPass, SplatSelection, splat_batch
 from cloudcore.gl.targets import TextureTarget
 from cloudcore.gl.texture_pool import TexturePool
 from cloudcore.light.eye_scattering import ParticleBuffer
@@ -43,10 +47,15 @@ class ImpostorStore:
         self._clouds: dict[tuple, tuple[list[AtlasImage], ImpostorView, tuple]] = {}
         self._ring: dict[tuple[RingGeneration, int], tuple[TextureTarget, tuple]] = {}  # (texture, extent)
 
-    def update(self, plan: FramePlan, particles: ParticleBuffer, settings: RenderSettings, time_s: float) -> int:
-        """Render this frame's regenerations and ring segment at scene time `time_s`; returns the particles rendered."""
+    def update(
+        self, plan: FramePlan, particles: ParticleBuffer, settings: RenderSettings, time_s: float, splat_order: str
+    ) -> int:
+        """Render this frame's regenerations and ring segment at scene time `time_s`, the regenerations' particles
+        chosen and sorted the way `splat_order` says ("cpu" or "gpu": `_cells_on_gpu`); returns the particles
+        rendered, but not those the GPU chose (`SplatPass.take_selected` counts those)."""
         units = plan.units
         renders = []  # (target, batch, view, projection, cleared first): all sorted, then all shaded, then drawn
+        on_gpu = []  # (atlas image, eye, clouds, their depth ranges, view, projection): the GPU's way
         for cloud in plan.clouds:
             if cloud.regenerate is None:
                 continue
@@ -59,7 +68,10 @@ class ImpostorStore:
                 _extent(particles, cloud.members, view.view, view.projection, (cloud.texture_size,) * 2),
             )
             for layer, target in enumerate(targets):
-                depth_ranges = [layer_bounds(record.splits, layer)] * len(cloud.members)
+                depth_ranges = (layer_bounds(record.splits, layer),) * len(cloud.members)
+                if splat_order == "gpu":
+                    on_gpu.append((target, record.eye, cloud.members, depth_ranges, view.view, view.projection))
+                    continue
                 batch = splat_batch(particles, cloud.members, record.eye, depth_ranges, time_s)
                 renders.append((target, batch, view.view, view.projection, True))
         for index in set(self._clouds) - set(plan.records):
@@ -82,8 +94,14 @@ class ImpostorStore:
             self._ring[generation, segment] = (target, extent)
             batch = splat_batch(particles, clouds, generation.eye, None, time_s)
             renders.append((target, batch, view, projection, first))
-        self._splats.shade_ahead([(batch, view) for _, batch, view, _, _ in renders])
+        selections = _cell_selections(particles, time_s, on_gpu)
+        self._splats.shade_ahead(
+            [(batch, view) for _, batch, view, _, _ in renders]
+            + [(selection, views) for selection, views, _ in selections]
+        )
         self._draw_cells([render[:4] for render in renders if isinstance(render[0], AtlasImage)], settings)
+        for selection, views, images in selections:
+            self._draw_cells_on_gpu(selection, views, images)
         for target, batch, view, projection, cleared in renders:
             if not isinstance(target, AtlasImage):
                 # the clouds alone, no depth test: the texture holds their premultiplied colour and opacity
@@ -123,6 +141,16 @@ class ImpostorStore:
             for image, batch, view, projection in alone:
                 image.bind()
                 self._splats.draw(batch, view, projection, depth_test=False, point_sprites=settings.point_sprites)
+
+    def _draw_cells_on_gpu(self, selection: SplatSelection, views: np.ndarray, cells) -> None:
+        """Render a selection of cells (`_cell_selections`): cleared one by one, then drawn in one multi-draw a
+        MAX_VIEWPORTS of them (`SplatPass.draw_cells`)."""
+        for image, _ in cells:
+            image.bind_cleared()
+        cells[0][0].atlas.bind_layers()
+        self._splats.draw_cells(
+            selection, views, [(projection, image.viewport, image.cell.layer) for image, projection in cells]
+        )
 
     @property
     def texture_bytes(self) -> int:
@@ -172,6 +200,26 @@ class ImpostorStore:
         self._ring.clear()
         self._atlases.clear()
         self.pool.close()
+
+
+def _cell_selections(particles: ParticleBuffer, time_s: float, cells) -> list[tuple]:
+    """The GPU's way for a frame's regenerations `cells` (atlas image, eye, clouds, their depth ranges, view,
+    projection): per atlas and eye, one selection of them all, each image a cell; as (selection, the cells'
+    views, (image, projection) per cell).  A frame remakes its impostors from its own eye, so one selection
+    an atlas serves them all."""
+    groups: dict[tuple, list] = {}
+    for cell in cells:
+        groups.setdefault((id(cell[0].atlas), tuple(cell[1])), []).append(cell)
+    selections = []
+    for group in groups.values():
+        clouds = tuple(cloud for _, _, members, *_ in group for cloud in members)
+        depth_ranges = tuple(depth for _, _, _, ranges, *_ in group for depth in ranges)
+        indices = tuple(index for index, (_, _, members, *_) in enumerate(group) for _ in members)
+        eye = np.asarray(group[0][1], dtype=np.float64)
+        selection = SplatSelection(particles, clouds, eye, depth_ranges, time_s, None, indices)
+        views = np.array([view for *_, view, _ in group], dtype=np.float64)
+        selections.append((selection, views, [(image, projection) for image, *_, projection in group]))
+    return selections
 
 
 def _union(extent: tuple, other: tuple) -> tuple:

@@ -13,7 +13,10 @@ eye; the batch uploads just those indices (4 bytes a particle).  Or, for
 a `SplatSelection`, the GPU does that too (`splat_select.comp.glsl`, then
 `cloudcore.gl.depth_sort`) and the quads are drawn by an indirect draw whose
 count the GPU wrote: the CPU's work for the draw no longer grows with its
-particles.  With the depth test on, terrain hides splats; splats never write
+particles.  One selection may hold many draws from one eye, each into its own
+cell of a layered target (a frame's impostor regenerations): chosen in one
+dispatch, sorted by distance then by cell in one sort, drawn by one indirect
+multi-draw a 16 cells.  With the depth test on, terrain hides splats; splats never write
 depth.  Drawn with `counting=True`, every fragment adds 1 instead (overdraw).
 """
 
@@ -77,7 +80,10 @@ _MAX_VIEWPORTS = 16
     _SELECT_KEYS,
     _SELECT_VALUES,
     _SELECT_COMMAND,
-) = range(7)
+    _SELECT_ORDER,
+) = range(8)
+#: uints of splat_select.comp.glsl's `Range`: first particle, slots before, depth range, cell, three unused
+_RANGE_UINTS = 8
 #: the compute shaders' local_size_x
 _SHADE_GROUP = _SELECT_GROUP = 64
 #: uints of a DrawElementsIndirectCommand: count, instance count, first index, base vertex, base instance
@@ -118,7 +124,11 @@ class SplatBatch:
 @dataclass(frozen=True, eq=False)
 class SplatSelection:
     """The particles of one draw as `splat_batch` chooses them (its arguments), chosen and ordered by the GPU
-    when `SplatPass` shades it: how many there are is known there only (`SplatPass.take_selected`)."""
+    when `SplatPass` shades it: how many there are is known there only (`SplatPass.take_selected`).
+
+    With `cells`, per cloud the draw its particles go to, from 0 up and non-decreasing: many draws from one
+    eye, one into each cell of a layered target (`SplatPass.draw_cells`), chosen in one dispatch and
+    sorted in one sort; shaded for one view a cell."""
 
     particles: ParticleBuffer
     clouds: tuple
@@ -126,12 +136,36 @@ class SplatSelection:
     depth_ranges: tuple | None
     time_s: float | None
     frustum: np.ndarray | None
+    cells: tuple | None = None
+
+    def __post_init__(self):
+        if self.cells is not None and (
+            len(self.cells) != len(self.clouds)
+            or (self.cells and self.cells[0] != 0)
+            or np.any(np.diff(self.cells) < 0)
+        ):
+            raise ValueError(f"a selection's cells go from 0 up, one a cloud, got {self.cells} for {self.clouds}")
 
     @property
     def slots(self) -> int:
         """Instances its shading fills: one per particle of its clouds, chosen or not."""
+        return int(self._counts.sum())
+
+    @property
+    def cell_count(self) -> int:
+        return 1 if self.cells is None else (self.cells[-1] + 1 if self.cells else 0)
+
+    def cell_slots(self) -> tuple[np.ndarray, np.ndarray]:
+        """(each cell's first slot from the selection's first, the slots it holds): the particles of its clouds."""
+        cells = np.zeros(len(self.clouds), dtype=np.int64) if self.cells is None else np.asarray(self.cells)
+        held = np.bincount(cells, weights=self._counts, minlength=self.cell_count).astype(np.int64)
+        return np.cumsum(held) - held, held
+
+    @property
+    def _counts(self) -> np.ndarray:
         starts = self.particles.cloud_starts
-        return int(sum(starts[c + 1] - starts[c] for c in self.clouds))
+        clouds = np.asarray(self.clouds, dtype=np.int64)
+        return (starts[clouds + 1] - starts[clouds]) if len(clouds) else np.zeros(0, dtype=np.int64)
 
     def on_cpu(self) -> SplatBatch:
         """The same particles chosen and sorted on the CPU, for what reads them there (overdraw's estimate)."""
@@ -254,12 +288,16 @@ class SplatPass:
             self._command_buffer,
         ) = self._selection_buffers = GL.glGenBuffers(5)
         self._keys_capacity = self._command_capacity = 0
-        #: the selections shaded since `shade_ahead` last began a pass: id -> their indirect command's index
+        #: the selections shaded since `shade_ahead` last began a pass: id -> their first indirect command's
+        #: index (one a cell); the commands made since `take_selected`, which begins them again from 0
         self._commands: dict[int, int] = {}
-        self._drawn_commands: list[int] = []  # those drawn (not counting fragments) since `take_selected`
-        #: `draw_point_cells`'s program (made when first needed) and its first cell's uniform
-        self._cell_points: int | None = None
-        self._cell_points_first = -1
+        self._commands_made = 0
+        #: commands drawn (not counting fragments) since `take_selected`: into the target, into cells
+        self._drawn_commands: list[int] = []
+        self._drawn_cell_commands: list[int] = []
+        #: the programs drawing many cells at once, made when first needed: (points?, atlas sprites?) -> (the
+        #: program, its first cell's uniform); points never are sprites
+        self._cell_programs: dict[tuple[bool, bool], tuple[int, int]] = {}
 
     def draw(
         self,
@@ -346,38 +384,75 @@ class SplatPass:
         shaded = [self._shaded.get(id(batch)) for batch, *_ in cells]
         if any(held is None or not np.array_equal(held[1], view) for held, (_, view, *_) in zip(shaded, cells)):
             raise ValueError("cells drawn together must be shaded ahead for their views (SplatPass.shade_ahead)")
-        if self._cell_points is None:
-            self._cell_points = build_program(
-                "splat",
-                {"SPLAT_SHARPNESS": SPLAT_SHARPNESS, "ATLAS_GRID": ATLAS_GRID, "POINT_SPRITE": 1, "CELLS": 1},
-            )
-            self._cell_points_first = GL.glGetUniformLocation(self._cell_points, "first_cell")
         firsts = np.array([held[0] for held in shaded], dtype=np.int32)
         counts = np.array([len(batch) for batch, *_ in cells], dtype=np.int32)
+        first_cell = self._use_cells(True, False, [cell[1:6] for cell in cells])
+        GL.glEnable(GL.GL_PROGRAM_POINT_SIZE)
+        with cloud_blending(depth_test=False, counting=False):
+            for start, stop in _viewport_groups(cells, [cell[3] for cell in cells], [cell[4] for cell in cells]):
+                GL.glUniform1i(first_cell, start)
+                GL.glMultiDrawArrays(GL.GL_POINTS, firsts[start:stop], counts[start:stop], stop - start)
+        GL.glDisable(GL.GL_PROGRAM_POINT_SIZE)
+        GL.glBindVertexArray(0)
+        self.particles_as_points += int(counts.sum())
+
+    def draw_cells(self, selection: SplatSelection, views: np.ndarray, cells) -> None:
+        """Draw a selection of many cells (`SplatSelection.cells`), shaded for `views` (one a cell), each cell
+        into its own rectangle of a layered target, as quads blended over it without a depth test: one
+        indirect multi-draw for each MAX_VIEWPORTS of them, as many particles each as the GPU chose.
+        `cells`: per cell (its projection, its viewport and scissor rectangle (x, y, width, height), its
+        layer); the layered target is bound, its scissor on."""
+        if not selection.slots:
+            return
+        self.shade(selection, views)
+        command = self._commands[id(selection)]
+        with_sprites = bool(self._cloud_sprites[list(selection.clouds)].any())
+        first_cell = self._use_cells(
+            False,
+            with_sprites,
+            [(view, projection, rect, rect, layer) for view, (projection, rect, layer) in zip(views, cells)],
+        )
+        self._bind_quads(selection.slots)
+        GL.glBindBuffer(GL.GL_DRAW_INDIRECT_BUFFER, self._command_buffer)
+        rects = [rect for _, rect, _ in cells]
+        with cloud_blending(depth_test=False, counting=False):
+            for start, stop in _viewport_groups(cells, rects, rects):
+                GL.glUniform1i(first_cell, start)
+                GL.glMultiDrawElementsIndirect(
+                    GL.GL_TRIANGLES,
+                    GL.GL_UNSIGNED_INT,
+                    ctypes.c_void_p(4 * _COMMAND_UINTS * (command + start)),
+                    stop - start,
+                    4 * _COMMAND_UINTS,
+                )
+        GL.glBindBuffer(GL.GL_DRAW_INDIRECT_BUFFER, 0)
+        GL.glBindVertexArray(0)
+        self._drawn_cell_commands.extend(range(command, command + selection.cell_count))
+
+    def _use_cells(self, points: bool, with_sprites: bool, cells) -> int:
+        """Make the program drawing many cells current, its table of `cells` (view, projection, viewport,
+        scissor, layer) uploaded, the instances bound; returns its first cell's uniform."""
+        key = (points, with_sprites)
+        if key not in self._cell_programs:
+            variant = {"POINT_SPRITE": points, "ATLAS_SPRITES": with_sprites}
+            program = build_program(
+                "splat",
+                {"SPLAT_SHARPNESS": SPLAT_SHARPNESS, "ATLAS_GRID": ATLAS_GRID, "CELLS": 1}
+                | {name: 1 for name, on in variant.items() if on},
+            )
+            self._cell_programs[key] = (program, GL.glGetUniformLocation(program, "first_cell"))
+        program, first_cell = self._cell_programs[key]
         table = np.zeros((len(cells), _CELL_FLOATS), dtype=np.float32)
-        for row, (_, view, projection, viewport, _, layer) in enumerate(cells):
+        for row, (view, projection, viewport, _, layer) in enumerate(cells):
             # GLSL reads matrices by columns
             table[row, 0:16], table[row, 16:32] = _rotation(view).T.ravel(), np.asarray(projection).T.ravel()
             table[row, 32:34] = viewport[3], layer
         _store(self._cell_buffer, table, GL.GL_STREAM_DRAW)
-        GL.glUseProgram(self._cell_points)
+        GL.glUseProgram(program)
         GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _INSTANCES_BINDING, self._instance_buffer)
         GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _CELLS_BINDING, self._cell_buffer)
         GL.glBindVertexArray(self._vertex_array)
-        GL.glEnable(GL.GL_PROGRAM_POINT_SIZE)
-        with cloud_blending(depth_test=False, counting=False):
-            for start in range(0, len(cells), _MAX_VIEWPORTS):
-                group = cells[start : start + _MAX_VIEWPORTS]
-                viewports = np.array([cell[3] for cell in group], dtype=np.float32)
-                scissors = np.array([cell[4] for cell in group], dtype=np.int32)
-                GL.glViewportArrayv(0, len(group), viewports)
-                GL.glScissorArrayv(0, len(group), scissors)
-                GL.glUniform1i(self._cell_points_first, start)
-                stop = start + len(group)
-                GL.glMultiDrawArrays(GL.GL_POINTS, firsts[start:stop], counts[start:stop], len(group))
-        GL.glDisable(GL.GL_PROGRAM_POINT_SIZE)
-        GL.glBindVertexArray(0)
-        self.particles_as_points += int(counts.sum())
+        return first_cell
 
     def _draw_selection(
         self, selection: SplatSelection, view: np.ndarray, projection: np.ndarray, depth_test: bool, counting: bool
@@ -401,33 +476,38 @@ class SplatPass:
             self._drawn_commands.append(command)
         return 0
 
-    def take_selected(self) -> int:
-        """The particles that the selections drawn since the last call chose, read from their commands
-        (after the draws finished, this waits for nothing)."""
-        if not self._drawn_commands:
-            return 0
-        GL.glMemoryBarrier(GL.GL_BUFFER_UPDATE_BARRIER_BIT)
-        GL.glBindBuffer(GL.GL_COPY_READ_BUFFER, self._command_buffer)
-        size = 4 * _COMMAND_UINTS * (max(self._drawn_commands) + 1)
-        commands = np.frombuffer(GL.glGetBufferSubData(GL.GL_COPY_READ_BUFFER, 0, size), dtype=np.uint32)
-        GL.glBindBuffer(GL.GL_COPY_READ_BUFFER, 0)
-        indices = commands.reshape(-1, _COMMAND_UINTS)[self._drawn_commands, 0]
-        self._drawn_commands = []
-        return int(indices.sum()) // 6
+    def take_selected(self) -> tuple[int, int]:
+        """(the particles that the selections drawn into targets since the last call chose, those drawn into
+        cells), read from their commands (after the draws finished, this waits for nothing); the commands
+        are made from the first again."""
+        drawn = self._drawn_commands + self._drawn_cell_commands
+        counts = self._command_counts(max(drawn) + 1) if drawn else np.zeros(0, dtype=np.int64)
+        taken = tuple(int(counts[commands].sum()) for commands in (self._drawn_commands, self._drawn_cell_commands))
+        self._drawn_commands, self._drawn_cell_commands, self._commands_made = [], [], 0
+        return taken
 
-    def read_order(self, selection: SplatSelection, view: np.ndarray) -> np.ndarray:
-        """The particles `selection` chose for `view`'s eye, far to near, read back from the GPU (to verify it
-        against `splat_batch`: it waits for the GPU)."""
+    def read_orders(self, selection: SplatSelection, view: np.ndarray) -> list[np.ndarray]:
+        """The particles `selection` chose for `view`'s eye (a view a cell, for cells), far to near, per cell,
+        read back from the GPU (to verify them against `splat_batch`: it waits for the GPU)."""
         _, first = self.shade(selection, view)
         command = self._commands[id(selection)]
+        counts = self._command_counts(command + selection.cell_count)[command:]
+        GL.glBindBuffer(GL.GL_COPY_READ_BUFFER, self._order_buffer)
+        size = 4 * selection.slots
+        order = np.frombuffer(
+            GL.glGetBufferSubData(GL.GL_COPY_READ_BUFFER, 4 * first, size) if size else b"", np.uint32
+        )
+        GL.glBindBuffer(GL.GL_COPY_READ_BUFFER, 0)
+        return [order[start : start + count].copy() for start, count in zip(selection.cell_slots()[0], counts)]
+
+    def _command_counts(self, commands: int) -> np.ndarray:
+        """The particles the first `commands` indirect commands count (reading them waits for the GPU)."""
         GL.glMemoryBarrier(GL.GL_BUFFER_UPDATE_BARRIER_BIT)
         GL.glBindBuffer(GL.GL_COPY_READ_BUFFER, self._command_buffer)
-        record = GL.glGetBufferSubData(GL.GL_COPY_READ_BUFFER, 4 * _COMMAND_UINTS * command, 4 * _COMMAND_UINTS)
-        count = int(np.frombuffer(record, dtype=np.uint32)[0]) // 6
-        GL.glBindBuffer(GL.GL_COPY_READ_BUFFER, self._order_buffer)
-        order = GL.glGetBufferSubData(GL.GL_COPY_READ_BUFFER, 4 * first, 4 * count) if count else b""
+        size = 4 * _COMMAND_UINTS * commands
+        records = np.frombuffer(GL.glGetBufferSubData(GL.GL_COPY_READ_BUFFER, 0, size), dtype=np.uint32)
         GL.glBindBuffer(GL.GL_COPY_READ_BUFFER, 0)
-        return np.frombuffer(order, dtype=np.uint32).copy()
+        return records.reshape(-1, _COMMAND_UINTS)[:, 0].astype(np.int64) // 6
 
     def _use(self, program: int, view_rotation: np.ndarray, projection: np.ndarray, viewport_height) -> None:
         """Make `program` current with a draw's matrices (and, for points, the viewport's height in pixels)."""
@@ -559,11 +639,18 @@ class SplatPass:
         for batch, _, slot in run:
             if isinstance(batch, SplatSelection):
                 self._select(batch, slot)
-        table = np.zeros((len(run), _BATCH_FLOATS), dtype=np.float32)
+        rows = []  # (first slot, slots, eye, view): a batch's, a cell's of a selection of cells
+        for batch, view, slot in run:
+            if isinstance(batch, SplatSelection) and batch.cells is not None:
+                firsts, held = batch.cell_slots()
+                rows.extend((slot + first, count, batch.eye, cell) for first, count, cell in zip(firsts, held, view))
+            else:
+                rows.append((slot, batch.slots, batch.eye, view))
+        table = np.zeros((len(rows), _BATCH_FLOATS), dtype=np.float32)
         slots = table.view(np.uint32)
-        for row, (batch, view, slot) in enumerate(run):
-            slots[row, 0:2] = slot, batch.slots
-            table[row, 4:7], table[row, 8:11], table[row, 12:15] = batch.eye, view[0, :3], view[1, :3]
+        for row, (slot, count, eye, view) in enumerate(rows):
+            slots[row, 0:2] = slot, count
+            table[row, 4:7], table[row, 8:11], table[row, 12:15] = eye, view[0, :3], view[1, :3]
         _store(self._batch_buffer, table, GL.GL_STREAM_DRAW)
         _bind_storage(
             (_PARTICLES_BINDING, self._particle_buffer),
@@ -580,36 +667,47 @@ class SplatPass:
         GL.glUseProgram(program)
         GL.glUniform1ui(uniforms["first"], first)
         GL.glUniform1ui(uniforms["slot_count"], end - first)
-        GL.glUniform1ui(uniforms["batch_count"], len(run))
+        GL.glUniform1ui(uniforms["batch_count"], len(rows))
         GL.glDispatchCompute(-(-(end - first) // _SHADE_GROUP), 1, 1)
 
     def _select(self, selection: SplatSelection, first: int) -> None:
-        """Choose and sort `selection`'s particles on the GPU into the order's slots from `first` on, the chosen
-        first, far to near, and count them into a new indirect command of quads from slot `first`."""
+        """Choose and sort `selection`'s particles on the GPU into the order's slots from `first` on, each cell's
+        from its first slot on (`SplatSelection.cell_slots`), the chosen first, far to near, and count them
+        into a new indirect command of quads a cell."""
         if self._selecting is None:
-            program = build_compute_program(
-                "splat_select",
-                {"PARTICLE_FLOATS": _PARTICLE_FLOATS, "FADE_START_RADII": FADE_START_RADII, "SPLAT_REACH": SPLAT_REACH},
-            )
+            defines = {
+                "PARTICLE_FLOATS": _PARTICLE_FLOATS,
+                "FADE_START_RADII": FADE_START_RADII,
+                "SPLAT_REACH": SPLAT_REACH,
+                "COMMAND_UINTS": _COMMAND_UINTS,
+            }
+            program = build_compute_program("splat_select", defines)
             names = ("count", "range_count", "command_at", "eye", "planes", "cull_to_frustum")
-            self._selecting = (program, uniform_locations(program, names), GpuDepthSort())
-        program, uniforms, sort = self._selecting
-        slots, command = selection.slots, len(self._commands)
-        self._reserve_selection(slots, command + 1)
+            resolve = build_compute_program("splat_select", defines | {"RESOLVE": 1})
+            resolving = uniform_locations(resolve, ("count", "range_count", "cell_keys", "first"))
+            self._selecting = (program, uniform_locations(program, names), GpuDepthSort(), resolve, resolving)
+        program, uniforms, sort = self._selecting[:3]
+        slots, command, cells = selection.slots, self._commands_made, selection.cell_count
+        self._reserve_selection(slots, command + cells)
         self._commands[id(selection)] = command
+        self._commands_made += cells
         starts = selection.particles.cloud_starts
         clouds = np.asarray(selection.clouds, dtype=np.int64)
         counts = starts[clouds + 1] - starts[clouds]
-        ranges = np.zeros((len(clouds), 4), dtype=np.uint32)  # the shader's Range: start, before, near, far
+        # the shader's Range: start, before, near, far, cell, three unused
+        ranges = np.zeros((len(clouds), _RANGE_UINTS), dtype=np.uint32)
         ranges[:, 0] = starts[clouds]
         ranges[:, 1] = np.cumsum(counts) - counts
         everything = [(-1.0, np.inf)] * len(clouds)
         depth = np.array(everything if selection.depth_ranges is None else selection.depth_ranges, dtype=np.float64)
-        ranges[:, 2:].view(np.float32)[:] = np.clip(depth, -1.0, np.finfo(np.float32).max)
+        ranges[:, 2:4].view(np.float32)[:] = np.clip(depth, -1.0, np.finfo(np.float32).max)
+        ranges[:, 4] = 0 if selection.cells is None else selection.cells
         _store(self._ranges_buffer, ranges, GL.GL_STREAM_DRAW)
+        # each cell's count is the GPU's to add to; its quads start at its first slot
+        records = np.zeros((cells, _COMMAND_UINTS), dtype=np.uint32)
+        records[:, 1], records[:, 3] = 1, 4 * (first + selection.cell_slots()[0])
         GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, self._command_buffer)
-        record = np.array([0, 1, 0, 4 * first, 0], dtype=np.uint32)  # its count is the GPU's to add to
-        GL.glBufferSubData(GL.GL_SHADER_STORAGE_BUFFER, record.nbytes * command, record.nbytes, record)
+        GL.glBufferSubData(GL.GL_SHADER_STORAGE_BUFFER, records[0].nbytes * command, records.nbytes, records)
         _bind_storage(
             (_SELECT_PARTICLES, self._particle_buffer),
             (_SELECT_FORMATION, self._formation_buffer),
@@ -633,12 +731,28 @@ class SplatPass:
         GL.glDispatchCompute(-(-slots // _SELECT_GROUP), 1, 1)
         GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT)
         sort.sort(self._keys_buffer, self._values_buffer, slots)
-        GL.glMemoryBarrier(GL.GL_BUFFER_UPDATE_BARRIER_BIT)
-        GL.glBindBuffer(GL.GL_COPY_READ_BUFFER, self._values_buffer)
-        GL.glBindBuffer(GL.GL_COPY_WRITE_BUFFER, self._order_buffer)
-        GL.glCopyBufferSubData(GL.GL_COPY_READ_BUFFER, GL.GL_COPY_WRITE_BUFFER, 0, 4 * first, 4 * slots)
-        GL.glBindBuffer(GL.GL_COPY_READ_BUFFER, 0)
-        GL.glBindBuffer(GL.GL_COPY_WRITE_BUFFER, 0)
+        if cells > 1:
+            self._resolve(slots, len(clouds), cell_keys=True)
+            sort.sort(self._keys_buffer, self._values_buffer, slots, key_bits=8 if cells <= 256 else 16)
+        self._resolve(slots, len(clouds), cell_keys=False, first=first)
+
+    def _resolve(self, slots: int, ranges: int, cell_keys: bool, first: int = 0) -> None:
+        """After a sort of a selection's slots: key each by its cell (`cell_keys`), or write each one's particle
+        into the order from slot `first` on (splat_select.comp.glsl's RESOLVE)."""
+        program, uniforms = self._selecting[3:]
+        _bind_storage(
+            (_SELECT_RANGES, self._ranges_buffer),
+            (_SELECT_KEYS, self._keys_buffer),
+            (_SELECT_VALUES, self._values_buffer),
+            (_SELECT_ORDER, self._order_buffer),
+        )
+        GL.glUseProgram(program)
+        GL.glUniform1ui(uniforms["count"], slots)
+        GL.glUniform1ui(uniforms["range_count"], ranges)
+        GL.glUniform1i(uniforms["cell_keys"], cell_keys)
+        GL.glUniform1ui(uniforms["first"], first)
+        GL.glDispatchCompute(-(-slots // _SELECT_GROUP), 1, 1)
+        GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT)
 
     def _reserve_selection(self, slots: int, commands: int) -> None:
         """Room for choosing `slots` particles and for `commands` indirect commands, keeping those made."""
@@ -735,10 +849,11 @@ class SplatPass:
         """Free the GL objects (the context must be current)."""
         for program in (*self._programs.values(), *(held[0] for held in self._shade_programs.values())):
             GL.glDeleteProgram(program)
-        if self._cell_points is not None:
-            GL.glDeleteProgram(self._cell_points)
+        for program, _ in self._cell_programs.values():
+            GL.glDeleteProgram(program)
         if self._selecting is not None:
             GL.glDeleteProgram(self._selecting[0])
+            GL.glDeleteProgram(self._selecting[3])
             self._selecting[2].close()
         if self._atlas is not None:
             GL.glDeleteTextures([self._atlas])
@@ -858,3 +973,13 @@ def _store(buffer: int, data: np.ndarray, usage=GL.GL_STATIC_DRAW) -> None:
     GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, buffer)
     GL.glBufferData(GL.GL_SHADER_STORAGE_BUFFER, data.nbytes, np.ascontiguousarray(data), usage)
     GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, 0)
+
+
+def _viewport_groups(cells, viewports, scissors):
+    """(start, stop) of each run of at most MAX_VIEWPORTS `cells`, their `viewports` and `scissors` (x, y,
+    width, height) set as the indexed viewports and scissors of one multi-draw."""
+    for start in range(0, len(cells), _MAX_VIEWPORTS):
+        stop = min(start + _MAX_VIEWPORTS, len(cells))
+        GL.glViewportArrayv(0, stop - start, np.array(viewports[start:stop], dtype=np.float32))
+        GL.glScissorArrayv(0, stop - start, np.array(scissors[start:stop], dtype=np.int32))
+        yield start, stop

@@ -1,14 +1,16 @@
-"""Where full-3D draws choose and sort their particles, the CPU or the GPU, picked by measurement.
+"""Where full-3D draws and impostor regenerations choose and sort their particles, the CPU or the GPU, picked
+by measurement.
 
 `RenderSettings.splat_order` "auto" resolves here, per renderer.  On a
 software rasterizer the GPU is the same cores, and its radix sort was
 measured 30-40 times slower than numpy's, the frame 1.65 times
 (docs/performance.md, "The GPU's order"): the CPU way, untried.  On a
-GPU, the first frames that draw particles in full 3D alternate the two
-ways, `TRIAL_FRAMES` each, and the way whose cloud passes took less time
-(median) is kept.  Neighbouring frames of a moving camera draw nearly the
-same particles, so the alternation compares like with like; a frame with
-no full-3D particles says nothing about either way and is not counted.
+GPU, the first frames that draw particles in full 3D or into impostors
+alternate the two ways, `TRIAL_FRAMES` each, and the way whose impostor
+updates and cloud passes together took less time (median) is kept.
+Neighbouring frames of a moving camera draw nearly the same particles, so
+the alternation compares like with like; a frame that sorts no particles
+says nothing about either way and is not counted.
 """
 
 from __future__ import annotations

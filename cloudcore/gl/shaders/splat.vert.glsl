@@ -10,7 +10,7 @@
 // defined, one vertex per particle instead, a point sprite of the quad's
 // square (cloudcore.point_sprites says when the picture is the same); its
 // centre and radius come back from the corners, so that one compute shader
-// serves both ways of drawing.  With CELLS defined too, the points of many
+// serves both ways of drawing.  With CELLS defined, the points or quads of many
 // impostors at once, one multi-draw's draw each: its cell's view, projection,
 // viewport and atlas layer come from a table (a frame's regenerations into the
 // atlas in one call; the viewports and scissors are the cells', set per index).
@@ -27,17 +27,18 @@ uniform mat4 projection;
 out vec4 colour;          // per corner: the artist model's varies up a sprite
 flat out int sprite;      // atlas cell, -1 for a Gaussian splat
 
-#ifdef POINT_SPRITE
-uniform float viewport_height;  // pixels
 #ifdef CELLS
 struct Cell {
     mat4 view_rotation;
     mat4 projection;
-    vec4 viewport_height_layer;  // the cell's (guard-banded) viewport height in pixels, its atlas layer
+    vec4 viewport_height_layer;  // the cell's (points: guard-banded) viewport height in pixels, its atlas layer
 };
 layout(std430, binding = 8) readonly buffer Cells { Cell cells[]; };
 uniform int first_cell;  // the cell of the multi-draw's first draw
 #endif
+
+#ifdef POINT_SPRITE
+uniform float viewport_height;  // pixels
 
 void main()
 {
@@ -70,7 +71,14 @@ void main()
 {
     int slot = gl_VertexID >> 2, k = gl_VertexID & 3;
     vec4 corner = instances[slot].corners[k];
+#ifdef CELLS
+    Cell cell = cells[first_cell + gl_DrawIDARB];
+    gl_Position = cell.projection * (cell.view_rotation * vec4(corner.xyz, 1.0));
+    gl_ViewportIndex = gl_DrawIDARB;
+    gl_Layer = int(cell.viewport_height_layer.y);
+#else
     gl_Position = projection * (view_rotation * vec4(corner.xyz, 1.0));
+#endif
     splat_position = CORNERS[k];
     colour = instances[slot].colours[k];
     sprite = int(corner.w);

@@ -10,6 +10,17 @@
 // key, which no kept one has, so that after the sort (depth_sort.comp.glsl)
 // the kept come first, far to near, in the count the command holds.
 //
+// The sort's values are the selection's slots; RESOLVE's ORDER stage then
+// turns the sorted slots into particles, the draw's order.  A selection may
+// feed many draws from one eye, each into its own cell of a layered target (a
+// frame's impostor regenerations: cloudcore.gl.splats.SplatPass.draw_cells).
+// Each cloud range names its cell, whose own command counts its particles;
+// after the distance passes, RESOLVE's CELL_KEYS stage keys each sorted slot
+// by its cell, and the sort's cell passes group the cells, each staying far
+// to near (the sort is stable).  Cell c then holds the slots of its ranges,
+// from those of the cells before it on, the kept first, as many as its
+// command counts.
+//
 // Distances come from float32 centres relative to the eye, where the CPU
 // computes them in float64: particles whose distances agree to a float32
 // rounding may swap places, and one on a depth range's or the frustum's
@@ -19,24 +30,61 @@ layout(local_size_x = 64) in;
 
 struct Range {
     uint start;    // the cloud's first particle
-    uint before;   // the draw's particles in the clouds before it
+    uint before;   // the selection's particles in the clouds before it
     float near;    // its depth range: near < distance <= far
     float far;
+    uint cell;     // the draw its particles go to: its command follows the first draw's
+    uint unused[3];
 };
+layout(std430, binding = 3) readonly buffer Ranges { Range ranges[]; };
+uniform uint count;        // the selection's particles, kept or not
+uniform uint range_count;  // its clouds
+
+// the range of slot i: the last starting at or before it
+Range range_of(uint i)
+{
+    uint low = 0u, high = range_count - 1u;
+    while (low < high) {
+        uint middle = (low + high + 1u) / 2u;
+        if (ranges[middle].before <= i)
+            low = middle;
+        else
+            high = middle - 1u;
+    }
+    return ranges[low];
+}
+
+#ifdef RESOLVE
+layout(std430, binding = 4) writeonly buffer Keys { uint keys[]; };
+layout(std430, binding = 5) readonly buffer Values { uint values[]; };  // sorted slots
+layout(std430, binding = 7) writeonly buffer Order { uint order[]; };
+
+uniform bool cell_keys;  // CELL_KEYS: key each sorted slot by its cell; else ORDER: its particle into the order
+uniform uint first;      // ORDER: the order's slot of the selection's first
+
+void main()
+{
+    uint j = gl_GlobalInvocationID.x;
+    if (j >= count)
+        return;
+    Range range = range_of(values[j]);
+    if (cell_keys)
+        keys[j] = range.cell;
+    else
+        order[first + j] = range.start + (values[j] - range.before);
+}
+#else
 // splat_shade.comp.glsl's Particle records, PARTICLE_FLOATS floats each: only the centre and radius are read
 layout(std430, binding = 0) readonly buffer Particles { float particles[]; };
 layout(std430, binding = 1) readonly buffer Formation { float formation[]; };
 // per particle: bit 0 faded next to the eye (splats; sprites lock instead), bit 1 opaque at all
 layout(std430, binding = 2) readonly buffer Flags { uint flags[]; };
-layout(std430, binding = 3) readonly buffer Ranges { Range ranges[]; };
 layout(std430, binding = 4) writeonly buffer Keys { uint keys[]; };
 layout(std430, binding = 5) writeonly buffer Values { uint values[]; };
-// DrawElementsIndirectCommand: its count, six indices a particle kept, is counted here
+// DrawElementsIndirectCommands, one a cell: their count, six indices a particle kept, is counted here
 layout(std430, binding = 6) buffer Command { uint command[]; };
 
-uniform uint count;        // the draw's particles, kept or not
-uniform uint range_count;  // its clouds
-uniform uint command_at;   // the command's first uint in the buffer
+uniform uint command_at;   // the first cell's command's first uint in the buffer
 uniform vec3 eye;
 uniform vec4 planes[6];    // the frustum, relative to the eye, inside positive
 uniform bool cull_to_frustum;
@@ -48,16 +96,7 @@ void main()
     uint i = gl_GlobalInvocationID.x;
     if (i >= count)
         return;
-    // the last range starting at or before i
-    uint low = 0u, high = range_count - 1u;
-    while (low < high) {
-        uint middle = (low + high + 1u) / 2u;
-        if (ranges[middle].before <= i)
-            low = middle;
-        else
-            high = middle - 1u;
-    }
-    Range range = ranges[low];
+    Range range = range_of(i);
     uint index = range.start + (i - range.before);
     uint record = index * uint(PARTICLE_FLOATS);
     vec4 centre_radius = vec4(particles[record], particles[record + 1u], particles[record + 2u], particles[record + 3u]);
@@ -70,11 +109,12 @@ void main()
     if (cull_to_frustum)
         for (int p = 0; p < 6; ++p)
             kept = kept && dot(planes[p].xyz, offset) + planes[p].w >= -SPLAT_REACH * centre_radius.w;
-    values[i] = index;
+    values[i] = i;
     if (kept) {
         keys[i] = min(~floatBitsToUint(distance), LEFT_OUT - 1u);
-        atomicAdd(command[command_at], 6u);
+        atomicAdd(command[command_at + uint(COMMAND_UINTS) * range.cell], 6u);
     } else {
         keys[i] = LEFT_OUT;
     }
 }
+#endif
