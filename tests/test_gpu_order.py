@@ -71,8 +71,12 @@ def _cloud(rng, name: str, count: int, centre, **fields) -> Cloud:
     return Cloud(name, np.column_stack([centres, rng.uniform(4.0, 20.0, count)]), **({"optical_depth": 1.0} | fields))
 
 
+def _distances(particles: ParticleBuffer, order: np.ndarray, eye) -> np.ndarray:
+    return np.linalg.norm(particles.centres[order] - eye, axis=1)
+
+
 def _far_to_near_up_to_ties(order: np.ndarray, particles: ParticleBuffer, eye) -> None:
-    distances = np.linalg.norm(particles.centres[order] - eye, axis=1)
+    distances = _distances(particles, order, eye)
     # float32 distances relative to the eye: a swap only between distances within a few float32 roundings
     assert np.all(distances[1:] <= distances[:-1] * (1.0 + 4e-7) + 1e-4)
 
@@ -111,7 +115,12 @@ def test_a_selection_chooses_and_orders_the_particles_splat_batch_does(renderer)
                 assert len(expected) == 0
             else:
                 assert len(expected) > 500
-                assert np.mean(chosen == expected) > 0.999  # near-ties aside, the very order
+                # the very order but where two distances agree to float32 rounding (the GPU's, its FMAs): where
+                # the orders differ, the particles there are as far (0.14% of the places on an H200)
+                differ = chosen != expected
+                assert np.mean(differ) < 0.01
+                gap = np.abs(_distances(particles, chosen[differ], eye) - _distances(particles, expected[differ], eye))
+                assert np.all(gap <= 4e-7 * _distances(particles, expected[differ], eye) + 1e-4)
     finally:
         splats.close()
 
@@ -130,7 +139,10 @@ def test_the_gpu_radix_sort_takes_keys_of_whole_bytes(renderer):
 
 @pytest.mark.parametrize("mode", ["full", "auto", "impostor"])
 def test_a_frame_drawn_from_gpu_selections_shows_the_cpus_picture_and_counts(renderer, valley, mode):
-    cpu_settings = RenderSettings(mode=mode)
+    """The GPU's way draws quads only; the CPU's draws as point sprites where the picture is the same, but on
+    NVIDIA (H200) a point sprite covers other fragments than its quad (the overdraw 0.7% higher), so both ways
+    here draw quads: the same fragments on any GL."""
+    cpu_settings = RenderSettings(mode=mode, splat_order="cpu", point_sprites=False)
     gpu_settings = dataclasses.replace(cpu_settings, splat_order="gpu")
     renderer.lod_state = type(renderer.lod_state)()
     cpu_image, cpu_stats = renderer.render(valley, settings=cpu_settings)
@@ -144,6 +156,6 @@ def test_a_frame_drawn_from_gpu_selections_shows_the_cpus_picture_and_counts(ren
     # the regenerations too are chosen on the GPU: the same particles, counted from their commands
     assert gpu_stats.particles_to_impostors == cpu_stats.particles_to_impostors
     assert cpu_stats.particles_drawn + cpu_stats.particles_to_impostors > 0
-    assert (cpu_stats.splat_order, gpu_stats.splat_order) == ("cpu", "gpu")  # "auto" on llvmpipe: the CPU
+    assert (cpu_stats.splat_order, gpu_stats.splat_order) == ("cpu", "gpu")
     assert gpu_overdraw.mean == pytest.approx(cpu_overdraw.mean, rel=1e-4)
     assert gpu_overdraw.analytic == pytest.approx(cpu_overdraw.analytic, rel=1e-9)

@@ -15,7 +15,7 @@ from conftest import VALLEY
 from test_frameplan import FILL_BOUND, UPKEEP_BOUND
 from test_render_golden import inside_a_cloud, into_the_sun
 
-from cloudcore.lod.costs import CostModel
+from cloudcore.lod.costs import LLVMPIPE_COSTS, CostModel
 from cloudcore.lod.frameplan import LodState
 from cloudcore.lod.ring import SEGMENTS
 from cloudcore.measure.imagecompare import compare
@@ -36,9 +36,9 @@ def valley():
     return load_scene(VALLEY)
 
 
-def settled(renderer, scene, camera, settings):
+def settled(renderer, scene, camera, settings, costs=None):
     for _ in range(SETTLE_FRAMES):
-        image, stats = renderer.render(scene, camera=camera, settings=settings)
+        image, stats = renderer.render(scene, camera=camera, settings=settings, costs=costs)
     return image, stats
 
 
@@ -59,11 +59,12 @@ def test_impostor_renders_agree_with_full_3d(renderer, valley, view, min_psnr_db
 
 def test_the_default_view_still_is_drawn_from_impostors(renderer, valley):
     """A still eye: every impostor lasts, so auto draws every unit from one (none is cheaper in full 3D), its own or
-    the ring's, whichever the plan priced cheaper."""
-    _, stats = settled(renderer, valley, None, RenderSettings())
+    the ring's, whichever the plan priced cheaper.  Priced with llvmpipe's costs pinned: a GPU's measured costs plan
+    otherwise (on an H200 one cloud stayed in full 3D), and the policy is what is tested here."""
+    _, stats = settled(renderer, valley, None, RenderSettings(), LLVMPIPE_COSTS)
     assert stats.plan.clouds_by_kind["impostor"] > 0 and stats.plan.clouds_by_kind["full"] == 0
     assert stats.plan.units_grouped > 0  # the default scene has interpenetrating clouds
-    _, again = renderer.render(valley, settings=RenderSettings())
+    _, again = renderer.render(valley, settings=RenderSettings(), costs=LLVMPIPE_COSTS)
     assert again.plan.impostors_regenerated == 0 and again.plan.ring_segments_built == 0  # nothing moved
 
 
@@ -140,15 +141,16 @@ def test_a_ring_rebuilt_in_pieces_shows_what_one_built_whole_does(renderer, vall
 
 def test_orbiting_draws_groups_apart_and_the_still_eye_whole_again(renderer, valley):
     """Auto mode plans a group of interpenetrating clouds as its clouds while the eye moves (their impostors last
-    longer than the group's); once the eye stops the group is one impostor again, remade from that eye."""
-    settled(renderer, valley, None, RenderSettings())
+    longer than the group's); once the eye stops the group is one impostor again, remade from that eye.  With
+    llvmpipe's costs pinned, as above (on an H200's measured costs no group was dearer whole)."""
+    settled(renderer, valley, None, RenderSettings(), LLVMPIPE_COSTS)
     cameras, images, opened = [valley.camera], [], set()
     for _ in range(12):
         cameras.append(orbited(cameras[-1], 0.5))
-        images.append(renderer.render(valley, camera=cameras[-1], settings=RenderSettings())[0])
+        images.append(renderer.render(valley, camera=cameras[-1], settings=RenderSettings(), costs=LLVMPIPE_COSTS)[0])
         opened |= renderer.last_plan.state.opened
     assert opened and all(len(members) > 1 for members in opened)
-    still, stats = settled(renderer, valley, cameras[-1], RenderSettings())
+    still, stats = settled(renderer, valley, cameras[-1], RenderSettings(), LLVMPIPE_COSTS)
     assert not renderer.last_plan.state.opened and stats.plan.units_grouped > 0
     references = [renderer.render(valley, camera=camera, settings=FULL_3D)[0] for camera in cameras[1:]]
     # measured: 37.0 dB on the worst frame moving (38.1 with groups whole), 40.0 still
