@@ -16,6 +16,7 @@
 #   lod: lod.json              `bench_lod.py --cases still,flythrough`: auto against impostor mode and full 3D
 #   compositing: compositing.json   full 3D at 640x480 blended by the raster (plain) or by the tiled compute
 #                    pass (volume), 61 frames of the flythrough
+#   sort: sort.json            the GPU's radix sort against numpy's (`bench_gpu_sort.py`), 10k to 1M keys
 # LOCAL=1 runs it here on llvmpipe with a few frames and no setup: a check of the script, not numbers.
 set -uo pipefail
 OUT=${OUT:-out/must_show}
@@ -86,6 +87,9 @@ fi
 if wanted compositing; then
   step "compositing 640x480" "${cloudview[@]}" bench "$scene" --camera-path flythrough --frames "$frames" \
     --sweep mode=full --sweep blending=plain,volume --no-shading --json "$OUT/compositing.json"
+fi
+if wanted sort; then
+  step "sort" "$python" scripts/bench_gpu_sort.py --json "$OUT/sort.json"
 fi
 if wanted lod; then
   # shellcheck disable=SC2086
