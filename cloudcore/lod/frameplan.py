@@ -82,7 +82,7 @@ from cloudcore.lod.ring import (
     ring_members,
     segment_texture_size,
 )
-from cloudcore.lod.splitting import layer_bounds, layer_counts, layer_sort_key, layers_hold, objects_inside
+from cloudcore.lod.splitting import layer_bounds, layer_counts, layer_sort_key, layers_hold, objects_reaching
 from cloudcore.lod.units import LodUnits
 from cloudcore.measure.frame_stats import PlanStats
 from cloudcore.measure.overdraw import analytic_overdraw
@@ -488,14 +488,16 @@ def _plan_units(
         splats = [cloud_splats(c) for c in units.members[index]]
         return np.concatenate([c for c, _ in splats]), np.concatenate([r for _, r in splats])
 
+    # most scenes have no objects: split_at is asked for every unit drawn, hundreds as a field's ring fades
+    reaching = (
+        objects_reaching(centres, radii, object_centres, object_radii)
+        if settings.split_objects and len(object_radii)
+        else None
+    )
+
     def split_at(index: int, from_eye) -> tuple[tuple, tuple]:
         """(objects inside the unit far to near from `from_eye`, their distances: the layers' boundaries)."""
-        # most scenes have no objects: asked for every unit drawn, hundreds as a field's ring fades
-        inside = (
-            objects_inside(centres[index], radii[index], object_centres, object_radii)
-            if settings.split_objects and len(object_radii)
-            else ()
-        )
+        inside = np.flatnonzero(reaching[index]) if reaching is not None else ()
         if not len(inside):
             return (), ()
         gaps = np.linalg.norm(object_centres[inside] - np.asarray(from_eye, dtype=np.float64), axis=1)

@@ -19,14 +19,17 @@ import math
 import numpy as np
 
 
-def objects_inside(
-    cloud_centre, cloud_radius: float, object_centres: np.ndarray, object_radii: np.ndarray
+def objects_reaching(
+    cloud_centres: np.ndarray, cloud_radii: np.ndarray, object_centres: np.ndarray, object_radii: np.ndarray
 ) -> np.ndarray:
-    """Indices of the objects whose bounding spheres reach into the cloud's bounding sphere."""
-    if cloud_radius <= 0.0 or len(object_radii) == 0:
-        return np.zeros(0, dtype=np.int64)
-    gaps = np.linalg.norm(object_centres - np.asarray(cloud_centre, dtype=np.float64), axis=1)
-    return np.flatnonzero(gaps < cloud_radius + object_radii)
+    """Boolean (clouds, objects): whose bounding spheres reach into whose (a cloud of no radius holds none).
+
+    One pass for every cloud of a frame: the planner asks for each unit it draws (2,000 times along the
+    default flythrough's 61 frames, 22 us a unit one by one)."""
+    cloud_centres = np.asarray(cloud_centres, dtype=np.float64).reshape(-1, 3)
+    cloud_radii = np.asarray(cloud_radii, dtype=np.float64).reshape(-1, 1)
+    gaps = np.linalg.norm(cloud_centres[:, None, :] - np.asarray(object_centres, dtype=np.float64)[None], axis=2)
+    return (gaps < cloud_radii + np.asarray(object_radii, dtype=np.float64)[None]) & (cloud_radii > 0.0)
 
 
 def layer_of(distances: np.ndarray, splits) -> np.ndarray:
