@@ -83,6 +83,7 @@ class FakeRenderer:
             world_gpu_ms=2.0,
             impostor_update_gpu_ms=0.0 if settings == FULL_3D else 3.0,
             cloud_gpu_ms=7.0,
+            splat_order="cpu" if settings == FULL_3D else "gpu",
         )
         return np.full((4, 4, 3), level, dtype=np.uint8), stats
 
@@ -97,6 +98,9 @@ def test_bench_path_reports_the_error_and_speedup_it_measured():
     assert report["reference"]["mode"] == "full" and report["frames"] == 3
     assert run["gpu_ms_by_pass"] == {"clouds": 7.0, "impostor_updates": 3.0, "world": 2.0}
     assert run["gpu_ms_mean"] == 12.0 and report["reference"]["gpu_ms_by_pass"]["impostor_updates"] == 0.0
+    # the way each frame sorted, frame by frame and counted: what a GPU's "auto" trial kept
+    assert [row["splat_order"] for row in run["per_frame"]] == ["gpu"] * 3 and run["splat_order_frames"] == {"gpu": 3}
+    assert report["reference"]["splat_order_frames"] == {"cpu": 3}
     twins = [FakeRenderer(offset=0) for _ in range(2)]
     identical = bench_path(twins, scene, "flythrough", 2, [RenderSettings()], (4, 4))
     assert identical["runs"][0]["psnr_min"] == 100.0  # identical frames: the cap, JSON has no infinity

@@ -192,6 +192,8 @@ def plot_error_against_time(report: dict, path: Path) -> None:
 
 
 def _cpu_and_gpu(summary: dict) -> str:
-    """A run's mean CPU time a frame and its GPU time per pass, as the bench prints them."""
+    """A run's mean CPU time a frame, its GPU time per pass and the frames sorted each way, as the bench prints
+    them."""
     passes = ", ".join(f"{name.replace('_', ' ')} {ms:.1f}" for name, ms in summary["gpu_ms_by_pass"].items())
-    return f"CPU {summary['cpu_ms_mean']:.1f} ms, GPU {summary['gpu_ms_mean']:.1f} ms ({passes})"
+    ways = ", ".join(f"{way} {frames}" for way, frames in sorted(summary["splat_order_frames"].items()) if way)
+    return f"CPU {summary['cpu_ms_mean']:.1f} ms, GPU {summary['gpu_ms_mean']:.1f} ms ({passes}), sorted on: {ways}"

@@ -18,6 +18,7 @@ import dataclasses
 import json
 import platform
 import time
+from collections import Counter
 from pathlib import Path
 
 import numpy as np
@@ -107,9 +108,9 @@ def _interleaved_rows(
         for index in order:
             renderer, settings = runs[index]
             images[index], stats = renderer.render(scene, camera=camera, settings=settings, time_s=time_s)
-            rows[index].append(
-                {"frame": frame, **{k: v for k, v in stats.as_dict().items() if isinstance(v, (int, float))}}
-            )
+            numbers = {k: v for k, v in stats.as_dict().items() if isinstance(v, (int, float))}
+            # which way the frame sorted ("cpu" or "gpu"): what a GPU's "auto" trial kept is read off the report
+            rows[index].append({"frame": frame, **numbers, "splat_order": stats.splat_order})
             if progress is not None:
                 progress()
         for index in range(1, len(runs)):
@@ -138,6 +139,7 @@ def _summary(rows) -> dict:
         "cpu_ms_mean": float(np.mean([r["cpu_ms"] for r in rows])),
         "gpu_ms_mean": sum(gpu_ms_by_pass.values()),
         "gpu_ms_by_pass": gpu_ms_by_pass,
+        "splat_order_frames": dict(Counter(r.get("splat_order", "") for r in rows)),
     }
 
 
