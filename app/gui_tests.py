@@ -462,7 +462,7 @@ def volume_blending_composites_in_the_window(ctx, app: EditorUnderTest):
 
 def the_gpu_sorts_the_splats_in_the_window(ctx, app: EditorUnderTest):
     # "Splat order/gpu": the compute shaders choose, sort and count in the window's own context, the indirect
-    # draw shows the CPU's picture; "auto" goes back to the CPU on llvmpipe
+    # draw shows the CPU's picture, and so does the compute compositor; "auto" goes back to the CPU on llvmpipe
     use_window(ctx, "LOD")
     ctx.combo_click("Mode/full")
     ctx.yield_(SETTLE)
@@ -476,6 +476,15 @@ def the_gpu_sorts_the_splats_in_the_window(ctx, app: EditorUnderTest):
     CHECK((cpu_stats.splat_order, gpu_stats.splat_order) == ("cpu", "gpu"))
     CHECK(gpu_stats.particles_drawn == cpu_stats.particles_drawn and gpu_stats.particles_drawn > 0)
     CHECK(bool(difference.psnr_db > 50.0))
+    # "Compositing/compute": the GPU's splats composited over GPU-binned tiles, the raster's picture again
+    ctx.combo_click("Compositing/compute")
+    CHECK(app.editor.settings.compositing == "compute")
+    ctx.yield_(SETTLE)
+    composited, composited_stats = app.capture(ctx), app.editor.last_stats.frame
+    app.outcome["compute_compositing_psnr_db"] = compare(on_gpu, composited).psnr_db
+    CHECK(composited_stats.particles_drawn == gpu_stats.particles_drawn)
+    CHECK(bool(compare(on_gpu, composited).psnr_db > 50.0))
+    ctx.combo_click("Compositing/raster")
     ctx.combo_click("Splat order/auto")
     ctx.yield_(SETTLE)
     CHECK(app.editor.last_stats.frame.splat_order == "cpu")

@@ -1,6 +1,7 @@
 """Depth interplay of the world and cloud passes: a hill hides a cloud behind it, not one in front.
 
-Both as full 3D and as impostors (a quad through the cloud's centre, depth-tested like the splats).
+Both as full 3D and as impostors (a quad through the cloud's centre, depth-tested like the splats), and as
+full 3D composited by the compute pass.
 """
 
 import numpy as np
@@ -33,7 +34,16 @@ def scene_with(*clouds, terrain=TERRAIN) -> Scene:
     return Scene(camera=camera, lighting=Lighting(time_of_day=12.0), clouds=clouds, terrain=terrain)
 
 
-@pytest.fixture(scope="module", params=[FULL_3D, RenderSettings(mode="impostor")], ids=["full", "impostor"])
+#: full 3D as the raster blends it, as impostors, and composited by the compute pass (which cuts each splat
+#: at the world's depth itself: `compositing = "compute"`)
+DEPTH_SETTINGS = {
+    "full": FULL_3D,
+    "impostor": RenderSettings(mode="impostor"),
+    "compute": RenderSettings(mode="full", splat_order="gpu", compositing="compute"),
+}
+
+
+@pytest.fixture(scope="module", params=list(DEPTH_SETTINGS.values()), ids=list(DEPTH_SETTINGS))
 def renders(renderer, request):
     in_front = [330.0, float(height_at(TERRAIN, 330.0, 0.0)) + 100.0, 0.0]
     behind = [980.0, float(height_at(TERRAIN, 980.0, 0.0)) - 180.0, 0.0]

@@ -78,6 +78,7 @@ class _CloudPassFrame:
     point_sprites: bool  # the setting: draw plain splats as points where the picture is the same
     blending: str  # the setting: full-3D splats as billboards ("plain") or as volumes ("volume")
     splat_order: str  # splats chosen and sorted on the "cpu" or the "gpu" (the setting, "auto" resolved)
+    compositing: str  # the setting: the GPU's plain full-3D splats blended by the "raster" or by "compute"
 
     @property
     def eye(self) -> np.ndarray:
@@ -384,6 +385,7 @@ class FrameRenderer:
             settings.point_sprites,
             settings.blending,
             splat_order,
+            settings.compositing,
         )
         self._replay, self._screen_batches = [], []
         steps = self._cloud_pass_steps(frame)
@@ -470,7 +472,18 @@ class FrameRenderer:
         (`SplatPass.take_selected`)."""
         view, projection, points = frame.view, frame.projection, frame.point_sprites
         if isinstance(batch, SplatSelection):
-            self._splats.draw(batch, view, projection)
+            if (
+                frame.compositing == "compute"
+                and self._volume.features.compute_shaders
+                and self._splats.plain_selection(batch)
+            ):
+                instances, count_at = self._splats.selected_instances(batch, view)
+                target = self.context.colour_texture if colour_texture is None else colour_texture
+                self._volume.draw_plain(
+                    instances, count_at, view, projection, target, self.context.framebuffer, self.size
+                )
+            else:
+                self._splats.draw(batch, view, projection)
             self._replay.append(lambda: self._splats.draw(batch, view, projection, counting=True))
             self._screen_batches.append(batch)
             return 0

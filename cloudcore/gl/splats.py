@@ -476,6 +476,22 @@ class SplatPass:
             self._drawn_commands.append(command)
         return 0
 
+    def selected_instances(self, selection: SplatSelection, view: np.ndarray) -> tuple[tuple, tuple]:
+        """For a compute pass that composites a selection where the raster would draw it (`cloudcore.gl.
+        tile_binning`): (its instances: buffer, first slot, slots; its indirect command's count: buffer, uint
+        index), shaded for `view`.  Its particles count as drawn (`take_selected`)."""
+        buffer, first = self.shade(selection, view)
+        command = self._commands[id(selection)]
+        self._drawn_commands.append(command)
+        return (buffer, first, selection.slots), (self._command_buffer, _COMMAND_UINTS * command)
+
+    def plain_selection(self, selection: SplatSelection) -> bool:
+        """Whether every particle of a selection's clouds is a plain Gaussian splat of one colour
+        (`cloudcore.point_sprites.plain_splats`): what a compute pass can composite."""
+        self._make_resident(selection.particles)
+        starts = selection.particles.cloud_starts
+        return all(bool(self._plain[starts[c] : starts[c + 1]].all()) for c in selection.clouds)
+
     def take_selected(self) -> tuple[int, int]:
         """(the particles that the selections drawn into targets since the last call chose, those drawn into
         cells), read from their commands (after the draws finished, this waits for nothing); the commands

@@ -20,6 +20,7 @@ from OpenGL import GL
 from cloudcore.gl.programs import build_compute_program, set_vec3
 from cloudcore.gl.splats import INSTANCE_BYTES, SplatBatch
 from cloudcore.gl.targets import blit_depth
+from cloudcore.gl.tile_binning import GpuTileBinning
 from cloudcore.light.kernel import SPLAT_SHARPNESS
 from cloudcore.light.volume_blending import MAX_OPTICAL_DEPTH, TILE_PIXELS, ScreenTiles, Splats
 
@@ -57,11 +58,13 @@ class VolumeBlendingPass:
 
     def __init__(self):
         self.features = GpuFeatures.query()
-        self._program = None
+        self._program = self._plain_program = None
         if self.features.compute_shaders:
             constants = {"TILE_PIXELS": TILE_PIXELS, "SPLAT_SHARPNESS": SPLAT_SHARPNESS}
             self._program = build_compute_program("volume_blend", constants | {"MAX_OPTICAL_DEPTH": MAX_OPTICAL_DEPTH})
-        self._buffers = self._starts, self._entries, self._occupied = GL.glGenBuffers(3)
+        self._buffers = self._starts, self._entries, self._occupied, self._all_tiles = GL.glGenBuffers(4)
+        self._binning: GpuTileBinning | None = None  # made with the plain program, when first needed
+        self._all_tiles_held = 0  # how many tiles `_all_tiles` lists, 0 to n - 1: a binned draw's groups
         self._depth: tuple[int, int, tuple[int, int]] | None = None  # (texture, framebuffer, size)
 
     def draw(
@@ -79,9 +82,6 @@ class VolumeBlendingPass:
         occupied = tiles.occupied
         if not len(occupied):
             return
-        bound = GL.glGetIntegerv(GL.GL_DRAW_FRAMEBUFFER_BINDING)
-        depth_texture = self._world_depth(depth_framebuffer, tiles.size)
-        GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, int(bound))
         for binding, buffer, data in (
             (_TILE_STARTS_BINDING, self._starts, tiles.starts),
             (_TILE_ENTRIES_BINDING, self._entries, tiles.entries),
@@ -91,14 +91,77 @@ class VolumeBlendingPass:
             GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, buffer)
             GL.glBufferData(GL.GL_SHADER_STORAGE_BUFFER, data.nbytes, np.ascontiguousarray(data), GL.GL_STREAM_DRAW)
             GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, binding, buffer)
+        self._composite(
+            self._program,
+            tiles.size,
+            tiles.across,
+            len(occupied),
+            instances,
+            view,
+            projection,
+            colour_texture,
+            depth_framebuffer,
+        )
+
+    def draw_plain(
+        self,
+        instances: tuple[int, int, int],
+        count_at: tuple[int, int],
+        view: np.ndarray,
+        projection: np.ndarray,
+        colour_texture: int,
+        depth_framebuffer: int,
+        size: tuple[int, int],
+    ) -> None:
+        """Composite a GPU-chosen draw's plain splats (`instances`: buffer, first slot, slots; `count_at`: its
+        indirect command's count) over `colour_texture` as the raster blends them, binned on the GPU
+        (`cloudcore.gl.tile_binning`), cut by the depth of `depth_framebuffer`."""
+        if self._binning is None:
+            self._binning = GpuTileBinning()
+            constants = {"TILE_PIXELS": TILE_PIXELS, "SPLAT_SHARPNESS": SPLAT_SHARPNESS, "MAX_OPTICAL_DEPTH": 1.0}
+            self._plain_program = build_compute_program("volume_blend", constants | {"PLAIN": 1})
+        binned = self._binning.bin(instances, count_at, view, projection, size)
+        if binned is None:
+            return
+        tiles = binned.across * binned.up
+        if self._all_tiles_held < tiles:
+            GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, self._all_tiles)
+            every = np.arange(tiles, dtype=np.uint32)
+            GL.glBufferData(GL.GL_SHADER_STORAGE_BUFFER, every.nbytes, every, GL.GL_STATIC_DRAW)
+            self._all_tiles_held = tiles
+        for binding, buffer in (
+            (_TILE_STARTS_BINDING, binned.starts),
+            (_TILE_ENTRIES_BINDING, binned.entries),
+            (_OCCUPIED_BINDING, self._all_tiles),
+        ):
+            GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, binding, buffer)
+        self._composite(
+            self._plain_program,
+            binned.size,
+            binned.across,
+            tiles,
+            instances,
+            view,
+            projection,
+            colour_texture,
+            depth_framebuffer,
+        )
+
+    def _composite(
+        self, program, size, across, groups, instances, view, projection, colour_texture, depth_framebuffer
+    ) -> None:
+        """Run a compositing `program` over `groups` tiles (the occupied buffer's first), its tile buffers
+        bound, the instances (buffer, first slot, count) bound here."""
+        bound = GL.glGetIntegerv(GL.GL_DRAW_FRAMEBUFFER_BINDING)
+        depth_texture = self._world_depth(depth_framebuffer, size)
+        GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, int(bound))
         buffer, first, count = instances
         GL.glBindBufferRange(
             GL.GL_SHADER_STORAGE_BUFFER, _INSTANCES_BINDING, buffer, first * INSTANCE_BYTES, count * INSTANCE_BYTES
         )
-        program = self._program
         GL.glUseProgram(program)
-        GL.glUniform2i(GL.glGetUniformLocation(program, "size"), *tiles.size)
-        GL.glUniform1i(GL.glGetUniformLocation(program, "tiles_across"), tiles.across)
+        GL.glUniform2i(GL.glGetUniformLocation(program, "size"), *size)
+        GL.glUniform1i(GL.glGetUniformLocation(program, "tiles_across"), across)
         set_vec3(program, "view_right", view[0, :3])
         set_vec3(program, "view_up", view[1, :3])
         set_vec3(program, "view_forward", -view[2, :3])
@@ -110,7 +173,7 @@ class VolumeBlendingPass:
         # what was drawn into the target before must be there to read
         GL.glMemoryBarrier(GL.GL_FRAMEBUFFER_BARRIER_BIT | GL.GL_SHADER_IMAGE_ACCESS_BARRIER_BIT)
         GL.glBindImageTexture(0, colour_texture, 0, GL.GL_FALSE, 0, GL.GL_READ_WRITE, GL.GL_RGBA16F)
-        GL.glDispatchCompute(len(occupied), 1, 1)
+        GL.glDispatchCompute(groups, 1, 1)
         # and what it wrote there, for the draws, blits and reads after it
         GL.glMemoryBarrier(
             GL.GL_FRAMEBUFFER_BARRIER_BIT | GL.GL_TEXTURE_FETCH_BARRIER_BIT | GL.GL_SHADER_IMAGE_ACCESS_BARRIER_BIT
@@ -143,8 +206,11 @@ class VolumeBlendingPass:
     def close(self) -> None:
         """Free the GL objects (the context must be current)."""
         self._close_depth()
-        if self._program is not None:
-            GL.glDeleteProgram(self._program)
+        for program in (self._program, self._plain_program):
+            if program is not None:
+                GL.glDeleteProgram(program)
+        if self._binning is not None:
+            self._binning.close()
         GL.glDeleteBuffers(len(self._buffers), list(self._buffers))
 
 

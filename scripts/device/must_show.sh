@@ -3,7 +3,7 @@
 #   command: bash scripts/device/must_show.sh      carry: [".whl", ".gl"]      timeout_s: 560
 # Every step is bounded by what is left of BUDGET_S (default 480 s) so the call ends inside its limit with
 # whatever finished; a step that fails is logged and the next one runs.  STEPS names the steps to run (default
-# "flythroughs renders editor tests field"; also "lod" and "compositing").  Writes to $OUT (8 files come back):
+# "flythroughs renders editor tests field"; also "lod", "compositing", "sort" and "compute").  Writes to $OUT (8 files come back):
 #   log.txt          every command's output: the GPU, frame means per mode and order, the GPU tests
 #   flythroughs: fly_640.json, fly_1600.json   the default flythrough at 640x480 (181 frames) and 1600x1200
 #                    (91): full 3D and auto, each with the CPU's and the GPU's splat order (the reference: full
@@ -17,6 +17,9 @@
 #   compositing: compositing.json   full 3D at 640x480 blended by the raster (plain) or by the tiled compute
 #                    pass (volume), 61 frames of the flythrough
 #   sort: sort.json            the GPU's radix sort against numpy's (`bench_gpu_sort.py`), 10k to 1M keys
+#   compute: compute_640.json, compute_1600.json   the flythrough (91 and 61 frames), full 3D and auto with the
+#                    GPU's order, their splats blended by the raster or composited by compute (`compositing`);
+#                    and the compute compositor's tests, in log.txt
 # LOCAL=1 runs it here on llvmpipe with a few frames and no setup: a check of the script, not numbers.
 set -uo pipefail
 OUT=${OUT:-out/must_show}
@@ -87,6 +90,15 @@ fi
 if wanted compositing; then
   step "compositing 640x480" "${cloudview[@]}" bench "$scene" --camera-path flythrough --frames "$frames" \
     --sweep mode=full --sweep blending=plain,volume --no-shading --json "$OUT/compositing.json"
+fi
+if wanted compute; then
+  step "compute compositing tests" "$python" -m pytest -q "${plugin[@]}" tests/test_compute_compositing.py \
+    tests/test_render_depth.py
+  compute=(--sweep mode=full,auto --sweep splat_order=gpu --sweep compositing=raster,compute --no-shading)
+  step "compute 640x480" "${cloudview[@]}" bench "$scene" --camera-path flythrough --frames "$frames" \
+    "${compute[@]}" --json "$OUT/compute_640.json"
+  step "compute 1600x1200" "${cloudview[@]}" bench "$scene" --camera-path flythrough --frames "$frames" \
+    --width 1600 --height 1200 "${compute[@]}" --json "$OUT/compute_1600.json"
 fi
 if wanted sort; then
   step "sort" "$python" scripts/bench_gpu_sort.py --json "$OUT/sort.json"

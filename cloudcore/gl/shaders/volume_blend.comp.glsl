@@ -1,5 +1,7 @@
 #version 430 core
-// Yusov's volume-aware blending (HPG 2014, section 5.5, eq. 10-17) without pixel-shader ordering:
+// Yusov's volume-aware blending (HPG 2014, section 5.5, eq. 10-17) without pixel-shader ordering,
+// or with PLAIN defined the billboards' own blending done the same way (a compute compositor of plain
+// splats, for GPUs whose raster is a small part of the chip: cloudcore.gl.tile_binning):
 // one work group per screen tile, one invocation per pixel, each walking its tile's particles in the
 // batch's far-to-near order (cloudcore.light.volume_blending.screen_tiles) and compositing their
 // segments along its ray as the numpy reference does (cloudcore.light.volume_blending.volume_blend):
@@ -123,6 +125,25 @@ void main()
     float opaque = stored >= 1.0 ? FAR : depth_terms.y / ((2.0 * stored - 1.0) + depth_terms.x) / dot(ray, view_forward);
     vec4 image = imageLoad(target, pixel);
 
+#ifdef PLAIN
+    // billboards blended over, far to near, as splat.frag.glsl's fragments are (premultiplied, GL_ONE,
+    // GL_ONE_MINUS_SRC_ALPHA), where the ray meets the quad in front of the world (the raster's depth test);
+    // the pixel stays float32 through its splats, where the raster rounds it to half floats at each blend
+    for (uint k = tile_starts[tile]; k < tile_starts[tile + 1u]; ++k) {
+        Splat p = splat_of(instances[tile_entries[k]]);
+        float facing = dot(ray, p.normal_plane.xyz);
+        if (abs(facing) <= TINY)
+            continue;
+        float plane = p.normal_plane.w / facing;
+        vec3 offset = plane * ray - p.centre_r2.xyz;
+        float du = dot(offset, p.u.xyz), dv = dot(offset, p.v.xyz);
+        float d2 = du * du + dv * dv;
+        if (plane <= 0.0 || plane >= opaque || d2 >= 1.0)
+            continue;
+        vec4 source = p.colour * kernel(d2);
+        image = source + (1.0 - source.a) * image;
+    }
+#else
     Segment held = Segment(0.0, 0.0, 0.0, vec3(0.0));
     for (uint k = tile_starts[tile]; k < tile_starts[tile + 1u]; ++k) {
         Segment s = segment_of(splat_of(instances[tile_entries[k]]), ray, opaque);
@@ -157,5 +178,6 @@ void main()
     }
     if (held.depth > 0.0)
         over_whole(image, held);
+#endif
     imageStore(target, pixel, image);
 }

@@ -1,0 +1,93 @@
+#version 430 core
+// The screen tiles of a GPU-chosen draw's splats, made on the GPU, for the tiled compute pass that
+// composites plain splats (volume_blend.comp.glsl's PLAIN): the numpy binning
+// (cloudcore.light.volume_blending.screen_tiles) without the CPU.  The draw's instances are those
+// splat_shade.comp.glsl made, far to near, as many kept as its indirect command counts (six indices
+// each).  Three stages, chosen by the stage defined:
+//   COUNT   per kept splat, the tiles its quad's image can touch, added to `total`;
+//   EMIT    per kept splat, one (slot, tile) pair a tile, at places an atomic counter hands out (so in
+//           no order: two stable radix sorts then put them by tile and, within a tile, by slot, which
+//           is far to near);
+//   STARTS  over the pairs sorted by tile: where each tile's run starts (tile_starts[t] to
+//           tile_starts[t + 1]), as ScreenTiles.starts.
+// A splat's image is bounded by its four corners' (it is a flat quad), one pixel wider on each side
+// for rounding; a splat reaching behind the near plane may touch any tile.
+
+layout(local_size_x = 64) in;
+
+struct Instance {
+    vec4 corners[4];  // relative to the eye; w: atlas cell (-1: Gaussian splat)
+    vec4 colours[4];  // premultiplied linear rgb, opacity
+};
+layout(std430, binding = 3) readonly buffer Instances { Instance instances[]; };  // from the draw's first
+layout(std430, binding = 6) readonly buffer Command { uint command[]; };
+layout(std430, binding = 9) buffer Counter { uint total; uint cursor; };
+layout(std430, binding = 10) buffer PairSlots { uint pair_slots[]; };
+layout(std430, binding = 11) buffer PairTiles { uint pair_tiles[]; };
+layout(std430, binding = 12) writeonly buffer TileStarts { uint tile_starts[]; };
+
+uniform uint slots;        // the draw's slots, kept or not
+uniform uint count_at;     // its command's count in the command buffer (six a kept splat)
+uniform mat4 view_rotation;
+uniform mat4 projection;
+uniform ivec2 size;        // pixels
+uniform int tiles_across;
+uniform int tiles_up;
+uniform float near;
+uniform uint pairs;        // STARTS: how many pairs there are
+
+// (first tile column, first row, last column, last row) of splat j's image; empty when last < first
+ivec4 tile_box(uint j)
+{
+    vec2 low = vec2(3.0e38), high = vec2(-3.0e38);
+    bool behind = false;
+    for (int k = 0; k < 4; ++k) {
+        vec4 clip = projection * (view_rotation * vec4(instances[j].corners[k].xyz, 1.0));
+        if (clip.w <= near) {
+            behind = true;
+            break;
+        }
+        vec2 pixel = (clip.xy / clip.w * 0.5 + 0.5) * vec2(size) - 0.5;  // pixel centres are whole numbers
+        low = min(low, pixel);
+        high = max(high, pixel);
+    }
+    ivec2 first = behind ? ivec2(0) : ivec2(clamp(floor(low) - 1.0, vec2(0.0), vec2(size)));
+    ivec2 last = behind ? size - 1 : ivec2(clamp(ceil(high) + 1.0, vec2(-1.0), vec2(size - 1)));
+    if (any(lessThan(last, first)))
+        return ivec4(0, 0, -1, -1);
+    return ivec4(first / TILE_PIXELS, last / TILE_PIXELS);
+}
+
+void main()
+{
+    uint i = gl_GlobalInvocationID.x;
+#ifdef STARTS
+    if (i >= pairs)
+        return;
+    uint tile = pair_tiles[i];
+    uint before = i == 0u ? 0u : pair_tiles[i - 1u] + 1u;
+    for (uint t = before; t <= tile; ++t)
+        tile_starts[t] = i;
+    if (i == pairs - 1u)
+        for (uint t = tile + 1u; t <= uint(tiles_across * tiles_up); ++t)
+            tile_starts[t] = pairs;
+#else
+    if (i >= slots || i >= command[count_at] / 6u)
+        return;
+    ivec4 box = tile_box(i);
+    if (box.z < box.x || box.w < box.y)
+        return;
+    uint covered = uint((box.z - box.x + 1) * (box.w - box.y + 1));
+#ifdef COUNT
+    atomicAdd(total, covered);
+#else
+    uint at = atomicAdd(cursor, covered);
+    for (int row = box.y; row <= box.w; ++row)
+        for (int column = box.x; column <= box.z; ++column) {
+            pair_slots[at] = i;
+            pair_tiles[at] = uint(row * tiles_across + column);
+            ++at;
+        }
+#endif
+#endif
+}

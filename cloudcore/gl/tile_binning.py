@@ -1,0 +1,157 @@
+"""A GPU-chosen draw's splats binned into screen tiles on the GPU, for compositing them by compute.
+
+On the H200 (docs/performance.md, "On a GPU (NVIDIA H200)") the raster of full 3D's splats took 16.5 of
+the frame's 17.4 GPU milliseconds at 640x480, and the tiled compute pass of volume-aware blending did
+more per splat in half the raster's time: such chips keep little of their area for the raster.  The
+compute pass needs each tile's splats far to near, which `cloudcore.light.volume_blending.screen_tiles`
+makes in numpy (79 ms of CPU a frame there).  Here the GPU makes them from the draw's shaded instances
+(`shaders/tile_bin.comp.glsl`): each kept splat counts the tiles its quad's image touches, one
+(slot, tile) pair a tile is written where an atomic counter says, and two stable radix sorts
+(`cloudcore.gl.depth_sort`), by slot then by tile, leave each tile's run far to near; the runs' starts
+are the tiles' `starts`, as `ScreenTiles` has them.  The CPU reads back one number, the pairs' count,
+to size the sorts.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from OpenGL import GL
+
+from cloudcore.camera import NEAR_PLANE_M
+from cloudcore.gl.depth_sort import GpuDepthSort
+from cloudcore.gl.programs import build_compute_program, set_matrix_at, uniform_locations
+from cloudcore.gl.splats import INSTANCE_BYTES
+from cloudcore.light.volume_blending import TILE_PIXELS
+
+#: the storage bindings of tile_bin.comp.glsl (instances and command as the splat pass binds them)
+_INSTANCES, _COMMAND, _COUNTER, _PAIR_SLOTS, _PAIR_TILES, _TILE_STARTS = 3, 6, 9, 10, 11, 12
+_GROUP = 64
+_UNIFORMS = ("slots", "count_at", "view_rotation", "projection", "size", "tiles_across", "tiles_up", "near", "pairs")
+
+
+@dataclass(frozen=True)
+class BinnedTiles:
+    """A draw's splats by screen tile, in GPU buffers: tile t's are the slots `entries[starts[t]:starts[t + 1]]`
+    (from the draw's first), far to near; tiles counted from the lower left, `TILE_PIXELS` square."""
+
+    size: tuple[int, int]
+    across: int
+    up: int
+    starts: int  # buffer of across * up + 1 uints
+    entries: int  # buffer of `pairs` uints
+    pairs: int
+
+
+class GpuTileBinning:
+    """The binning's programs and buffers; `bin` bins one draw."""
+
+    def __init__(self):
+        defines = {"TILE_PIXELS": TILE_PIXELS}
+        self._programs = {
+            stage: build_compute_program("tile_bin", defines | {stage: 1}) for stage in ("COUNT", "EMIT", "STARTS")
+        }
+        self._uniforms = {stage: uniform_locations(program, _UNIFORMS) for stage, program in self._programs.items()}
+        self._counter, self._slots, self._tiles, self._starts = self._buffers = GL.glGenBuffers(4)
+        self._pair_capacity = self._tile_capacity = 0
+        self._sort = GpuDepthSort()
+
+    def bin(
+        self,
+        instances: tuple[int, int, int],
+        count_at: tuple[int, int],
+        view: np.ndarray,
+        projection: np.ndarray,
+        size: tuple[int, int],
+    ) -> BinnedTiles | None:
+        """Bin a draw's shaded splats (`instances`: their buffer, first slot, slots; `count_at`: the buffer
+        and uint index of its indirect command's count, six a kept splat) for a screen of `size` pixels seen
+        with `view` and `projection`; None when no splat touches the screen."""
+        buffer, first, slots = instances
+        across, up = -(-size[0] // TILE_PIXELS), -(-size[1] // TILE_PIXELS)
+        if not slots:
+            return None
+        GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, self._counter)
+        GL.glBufferData(GL.GL_SHADER_STORAGE_BUFFER, 8, np.zeros(2, dtype=np.uint32), GL.GL_STREAM_COPY)
+        GL.glBindBufferRange(
+            GL.GL_SHADER_STORAGE_BUFFER, _INSTANCES, buffer, first * INSTANCE_BYTES, slots * INSTANCE_BYTES
+        )
+        GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _COMMAND, count_at[0])
+        GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _COUNTER, self._counter)
+        GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT | GL.GL_BUFFER_UPDATE_BARRIER_BIT)
+        self._dispatch("COUNT", slots, count_at[1], view, projection, size, (across, up))
+        GL.glMemoryBarrier(GL.GL_BUFFER_UPDATE_BARRIER_BIT)
+        GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, self._counter)
+        pairs = int(np.frombuffer(GL.glGetBufferSubData(GL.GL_SHADER_STORAGE_BUFFER, 0, 4), dtype=np.uint32)[0])
+        if not pairs:
+            return None
+        self._reserve(pairs, across * up + 1)
+        GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _PAIR_SLOTS, self._slots)
+        GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _PAIR_TILES, self._tiles)
+        self._dispatch("EMIT", slots, count_at[1], view, projection, size, (across, up))
+        GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT)
+        # by slot (far to near), then stably by tile: each tile's run keeps the draw's order
+        self._sort.sort(self._slots, self._tiles, pairs, key_bits=_whole_bytes(slots - 1))
+        self._sort.sort(self._tiles, self._slots, pairs, key_bits=_whole_bytes(across * up - 1))
+        GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT)
+        GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _PAIR_TILES, self._tiles)
+        GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _TILE_STARTS, self._starts)
+        program, uniforms = self._programs["STARTS"], self._uniforms["STARTS"]
+        GL.glUseProgram(program)
+        GL.glUniform1ui(uniforms["pairs"], pairs)
+        GL.glUniform1i(uniforms["tiles_across"], across)
+        GL.glUniform1i(uniforms["tiles_up"], up)
+        GL.glDispatchCompute(-(-pairs // _GROUP), 1, 1)
+        GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT)
+        return BinnedTiles(tuple(size), across, up, self._starts, self._slots, pairs)
+
+    def read(self, binned: BinnedTiles) -> tuple[np.ndarray, np.ndarray]:
+        """(starts, entries) of `binned` read back, as `ScreenTiles` holds them (the tests compare the two)."""
+        GL.glMemoryBarrier(GL.GL_BUFFER_UPDATE_BARRIER_BIT)
+        arrays = []
+        for buffer, count in ((binned.starts, binned.across * binned.up + 1), (binned.entries, binned.pairs)):
+            GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, buffer)
+            arrays.append(np.frombuffer(GL.glGetBufferSubData(GL.GL_SHADER_STORAGE_BUFFER, 0, 4 * count), np.uint32))
+        GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, 0)
+        return arrays[0].copy(), arrays[1].copy()
+
+    def _dispatch(self, stage: str, slots: int, count_at: int, view, projection, size, tiles) -> None:
+        program, uniforms = self._programs[stage], self._uniforms[stage]
+        GL.glUseProgram(program)
+        GL.glUniform1ui(uniforms["slots"], slots)
+        GL.glUniform1ui(uniforms["count_at"], count_at)
+        rotation = np.eye(4)
+        rotation[:3, :3] = view[:3, :3]  # the instances' corners are relative to the eye
+        set_matrix_at(uniforms["view_rotation"], rotation)
+        set_matrix_at(uniforms["projection"], projection)
+        GL.glUniform2i(uniforms["size"], *size)
+        GL.glUniform1i(uniforms["tiles_across"], tiles[0])
+        GL.glUniform1i(uniforms["tiles_up"], tiles[1])
+        GL.glUniform1f(uniforms["near"], NEAR_PLANE_M)
+        GL.glDispatchCompute(-(-slots // _GROUP), 1, 1)
+
+    def _reserve(self, pairs: int, starts: int) -> None:
+        """Room for `pairs` pairs and `starts` tile starts, growing geometrically."""
+        if pairs > self._pair_capacity:
+            self._pair_capacity = max(pairs, 2 * self._pair_capacity)
+            for buffer in (self._slots, self._tiles):
+                GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, buffer)
+                GL.glBufferData(GL.GL_SHADER_STORAGE_BUFFER, 4 * self._pair_capacity, None, GL.GL_DYNAMIC_COPY)
+        if starts > self._tile_capacity:
+            self._tile_capacity = starts
+            GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, self._starts)
+            GL.glBufferData(GL.GL_SHADER_STORAGE_BUFFER, 4 * starts, None, GL.GL_DYNAMIC_COPY)
+        GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, 0)
+
+    def close(self) -> None:
+        """Free the GL objects (the context must be current)."""
+        for program in self._programs.values():
+            GL.glDeleteProgram(program)
+        GL.glDeleteBuffers(len(self._buffers), list(self._buffers))
+        self._sort.close()
+
+
+def _whole_bytes(largest: int) -> int:
+    """The bits of the radix sort's keys up to `largest`: whole bytes, as the sort takes them."""
+    return 8 * max(1, -(-max(int(largest), 1).bit_length() // 8))
