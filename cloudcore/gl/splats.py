@@ -774,10 +774,7 @@ class SplatPass:
         """Room for choosing `slots` particles and for `commands` indirect commands, keeping those made."""
         if slots > self._keys_capacity:
             self._keys_capacity = max(slots, 2 * self._keys_capacity)
-            for buffer in (self._keys_buffer, self._values_buffer):
-                GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, buffer)
-                GL.glBufferData(GL.GL_SHADER_STORAGE_BUFFER, 4 * self._keys_capacity, None, GL.GL_DYNAMIC_COPY)
-            GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, 0)
+            reallocate_storage((self._keys_buffer, self._values_buffer), 4 * self._keys_capacity)
         if commands > self._command_capacity:
             capacity, size = max(commands, 2 * self._command_capacity, 16), 4 * _COMMAND_UINTS
             scratch = GL.glGenBuffers(1)
@@ -966,6 +963,14 @@ def _rotation(view: np.ndarray) -> np.ndarray:
     rotation = np.array(view, dtype=np.float64)
     rotation[:3, 3] = 0.0
     return rotation
+
+
+def reallocate_storage(buffers, size: int) -> None:
+    """Give each storage buffer of `buffers` `size` bytes, its contents undefined (scratch space that grows)."""
+    for buffer in buffers:
+        GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, buffer)
+        GL.glBufferData(GL.GL_SHADER_STORAGE_BUFFER, size, None, GL.GL_DYNAMIC_COPY)
+    GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, 0)
 
 
 def _bind_storage(*bindings) -> None:

@@ -22,7 +22,7 @@ from OpenGL import GL
 from cloudcore.camera import NEAR_PLANE_M
 from cloudcore.gl.depth_sort import GpuDepthSort
 from cloudcore.gl.programs import build_compute_program, set_matrix_at, uniform_locations
-from cloudcore.gl.splats import INSTANCE_BYTES
+from cloudcore.gl.splats import INSTANCE_BYTES, reallocate_storage
 from cloudcore.light.volume_blending import TILE_PIXELS
 
 #: the storage bindings of tile_bin.comp.glsl (instances and command as the splat pass binds them)
@@ -135,14 +135,10 @@ class GpuTileBinning:
         """Room for `pairs` pairs and `starts` tile starts, growing geometrically."""
         if pairs > self._pair_capacity:
             self._pair_capacity = max(pairs, 2 * self._pair_capacity)
-            for buffer in (self._slots, self._tiles):
-                GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, buffer)
-                GL.glBufferData(GL.GL_SHADER_STORAGE_BUFFER, 4 * self._pair_capacity, None, GL.GL_DYNAMIC_COPY)
+            reallocate_storage((self._slots, self._tiles), 4 * self._pair_capacity)
         if starts > self._tile_capacity:
             self._tile_capacity = starts
-            GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, self._starts)
-            GL.glBufferData(GL.GL_SHADER_STORAGE_BUFFER, 4 * starts, None, GL.GL_DYNAMIC_COPY)
-        GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, 0)
+            reallocate_storage((self._starts,), 4 * starts)
 
     def close(self) -> None:
         """Free the GL objects (the context must be current)."""
