@@ -18,6 +18,7 @@ from cloudcore.settings import RenderSettings
 
 RASTER = RenderSettings(mode="full", splat_order="gpu")
 COMPUTE = dataclasses.replace(RASTER, compositing="compute")
+VOLUME = RenderSettings(mode="full", blending="volume")
 
 
 @pytest.fixture(scope="module")
@@ -92,3 +93,35 @@ def test_the_gpu_bins_each_tile_far_to_near_and_only_the_kept_splats(renderer, v
     columns, rows = (np.round(pixels[on_screen]).astype(np.int64) // TILE_PIXELS).T
     for slot, tile in zip(np.flatnonzero(ahead)[on_screen], rows * binned.across + columns):
         assert slot in entries[starts[tile] : starts[tile + 1]], (slot, tile)
+
+
+def test_dispatches_past_the_gls_group_limit_loop_to_the_same_picture(renderer, valley, monkeypatch):
+    """At 1600x1200 inside a cloud the binning has 7 million pairs, 110,644 groups of 64 where llvmpipe
+    dispatches 65,535 at most; a scene of 4.2 million particles passes it in the selection too.  With the
+    limit made 100 groups, every compute shader of the GPU's ways loops over what it was given: the same
+    pictures and counts.  (Not fewer: with 3, llvmpipe stopped each compositing invocation after about 45
+    tiles of this view, some 65,000 splats walked, the iteration cap it puts on a shader's loops.)"""
+    from cloudcore.gl import programs
+
+    camera = inside_a_cloud(valley)
+    expected = {
+        name: renderer.render(valley, camera=camera, settings=settings)
+        for name, settings in (("raster", RASTER), ("compute", COMPUTE), ("volume", VOLUME))
+    }
+    monkeypatch.setattr(programs, "max_dispatch_groups", lambda: 100)
+    for name, settings in (("raster", RASTER), ("compute", COMPUTE), ("volume", VOLUME)):
+        image, stats = renderer.render(valley, camera=camera, settings=settings)
+        assert compare(image, expected[name][0]).psnr_db >= 99.0, name
+        assert stats.particles_drawn == expected[name][1].particles_drawn > 0, name
+
+
+def test_a_draw_with_too_many_tile_pairs_is_left_to_the_raster(renderer, valley, monkeypatch):
+    """Past `MAX_PAIRS` (512 MiB of bins; a 4K screen inside a cloud comes near) the draw is the raster's:
+    its picture exactly, its particles counted once."""
+    from cloudcore.gl import tile_binning
+
+    raster, raster_stats = renderer.render(valley, settings=RASTER)
+    monkeypatch.setattr(tile_binning, "MAX_PAIRS", 10)
+    image, stats = renderer.render(valley, settings=COMPUTE)
+    assert compare(image, raster).max_abs == 0
+    assert stats.particles_drawn == raster_stats.particles_drawn > 0

@@ -472,6 +472,7 @@ class FrameRenderer:
         (`SplatPass.take_selected`)."""
         view, projection, points = frame.view, frame.projection, frame.point_sprites
         if isinstance(batch, SplatSelection):
+            composited = False
             if (
                 frame.compositing == "compute"
                 and self._volume.features.compute_shaders
@@ -479,10 +480,12 @@ class FrameRenderer:
             ):
                 instances, count_at = self._splats.selected_instances(batch, view)
                 target = self.context.colour_texture if colour_texture is None else colour_texture
-                self._volume.draw_plain(
+                composited = self._volume.draw_plain(
                     instances, count_at, view, projection, target, self.context.framebuffer, self.size
                 )
-            else:
+            if composited:
+                self._splats.count_drawn(batch)
+            else:  # not asked for, not plain splats, or too many pairs to bin
                 self._splats.draw(batch, view, projection)
             self._replay.append(lambda: self._splats.draw(batch, view, projection, counting=True))
             self._screen_batches.append(batch)

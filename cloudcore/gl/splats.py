@@ -36,7 +36,14 @@ from cloudcore.camera import splats_in_frustum
 from cloudcore.cloud_records import ATLAS_GRID
 from cloudcore.gl.blending import cloud_blending
 from cloudcore.gl.depth_sort import GpuDepthSort
-from cloudcore.gl.programs import build_compute_program, build_program, set_matrix_at, set_vec3_at, uniform_locations
+from cloudcore.gl.programs import (
+    build_compute_program,
+    build_program,
+    dispatch,
+    set_matrix_at,
+    set_vec3_at,
+    uniform_locations,
+)
 from cloudcore.light.eye_scattering import FADE_END_RADII, FADE_START_RADII, ParticleBuffer
 from cloudcore.light.kernel import SPLAT_REACH, SPLAT_SHARPNESS
 from cloudcore.light.phase import PHASE_NAMES
@@ -479,11 +486,14 @@ class SplatPass:
     def selected_instances(self, selection: SplatSelection, view: np.ndarray) -> tuple[tuple, tuple]:
         """For a compute pass that composites a selection where the raster would draw it (`cloudcore.gl.
         tile_binning`): (its instances: buffer, first slot, slots; its indirect command's count: buffer, uint
-        index), shaded for `view`.  Its particles count as drawn (`take_selected`)."""
+        index), shaded for `view`.  Once composited, `count_drawn` counts its particles."""
         buffer, first = self.shade(selection, view)
         command = self._commands[id(selection)]
-        self._drawn_commands.append(command)
         return (buffer, first, selection.slots), (self._command_buffer, _COMMAND_UINTS * command)
+
+    def count_drawn(self, selection: SplatSelection) -> None:
+        """Count a selection's particles as drawn (`take_selected`) when something else than `draw` drew them."""
+        self._drawn_commands.append(self._commands[id(selection)])
 
     def plain_selection(self, selection: SplatSelection) -> bool:
         """Whether every particle of a selection's clouds is a plain Gaussian splat of one colour
@@ -684,7 +694,7 @@ class SplatPass:
         GL.glUniform1ui(uniforms["first"], first)
         GL.glUniform1ui(uniforms["slot_count"], end - first)
         GL.glUniform1ui(uniforms["batch_count"], len(rows))
-        GL.glDispatchCompute(-(-(end - first) // _SHADE_GROUP), 1, 1)
+        dispatch(-(-(end - first) // _SHADE_GROUP))
 
     def _select(self, selection: SplatSelection, first: int) -> None:
         """Choose and sort `selection`'s particles on the GPU into the order's slots from `first` on, each cell's
@@ -744,7 +754,7 @@ class SplatPass:
             planes = np.array(selection.frustum, dtype=np.float64)
             planes[:, 3] += planes[:, :3] @ eye  # relative to the eye: float32 keeps their precision there
             GL.glUniform4fv(uniforms["planes"], 6, np.ascontiguousarray(planes, dtype=np.float32))
-        GL.glDispatchCompute(-(-slots // _SELECT_GROUP), 1, 1)
+        dispatch(-(-slots // _SELECT_GROUP))
         GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT)
         sort.sort(self._keys_buffer, self._values_buffer, slots)
         if cells > 1:
@@ -767,7 +777,7 @@ class SplatPass:
         GL.glUniform1ui(uniforms["range_count"], ranges)
         GL.glUniform1i(uniforms["cell_keys"], cell_keys)
         GL.glUniform1ui(uniforms["first"], first)
-        GL.glDispatchCompute(-(-slots // _SELECT_GROUP), 1, 1)
+        dispatch(-(-slots // _SELECT_GROUP))
         GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT)
 
     def _reserve_selection(self, slots: int, commands: int) -> None:

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from OpenGL import GL
 
-from cloudcore.gl.programs import build_compute_program, set_vec3
+from cloudcore.gl.programs import build_compute_program, dispatch, set_vec3
 from cloudcore.gl.splats import INSTANCE_BYTES, SplatBatch
 from cloudcore.gl.targets import blit_depth
 from cloudcore.gl.tile_binning import GpuTileBinning
@@ -112,17 +112,18 @@ class VolumeBlendingPass:
         colour_texture: int,
         depth_framebuffer: int,
         size: tuple[int, int],
-    ) -> None:
+    ) -> bool:
         """Composite a GPU-chosen draw's plain splats (`instances`: buffer, first slot, slots; `count_at`: its
         indirect command's count) over `colour_texture` as the raster blends them, binned on the GPU
-        (`cloudcore.gl.tile_binning`), cut by the depth of `depth_framebuffer`."""
+        (`cloudcore.gl.tile_binning`), cut by the depth of `depth_framebuffer`; False, nothing done, where the
+        binning would hold too many pairs (`MAX_PAIRS`): the raster's to draw."""
         if self._binning is None:
             self._binning = GpuTileBinning()
             constants = {"TILE_PIXELS": TILE_PIXELS, "SPLAT_SHARPNESS": SPLAT_SHARPNESS, "MAX_OPTICAL_DEPTH": 1.0}
             self._plain_program = build_compute_program("volume_blend", constants | {"PLAIN": 1})
         binned = self._binning.bin(instances, count_at, view, projection, size)
-        if binned is None:
-            return
+        if binned is None or not binned.pairs:
+            return binned is not None
         tiles = binned.across * binned.up
         if self._all_tiles_held < tiles:
             GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, self._all_tiles)
@@ -146,6 +147,7 @@ class VolumeBlendingPass:
             colour_texture,
             depth_framebuffer,
         )
+        return True
 
     def _composite(
         self, program, size, across, groups, instances, view, projection, colour_texture, depth_framebuffer
@@ -173,7 +175,8 @@ class VolumeBlendingPass:
         # what was drawn into the target before must be there to read
         GL.glMemoryBarrier(GL.GL_FRAMEBUFFER_BARRIER_BIT | GL.GL_SHADER_IMAGE_ACCESS_BARRIER_BIT)
         GL.glBindImageTexture(0, colour_texture, 0, GL.GL_FALSE, 0, GL.GL_READ_WRITE, GL.GL_RGBA16F)
-        GL.glDispatchCompute(groups, 1, 1)
+        GL.glUniform1ui(GL.glGetUniformLocation(program, "group_count"), groups)
+        dispatch(groups)
         # and what it wrote there, for the draws, blits and reads after it
         GL.glMemoryBarrier(
             GL.GL_FRAMEBUFFER_BARRIER_BIT | GL.GL_TEXTURE_FETCH_BARRIER_BIT | GL.GL_SHADER_IMAGE_ACCESS_BARRIER_BIT

@@ -62,16 +62,19 @@ layout(std430, binding = 7) writeonly buffer Order { uint order[]; };
 uniform bool cell_keys;  // CELL_KEYS: key each sorted slot by its cell; else ORDER: its particle into the order
 uniform uint first;      // ORDER: the order's slot of the selection's first
 
-void main()
+void resolve(uint j)
 {
-    uint j = gl_GlobalInvocationID.x;
-    if (j >= count)
-        return;
     Range range = range_of(values[j]);
     if (cell_keys)
         keys[j] = range.cell;
     else
         order[first + j] = range.start + (values[j] - range.before);
+}
+
+void main()
+{
+    for (uint j = gl_GlobalInvocationID.x; j < count; j += gl_NumWorkGroups.x * gl_WorkGroupSize.x)
+        resolve(j);
 }
 #else
 // splat_shade.comp.glsl's Particle records, PARTICLE_FLOATS floats each: only the centre and radius are read
@@ -91,11 +94,8 @@ uniform bool cull_to_frustum;
 
 const uint LEFT_OUT = 0xFFFFFFFFu;
 
-void main()
+void select(uint i)
 {
-    uint i = gl_GlobalInvocationID.x;
-    if (i >= count)
-        return;
     Range range = range_of(i);
     uint index = range.start + (i - range.before);
     uint record = index * uint(PARTICLE_FLOATS);
@@ -116,5 +116,12 @@ void main()
     } else {
         keys[i] = LEFT_OUT;
     }
+}
+
+// as many invocations as the GL dispatches, each taking every so many slots (cloudcore.gl.programs.dispatch)
+void main()
+{
+    for (uint i = gl_GlobalInvocationID.x; i < count; i += gl_NumWorkGroups.x * gl_WorkGroupSize.x)
+        select(i);
 }
 #endif

@@ -152,11 +152,9 @@ vec4 artist_colour(CloudStyle style, vec3 vertex, vec3 group_centre)
 }
 #endif
 
-void main()
+void shade(uint invocation)
 {
-    if (gl_GlobalInvocationID.x >= slot_count)
-        return;
-    uint slot = first + gl_GlobalInvocationID.x;
+    uint slot = first + invocation;
     uint low = 0u, high = batch_count - 1u;  // the last batch starting at or before the slot
     while (low < high) {
         uint middle = (low + high + 1u) / 2u;
@@ -212,4 +210,11 @@ void main()
         instances[slot].colours[k] = colour;
 #endif
     }
+}
+
+// as many invocations as the GL dispatches, each taking every so many slots (cloudcore.gl.programs.dispatch)
+void main()
+{
+    for (uint i = gl_GlobalInvocationID.x; i < slot_count; i += gl_NumWorkGroups.x * gl_WorkGroupSize.x)
+        shade(i);
 }

@@ -58,12 +58,9 @@ ivec4 tile_box(uint j)
     return ivec4(first / TILE_PIXELS, last / TILE_PIXELS);
 }
 
-void main()
+void run(uint i)
 {
-    uint i = gl_GlobalInvocationID.x;
 #ifdef STARTS
-    if (i >= pairs)
-        return;
     uint tile = pair_tiles[i];
     uint before = i == 0u ? 0u : pair_tiles[i - 1u] + 1u;
     for (uint t = before; t <= tile; ++t)
@@ -72,7 +69,7 @@ void main()
         for (uint t = tile + 1u; t <= uint(tiles_across * tiles_up); ++t)
             tile_starts[t] = pairs;
 #else
-    if (i >= slots || i >= command[count_at] / 6u)
+    if (i >= command[count_at] / 6u)
         return;
     ivec4 box = tile_box(i);
     if (box.z < box.x || box.w < box.y)
@@ -90,4 +87,16 @@ void main()
         }
 #endif
 #endif
+}
+
+// as many invocations as the GL dispatches, each taking every so many items (cloudcore.gl.programs.dispatch)
+void main()
+{
+#ifdef STARTS
+    uint items = pairs;
+#else
+    uint items = slots;
+#endif
+    for (uint i = gl_GlobalInvocationID.x; i < items; i += gl_NumWorkGroups.x * gl_WorkGroupSize.x)
+        run(i);
 }

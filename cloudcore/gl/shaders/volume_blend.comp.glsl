@@ -31,6 +31,7 @@ uniform sampler2D world_depth;  // the frame's depth, window coordinates in [0, 
 
 uniform ivec2 size;
 uniform int tiles_across;
+uniform uint group_count;  // the occupied tiles
 uniform vec3 view_right;
 uniform vec3 view_up;
 uniform vec3 view_forward;
@@ -112,9 +113,8 @@ Segment segment_of(Splat p, vec3 ray, float opaque)
     return s;
 }
 
-void main()
+void composite(uint tile)
 {
-    uint tile = occupied[gl_WorkGroupID.x];
     ivec2 pixel = TILE_PIXELS * ivec2(tile % uint(tiles_across), tile / uint(tiles_across))
                 + ivec2(gl_LocalInvocationID.xy);
     if (any(greaterThanEqual(pixel, size)))
@@ -180,4 +180,11 @@ void main()
         over_whole(image, held);
 #endif
     imageStore(target, pixel, image);
+}
+
+// as many groups as the GL dispatches, each taking every so many tiles (cloudcore.gl.programs.dispatch)
+void main()
+{
+    for (uint group = gl_WorkGroupID.x; group < group_count; group += gl_NumWorkGroups.x)
+        composite(occupied[group]);
 }
