@@ -484,7 +484,9 @@ def the_gpu_sorts_the_splats_in_the_window(ctx, app: EditorUnderTest):
     app.outcome["compute_compositing_psnr_db"] = compare(on_gpu, composited).psnr_db
     CHECK(composited_stats.particles_drawn == gpu_stats.particles_drawn)
     CHECK(bool(compare(on_gpu, composited).psnr_db > 50.0))
-    ctx.combo_click("Compositing/raster")
+    ctx.combo_click("Compositing/auto")
+    ctx.yield_(SETTLE)
+    CHECK(app.editor.last_stats.frame.compositing == "raster")  # "auto" on llvmpipe: the raster, untried
     ctx.combo_click("Splat order/auto")
     ctx.yield_(SETTLE)
     CHECK(app.editor.last_stats.frame.splat_order == "cpu")

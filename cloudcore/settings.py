@@ -24,11 +24,11 @@ TRANSLATION_METRICS = ("parallax", "centre")
 #: how full-3D splats are composited (`cloudcore.light.volume_blending`)
 BLENDINGS = ("plain", "volume")
 #: where full-3D draws and impostor regenerations choose and order their particles (`cloudcore.gl.splats`; "auto":
-#: `cloudcore.lod.splat_order`)
+#: `cloudcore.lod.measured_way`)
 SPLAT_ORDERS = ("auto", "cpu", "gpu")
 #: what composites full 3D's plain splats chosen on the GPU: the raster, or a compute pass over screen tiles
-#: binned on the GPU (`cloudcore.gl.tile_binning`)
-COMPOSITINGS = ("raster", "compute")
+#: binned on the GPU (`cloudcore.gl.tile_binning`); "auto": `cloudcore.lod.measured_way`, per mode
+COMPOSITINGS = ("auto", "raster", "compute")
 
 
 @dataclass(frozen=True)
@@ -232,7 +232,7 @@ class RenderSettings:
     #: "cpu": a draw's particles are chosen and sorted far to near in numpy and their order uploaded; "gpu":
     #: chosen, sorted and counted by compute shaders, drawn as quads by an indirect draw, so that the CPU's
     #: work for a draw does not grow with its particles; "auto": the one measured faster on this GL
-    #: (`cloudcore.lod.splat_order`: on llvmpipe the CPU's, whose sort is 30-40 times faster, the frame 1.65)
+    #: (`cloudcore.lod.measured_way`: on llvmpipe the CPU's, whose sort is 30-40 times faster, the frame 1.65)
     splat_order: str = _setting(
         "auto",
         flag="--splat-order",
@@ -244,13 +244,14 @@ class RenderSettings:
 
     #: "raster": full 3D's splats drawn as quads and blended by the raster; "compute": those chosen on the GPU
     #: (`splat_order` "gpu") and plain, composited the same way by a compute pass over screen tiles binned on the
-    #: GPU, for chips whose raster is a small part of them (on an H200 the raster of the default view's splats
-    #: took 16.5 ms, the tiled compute pass of volume blending, which does more, 8.6)
+    #: GPU, for chips whose raster is a small part of them (on an H200, full 3D at 640x480: 7.4 ms of GPU against
+    #: the raster's 17.5); "auto": the one measured faster here, per mode (the raster on llvmpipe, untried)
     compositing: str = _setting(
-        "raster",
+        "auto",
         flag="--compositing",
         help="raster: full-3D splats blended by the raster; compute: those sorted on the GPU composited by a "
-        "compute pass over screen tiles instead (the same picture; faster where the raster is small)",
+        "compute pass over screen tiles instead (the same picture; faster where the raster is small); auto: the "
+        "one measured faster here (the raster on llvmpipe)",
         choices=COMPOSITINGS,
         label="Compositing",
     )

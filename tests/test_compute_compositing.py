@@ -16,7 +16,7 @@ from cloudcore.resources import resource_path
 from cloudcore.scenefile import load_scene
 from cloudcore.settings import RenderSettings
 
-RASTER = RenderSettings(mode="full", splat_order="gpu")
+RASTER = RenderSettings(mode="full", splat_order="gpu", compositing="raster")
 COMPUTE = dataclasses.replace(RASTER, compositing="compute")
 VOLUME = RenderSettings(mode="full", blending="volume")
 
@@ -38,7 +38,10 @@ def test_the_compute_pass_composites_the_rasters_picture(renderer, valley, view)
     difference = compare(raster, composited)
     assert difference.within(min_psnr_db=50.0, max_abs=1), f"{view}: {difference}"
     assert stats.particles_drawn == raster_stats.particles_drawn > 0
-    assert compare(raster, renderer.render(valley, camera=camera, settings=RenderSettings(mode="full"))[0]).psnr_db > 60
+    assert (raster_stats.compositing, stats.compositing) == ("raster", "compute")
+    on_cpu, cpu_stats = renderer.render(valley, camera=camera, settings=RenderSettings(mode="full"))
+    assert compare(raster, on_cpu).psnr_db > 60
+    assert cpu_stats.compositing == ""  # sorted on the CPU: nothing either way could composite
 
 
 def test_layers_split_around_an_object_composite_as_the_raster_draws_them(renderer):

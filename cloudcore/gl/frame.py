@@ -54,7 +54,7 @@ from cloudcore.light.volume_blending import blending_path, screen_tiles
 from cloudcore.lod.costs import CostModel
 from cloudcore.lod.frameplan import FramePlan, LodState, inside_runs, plan_frame
 from cloudcore.lod.impostors import cropped_corners, particle_extent
-from cloudcore.lod.splat_order import SplatOrderChoice
+from cloudcore.lod.measured_way import COMPOSITING_WAYS, MeasuredWay
 from cloudcore.lod.units import LodUnits, lod_units
 from cloudcore.measure.frame_stats import FrameStats
 from cloudcore.measure.overdraw import Overdraw, analytic_overdraw, overdraw_statistics
@@ -78,7 +78,7 @@ class _CloudPassFrame:
     point_sprites: bool  # the setting: draw plain splats as points where the picture is the same
     blending: str  # the setting: full-3D splats as billboards ("plain") or as volumes ("volume")
     splat_order: str  # splats chosen and sorted on the "cpu" or the "gpu" (the setting, "auto" resolved)
-    compositing: str  # the setting: the GPU's plain full-3D splats blended by the "raster" or by "compute"
+    compositing: str  # the GPU's plain full-3D splats blended by the "raster" or by "compute" ("auto" resolved)
 
     @property
     def eye(self) -> np.ndarray:
@@ -110,7 +110,11 @@ class FrameRenderer:
         self._key_serial = 0
         #: the level of detail's state between frames (impostor cache, ring, representations, costs)
         self.lod_state = LodState()
-        self.splat_order = SplatOrderChoice()  # where draws and regenerations sort, measured (settings' "auto")
+        self.splat_order = MeasuredWay()  # where draws and regenerations sort, measured (settings' "auto")
+        #: per mode, what composites the GPU's plain full-3D splats, measured (settings' "auto"): on the H200 the
+        #: compute pass won in full 3D and lost in auto mode, whose full-3D draws are a few near clouds
+        self.compositing: dict[str, MeasuredWay] = {}
+        self._compositable = 0  # this frame's particles in draws either way could composite
         #: the cloud field's cells made for the last eye, and its particles' blend weights (None: no field)
         self.field_state = FieldState()
         self._field_weights: np.ndarray | None = None
@@ -220,17 +224,24 @@ class FrameRenderer:
                 self._objects.draw(
                     self.context, camera, poses, plan.objects_with_world, write_depth=True, antialiased=antialiased
                 )
-        way = self.splat_order.way(settings.splat_order, self._volume.features.renderer)
+        gl_renderer = self._volume.features.renderer
+        way = self.splat_order.way(settings.splat_order, gl_renderer)
+        compositing = self.compositing.get(settings.mode, MeasuredWay(COMPOSITING_WAYS))
+        composited_by = compositing.way(settings.compositing, gl_renderer)
+        self._compositable = 0
         with clock.timed("impostor updates"):
             rendered = self._impostors.update(plan, particles, settings, time_s, way)
         with clock.timed("clouds"):
             self.context.bind_target()
-            drawn = self._draw_clouds(plan, particles, camera, view, projection, settings, poses, time_s, way)
+            drawn = self._draw_clouds(
+                plan, particles, camera, view, projection, settings, poses, time_s, way, composited_by
+            )
         drawn_by_gpu, rendered_by_gpu = self._splats.take_selected()
         drawn, rendered = drawn + drawn_by_gpu, rendered + rendered_by_gpu
         world, updates, clouds = (clock.times[name] for name in ("world", "impostor updates", "clouds"))
         self.lod_state = plan.state.measured([(plan.update_work, updates.wall_ms), (plan.cloud_work, clouds.wall_ms)])
         self.splat_order = self.splat_order.observe(way, updates.wall_ms + clouds.wall_ms, drawn + rendered)
+        self.compositing[settings.mode] = compositing.observe(composited_by, clouds.wall_ms, self._compositable)
         stats = FrameStats(
             plan=plan.stats(),
             illumination_ms=illumination_ms,
@@ -247,6 +258,7 @@ class FrameRenderer:
             particles_as_points=self._splats.particles_as_points,
             particles_as_volumes=self._particles_as_volumes,
             splat_order=way,
+            compositing=composited_by if self._compositable else "",
             particles_to_impostors=rendered,
             clouds_drawn=sum(len(plan.clouds[i].members) for i in plan.draw_order),
             texture_bytes=self.texture_bytes,
@@ -368,9 +380,11 @@ class FrameRenderer:
         poses,
         time_s: float,
         splat_order: str,
+        compositing: str,
     ) -> int:
         """Execute the plan's cloud pass into the frame target at scene time `time_s`, one method per draw kind,
-        full-3D draws sorted the way `splat_order` ("cpu" or "gpu"); returns the particles drawn."""
+        full-3D draws sorted the way `splat_order` ("cpu" or "gpu"), the GPU's plain ones composited the way
+        `compositing` ("raster" or "compute"); returns the particles drawn."""
         view_projection = projection @ view
         frame = _CloudPassFrame(
             plan,
@@ -385,7 +399,7 @@ class FrameRenderer:
             settings.point_sprites,
             settings.blending,
             splat_order,
-            settings.compositing,
+            compositing,
         )
         self._replay, self._screen_batches = [], []
         steps = self._cloud_pass_steps(frame)
@@ -473,11 +487,9 @@ class FrameRenderer:
         view, projection, points = frame.view, frame.projection, frame.point_sprites
         if isinstance(batch, SplatSelection):
             composited = False
-            if (
-                frame.compositing == "compute"
-                and self._volume.features.compute_shaders
-                and self._splats.plain_selection(batch)
-            ):
+            compositable = self._volume.features.compute_shaders and self._splats.plain_selection(batch)
+            self._compositable += batch.slots if compositable else 0
+            if frame.compositing == "compute" and compositable:
                 instances, count_at = self._splats.selected_instances(batch, view)
                 target = self.context.colour_texture if colour_texture is None else colour_texture
                 composited = self._volume.draw_plain(

@@ -109,8 +109,9 @@ def _interleaved_rows(
             renderer, settings = runs[index]
             images[index], stats = renderer.render(scene, camera=camera, settings=settings, time_s=time_s)
             numbers = {k: v for k, v in stats.as_dict().items() if isinstance(v, (int, float))}
-            # which way the frame sorted ("cpu" or "gpu"): what a GPU's "auto" trial kept is read off the report
-            rows[index].append({"frame": frame, **numbers, "splat_order": stats.splat_order})
+            # which ways the frame took: what a GPU's "auto" trials kept is read off the report
+            ways = {"splat_order": stats.splat_order, "compositing": stats.compositing}
+            rows[index].append({"frame": frame, **numbers, **ways})
             if progress is not None:
                 progress()
         for index in range(1, len(runs)):

@@ -70,6 +70,7 @@ class FrameStats:
     particles_as_points: int = 0  # of those and of the regenerations', drawn as point sprites
     particles_as_volumes: int = 0  # of those on the screen, composited as volumes (blending = "volume")
     splat_order: str = ""  # where full-3D draws and regenerations chose and sorted theirs: "cpu" or "gpu"
+    compositing: str = ""  # what composited the GPU's plain full-3D splats: "raster", "compute" ("": none drawn)
     particles_to_impostors: int = 0
     clouds_drawn: int = 0
     texture_bytes: int = 0
