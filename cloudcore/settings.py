@@ -18,6 +18,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, fields
 
+from cloudcore.lod.measured_way import COMPOSITING_WAYS, SPLAT_ORDER_WAYS
+
 MODES = ("auto", "full", "impostor")
 #: the names of `cloudcore.lod.impostors.TRANSLATION_METRICS` (kept here so settings import no geometry)
 TRANSLATION_METRICS = ("parallax", "centre")
@@ -25,10 +27,10 @@ TRANSLATION_METRICS = ("parallax", "centre")
 BLENDINGS = ("plain", "volume")
 #: where full-3D draws and impostor regenerations choose and order their particles (`cloudcore.gl.splats`; "auto":
 #: `cloudcore.lod.measured_way`)
-SPLAT_ORDERS = ("auto", "cpu", "gpu")
+SPLAT_ORDERS = ("auto", *SPLAT_ORDER_WAYS)
 #: what composites full 3D's plain splats chosen on the GPU: the raster, or a compute pass over screen tiles
 #: binned on the GPU (`cloudcore.gl.tile_binning`); "auto": `cloudcore.lod.measured_way`, per mode
-COMPOSITINGS = ("auto", "raster", "compute")
+COMPOSITINGS = ("auto", *COMPOSITING_WAYS)
 
 
 @dataclass(frozen=True)

@@ -83,3 +83,8 @@ class GpuDepthSort:
         for program in self._programs.values():
             GL.glDeleteProgram(program)
         GL.glDeleteBuffers(len(self._buffers), list(self._buffers))
+
+
+def key_bits_for(largest: int) -> int:
+    """The fewest bits `GpuDepthSort.sort` takes (whole bytes) for keys up to `largest`."""
+    return 8 * max(1, -(-max(int(largest), 1).bit_length() // 8))

@@ -35,7 +35,7 @@ from cloudcore.artist.sprites import ATLAS_MAX_MIP_LEVEL, load_atlas
 from cloudcore.camera import splats_in_frustum
 from cloudcore.cloud_records import ATLAS_GRID
 from cloudcore.gl.blending import cloud_blending
-from cloudcore.gl.depth_sort import GpuDepthSort
+from cloudcore.gl.depth_sort import GpuDepthSort, key_bits_for
 from cloudcore.gl.programs import (
     build_compute_program,
     build_program,
@@ -759,7 +759,7 @@ class SplatPass:
         sort.sort(self._keys_buffer, self._values_buffer, slots)
         if cells > 1:
             self._resolve(slots, len(clouds), cell_keys=True)
-            sort.sort(self._keys_buffer, self._values_buffer, slots, key_bits=8 if cells <= 256 else 16)
+            sort.sort(self._keys_buffer, self._values_buffer, slots, key_bits=key_bits_for(cells - 1))
         self._resolve(slots, len(clouds), cell_keys=False, first=first)
 
     def _resolve(self, slots: int, ranges: int, cell_keys: bool, first: int = 0) -> None:

@@ -20,7 +20,7 @@ import numpy as np
 from OpenGL import GL
 
 from cloudcore.camera import NEAR_PLANE_M
-from cloudcore.gl.depth_sort import GpuDepthSort
+from cloudcore.gl.depth_sort import GpuDepthSort, key_bits_for
 from cloudcore.gl.programs import build_compute_program, dispatch, set_matrix_at, uniform_locations
 from cloudcore.gl.splats import INSTANCE_BYTES, reallocate_storage
 from cloudcore.light.volume_blending import TILE_PIXELS
@@ -74,8 +74,9 @@ class GpuTileBinning:
         than `MAX_PAIRS` (the raster draws those)."""
         buffer, first, slots = instances
         across, up = -(-size[0] // TILE_PIXELS), -(-size[1] // TILE_PIXELS)
+        empty = BinnedTiles(tuple(size), across, up, self._starts, self._slots, 0)
         if not slots:
-            return BinnedTiles(tuple(size), across, up, self._starts, self._slots, 0)
+            return empty
         GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, self._counter)
         GL.glBufferData(GL.GL_SHADER_STORAGE_BUFFER, 8, np.zeros(2, dtype=np.uint32), GL.GL_STREAM_COPY)
         GL.glBindBufferRange(
@@ -89,15 +90,15 @@ class GpuTileBinning:
         GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, self._counter)
         pairs = int(np.frombuffer(GL.glGetBufferSubData(GL.GL_SHADER_STORAGE_BUFFER, 0, 4), dtype=np.uint32)[0])
         if not pairs or pairs > MAX_PAIRS:
-            return None if pairs else BinnedTiles(tuple(size), across, up, self._starts, self._slots, 0)
+            return None if pairs else empty
         self._reserve(pairs, across * up + 1)
         GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _PAIR_SLOTS, self._slots)
         GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _PAIR_TILES, self._tiles)
         self._dispatch("EMIT", slots, count_at[1], view, projection, size, (across, up))
         GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT)
         # by slot (far to near), then stably by tile: each tile's run keeps the draw's order
-        self._sort.sort(self._slots, self._tiles, pairs, key_bits=_whole_bytes(slots - 1))
-        self._sort.sort(self._tiles, self._slots, pairs, key_bits=_whole_bytes(across * up - 1))
+        self._sort.sort(self._slots, self._tiles, pairs, key_bits=key_bits_for(slots - 1))
+        self._sort.sort(self._tiles, self._slots, pairs, key_bits=key_bits_for(across * up - 1))
         GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT)
         GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _PAIR_TILES, self._tiles)
         GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _TILE_STARTS, self._starts)
@@ -150,8 +151,3 @@ class GpuTileBinning:
             GL.glDeleteProgram(program)
         GL.glDeleteBuffers(len(self._buffers), list(self._buffers))
         self._sort.close()
-
-
-def _whole_bytes(largest: int) -> int:
-    """The bits of the radix sort's keys up to `largest`: whole bytes, as the sort takes them."""
-    return 8 * max(1, -(-max(int(largest), 1).bit_length() // 8))

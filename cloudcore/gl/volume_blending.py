@@ -27,6 +27,8 @@ from cloudcore.light.volume_blending import MAX_OPTICAL_DEPTH, TILE_PIXELS, Scre
 _TILE_STARTS_BINDING, _TILE_ENTRIES_BINDING, _OCCUPIED_BINDING = 6, 7, 8
 #: the instances' binding, as `cloudcore.gl.splats` writes them
 _INSTANCES_BINDING = 3
+#: volume_blend.comp.glsl's constants, both variants'
+_CONSTANTS = {"TILE_PIXELS": TILE_PIXELS, "SPLAT_SHARPNESS": SPLAT_SHARPNESS, "MAX_OPTICAL_DEPTH": MAX_OPTICAL_DEPTH}
 
 
 @dataclass(frozen=True)
@@ -60,11 +62,9 @@ class VolumeBlendingPass:
         self.features = GpuFeatures.query()
         self._program = self._plain_program = None
         if self.features.compute_shaders:
-            constants = {"TILE_PIXELS": TILE_PIXELS, "SPLAT_SHARPNESS": SPLAT_SHARPNESS}
-            self._program = build_compute_program("volume_blend", constants | {"MAX_OPTICAL_DEPTH": MAX_OPTICAL_DEPTH})
-        self._buffers = self._starts, self._entries, self._occupied, self._all_tiles = GL.glGenBuffers(4)
+            self._program = build_compute_program("volume_blend", _CONSTANTS)
+        self._buffers = self._starts, self._entries, self._occupied = GL.glGenBuffers(3)
         self._binning: GpuTileBinning | None = None  # made with the plain program, when first needed
-        self._all_tiles_held = 0  # how many tiles `_all_tiles` lists, 0 to n - 1: a binned draw's groups
         self._depth: tuple[int, int, tuple[int, int]] | None = None  # (texture, framebuffer, size)
 
     def draw(
@@ -119,28 +119,17 @@ class VolumeBlendingPass:
         binning would hold too many pairs (`MAX_PAIRS`): the raster's to draw."""
         if self._binning is None:
             self._binning = GpuTileBinning()
-            constants = {"TILE_PIXELS": TILE_PIXELS, "SPLAT_SHARPNESS": SPLAT_SHARPNESS, "MAX_OPTICAL_DEPTH": 1.0}
-            self._plain_program = build_compute_program("volume_blend", constants | {"PLAIN": 1})
+            self._plain_program = build_compute_program("volume_blend", _CONSTANTS | {"PLAIN": 1})
         binned = self._binning.bin(instances, count_at, view, projection, size)
         if binned is None or not binned.pairs:
             return binned is not None
-        tiles = binned.across * binned.up
-        if self._all_tiles_held < tiles:
-            GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, self._all_tiles)
-            every = np.arange(tiles, dtype=np.uint32)
-            GL.glBufferData(GL.GL_SHADER_STORAGE_BUFFER, every.nbytes, every, GL.GL_STATIC_DRAW)
-            self._all_tiles_held = tiles
-        for binding, buffer in (
-            (_TILE_STARTS_BINDING, binned.starts),
-            (_TILE_ENTRIES_BINDING, binned.entries),
-            (_OCCUPIED_BINDING, self._all_tiles),
-        ):
-            GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, binding, buffer)
+        GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _TILE_STARTS_BINDING, binned.starts)
+        GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _TILE_ENTRIES_BINDING, binned.entries)
         self._composite(
             self._plain_program,
             binned.size,
             binned.across,
-            tiles,
+            binned.across * binned.up,
             instances,
             view,
             projection,
@@ -152,8 +141,8 @@ class VolumeBlendingPass:
     def _composite(
         self, program, size, across, groups, instances, view, projection, colour_texture, depth_framebuffer
     ) -> None:
-        """Run a compositing `program` over `groups` tiles (the occupied buffer's first), its tile buffers
-        bound, the instances (buffer, first slot, count) bound here."""
+        """Run a compositing `program` over `groups` tiles (the occupied buffer's first; the plain program's: the
+        screen's first), its tile buffers bound, the instances (buffer, first slot, count) bound here."""
         bound = GL.glGetIntegerv(GL.GL_DRAW_FRAMEBUFFER_BINDING)
         depth_texture = self._world_depth(depth_framebuffer, size)
         GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, int(bound))

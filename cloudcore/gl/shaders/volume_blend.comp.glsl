@@ -31,7 +31,7 @@ uniform sampler2D world_depth;  // the frame's depth, window coordinates in [0, 
 
 uniform ivec2 size;
 uniform int tiles_across;
-uniform uint group_count;  // the occupied tiles
+uniform uint group_count;  // the occupied tiles (PLAIN: all the screen's)
 uniform vec3 view_right;
 uniform vec3 view_up;
 uniform vec3 view_forward;
@@ -186,5 +186,9 @@ void composite(uint tile)
 void main()
 {
     for (uint group = gl_WorkGroupID.x; group < group_count; group += gl_NumWorkGroups.x)
+#ifdef PLAIN
+        composite(group);  // every tile: the binned ones are all the screen's
+#else
         composite(occupied[group]);
+#endif
 }
