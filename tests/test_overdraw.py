@@ -3,8 +3,15 @@
 import numpy as np
 import pytest
 
-from cloudcore.camera import NEAR_PLANE_M, projection_matrix, view_matrix
-from cloudcore.measure.overdraw import Overdraw, analytic_overdraw, overdraw_statistics
+from cloudcore.camera import (
+    FAR_PLANE_M,
+    NEAR_PLANE_M,
+    frustum_planes,
+    projection_matrix,
+    splats_in_frustum,
+    view_matrix,
+)
+from cloudcore.measure.overdraw import Overdraw, analytic_overdraw, overdraw_statistics, splats_in_view
 from cloudcore.scene import Camera, Cloud, Scene
 from cloudcore.settings import FULL_3D
 
@@ -60,3 +67,26 @@ def test_analytic_overdraw_counts_only_the_part_on_screen():
     centred = analytic_overdraw(np.zeros((1, 3)), np.array([50.0]), view, projection, NEAR_PLANE_M)
     on_edge = analytic_overdraw(np.array([[edge, 0.0, 0.0]]), np.array([50.0]), view, projection, NEAR_PLANE_M)
     assert on_edge == pytest.approx(centred / 2)
+
+
+def test_splats_in_view_keeps_what_the_frustum_keeps_and_estimates_those():
+    """The planner's one-transform cull and estimate against the world-space cull and `analytic_overdraw`:
+    splats round the eye, behind it, astride the near plane, past the far plane and along every side."""
+    rng = np.random.default_rng(3)
+    camera = Camera((100.0, 50.0, 900.0), (0.0, 30.0, 0.0), 50.0)
+    view, projection = view_matrix(camera), projection_matrix(camera.fov_y_deg, 16 / 9)
+    eye, forward = np.array(camera.position), np.array(camera.look_at) - np.array(camera.position)
+    forward /= np.linalg.norm(forward)
+    centres = np.concatenate(
+        [
+            eye + rng.normal(scale=300.0, size=(4000, 3)),
+            eye + forward * rng.uniform(FAR_PLANE_M - 50.0, FAR_PLANE_M + 50.0, size=(200, 1)),
+            eye + forward * rng.uniform(-1.0, 2.0 * NEAR_PLANE_M, size=(200, 1)),
+        ]
+    )
+    radii = rng.uniform(0.0, 60.0, size=len(centres))
+    kept = splats_in_frustum(frustum_planes(projection @ view), centres, radii)
+    assert 0 < np.count_nonzero(kept) < len(radii)
+    count, overdraw = splats_in_view(centres, radii, view, projection)
+    assert count == np.count_nonzero(kept)
+    assert overdraw == pytest.approx(analytic_overdraw(centres[kept], radii[kept], view, projection, NEAR_PLANE_M))

@@ -19,12 +19,13 @@ screen asks for.
 from __future__ import annotations
 
 import math
+import sys
 from collections.abc import Hashable
 from dataclasses import dataclass
 
 import numpy as np
 
-from cloudcore.camera import camera_pose, pose_to_view, projection_matrix
+from cloudcore.camera import camera_pose, points_in_eye_space, pose_to_view, projection_matrix
 from cloudcore.scene import Camera
 
 #: an impostor texture at least this many times finer than needed is remade smaller (saves memory;
@@ -96,7 +97,7 @@ def particle_extent(
     """
     if len(radii) == 0:
         return (0.0, 0.0, 0.0, 0.0)
-    eye_space = centres @ view[:3, :3].T + view[:3, 3]
+    eye_space = points_in_eye_space(centres, view)
     depth = -eye_space[:, 2]
     if not np.all(depth - radii > 0.0):
         return (0.0, 0.0, 1.0, 1.0)
@@ -127,7 +128,9 @@ def cropped_corners(corners: np.ndarray, extent) -> np.ndarray:
 
 def _tangent(radius: float, distance: float) -> float:
     """Half side of the impostor quad of a sphere seen from `distance` (> radius), over that distance."""
-    return radius / math.sqrt(max((distance - radius) * (distance + radius), np.finfo(float).tiny))
+    # the smallest normal float (np.finfo's tiny) from sys: np.finfo builds an object per call, and the planner
+    # asks for every unit it draws
+    return radius / math.sqrt(max((distance - radius) * (distance + radius), sys.float_info.min))
 
 
 def quad_half_side(radius: float, distance: float) -> float:
