@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from cloudcore.ramps import smoothstep
-from cloudcore.vectors import unit_rows
+from cloudcore.vectors import row_lengths, unit_rows
 
 #: Wang: lock "when the camera comes within half of the sprite radius"
 LOCK_RADII = 0.5
@@ -113,7 +113,7 @@ class FacingLocks:
         with np.errstate(over="ignore"):
             # a sprite this far is never locked; clipping keeps the squares below finite
             offsets = np.clip(eye - centres, -_FAR, _FAR)
-        distances = np.sqrt(np.einsum("ij,ij->i", offsets, offsets))
+        distances = row_lengths(offsets)
         at_centre = distances == 0.0
         directions = offsets / np.where(at_centre, 1.0, distances)[:, None]
         directions[at_centre] = self._directions[at_centre]

@@ -50,6 +50,7 @@ from cloudcore.light.phase import PHASE_NAMES
 from cloudcore.limits import MAX_LIGHTS
 from cloudcore.lod.depth_order import far_to_near
 from cloudcore.point_sprites import draw_runs, guard_band, plain_splats, point_sprite_mask
+from cloudcore.vectors import row_lengths
 
 #: two triangles over a particle's four corners (lower left, lower right, upper left, upper right)
 _QUAD_TRIANGLES = np.array([0, 1, 2, 2, 1, 3], dtype=np.uint32)
@@ -203,7 +204,7 @@ def splat_batch(
     centres = np.concatenate([particles.centres[piece] for piece in pieces]) if pieces else np.zeros((0, 3))
     eye = np.asarray(eye, dtype=np.float64)
     offsets = centres - eye
-    distances = np.sqrt(np.einsum("ij,ij->i", offsets, offsets))
+    distances = row_lengths(offsets)
     kept = particles.drawn(indices, distances, time_s)
     if depth_ranges is not None:
         near = np.repeat([r[0] for r in depth_ranges], counts)

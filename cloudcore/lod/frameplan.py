@@ -87,6 +87,7 @@ from cloudcore.measure.frame_stats import PlanStats
 from cloudcore.measure.overdraw import splats_in_view
 from cloudcore.scene import Camera
 from cloudcore.settings import RenderSettings
+from cloudcore.vectors import row_lengths
 
 KINDS = ("empty", "culled", "ring", "full", "crossfade", "impostor", "inside")
 #: kinds that draw from an impostor texture kept in the cache
@@ -927,7 +928,7 @@ def _in_view_work(units: LodUnits, chosen, planes, eye, focal_px, screen_pixels,
     seen = np.flatnonzero(splats_in_frustum(planes, centres, radii))
     owners, centres, radii, weights = owners[seen], centres[seen], radii[seen], weights[seen]
     offsets = centres - eye
-    depths = np.maximum(np.sqrt(np.einsum("ij,ij->i", offsets, offsets)), radii)
+    depths = np.maximum(row_lengths(offsets), radii)
     discs = np.minimum(math.pi * np.square(focal_px * radii / depths), screen_pixels)
     count = len(indices)
     particles += np.bincount(owners, weights=weights, minlength=count)

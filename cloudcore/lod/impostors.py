@@ -27,6 +27,7 @@ import numpy as np
 
 from cloudcore.camera import camera_pose, points_in_eye_space, pose_to_view, projection_matrix
 from cloudcore.scene import Camera
+from cloudcore.vectors import row_lengths
 
 #: an impostor texture at least this many times finer than needed is remade smaller (saves memory;
 #: the factor keeps a cloud at a steady distance from flipping between two sizes)
@@ -230,7 +231,7 @@ def parallax_errors_deg(centres, radii, eyes_then, eye_now) -> np.ndarray:
     then = np.asarray(eyes_then, dtype=np.float64)
     now = np.asarray(eye_now, dtype=np.float64)
     axis = centres - then
-    distances = np.sqrt(np.einsum("ij,ij->i", axis, axis))
+    distances = row_lengths(axis)
     outside = distances > radii  # False for NaN
     with np.errstate(divide="ignore", invalid="ignore"):
         axis /= np.where(outside, distances, 1.0)[:, None]

@@ -18,6 +18,8 @@ import math
 
 import numpy as np
 
+from cloudcore.vectors import row_lengths
+
 
 def objects_reaching(
     cloud_centres: np.ndarray, cloud_radii: np.ndarray, object_centres: np.ndarray, object_radii: np.ndarray
@@ -42,7 +44,7 @@ def layer_of(distances: np.ndarray, splits) -> np.ndarray:
 
 def layer_counts(centres: np.ndarray, eye, splits) -> tuple[int, ...]:
     """Particles in each of the len(splits)+1 layers, seen from `eye`."""
-    distances = np.linalg.norm(centres - np.asarray(eye, dtype=np.float64), axis=1)
+    distances = row_lengths(np.asarray(centres, dtype=np.float64) - np.asarray(eye, dtype=np.float64))
     return tuple(int(c) for c in np.bincount(layer_of(distances, splits), minlength=len(splits) + 1))
 
 
@@ -60,7 +62,7 @@ def layers_hold(
     """
     eye = np.asarray(eye, dtype=np.float64)
     offsets = np.asarray(centres, dtype=np.float64) - eye
-    distances = np.linalg.norm(offsets, axis=1)
+    distances = row_lengths(offsets)
     radii = np.asarray(radii, dtype=np.float64)
     tiny = np.finfo(np.float64).tiny
     for centre, radius, split in zip(np.asarray(object_centres, dtype=np.float64), object_radii, splits):
