@@ -48,7 +48,11 @@ class RenderTargets:
         self.framebuffer = _framebuffer(self.colour_texture, self.depth_renderbuffer)
         self.world_texture = _texture(self.width, self.height, GL.GL_RGBA8)
         self.world_framebuffer = _framebuffer(self.world_texture, self.depth_renderbuffer)
+        # the world's scene and the objects' each have a pyrender renderer: a renderer frees the meshes of every
+        # scene but the one it draws (`Renderer._update_context`), so one renderer for both deleted and uploaded
+        # the terrain and the objects again every frame
         self._pyrender = _RendererIntoFramebuffer(self.width, self.height)
+        self._pyrender_objects = _RendererIntoFramebuffer(self.width, self.height)
         #: (framebuffer, colour and depth renderbuffers) with 4 samples, made by the first antialiased render
         self._multisampled: tuple[int, list[int]] | None = None
 
@@ -82,8 +86,9 @@ class RenderTargets:
         self.make_current()
         destination = self.world_framebuffer if framebuffer is None else framebuffer
         drawn_into = self._multisampled_framebuffer() if antialiased else destination
-        self._pyrender.target_framebuffer = drawn_into
-        self._pyrender.render(scene, flags)
+        renderer = self._pyrender if framebuffer is None else self._pyrender_objects
+        renderer.target_framebuffer = drawn_into
+        renderer.render(scene, flags)
         if antialiased:
             GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, drawn_into)
             GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, destination)
@@ -126,6 +131,7 @@ class RenderTargets:
 
     def close_targets(self) -> None:
         self._pyrender.delete()
+        self._pyrender_objects.delete()
         GL.glDeleteFramebuffers(2, [self.framebuffer, self.world_framebuffer])
         GL.glDeleteRenderbuffers(1, [self.depth_renderbuffer])
         GL.glDeleteTextures([self.colour_texture, self.world_texture])
