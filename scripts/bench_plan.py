@@ -7,9 +7,11 @@ Each case of `bench_lod.py` is rendered once per mode (full 3D, impostor mode, a
 and the particles.  The frames after the case's warm-up are then planned again, alone, in passes taking
 turns: a pass plans every frame once.  `--against REV` takes `cloudcore/lod/frameplan.py` of a git revision
 beside the working tree's, on the same inputs, the two taking turns pass by pass (what a change to the
-planner saves, without the noise of two runs; the other modules are the working tree's for both).  Reports
-the median and the least of each way's passes, in ms a frame.  Nothing is drawn while it times: on the
-GPU's machine the planner is what auto mode costs over impostor mode (docs/performance.md).
+planner saves, without the noise of two runs; the other modules are the working tree's for both), and
+counts the frames whose plans differ between the two in any field (`plans_differing`: 0 for a change
+meant only to be faster).  Reports the median and the least of each way's passes, in ms a frame.  Nothing
+is drawn while it times: on the GPU's machine the planner is what auto mode costs over impostor mode
+(docs/performance.md).
 """
 
 from __future__ import annotations
@@ -84,6 +86,15 @@ def timed_passes(planners: dict, calls: list) -> dict:
     return times
 
 
+def plans_differing(planners: dict, calls: list) -> int:
+    """How many of `calls` the planners plan differently (their plans' reprs, every field, compared)."""
+    first, *others = planners.values()
+    return sum(
+        any(repr(other(*arguments, **keywords)) != repr(first(*arguments, **keywords)) for other in others)
+        for arguments, keywords in calls
+    )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cases", default="flythrough")
@@ -99,6 +110,7 @@ def main() -> None:
         views = views[: warmup + args.frames]
         for mode in MODES:
             calls = captured_calls(scene, views, size, warmup, mode)
+            differing = plans_differing(planners, calls) if args.against else None
             for planner, times in timed_passes(planners, calls).items():
                 row = {
                     "case": name,
@@ -107,11 +119,12 @@ def main() -> None:
                     "frames": len(calls),
                     "plan_ms_median": float(np.median(times)),
                     "plan_ms_least": float(np.min(times)),
+                    "plans_differing": differing,
                 }
                 rows.append(row)
                 print(
                     f"{name} {mode:8s} {planner}: {row['plan_ms_median']:.3f} ms a frame"
-                    f" (least {row['plan_ms_least']:.3f})",
+                    f" (least {row['plan_ms_least']:.3f})" + (f", {differing} plans differ" if args.against else ""),
                     file=sys.stderr,
                     flush=True,
                 )
