@@ -79,7 +79,8 @@ class RenderTargets:
     def render_pyrender_scene(self, scene, flags, framebuffer: int | None = None, *, antialiased: bool = False):
         """Render a pyrender scene: its depth into the target's depth, its colour into `world_texture`.
 
-        Or both into `framebuffer` (colour RGBA8, depth DEPTH_COMPONENT24), the objects' target.  With
+        Or both into `framebuffer` (colour RGBA8, depth DEPTH_COMPONENT24), the objects' target, by the objects'
+        own pyrender renderer (the world's scene and theirs would evict each other's meshes from one).  With
         `antialiased`, into a 4x multisampled framebuffer first, resolved into the destination (the
         depth takes one sample per pixel, as a resolve of depth does).
         """
