@@ -82,7 +82,7 @@ from cloudcore.lod.ring import (
     ring_members,
     segment_texture_size,
 )
-from cloudcore.lod.splitting import layer_bounds, layer_counts, layer_sort_key, layers_hold, objects_reaching
+from cloudcore.lod.splitting import layer_bounds, layer_sort_key, layers_hold, objects_reaching
 from cloudcore.lod.units import LodUnits
 from cloudcore.measure.frame_stats import PlanStats
 from cloudcore.measure.overdraw import splats_in_view
@@ -133,7 +133,6 @@ class CloudPlan(NamedTuple):
     texture_size: int = 0  # side of the impostor texture used
     split_objects: tuple = ()  # indices of the objects inside it, far to near
     splits: tuple = ()  # their distances from the eye: the layers' boundaries
-    layer_counts: tuple = ()  # particles per layer, far to near (of the impostor's layers when textured)
     members: tuple = ()  # the clouds of the unit
     full_ms: float = 0.0  # predicted cost of full 3D this frame (0 in impostor mode, which never draws it)
     impostor_ms: float = 0.0  # auto mode: predicted cost of the impostor per frame, its regeneration amortised
@@ -528,10 +527,6 @@ def _plan_units(
             particles, particle_radii, record.eye, object_centres[cut], object_radii[cut], record.splits
         )
 
-    def counts(index: int, from_eye, splits) -> tuple:
-        """Particles per layer seen from `from_eye`; the particles are looked at only when there are splits."""
-        return layer_counts(particles_of(index), from_eye, splits) if splits else (0,)
-
     def in_full(index: int, distance: float, inside: tuple, splits: tuple, **prices) -> CloudPlan:
         """The plan of a unit drawn in full 3D (split around the objects `inside` it at `splits`)."""
         return CloudPlan(
@@ -541,7 +536,6 @@ def _plan_units(
             full_weight=1.0,
             split_objects=inside,
             splits=splits,
-            layer_counts=counts(index, eye, splits),
             members=units.members[index],
             **prices,
         )
@@ -632,7 +626,6 @@ def _plan_units(
                     full_weight=individual,
                     split_objects=inside,
                     splits=splits,
-                    layer_counts=counts(index, eye, splits),
                     members=members,
                     full_ms=full_ms,
                     impostor_ms=inside_ms,
@@ -725,7 +718,6 @@ def _plan_units(
                 cloud.texture_size,
                 keys[index],
                 cloud.splits,
-                counts(index, eye, cloud.splits),
                 cloud.split_objects,
                 content_depth(centres[index], radii[index], eye, *splats_of(index)) if cloud_splats else None,
             )
@@ -734,7 +726,6 @@ def _plan_units(
             regenerate=regenerate,
             postponed=postponed,
             texture_size=record.size,
-            layer_counts=record.layer_counts if cloud.splits else (0,),
         )
     if ring is not None:
         for generation, _ in ring.draws:

@@ -42,15 +42,13 @@ class ImpostorRecord:
     """What an impostor texture was made from: the eye, the texture side, the lighting, the layers.
 
     A cloud split around objects (`cloudcore.lod.splitting`) has one texture per layer: `splits`
-    are the distances from `eye` of the objects `split_objects` (far to near) when it was made and
-    `layer_counts` its layers' particle counts.
+    are the distances from `eye` of the objects `split_objects` (far to near) when it was made.
     """
 
     eye: tuple[float, float, float]
     size: int
     lighting_key: Hashable
     splits: tuple[float, ...] = ()
-    layer_counts: tuple[int, ...] = (0,)
     split_objects: tuple[int, ...] = ()
     #: the middle and half the depth, along the view axis from `eye`, of what the texture holds (its particles'
     #: discs; `content_depth`): the near and far points of Harris's parallax (None: the bounding sphere's)

@@ -42,12 +42,6 @@ def layer_of(distances: np.ndarray, splits) -> np.ndarray:
     return np.count_nonzero(np.asarray(distances)[:, None] <= splits[None, :], axis=1)
 
 
-def layer_counts(centres: np.ndarray, eye, splits) -> tuple[int, ...]:
-    """Particles in each of the len(splits)+1 layers, seen from `eye`."""
-    distances = row_lengths(np.asarray(centres, dtype=np.float64) - np.asarray(eye, dtype=np.float64))
-    return tuple(int(c) for c in np.bincount(layer_of(distances, splits), minlength=len(splits) + 1))
-
-
 def layers_hold(
     centres: np.ndarray, radii: np.ndarray, eye, object_centres: np.ndarray, object_radii: np.ndarray, splits
 ) -> bool:
