@@ -451,15 +451,18 @@ def test_full_3d_near_the_eye_counts_only_the_splats_in_the_frustum():
         splat_centres,
         splat_radii,
     )
+    # auto mode, its fragments free: the unit, the eye inside it, is cheaper drawn in full 3D than as a screen impostor
     full = plan_frame(
         units,
         eye,
         VIEWPORT,
-        dataclasses.replace(NO_RING, mode="full"),
+        NO_RING,
         LodState(),
         1,
         cloud_splats=lambda cloud: (splat_centres, splat_radii),
+        costs=CostModel(fragments=0.0),
     )
+    assert full.clouds[0].kind == "full"
     assert full.cloud_work.particles == np.count_nonzero(seen) < 400
 
 

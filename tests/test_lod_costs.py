@@ -134,10 +134,22 @@ def test_a_frame_budget_postpones_regenerations_and_reports_the_error_it_accepte
 
 
 def test_the_plan_predicts_the_work_it_schedules():
-    p = plan(camera_at((0.0, 0.0, 1000.0)), dataclasses.replace(NO_RING, mode="full"), costs=FILL_BOUND)
-    assert p.cloud_work.particles == 1000 and p.update_work == Work()
-    assert p.predicted_ms == pytest.approx(FILL_BOUND.ms(p.cloud_work))
+    p = plan(camera_at((0.0, 0.0, 1000.0)), dataclasses.replace(NO_RING, mode="impostor"), costs=FILL_BOUND)
+    assert p.priced and p.cloud_work.quads == 1 and p.update_work.particles == 1000
+    assert p.predicted_ms == pytest.approx(FILL_BOUND.ms(p.update_work + p.cloud_work))
     assert isinstance(p.state, LodState) and p.state.eye == (0.0, 0.0, 1000.0)
+
+
+def test_full_3d_prices_nothing_and_its_frames_fit_no_costs():
+    """Full 3D draws every unit in view whatever it costs: its plan counts no work, and its measured passes
+    leave the cost fit as it was (they still time the way auto mode drew, when auto planned as full 3D)."""
+    p = plan(camera_at((0.0, 0.0, 1000.0)), dataclasses.replace(NO_RING, mode="full"), costs=FILL_BOUND)
+    assert not p.priced and not p.stats().priced
+    assert (p.update_work, p.cloud_work, p.predicted_ms) == (Work(), Work(), 0.0)
+    assert [c.kind for c in p.clouds] == ["full"] and p.draw_order == (0,)
+    measured = p.state.measured([(p.update_work, 2.0), (p.cloud_work, 30.0)], fit=p.priced)
+    assert measured.costs is p.state.costs
+    assert p.state.measured([(Work(particles=1000.0), 30.0)]).costs.frames == p.state.costs.frames + 1
 
 
 def test_a_cost_model_prices_each_field_of_work_by_its_own_coefficient():

@@ -48,11 +48,15 @@ class StatisticsPanel:
             f"clouds: full {kinds['full']}, crossfade {kinds['crossfade']}, impostor {kinds['impostor']}, "
             f"inside {kinds['inside']}, ring {kinds['ring']}, culled {kinds['culled']}"
         )
+        measured_ms = frame.impostor_update_ms + frame.cloud_ms
+        prediction = (
+            f"predicted {plan.predicted_ms:.1f} ms against {measured_ms:.1f} measured"
+            if plan.priced
+            else f"not priced (full 3D draws every cloud in view): {measured_ms:.1f} ms measured"
+        )
         imgui.text(
-            f"units {plan.units} ({plan.units_grouped} of interpenetrating clouds); predicted "
-            f"{plan.predicted_ms:.1f} ms against {frame.impostor_update_ms + frame.cloud_ms:.1f} "
-            f"measured; largest error drawn {plan.accepted_error_tolerances:.2f} x the tolerance "
-            f"({plan.tolerance_deg:.3f} deg)"
+            f"units {plan.units} ({plan.units_grouped} of interpenetrating clouds); {prediction}; "
+            f"largest error drawn {plan.accepted_error_tolerances:.2f} x the tolerance ({plan.tolerance_deg:.3f} deg)"
         )
         if plan.drawn_as:
             way = {"units": "each unit as priced", "full": "every unit in full 3D, one draw"}[plan.drawn_as]

@@ -239,7 +239,9 @@ class FrameRenderer:
         drawn_by_gpu, rendered_by_gpu = self._splats.take_selected()
         drawn, rendered = drawn + drawn_by_gpu, rendered + rendered_by_gpu
         world, updates, clouds = (clock.times[name] for name in ("world", "impostor updates", "clouds"))
-        self.lod_state = plan.state.measured([(plan.update_work, updates.wall_ms), (plan.cloud_work, clouds.wall_ms)])
+        self.lod_state = plan.state.measured(
+            [(plan.update_work, updates.wall_ms), (plan.cloud_work, clouds.wall_ms)], fit=plan.priced
+        )
         self.splat_order = self.splat_order.observe(way, updates.wall_ms + clouds.wall_ms, drawn + rendered)
         self.compositing[settings.mode] = compositing.observe(composited_by, clouds.wall_ms, self._compositable)
         stats = FrameStats(

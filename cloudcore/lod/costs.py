@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, fields
+from functools import cached_property
 
 import numpy as np
 
@@ -194,6 +195,10 @@ class CostEstimator:
 
     def model(self) -> CostModel:
         """The coefficients the measurements so far support (the prior before any)."""
+        return self._fitted
+
+    @cached_property  # the estimator is immutable: a frame that fits no costs (full 3D) keeps the last one's
+    def _fitted(self) -> CostModel:
         size = len(self.right)
         ratios = np.linalg.solve(self.normal + PRIOR_WEIGHT * np.eye(size), self.right + PRIOR_WEIGHT)
         ratios = np.clip(np.nan_to_num(ratios, nan=1.0), 1.0 / RATIO_LIMIT, RATIO_LIMIT)

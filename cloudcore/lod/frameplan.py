@@ -186,9 +186,10 @@ class LodState:
     #: (units, camera, viewport, {members: (their clouds' keys, Work)}), or None
     near_work: tuple | None = None
 
-    def measured(self, measurements) -> LodState:
-        """The state with this frame's (predicted work, measured ms) pairs folded into the cost fit, and their
-        sum into the measured time of the way the frame was drawn (once the switch to it has settled)."""
+    def measured(self, measurements, fit: bool = True) -> LodState:
+        """The state with this frame's (predicted work, measured ms) pairs folded into the cost fit (unless not
+        `fit`: a frame planned without prices), and their sum into the measured time of the way the frame was
+        drawn (once the switch to it has settled)."""
         frame_times = self.frame_times
         total_ms = sum(ms for _, ms in measurements if math.isfinite(ms) and ms >= 0.0)
         if self.drawn_as is not None and self.frames_drawn_as > FRAME_SETTLE_FRAMES:
@@ -198,7 +199,8 @@ class LodState:
                 **frame_times,
                 self.drawn_as: FrameTime.after(held if running else None, total_ms, self.frame_index),
             }
-        return dataclasses.replace(self, costs=self.costs.observe(measurements), frame_times=frame_times)
+        costs = self.costs.observe(measurements) if fit else self.costs
+        return dataclasses.replace(self, costs=costs, frame_times=frame_times)
 
 
 @dataclass(frozen=True)
@@ -228,6 +230,9 @@ class FramePlan:
     objects_with_world: tuple = ()  # visible objects outside split clouds: drawn before the cloud pass
     update_work: Work = Work()  # predicted work of the impostor updates (regenerations, ring segment)
     cloud_work: Work = Work()  # predicted work of the cloud pass
+    #: whether the works above were priced: full 3D draws every unit in view whatever it costs, so it prices
+    #: nothing (its works are empty and its frames fit no costs: `LodState.measured`)
+    priced: bool = True
     costs: CostModel = CostModel()  # the model the plan priced its choices with
     tolerance_deg: float = 0.0  # the translation tolerance in force
     #: the largest translation error drawn, in tolerances (> 1: a budget postponed it, or auto kept Wang's ring by
@@ -277,6 +282,7 @@ class FramePlan:
             layers_drawn=sum(c.layers for c in self.clouds if c.splits),
             layers_rebuilt=sum(c.layers for c in self.clouds if c.splits and c.regenerate),
             predicted_ms=self.predicted_ms,
+            priced=self.priced,
             tolerance_deg=self.tolerance_deg,
             accepted_error_tolerances=self.accepted_error,
             drawn_as=self.state.drawn_as or "",
@@ -360,7 +366,7 @@ def plan_frame(
     groups_may_open = settings.mode == "auto" and settings.groups_apart_in_motion and units.clouds is not None
     # the units and, where groups may be planned apart, their clouds, priced in one pass: a pass costs about
     # 0.2 ms whatever its size (the field's groups priced apart 0.72 -> 0.15 ms a frame)
-    seen = _seen(units.and_clouds if groups_may_open else units, *pricing)
+    seen = _seen(units.and_clouds if groups_may_open else units, *pricing, priced=_priced(settings))
     arguments = (pricing, seen, camera, viewport, settings, state, lighting_key, objects, cloud_particles, costs)
     arguments += (cloud_splats,)
     if not groups_may_open:
@@ -401,6 +407,7 @@ def _plan_units(
     else:
         seen = seen.take(slice(0, len(units.radii)))  # views: the units' own rows, first in `and_clouds`
     width, height = viewport
+    priced = _priced(settings)
     eye, last_eye, translation_error, tolerance, focal_px, screen_pixels, _ = pricing
     centres, radii = units.centres, units.radii
     view, projection = view_matrix(camera), projection_matrix(camera.fov_y_deg, width / height)
@@ -550,6 +557,8 @@ def _plan_units(
         """The unit drawn in full 3D: a ball of discs far off; near, splat by splat, only the splats in the
         frustum (the renderer leaves out the rest), their discs clipped to the screen; a still eye's again
         from last frame (auto mode's plan of the default view 4.65 -> 3.2 ms, best of 40)."""
+        if not priced:
+            return Work()
         if cloud_splats is None or distance >= NEAR_EXACT_RADII * radius:
             return Work(particles=float(units.particle_counts[index]), fragments=float(ball_fragments[index]))
         members = units.members[index]
@@ -779,8 +788,9 @@ def _plan_units(
         inside_size,
         items,
         with_world,
-        update_work,
-        cloud_work,
+        update_work if priced else Work(),
+        cloud_work if priced else Work(),
+        priced,
         costs,
         tolerance,
         accepted,
@@ -837,6 +847,11 @@ def _known(state: LodState, choice: str) -> bool:
     time = state.frame_times.get(choice)
     frame = state.frame_index + 1  # the frame being planned
     return time is not None and time.frames >= PROBE_FRAMES and frame - time.last_frame <= MEASUREMENT_AGE_FRAMES
+
+
+def _priced(settings: RenderSettings) -> bool:
+    """Whether the plan prices its units: full 3D draws every unit in view whatever it costs, so it does not."""
+    return settings.mode != "full"
 
 
 def _settled_in_full_3d(state: LodState) -> bool:
@@ -954,12 +969,24 @@ class _Seen:
 
 
 def _seen(
-    units: LodUnits, eye, last_eye, translation_error, tolerance: float, focal_px, screen_pixels, objects
+    units: LodUnits,
+    eye,
+    last_eye,
+    translation_error,
+    tolerance: float,
+    focal_px,
+    screen_pixels,
+    objects,
+    priced: bool = True,
 ) -> _Seen:
     """`objects`: (centres, radii, depth steps) of the objects that split units into layers (none when not
-    split), the steps how far each moved in depth since last frame."""
+    split), the steps how far each moved in depth since last frame.  Not `priced` (full 3D), only the
+    distances: every price zero."""
     centres, radii = units.centres, units.radii
     distances = np.linalg.norm(centres - eye, axis=1)
+    if not priced:
+        nothing = np.zeros(len(radii))
+        return _Seen(distances, nothing, nothing, nothing, nothing, nothing + 1.0)
     # the translation error of one frame at the eye's current speed
     rates = translation_error(centres, radii, last_eye, eye) if last_eye is not None else np.zeros(len(radii))
     object_centres, object_radii, depth_steps = objects

@@ -36,6 +36,7 @@ class PlanStats:
     layers_drawn: int = 0
     layers_rebuilt: int = 0
     predicted_ms: float = 0.0
+    priced: bool = True  # False in full 3D, which prices nothing: predicted_ms is then 0
     tolerance_deg: float = 0.0
     accepted_error_tolerances: float = 0.0  # the largest error drawn, in tolerances
     #: auto mode: the frame drawn with its units each as priced ("units") or all in full 3D ("full"; "" in the
