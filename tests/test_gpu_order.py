@@ -11,6 +11,7 @@ import pytest
 from conftest import VALLEY
 
 from cloudcore.camera import frustum_planes, projection_matrix, view_matrix
+from cloudcore.gl.prefix_sum import ONE_GROUP_ITEMS, GpuPrefixSum
 from cloudcore.light.eye_scattering import ParticleBuffer
 from cloudcore.measure.imagecompare import compare
 from cloudcore.scene import Camera, Cloud, Formation, Light, Shading
@@ -28,10 +29,12 @@ AMBIENT = (0.05, 0.06, 0.09)
 
 
 @pytest.mark.parametrize(
-    "count, key_bits", [(0, 32), (1, 32), (2, 32), (2047, 32), (2048, 32), (2049, 32), (30000, 32), (5000, 8)]
+    "count, key_bits",
+    [(0, 32), (1, 32), (2, 32), (2047, 32), (2048, 32), (2049, 32), (30000, 32), (5000, 8), (300_000, 16)],
 )
 def test_the_gpu_radix_sort_orders_as_a_stable_sort(renderer, count, key_bits):
-    """8-bit keys (a selection's cells) need only two passes."""
+    """8-bit keys (a selection's cells) need only two passes; past 128 tiles of keys the digits' counts are
+    summed block by block (`GpuPrefixSum`'s three stages), below in one workgroup."""
     from OpenGL import GL
 
     from cloudcore.gl.depth_sort import GpuDepthSort
@@ -64,6 +67,33 @@ def test_the_gpu_radix_sort_orders_as_a_stable_sort(renderer, count, key_bits):
     expected = np.argsort(keys, kind="stable")
     np.testing.assert_array_equal(sorted_pairs[0], keys[expected])
     np.testing.assert_array_equal(sorted_pairs[1], values[expected])
+
+
+@pytest.mark.parametrize("count", [1, 2, 2047, 2048, 2049, 20_000, ONE_GROUP_ITEMS, ONE_GROUP_ITEMS + 1, 600_000])
+def test_the_gpu_prefix_sum_is_the_sum_of_the_items_before_each(renderer, count):
+    """Up to `ONE_GROUP_ITEMS` items are scanned by one workgroup, more block by block from the blocks' scanned
+    sums (a last block part full, at 600,000);
+    whatever the count, each item becomes the sum of those before it (the values past `count` untouched)."""
+    from OpenGL import GL
+
+    values = np.random.default_rng(count).integers(0, 1000, count + 3, dtype=np.uint32)
+    renderer.context.make_current()
+    prefix_sum, buffer = GpuPrefixSum(), GL.glGenBuffers(1)
+    try:
+        GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, buffer)
+        GL.glBufferData(GL.GL_SHADER_STORAGE_BUFFER, values.nbytes, values, GL.GL_DYNAMIC_COPY)
+        GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT)
+        prefix_sum.scan(buffer, count)
+        GL.glMemoryBarrier(GL.GL_BUFFER_UPDATE_BARRIER_BIT)
+        GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, buffer)
+        summed = np.frombuffer(GL.glGetBufferSubData(GL.GL_SHADER_STORAGE_BUFFER, 0, values.nbytes), np.uint32)
+        GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, 0)
+    finally:
+        prefix_sum.close()
+        GL.glDeleteBuffers(1, [buffer])
+    expected = np.concatenate([[0], np.cumsum(values[: count - 1], dtype=np.uint32)])
+    np.testing.assert_array_equal(summed[:count], expected)
+    np.testing.assert_array_equal(summed[count:], values[count:])
 
 
 def _cloud(rng, name: str, count: int, centre, **fields) -> Cloud:

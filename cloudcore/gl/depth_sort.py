@@ -4,7 +4,8 @@ The GPU counterpart of `cloudcore.lod.depth_order.far_to_near`: given keys
 that are the inverted bit patterns of float32 distances, sorting them
 ascending orders the values (particle indices) far to near, equal distances
 in their input order, exactly as the CPU does.  Eight passes of four bits
-(fewer for shorter keys), each three dispatches (`shaders/depth_sort.comp.glsl`), ping-ponging between
+(fewer for shorter keys), each a count, a prefix sum of the counts (`cloudcore.gl.prefix_sum`) and a
+scatter (`shaders/depth_sort.comp.glsl`), ping-ponging between
 the caller's buffers and two of its own, so the sorted pairs end where they
 began.  No data comes back to the CPU: what draws from the order reads it
 where it is.
@@ -14,6 +15,7 @@ from __future__ import annotations
 
 from OpenGL import GL
 
+from cloudcore.gl.prefix_sum import GpuPrefixSum
 from cloudcore.gl.programs import build_compute_program, uniform_locations
 
 #: bits of the key a pass sorts by; see the shader for why four
@@ -21,7 +23,7 @@ DIGIT_BITS = 4
 #: keys one invocation takes; 256 invocations a workgroup make a tile of 2048
 ITEMS = 8
 TILE = 256 * ITEMS
-_STAGES = ("COUNT", "SCAN", "SCATTER")
+_STAGES = ("COUNT", "SCATTER")
 _KEYS_IN, _VALUES_IN, _KEYS_OUT, _VALUES_OUT, _TILE_COUNTS = range(5)
 
 
@@ -34,6 +36,7 @@ class GpuDepthSort:
         }
         self._scratch_keys, self._scratch_values, self._tile_counts = self._buffers = GL.glGenBuffers(3)
         self._capacity = 0  # pairs the scratch buffers hold
+        self._prefix_sum = GpuPrefixSum()
 
     def sort(self, keys: int, values: int, count: int, key_bits: int = 32) -> None:
         """Sort the first `count` pairs of buffers `keys` and `values` by key, in place, stably; keys below
@@ -50,18 +53,23 @@ class GpuDepthSort:
         tiles = -(-count // TILE)
         sources, targets = (keys, values), (self._scratch_keys, self._scratch_values)
         for sort_pass in range(key_bits // DIGIT_BITS):
-            for binding, buffer in zip((_KEYS_IN, _VALUES_IN, _KEYS_OUT, _VALUES_OUT), sources + targets):
-                GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, binding, buffer)
-            GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _TILE_COUNTS, self._tile_counts)
-            for stage, groups in zip(_STAGES, (tiles, 1, tiles)):
-                GL.glUseProgram(self._programs[stage])
-                uniforms = self._uniforms[stage]
-                GL.glUniform1ui(uniforms["count"], count)
-                GL.glUniform1ui(uniforms["shift"], sort_pass * DIGIT_BITS)
-                GL.glUniform1ui(uniforms["tiles"], tiles)
-                GL.glDispatchCompute(groups, 1, 1)
-                GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT)
+            self._run("COUNT", sources + targets, count, sort_pass * DIGIT_BITS, tiles)
+            self._prefix_sum.scan(self._tile_counts, tiles << DIGIT_BITS)  # each (digit, tile) run's start
+            self._run("SCATTER", sources + targets, count, sort_pass * DIGIT_BITS, tiles)
             sources, targets = targets, sources
+
+    def _run(self, stage: str, buffers: tuple[int, ...], count: int, shift: int, tiles: int) -> None:
+        """One stage of a pass over `tiles` workgroups, reading the first two `buffers` and writing the others."""
+        for binding, buffer in zip((_KEYS_IN, _VALUES_IN, _KEYS_OUT, _VALUES_OUT), buffers):
+            GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, binding, buffer)
+        GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _TILE_COUNTS, self._tile_counts)
+        GL.glUseProgram(self._programs[stage])
+        uniforms = self._uniforms[stage]
+        GL.glUniform1ui(uniforms["count"], count)
+        GL.glUniform1ui(uniforms["shift"], shift)
+        GL.glUniform1ui(uniforms["tiles"], tiles)
+        GL.glDispatchCompute(tiles, 1, 1)
+        GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT)
 
     def _reserve(self, count: int) -> None:
         if count <= self._capacity:
@@ -83,6 +91,7 @@ class GpuDepthSort:
         for program in self._programs.values():
             GL.glDeleteProgram(program)
         GL.glDeleteBuffers(len(self._buffers), list(self._buffers))
+        self._prefix_sum.close()
 
 
 def key_bits_for(largest: int) -> int:

@@ -22,7 +22,13 @@ from cloudcore.gl.splats import INSTANCE_BYTES, SplatBatch
 from cloudcore.gl.targets import blit_depth
 from cloudcore.gl.tile_binning import GpuTileBinning
 from cloudcore.light.kernel import SPLAT_SHARPNESS
-from cloudcore.light.volume_blending import MAX_OPTICAL_DEPTH, TILE_PIXELS, ScreenTiles, Splats
+from cloudcore.light.volume_blending import (
+    FINISHED_TRANSMITTANCE,
+    MAX_OPTICAL_DEPTH,
+    TILE_PIXELS,
+    ScreenTiles,
+    Splats,
+)
 
 _TILE_STARTS_BINDING, _TILE_ENTRIES_BINDING, _OCCUPIED_BINDING = 6, 7, 8
 #: the instances' binding, as `cloudcore.gl.splats` writes them
@@ -119,7 +125,9 @@ class VolumeBlendingPass:
         binning would hold too many pairs (`MAX_PAIRS`): the raster's to draw."""
         if self._binning is None:
             self._binning = GpuTileBinning()
-            self._plain_program = build_compute_program("volume_blend", _CONSTANTS | {"PLAIN": 1})
+            self._plain_program = build_compute_program(
+                "volume_blend", _CONSTANTS | {"PLAIN": 1, "FINISHED_TRANSMITTANCE": FINISHED_TRANSMITTANCE}
+            )
         binned = self._binning.bin(instances, count_at, view, projection, size)
         if binned is None or not binned.pairs:
             return binned is not None

@@ -2,11 +2,11 @@
 // One pass of a stable least-significant-digit radix sort of (key, value)
 // pairs of uint32, ascending by key, on DIGIT_BITS bits of the key from
 // `shift` (reference: cloudcore.lod.depth_order.far_to_near, whose keys are
-// the inverted bit patterns of float32 distances).  A pass is three
-// dispatches, chosen by the stage defined:
-//   COUNT    one workgroup a tile: how many of its keys have each digit;
-//   SCAN     one workgroup: where each (digit, tile) run starts in the output,
-//            digit-major so that all of digit 0 comes first, tile by tile;
+// the inverted bit patterns of float32 distances).  A pass is two stages,
+// chosen by the stage defined, around a prefix sum (prefix_sum.comp.glsl):
+//   COUNT    one workgroup a tile: how many of its keys have each digit,
+//            digit-major so that, summed, all of digit 0 comes first, tile by
+//            tile, and each count becomes where its (digit, tile) run starts;
 //   SCATTER  one workgroup a tile: each key to its run's start plus the keys
 //            of its digit before it in the tile.
 // Stable because each invocation takes ITEMS consecutive keys in order and
@@ -25,7 +25,7 @@ layout(std430, binding = 0) readonly buffer KeysIn { uint keys_in[]; };
 layout(std430, binding = 1) readonly buffer ValuesIn { uint values_in[]; };
 layout(std430, binding = 2) writeonly buffer KeysOut { uint keys_out[]; };
 layout(std430, binding = 3) writeonly buffer ValuesOut { uint values_out[]; };
-// per (digit, tile), digit-major: COUNT writes the counts, SCAN turns them into output starts
+// per (digit, tile), digit-major: COUNT writes the counts, the prefix sum turns them into output starts
 layout(std430, binding = 4) buffer TileCounts { uint tile_counts[]; };
 
 uniform uint count;  // pairs to sort
@@ -53,36 +53,6 @@ void main()
     barrier();
     if (thread < DIGITS)
         tile_counts[thread * tiles + tile] = histogram[thread];
-}
-#endif
-
-#ifdef SCAN
-shared uint sums[GROUP];
-
-void main()
-{
-    uint thread = gl_LocalInvocationID.x;
-    uint total = uint(DIGITS) * tiles;
-    uint chunk = (total + GROUP - 1u) / GROUP;
-    uint first = min(thread * chunk, total), last = min(first + chunk, total);
-    uint sum = 0u;
-    for (uint i = first; i < last; ++i)
-        sum += tile_counts[i];
-    sums[thread] = sum;
-    barrier();
-    // inclusive Hillis-Steele scan of the chunks' sums
-    for (uint offset = 1u; offset < GROUP; offset <<= 1) {
-        uint before = thread >= offset ? sums[thread - offset] : 0u;
-        barrier();
-        sums[thread] += before;
-        barrier();
-    }
-    uint start = sums[thread] - sum;
-    for (uint i = first; i < last; ++i) {
-        uint counted = tile_counts[i];
-        tile_counts[i] = start;
-        start += counted;
-    }
 }
 #endif
 

@@ -4,10 +4,11 @@
 // (cloudcore.light.volume_blending.screen_tiles) without the CPU.  The draw's instances are those
 // splat_shade.comp.glsl made, far to near, as many kept as its indirect command counts (six indices
 // each).  Three stages, chosen by the stage defined:
-//   COUNT   per kept splat, the tiles its quad's image can touch, added to `total`;
-//   EMIT    per kept splat, one (slot, tile) pair a tile, at places an atomic counter hands out (so in
-//           no order: two stable radix sorts then put them by tile and, within a tile, by slot, which
-//           is far to near);
+//   COUNT   per slot, the tiles its kept splat's quad image can touch (0 for a slot not kept), into
+//           pair_starts[slot] and added to `total`; a prefix sum over the slots then makes each slot's
+//           count where its pairs start (cloudcore.gl.prefix_sum);
+//   EMIT    per kept splat, one (slot, tile) pair a tile from where its pairs start: the pairs in slot
+//           order, far to near, so that one stable radix sort by tile leaves each tile's run far to near;
 //   STARTS  over the pairs sorted by tile: where each tile's run starts (tile_starts[t] to
 //           tile_starts[t + 1]), as ScreenTiles.starts.
 // A splat's image is bounded by its four corners' (it is a flat quad), one pixel wider on each side
@@ -21,7 +22,8 @@ struct Instance {
 };
 layout(std430, binding = 3) readonly buffer Instances { Instance instances[]; };  // from the draw's first
 layout(std430, binding = 6) readonly buffer Command { uint command[]; };
-layout(std430, binding = 9) buffer Counter { uint total; uint cursor; };
+layout(std430, binding = 9) buffer Counter { uint total; };
+layout(std430, binding = 13) buffer PairStarts { uint pair_starts[]; };  // per slot
 layout(std430, binding = 10) buffer PairSlots { uint pair_slots[]; };
 layout(std430, binding = 11) buffer PairTiles { uint pair_tiles[]; };
 layout(std430, binding = 12) writeonly buffer TileStarts { uint tile_starts[]; };
@@ -69,16 +71,16 @@ void run(uint i)
         for (uint t = tile + 1u; t <= uint(tiles_across * tiles_up); ++t)
             tile_starts[t] = pairs;
 #else
-    if (i >= command[count_at] / 6u)
-        return;
-    ivec4 box = tile_box(i);
-    if (box.z < box.x || box.w < box.y)
-        return;
-    uint covered = uint((box.z - box.x + 1) * (box.w - box.y + 1));
+    ivec4 box = i < command[count_at] / 6u ? tile_box(i) : ivec4(0, 0, -1, -1);
+    bool touches = box.z >= box.x && box.w >= box.y;
 #ifdef COUNT
+    uint covered = touches ? uint((box.z - box.x + 1) * (box.w - box.y + 1)) : 0u;
+    pair_starts[i] = covered;
     atomicAdd(total, covered);
 #else
-    uint at = atomicAdd(cursor, covered);
+    if (!touches)
+        return;
+    uint at = pair_starts[i];
     for (int row = box.y; row <= box.w; ++row)
         for (int column = box.x; column <= box.z; ++column) {
             pair_slots[at] = i;

@@ -3,8 +3,8 @@
 // or with PLAIN defined the billboards' own blending done the same way (a compute compositor of plain
 // splats, for GPUs whose raster is a small part of the chip: cloudcore.gl.tile_binning):
 // one work group per screen tile, one invocation per pixel, each walking its tile's particles in the
-// batch's far-to-near order (cloudcore.light.volume_blending.screen_tiles) and compositing their
-// segments along its ray as the numpy reference does (cloudcore.light.volume_blending.volume_blend):
+// batch's far-to-near order (cloudcore.light.volume_blending.screen_tiles; PLAIN: near to far, below) and
+// compositing their segments along its ray as the numpy reference does (cloudcore.light.volume_blending.volume_blend):
 // one segment held (extent, optical depth, colour), the farther of two apart into the frame, or of
 // two overlapping the back part and the intersection, the front part held.  A pixel is one invocation's alone,
 // so its read-modify-write of the target needs no interlock.  Each pixel reads its tile's splats
@@ -126,11 +126,17 @@ void composite(uint tile)
     vec4 image = imageLoad(target, pixel);
 
 #ifdef PLAIN
-    // billboards blended over, far to near, as splat.frag.glsl's fragments are (premultiplied, GL_ONE,
-    // GL_ONE_MINUS_SRC_ALPHA), where the ray meets the quad in front of the world (the raster's depth test);
-    // the pixel stays float32 through its splats, where the raster rounds it to half floats at each blend
-    for (uint k = tile_starts[tile]; k < tile_starts[tile + 1u]; ++k) {
-        Splat p = splat_of(instances[tile_entries[k]]);
+    // billboards blended as splat.frag.glsl's fragments are (premultiplied, GL_ONE, GL_ONE_MINUS_SRC_ALPHA),
+    // where the ray meets the quad in front of the world (the raster's depth test).  The raster blends far to
+    // near, each splat over the pixel; the same sum taken near to far (each splat under those in front of it)
+    // is the same picture, and it can stop once the pixel lets through too little to show: the splats left
+    // would change it by at most the transmittance times their brightest radiance, since what was drawn
+    // before stays behind them, weighed by the transmittance, as the splats would have left it where opaque.
+    // The pixel stays float32 through its splats, where the raster rounds it to half floats at each blend.
+    vec4 in_front = vec4(0.0);  // premultiplied: the splats nearer than the next one
+    float transmittance = 1.0;
+    for (uint k = tile_starts[tile + 1u]; k > tile_starts[tile] && transmittance > FINISHED_TRANSMITTANCE;) {
+        Splat p = splat_of(instances[tile_entries[--k]]);
         float facing = dot(ray, p.normal_plane.xyz);
         if (abs(facing) <= TINY)
             continue;
@@ -141,8 +147,10 @@ void composite(uint tile)
         if (plane <= 0.0 || plane >= opaque || d2 >= 1.0)
             continue;
         vec4 source = p.colour * kernel(d2);
-        image = source + (1.0 - source.a) * image;
+        in_front += transmittance * source;
+        transmittance *= 1.0 - source.a;
     }
+    image = in_front + transmittance * image;
 #else
     Segment held = Segment(0.0, 0.0, 0.0, vec3(0.0));
     for (uint k = tile_starts[tile]; k < tile_starts[tile + 1u]; ++k) {
