@@ -234,7 +234,7 @@ class RenderSettings:
     #: "cpu": a draw's particles are chosen and sorted far to near in numpy and their order uploaded; "gpu":
     #: chosen, sorted and counted by compute shaders, drawn as quads by an indirect draw, so that the CPU's
     #: work for a draw does not grow with its particles; "auto": the one measured faster on this GL
-    #: (`cloudcore.lod.measured_way`: on llvmpipe the CPU's, whose sort is 30-40 times faster, the frame 1.65)
+    #: (`cloudcore.lod.measured_way`: on llvmpipe the CPU's, whose sort is 5-9 times faster, the frame 1.32)
     splat_order: str = _setting(
         "auto",
         flag="--splat-order",

@@ -9,8 +9,8 @@ import pytest
 from conftest import RENDER_HEIGHT, RENDER_WIDTH, VALLEY
 from test_render_golden import inside_a_cloud, into_the_sun
 
-from cloudcore.camera import projection_matrix, view_matrix
-from cloudcore.light.volume_blending import TILE_PIXELS
+from cloudcore.camera import NEAR_PLANE_M, projection_matrix, view_matrix
+from cloudcore.light.volume_blending import TILE_PIXELS, screen_tiles
 from cloudcore.measure.imagecompare import compare
 from cloudcore.resources import resource_path
 from cloudcore.scenefile import load_scene
@@ -58,7 +58,8 @@ def test_layers_split_around_an_object_composite_as_the_raster_draws_them(render
 def test_the_gpu_bins_each_tile_far_to_near_and_only_the_kept_splats(renderer, valley):
     """The bins' structure as `ScreenTiles` has it: tile t's entries from starts[t] to starts[t + 1], each run
     ascending (the draw's far-to-near order), every entry a splat the selection kept, and every kept splat
-    on screen in the tile of its centre."""
+    on screen in the tile of its centre; each tile as many as the numpy binning lists of the same splats (its
+    disc's tiles, not its square's), but where float32 rounding puts a disc's edge across a tile's."""
     from cloudcore.gl.splats import SplatPass, SplatSelection
     from cloudcore.gl.tile_binning import GpuTileBinning
 
@@ -96,6 +97,9 @@ def test_the_gpu_bins_each_tile_far_to_near_and_only_the_kept_splats(renderer, v
     columns, rows = (np.round(pixels[on_screen]).astype(np.int64) // TILE_PIXELS).T
     for slot, tile in zip(np.flatnonzero(ahead)[on_screen], rows * binned.across + columns):
         assert slot in entries[starts[tile] : starts[tile + 1]], (slot, tile)
+    in_numpy = screen_tiles(relative, particles.radii[order], view, projection, binned.size, NEAR_PLANE_M)
+    differing = np.abs(np.diff(starts.astype(np.int64)) - np.diff(in_numpy.starts.astype(np.int64))).sum()
+    assert differing <= 1e-4 * binned.pairs, (differing, binned.pairs, in_numpy.starts[-1])
 
 
 def test_dispatches_past_the_gls_group_limit_loop_to_the_same_picture(renderer, valley, monkeypatch):

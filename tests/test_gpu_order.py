@@ -28,16 +28,17 @@ LIGHTS = (Light((0.0, 0.6, -0.8), (1.0, 0.95, 0.9), 1.0),)
 AMBIENT = (0.05, 0.06, 0.09)
 
 
+@pytest.mark.parametrize("items", ["gpu", "cpu"])
 @pytest.mark.parametrize(
     "count, key_bits",
     [(0, 32), (1, 32), (2, 32), (2047, 32), (2048, 32), (2049, 32), (30000, 32), (5000, 8), (300_000, 16)],
 )
-def test_the_gpu_radix_sort_orders_as_a_stable_sort(renderer, count, key_bits):
-    """8-bit keys (a selection's cells) need only two passes; past 128 tiles of keys the digits' counts are
-    summed block by block (`GpuPrefixSum`'s three stages), below in one workgroup."""
+def test_the_gpu_radix_sort_orders_as_a_stable_sort(renderer, count, key_bits, items):
+    """8-bit keys (a selection's cells) need only two passes; the tiles of keys a workgroup takes are a GPU's
+    (2048, the counts about them) and a software GL's (32,768: 300,000 keys in ten)."""
     from OpenGL import GL
 
-    from cloudcore.gl.depth_sort import GpuDepthSort
+    from cloudcore.gl.depth_sort import ITEMS_ON_CPU, ITEMS_ON_GPU, GpuDepthSort
 
     rng = np.random.default_rng(count)
     keys = rng.integers(0, 2**key_bits, count, dtype=np.uint64).astype(np.uint32)
@@ -45,7 +46,7 @@ def test_the_gpu_radix_sort_orders_as_a_stable_sort(renderer, count, key_bits):
     keys[1::7] = rng.integers(0, 4, len(keys[1::7]))  # and keys differing only in the lowest digits
     values = rng.permutation(count).astype(np.uint32)
     renderer.context.make_current()
-    sort, buffers = GpuDepthSort(), GL.glGenBuffers(2)
+    sort, buffers = GpuDepthSort({"gpu": ITEMS_ON_GPU, "cpu": ITEMS_ON_CPU}[items]), GL.glGenBuffers(2)
     try:
         for buffer, data in zip(buffers, (keys, values)):
             GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, buffer)

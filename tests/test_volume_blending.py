@@ -149,7 +149,9 @@ def test_the_path_follows_the_setting_and_what_the_gl_can_do(requested, compute,
     assert blending_path(requested, compute_shaders=compute, plain_splats_only=plain_only) == expected
 
 
-def test_screen_tiles_list_every_splat_where_it_draws_in_the_batch_order():
+def test_screen_tiles_list_every_splat_where_it_draws_and_only_there_in_the_batch_order():
+    """Every tile with a pixel a splat reaches lists it, and no tile more than two pixels from one (its disc,
+    a pixel wider for rounding: not the corners of its square, which hold a quarter of its tiles)."""
     camera = Camera((0.0, 0.0, 0.0), (0.0, 0.0, -1.0), 50.0)
     width, height = 70, 45  # tiles that do not divide the screen
     view, projection = view_matrix(camera), projection_matrix(camera.fov_y_deg, width / height)
@@ -162,11 +164,18 @@ def test_screen_tiles_list_every_splat_where_it_draws_in_the_batch_order():
     assert (tiles.across, tiles.up) == (across, up) and len(tiles.starts) == across * up + 1
     drawn = Splats(centres, radii, np.ones((50, 3)), np.ones(50), view[0, :3], view[1, :3])
     rays = pixel_rays(camera, width, height).reshape(height, width, 3)[::-1].reshape(-1, 3)  # rows bottom first
+    listed_by_tile = [tiles.entries[tiles.starts[t] : tiles.starts[t + 1]] for t in range(tiles.count)]
     for position in range(50):
         reached = particle_segments(drawn, position, rays).optical_depth.reshape(height, width) > 0.0
         for row, column in zip(*np.nonzero(reached)):
             tile = (row // TILE_PIXELS) * tiles.across + column // TILE_PIXELS
-            assert position in tiles.entries[tiles.starts[tile] : tiles.starts[tile + 1]], (position, row, column)
+            assert position in listed_by_tile[tile], (position, row, column)
+        near_reached = np.zeros((up * TILE_PIXELS + 4, across * TILE_PIXELS + 4), dtype=bool)
+        for dy, dx in np.ndindex(5, 5):  # two pixels around each pixel reached
+            near_reached[dy : dy + height, dx : dx + width] |= reached
+        near_reached = near_reached[2:-2, 2:-2].reshape(up, TILE_PIXELS, across, TILE_PIXELS).any(axis=(1, 3))
+        listing = [t for t in range(tiles.count) if position in listed_by_tile[t]]
+        assert all(near_reached.ravel()[listing]), position
     assert 0 not in tiles.entries
     listing = [tile for tile in range(tiles.count) if tiles.starts[tile + 1] > tiles.starts[tile]]
     assert list(tiles.occupied) == listing and len(listing) < tiles.count

@@ -16,20 +16,29 @@ from __future__ import annotations
 from OpenGL import GL
 
 from cloudcore.gl.prefix_sum import GpuPrefixSum
-from cloudcore.gl.programs import build_compute_program, uniform_locations
+from cloudcore.gl.programs import build_compute_program, gl_renderer, uniform_locations
+from cloudcore.lod.measured_way import software_rasterizer
 
 #: bits of the key a pass sorts by; see the shader for why four
 DIGIT_BITS = 4
-#: keys one invocation takes; 256 invocations a workgroup make a tile of 2048
-ITEMS = 8
-TILE = 256 * ITEMS
+#: keys one invocation takes, per kind of GL (256 invocations a workgroup make a tile of 256 times that).  A
+#: workgroup's scan of its invocations' digit counts costs the same whatever its tile: a GPU runs many
+#: workgroups at once, so small tiles keep it busy (the H200's times in docs/performance.md are with 8); llvmpipe
+#: runs each on one thread, stepping its 256 invocations through the scan's 16 barriers, so large tiles
+#: amortise them: with 128 the 16-bit sort of the default view's 510,000 tile pairs took 42 against 214 ms, the
+#: depth sort of its 90,000 particles 15 against 87 (256: the same again)
+ITEMS_ON_GPU, ITEMS_ON_CPU = 8, 128
 _STAGES = ("COUNT", "SCATTER")
 _KEYS_IN, _VALUES_IN, _KEYS_OUT, _VALUES_OUT, _TILE_COUNTS = range(5)
 
 
 class GpuDepthSort:
-    def __init__(self):
-        defines = {"DIGIT_BITS": DIGIT_BITS, "ITEMS": ITEMS}
+    def __init__(self, items: int | None = None):
+        """`items`: the keys an invocation takes, by default this GL's (`ITEMS_ON_GPU`, `ITEMS_ON_CPU`)."""
+        if items is None:
+            items = ITEMS_ON_CPU if software_rasterizer(gl_renderer()) else ITEMS_ON_GPU
+        self._tile = 256 * items
+        defines = {"DIGIT_BITS": DIGIT_BITS, "ITEMS": items}
         self._programs = {stage: build_compute_program("depth_sort", defines | {stage: 1}) for stage in _STAGES}
         self._uniforms = {
             stage: uniform_locations(program, ("count", "shift", "tiles")) for stage, program in self._programs.items()
@@ -50,7 +59,7 @@ class GpuDepthSort:
         if count <= 1:
             return
         self._reserve(count)
-        tiles = -(-count // TILE)
+        tiles = -(-count // self._tile)
         sources, targets = (keys, values), (self._scratch_keys, self._scratch_values)
         for sort_pass in range(key_bits // DIGIT_BITS):
             self._run("COUNT", sources + targets, count, sort_pass * DIGIT_BITS, tiles)
@@ -75,7 +84,7 @@ class GpuDepthSort:
         if count <= self._capacity:
             return
         capacity = max(count, 2 * self._capacity)
-        tiles = -(-capacity // TILE)
+        tiles = -(-capacity // self._tile)
         for buffer, size in (
             (self._scratch_keys, 4 * capacity),
             (self._scratch_values, 4 * capacity),

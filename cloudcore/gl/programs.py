@@ -102,6 +102,12 @@ def max_dispatch_groups() -> int:
     return int(np.asarray(GL.glGetIntegeri_v(GL.GL_MAX_COMPUTE_WORK_GROUP_COUNT, 0)).ravel()[0])
 
 
+def gl_renderer() -> str:
+    """GL_RENDERER of the current context: which GL this is (llvmpipe, a GPU)."""
+    renderer = GL.glGetString(GL.GL_RENDERER)
+    return renderer.decode() if isinstance(renderer, bytes) else str(renderer)
+
+
 def dispatch(groups: int) -> None:
     """Dispatch the current compute program over `groups` work groups along x, at most as many as the GL
     allows: the shaders dispatched this way loop, each invocation (or group) taking every so many items."""

@@ -5,7 +5,7 @@ the frame's 17.4 GPU milliseconds at 640x480, and the tiled compute pass of volu
 more per splat in half the raster's time: such chips keep little of their area for the raster.  The
 compute pass needs each tile's splats far to near, which `cloudcore.light.volume_blending.screen_tiles`
 makes in numpy (79 ms of CPU a frame there).  Here the GPU makes them from the draw's shaded instances
-(`shaders/tile_bin.comp.glsl`): each kept splat counts the tiles its quad's image touches, the counts'
+(`shaders/tile_bin.comp.glsl`): each kept splat counts the tiles its disc's image touches, the counts'
 prefix sum over the slots (`cloudcore.gl.prefix_sum`) says where each splat's pairs go, one (slot, tile)
 pair a tile is written there, in the draw's far-to-near order, and one stable radix sort by tile
 (`cloudcore.gl.depth_sort`) leaves each tile's run far to near; the runs' starts are the tiles'
@@ -13,7 +13,9 @@ pair a tile is written there, in the draw's far-to-near order, and one stable ra
 
 The pairs were first written where an atomic counter handed out places, in no order, and sorted by slot
 before the sort by tile: that sort by slot (24 bits for the default scene's 82,000 slots) took 44% of the
-pass on llvmpipe inside a cloud (456 of 1048 ms at 640x480), where the prefix sum takes a few.
+pass on llvmpipe inside a cloud (456 of 1048 ms at 640x480), where the prefix sum takes a few.  The tiles
+were those of the quad's square: its corners, outside the disc where the kernel is 0, held a quarter of the
+pairs, and splats wholly behind the near plane (kept by the frustum, clipped by the raster) the whole screen.
 """
 
 from __future__ import annotations

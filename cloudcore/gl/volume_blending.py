@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from OpenGL import GL
 
-from cloudcore.gl.programs import build_compute_program, dispatch, set_vec3
+from cloudcore.gl.programs import build_compute_program, dispatch, gl_renderer, set_vec3
 from cloudcore.gl.splats import INSTANCE_BYTES, SplatBatch
 from cloudcore.gl.targets import blit_depth
 from cloudcore.gl.tile_binning import GpuTileBinning
@@ -56,9 +56,7 @@ class GpuFeatures:
         }
         version = (int(GL.glGetIntegerv(GL.GL_MAJOR_VERSION)), int(GL.glGetIntegerv(GL.GL_MINOR_VERSION)))
         compute = version >= (4, 3) or {"GL_ARB_compute_shader", "GL_ARB_shader_image_load_store"} <= extensions
-        renderer = GL.glGetString(GL.GL_RENDERER)
-        renderer = renderer.decode() if isinstance(renderer, bytes) else str(renderer)
-        return cls(compute, "GL_ARB_fragment_shader_interlock" in extensions, renderer)
+        return cls(compute, "GL_ARB_fragment_shader_interlock" in extensions, gl_renderer())
 
 
 class VolumeBlendingPass:

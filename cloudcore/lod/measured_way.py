@@ -2,10 +2,10 @@
 composites full 3D's splats (`compositing`).
 
 A setting's "auto" resolves here, per renderer.  On a software rasterizer the
-GPU is the same cores: there the first way is taken untried (the CPU's sort,
-whose radix sort on llvmpipe was 30-40 times slower than numpy's, the frame
-1.65 times; the raster, 8 times faster there than the compute compositor:
-docs/performance.md).  On a GPU, the first frames that do the work alternate
+GPU is the same cores: there the first way is taken untried (the CPU's sort:
+the radix sort on llvmpipe is 5-9 times slower than numpy's from 100,000 keys,
+the flythrough's full-3D frame 1.32 times; the raster: the compute compositor
+takes 1.1-2.3 times as long there, docs/performance.md).  On a GPU, the first frames that do the work alternate
 the two ways, `TRIAL_FRAMES` each, and the way whose passes took less time
 (median) is kept.  Neighbouring frames of a moving camera draw nearly the
 same particles, so the alternation compares like with like; a frame that does

@@ -4,7 +4,7 @@
 // (cloudcore.light.volume_blending.screen_tiles) without the CPU.  The draw's instances are those
 // splat_shade.comp.glsl made, far to near, as many kept as its indirect command counts (six indices
 // each).  Three stages, chosen by the stage defined:
-//   COUNT   per slot, the tiles its kept splat's quad image can touch (0 for a slot not kept), into
+//   COUNT   per slot, the tiles its kept splat's disc can touch (0 for a slot not kept), into
 //           pair_starts[slot] and added to `total`; a prefix sum over the slots then makes each slot's
 //           count where its pairs start (cloudcore.gl.prefix_sum);
 //   EMIT    per kept splat, one (slot, tile) pair a tile from where its pairs start: the pairs in slot
@@ -12,7 +12,8 @@
 //   STARTS  over the pairs sorted by tile: where each tile's run starts (tile_starts[t] to
 //           tile_starts[t + 1]), as ScreenTiles.starts.
 // A splat's image is bounded by its four corners' (it is a flat quad), one pixel wider on each side
-// for rounding; a splat reaching behind the near plane may touch any tile.
+// for rounding, and of that box's tiles only those its disc reaches (a quarter fewer pairs on the default
+// view: the kernel is 0 past the disc).
 
 layout(local_size_x = 64) in;
 
@@ -38,26 +39,56 @@ uniform int tiles_up;
 uniform float near;
 uniform uint pairs;        // STARTS: how many pairs there are
 
-// (first tile column, first row, last column, last row) of splat j's image; empty when last < first
-ivec4 tile_box(uint j)
+// The tiles splat j can touch: the box of its quad's image (first tile column, first row, last column, last
+// row; empty when last < first) and, in pixels, the centre and radius of the disc its kernel covers, the
+// circle inscribed in that image (a plain splat's quad faces the image plane: its image is a square), one
+// pixel wider for rounding.  Wholly behind the near plane, none; partly (rounding: the quad's corners are
+// at one depth), the whole screen, radius < 0.
+struct Footprint {
+    ivec4 box;
+    vec3 disc;
+};
+
+Footprint footprint(uint j)
 {
     vec2 low = vec2(3.0e38), high = vec2(-3.0e38);
-    bool behind = false;
+    int corners_behind = 0;
     for (int k = 0; k < 4; ++k) {
         vec4 clip = projection * (view_rotation * vec4(instances[j].corners[k].xyz, 1.0));
         if (clip.w <= near) {
-            behind = true;
-            break;
+            ++corners_behind;
+            continue;
         }
         vec2 pixel = (clip.xy / clip.w * 0.5 + 0.5) * vec2(size) - 0.5;  // pixel centres are whole numbers
         low = min(low, pixel);
         high = max(high, pixel);
     }
+    if (corners_behind == 4)  // the raster clips it all away (the frustum keeps a sphere reaching past the plane)
+        return Footprint(ivec4(0, 0, -1, -1), vec3(0.0, 0.0, -1.0));
+    bool behind = corners_behind > 0;
     ivec2 first = behind ? ivec2(0) : ivec2(clamp(floor(low) - 1.0, vec2(0.0), vec2(size)));
     ivec2 last = behind ? size - 1 : ivec2(clamp(ceil(high) + 1.0, vec2(-1.0), vec2(size - 1)));
     if (any(lessThan(last, first)))
-        return ivec4(0, 0, -1, -1);
-    return ivec4(first / TILE_PIXELS, last / TILE_PIXELS);
+        return Footprint(ivec4(0, 0, -1, -1), vec3(0.0, 0.0, -1.0));
+    vec2 half_size = 0.5 * (high - low);
+    vec3 disc = behind ? vec3(0.0, 0.0, -1.0) : vec3(0.5 * (low + high), max(half_size.x, half_size.y) + 1.0);
+    return Footprint(ivec4(first / TILE_PIXELS, last / TILE_PIXELS), disc);
+}
+
+// the first and last columns of the footprint's tiles in `row` whose pixel centres its disc reaches (the
+// tile's pixel nearest the disc's centre within its radius); empty when last < first
+ivec2 columns_in_row(Footprint f, int row)
+{
+    if (f.disc.z < 0.0)
+        return f.box.xz;
+    float nearest_y = clamp(f.disc.y, float(row * TILE_PIXELS), float(row * TILE_PIXELS + TILE_PIXELS - 1));
+    float across2 = f.disc.z * f.disc.z - (nearest_y - f.disc.y) * (nearest_y - f.disc.y);
+    if (across2 < 0.0)
+        return ivec2(0, -1);
+    float across = sqrt(across2);
+    int first = int(ceil((f.disc.x - across - float(TILE_PIXELS - 1)) / float(TILE_PIXELS)));
+    int last = int(floor((f.disc.x + across) / float(TILE_PIXELS)));
+    return ivec2(max(first, f.box.x), min(last, f.box.z));
 }
 
 void run(uint i)
@@ -71,22 +102,25 @@ void run(uint i)
         for (uint t = tile + 1u; t <= uint(tiles_across * tiles_up); ++t)
             tile_starts[t] = pairs;
 #else
-    ivec4 box = i < command[count_at] / 6u ? tile_box(i) : ivec4(0, 0, -1, -1);
-    bool touches = box.z >= box.x && box.w >= box.y;
+    Footprint f = i < command[count_at] / 6u ? footprint(i) : Footprint(ivec4(0, 0, -1, -1), vec3(0.0));
 #ifdef COUNT
-    uint covered = touches ? uint((box.z - box.x + 1) * (box.w - box.y + 1)) : 0u;
+    uint covered = 0u;
+    for (int row = f.box.y; row <= f.box.w; ++row) {
+        ivec2 columns = columns_in_row(f, row);
+        covered += uint(max(columns.y - columns.x + 1, 0));
+    }
     pair_starts[i] = covered;
     atomicAdd(total, covered);
 #else
-    if (!touches)
-        return;
     uint at = pair_starts[i];
-    for (int row = box.y; row <= box.w; ++row)
-        for (int column = box.x; column <= box.z; ++column) {
+    for (int row = f.box.y; row <= f.box.w; ++row) {
+        ivec2 columns = columns_in_row(f, row);
+        for (int column = columns.x; column <= columns.y; ++column) {
             pair_slots[at] = i;
             pair_tiles[at] = uint(row * tiles_across + column);
             ++at;
         }
+    }
 #endif
 #endif
 }
