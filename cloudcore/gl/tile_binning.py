@@ -34,6 +34,10 @@ from cloudcore.light.volume_blending import TILE_PIXELS
 
 #: the storage bindings of tile_bin.comp.glsl (instances and command as the splat pass binds them)
 _INSTANCES, _COMMAND, _COUNTER, _PAIR_SLOTS, _PAIR_TILES, _TILE_STARTS, _PAIR_STARTS = 3, 6, 9, 10, 11, 12, 13
+#: and of its discs, which volume_blend.comp.glsl's PLAIN reads at the same binding
+DISCS_BINDING = 14
+#: a disc's bytes: its image (vec4), colour (vec4) and depth, a std430 struct padded to 16
+_DISC_BYTES = 48
 _GROUP = 64
 #: pairs past which a draw is left to the raster: 16 bytes each with the sorts' scratch, 512 MiB (at 1600x1200
 #: inside a cloud of the default scene, 7.1 million; a 4K screen there, about 30)
@@ -52,6 +56,7 @@ class BinnedTiles:
     starts: int  # buffer of across * up + 1 uints
     entries: int  # buffer of `pairs` uints
     pairs: int
+    discs: int  # buffer of what the compositing reads of each slot's splat (tile_bin.comp.glsl's Disc)
 
 
 class GpuTileBinning:
@@ -63,7 +68,8 @@ class GpuTileBinning:
             stage: build_compute_program("tile_bin", defines | {stage: 1}) for stage in ("COUNT", "EMIT", "STARTS")
         }
         self._uniforms = {stage: uniform_locations(program, _UNIFORMS) for stage, program in self._programs.items()}
-        self._counter, self._slots, self._tiles, self._starts, self._pair_starts = self._buffers = GL.glGenBuffers(5)
+        buffers = GL.glGenBuffers(6)
+        self._counter, self._slots, self._tiles, self._starts, self._pair_starts, self._discs = self._buffers = buffers
         self._pair_capacity = self._tile_capacity = self._slot_capacity = 0
         self._sort = GpuDepthSort()
         self._prefix_sum = GpuPrefixSum()
@@ -82,7 +88,7 @@ class GpuTileBinning:
         than `MAX_PAIRS` (the raster draws those)."""
         buffer, first, slots = instances
         across, up = -(-size[0] // TILE_PIXELS), -(-size[1] // TILE_PIXELS)
-        empty = BinnedTiles(tuple(size), across, up, self._starts, self._slots, 0)
+        empty = BinnedTiles(tuple(size), across, up, self._starts, self._slots, 0, self._discs)
         if not slots:
             return empty
         GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, self._counter)
@@ -90,12 +96,14 @@ class GpuTileBinning:
         if slots > self._slot_capacity:
             self._slot_capacity = max(slots, 2 * self._slot_capacity)
             reallocate_storage((self._pair_starts,), 4 * self._slot_capacity)
+            reallocate_storage((self._discs,), _DISC_BYTES * self._slot_capacity)
         GL.glBindBufferRange(
             GL.GL_SHADER_STORAGE_BUFFER, _INSTANCES, buffer, first * INSTANCE_BYTES, slots * INSTANCE_BYTES
         )
         GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _COMMAND, count_at[0])
         GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _COUNTER, self._counter)
         GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _PAIR_STARTS, self._pair_starts)
+        GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, DISCS_BINDING, self._discs)
         GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT | GL.GL_BUFFER_UPDATE_BARRIER_BIT)
         self._dispatch("COUNT", slots, count_at[1], view, projection, size, (across, up))
         GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT | GL.GL_BUFFER_UPDATE_BARRIER_BIT)
@@ -121,7 +129,7 @@ class GpuTileBinning:
         GL.glUniform1i(uniforms["tiles_up"], up)
         dispatch(-(-pairs // _GROUP))
         GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT)
-        return BinnedTiles(tuple(size), across, up, self._starts, self._slots, pairs)
+        return BinnedTiles(tuple(size), across, up, self._starts, self._slots, pairs, self._discs)
 
     def read(self, binned: BinnedTiles) -> tuple[np.ndarray, np.ndarray]:
         """(starts, entries) of `binned` read back, as `ScreenTiles` holds them (the tests compare the two)."""

@@ -20,7 +20,7 @@ from OpenGL import GL
 from cloudcore.gl.programs import build_compute_program, dispatch, gl_renderer, set_vec3
 from cloudcore.gl.splats import INSTANCE_BYTES, SplatBatch
 from cloudcore.gl.targets import blit_depth
-from cloudcore.gl.tile_binning import GpuTileBinning
+from cloudcore.gl.tile_binning import DISCS_BINDING, GpuTileBinning
 from cloudcore.light.kernel import SPLAT_SHARPNESS
 from cloudcore.light.volume_blending import (
     FINISHED_TRANSMITTANCE,
@@ -131,6 +131,7 @@ class VolumeBlendingPass:
             return binned is not None
         GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _TILE_STARTS_BINDING, binned.starts)
         GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _TILE_ENTRIES_BINDING, binned.entries)
+        GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, DISCS_BINDING, binned.discs)
         self._composite(
             self._plain_program,
             binned.size,

@@ -28,6 +28,14 @@ layout(std430, binding = 13) buffer PairStarts { uint pair_starts[]; };  // per 
 layout(std430, binding = 10) buffer PairSlots { uint pair_slots[]; };
 layout(std430, binding = 11) buffer PairTiles { uint pair_tiles[]; };
 layout(std430, binding = 12) writeonly buffer TileStarts { uint tile_starts[]; };
+// per slot: the splat's image in pixels (centre, 1 / half width, 1 / half height), premultiplied colour and
+// depth, as volume_blend.comp.glsl's PLAIN composites it
+struct Disc {
+    vec4 image;
+    vec4 colour;
+    float depth;
+};
+layout(std430, binding = 14) writeonly buffer Discs { Disc discs[]; };
 
 uniform uint slots;        // the draw's slots, kept or not
 uniform uint count_at;     // its command's count in the command buffer (six a kept splat)
@@ -39,55 +47,56 @@ uniform int tiles_up;
 uniform float near;
 uniform uint pairs;        // STARTS: how many pairs there are
 
+const float TINY = 1e-30;
+
 // The tiles splat j can touch: the box of its quad's image (first tile column, first row, last column, last
-// row; empty when last < first) and, in pixels, the centre and radius of the disc its kernel covers, the
-// circle inscribed in that image (a plain splat's quad faces the image plane: its image is a square), one
-// pixel wider for rounding.  Wholly behind the near plane, none; partly (rounding: the quad's corners are
-// at one depth), the whole screen, radius < 0.
+// row; empty when last < first), and the image itself in pixels: its centre, half width and half height
+// (a plain splat's quad faces the image plane, so its image is a rectangle, the kernel's disc the ellipse
+// inscribed in it, a circle on square pixels), and its depth.  Behind the near plane, nothing: the quad's
+// corners are at the splat's depth, so the raster clips it whole (a corner across the plane from the others
+// is the rounding of an axis; the frustum keeps a sphere reaching past the plane).
 struct Footprint {
     ivec4 box;
-    vec3 disc;
+    vec4 image;
+    float depth;
 };
+
+const Footprint NOWHERE = Footprint(ivec4(0, 0, -1, -1), vec4(0.0, 0.0, 1.0, 1.0), 0.0);
 
 Footprint footprint(uint j)
 {
     vec2 low = vec2(3.0e38), high = vec2(-3.0e38);
-    int corners_behind = 0;
+    float depth = 0.0;
     for (int k = 0; k < 4; ++k) {
         vec4 clip = projection * (view_rotation * vec4(instances[j].corners[k].xyz, 1.0));
-        if (clip.w <= near) {
-            ++corners_behind;
-            continue;
-        }
+        if (clip.w <= near)
+            return NOWHERE;
+        depth = max(depth, clip.w);
         vec2 pixel = (clip.xy / clip.w * 0.5 + 0.5) * vec2(size) - 0.5;  // pixel centres are whole numbers
         low = min(low, pixel);
         high = max(high, pixel);
     }
-    if (corners_behind == 4)  // the raster clips it all away (the frustum keeps a sphere reaching past the plane)
-        return Footprint(ivec4(0, 0, -1, -1), vec3(0.0, 0.0, -1.0));
-    bool behind = corners_behind > 0;
-    ivec2 first = behind ? ivec2(0) : ivec2(clamp(floor(low) - 1.0, vec2(0.0), vec2(size)));
-    ivec2 last = behind ? size - 1 : ivec2(clamp(ceil(high) + 1.0, vec2(-1.0), vec2(size - 1)));
+    ivec2 first = ivec2(clamp(floor(low) - 1.0, vec2(0.0), vec2(size)));
+    ivec2 last = ivec2(clamp(ceil(high) + 1.0, vec2(-1.0), vec2(size - 1)));
     if (any(lessThan(last, first)))
-        return Footprint(ivec4(0, 0, -1, -1), vec3(0.0, 0.0, -1.0));
-    vec2 half_size = 0.5 * (high - low);
-    vec3 disc = behind ? vec3(0.0, 0.0, -1.0) : vec3(0.5 * (low + high), max(half_size.x, half_size.y) + 1.0);
-    return Footprint(ivec4(first / TILE_PIXELS, last / TILE_PIXELS), disc);
+        return NOWHERE;
+    vec4 image = vec4(0.5 * (low + high), 0.5 * (high - low));
+    return Footprint(ivec4(first / TILE_PIXELS, last / TILE_PIXELS), image, depth);
 }
 
 // the first and last columns of the footprint's tiles in `row` whose pixel centres its disc reaches (the
 // tile's pixel nearest the disc's centre within its radius); empty when last < first
 ivec2 columns_in_row(Footprint f, int row)
 {
-    if (f.disc.z < 0.0)
-        return f.box.xz;
-    float nearest_y = clamp(f.disc.y, float(row * TILE_PIXELS), float(row * TILE_PIXELS + TILE_PIXELS - 1));
-    float across2 = f.disc.z * f.disc.z - (nearest_y - f.disc.y) * (nearest_y - f.disc.y);
+    vec2 centre = f.image.xy;
+    float radius = max(f.image.z, f.image.w) + 1.0;  // a pixel wider, for rounding
+    float nearest_y = clamp(centre.y, float(row * TILE_PIXELS), float(row * TILE_PIXELS + TILE_PIXELS - 1));
+    float across2 = radius * radius - (nearest_y - centre.y) * (nearest_y - centre.y);
     if (across2 < 0.0)
         return ivec2(0, -1);
     float across = sqrt(across2);
-    int first = int(ceil((f.disc.x - across - float(TILE_PIXELS - 1)) / float(TILE_PIXELS)));
-    int last = int(floor((f.disc.x + across) / float(TILE_PIXELS)));
+    int first = int(ceil((centre.x - across - float(TILE_PIXELS - 1)) / float(TILE_PIXELS)));
+    int last = int(floor((centre.x + across) / float(TILE_PIXELS)));
     return ivec2(max(first, f.box.x), min(last, f.box.z));
 }
 
@@ -102,8 +111,10 @@ void run(uint i)
         for (uint t = tile + 1u; t <= uint(tiles_across * tiles_up); ++t)
             tile_starts[t] = pairs;
 #else
-    Footprint f = i < command[count_at] / 6u ? footprint(i) : Footprint(ivec4(0, 0, -1, -1), vec3(0.0));
+    Footprint f = i < command[count_at] / 6u ? footprint(i) : NOWHERE;
 #ifdef COUNT
+    // what the compositing reads of the splat for each of its pixels
+    discs[i] = Disc(vec4(f.image.xy, 1.0 / max(f.image.zw, vec2(TINY))), instances[i].colours[0], f.depth);
     uint covered = 0u;
     for (int row = f.box.y; row <= f.box.w; ++row) {
         ivec2 columns = columns_in_row(f, row);
