@@ -21,7 +21,6 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import os
-import time
 from pathlib import Path
 
 import numpy as np
@@ -105,17 +104,6 @@ def scene_batch(scene: Scene, size):
     return batch, view, projection
 
 
-def binning_ms(scene: Scene, size, repeat: int) -> float:
-    """Best time of the volume pass's CPU share: binning the scene's splats into screen tiles."""
-    batch, view, projection = scene_batch(scene, size)
-    best = np.inf
-    for _ in range(repeat):
-        start = time.perf_counter()
-        screen_tiles(batch.centres - batch.eye, batch.radii, view, projection, size, NEAR_PLANE_M)
-        best = min(best, time.perf_counter() - start)
-    return 1e3 * best
-
-
 def reference(renderer: FrameRenderer, scene: Scene, steps: int) -> np.ndarray:
     """The ray-marched frame, linear (height, width, 3): the particles over the world the renderer draws."""
     width, height = renderer.size
@@ -169,7 +157,6 @@ def measure(renderer: FrameRenderer, name: str, scene: Scene, repeat: int, steps
     for blending in BLENDINGS:
         row[f"{blending}_cloud_ms"] = float(np.median(cloud_ms[blending]))
     row["volume_over_plain_cost"] = row["volume_cloud_ms"] / max(row["plain_cloud_ms"], 1e-9)
-    row["volume_binning_ms"] = binning_ms(scene, renderer.size, repeat)
     volume_vs_plain = compare(frames["volume"], frames["plain"])
     row["volume_vs_plain_psnr_db"], row["volume_vs_plain_max"] = volume_vs_plain.psnr_db, volume_vs_plain.max_abs
     panels = [frames["plain"], frames["volume"]]

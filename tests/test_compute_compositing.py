@@ -76,7 +76,7 @@ def test_the_gpu_bins_each_tile_far_to_near_and_only_the_kept_splats(renderer, v
         instances, count_at = splats.selected_instances(selection, view)
         (order,) = splats.read_orders(selection, view)
         binned = binning.bin(instances, count_at, view, projection, (RENDER_WIDTH, RENDER_HEIGHT))
-        starts, entries = binning.read(binned)
+        starts, entries, occupied, groups = binning.read(binned)
     finally:
         splats.close()
         binning.close()
@@ -88,6 +88,9 @@ def test_the_gpu_bins_each_tile_far_to_near_and_only_the_kept_splats(renderer, v
     for tile in range(tiles):
         run = entries[starts[tile] : starts[tile + 1]].astype(np.int64)
         assert np.all(np.diff(run) > 0), tile  # far to near, each splat once
+    # the compositing's groups: one a tile with splats, and only those
+    np.testing.assert_array_equal(np.sort(occupied), np.flatnonzero(np.diff(starts) > 0))
+    assert list(groups) == [len(occupied), 1, 1] and 0 < len(occupied) < tiles
     # the tile under each kept splat's centre lists it
     relative = particles.centres[order] - eye
     clip = (projection @ np.c_[relative @ view[:3, :3].T, np.ones(kept)].T).T
@@ -108,7 +111,7 @@ def test_dispatches_past_the_gls_group_limit_loop_to_the_same_picture(renderer, 
     limit made 100 groups, every compute shader of the GPU's ways loops over what it was given: the same
     pictures and counts.  (Not fewer: with 3, llvmpipe stopped each compositing invocation after about 45
     tiles of this view, some 65,000 splats walked, the iteration cap it puts on a shader's loops.)"""
-    from cloudcore.gl import programs
+    from cloudcore.gl import programs, tile_binning
 
     camera = inside_a_cloud(valley)
     expected = {
@@ -116,6 +119,7 @@ def test_dispatches_past_the_gls_group_limit_loop_to_the_same_picture(renderer, 
         for name, settings in (("raster", RASTER), ("compute", COMPUTE), ("volume", VOLUME))
     }
     monkeypatch.setattr(programs, "max_dispatch_groups", lambda: 100)
+    monkeypatch.setattr(tile_binning, "max_dispatch_groups", lambda: 100)  # the compositing's indirect dispatch
     for name, settings in (("raster", RASTER), ("compute", COMPUTE), ("volume", VOLUME)):
         image, stats = renderer.render(valley, camera=camera, settings=settings)
         assert compare(image, expected[name][0]).psnr_db >= 99.0, name

@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 
 from cloudcore.artist.particle_styles import particle_styles
-from cloudcore.camera import NEAR_PLANE_M, pixel_rays, projection_matrix, view_matrix
+from cloudcore.camera import pixel_rays, projection_matrix, view_matrix
 from cloudcore.light.eye_scattering import ParticleBuffer
 from cloudcore.light.lighting import scene_lights
-from cloudcore.light.volume_blending import plain_blend, ray_distances, ray_marched, screen_tiles, volume_blend
+from cloudcore.light.volume_blending import plain_blend, ray_distances, ray_marched, volume_blend
 from cloudcore.scene import Camera, Cloud, Light, Scene, Shading
 from cloudcore.settings import FULL_3D
 
@@ -42,7 +42,6 @@ def test_the_compute_pass_composites_as_the_reference_does(renderer, wall_m):
     try:
         assert volume.features.compute_shaders
         batch = splat_batch(particles, [0, 1], CAMERA.position)
-        tiles = screen_tiles(batch.centres - batch.eye, batch.radii, view, projection, (WIDTH, HEIGHT), NEAR_PLANE_M)
         target.bind_cleared()
         GL.glClearColor(*background)
         GL.glClear(GL.GL_COLOR_BUFFER_BIT)
@@ -53,13 +52,13 @@ def test_the_compute_pass_composites_as_the_reference_does(renderer, wall_m):
         GL.glClearDepth(window_depth)
         GL.glClear(GL.GL_DEPTH_BUFFER_BIT)
         GL.glClearDepth(1.0)
-        volume.draw(
-            tiles,
+        assert volume.draw(
             (*splats.shade(batch, view), len(batch)),
             view,
             projection,
             target.texture,
             renderer.context.framebuffer,
+            (WIDTH, HEIGHT),
         )
         pixels = target.read()
     finally:

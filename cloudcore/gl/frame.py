@@ -50,7 +50,7 @@ from cloudcore.gl.world import WorldPass
 from cloudcore.light.eye_scattering import ParticleBuffer
 from cloudcore.light.illumination import IlluminationCache
 from cloudcore.light.lighting import scene_hour, scene_lights, sky_colors
-from cloudcore.light.volume_blending import blending_path, screen_tiles
+from cloudcore.light.volume_blending import blending_path
 from cloudcore.lod.costs import CostModel
 from cloudcore.lod.frameplan import FramePlan, LodState, inside_runs, plan_frame
 from cloudcore.lod.impostors import cropped_corners, particle_extent
@@ -494,8 +494,15 @@ class FrameRenderer:
             if frame.compositing == "compute" and compositable:
                 instances, count_at = self._splats.selected_instances(batch, view)
                 target = self.context.colour_texture if colour_texture is None else colour_texture
-                composited = self._volume.draw_plain(
-                    instances, count_at, view, projection, target, self.context.framebuffer, self.size
+                composited = self._volume.draw(
+                    instances,
+                    view,
+                    projection,
+                    target,
+                    self.context.framebuffer,
+                    self.size,
+                    plain=True,
+                    count_at=count_at,
                 )
             if composited:
                 self._splats.count_drawn(batch)
@@ -509,13 +516,15 @@ class FrameRenderer:
             compute_shaders=self._volume.features.compute_shaders,
             plain_splats_only=bool(np.all(self._splats.plain_splats(batch))),
         )
+        composited = False
         if path == "volume" and len(batch):
-            tiles = screen_tiles(batch.centres - batch.eye, batch.radii, view, projection, self.size, NEAR_PLANE_M)
             buffer, first = self._splats.shade(batch, view)
             target = self.context.colour_texture if colour_texture is None else colour_texture
-            self._volume.draw(tiles, (buffer, first, len(batch)), view, projection, target, self.context.framebuffer)
-            self._particles_as_volumes += len(batch)
-        else:
+            composited = self._volume.draw(
+                (buffer, first, len(batch)), view, projection, target, self.context.framebuffer, self.size
+            )
+            self._particles_as_volumes += len(batch) if composited else 0
+        if not composited:  # plain billboards, asked for or past the binning's pairs
             self._splats.draw(batch, view, projection, point_sprites=points)
         self._replay.append(lambda: self._splats.draw(batch, view, projection, counting=True, point_sprites=points))
         self._screen_batches.append(batch)

@@ -1,4 +1,5 @@
-"""A GPU-chosen draw's splats binned into screen tiles on the GPU, for compositing them by compute.
+"""A draw's splats binned into screen tiles on the GPU, for compositing them by compute (as volumes, or plain
+splats chosen on the GPU as the raster blends them).
 
 On the H200 (docs/performance.md, "On a GPU (NVIDIA H200)") the raster of full 3D's splats took 16.5 of
 the frame's 17.4 GPU milliseconds at 640x480, and the tiled compute pass of volume-aware blending did
@@ -28,12 +29,18 @@ from OpenGL import GL
 from cloudcore.camera import NEAR_PLANE_M
 from cloudcore.gl.depth_sort import GpuDepthSort, key_bits_for
 from cloudcore.gl.prefix_sum import GpuPrefixSum
-from cloudcore.gl.programs import build_compute_program, dispatch, set_matrix_at, uniform_locations
+from cloudcore.gl.programs import build_compute_program, dispatch, max_dispatch_groups, set_matrix_at, uniform_locations
 from cloudcore.gl.splats import INSTANCE_BYTES, reallocate_storage
 from cloudcore.light.volume_blending import TILE_PIXELS
 
 #: the storage bindings of tile_bin.comp.glsl (instances and command as the splat pass binds them)
 _INSTANCES, _COMMAND, _COUNTER, _PAIR_SLOTS, _PAIR_TILES, _TILE_STARTS, _PAIR_STARTS = 3, 6, 9, 10, 11, 12, 13
+#: and of the occupied tiles, which volume_blend.comp.glsl reads at the same binding
+OCCUPIED_BINDING = 8
+#: the occupied buffer's header: a DispatchIndirectCommand (x, y, z groups) and the tiles' count
+_OCCUPIED_HEADER = np.array([0, 1, 1, 0], dtype=np.uint32)
+#: the command's index that says every slot is kept (tile_bin.comp.glsl's ALL_SLOTS)
+_ALL_SLOTS = 0xFFFFFFFF
 #: and of its discs, which volume_blend.comp.glsl's PLAIN reads at the same binding
 DISCS_BINDING = 14
 #: a disc's bytes: its image (vec4), colour (vec4) and depth, a std430 struct padded to 16
@@ -43,6 +50,7 @@ _GROUP = 64
 #: inside a cloud of the default scene, 7.1 million; a 4K screen there, about 30)
 MAX_PAIRS = 1 << 25
 _UNIFORMS = ("slots", "count_at", "view_rotation", "projection", "size", "tiles_across", "tiles_up", "near", "pairs")
+_UNIFORMS += ("max_groups",)
 
 
 @dataclass(frozen=True)
@@ -57,6 +65,9 @@ class BinnedTiles:
     entries: int  # buffer of `pairs` uints
     pairs: int
     discs: int  # buffer of what the compositing reads of each slot's splat (tile_bin.comp.glsl's Disc)
+    #: buffer of the tiles with splats, in no order, after the indirect dispatch that composites them (one
+    #: group a tile: `_OCCUPIED_HEADER`)
+    occupied: int
 
 
 class GpuTileBinning:
@@ -68,8 +79,10 @@ class GpuTileBinning:
             stage: build_compute_program("tile_bin", defines | {stage: 1}) for stage in ("COUNT", "EMIT", "STARTS")
         }
         self._uniforms = {stage: uniform_locations(program, _UNIFORMS) for stage, program in self._programs.items()}
-        buffers = GL.glGenBuffers(6)
-        self._counter, self._slots, self._tiles, self._starts, self._pair_starts, self._discs = self._buffers = buffers
+        self._buffers = GL.glGenBuffers(7)
+        self._counter, self._slots, self._tiles, self._starts, self._pair_starts, self._discs, self._occupied = (
+            self._buffers
+        )
         self._pair_capacity = self._tile_capacity = self._slot_capacity = 0
         self._sort = GpuDepthSort()
         self._prefix_sum = GpuPrefixSum()
@@ -77,18 +90,18 @@ class GpuTileBinning:
     def bin(
         self,
         instances: tuple[int, int, int],
-        count_at: tuple[int, int],
+        count_at: tuple[int, int] | None,
         view: np.ndarray,
         projection: np.ndarray,
         size: tuple[int, int],
     ) -> BinnedTiles | None:
         """Bin a draw's shaded splats (`instances`: their buffer, first slot, slots; `count_at`: the buffer
-        and uint index of its indirect command's count, six a kept splat) for a screen of `size` pixels seen
-        with `view` and `projection`; `pairs` 0 when no splat touches the screen, None when there would be more
-        than `MAX_PAIRS` (the raster draws those)."""
+        and uint index of its indirect command's count, six a kept splat, or None where every slot is kept)
+        for a screen of `size` pixels seen with `view` and `projection`; `pairs` 0 when no splat touches the
+        screen, None when there would be more than `MAX_PAIRS` (the raster draws those)."""
         buffer, first, slots = instances
         across, up = -(-size[0] // TILE_PIXELS), -(-size[1] // TILE_PIXELS)
-        empty = BinnedTiles(tuple(size), across, up, self._starts, self._slots, 0, self._discs)
+        empty = BinnedTiles(tuple(size), across, up, self._starts, self._slots, 0, self._discs, self._occupied)
         if not slots:
             return empty
         GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, self._counter)
@@ -100,6 +113,8 @@ class GpuTileBinning:
         GL.glBindBufferRange(
             GL.GL_SHADER_STORAGE_BUFFER, _INSTANCES, buffer, first * INSTANCE_BYTES, slots * INSTANCE_BYTES
         )
+        # without a command, the counter stands in for it: a shader's storage blocks must all be bound
+        count_at = (self._counter, _ALL_SLOTS) if count_at is None else count_at
         GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _COMMAND, count_at[0])
         GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _COUNTER, self._counter)
         GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _PAIR_STARTS, self._pair_starts)
@@ -122,24 +137,35 @@ class GpuTileBinning:
         GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT)
         GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _PAIR_TILES, self._tiles)
         GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _TILE_STARTS, self._starts)
+        GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, self._occupied)
+        GL.glBufferSubData(GL.GL_SHADER_STORAGE_BUFFER, 0, _OCCUPIED_HEADER.nbytes, _OCCUPIED_HEADER)
+        GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, OCCUPIED_BINDING, self._occupied)
+        GL.glMemoryBarrier(GL.GL_BUFFER_UPDATE_BARRIER_BIT)
         program, uniforms = self._programs["STARTS"], self._uniforms["STARTS"]
         GL.glUseProgram(program)
         GL.glUniform1ui(uniforms["pairs"], pairs)
+        GL.glUniform1ui(uniforms["max_groups"], max_dispatch_groups())
         GL.glUniform1i(uniforms["tiles_across"], across)
         GL.glUniform1i(uniforms["tiles_up"], up)
         dispatch(-(-pairs // _GROUP))
-        GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT)
-        return BinnedTiles(tuple(size), across, up, self._starts, self._slots, pairs, self._discs)
+        GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT | GL.GL_COMMAND_BARRIER_BIT)
+        return BinnedTiles(tuple(size), across, up, self._starts, self._slots, pairs, self._discs, self._occupied)
 
-    def read(self, binned: BinnedTiles) -> tuple[np.ndarray, np.ndarray]:
-        """(starts, entries) of `binned` read back, as `ScreenTiles` holds them (the tests compare the two)."""
+    def read(self, binned: BinnedTiles) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(starts, entries, occupied tiles, their dispatch's groups) of `binned` read back, as `ScreenTiles` holds
+        the first three (the tests compare them)."""
         GL.glMemoryBarrier(GL.GL_BUFFER_UPDATE_BARRIER_BIT)
-        arrays = []
-        for buffer, count in ((binned.starts, binned.across * binned.up + 1), (binned.entries, binned.pairs)):
-            GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, buffer)
-            arrays.append(np.frombuffer(GL.glGetBufferSubData(GL.GL_SHADER_STORAGE_BUFFER, 0, 4 * count), np.uint32))
+        header = self._read(binned.occupied, 0, len(_OCCUPIED_HEADER))
+        starts = self._read(binned.starts, 0, binned.across * binned.up + 1)
+        occupied = self._read(binned.occupied, len(_OCCUPIED_HEADER), int(header[3]))
+        return starts, self._read(binned.entries, 0, binned.pairs), occupied, header[:3]
+
+    @staticmethod
+    def _read(buffer: int, first: int, count: int) -> np.ndarray:
+        GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, buffer)
+        data = GL.glGetBufferSubData(GL.GL_SHADER_STORAGE_BUFFER, 4 * first, 4 * count) if count else b""
         GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, 0)
-        return arrays[0].copy(), arrays[1].copy()
+        return np.frombuffer(data, np.uint32).copy()
 
     def _dispatch(self, stage: str, slots: int, count_at: int, view, projection, size, tiles) -> None:
         program, uniforms = self._programs[stage], self._uniforms[stage]
@@ -164,6 +190,7 @@ class GpuTileBinning:
         if starts > self._tile_capacity:
             self._tile_capacity = starts
             reallocate_storage((self._starts,), 4 * starts)
+            reallocate_storage((self._occupied,), _OCCUPIED_HEADER.nbytes + 4 * starts)
 
     def close(self) -> None:
         """Free the GL objects (the context must be current)."""

@@ -1,16 +1,17 @@
 #version 430 core
-// The screen tiles of a GPU-chosen draw's splats, made on the GPU, for the tiled compute pass that
-// composites plain splats (volume_blend.comp.glsl's PLAIN): the numpy binning
+// The screen tiles of a draw's splats, made on the GPU, for the tiled compute pass that composites them
+// (volume_blend.comp.glsl, as volumes or as the raster blends them): the numpy binning
 // (cloudcore.light.volume_blending.screen_tiles) without the CPU.  The draw's instances are those
-// splat_shade.comp.glsl made, far to near, as many kept as its indirect command counts (six indices
-// each).  Three stages, chosen by the stage defined:
+// splat_shade.comp.glsl made, far to near: a GPU-chosen draw's as many kept as its indirect command counts
+// (six indices each), a draw sorted on the CPU all of them.  Three stages, chosen by the stage defined:
 //   COUNT   per slot, the tiles its kept splat's disc can touch (0 for a slot not kept), into
 //           pair_starts[slot] and added to `total`; a prefix sum over the slots then makes each slot's
 //           count where its pairs start (cloudcore.gl.prefix_sum);
 //   EMIT    per kept splat, one (slot, tile) pair a tile from where its pairs start: the pairs in slot
 //           order, far to near, so that one stable radix sort by tile leaves each tile's run far to near;
 //   STARTS  over the pairs sorted by tile: where each tile's run starts (tile_starts[t] to
-//           tile_starts[t + 1]), as ScreenTiles.starts.
+//           tile_starts[t + 1]), as ScreenTiles.starts, and the tiles with a run, as ScreenTiles.occupied
+//           (in no order), with the indirect dispatch that composites them.
 // A splat's image is bounded by its four corners' (it is a flat quad), one pixel wider on each side
 // for rounding, and of that box's tiles only those its disc reaches (a quarter fewer pairs on the default
 // view: the kernel is 0 past the disc).
@@ -28,6 +29,15 @@ layout(std430, binding = 13) buffer PairStarts { uint pair_starts[]; };  // per 
 layout(std430, binding = 10) buffer PairSlots { uint pair_slots[]; };
 layout(std430, binding = 11) buffer PairTiles { uint pair_tiles[]; };
 layout(std430, binding = 12) writeonly buffer TileStarts { uint tile_starts[]; };
+// the tiles with splats: a DispatchIndirectCommand of one group a tile (at most max_groups, the groups
+// looping over the rest), their count, and the tiles; the command's y and z and the count start at 1, 1, 0
+layout(std430, binding = 8) buffer Occupied {
+    uint groups_x;
+    uint groups_y;
+    uint groups_z;
+    uint occupied_count;
+    uint occupied[];
+};
 // per slot: the splat's image in pixels (centre, 1 / half width, 1 / half height), premultiplied colour and
 // depth, as volume_blend.comp.glsl's PLAIN composites it
 struct Disc {
@@ -38,7 +48,7 @@ struct Disc {
 layout(std430, binding = 14) writeonly buffer Discs { Disc discs[]; };
 
 uniform uint slots;        // the draw's slots, kept or not
-uniform uint count_at;     // its command's count in the command buffer (six a kept splat)
+uniform uint count_at;     // its command's count in the command buffer (six a kept splat), or ALL_SLOTS
 uniform mat4 view_rotation;
 uniform mat4 projection;
 uniform ivec2 size;        // pixels
@@ -46,8 +56,10 @@ uniform int tiles_across;
 uniform int tiles_up;
 uniform float near;
 uniform uint pairs;        // STARTS: how many pairs there are
+uniform uint max_groups;   // STARTS: the most work groups a dispatch may ask for
 
 const float TINY = 1e-30;
+const uint ALL_SLOTS = 0xFFFFFFFFu;  // a draw whose slots are all kept (sorted on the CPU): no command
 
 // The tiles splat j can touch: the box of its quad's image (first tile column, first row, last column, last
 // row; empty when last < first), and the image itself in pixels: its centre, half width and half height
@@ -107,11 +119,17 @@ void run(uint i)
     uint before = i == 0u ? 0u : pair_tiles[i - 1u] + 1u;
     for (uint t = before; t <= tile; ++t)
         tile_starts[t] = i;
+    if (before <= tile) {  // the first of its tile's run
+        uint at = atomicAdd(occupied_count, 1u);
+        occupied[at] = tile;
+        atomicMax(groups_x, min(at + 1u, max_groups));
+    }
     if (i == pairs - 1u)
         for (uint t = tile + 1u; t <= uint(tiles_across * tiles_up); ++t)
             tile_starts[t] = pairs;
 #else
-    Footprint f = i < command[count_at] / 6u ? footprint(i) : NOWHERE;
+    uint kept = count_at == ALL_SLOTS ? slots : command[count_at] / 6u;
+    Footprint f = i < kept ? footprint(i) : NOWHERE;
 #ifdef COUNT
     // what the compositing reads of the splat for each of its pixels
     discs[i] = Disc(vec4(f.image.xy, 1.0 / max(f.image.zw, vec2(TINY))), instances[i].colours[0], f.depth);
