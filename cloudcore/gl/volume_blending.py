@@ -20,9 +20,9 @@ import numpy as np
 from OpenGL import GL
 
 from cloudcore.gl.programs import build_compute_program, gl_renderer, set_vec3
-from cloudcore.gl.splats import INSTANCE_BYTES, SplatBatch
+from cloudcore.gl.splats import SplatBatch
 from cloudcore.gl.targets import blit_depth
-from cloudcore.gl.tile_binning import DISCS_BINDING, OCCUPIED_BINDING, GpuTileBinning
+from cloudcore.gl.tile_binning import DISCS_BINDING, OCCUPIED_BINDING, BinnedTiles, GpuTileBinning
 from cloudcore.light.kernel import SPLAT_SHARPNESS
 from cloudcore.light.volume_blending import (
     FINISHED_TRANSMITTANCE,
@@ -32,8 +32,6 @@ from cloudcore.light.volume_blending import (
 )
 
 _TILE_STARTS_BINDING, _TILE_ENTRIES_BINDING = 6, 7
-#: the instances' binding, as `cloudcore.gl.splats` writes them
-_INSTANCES_BINDING = 3
 #: volume_blend.comp.glsl's constants, both variants'
 _CONSTANTS = {"TILE_PIXELS": TILE_PIXELS, "SPLAT_SHARPNESS": SPLAT_SHARPNESS, "MAX_OPTICAL_DEPTH": MAX_OPTICAL_DEPTH}
 
@@ -95,36 +93,25 @@ class VolumeBlendingPass:
         binned = self._binning.bin(instances, count_at, view, projection, size)
         if binned is None or not binned.pairs:
             return binned is not None
-        GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _TILE_STARTS_BINDING, binned.starts)
-        GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _TILE_ENTRIES_BINDING, binned.entries)
-        GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, DISCS_BINDING, binned.discs)
-        GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, OCCUPIED_BINDING, binned.occupied)
-        GL.glBindBuffer(GL.GL_DISPATCH_INDIRECT_BUFFER, binned.occupied)
-        self._composite(
-            self._programs[plain],
-            binned.size,
-            binned.across,
-            instances,
-            view,
-            projection,
-            colour_texture,
-            depth_framebuffer,
-        )
+        self._composite(self._programs[plain], binned, view, projection, colour_texture, depth_framebuffer)
         return True
 
-    def _composite(self, program, size, across, instances, view, projection, colour_texture, depth_framebuffer) -> None:
-        """Run a compositing `program` over the occupied tiles, its tile buffers and indirect dispatch bound, the
-        instances (buffer, first slot, count) bound here."""
+    def _composite(self, program, binned: BinnedTiles, view, projection, colour_texture, depth_framebuffer) -> None:
+        """Run a compositing `program` over `binned`'s occupied tiles, by the indirect dispatch the binning made."""
         bound = GL.glGetIntegerv(GL.GL_DRAW_FRAMEBUFFER_BINDING)
-        depth_texture = self._world_depth(depth_framebuffer, size)
+        depth_texture = self._world_depth(depth_framebuffer, binned.size)
         GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, int(bound))
-        buffer, first, count = instances
-        GL.glBindBufferRange(
-            GL.GL_SHADER_STORAGE_BUFFER, _INSTANCES_BINDING, buffer, first * INSTANCE_BYTES, count * INSTANCE_BYTES
-        )
+        for binding, buffer in (
+            (_TILE_STARTS_BINDING, binned.starts),
+            (_TILE_ENTRIES_BINDING, binned.entries),
+            (DISCS_BINDING, binned.discs),
+            (OCCUPIED_BINDING, binned.occupied),
+        ):
+            GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, binding, buffer)
+        GL.glBindBuffer(GL.GL_DISPATCH_INDIRECT_BUFFER, binned.occupied)
         GL.glUseProgram(program)
-        GL.glUniform2i(GL.glGetUniformLocation(program, "size"), *size)
-        GL.glUniform1i(GL.glGetUniformLocation(program, "tiles_across"), across)
+        GL.glUniform2i(GL.glGetUniformLocation(program, "size"), *binned.size)
+        GL.glUniform1i(GL.glGetUniformLocation(program, "tiles_across"), binned.across)
         set_vec3(program, "view_right", view[0, :3])
         set_vec3(program, "view_up", view[1, :3])
         set_vec3(program, "view_forward", -view[2, :3])

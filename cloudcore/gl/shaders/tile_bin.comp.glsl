@@ -38,12 +38,11 @@ layout(std430, binding = 8) buffer Occupied {
     uint occupied_count;
     uint occupied[];
 };
-// per slot: the splat's image in pixels (centre, 1 / half width, 1 / half height), premultiplied colour and
-// depth, as volume_blend.comp.glsl's PLAIN composites it
+// per slot, the splat as volume_blend.comp.glsl composites it
 struct Disc {
-    vec4 image;
-    vec4 colour;
-    float depth;
+    vec4 image;      // in pixels: the centre, 1 / half width, 1 / half height
+    vec4 colour;     // premultiplied linear rgb, opacity
+    vec4 centre_r2;  // relative to the eye, and the radius squared
 };
 layout(std430, binding = 14) writeonly buffer Discs { Disc discs[]; };
 
@@ -64,26 +63,23 @@ const uint ALL_SLOTS = 0xFFFFFFFFu;  // a draw whose slots are all kept (sorted 
 // The tiles splat j can touch: the box of its quad's image (first tile column, first row, last column, last
 // row; empty when last < first), and the image itself in pixels: its centre, half width and half height
 // (a plain splat's quad faces the image plane, so its image is a rectangle, the kernel's disc the ellipse
-// inscribed in it, a circle on square pixels), and its depth.  Behind the near plane, nothing: the quad's
+// inscribed in it, a circle on square pixels).  Behind the near plane, nothing: the quad's
 // corners are at the splat's depth, so the raster clips it whole (a corner across the plane from the others
 // is the rounding of an axis; the frustum keeps a sphere reaching past the plane).
 struct Footprint {
     ivec4 box;
     vec4 image;
-    float depth;
 };
 
-const Footprint NOWHERE = Footprint(ivec4(0, 0, -1, -1), vec4(0.0, 0.0, 1.0, 1.0), 0.0);
+const Footprint NOWHERE = Footprint(ivec4(0, 0, -1, -1), vec4(0.0, 0.0, 1.0, 1.0));
 
 Footprint footprint(uint j)
 {
     vec2 low = vec2(3.0e38), high = vec2(-3.0e38);
-    float depth = 0.0;
     for (int k = 0; k < 4; ++k) {
         vec4 clip = projection * (view_rotation * vec4(instances[j].corners[k].xyz, 1.0));
         if (clip.w <= near)
             return NOWHERE;
-        depth = max(depth, clip.w);
         vec2 pixel = (clip.xy / clip.w * 0.5 + 0.5) * vec2(size) - 0.5;  // pixel centres are whole numbers
         low = min(low, pixel);
         high = max(high, pixel);
@@ -93,7 +89,7 @@ Footprint footprint(uint j)
     if (any(lessThan(last, first)))
         return NOWHERE;
     vec4 image = vec4(0.5 * (low + high), 0.5 * (high - low));
-    return Footprint(ivec4(first / TILE_PIXELS, last / TILE_PIXELS), image, depth);
+    return Footprint(ivec4(first / TILE_PIXELS, last / TILE_PIXELS), image);
 }
 
 // the first and last columns of the footprint's tiles in `row` whose pixel centres its disc reaches (the
@@ -132,7 +128,11 @@ void run(uint i)
     Footprint f = i < kept ? footprint(i) : NOWHERE;
 #ifdef COUNT
     // what the compositing reads of the splat for each of its pixels
-    discs[i] = Disc(vec4(f.image.xy, 1.0 / max(f.image.zw, vec2(TINY))), instances[i].colours[0], f.depth);
+    Instance splat = instances[i];
+    vec3 centre = 0.5 * (splat.corners[0].xyz + splat.corners[3].xyz);
+    vec3 right = 0.5 * (splat.corners[1].xyz - splat.corners[0].xyz);  // the radius along the splat's right
+    vec4 image = vec4(f.image.xy, 1.0 / max(f.image.zw, vec2(TINY)));
+    discs[i] = Disc(image, splat.colours[0], vec4(centre, dot(right, right)));
     uint covered = 0u;
     for (int row = f.box.y; row <= f.box.w; ++row) {
         ivec2 columns = columns_in_row(f, row);

@@ -14,17 +14,14 @@
 // A particle's segment along the ray: the ray meets the splat's plane at d radii from its centre
 // (as splat.frag.glsl measures it); opacity alpha K(d) gives the optical depth -ln(1 - alpha K(d)),
 // spread over the chord of half length r sqrt(1 - d^2) around the ray's closest approach; the world's
-// depth cuts the chord.  Instances are those splat_shade.comp.glsl built: corners relative to the eye.
-// PLAIN reads instead what tile_bin.comp.glsl made of them, each splat's image in pixels (a third of the
-// bytes, and no ray to intersect: the walk took 108 against 200 ms on llvmpipe, docs/performance.md).
+// depth cuts the chord.  Each splat is read as tile_bin.comp.glsl made it of the instance splat_shade.comp.glsl
+// built: its image in pixels, colour, centre and radius (a third of the instance's bytes).  A splat faces the
+// image plane, so its quad's image is a rectangle over which the raster interpolates the kernel's coordinates
+// linearly: d is the pixel's offset from the image's centre over its half sizes, with no ray to intersect
+// with the splat's plane (the plain walk took 108 against 200 ms on llvmpipe, docs/performance.md).
 
 layout(local_size_x = TILE_PIXELS, local_size_y = TILE_PIXELS) in;
 
-struct Instance {
-    vec4 corners[4];  // relative to the eye; w: atlas cell (-1: Gaussian splat)
-    vec4 colours[4];  // premultiplied linear rgb, opacity
-};
-layout(std430, binding = 3) readonly buffer Instances { Instance instances[]; };
 layout(std430, binding = 6) readonly buffer TileStarts { uint tile_starts[]; };
 layout(std430, binding = 7) readonly buffer TileEntries { uint tile_entries[]; };
 // the tiles with splats, one group each (the dispatch's command first: tile_bin.comp.glsl's STARTS)
@@ -33,16 +30,13 @@ layout(std430, binding = 8) readonly buffer Occupied {
     uint occupied_count;
     uint occupied[];
 };
-#ifdef PLAIN
-// per slot, what tile_bin.comp.glsl's COUNT made of its instance: its image in pixels (centre, 1 / half width,
-// 1 / half height), premultiplied colour and depth
+// per slot, what tile_bin.comp.glsl's COUNT made of its instance
 struct Disc {
-    vec4 image;
-    vec4 colour;
-    float depth;
+    vec4 image;      // in pixels: the centre, 1 / half width, 1 / half height
+    vec4 colour;     // premultiplied linear rgb, opacity
+    vec4 centre_r2;  // relative to the eye, and the radius squared
 };
 layout(std430, binding = 14) readonly buffer Discs { Disc discs[]; };
-#endif
 layout(rgba16f, binding = 0) uniform image2D target;  // premultiplied linear colour, what was drawn so far
 uniform sampler2D world_depth;  // the frame's depth, window coordinates in [0, 1]
 
@@ -82,40 +76,14 @@ float kernel(float d2)
     return max((exp(-SPLAT_SHARPNESS * d2) - floor_value) / (1.0 - floor_value), 0.0);
 }
 
-// a particle as the pass reads it: its plane, and its axes scaled so that they measure d
-struct Splat {
-    vec4 centre_r2;      // relative to the eye, radius squared
-    vec4 u;              // the splat's right over its radius: offset . u is d's first coordinate
-    vec4 v;              // and up
-    vec4 normal_plane;   // the plane's normal, and its distance term centre . normal
-    vec4 colour;         // premultiplied rgb, opacity
-};
-
-Splat splat_of(Instance p)
-{
-    vec3 centre = 0.5 * (p.corners[0].xyz + p.corners[3].xyz);
-    vec3 u = 0.5 * (p.corners[1].xyz - p.corners[0].xyz);  // radius times the splat's right
-    vec3 v = 0.5 * (p.corners[2].xyz - p.corners[0].xyz);  // and up
-    float r2 = dot(u, u);
-    vec3 normal = cross(u, v);
-    float scale = r2 > 0.0 ? 1.0 / r2 : 0.0;
-    return Splat(vec4(centre, r2), vec4(u * scale, 0.0), vec4(v * scale, 0.0), vec4(normal, dot(centre, normal)),
-                 r2 > 0.0 ? p.colours[0] : vec4(0.0));
-}
-
-// the particle's segment along `ray`, cut at `opaque`; depth 0 where the ray misses it
-Segment segment_of(Splat p, vec3 ray, float opaque)
+// the particle's segment along `ray` through `pixel`, cut at `opaque`; depth 0 where the ray misses it
+Segment segment_of(Disc p, vec2 pixel, vec3 ray, float opaque)
 {
     Segment s = Segment(0.0, 0.0, 0.0, vec3(0.0));
     float alpha = p.colour.a;
-    float facing = dot(ray, p.normal_plane.xyz);
-    if (alpha <= 0.0 || abs(facing) <= TINY)
-        return s;
-    float plane = p.normal_plane.w / facing;
-    vec3 offset = plane * ray - p.centre_r2.xyz;
-    float du = dot(offset, p.u.xyz), dv = dot(offset, p.v.xyz);
-    float d2 = du * du + dv * dv;
-    if (plane <= 0.0 || d2 >= 1.0)
+    vec2 offset = (pixel - p.image.xy) * p.image.zw;
+    float d2 = dot(offset, offset);
+    if (alpha <= 0.0 || d2 >= 1.0)
         return s;
     float opacity = min(alpha * kernel(d2), 1.0);
     float depth = opacity < 1.0 ? min(-log(1.0 - opacity), MAX_OPTICAL_DEPTH) : MAX_OPTICAL_DEPTH;
@@ -147,15 +115,13 @@ void composite(uint tile)
     // would change it by at most the transmittance times their brightest radiance, since what was drawn
     // before stays behind them, weighed by the transmittance, as the splats would have left it where opaque.
     // The pixel stays float32 through its splats, where the raster rounds it to half floats at each blend.
-    // A plain splat faces the image plane: its quad's image is a rectangle, over which the raster interpolates
-    // the kernel's coordinates linearly, so d is the pixel's offset from the image's centre over its half sizes.
     vec4 in_front = vec4(0.0);  // premultiplied: the splats nearer than the next one
     float transmittance = 1.0;
     for (uint k = tile_starts[tile + 1u]; k > tile_starts[tile] && transmittance > FINISHED_TRANSMITTANCE;) {
         Disc p = discs[tile_entries[--k]];
         vec2 offset = (vec2(pixel) - p.image.xy) * p.image.zw;
         float d2 = dot(offset, offset);
-        if (d2 >= 1.0 || p.depth >= world)
+        if (d2 >= 1.0 || dot(p.centre_r2.xyz, view_forward) >= world)
             continue;
         vec4 source = p.colour * kernel(d2);
         in_front += transmittance * source;
@@ -168,7 +134,7 @@ void composite(uint tile)
     float opaque = stored >= 1.0 ? FAR : world / dot(ray, view_forward);  // the world's distance along the ray
     Segment held = Segment(0.0, 0.0, 0.0, vec3(0.0));
     for (uint k = tile_starts[tile]; k < tile_starts[tile + 1u]; ++k) {
-        Segment s = segment_of(splat_of(instances[tile_entries[k]]), ray, opaque);
+        Segment s = segment_of(discs[tile_entries[k]], vec2(pixel), ray, opaque);
         if (s.depth <= 0.0)
             continue;
         if (held.depth <= 0.0) {
