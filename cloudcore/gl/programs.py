@@ -1,13 +1,15 @@
 """GLSL programs built from the .glsl files in `shaders/`, with constants injected as #defines.
 
 Constants shared with the numpy side (such as the splat sharpness) are
-injected rather than written twice, so the two cannot drift apart.  Compile
-and link errors raise with the driver's log and the file name.
+injected rather than written twice, so the two cannot drift apart; declarations
+shared by shaders live in a file of their own, which a line `#include "file.glsl"`
+stands for.  Compile and link errors raise with the driver's log and the file name.
 """
 
 from __future__ import annotations
 
 import functools
+import re
 from importlib.resources import files
 
 import numpy as np
@@ -47,8 +49,13 @@ def _link(name: str, shaders: list[int]) -> int:
     return program
 
 
+#: a line that stands for a file of `shaders/`: declarations shared by the shaders that include it
+_INCLUDE = re.compile(r'^#include "([\w.]+)"[^\n]*$', re.MULTILINE)
+
+
 def _compile(kind: int, file: str, defines: dict[str, int | float]) -> int:
     source = SHADER_DIR.joinpath(file).read_text(encoding="utf-8")
+    source = _INCLUDE.sub(lambda include: _included(source, include), source)
     version, _, body = source.partition("\n")
     if not version.startswith("#version"):
         raise ShaderError(f"{file}: the first line must be the #version directive")
@@ -66,6 +73,12 @@ def _compile(kind: int, file: str, defines: dict[str, int | float]) -> int:
         GL.glDeleteShader(shader)
         raise ShaderError(f"{file} failed to compile:\n{log}")
     return shader
+
+
+def _included(source: str, include: re.Match) -> str:
+    """The text of the file `include` names, then a #line that numbers the includer's next line as its own."""
+    next_line = source.count("\n", 0, include.start()) + 2
+    return f"{SHADER_DIR.joinpath(include.group(1)).read_text(encoding='utf-8')}#line {next_line}"
 
 
 def _text(log) -> str:

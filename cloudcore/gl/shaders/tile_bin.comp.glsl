@@ -29,22 +29,7 @@ layout(std430, binding = 13) buffer PairStarts { uint pair_starts[]; };  // per 
 layout(std430, binding = 10) buffer PairSlots { uint pair_slots[]; };
 layout(std430, binding = 11) buffer PairTiles { uint pair_tiles[]; };
 layout(std430, binding = 12) writeonly buffer TileStarts { uint tile_starts[]; };
-// the tiles with splats: a DispatchIndirectCommand of one group a tile (at most max_groups, the groups
-// looping over the rest), their count, and the tiles; the command's y and z and the count start at 1, 1, 0
-layout(std430, binding = 8) buffer Occupied {
-    uint groups_x;
-    uint groups_y;
-    uint groups_z;
-    uint occupied_count;
-    uint occupied[];
-};
-// per slot, the splat as volume_blend.comp.glsl composites it
-struct Disc {
-    vec4 image;      // in pixels: the centre, 1 / half width, 1 / half height
-    vec4 colour;     // premultiplied linear rgb, opacity
-    vec4 centre_r2;  // relative to the eye, and the radius squared
-};
-layout(std430, binding = 14) writeonly buffer Discs { Disc discs[]; };
+#include "binned_splats.glsl"
 
 uniform uint slots;        // the draw's slots, kept or not
 uniform uint count_at;     // its command's count in the command buffer (six a kept splat), or ALL_SLOTS

@@ -24,19 +24,7 @@ layout(local_size_x = TILE_PIXELS, local_size_y = TILE_PIXELS) in;
 
 layout(std430, binding = 6) readonly buffer TileStarts { uint tile_starts[]; };
 layout(std430, binding = 7) readonly buffer TileEntries { uint tile_entries[]; };
-// the tiles with splats, one group each (the dispatch's command first: tile_bin.comp.glsl's STARTS)
-layout(std430, binding = 8) readonly buffer Occupied {
-    uint groups[3];
-    uint occupied_count;
-    uint occupied[];
-};
-// per slot, what tile_bin.comp.glsl's COUNT made of its instance
-struct Disc {
-    vec4 image;      // in pixels: the centre, 1 / half width, 1 / half height
-    vec4 colour;     // premultiplied linear rgb, opacity
-    vec4 centre_r2;  // relative to the eye, and the radius squared
-};
-layout(std430, binding = 14) readonly buffer Discs { Disc discs[]; };
+#include "binned_splats.glsl"  // the occupied tiles, one group each, and the splats as binned
 layout(rgba16f, binding = 0) uniform image2D target;  // premultiplied linear colour, what was drawn so far
 uniform sampler2D world_depth;  // the frame's depth, window coordinates in [0, 1]
 
