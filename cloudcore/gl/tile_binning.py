@@ -35,22 +35,23 @@ from cloudcore.light.volume_blending import TILE_PIXELS
 
 #: the storage bindings of tile_bin.comp.glsl (instances and command as the splat pass binds them)
 _INSTANCES, _COMMAND, _COUNTER, _PAIR_SLOTS, _PAIR_TILES, _TILE_STARTS, _PAIR_STARTS = 3, 6, 9, 10, 11, 12, 13
-#: and of the occupied tiles, which volume_blend.comp.glsl reads at the same binding
-OCCUPIED_BINDING = 8
+#: and of shaders/binned_splats.glsl, which volume_blend.comp.glsl reads at the same bindings: the occupied
+#: tiles and the splats' discs
+OCCUPIED_BINDING, DISCS_BINDING = 8, 14
 #: the occupied buffer's header: a DispatchIndirectCommand (x, y, z groups) and the tiles' count
 _OCCUPIED_HEADER = np.array([0, 1, 1, 0], dtype=np.uint32)
+#: a disc's bytes: its image, colour, centre and radius squared (three vec4)
+_DISC_BYTES = 48
 #: the command's index that says every slot is kept (tile_bin.comp.glsl's ALL_SLOTS)
 _ALL_SLOTS = 0xFFFFFFFF
-#: and of its discs, which volume_blend.comp.glsl's PLAIN reads at the same binding
-DISCS_BINDING = 14
-#: a disc's bytes: its image (vec4), colour (vec4) and depth, a std430 struct padded to 16
-_DISC_BYTES = 48
 _GROUP = 64
 #: pairs past which a draw is left to the raster: 16 bytes each with the sorts' scratch, 512 MiB (at 1600x1200
 #: inside a cloud of the default scene, 7.1 million; a 4K screen there, about 30)
 MAX_PAIRS = 1 << 25
-_UNIFORMS = ("slots", "count_at", "view_rotation", "projection", "size", "tiles_across", "tiles_up", "near", "pairs")
-_UNIFORMS += ("max_groups",)
+_UNIFORMS = (
+    *("slots", "count_at", "view_rotation", "projection", "size", "tiles_across", "tiles_up", "near"),
+    *("pairs", "max_groups"),
+)
 
 
 @dataclass(frozen=True)

@@ -19,3 +19,11 @@ struct Disc {
     vec4 centre_r2;  // relative to the eye, and the radius squared
 };
 layout(std430, binding = 14) buffer Discs { Disc discs[]; };
+
+// the kernel's d squared at `pixel` (pixel centres whole numbers): its offset from the image's centre over the
+// half sizes, the raster's interpolation over a quad that faces the image plane
+float d2_at(Disc p, vec2 pixel)
+{
+    vec2 offset = (pixel - p.image.xy) * p.image.zw;
+    return dot(offset, offset);
+}

@@ -69,8 +69,7 @@ Segment segment_of(Disc p, vec2 pixel, vec3 ray, float opaque)
 {
     Segment s = Segment(0.0, 0.0, 0.0, vec3(0.0));
     float alpha = p.colour.a;
-    vec2 offset = (pixel - p.image.xy) * p.image.zw;
-    float d2 = dot(offset, offset);
+    float d2 = d2_at(p, pixel);
     if (alpha <= 0.0 || d2 >= 1.0)
         return s;
     float opacity = min(alpha * kernel(d2), 1.0);
@@ -107,8 +106,7 @@ void composite(uint tile)
     float transmittance = 1.0;
     for (uint k = tile_starts[tile + 1u]; k > tile_starts[tile] && transmittance > FINISHED_TRANSMITTANCE;) {
         Disc p = discs[tile_entries[--k]];
-        vec2 offset = (vec2(pixel) - p.image.xy) * p.image.zw;
-        float d2 = dot(offset, offset);
+        float d2 = d2_at(p, vec2(pixel));
         if (d2 >= 1.0 || dot(p.centre_r2.xyz, view_forward) >= world)
             continue;
         vec4 source = p.colour * kernel(d2);
