@@ -50,7 +50,7 @@ def test_each_pass_is_timed_on_the_cpu_and_on_the_gpu_within_its_wall_time(after
         "impostor updates": (stats.impostor_update_ms, stats.impostor_update_gpu_ms),
         "clouds": (stats.cloud_ms, stats.cloud_gpu_ms),
     }
-    # the GPU's time lies inside the pass's bracket on the wall clock (a millisecond for the clocks' grain)
+    # the GPU's time lies inside the pass's share of the frame (a millisecond for the clocks' grain)
     for name, (wall_ms, gpu_ms) in passes.items():
         assert 0.0 <= gpu_ms <= wall_ms + 1.0, (name, wall_ms, gpu_ms)
     assert stats.cloud_gpu_ms > 0.0 and stats.world_gpu_ms > 0.0  # full 3D draws both

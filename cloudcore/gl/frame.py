@@ -216,26 +216,27 @@ class FrameRenderer:
         before_passes_ms = 1e3 * (time.perf_counter() - planning_started)
         self._splats.particles_as_points = 0
         self._particles_as_volumes = 0
-        clock = self._clock
-        with clock.timed("world"):
-            antialiased = settings.world_antialiasing
-            self._world.draw(self.context, camera, projection @ view, antialiased=antialiased)
-            if plan.objects_with_world:
-                self._objects.draw(
-                    self.context, camera, poses, plan.objects_with_world, write_depth=True, antialiased=antialiased
-                )
         gl_renderer = self._volume.features.renderer
         way = self.splat_order.way(settings.splat_order, gl_renderer)
         compositing = self.compositing.get(settings.mode, MeasuredWay(COMPOSITING_WAYS))
         composited_by = compositing.way(settings.compositing, gl_renderer)
         self._compositable = 0
-        with clock.timed("impostor updates"):
-            rendered = self._impostors.update(plan, particles, settings, time_s, way)
-        with clock.timed("clouds"):
-            self.context.bind_target()
-            drawn = self._draw_clouds(
-                plan, particles, camera, view, projection, settings, poses, time_s, way, composited_by
-            )
+        clock = self._clock
+        with clock.frame():
+            with clock.timed("world"):
+                antialiased = settings.world_antialiasing
+                self._world.draw(self.context, camera, projection @ view, antialiased=antialiased)
+                if plan.objects_with_world:
+                    self._objects.draw(
+                        self.context, camera, poses, plan.objects_with_world, write_depth=True, antialiased=antialiased
+                    )
+            with clock.timed("impostor updates"):
+                rendered = self._impostors.update(plan, particles, settings, time_s, way)
+            with clock.timed("clouds"):
+                self.context.bind_target()
+                drawn = self._draw_clouds(
+                    plan, particles, camera, view, projection, settings, poses, time_s, way, composited_by
+                )
         drawn_by_gpu, rendered_by_gpu = self._splats.take_selected()
         drawn, rendered = drawn + drawn_by_gpu, rendered + rendered_by_gpu
         world, updates, clouds = (clock.times[name] for name in ("world", "impostor updates", "clouds"))

@@ -6,8 +6,8 @@ on the screen and into textures, impostor-quad pixels, regenerations, splat
 draws) and prices it with a
 `CostModel`, milliseconds per unit of work.  The coefficients are not
 constants of the code: `CostEstimator` fits them to the passes' measured
-times (the renderer times its impostor updates and its cloud pass to
-`glFinish`) by exponentially forgetting least squares, anchored to a prior.
+times (what the renderer's impostor updates and cloud pass each add to the
+frame: `cloudcore.gl.pass_clock`) by exponentially forgetting least squares, anchored to a prior.
 On llvmpipe fragments dominate, so impostors win; on a GPU where a
 regeneration's fixed cost dominates, full 3D does; the same plan code picks
 each, from numbers measured on the machine it runs on.  The fragment counts

@@ -49,12 +49,12 @@ class PlanStats:
 
 @dataclass(frozen=True)
 class FrameStats:
-    """One frame: the plan's choices, what the renderer drew, and the passes' times (to glFinish, on the
-    CPU, on the GPU); the defaults are an empty frame's."""
+    """One frame: the plan's choices, what the renderer drew, and the passes' times (what each added to the
+    frame, on the CPU, on the GPU: `cloudcore.gl.pass_clock`); the defaults are an empty frame's."""
 
     plan: PlanStats = field(default_factory=PlanStats)
     illumination_ms: float = 0.0  # shading the particles' light, when the scene or its light changed
-    frame_ms: float = 0.0  # planning, then world, impostor updates and cloud pass, each to its glFinish
+    frame_ms: float = 0.0  # planning, then world, impostor updates and cloud pass, to the frame's glFinish
     #: on the CPU before the passes: the plan, the splats' facings; auto mode prices its choices there, and on a
     #: 1.2M-particle field that once took longer than its passes
     plan_ms: float = 0.0
@@ -63,7 +63,7 @@ class FrameStats:
     cloud_ms: float = 0.0
     #: the CPU's part: planning, then issuing the three passes (Python, numpy, driver calls), not waiting for them
     cpu_ms: float = 0.0
-    #: the GPU's time on each pass (GL_TIME_ELAPSED queries: `cloudcore.gl.pass_clock`)
+    #: the GPU's time on each pass (GL_TIMESTAMP queries: `cloudcore.gl.pass_clock`)
     world_gpu_ms: float = 0.0
     impostor_update_gpu_ms: float = 0.0
     cloud_gpu_ms: float = 0.0

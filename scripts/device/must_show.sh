@@ -3,7 +3,7 @@
 #   command: bash scripts/device/must_show.sh      carry: [".whl", ".gl"]      timeout_s: 560
 # Every step is bounded by what is left of BUDGET_S (default 480 s) so the call ends inside its limit with
 # whatever finished; a step that fails is logged and the next one runs.  STEPS names the steps to run (default
-# "flythroughs renders editor tests field"; also "lod", "compositing", "sort" and "compute").  Writes to $OUT (8 files come back):
+# "flythroughs renders editor tests field"; also "lod", "compositing", "sort", "compute" and "waits").  Writes to $OUT (8 files come back):
 #   log.txt          every command's output: the GPU, frame means per mode and order, the GPU tests
 #   flythroughs: fly_640.json, fly_1600.json   the default flythrough at 640x480 (181 frames) and 1600x1200
 #                    (91): full 3D and auto, each with the CPU's and the GPU's splat order (the reference: full
@@ -20,6 +20,8 @@
 #   compute: compute_640.json, compute_1600.json   the flythrough (91 and 61 frames), full 3D and auto with the
 #                    GPU's order, their splats blended by the raster or composited by compute (`compositing`);
 #                    and the compute compositor's tests, in log.txt
+#   waits: waits.json          a frame waited for once against a wait after each pass, side by side
+#                    (`bench_pass_waits.py`): the flythrough (181 frames) and the still view, each mode
 # LOCAL=1 runs it here on llvmpipe with a few frames and no setup: a check of the script, not numbers.
 set -uo pipefail
 OUT=${OUT:-out/must_show}
@@ -102,6 +104,10 @@ if wanted compute; then
 fi
 if wanted sort; then
   step "sort" "$python" scripts/bench_gpu_sort.py --json "$OUT/sort.json"
+fi
+if wanted waits; then
+  step "waits" "$python" scripts/bench_pass_waits.py --cases flythrough,still --frames "$fly_640" \
+    --json "$OUT/waits.json"
 fi
 if wanted lod; then
   # shellcheck disable=SC2086

@@ -1,0 +1,71 @@
+"""A frame's passes timed on one timeline (`cloudcore.gl.pass_clock`): the GPU runs behind the CPU until the
+frame's one glFinish, and the passes' wall times add up to the frame's."""
+
+import time
+
+import pytest
+
+
+@pytest.fixture
+def clock(renderer):
+    from cloudcore.gl.pass_clock import PassClock
+
+    renderer.context.make_current()
+    clock = PassClock()
+    yield clock
+    clock.close()
+
+
+def clear_screen(renderer):
+    from OpenGL import GL
+
+    renderer.context.bind_target()
+    GL.glClearColor(0.2, 0.3, 0.4, 1.0)
+    GL.glClear(GL.GL_COLOR_BUFFER_BIT)
+
+
+def test_a_frame_waits_for_the_gpu_once_not_after_each_pass(renderer, clock, monkeypatch):
+    from OpenGL import GL
+
+    finishes = []
+    finish = GL.glFinish
+    monkeypatch.setattr(GL, "glFinish", lambda: (finishes.append(sorted(clock._issued)), finish())[1])
+    with clock.frame():
+        for name in ("world", "impostor updates", "clouds"):
+            with clock.timed(name):
+                clear_screen(renderer)
+    assert finishes == [["clouds", "impostor updates", "world"]]  # once, after the last pass was issued
+    assert list(clock.times) == ["world", "impostor updates", "clouds"]
+
+
+def test_the_passes_wall_times_add_up_to_the_frames_and_count_the_cpu_between_them(renderer, clock):
+    started = time.perf_counter()
+    with clock.frame():
+        with clock.timed("draw"):
+            clear_screen(renderer)
+        time.sleep(0.02)  # the CPU's work between two passes is the second's
+        with clock.timed("wait"):
+            time.sleep(0.03)
+    frame_ms = 1e3 * (time.perf_counter() - started)
+    draw, wait = clock.times["draw"], clock.times["wait"]
+    print(f"draw {draw}, wait {wait}, frame {frame_ms:.2f} ms")
+    assert wait.cpu_ms >= 30.0 and wait.wall_ms >= 50.0
+    assert draw.wall_ms + wait.wall_ms == pytest.approx(frame_ms, abs=2.0)
+    for time_of in (draw, wait):
+        assert 0.0 <= time_of.gpu_ms <= time_of.wall_ms + 1.0  # the GPU's time within the pass's share of the frame
+
+
+def test_passes_are_timed_only_inside_a_frame_and_once_each(clock):
+    with pytest.raises(RuntimeError, match="outside a frame"):
+        with clock.timed("world"):
+            pass
+    with pytest.raises(ValueError, match="timed twice"):
+        with clock.frame():
+            with clock.timed("world"):
+                pass
+            with clock.timed("world"):
+                pass
+    with clock.frame():  # a refused frame leaves the clock ready for the next
+        with clock.timed("world"):
+            pass
+    assert list(clock.times) == ["world"]
