@@ -136,3 +136,38 @@ def test_a_draw_with_too_many_tile_pairs_is_left_to_the_raster(renderer, valley,
     image, stats = renderer.render(valley, settings=COMPUTE)
     assert compare(image, raster).max_abs == 0
     assert stats.particles_drawn == raster_stats.particles_drawn > 0
+
+
+def test_only_selections_of_plain_splats_are_compositable(renderer):
+    """A selection is composited by compute only where all its clouds' particles are plain Gaussian splats of one
+    colour; the formation scene's are sprites, the aircraft scene's cloud plain."""
+    from cloudcore.artist.particle_styles import particle_styles
+    from cloudcore.gl.splats import SplatPass, SplatSelection
+    from cloudcore.light.eye_scattering import ParticleBuffer
+    from cloudcore.light.illumination import IlluminationCache
+    from cloudcore.light.lighting import scene_lights
+    from cloudcore.point_sprites import plain_splats
+
+    sprites = load_scene(resource_path("scenes", "formation.toml"))
+    clouds = sprites.clouds + load_scene(resource_path("scenes", "aircraft_in_cloud.toml")).clouds
+    lights, ambient = scene_lights(sprites.lighting)
+    particles = ParticleBuffer(
+        clouds,
+        sprites.shading,
+        lights,
+        ambient,
+        "exact",
+        IlluminationCache(),
+        particle_styles(clouds, sprites.lighting),
+    )
+    plain, starts = plain_splats(particles.styles), particles.cloud_starts
+    cloud_plain = [bool(plain[start:end].all()) for start, end in zip(starts[:-1], starts[1:])]
+    assert cloud_plain == [False] * len(sprites.clouds) + [True]
+    renderer.context.make_current()
+    splats = SplatPass()
+    try:
+        for members in [(cloud,) for cloud in range(len(clouds))] + [tuple(range(len(clouds))), (3, 0)]:
+            selection = SplatSelection(particles, members, np.zeros(3), None, 0.0, None)
+            assert splats.plain_selection(selection) == all(cloud_plain[c] for c in members), members
+    finally:
+        splats.close()

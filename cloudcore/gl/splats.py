@@ -249,6 +249,7 @@ class SplatPass:
         }
         self._point_sizes_px = tuple(float(size) for size in GL.glGetFloatv(GL.GL_POINT_SIZE_RANGE))
         self._plain: np.ndarray = np.zeros(0, dtype=bool)  # of the resident particles: `plain_splats`
+        self._cloud_plain: np.ndarray = np.zeros(0, dtype=bool)  # of their clouds: all particles plain
         self._sprites: np.ndarray = np.zeros(0, dtype=bool)  # of the resident particles: drawn from the atlas
         #: of the resident particles: per particle, (facing, artist) as bits; whether there are Yusov's profiles
         self._feature_bits: np.ndarray = np.zeros(0, dtype=np.uint8)
@@ -500,8 +501,7 @@ class SplatPass:
         """Whether every particle of a selection's clouds is a plain Gaussian splat of one colour
         (`cloudcore.point_sprites.plain_splats`): what a compute pass can composite."""
         self._make_resident(selection.particles)
-        starts = selection.particles.cloud_starts
-        return all(bool(self._plain[starts[c] : starts[c + 1]].all()) for c in selection.clouds)
+        return bool(np.all(self._cloud_plain[list(selection.clouds)]))
 
     def take_selected(self) -> tuple[int, int]:
         """(the particles that the selections drawn into targets since the last call chose, those drawn into
@@ -810,6 +810,9 @@ class SplatPass:
                 GL.GL_DYNAMIC_DRAW,
             )
             self._plain = plain_splats(particles.styles)
+            # per cloud, whether all its particles are plain: asked each frame, of hundreds of clouds on a field
+            not_plain = np.concatenate([[0], np.cumsum(~self._plain)])
+            self._cloud_plain = not_plain[particles.cloud_starts[1:]] == not_plain[particles.cloud_starts[:-1]]
             self._sprites = particles.styles.sprite_index >= 0
             if self._atlas is None and np.any(particles.styles.sprite_index >= 0):
                 self._atlas = _atlas_texture()
