@@ -23,8 +23,9 @@ the frame ends with one glFinish.  Each pass is timed three ways:
 
 The wall time is what the cost model fits (`LodState.measured`).  Before, each
 pass ended with its own glFinish, and the GPU idled while the CPU issued the
-next pass: full 3D along the default flythrough took 4-7% longer a frame on
-llvmpipe (docs/performance.md, "One wait a frame").  A pass that keeps the
+next pass: impostor and auto frames took 2-6% longer on llvmpipe, whose
+rasteriser shares the cores with the Python issuing the next pass
+(docs/performance.md, "One wait a frame").  A pass that keeps the
 GPU busy shows GPU near wall; one bound by the CPU shows CPU near wall.  The
 queries are read after the frame's glFinish, so reading them never waits.
 """
