@@ -21,12 +21,13 @@
 
 layout(local_size_x = GROUP) in;
 
-layout(std430, binding = 0) readonly buffer KeysIn { uint keys_in[]; };
-layout(std430, binding = 1) readonly buffer ValuesIn { uint values_in[]; };
-layout(std430, binding = 2) writeonly buffer KeysOut { uint keys_out[]; };
-layout(std430, binding = 3) writeonly buffer ValuesOut { uint values_out[]; };
+// past the prefix sum's bindings (0 and 1): its scan between the stages leaves these bound
+layout(std430, binding = 2) readonly buffer KeysIn { uint keys_in[]; };
+layout(std430, binding = 3) readonly buffer ValuesIn { uint values_in[]; };
+layout(std430, binding = 4) writeonly buffer KeysOut { uint keys_out[]; };
+layout(std430, binding = 5) writeonly buffer ValuesOut { uint values_out[]; };
 // per (digit, tile), digit-major: COUNT writes the counts, the prefix sum turns them into output starts
-layout(std430, binding = 4) buffer TileCounts { uint tile_counts[]; };
+layout(std430, binding = 6) buffer TileCounts { uint tile_counts[]; };
 
 uniform uint count;  // pairs to sort
 uniform uint shift;  // the digit's lowest bit
