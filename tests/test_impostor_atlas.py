@@ -8,9 +8,10 @@ from conftest import VALLEY
 from OpenGL import GL
 from test_atlas import overlaps
 
-from cloudcore.gl.impostor_atlas import INSTANCE_FLOATS, AtlasImage, ImpostorAtlas
+from cloudcore.gl.impostor_atlas import INSTANCE_FLOATS, AtlasImage, ImpostorAtlas, atlas_instances
 from cloudcore.gl.targets import TextureTarget
 from cloudcore.lod.atlas import Cell
+from cloudcore.lod.impostors import cropped_corners
 from cloudcore.scenefile import load_scene
 from cloudcore.settings import RenderSettings
 
@@ -48,7 +49,7 @@ def test_an_instance_samples_its_own_texels_clamped_half_a_texel_inside_them():
     atlas = types.SimpleNamespace(layer_side=512)
     image = AtlasImage(atlas, Cell(layer=3, y=256, x=128, side=128), side=100)
     corners = np.arange(12.0).reshape(4, 3)
-    instance = image.instance(corners, 0.75, (0.0, 0.5, 1.0, 1.0))
+    (instance,) = atlas_instances([image], corners[None], [0.75], np.array([(0.0, 0.5, 1.0, 1.0)]))
     assert instance.shape == (INSTANCE_FLOATS,) and instance.dtype == np.float32
     np.testing.assert_array_equal(instance[:12], corners.ravel())
     np.testing.assert_allclose(instance[12:16], np.array([128, 306, 228, 356]) / 512, rtol=1e-6)
@@ -210,3 +211,25 @@ def test_cells_chosen_and_sorted_on_the_gpu_hold_what_each_drawn_alone_holds(ren
     finally:
         splats.close()
         atlas.close()
+
+
+def test_a_frames_instances_made_at_once_are_each_made_alone():
+    """`atlas_instances` and `cropped_corners` over many quads give, row by row, what each gives alone."""
+    atlas = types.SimpleNamespace(layer_side=256)
+    rng = np.random.default_rng(3)
+    images = [AtlasImage(atlas, Cell(layer=i, y=32 * i, x=64, side=64), side=40 + i) for i in range(5)]
+    corners = rng.normal(size=(5, 4, 3))
+    u, v = np.sort(rng.uniform(size=(5, 2)), axis=1), np.sort(rng.uniform(size=(5, 2)), axis=1)
+    extents = np.column_stack([u[:, 0], v[:, 0], u[:, 1], v[:, 1]])  # u0, v0, u1, v1
+    weights = rng.uniform(size=5)
+    cropped = cropped_corners(corners, extents)
+    together = atlas_instances(images, cropped, weights, extents)
+    for i in range(5):
+        alone = cropped_corners(corners[i], tuple(extents[i]))
+        np.testing.assert_allclose(cropped[i], alone, rtol=1e-12, atol=1e-12)
+        u0, v0, u1, v1 = extents[i]  # the quad's corners at the extent's, on its plane
+        origin, right, up = corners[i, 0], corners[i, 1] - corners[i, 0], corners[i, 2] - corners[i, 0]
+        np.testing.assert_allclose(alone[3], origin + u1 * right + v1 * up, rtol=1e-12, atol=1e-12)
+        np.testing.assert_array_equal(
+            together[i], atlas_instances([images[i]], alone[None], [weights[i]], extents[i : i + 1])[0]
+        )

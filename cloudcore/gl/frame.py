@@ -38,6 +38,7 @@ from cloudcore.camera import NEAR_PLANE_M, frustum_planes, projection_matrix, vi
 from cloudcore.colour import linear_to_srgb8
 from cloudcore.field.state import FieldState, update_field
 from cloudcore.gl.context import HeadlessContext, WindowContext, check_frame_size
+from cloudcore.gl.impostor_atlas import atlas_instances
 from cloudcore.gl.impostor_store import ImpostorStore
 from cloudcore.gl.objects import ObjectPass
 from cloudcore.gl.pass_clock import PassClock
@@ -552,15 +553,15 @@ class FrameRenderer:
     def _draw_impostors(self, frame: _CloudPassFrame, items) -> None:
         """Units' impostors (a layer each, when split around objects), consecutive in the pass: one instanced
         draw from the atlas (two, where larger impostors than its layers' side need one of their own)."""
-        runs = []  # [atlas, instances]: consecutive quads from one atlas
-        for item in items:
-            cloud = frame.plan.clouds[item.index]
-            image, corners, extent = self._impostors.cloud_impostor(cloud.members, item.layer)
-            if not runs or runs[-1][0] is not image.atlas:
-                runs.append([image.atlas, []])
-            runs[-1][1].append(image.instance(corners, cloud.impostor_weight, extent))
-        for atlas, instances in runs:
-            self._draw_instanced(frame, atlas.texture, np.stack(instances))
+        clouds = [frame.plan.clouds[item.index] for item in items]
+        images, corners, extents = self._impostors.cloud_impostors(
+            [(cloud.members, item.layer) for cloud, item in zip(clouds, items)]
+        )
+        weights = [cloud.impostor_weight for cloud in clouds]
+        run_starts = [i for i, image in enumerate(images) if i == 0 or image.atlas is not images[i - 1].atlas]
+        for start, end in zip(run_starts, [*run_starts[1:], len(images)]):  # consecutive quads from one atlas
+            instances = atlas_instances(images[start:end], corners[start:end], weights[start:end], extents[start:end])
+            self._draw_instanced(frame, images[start].atlas.texture, instances)
 
     def _draw_instanced(self, frame: _CloudPassFrame, atlas_texture: int, instances: np.ndarray, **crossfade) -> None:
         """Quads from the atlas (`QuadPass.draw_instanced`), depth-tested, in one draw."""
@@ -582,7 +583,7 @@ class FrameRenderer:
         layer.bind_cleared()
         drawn = self._draw_splats(frame, batch, layer.texture)
         self.context.bind_target()
-        instance = image.instance(corners, cloud.impostor_weight, extent)[None]
+        instance = atlas_instances([image], corners[None], [cloud.impostor_weight], extent[None])
         self._draw_instanced(
             frame, image.atlas.texture, instance, layer_texture=layer.texture, layer_weight=cloud.full_weight
         )

@@ -140,14 +140,24 @@ class AtlasImage:
     def read(self) -> np.ndarray:
         return self.atlas.read(self.cell, self.side)
 
-    def instance(self, corners: np.ndarray, weight: float, extent) -> np.ndarray:
-        """The quad of world `corners` (4, 3) showing the part `extent` (u0, v0, u1, v1) of this image at
-        `weight`, as one instance of `QuadPass.draw_instanced`."""
-        scale, (x, y) = self.side / self.atlas.layer_side, (self.cell.x, self.cell.y)
-        origin = np.array([x, y, x, y], dtype=np.float64) / self.atlas.layer_side
-        uv_rect = origin + scale * np.asarray(extent, dtype=np.float64)
-        half = 0.5 / self.atlas.layer_side
-        clamp_rect = origin + np.array([half, half, scale - half, scale - half])
-        return np.concatenate(
-            [np.asarray(corners, dtype=np.float64).ravel(), uv_rect, clamp_rect, [weight, self.cell.layer]]
-        ).astype(np.float32)
+
+def atlas_instances(images, corners: np.ndarray, weights, extents: np.ndarray) -> np.ndarray:
+    """Instances of `QuadPass.draw_instanced` (n, `INSTANCE_FLOATS`), one per image of `images` (of one atlas):
+    the quad of world `corners` (n, 4, 3) showing the part `extents` (n, 4: u0, v0, u1, v1) of its image at
+    its weight of `weights`, its texels clamped half a texel inside its own.  A frame's impostors at once: one
+    at a time cost 29 us each on the CPU, 18 a frame along the default flythrough."""
+    layer_side = float(images[0].atlas.layer_side)
+    cells = np.array([(image.cell.x, image.cell.y, image.side, image.cell.layer) for image in images], dtype=np.float64)
+    origin, scale = cells[:, [0, 1, 0, 1]] / layer_side, cells[:, 2:3] / layer_side
+    half = 0.5 / layer_side
+    inside = np.concatenate([np.full((len(cells), 2), half), np.repeat(scale - half, 2, axis=1)], axis=1)
+    return np.concatenate(
+        [
+            np.asarray(corners, dtype=np.float64).reshape(len(cells), 12),
+            origin + scale * np.asarray(extents, dtype=np.float64),  # the part of the image shown
+            origin + inside,  # where its texels are sampled: its own, half a texel in
+            np.asarray(weights, dtype=np.float64)[:, None],
+            cells[:, 3:4],
+        ],
+        axis=1,
+    ).astype(np.float32)

@@ -157,11 +157,18 @@ class ImpostorStore:
         """GPU memory of the atlases and of the ring's textures, in use and idle."""
         return self.pool.bytes_total + sum(atlas.nbytes for atlas in self._atlases.values())
 
-    def cloud_impostor(self, members: tuple, layer: int = 0) -> tuple[AtlasImage, np.ndarray, tuple]:
+    def cloud_impostor(self, members: tuple, layer: int = 0) -> tuple[AtlasImage, np.ndarray, np.ndarray]:
         """(image of layer `layer` of the unit of clouds `members`, the world corners of the part of its
         quad that can show particles, the part of the image they cover (u0, v0, u1, v1))."""
-        targets, view, extent = self._clouds[members]
-        return targets[layer], cropped_corners(view.corners, extent), extent
+        images, corners, extents = self.cloud_impostors([(members, layer)])
+        return images[0], corners[0], extents[0]
+
+    def cloud_impostors(self, keys) -> tuple[list[AtlasImage], np.ndarray, np.ndarray]:
+        """`cloud_impostor` of each (members, layer) of `keys`, the corners (n, 4, 3) and parts (n, 4) as arrays."""
+        held = [(self._clouds[members], layer) for members, layer in keys]
+        corners = np.array([view.corners for (_, view, _), _ in held], dtype=np.float64).reshape(-1, 4, 3)
+        extents = np.array([extent for (_, _, extent), _ in held], dtype=np.float64).reshape(-1, 4)
+        return [targets[layer] for (targets, _, _), layer in held], cropped_corners(corners, extents), extents
 
     def ring_panel(
         self, generation: RingGeneration, segment: int, elevation_deg: float

@@ -119,10 +119,14 @@ def particle_extent(
 
 
 def cropped_corners(corners: np.ndarray, extent) -> np.ndarray:
-    """The quad `corners` (lower left, lower right, upper left, upper right) cut to `extent` (u0, v0, u1, v1)."""
-    u0, v0, u1, v1 = extent
-    right, up = corners[1] - corners[0], corners[2] - corners[0]
-    return np.array([corners[0] + u * right + v * up for u, v in ((u0, v0), (u1, v0), (u0, v1), (u1, v1))])
+    """The quad `corners` (..., 4, 3: lower left, lower right, upper left, upper right) cut to `extent`
+    (..., 4: u0, v0, u1, v1): one quad, or many at once (a frame's impostors)."""
+    corners, extent = np.asarray(corners, dtype=np.float64), np.asarray(extent, dtype=np.float64)
+    origin = corners[..., 0:1, :]
+    right, up = corners[..., 1:2, :] - origin, corners[..., 2:3, :] - origin
+    u = extent[..., [0, 2, 0, 2], None]  # per corner: u0, u1, u0, u1
+    v = extent[..., [1, 1, 3, 3], None]
+    return origin + u * right + v * up
 
 
 def _tangent(radius: float, distance: float) -> float:
