@@ -25,6 +25,7 @@ folds the two timed passes into the state's cost fit:
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import time
 from dataclasses import dataclass
 
@@ -557,11 +558,11 @@ class FrameRenderer:
         images, corners, extents = self._impostors.cloud_impostors(
             [(cloud.members, item.layer) for cloud, item in zip(clouds, items)]
         )
-        weights = [cloud.impostor_weight for cloud in clouds]
-        run_starts = [i for i, image in enumerate(images) if i == 0 or image.atlas is not images[i - 1].atlas]
-        for start, end in zip(run_starts, [*run_starts[1:], len(images)]):  # consecutive quads from one atlas
-            instances = atlas_instances(images[start:end], corners[start:end], weights[start:end], extents[start:end])
-            self._draw_instanced(frame, images[start].atlas.texture, instances)
+        weights = np.array([cloud.impostor_weight for cloud in clouds])
+        for _, run in itertools.groupby(range(len(images)), key=lambda i: id(images[i].atlas)):  # one atlas a run
+            run = list(run)
+            instances = atlas_instances([images[i] for i in run], corners[run], weights[run], extents[run])
+            self._draw_instanced(frame, images[run[0]].atlas.texture, instances)
 
     def _draw_instanced(self, frame: _CloudPassFrame, atlas_texture: int, instances: np.ndarray, **crossfade) -> None:
         """Quads from the atlas (`QuadPass.draw_instanced`), depth-tested, in one draw."""
