@@ -56,6 +56,34 @@ def test_the_passes_wall_times_add_up_to_the_frames_and_count_the_cpu_between_th
         assert 0.0 <= time_of.gpu_ms <= time_of.wall_ms + 1.0  # the GPU's time within the pass's share of the frame
 
 
+def test_a_pass_gpu_time_covers_its_raster_work(renderer, clock):
+    """A pass whose one draw fills the screen 400 times is bound by the raster: its GPU time is nearly its wall
+    time.  llvmpipe answers a timestamp when it rasterises the last tile holding it, so a pass's first query,
+    binned with the pass's draws, came back as late as the last tile's start: 0.04 of a 5 ms cloud pass."""
+    from OpenGL import GL
+
+    from cloudcore.gl.programs import build_program
+
+    program = build_program("world")  # one triangle over the screen, from gl_VertexID alone
+    vertex_array = GL.glGenVertexArrays(1)
+    try:
+        with clock.frame():
+            with clock.timed("clear"):
+                clear_screen(renderer)
+            with clock.timed("fill"):
+                GL.glUseProgram(program)
+                GL.glDisable(GL.GL_DEPTH_TEST)
+                GL.glBindVertexArray(vertex_array)
+                GL.glDrawArraysInstanced(GL.GL_TRIANGLES, 0, 3, 400)
+                GL.glBindVertexArray(0)
+    finally:
+        GL.glDeleteVertexArrays(1, [vertex_array])
+        GL.glDeleteProgram(program)
+    fill = clock.times["fill"]
+    print(f"fill {fill}")
+    assert fill.gpu_ms >= 0.5 * fill.wall_ms - 0.5  # the absolute half millisecond: a GPU fills it in far less
+
+
 def test_passes_are_timed_only_inside_a_frame_and_once_each(clock):
     with pytest.raises(RuntimeError, match="outside a frame"):
         with clock.timed("world"):
