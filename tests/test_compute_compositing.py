@@ -55,7 +55,15 @@ def test_layers_split_around_an_object_composite_as_the_raster_draws_them(render
     assert difference.within(min_psnr_db=50.0, max_abs=1), str(difference)
 
 
-def test_the_gpu_bins_each_tile_far_to_near_and_only_the_kept_splats(renderer, valley):
+@pytest.fixture
+def counts_on_gpu(monkeypatch):
+    """Draws' tile pair counts kept on the GPU, as on a GPU (a software GL reads them back: `counts_stay_on_gpu`)."""
+    from cloudcore.gl import tile_binning
+
+    monkeypatch.setattr(tile_binning, "counts_stay_on_gpu", lambda: True)
+
+
+def test_the_gpu_bins_each_tile_far_to_near_and_only_the_kept_splats(renderer, valley, counts_on_gpu):
     """The bins' structure as `ScreenTiles` has it: tile t's entries from starts[t] to starts[t + 1], each run
     ascending (the draw's far-to-near order), every entry a splat the selection kept, and every kept splat
     on screen in the tile of its centre; each tile as many as the numpy binning lists of the same splats (its
@@ -77,9 +85,18 @@ def test_the_gpu_bins_each_tile_far_to_near_and_only_the_kept_splats(renderer, v
         (order,) = splats.read_orders(selection, view)
         binned = binning.bin(instances, count_at, view, projection, (RENDER_WIDTH, RENDER_HEIGHT))
         starts, entries, occupied, groups = binning.read(binned)
+        assert not binning.settle()  # counted here, nothing to draw again; the next draw's count stays on the GPU
+        on_gpu = binning.bin(instances, count_at, view, projection, (RENDER_WIDTH, RENDER_HEIGHT))
+        counted_on_gpu = binning.read(on_gpu)
     finally:
         splats.close()
         binning.close()
+    assert on_gpu.pairs is None and on_gpu.room >= binned.pairs  # the same bins (the occupied tiles in no order)
+    starts_there, entries_there, occupied_there, groups_there = counted_on_gpu
+    np.testing.assert_array_equal(starts_there, starts)
+    np.testing.assert_array_equal(entries_there, entries)
+    np.testing.assert_array_equal(np.sort(occupied_there), np.sort(occupied))
+    np.testing.assert_array_equal(groups_there, groups)
     tiles = binned.across * binned.up
     assert len(starts) == tiles + 1 and starts[0] == 0 and starts[-1] == binned.pairs == len(entries)
     assert np.all(np.diff(starts.astype(np.int64)) >= 0)
@@ -136,6 +153,37 @@ def test_a_draw_with_too_many_tile_pairs_is_left_to_the_raster(renderer, valley,
     image, stats = renderer.render(valley, settings=COMPUTE)
     assert compare(image, raster).max_abs == 0
     assert stats.particles_drawn == raster_stats.particles_drawn > 0
+
+
+def test_a_frame_reads_no_tile_count_back_before_its_one_wait(renderer, valley, counts_on_gpu, monkeypatch):
+    """Once a frame has been binned, the next frames' counts stay on the GPU: the CPU never waits mid-frame for
+    them (on the H200 reading the count back cost the compute pass 2.4 ms of CPU a frame)."""
+    from OpenGL import GL
+
+    renderer.render(valley, settings=COMPUTE)  # counted on the CPU's side if the renderer had not binned before
+    events = []
+    finish, read = GL.glFinish, GL.glGetBufferSubData
+    monkeypatch.setattr(GL, "glFinish", lambda: (events.append("wait"), finish())[1])
+    monkeypatch.setattr(GL, "glGetBufferSubData", lambda *arguments: (events.append("read"), read(*arguments))[1])
+    _, stats = renderer.render(valley, settings=COMPUTE, read_back=False)
+    assert stats.compositing == "compute" and not stats.drawn_again
+    assert events[0] == "wait", events  # the counts are read after it, when reading waits for nothing
+
+
+def test_a_draw_past_the_room_for_its_pairs_is_drawn_again_counted_first(renderer, valley, counts_on_gpu, monkeypatch):
+    """With each draw's room half the pairs it had the frame before, a draw loses its nearest splats; the frame
+    is drawn again with the count read back first: the picture is the one counted first, the frame's times both
+    drawings'."""
+    from cloudcore.gl import tile_binning
+
+    expected, _ = renderer.render(valley, settings=COMPUTE)
+    monkeypatch.setattr(tile_binning, "ROOM_FACTOR", 0.5)
+    monkeypatch.setattr(tile_binning, "MIN_ROOM", 1)
+    renderer.render(valley, settings=COMPUTE)  # settles with room for half its pairs
+    image, stats = renderer.render(valley, settings=COMPUTE)
+    assert stats.drawn_again and stats.compositing == "compute"
+    assert compare(image, expected).max_abs == 0
+    assert stats.frame_ms >= stats.plan_ms + stats.world_ms + stats.impostor_update_ms + stats.cloud_ms
 
 
 def test_only_selections_of_plain_splats_are_compositable(renderer):

@@ -70,6 +70,45 @@ def test_the_gpu_radix_sort_orders_as_a_stable_sort(renderer, count, key_bits, i
     np.testing.assert_array_equal(sorted_pairs[1], values[expected])
 
 
+@pytest.mark.parametrize("count", [0, 2049, 30_000])
+def test_the_gpu_radix_sort_takes_a_count_only_the_gpu_holds(renderer, count):
+    """The tile binning's pairs are counted on the GPU: the sort is given the room (here 40,000 pairs, the rest
+    other keys) and where the count is; it sorts that many and leaves the rest of the room as it was."""
+    from OpenGL import GL
+
+    from cloudcore.gl.depth_sort import GpuDepthSort
+
+    room, held_at = 40_000, 3
+    rng = np.random.default_rng(count)
+    keys = rng.integers(0, 2**16, room, dtype=np.uint32)
+    values = rng.permutation(room).astype(np.uint32)
+    counts = np.array([7, 7, 7, count], dtype=np.uint32)
+    renderer.context.make_current()
+    sort, buffers = GpuDepthSort(), GL.glGenBuffers(3)
+    try:
+        for buffer, data in zip(buffers, (keys, values, counts)):
+            GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, buffer)
+            GL.glBufferData(GL.GL_SHADER_STORAGE_BUFFER, data.nbytes, data, GL.GL_DYNAMIC_COPY)
+        GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT)
+        sort.sort(buffers[0], buffers[1], room, key_bits=16, count_at=(buffers[2], held_at))
+        GL.glMemoryBarrier(GL.GL_BUFFER_UPDATE_BARRIER_BIT)
+        sorted_pairs = []
+        for buffer in buffers[:2]:
+            GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, buffer)
+            sorted_pairs.append(
+                np.frombuffer(GL.glGetBufferSubData(GL.GL_SHADER_STORAGE_BUFFER, 0, 4 * room), np.uint32)
+            )
+        GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, 0)
+    finally:
+        sort.close()
+        GL.glDeleteBuffers(3, list(buffers))
+    expected = np.argsort(keys[:count], kind="stable")
+    np.testing.assert_array_equal(sorted_pairs[0][:count], keys[expected])
+    np.testing.assert_array_equal(sorted_pairs[1][:count], values[expected])
+    np.testing.assert_array_equal(sorted_pairs[0][count:], keys[count:])
+    np.testing.assert_array_equal(sorted_pairs[1][count:], values[count:])
+
+
 @pytest.mark.parametrize("count", [1, 2, 2047, 2048, 2049, 20_000, ONE_GROUP_ITEMS, ONE_GROUP_ITEMS + 1, 600_000])
 def test_the_gpu_prefix_sum_is_the_sum_of_the_items_before_each(renderer, count):
     """Up to `ONE_GROUP_ITEMS` items are scanned by one workgroup, more block by block from the blocks' scanned

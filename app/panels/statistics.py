@@ -27,6 +27,8 @@ class StatisticsPanel:
             f"GPU: clouds {frame.cloud_gpu_ms:.1f}  impostor updates {frame.impostor_update_gpu_ms:.1f}  "
             f"world {frame.world_gpu_ms:.1f};  CPU {frame.cpu_ms:.1f} (planning and issuing the passes)"
         )
+        if frame.drawn_again:
+            imgui.text("drawn twice: a draw had more tile pairs than the GPU had room for (both drawings' time above)")
         if shown.picture_reused:
             imgui.text("picture kept: nothing changed since it was drawn (clouds, updates, world: that frame's)")
         if shown.relighting:

@@ -30,7 +30,9 @@ DIGIT_BITS = 4
 ITEMS_ON_GPU, ITEMS_ON_CPU = 8, 128
 _STAGES = ("COUNT", "SCATTER")
 #: the shader's storage bindings, past the prefix sum's, so a pass binds its buffers once for both stages
-_KEYS_IN, _VALUES_IN, _KEYS_OUT, _VALUES_OUT, _TILE_COUNTS = range(2, 7)
+_KEYS_IN, _VALUES_IN, _KEYS_OUT, _VALUES_OUT, _TILE_COUNTS, _COUNTED = range(2, 8)
+#: the shader's `count_at` for a count the CPU gives
+_COUNT_GIVEN = 0xFFFFFFFF
 
 
 class GpuDepthSort:
@@ -42,16 +44,21 @@ class GpuDepthSort:
         defines = {"DIGIT_BITS": DIGIT_BITS, "ITEMS": items}
         self._programs = {stage: build_compute_program("depth_sort", defines | {stage: 1}) for stage in _STAGES}
         self._uniforms = {
-            stage: uniform_locations(program, ("count", "shift", "tiles")) for stage, program in self._programs.items()
+            stage: uniform_locations(program, ("count", "count_at", "shift", "tiles"))
+            for stage, program in self._programs.items()
         }
         self._scratch_keys, self._scratch_values, self._tile_counts = self._buffers = GL.glGenBuffers(3)
         self._capacity = 0  # pairs the scratch buffers hold
         self._prefix_sum = GpuPrefixSum()
 
-    def sort(self, keys: int, values: int, count: int, key_bits: int = 32) -> None:
+    def sort(
+        self, keys: int, values: int, count: int, key_bits: int = 32, count_at: tuple[int, int] | None = None
+    ) -> None:
         """Sort the first `count` pairs of buffers `keys` and `values` by key, in place, stably; keys below
         2**`key_bits` need only that many bits sorted (a multiple of 8: the pairs end where they began
-        after an even count of passes).
+        after an even count of passes).  Where only the GPU knows how many pairs there are, `count_at` says
+        where (a storage buffer, a uint's index in it) and `count` is the most there can be: the lesser is
+        sorted, and the CPU need not wait to read it (the tile binning's pairs).
 
         The caller orders its writes to the buffers before this with a storage barrier, and its reads after
         it with the barrier its reads need; between the passes this issues its own."""
@@ -64,9 +71,13 @@ class GpuDepthSort:
         # what every pass shares is set once: a frame sorts a few times, 8 passes of 2 stages each, and each GL
         # call costs the CPU a microsecond or two (the default flythrough's full 3D: 2 sorts a frame)
         GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _TILE_COUNTS, self._tile_counts)
+        # without a count on the GPU, the tile counts stand in for its buffer: a shader's blocks must all be bound
+        counted, index = (self._tile_counts, _COUNT_GIVEN) if count_at is None else count_at
+        GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _COUNTED, counted)
         for stage, program in self._programs.items():
             GL.glUseProgram(program)
             GL.glUniform1ui(self._uniforms[stage]["count"], count)
+            GL.glUniform1ui(self._uniforms[stage]["count_at"], index)
             GL.glUniform1ui(self._uniforms[stage]["tiles"], tiles)
         sources, targets = (keys, values), (self._scratch_keys, self._scratch_values)
         for sort_pass in range(key_bits // DIGIT_BITS):

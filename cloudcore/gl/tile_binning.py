@@ -10,7 +10,18 @@ makes in numpy (79 ms of CPU a frame there).  Here the GPU makes them from the d
 prefix sum over the slots (`cloudcore.gl.prefix_sum`) says where each splat's pairs go, one (slot, tile)
 pair a tile is written there, in the draw's far-to-near order, and one stable radix sort by tile
 (`cloudcore.gl.depth_sort`) leaves each tile's run far to near; the runs' starts are the tiles'
-`starts`, as `ScreenTiles` has them.  The CPU reads back one number, the pairs' count, to size the sort.
+`starts`, as `ScreenTiles` has them.
+
+How many pairs a draw makes is known only once the GPU has counted them, and a draw's buffers and the sort's
+work must be sized before.  Reading the count back made the CPU wait, mid-frame, for everything the GPU had
+queued before it: on the H200 that cost the compute pass 2.4 ms of CPU a frame at 640x480 (docs/performance.md),
+more than auto mode's small full-3D draws gain by it.  So the count stays on the GPU: the buffers get `room`
+for `ROOM_FACTOR` times the most pairs a draw had in the frame before (at least `MIN_ROOM`), the shaders take
+the lesser of the count and the room, and the counts are read once the frame has been waited for
+(`GpuTileBinning.settle`).  A draw with more pairs than its room has lost its nearest splats: `settle` says so,
+and the frame is drawn again, each draw's count read back first as before (`cloudcore.gl.frame`).  That first
+frame, and a frame whose draw had more than `MAX_PAIRS` (which the raster then draws), count on the CPU's side,
+and so does a software GL (`counts_stay_on_gpu`).
 
 The pairs were first written where an atomic counter handed out places, in no order, and sorted by slot
 before the sort by tile: that sort by slot (24 bits for the default scene's 82,000 slots) took 44% of the
@@ -29,12 +40,20 @@ from OpenGL import GL
 from cloudcore.camera import NEAR_PLANE_M
 from cloudcore.gl.depth_sort import GpuDepthSort, key_bits_for
 from cloudcore.gl.prefix_sum import GpuPrefixSum
-from cloudcore.gl.programs import build_compute_program, dispatch, max_dispatch_groups, set_matrix_at, uniform_locations
+from cloudcore.gl.programs import (
+    build_compute_program,
+    dispatch,
+    gl_renderer,
+    max_dispatch_groups,
+    set_matrix_at,
+    uniform_locations,
+)
 from cloudcore.gl.splats import INSTANCE_BYTES, reallocate_storage
 from cloudcore.light.volume_blending import TILE_PIXELS
+from cloudcore.lod.measured_way import software_rasterizer
 
 #: the storage bindings of tile_bin.comp.glsl (instances and command as the splat pass binds them)
-_INSTANCES, _COMMAND, _COUNTER, _PAIR_SLOTS, _PAIR_TILES, _TILE_STARTS, _PAIR_STARTS = 3, 6, 9, 10, 11, 12, 13
+_INSTANCES, _COMMAND, _TOTALS, _PAIR_SLOTS, _PAIR_TILES, _TILE_STARTS, _PAIR_STARTS = 3, 6, 9, 10, 11, 12, 13
 #: and of shaders/binned_splats.glsl, which volume_blend.comp.glsl reads at the same bindings: the occupied
 #: tiles and the splats' discs
 OCCUPIED_BINDING, DISCS_BINDING = 8, 14
@@ -48,10 +67,26 @@ _GROUP = 64
 #: pairs past which a draw is left to the raster: 16 bytes each with the sorts' scratch, 512 MiB (at 1600x1200
 #: inside a cloud of the default scene, 7.1 million; a 4K screen there, about 30)
 MAX_PAIRS = 1 << 25
+#: a draw's room over the most pairs a draw had the frame before: along the default flythrough in full 3D a
+#: frame's pairs grew by at most 1.42 times the frame before's (99% of frames by less than 1.005)
+ROOM_FACTOR = 1.5
+#: the least room: auto mode's full-3D draws come and go, from none to 82,459 pairs between two frames along the
+#: flythrough; with this floor 1 frame of its 901 was drawn again (2^16: 2), and a room past the pairs costs a
+#: GPU only the sort's and the starts' work groups that find nothing to do
+MIN_ROOM = 1 << 17
+#: the draws a frame bins with their count left on the GPU; past them, a draw's count is read back at once
+_TOTALS_HELD = 64
 _UNIFORMS = (
     *("slots", "count_at", "view_rotation", "projection", "size", "tiles_across", "tiles_up", "near"),
-    *("pairs", "max_groups"),
+    *("total_at", "room", "max_groups"),
 )
+
+
+def counts_stay_on_gpu() -> bool:
+    """Whether draws' pair counts stay on the GPU (the module's docstring).  A software GL runs each compute
+    dispatch as it is issued, so there the count is ready to read without waiting, and a room past the pairs
+    costs it what the GPU skips: the default view's binning took 62 against 48 ms on llvmpipe."""
+    return not software_rasterizer(gl_renderer())
 
 
 @dataclass(frozen=True)
@@ -64,7 +99,9 @@ class BinnedTiles:
     up: int
     starts: int  # buffer of across * up + 1 uints
     entries: int  # buffer of `pairs` uints
-    pairs: int
+    pairs: int | None  # None: counted on the GPU, at most `room` (`GpuTileBinning.read` reads it)
+    room: int
+    total: tuple[int, int]  # the buffer and uint index of the pairs' count
     discs: int  # buffer of what the compositing reads of each slot's splat (tile_bin.comp.glsl's Disc)
     #: buffer of the tiles with splats, in no order, after the indirect dispatch that composites them (one
     #: group a tile: `_OCCUPIED_HEADER`)
@@ -72,7 +109,7 @@ class BinnedTiles:
 
 
 class GpuTileBinning:
-    """The binning's programs and buffers; `bin` bins one draw."""
+    """The binning's programs and buffers; `bin` bins one draw, `settle` ends a frame's."""
 
     def __init__(self):
         defines = {"TILE_PIXELS": TILE_PIXELS}
@@ -80,11 +117,16 @@ class GpuTileBinning:
             stage: build_compute_program("tile_bin", defines | {stage: 1}) for stage in ("COUNT", "EMIT", "STARTS")
         }
         self._uniforms = {stage: uniform_locations(program, _UNIFORMS) for stage, program in self._programs.items()}
-        self._buffers = GL.glGenBuffers(7)
-        self._counter, self._slots, self._tiles, self._starts, self._pair_starts, self._discs, self._occupied = (
-            self._buffers
-        )
+        self._buffers = GL.glGenBuffers(8)
+        self._totals, self._read_total = self._buffers[:2]
+        self._slots, self._tiles, self._starts, self._pair_starts, self._discs, self._occupied = self._buffers[2:]
+        reallocate_storage((self._totals,), 4 * _TOTALS_HELD)
+        reallocate_storage((self._read_total,), 4)
         self._pair_capacity = self._tile_capacity = self._slot_capacity = 0
+        #: pairs a draw's buffers hold while the counts stay on the GPU; None: read each draw's count back
+        self._room: int | None = None
+        #: this frame's draws: (index in `_totals`, the room they had), or (None, the count read back)
+        self._binned: list[tuple[int | None, int]] = []
         self._sort = GpuDepthSort()
         self._prefix_sum = GpuPrefixSum()
 
@@ -98,15 +140,23 @@ class GpuTileBinning:
     ) -> BinnedTiles | None:
         """Bin a draw's shaded splats (`instances`: their buffer, first slot, slots; `count_at`: the buffer
         and uint index of its indirect command's count, six a kept splat, or None where every slot is kept)
-        for a screen of `size` pixels seen with `view` and `projection`; `pairs` 0 when no splat touches the
-        screen, None when there would be more than `MAX_PAIRS` (the raster draws those)."""
+        for a screen of `size` pixels seen with `view` and `projection`.  Counted on the GPU (the module's
+        docstring), `pairs` is None; counted here, 0 when no splat touches the screen, and None returned
+        when there would be more than `MAX_PAIRS` (the raster draws those)."""
         buffer, first, slots = instances
         across, up = -(-size[0] // TILE_PIXELS), -(-size[1] // TILE_PIXELS)
-        empty = BinnedTiles(tuple(size), across, up, self._starts, self._slots, 0, self._discs, self._occupied)
+        on_gpu = self._room is not None and len(self._binned) < _TOTALS_HELD
+        total = (self._totals, len(self._binned)) if on_gpu else (self._read_total, 0)
+
+        def binned(pairs: int | None, room: int) -> BinnedTiles:
+            return BinnedTiles(
+                tuple(size), across, up, self._starts, self._slots, pairs, room, total, self._discs, self._occupied
+            )
+
         if not slots:
-            return empty
-        GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, self._counter)
-        GL.glBufferData(GL.GL_SHADER_STORAGE_BUFFER, 4, np.zeros(1, dtype=np.uint32), GL.GL_STREAM_COPY)
+            return binned(0, 0)
+        GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, total[0])
+        GL.glBufferSubData(GL.GL_SHADER_STORAGE_BUFFER, 4 * total[1], 4, np.zeros(1, dtype=np.uint32))
         if slots > self._slot_capacity:
             self._slot_capacity = max(slots, 2 * self._slot_capacity)
             reallocate_storage((self._pair_starts,), 4 * self._slot_capacity)
@@ -114,28 +164,36 @@ class GpuTileBinning:
         GL.glBindBufferRange(
             GL.GL_SHADER_STORAGE_BUFFER, _INSTANCES, buffer, first * INSTANCE_BYTES, slots * INSTANCE_BYTES
         )
-        # without a command, the counter stands in for it: a shader's storage blocks must all be bound
-        count_at = (self._counter, _ALL_SLOTS) if count_at is None else count_at
+        # without a command, the totals stand in for it: a shader's storage blocks must all be bound
+        count_at = (total[0], _ALL_SLOTS) if count_at is None else count_at
         GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _COMMAND, count_at[0])
-        GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _COUNTER, self._counter)
+        GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _TOTALS, total[0])
         GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _PAIR_STARTS, self._pair_starts)
         GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, DISCS_BINDING, self._discs)
         GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT | GL.GL_BUFFER_UPDATE_BARRIER_BIT)
-        self._dispatch("COUNT", slots, count_at[1], view, projection, size, (across, up))
+        shared = (count_at[1], view, projection, size, (across, up), total[1])  # what the stages share
+        self._dispatch("COUNT", slots, *shared, room=0)
         GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT | GL.GL_BUFFER_UPDATE_BARRIER_BIT)
-        self._prefix_sum.scan(self._pair_starts, slots)  # issued before the read-back waits: the GPU goes on
-        GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, self._counter)
-        pairs = int(np.frombuffer(GL.glGetBufferSubData(GL.GL_SHADER_STORAGE_BUFFER, 0, 4), dtype=np.uint32)[0])
-        if not pairs or pairs > MAX_PAIRS:
-            return None if pairs else empty
-        self._reserve(pairs, across * up + 1)
+        self._prefix_sum.scan(self._pair_starts, slots)  # issued before any read-back waits: the GPU goes on
+        if on_gpu:  # past MAX_PAIRS the raster draws: a draw with more overflows its room, then counted here
+            pairs, room = None, min(self._room, MAX_PAIRS)
+            self._binned.append((total[1], room))
+        else:
+            GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, total[0])
+            pairs = room = int(np.frombuffer(GL.glGetBufferSubData(GL.GL_SHADER_STORAGE_BUFFER, 0, 4), np.uint32)[0])
+            self._binned.append((None, pairs))
+            if not pairs or pairs > MAX_PAIRS:
+                return None if pairs else binned(0, 0)
+        self._reserve(room, across * up + 1)
         GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _PAIR_SLOTS, self._slots)
         GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _PAIR_TILES, self._tiles)
-        self._dispatch("EMIT", slots, count_at[1], view, projection, size, (across, up))
+        self._dispatch("EMIT", slots, *shared, room=room)
         GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT)
         # the pairs in the draw's order (far to near), sorted stably by tile: each tile's run keeps that order
-        self._sort.sort(self._tiles, self._slots, pairs, key_bits=key_bits_for(across * up - 1))
+        key_bits = key_bits_for(across * up - 1)
+        self._sort.sort(self._tiles, self._slots, room, key_bits=key_bits, count_at=total if on_gpu else None)
         GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT)
+        GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _TOTALS, total[0])
         GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _PAIR_TILES, self._tiles)
         GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _TILE_STARTS, self._starts)
         GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, self._occupied)
@@ -144,22 +202,43 @@ class GpuTileBinning:
         GL.glMemoryBarrier(GL.GL_BUFFER_UPDATE_BARRIER_BIT)
         program, uniforms = self._programs["STARTS"], self._uniforms["STARTS"]
         GL.glUseProgram(program)
-        GL.glUniform1ui(uniforms["pairs"], pairs)
+        GL.glUniform1ui(uniforms["total_at"], total[1])
+        GL.glUniform1ui(uniforms["room"], room)
         GL.glUniform1ui(uniforms["max_groups"], max_dispatch_groups())
         GL.glUniform1i(uniforms["tiles_across"], across)
         GL.glUniform1i(uniforms["tiles_up"], up)
-        dispatch(-(-pairs // _GROUP))
+        dispatch(-(-room // _GROUP))
         GL.glMemoryBarrier(GL.GL_SHADER_STORAGE_BARRIER_BIT | GL.GL_COMMAND_BARRIER_BIT)
-        return BinnedTiles(tuple(size), across, up, self._starts, self._slots, pairs, self._discs, self._occupied)
+        return binned(pairs, room)
+
+    def settle(self) -> bool:
+        """End a frame's binning, once the frame has been waited for (reading its counts then waits for
+        nothing): whether a draw counted on the GPU had more pairs than its room, so that its nearest splats
+        are missing and the frame must be drawn again.  The next frames' room follows this one's largest
+        draw; past `MAX_PAIRS`, and for the frame drawn again, each draw's count is read back."""
+        binned, self._binned = self._binned, []
+        if not binned:
+            return False
+        held = [index for index, _ in binned if index is not None]
+        totals = self._read(self._totals, 0, max(held) + 1) if held else np.zeros(0, np.uint32)
+        counts = [int(totals[index]) if index is not None else room for index, room in binned]
+        overflowed = any(index is not None and count > room for (index, room), count in zip(binned, counts))
+        most = max(counts)
+        on_gpu = counts_stay_on_gpu() and not overflowed and most <= MAX_PAIRS
+        self._room = max(MIN_ROOM, int(np.ceil(ROOM_FACTOR * most))) if on_gpu else None
+        return overflowed
 
     def read(self, binned: BinnedTiles) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """(starts, entries, occupied tiles, their dispatch's groups) of `binned` read back, as `ScreenTiles` holds
         the first three (the tests compare them)."""
         GL.glMemoryBarrier(GL.GL_BUFFER_UPDATE_BARRIER_BIT)
+        pairs = binned.pairs
+        if pairs is None:
+            pairs = min(int(self._read(binned.total[0], binned.total[1], 1)[0]), binned.room)
         header = self._read(binned.occupied, 0, len(_OCCUPIED_HEADER))
         starts = self._read(binned.starts, 0, binned.across * binned.up + 1)
         occupied = self._read(binned.occupied, len(_OCCUPIED_HEADER), int(header[3]))
-        return starts, self._read(binned.entries, 0, binned.pairs), occupied, header[:3]
+        return starts, self._read(binned.entries, 0, pairs), occupied, header[:3]
 
     @staticmethod
     def _read(buffer: int, first: int, count: int) -> np.ndarray:
@@ -168,7 +247,7 @@ class GpuTileBinning:
         GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, 0)
         return np.frombuffer(data, np.uint32).copy()
 
-    def _dispatch(self, stage: str, slots: int, count_at: int, view, projection, size, tiles) -> None:
+    def _dispatch(self, stage: str, slots: int, count_at: int, view, projection, size, tiles, total_at, room) -> None:
         program, uniforms = self._programs[stage], self._uniforms[stage]
         GL.glUseProgram(program)
         GL.glUniform1ui(uniforms["slots"], slots)
@@ -181,6 +260,8 @@ class GpuTileBinning:
         GL.glUniform1i(uniforms["tiles_across"], tiles[0])
         GL.glUniform1i(uniforms["tiles_up"], tiles[1])
         GL.glUniform1f(uniforms["near"], NEAR_PLANE_M)
+        GL.glUniform1ui(uniforms["total_at"], total_at)
+        GL.glUniform1ui(uniforms["room"], room)
         dispatch(-(-slots // _GROUP))
 
     def _reserve(self, pairs: int, starts: int) -> None:

@@ -91,10 +91,17 @@ class VolumeBlendingPass:
             defines = {"PLAIN": 1, "FINISHED_TRANSMITTANCE": FINISHED_TRANSMITTANCE} if plain else {}
             self._programs[plain] = build_compute_program("volume_blend", _CONSTANTS | defines)
         binned = self._binning.bin(instances, count_at, view, projection, size)
-        if binned is None or not binned.pairs:
-            return binned is not None
+        if binned is None:
+            return False
+        if binned.pairs == 0:  # counted: no splat on the screen (counted on the GPU, None: the dispatch finds out)
+            return True
         self._composite(self._programs[plain], binned, view, projection, colour_texture, depth_framebuffer)
         return True
+
+    def settle(self) -> bool:
+        """After the frame's wait: whether it must be drawn again, a draw's tile pairs past the room it had
+        (`GpuTileBinning.settle`)."""
+        return self._binning is not None and self._binning.settle()
 
     def _composite(self, program, binned: BinnedTiles, view, projection, colour_texture, depth_framebuffer) -> None:
         """Run a compositing `program` over `binned`'s occupied tiles, by the indirect dispatch the binning made."""

@@ -141,6 +141,8 @@ def _summary(rows) -> dict:
         "gpu_ms_mean": sum(gpu_ms_by_pass.values()),
         "gpu_ms_by_pass": gpu_ms_by_pass,
         "splat_order_frames": dict(Counter(r.get("splat_order", "") for r in rows)),
+        # drawn twice: a compute-composited draw had more tile pairs than the GPU had room for (in frame_ms)
+        "frames_drawn_again": int(sum(r.get("drawn_again", False) for r in rows)),
     }
 
 

@@ -75,6 +75,9 @@ class FrameStats:
     particles_to_impostors: int = 0
     clouds_drawn: int = 0
     texture_bytes: int = 0
+    #: a draw composited by compute had more tile pairs than the GPU had room for (`cloudcore.gl.tile_binning`):
+    #: the frame was drawn twice, both in `frame_ms` and `cpu_ms`
+    drawn_again: bool = False
     overdraw: Overdraw | None = None
 
     @property

@@ -28,10 +28,20 @@ layout(std430, binding = 4) writeonly buffer KeysOut { uint keys_out[]; };
 layout(std430, binding = 5) writeonly buffer ValuesOut { uint values_out[]; };
 // per (digit, tile), digit-major: COUNT writes the counts, the prefix sum turns them into output starts
 layout(std430, binding = 6) buffer TileCounts { uint tile_counts[]; };
+// where only the GPU knows how many pairs there are (a tile binning's): their count, at `count_at`
+layout(std430, binding = 7) readonly buffer Counted { uint counted[]; };
 
-uniform uint count;  // pairs to sort
-uniform uint shift;  // the digit's lowest bit
+uniform uint count;     // pairs to sort, or with `count_at` the most there can be (the buffers' room)
+uniform uint count_at;  // where `counted` holds their count, or COUNT_GIVEN
+uniform uint shift;     // the digit's lowest bit
 uniform uint tiles;
+
+const uint COUNT_GIVEN = 0xFFFFFFFFu;
+
+uint pairs_to_sort()
+{
+    return count_at == COUNT_GIVEN ? count : min(count, counted[count_at]);
+}
 
 uint digit_of(uint key)
 {
@@ -43,13 +53,18 @@ shared uint histogram[DIGITS];
 
 void main()
 {
-    uint tile = gl_WorkGroupID.x, thread = gl_LocalInvocationID.x;
+    uint tile = gl_WorkGroupID.x, thread = gl_LocalInvocationID.x, pairs = pairs_to_sort();
+    if (tile * TILE >= pairs) {  // a tile of the room past the pairs (the whole group alike: before any barrier)
+        if (thread < DIGITS)
+            tile_counts[thread * tiles + tile] = 0u;
+        return;
+    }
     if (thread < DIGITS)
         histogram[thread] = 0u;
     barrier();
     uint first = tile * TILE + thread * ITEMS;
     for (uint i = 0u; i < ITEMS; ++i)
-        if (first + i < count)
+        if (first + i < pairs)
             atomicAdd(histogram[digit_of(keys_in[first + i])], 1u);
     barrier();
     if (thread < DIGITS)
@@ -63,13 +78,15 @@ shared uint prefix[DIGITS][GROUP];
 
 void main()
 {
-    uint tile = gl_WorkGroupID.x, thread = gl_LocalInvocationID.x;
+    uint tile = gl_WorkGroupID.x, thread = gl_LocalInvocationID.x, pairs = pairs_to_sort();
+    if (tile * TILE >= pairs)
+        return;  // as COUNT's
     uint first = tile * TILE + thread * ITEMS;
     uint own[DIGITS];
     for (int d = 0; d < DIGITS; ++d)
         own[d] = 0u;
     for (uint i = 0u; i < ITEMS; ++i)
-        if (first + i < count)
+        if (first + i < pairs)
             own[digit_of(keys_in[first + i])] += 1u;
     for (int d = 0; d < DIGITS; ++d)
         prefix[d][thread] = own[d];
@@ -87,7 +104,7 @@ void main()
     for (int d = 0; d < DIGITS; ++d)
         next[d] = tile_counts[uint(d) * tiles + tile] + prefix[d][thread] - own[d];
     for (uint i = 0u; i < ITEMS; ++i) {
-        if (first + i >= count)
+        if (first + i >= pairs)
             break;
         uint key = keys_in[first + i];
         uint d = digit_of(key);

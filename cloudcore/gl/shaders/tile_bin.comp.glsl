@@ -5,13 +5,16 @@
 // splat_shade.comp.glsl made, far to near: a GPU-chosen draw's as many kept as its indirect command counts
 // (six indices each), a draw sorted on the CPU all of them.  Three stages, chosen by the stage defined:
 //   COUNT   per slot, the tiles its kept splat's disc can touch (0 for a slot not kept), into
-//           pair_starts[slot] and added to `total`; a prefix sum over the slots then makes each slot's
-//           count where its pairs start (cloudcore.gl.prefix_sum);
-//   EMIT    per kept splat, one (slot, tile) pair a tile from where its pairs start: the pairs in slot
-//           order, far to near, so that one stable radix sort by tile leaves each tile's run far to near;
-//   STARTS  over the pairs sorted by tile: where each tile's run starts (tile_starts[t] to
-//           tile_starts[t + 1]), as ScreenTiles.starts, and the tiles with a run, as ScreenTiles.occupied
-//           (in no order), with the indirect dispatch that composites them.
+//           pair_starts[slot] and added to the draw's total; a prefix sum over the slots then makes each
+//           slot's count where its pairs start (cloudcore.gl.prefix_sum);
+//   EMIT    per kept splat, one (slot, tile) pair a tile from where its pairs start, those within the
+//           `room` of the buffers: the pairs in slot order, far to near, so that one stable radix sort by
+//           tile leaves each tile's run far to near;
+//   STARTS  over the pairs sorted by tile (the total's, at most the room's): where each tile's run starts
+//           (tile_starts[t] to tile_starts[t + 1]), as ScreenTiles.starts, and the tiles with a run, as
+//           ScreenTiles.occupied (in no order), with the indirect dispatch that composites them.
+// The total stays on the GPU: the CPU gives the room, and reads the total after the frame (a total past
+// the room left out the draw's nearest pairs: cloudcore.gl.tile_binning draws the frame again).
 // A splat's image is bounded by its four corners' (it is a flat quad), one pixel wider on each side
 // for rounding, and of that box's tiles only those its disc reaches (a quarter fewer pairs on the default
 // view: the kernel is 0 past the disc).
@@ -24,7 +27,7 @@ struct Instance {
 };
 layout(std430, binding = 3) readonly buffer Instances { Instance instances[]; };  // from the draw's first
 layout(std430, binding = 6) readonly buffer Command { uint command[]; };
-layout(std430, binding = 9) buffer Counter { uint total; };
+layout(std430, binding = 9) buffer Totals { uint totals[]; };  // the draw's at `total_at`
 layout(std430, binding = 13) buffer PairStarts { uint pair_starts[]; };  // per slot
 layout(std430, binding = 10) buffer PairSlots { uint pair_slots[]; };
 layout(std430, binding = 11) buffer PairTiles { uint pair_tiles[]; };
@@ -39,7 +42,8 @@ uniform ivec2 size;        // pixels
 uniform int tiles_across;
 uniform int tiles_up;
 uniform float near;
-uniform uint pairs;        // STARTS: how many pairs there are
+uniform uint total_at;     // where the draw's total of pairs is counted in `totals`
+uniform uint room;         // EMIT, STARTS: the most pairs the buffers hold
 uniform uint max_groups;   // STARTS: the most work groups a dispatch may ask for
 
 const float TINY = 1e-30;
@@ -93,7 +97,7 @@ ivec2 columns_in_row(Footprint f, int row)
     return ivec2(max(first, f.box.x), min(last, f.box.z));
 }
 
-void run(uint i)
+void run(uint i, uint items)
 {
 #ifdef STARTS
     uint tile = pair_tiles[i];
@@ -105,9 +109,9 @@ void run(uint i)
         occupied[at] = tile;
         atomicMax(groups_x, min(at + 1u, max_groups));
     }
-    if (i == pairs - 1u)
+    if (i == items - 1u)  // the last pair: the tiles after its own start past the pairs
         for (uint t = tile + 1u; t <= uint(tiles_across * tiles_up); ++t)
-            tile_starts[t] = pairs;
+            tile_starts[t] = items;
 #else
     uint kept = count_at == ALL_SLOTS ? slots : command[count_at] / 6u;
     Footprint f = i < kept ? footprint(i) : NOWHERE;
@@ -124,12 +128,14 @@ void run(uint i)
         covered += uint(max(columns.y - columns.x + 1, 0));
     }
     pair_starts[i] = covered;
-    atomicAdd(total, covered);
+    atomicAdd(totals[total_at], covered);
 #else
     uint at = pair_starts[i];
     for (int row = f.box.y; row <= f.box.w; ++row) {
         ivec2 columns = columns_in_row(f, row);
         for (int column = columns.x; column <= columns.y; ++column) {
+            if (at >= room)
+                return;
             pair_slots[at] = i;
             pair_tiles[at] = uint(row * tiles_across + column);
             ++at;
@@ -143,10 +149,10 @@ void run(uint i)
 void main()
 {
 #ifdef STARTS
-    uint items = pairs;
+    uint items = min(totals[total_at], room);
 #else
     uint items = slots;
 #endif
     for (uint i = gl_GlobalInvocationID.x; i < items; i += gl_NumWorkGroups.x * gl_WorkGroupSize.x)
-        run(i);
+        run(i, items);
 }
