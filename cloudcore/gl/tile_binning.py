@@ -156,7 +156,11 @@ class GpuTileBinning:
         if not slots:
             return binned(0, 0)
         GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, total[0])
-        GL.glBufferSubData(GL.GL_SHADER_STORAGE_BUFFER, 4 * total[1], 4, np.zeros(1, dtype=np.uint32))
+        # cleared by the GPU in its queue: a copy from the CPU into a buffer the frame's draws before still use
+        # may make a driver wait for them
+        GL.glClearBufferSubData(
+            GL.GL_SHADER_STORAGE_BUFFER, GL.GL_R32UI, 4 * total[1], 4, GL.GL_RED_INTEGER, GL.GL_UNSIGNED_INT, None
+        )
         if slots > self._slot_capacity:
             self._slot_capacity = max(slots, 2 * self._slot_capacity)
             reallocate_storage((self._pair_starts,), 4 * self._slot_capacity)
