@@ -652,6 +652,21 @@ def the_cloud_field_panel_edits_the_field(ctx, app: EditorUnderTest):
     app.editor.edit(start)
 
 
+def every_panel_shows_its_lines_whole(ctx, app: EditorUnderTest):
+    """At the editor's default size no panel's widest line is wider than the panel, so no label or number is
+    cut: the Statistics panel's lines of prose ran to 746 pixels in its 353, the LOD panel's labels to 436."""
+    widths = {}
+    for title, _, _ in app.panels.windows():
+        use_window(ctx, title)
+        ctx.yield_(SETTLE)
+        window = imgui.internal.find_window_by_name(title)
+        room = window.content_region_rect
+        widths[title] = {"widest line": window.content_size_ideal.x, "panel": room.max.x - room.min.x}
+    app.outcome["panel_widths"] = widths
+    for width in widths.values():
+        CHECK(width["widest line"] <= width["panel"])
+
+
 #: the GUI tests, in the order they run; `tests/test_gui.py` reads their names here
 GUI_TESTS = (
     place_particles_by_clicking,
@@ -676,6 +691,7 @@ GUI_TESTS = (
     recording_runs_in_the_background,
     a_click_within_one_frame_is_not_lost,
     the_cloud_field_panel_edits_the_field,
+    every_panel_shows_its_lines_whole,
 )
 
 

@@ -34,6 +34,7 @@ from imgui_bundle import hello_imgui, imgui, immapp  # noqa: E402
 
 from app.editor import Editor  # noqa: E402
 from app.panels import Panels  # noqa: E402
+from app.panels.widgets import labels_in_full  # noqa: E402
 from app.viewport import Viewport  # noqa: E402
 from cloudcore.collector import freeze_what_is_set_up  # noqa: E402
 from cloudcore.errors import SceneError  # noqa: E402
@@ -62,10 +63,9 @@ def runner_params(
     left = hello_imgui.DockingSplit("MainDockSpace", "Left", imgui.Dir.left, 0.3)
     bottom = hello_imgui.DockingSplit("Left", "LeftBottom", imgui.Dir.down, 0.45)
     params.docking_params.docking_splits = [left, bottom]
-    windows = []
-    for label, dock, function in [("Viewport", "MainDockSpace", viewport.gui), *panels.windows()]:
-        window = hello_imgui.DockableWindow(label, dock, function)
-        windows.append(window)
+    windows = [hello_imgui.DockableWindow("Viewport", "MainDockSpace", viewport.gui)]
+    for label, dock, function in panels.windows():
+        windows.append(hello_imgui.DockableWindow(label, dock, with_labels_in_full(function)))
     params.docking_params.dockable_windows = windows
 
     frames = 0
@@ -86,6 +86,16 @@ def runner_params(
     params.callbacks.pre_new_frame = every_frame
     params.callbacks.before_exit = before_exit
     return params
+
+
+def with_labels_in_full(draw):
+    """A panel's `draw`, its widgets leaving their labels room (`labels_in_full`)."""
+
+    def drawn() -> None:
+        with labels_in_full():
+            draw()
+
+    return drawn
 
 
 def shortcuts(editor: Editor) -> None:

@@ -119,7 +119,7 @@ class RenderSettings:
         flag="--detail-texels",
         help="an impostor texture is never finer than this many texels across the radius of its cloud's "
         "smallest particle; 0: the screen's resolution alone decides",
-        label="Detail (texels per particle)",
+        label="Texels per particle",
         high=8.0,
         display="%.1f",
     )
@@ -187,7 +187,7 @@ class RenderSettings:
         0.25,
         flag="--inside-resolution",
         help="per axis, the fraction of the screen's resolution of the screen impostor of a cloud the eye is in",
-        label="Screen impostor (of the screen)",
+        label="Screen impostor scale",
         low=0.05,
         high=1.0,
         display="%.3f",

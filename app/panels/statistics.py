@@ -17,66 +17,40 @@ class StatisticsPanel:
         editor, shown = self.editor, self.editor.last_stats
         if shown is None:
             return
-        frame, plan, kinds = shown.frame, shown.frame.plan, shown.frame.plan.clouds_by_kind
+        frame = shown.frame
         ms = shown.viewport_ms
-        imgui.text(
-            f"{ms:6.1f} ms ({1000.0 / max(ms, 1e-3):5.1f} fps)  clouds {frame.cloud_ms:.1f}  "
-            f"impostor updates {frame.impostor_update_ms:.1f}  world {frame.world_ms:.1f}  plan {frame.plan_ms:.1f}"
-        )
-        imgui.text(
-            f"GPU: clouds {frame.cloud_gpu_ms:.1f}  impostor updates {frame.impostor_update_gpu_ms:.1f}  "
-            f"world {frame.world_gpu_ms:.1f};  CPU {frame.cpu_ms:.1f} (planning and issuing the passes)"
+        imgui.text(f"{ms:.1f} ms in the viewport ({1000.0 / max(ms, 1e-3):.0f} fps)")
+        # tables of short rows: at the editor's default size the panel is 350 pixels wide, and lines of prose
+        # were cut there, most of them in the middle
+        _table(
+            "passes",
+            ("pass", "wall ms", "GPU ms"),
+            [
+                ("plan", f"{frame.plan_ms:.1f}", ""),
+                ("world", f"{frame.world_ms:.1f}", f"{frame.world_gpu_ms:.1f}"),
+                ("impostor updates", f"{frame.impostor_update_ms:.1f}", f"{frame.impostor_update_gpu_ms:.1f}"),
+                ("clouds", f"{frame.cloud_ms:.1f}", f"{frame.cloud_gpu_ms:.1f}"),
+                ("CPU: plan, issuing", f"{frame.cpu_ms:.1f}", ""),
+            ],
         )
         if frame.drawn_again:
-            imgui.text("drawn twice: a draw had more tile pairs than the GPU had room for (both drawings' time above)")
+            imgui.text_wrapped("Drawn twice: a draw had more tile pairs than the GPU had room for (both in the times).")
         if shown.picture_reused:
-            imgui.text("picture kept: nothing changed since it was drawn (clouds, updates, world: that frame's)")
+            imgui.text_wrapped("Picture kept: nothing changed since it was drawn (the times are that frame's).")
         if shown.relighting:
-            imgui.text(
-                f"relighting in the background; shown meanwhile: {shown.shown_illumination} light"
-                f" at {shown.shown_time_of_day:.2f} h"
+            imgui.text_wrapped(
+                f"Relighting in the background; shown meanwhile: {shown.shown_illumination} light"
+                f" at {shown.shown_time_of_day:.2f} h."
             )
-        imgui.text(
-            f"particles drawn {frame.particles_drawn}, rendered to impostors {frame.particles_to_impostors}, "
-            f"as point sprites {frame.particles_as_points}, as volumes {frame.particles_as_volumes}; "
-            f"sorted on the {frame.splat_order.upper()}"
-        )
-        imgui.text(
-            f"impostors drawn {plan.impostors_drawn}, regenerated {shown.impostors_regenerated} "
-            f"(total {self.viewport.regenerations_total}), postponed {plan.regenerations_postponed}, "
-            f"ring segments built {plan.ring_segments_built}"
-        )
-        imgui.text(
-            f"clouds: full {kinds['full']}, crossfade {kinds['crossfade']}, impostor {kinds['impostor']}, "
-            f"inside {kinds['inside']}, ring {kinds['ring']}, culled {kinds['culled']}"
-        )
-        measured_ms = frame.impostor_update_ms + frame.cloud_ms
-        prediction = (
-            f"predicted {plan.predicted_ms:.1f} ms against {measured_ms:.1f} measured"
-            if plan.priced
-            else f"not priced (full 3D draws every cloud in view): {measured_ms:.1f} ms measured"
-        )
-        imgui.text(
-            f"units {plan.units} ({plan.units_grouped} of interpenetrating clouds); {prediction}; "
-            f"largest error drawn {plan.accepted_error_tolerances:.2f} x the tolerance ({plan.tolerance_deg:.3f} deg)"
-        )
-        if plan.drawn_as:
-            way = {"units": "each unit as priced", "full": "every unit in full 3D, one draw"}[plan.drawn_as]
-            imgui.text(
-                f"auto drew {way}; measured: as priced {_measured(plan.measured_units_ms)}, "
-                f"all in full 3D {_measured(plan.measured_full_ms)}"
-            )
-        imgui.text(
-            f"objects in clouds {plan.objects_in_clouds}: layers drawn {plan.layers_drawn}, "
-            f"rebuilt {plan.layers_rebuilt}"
-        )
-        imgui.text(f"texture memory {frame.texture_bytes / 2**20:.1f} MiB")
+        _table("counts", ("", ""), _counts(shown, self.viewport.regenerations_total))
         _, self.viewport.measure_overdraw = imgui.checkbox("Measure overdraw", self.viewport.measure_overdraw)
         imgui.same_line()
         _, self.viewport.heat_map = imgui.checkbox("Overdraw heat map", self.viewport.heat_map)
         if frame.overdraw is not None:
             overdraw = frame.overdraw
-            imgui.text(f"overdraw mean {overdraw.mean:.1f}, max {overdraw.max:.0f}, analytic {overdraw.analytic:.1f}")
+            imgui.text_wrapped(
+                f"Overdraw: mean {overdraw.mean:.1f}, max {overdraw.max:.0f}, analytic {overdraw.analytic:.1f}."
+            )
         history = list(editor.frame_times)
         if implot.begin_plot("Frame time (ms)", imgui.ImVec2(-1, 180)):
             frames = np.arange(len(history), dtype=np.float64)
@@ -92,6 +66,58 @@ class StatisticsPanel:
             ):
                 implot.plot_line(label, frames, np.array(times, dtype=np.float64))
             implot.end_plot()
+
+
+def _counts(shown, regenerations_total: int) -> list[tuple[str, str]]:
+    """(what, how many) of the frame shown: its particles, impostors, clouds by kind and the plan's choices."""
+    frame, plan = shown.frame, shown.frame.plan
+    kinds = plan.clouds_by_kind
+    rows = [
+        ("particles drawn", f"{frame.particles_drawn}"),
+        ("  sorted on the", frame.splat_order.upper()),
+        ("  as point sprites", f"{frame.particles_as_points}"),
+        ("  as volumes", f"{frame.particles_as_volumes}"),
+        ("particles to impostors", f"{frame.particles_to_impostors}"),
+        ("impostors drawn", f"{plan.impostors_drawn}"),
+        ("  regenerated", f"{shown.impostors_regenerated} (total {regenerations_total})"),
+        ("  postponed", f"{plan.regenerations_postponed}"),
+        ("ring segments built", f"{plan.ring_segments_built}"),
+        ("clouds full, crossfade", f"{kinds['full']}, {kinds['crossfade']}"),
+        ("  impostor, inside", f"{kinds['impostor']}, {kinds['inside']}"),
+        ("  ring, culled", f"{kinds['ring']}, {kinds['culled']}"),
+        ("units (of groups)", f"{plan.units} ({plan.units_grouped})"),
+    ]
+    measured_ms = frame.impostor_update_ms + frame.cloud_ms
+    if plan.priced:
+        rows.append(("predicted, measured", f"{plan.predicted_ms:.1f}, {measured_ms:.1f} ms"))
+    else:
+        rows.append(("not priced (full 3D)", f"{measured_ms:.1f} ms"))
+    rows.append(("largest error drawn", f"{plan.accepted_error_tolerances:.2f} x {plan.tolerance_deg:.3f} deg"))
+    if plan.drawn_as:
+        rows.append(("auto drew", {"units": "units as priced", "full": "all in full 3D"}[plan.drawn_as]))
+        rows.append(("  measured as priced", _measured(plan.measured_units_ms)))
+        rows.append(("  measured in full 3D", _measured(plan.measured_full_ms)))
+    rows.append(("objects in clouds", f"{plan.objects_in_clouds}"))
+    rows.append(("  layers drawn, rebuilt", f"{plan.layers_drawn}, {plan.layers_rebuilt}"))
+    rows.append(("texture memory", f"{frame.texture_bytes / 2**20:.1f} MiB"))
+    return rows
+
+
+def _table(name: str, headers: tuple[str, ...], rows) -> None:
+    """A table of `rows` of short strings, the first column as wide as its text, the others right of it."""
+    if not imgui.begin_table(name, len(headers), imgui.TableFlags_.row_bg | imgui.TableFlags_.borders_inner_v):
+        return
+    imgui.table_setup_column(headers[0], imgui.TableColumnFlags_.width_fixed)
+    for header in headers[1:]:
+        imgui.table_setup_column(header, imgui.TableColumnFlags_.width_stretch)
+    if any(headers[1:]):
+        imgui.table_headers_row()
+    for row in rows:
+        imgui.table_next_row()
+        for column, text in enumerate(row):
+            imgui.table_set_column_index(column)
+            imgui.text(text)
+    imgui.end_table()
 
 
 def _measured(ms: float) -> str:

@@ -2,7 +2,28 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
+
 from imgui_bundle import imgui
+
+#: room at a widget's right for its label, in ems: ImGui's default gives a widget two thirds of the panel, which at
+#: the editor's default size (panels 367 pixels wide) cut the LOD panel's longer labels in the middle; the longest
+#: labels ("Screen impostor scale", "Regeneration budget") take 8.6 and 8.3 ems
+LABEL_EMS = 10.5
+#: the narrowest a widget is made to leave its label room: a narrower panel cuts the labels instead
+_FEWEST_EMS = 6.0
+
+
+@contextmanager
+def labels_in_full() -> Iterator[None]:
+    """Within the body, widgets leave `LABEL_EMS` at their right for their labels."""
+    em = imgui.get_font_size()
+    imgui.push_item_width(max(imgui.get_content_region_avail().x - LABEL_EMS * em, _FEWEST_EMS * em))
+    try:
+        yield
+    finally:
+        imgui.pop_item_width()
 
 
 class ReleasedSliders:
