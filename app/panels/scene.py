@@ -16,7 +16,11 @@ class ScenePanel:
 
     def draw(self) -> None:
         editor = self.editor
-        imgui.text(f"{editor.path or '(unsaved scene)'}{' *' if editor.dirty else ''}")
+        # the file's name first, with the mark of unsaved edits beside it: at the end of a whole path the
+        # mark fell past a panel's edge; the path is the tooltip
+        imgui.text(f"{editor.path.name if editor.path else '(unsaved scene)'}{' *' if editor.dirty else ''}")
+        if editor.path is not None:
+            imgui.set_item_tooltip(str(editor.path))
         _, self.file_field = imgui.input_text("File", self.file_field)
         if imgui.button("Open"):
             editor.open_file(Path(self.file_field))
@@ -37,9 +41,10 @@ class ScenePanel:
                 editor.recover()
             imgui.set_item_tooltip(f"load {recovery_path(editor.path)}, written before the last session ended")
         for path in editor.recent[1:]:
-            if imgui.small_button(f"recent: {path}"):
+            if imgui.small_button(f"recent: {path.name}##{path}"):
                 self.file_field = str(path)
                 editor.open_file(path)
+            imgui.set_item_tooltip(str(path))
         imgui.separator()
         for message in reversed(editor.messages):
             imgui.text_wrapped(message)
