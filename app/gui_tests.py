@@ -529,6 +529,22 @@ def playing_a_camera_path_moves_the_camera(ctx, app: EditorUnderTest):
     ctx.item_click("Reset to the scene's camera")
 
 
+def an_untouched_editor_comes_to_rest(ctx, app: EditorUnderTest):
+    """Left alone, the viewport shows its picture again and is at rest, when the window waits for input between
+    frames (`app.main`; not while GUI tests drive it); while a path plays it is never at rest."""
+    for _ in range(300):  # the impostors settle first
+        if app.viewport.at_rest:
+            break
+        ctx.yield_()
+    CHECK(app.viewport.at_rest and app.editor.last_stats.picture_reused)
+    use_window(ctx, "Camera")
+    ctx.item_click("Play")
+    ctx.yield_(3)
+    CHECK(app.editor.playing and not app.viewport.at_rest)
+    ctx.item_click("Pause")
+    ctx.item_click("Reset to the scene's camera")
+
+
 def recording_runs_in_the_background(ctx, app: EditorUnderTest):
     use_window(ctx, "Camera")
     video = app.results_path.with_name("pan.mp4")
@@ -688,6 +704,7 @@ GUI_TESTS = (
     the_gpu_sorts_the_splats_in_the_window,
     overlays_outline_impostors_and_the_ring,
     playing_a_camera_path_moves_the_camera,
+    an_untouched_editor_comes_to_rest,
     recording_runs_in_the_background,
     a_click_within_one_frame_is_not_lost,
     the_cloud_field_panel_edits_the_field,

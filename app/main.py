@@ -42,8 +42,15 @@ from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
 
 
 def runner_params(
-    editor: Editor, viewport: Viewport, panels: Panels, testing: bool, window_size: tuple[int, int] = (1280, 800)
+    editor: Editor,
+    viewport: Viewport,
+    panels: Panels,
+    testing: bool,
+    window_size: tuple[int, int] = (1280, 800),
+    scripted: bool = False,
 ) -> hello_imgui.RunnerParams:
+    """The editor's window, panels and per-frame work; `testing`: GUI tests drive it, `scripted`: it quits after
+    a count of frames (neither waits for input between frames)."""
     params = hello_imgui.RunnerParams()
     params.app_window_params.window_title = "cloudview"
     params.app_window_params.window_geometry.size = window_size
@@ -55,6 +62,7 @@ def runner_params(
     options = hello_imgui.OpenGlOptions()
     options.anti_aliasing_samples = 0
     params.renderer_backend_options.open_gl_options = options
+    # hello_imgui's idling, switched on and off each frame (below)
     params.fps_idling.enable_idling = False
     params.ini_folder_type = hello_imgui.IniFolderType.app_user_config_folder
     params.ini_filename = "cloudview/layout.ini"
@@ -78,6 +86,10 @@ def runner_params(
         shortcuts(editor)
         panels.poll_recording()
         editor.autosave()
+        # at rest (the last frame showed the same picture again, no path playing) the window waits for input, up
+        # to a ninth of a second, between frames, instead of drawing them as fast as it can: an idle editor took
+        # a whole core on llvmpipe.  Input, an edit, playing or a relit picture drawing wakes it at once
+        hello_imgui.get_runner_params().fps_idling.enable_idling = not (testing or scripted) and viewport.at_rest
 
     def before_exit():
         panels.close()
@@ -151,7 +163,14 @@ def main(argv=None) -> int:
         return 2
     viewport = Viewport(editor)
     panels = Panels(editor, viewport)
-    params = runner_params(editor, viewport, panels, testing=args.self_test is not None, window_size=args.window_size)
+    params = runner_params(
+        editor,
+        viewport,
+        panels,
+        testing=args.self_test is not None,
+        window_size=args.window_size,
+        scripted=args.frames is not None,
+    )
     outcome = {}
     if args.self_test is not None:
         from app.gui_tests import EditorUnderTest, install

@@ -60,6 +60,9 @@ class Viewport:
         self.relighting = LiveIllumination(IlluminationCache())
         self.relighting.start()
         self._last_inputs, self._last_stats = None, None  # what the picture shown was drawn from, and its stats
+        #: the last frame showed the picture before it again and no path is playing: nothing moves on its own
+        self.at_rest = False
+        self._shown: int | None = None  # the display texture of the picture shown
         self._heat_texture: ImageTexture | None = None
         self._last_time = time.perf_counter()
 
@@ -107,7 +110,9 @@ class Viewport:
             counts, overdraw = self.renderer.measure_overdraw()
             stats = stats.with_overdraw(overdraw)
             heat = heat_image(counts) if self.heat_map else None
-        texture = self.renderer.display_texture()
+        if not reused or self._shown is None:  # a picture shown again is in its display texture already
+            self._shown = self.renderer.display_texture()
+        texture = self._shown
         # texture coordinates of the image's top left and bottom right corners: the frame's rows are bottom
         # first as GL keeps them (flip v), the heat map's top first
         uv_top_left, uv_bottom_right = imgui.ImVec2(0, 1), imgui.ImVec2(1, 0)
@@ -131,6 +136,7 @@ class Viewport:
             viewport_height=height,
         )
         self.regenerations_total += shown.impostors_regenerated
+        self.at_rest = reused and not editor.playing
         editor.record_frame(shown)
 
         origin = imgui.get_cursor_screen_pos()
