@@ -167,6 +167,9 @@ class FrameRenderer:
 
         With `read_back=False` the image stays on the GPU (None is returned in its place): the
         editor shows it through `display_texture`.
+
+        A frame one of whose draws composited by compute had more tile pairs than the GPU had room for is
+        drawn twice (`FrameStats.drawn_again`; `cloudcore.gl.tile_binning`).
         """
         drawing = (scene, time_of_day, camera, illumination_method, settings, time_s, costs)
         stats = self._draw_frame(*drawing)
