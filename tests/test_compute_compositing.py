@@ -183,7 +183,8 @@ def test_a_draw_past_the_room_for_its_pairs_is_drawn_again_counted_first(rendere
     image, stats = renderer.render(valley, settings=COMPUTE)
     assert stats.drawn_again and stats.compositing == "compute"
     assert compare(image, expected).max_abs == 0
-    assert stats.frame_ms >= stats.plan_ms + stats.world_ms + stats.impostor_update_ms + stats.cloud_ms
+    # the second drawing's parts, and the first drawing's whole frame beside them (some milliseconds anywhere)
+    assert stats.frame_ms > stats.plan_ms + stats.world_ms + stats.impostor_update_ms + stats.cloud_ms + 0.1
 
 
 def test_only_selections_of_plain_splats_are_compositable(renderer):
