@@ -28,11 +28,16 @@ def camera_pose(camera: Camera) -> np.ndarray:
     """
     ex, ey, ez = (float(value) for value in camera.position)
     fx, fy, fz = (float(target) - origin for target, origin in zip(camera.look_at, (ex, ey, ez)))
-    length = math.sqrt(fx * fx + fy * fy + fz * fz)
+    # hypot, not the root of the squares: a look-at point 1e-300 m away squares to 0
+    length = math.hypot(fx, fy, fz)
+    if length == 0.0:
+        # the eye at its own look-at point (a camera path whose two keys swap eye and target, halfway): the
+        # loader refuses it in a key; between keys the view looks down -z
+        fx, fy, fz, length = 0.0, 0.0, -1.0, 1.0
     fx, fy, fz = fx / length, fy / length, fz / length
     # right = forward x world up (0, 1, 0), horizontal
     rx, rz = -fz, fx
-    horizontal = math.sqrt(rx * rx + rz * rz)
+    horizontal = math.hypot(rx, rz)
     if horizontal < 1e-9:
         # looking straight up or down: any horizontal right axis will do; take east
         rx, rz, horizontal = 1.0, 0.0, 1.0

@@ -11,6 +11,11 @@ such a scene first.  docs/scene-format.md lists them.
 
 from __future__ import annotations
 
+import dataclasses
+from collections.abc import Iterator
+
+import numpy as np
+
 from cloudcore.artist.artist_shading import default_group_size, shading_grid_fits
 from cloudcore.light.lighting import active_lights
 
@@ -21,6 +26,22 @@ MAX_LIGHTS = 8
 DRAWN_TERRAIN_KINDS = ("heightfield",)
 #: the largest side of a frame in pixels (llvmpipe's and most GPUs' largest renderbuffer)
 MAX_FRAME_SIDE = 16384
+#: the memory a frame of the headless commands takes, per pixel: the peak resident size of `cloudview render`
+#: on llvmpipe, whose targets are in the process's memory, was 0.35 GB at 1024x1024 and 2.31 GB at 4096x4096
+#: (2026-12-06), 125 bytes a pixel; a 16384x16384 frame, within MAX_FRAME_SIDE, was killed for memory at 24 GB
+FRAME_BYTES_PER_PIXEL = 125
+#: the memory a frame takes whatever its size (the process, its libraries, the scene)
+FRAME_BASE_BYTES = 350 * 2**20
+#: the largest magnitude of any number a scene holds (metres, seconds, optical depths, colours, intensities):
+#: the product of three such stays finite in float32 (3.4e38) on the GPU and in its half-float targets' sums,
+#: and a float64 position keeps a tenth of a millimetre.  A camera 1e20 m out made the view singular, a
+#: particle at 1e200 m overflowed the shading's distances, an ambient of 1e39 put Inf in the frame
+MAX_MAGNITUDE = 1.0e12
+#: the longest name of a cloud, object, camera path or view, in characters: names become file names (a
+#: cloud's particles, a view's golden), and a 240-character cloud name made every save fail
+MAX_NAME_LENGTH = 64
+#: where a record's field is not the scene file's key: an object's vertices come from its mesh file
+_FILE_KEYS = {"vertices": "mesh"}
 
 
 def scene_limit_problems(scene, unchanged=None) -> list[tuple[str, str]]:
@@ -48,8 +69,13 @@ def scene_limit_problems(scene, unchanged=None) -> list[tuple[str, str]]:
             )
         )
     previous = {id(cloud) for cloud in unchanged.clouds} if unchanged is not None else set()
+    for key in ("camera", "lighting", "shading", "terrain", "objects", "camera_paths", "views", "cloud_field"):
+        problems.extend(_out_of_bounds(key, getattr(scene, key)))
     for i, cloud in enumerate(scene.clouds):
-        if cloud.artist is None or not len(cloud.particles) or id(cloud) in previous:
+        if id(cloud) in previous:
+            continue
+        problems.extend(_out_of_bounds(f"clouds[{i}]", cloud))
+        if cloud.artist is None or not len(cloud.particles):
             continue
         size = cloud.shading_group_size or default_group_size(cloud.radii)
         if not shading_grid_fits(cloud.centres, size):
@@ -62,3 +88,69 @@ def scene_limit_problems(scene, unchanged=None) -> list[tuple[str, str]]:
                 )
             )
     return problems
+
+
+def _out_of_bounds(field: str, value) -> Iterator[tuple[str, str]]:
+    """(field, problem) for each finite number in `value` (a record, a tuple, an array) past MAX_MAGNITUDE and
+    each name past MAX_NAME_LENGTH; infinities are the records' own to allow (a ring radius) or refuse."""
+    if dataclasses.is_dataclass(value):
+        for item in dataclasses.fields(value):
+            name = _FILE_KEYS.get(item.name, item.name)
+            if item.name == "particles" and getattr(value, "particles_file", None) is not None:
+                name = "particles_file"  # the cloud's particles are in that file, not in the scene's
+            inner = getattr(value, item.name)
+            if item.name == "name" and isinstance(inner, str) and len(inner) > MAX_NAME_LENGTH:
+                yield (
+                    f"{field}.name",
+                    f"at most {MAX_NAME_LENGTH} characters (names become file names), got {len(inner)}",
+                )
+            elif item.name == "settings" and isinstance(inner, tuple):  # a view's (setting, value): keys of its table
+                for key, setting in inner:
+                    yield from _out_of_bounds(f"{field}.{key}", setting)
+            else:
+                yield from _out_of_bounds(f"{field}.{name}", inner)
+    elif isinstance(value, (tuple, list)) and value and all(dataclasses.is_dataclass(item) for item in value):
+        for i, item in enumerate(value):
+            yield from _out_of_bounds(f"{field}[{i}]", item)
+    else:
+        largest = _largest_finite(value)
+        if largest > MAX_MAGNITUDE:
+            yield field, f"numbers must be within +-{MAX_MAGNITUDE:g}, got {largest:.3g}"
+
+
+def _largest_finite(value) -> float:
+    """The largest magnitude of the finite floats of a value: a number, a float array, or tuples of them nested
+    (0 where there is none; strings and integers are not magnitudes: names, choices, counts, seeds)."""
+    if isinstance(value, np.ndarray):
+        finite = np.abs(value[np.isfinite(value)]) if value.dtype.kind == "f" else ()
+        return float(finite.max()) if len(finite) else 0.0
+    if isinstance(value, (tuple, list)):
+        return max((_largest_finite(item) for item in value), default=0.0)
+    if isinstance(value, (float, np.floating)) and np.isfinite(value):
+        return abs(float(value))
+    return 0.0
+
+
+def frame_memory_problem(width: int, height: int, available_bytes: int | None = None) -> str | None:
+    """Why a `width` x `height` frame would not fit in the memory available (`available_bytes`, else this
+    machine's), or None where it fits or the available memory is unknown."""
+    available = available_memory_bytes() if available_bytes is None else available_bytes
+    needed = FRAME_BASE_BYTES + FRAME_BYTES_PER_PIXEL * width * height
+    if available is None or needed <= available:
+        return None
+    return (
+        f"a {width}x{height} frame needs about {needed / 1e9:.1f} GB of memory "
+        f"({FRAME_BYTES_PER_PIXEL} bytes a pixel), {available / 1e9:.1f} GB are available"
+    )
+
+
+def available_memory_bytes() -> int | None:
+    """What the kernel says new allocations can take without swapping (Linux's MemAvailable), else None."""
+    try:
+        with open("/proc/meminfo") as info:
+            for line in info:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    return None

@@ -19,7 +19,8 @@ from cloudcore.scene import Cloud
 
 def particles_file_for(scene_path, cloud_name: str) -> str:
     """Where `save_scene` puts a large cloud's particles, relative to the scene file (when that file is free)."""
-    safe = "".join(ch if ch.isalnum() or ch in "-_" else "_" for ch in cloud_name)
+    # ASCII: a name's 64 characters (`limits.MAX_NAME_LENGTH`) stay 64 bytes of the file system's 255
+    safe = "".join(ch if (ch.isascii() and ch.isalnum()) or ch in "-_" else "_" for ch in cloud_name)
     return f"{particles_folder(scene_path)}/{safe}.npy"
 
 

@@ -47,6 +47,9 @@ from cloudcore.settings import MODES, RenderSettings, setting_options
 from cloudcore.toml_table import Table, checked_matrix, field_error
 
 PRIMITIVES = ("box", "sphere", "aircraft")
+#: a terrain's side in metres, at least: its noise is scaled to the side, and a side of 5e-324 m halved to 0
+#: and put NaN in the heights
+MIN_TERRAIN_SIDE_M = 1.0
 TERRAIN_KINDS = ("heightfield", "mesh")
 #: TOML arrays are slow to parse; clouds larger than this are saved to .npy.
 INLINE_PARTICLE_LIMIT = 64
@@ -343,10 +346,22 @@ def _artist(t: Table) -> ArtistShading:
     )
 
 
+def _check_regular_file(t: Table, key: str, file: Path) -> None:
+    """`file` is a file to read: not missing, not a folder, and not a pipe or device (a FIFO blocked the load
+    forever)."""
+    if not file.exists():
+        t.fail(key, f"{file}: no such file")
+    if file.is_dir():
+        t.fail(key, f"{file}: is a folder, not a file")
+    if not file.is_file():
+        t.fail(key, f"{file}: not a regular file (a pipe or a device)")
+
+
 def _read_particles(t: Table, file: Path) -> np.ndarray:
+    _check_regular_file(t, "particles_file", file)
     try:
         array = open_particle_array(file)  # memory-mapped: checked_matrix copies the data out of the map
-    except FileNotFoundError:
+    except FileNotFoundError:  # removed since it was looked at
         t.fail("particles_file", f"{file}: no such file")
     except Exception as error:  # a forged header raises ValueError, OverflowError, TokenError, BadZipFile...
         t.fail("particles_file", f"{file}: not a readable .npy ({error})")
@@ -365,7 +380,7 @@ def _terrain(t: Table) -> Terrain:
     sx = Table(t.source, t.path("size"), {"x": size[0], "z": size[1]})
     return Terrain(
         kind=kind,
-        size=(sx.number("x", low=0.0, low_open=True), sx.number("z", low=0.0, low_open=True)),
+        size=(sx.number("x", low=MIN_TERRAIN_SIDE_M), sx.number("z", low=MIN_TERRAIN_SIDE_M)),
         resolution=t.integer("resolution", d.resolution, low=2, high=4096),
         height=t.number("height", d.height, low=0.0),
         seed=t.integer("seed", d.seed, low=0, high=2**31 - 1),
@@ -401,8 +416,7 @@ def _read_mesh(t: Table, file: Path) -> tuple[np.ndarray, np.ndarray]:
     """The triangles of a mesh file trimesh reads (all its geometry merged), checked finite."""
     import trimesh
 
-    if not file.is_file():
-        t.fail("mesh", f"{file}: no such file")
+    _check_regular_file(t, "mesh", file)
     try:
         mesh = trimesh.load(file, force="mesh")
     except Exception as error:  # trimesh raises many kinds on a file it cannot parse

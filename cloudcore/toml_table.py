@@ -149,7 +149,8 @@ class Table:
 
 def checked_matrix(value, columns, source, field, allow_empty) -> np.ndarray:
     try:
-        array = np.array(value, dtype=np.float64)
+        with np.errstate(over="ignore"):  # a long double past float64 becomes inf, refused below in one line
+            array = np.array(value, dtype=np.float64)
         # numpy would take the strings "1.5" and booleans as numbers: TOML input must hold numbers
         if not isinstance(value, np.ndarray) and not all(
             isinstance(x, (int, float)) and not isinstance(x, bool) for x in np.array(value, dtype=object).flat

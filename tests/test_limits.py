@@ -18,9 +18,17 @@ from app.editor import Editor
 from cloudcore.cloud_records import ArtistShading
 from cloudcore.editing import add_particle
 from cloudcore.errors import SceneError
-from cloudcore.limits import DRAWN_TERRAIN_KINDS, MAX_FRAME_SIDE, MAX_LIGHTS, scene_limit_problems
-from cloudcore.scene import Cloud, Light, Lighting, Scene, Terrain
-from cloudcore.scenefile import load_scene
+from cloudcore.limits import (
+    DRAWN_TERRAIN_KINDS,
+    MAX_FRAME_SIDE,
+    MAX_LIGHTS,
+    MAX_MAGNITUDE,
+    MAX_NAME_LENGTH,
+    frame_memory_problem,
+    scene_limit_problems,
+)
+from cloudcore.scene import Camera, Cloud, Light, Lighting, Scene, Terrain
+from cloudcore.scenefile import load_scene, save_scene
 
 pytestmark = pytest.mark.gl
 
@@ -63,6 +71,34 @@ LIMITS = [
         "too small",
         ARTIST_CLOUD.format(size=1.0),
     ),
+    (
+        "camera far out",
+        "[camera]\nposition = [0, 800, 1e20]\nlook_at = [0, 800, 0]\n" + CLOUD,
+        "camera.position",
+        "within +-1e+12",
+        f"[camera]\nposition = [0, 800, {MAX_MAGNITUDE}]\nlook_at = [0, 800, 0]\n" + CLOUD,
+    ),
+    (
+        "particle far out",
+        '[[clouds]]\nname = "c"\nparticles = [[0, 800, 0, 50], [1e200, 850, 0, 60]]\n',
+        "clouds[0].particles",
+        "within +-1e+12",
+        f'[[clouds]]\nname = "c"\nparticles = [[0, 800, 0, 50], [{-MAX_MAGNITUDE}, 850, 0, {MAX_MAGNITUDE}]]\n',
+    ),
+    (
+        "ambient past float32",
+        "[lighting]\nambient = [1e39, 1e39, 1e39]\n" + CLOUD,
+        "lighting.ambient",
+        "within +-1e+12",
+        f"[lighting]\nambient = [{MAX_MAGNITUDE}, 1, 1]\n" + CLOUD,
+    ),
+    (
+        "long name",
+        CLOUD.replace('"c"', f'"{"n" * (MAX_NAME_LENGTH + 1)}"'),
+        "clouds[0].name",
+        f"at most {MAX_NAME_LENGTH} characters",
+        CLOUD.replace('"c"', f'"{"n" * MAX_NAME_LENGTH}"'),
+    ),
 ]
 
 
@@ -74,24 +110,52 @@ def past_limit(name: str) -> Scene:
         return dataclasses.replace(base, lighting=Lighting(time_of_day=None, lights=lights))
     if name == "terrain kind":
         return dataclasses.replace(base, terrain=Terrain(kind="mesh", mesh="ground.obj"))
+    if name == "camera far out":
+        return dataclasses.replace(base, camera=Camera((0.0, 800.0, 1e20), (0.0, 800.0, 0.0)))
+    if name == "particle far out":
+        return dataclasses.replace(base, clouds=(Cloud("c", np.array([[0, 800, 0, 50], [1e200, 850, 0, 60]])),))
+    if name == "ambient past float32":
+        return dataclasses.replace(base, lighting=Lighting(ambient=(1e39, 1e39, 1e39)))
+    if name == "long name":
+        return dataclasses.replace(
+            base, clouds=(dataclasses.replace(base.clouds[0], name="n" * (MAX_NAME_LENGTH + 1)),)
+        )
     cloud = Cloud(
         "c", np.array([[0, 800, 0, 50], [1e5, 850, 0, 60]], float), artist=ArtistShading(), shading_group_size=1e-12
     )
     return dataclasses.replace(base, clouds=(cloud,))
 
 
-#: what the GL side says past each limit, had the scene got that far
+#: what the renderer says past each limit it refuses or fails at, had the scene got that far
 RENDERER_REFUSALS = {
     "lights": f"at most {MAX_LIGHTS} lights",
     "terrain kind": "heightfield terrain only",
     "shading groups": "too small for a cloud this large",
+    "camera far out": "Singular matrix",  # the world pass inverts the view-projection
+    "particle far out": "overflow",  # the shading's distances between particles
 }
 
 
-@pytest.mark.parametrize("name", [limit[0] for limit in LIMITS])
+@pytest.mark.parametrize("name", list(RENDERER_REFUSALS))
 def test_the_renderer_fails_past_the_limit_so_the_check_guards_something(renderer, name):
     with pytest.raises(ValueError, match=RENDERER_REFUSALS[name]):
         renderer.render(past_limit(name))
+
+
+@pytest.mark.filterwarnings("ignore:overflow encountered in cast:RuntimeWarning")  # what it shows
+def test_past_the_magnitude_limit_an_ambient_puts_inf_in_the_frame_so_the_check_guards_something(renderer):
+    renderer.render(past_limit("ambient past float32"))
+    assert not np.isfinite(renderer.context.read_linear_rgb()).all()
+
+
+def test_past_the_name_limit_a_cloud_cannot_be_saved_so_the_check_guards_something(tmp_path):
+    """A cloud of more than 64 particles goes to a file named after it; 240 characters are past the file system's
+    255 bytes with the save's temporary name around them."""
+    particles = np.column_stack([np.arange(100.0), np.full(100, 800.0), np.zeros(100), np.full(100, 50.0)])
+    with pytest.raises(OSError, match="File name too long"):
+        save_scene(Scene(clouds=(Cloud("n" * 240, particles),)), tmp_path / "s.toml")
+    save_scene(Scene(clouds=(Cloud("n" * MAX_NAME_LENGTH, particles),)), tmp_path / "s.toml")
+    assert len(load_scene(tmp_path / "s.toml").clouds[0].particles) == 100
 
 
 @pytest.mark.parametrize("name, text, field, problem, within", LIMITS)
@@ -134,12 +198,14 @@ def test_the_editor_refuses_the_edit_with_a_message_and_keeps_the_scene(name, te
 
 def test_placing_a_particle_far_outside_an_artist_cloud_is_refused_and_the_cloud_kept():
     cloud = Cloud(
-        "c", np.array([[0, 800, 0, 50.0], [10, 800, 0, 50.0]]), artist=ArtistShading(), shading_group_size=1.0
+        "c", np.array([[0, 800, 0, 50.0], [10, 800, 0, 50.0]]), artist=ArtistShading(), shading_group_size=1e-6
     )
     editor = Editor(Scene(clouds=(cloud,)), None)
-    assert editor.change(lambda: add_particle(editor.scene, 0, (1e17, 800.0, 0.0), 50.0)) is False
+    assert editor.change(lambda: add_particle(editor.scene, 0, (1e11, 800.0, 0.0), 50.0)) is False
     assert editor.scene.clouds[0] is cloud
     assert "clouds[0].shading_group_size" in editor.messages[-1]
+    assert editor.change(lambda: add_particle(editor.scene, 0, (1e17, 800.0, 0.0), 50.0)) is False
+    assert "clouds[0].particles: numbers must be within" in editor.messages[-1]
     assert editor.change(lambda: add_particle(editor.scene, 0, (1e3, 800.0, 0.0), 50.0)) is True
     assert len(editor.scene.clouds[0].particles) == 3
 
@@ -171,3 +237,31 @@ def test_a_frame_side_past_the_limit_is_refused_at_the_command_line(tmp_path, si
     )
     assert result.returncode == status
     assert len(result.stderr.strip().splitlines()) == 1 and "--width" in result.stderr
+
+
+def test_a_frame_past_the_memory_available_is_refused_naming_what_it_needs():
+    problem = frame_memory_problem(16384, 16384, available_bytes=8 * 10**9)
+    assert problem is not None and "16384x16384" in problem and "8.0 GB are available" in problem
+    assert frame_memory_problem(640, 480, available_bytes=8 * 10**9) is None
+
+
+@pytest.mark.parametrize(
+    "arguments, words, output",
+    [
+        (["render", "--out", "{tmp}/x"], "not an image file name", "x"),
+        (["render", "--out", "{tmp}/x.png", "--camera-path", "orbit", "--path-time", "nan"], "--path-time", "x.png"),
+        (["bench", "--still", "--frames", "1", "--json", "{tmp}/folder"], "is a folder", "folder/x"),
+        (["record", "--camera-path", "orbit", "--out", "{tmp}/video"], "not a video file name", "video"),
+    ],
+)
+def test_bad_outputs_and_times_are_refused_in_one_line_before_any_frame(
+    tmp_path, small_scene, arguments, words, output
+):
+    scene = tmp_path / "scene.toml"
+    save_scene(small_scene, scene)
+    (tmp_path / "folder").mkdir()
+    command = [arguments[0], str(scene), *(a.replace("{tmp}", str(tmp_path)) for a in arguments[1:])]
+    result = subprocess.run([sys.executable, "-m", "cloudcore.cli", *command], capture_output=True, text=True)
+    assert result.returncode == 2
+    assert len(result.stderr.strip().splitlines()) == 1 and words in result.stderr, result.stderr
+    assert not (tmp_path / output).exists()

@@ -8,7 +8,7 @@ import pytest
 
 from cloudcore.measure.frame_stats import FrameStats, PlanStats
 from cloudcore.measure.overdraw import Overdraw
-from cloudcore.measure.recording import COLUMNS, frame_row, frame_times
+from cloudcore.measure.recording import COLUMNS, MAX_RECORDED_FRAMES, frame_row, frame_times
 
 
 def test_a_30_s_path_at_30_fps_is_901_frames_ending_on_the_last_key():
@@ -66,3 +66,13 @@ def test_row_takes_layers_and_overdraw_when_given():
     row = frame_row(0, 0.0, stats)
     assert (row["layers_drawn"], row["layers_rebuilt"]) == (4, 2)
     assert (row["overdraw_mean"], row["overdraw_max"], row["overdraw_analytic"]) == (3.25, 17.0, 3.5)
+
+
+def test_a_recording_past_the_frame_limit_is_refused_unless_frames_cut_it():
+    """A 2e12 s path asked for 6e13 frame times at once (a MemoryError); 1e300 fps overflowed to inf."""
+    with pytest.raises(ValueError, match="past the 10,000,000"):
+        frame_times(2e12, 30.0)
+    with pytest.raises(ValueError, match="past the 10,000,000"):
+        frame_times(2e12, 1e300)
+    assert len(frame_times(2e12, 30.0, frames=3)) == 3
+    assert len(frame_times((MAX_RECORDED_FRAMES - 1) / 30.0, 30.0)) == MAX_RECORDED_FRAMES

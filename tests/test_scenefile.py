@@ -1,5 +1,6 @@
 """Scene files: lossless round trips, clear refusals, atomic saves."""
 
+import os
 import subprocess
 import sys
 import tomllib
@@ -37,7 +38,7 @@ def test_default_scene_round_trips(tmp_path):
 def test_awkward_floats_survive(tmp_path, small_scene):
     from dataclasses import replace
 
-    particles = np.array([[0.1 + 0.2, 1e-300, -2.5e17, 1e-6], [1 / 3, 5e-324, 1e6, 1e6]])
+    particles = np.array([[0.1 + 0.2, 1e-300, -2.5e11, 1e-6], [1 / 3, 5e-324, 1e6, 1e6]])
     scene = replace(small_scene, clouds=(replace(small_scene.clouds[0], particles=particles),))
     save_scene(scene, tmp_path / "f.toml")
     np.testing.assert_array_equal(load_scene(tmp_path / "f.toml").clouds[0].particles, particles)
@@ -232,11 +233,23 @@ def test_a_byte_order_mark_anywhere_but_the_start_is_still_refused(tmp_path):
         ("truncated", "not a readable .npy"),
         ("3 columns", "rows of 4"),
         ("strings", "numeric array"),
+        ("a folder", "is a folder, not a file"),
+        ("a pipe", "not a regular file"),
+        ("long doubles past float64", "not finite"),
     ],
 )
-def test_bad_particle_files_are_refused(tmp_path, content, problem):
+def test_bad_particle_files_are_refused(tmp_path, content, problem, recwarn):
+    """Each in one line, without a warning besides it; a pipe is refused, not read (the load blocked for ever)."""
     npy = tmp_path / "p.npy"
-    if content == "truncated":
+    if content == "a folder":
+        npy.mkdir()
+    elif content == "a pipe":
+        os.mkfifo(npy)
+    elif content == "long doubles past float64":
+        if np.finfo(np.longdouble).max <= np.finfo(np.float64).max:
+            pytest.skip("this platform's long double is a float64")
+        np.save(npy, np.array([[0.0, 800.0, 0.0, 1.0]], dtype=np.longdouble) * np.longdouble("1e400"))
+    elif content == "truncated":
         np.save(npy, np.ones((100, 4)))
         npy.write_bytes(npy.read_bytes()[:-37])
     elif content == "3 columns":
@@ -249,6 +262,16 @@ def test_bad_particle_files_are_refused(tmp_path, content, problem):
     with pytest.raises(SceneError, match=problem) as caught:
         load_scene(tmp_path / "s.toml")
     assert caught.value.field == "clouds[0].particles_file"
+    assert not [str(warning.message) for warning in recwarn]
+
+
+@pytest.mark.parametrize("mesh, problem", [(".", "is a folder, not a file"), ("/dev/null", "not a regular file")])
+def test_a_mesh_that_is_not_a_file_is_refused_as_such(tmp_path, mesh, problem):
+    """It was "no such file" for both."""
+    (tmp_path / "s.toml").write_text(f'[[objects]]\nname = "o"\nmesh = "{mesh}"\n')
+    with pytest.raises(SceneError, match=problem) as caught:
+        load_scene(tmp_path / "s.toml")
+    assert caught.value.field == "objects[0].mesh"
 
 
 def test_failed_save_leaves_the_previous_file_intact(tmp_path, small_scene, monkeypatch):

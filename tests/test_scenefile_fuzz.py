@@ -35,6 +35,7 @@ from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
 from cloudcore.errors import SceneError
+from cloudcore.limits import MAX_MAGNITUDE
 from cloudcore.scene import Scene
 from cloudcore.scenefile import load_scene, save_scene
 
@@ -632,7 +633,9 @@ def test_npy_of_the_wrong_shape_is_refused(saved, array):
 def test_npy_of_the_right_shape_is_checked_value_by_value(saved, array):
     with np.errstate(over="ignore", invalid="ignore"):
         as_float = np.asarray(array, dtype=np.float64)
-        good = bool(np.all(np.isfinite(as_float)) and np.all(as_float[:, 3] > 0))
+        good = bool(
+            np.all(np.isfinite(as_float)) and np.all(as_float[:, 3] > 0) and np.all(np.abs(as_float) <= MAX_MAGNITUDE)
+        )
     outcome = load_with_npy(saved, save_npy(array))
     if good:
         np.testing.assert_array_equal(outcome.clouds[1].particles, as_float)

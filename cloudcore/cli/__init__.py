@@ -63,6 +63,7 @@ def main(argv=None) -> int:
         return _editor(argv)
     args = parser.parse_args(argv)
     try:
+        _check_frame_memory(args)
         return int(args.run(args) or 0)
     except SceneError as error:
         print(f"cloudview: error: {error}", file=sys.stderr)
@@ -70,6 +71,22 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print("cloudview: interrupted", file=sys.stderr)
         return 130
+
+
+def _check_frame_memory(args) -> None:
+    """A command's frame size (`--width` and `--height`, or `--size`) fits in this machine's memory: refused
+    before any work, where the kernel killed a frame too large after minutes, without a word."""
+    from cloudcore.limits import frame_memory_problem
+
+    if hasattr(args, "width") and hasattr(args, "height"):
+        size = args.width, args.height
+    elif isinstance(getattr(args, "size", None), tuple):
+        size = args.size
+    else:
+        return
+    problem = frame_memory_problem(*size)
+    if problem is not None:
+        raise SceneError("--width/--height" if hasattr(args, "width") else "--size", "size", problem)
 
 
 def _editor(argv: list[str]) -> int:

@@ -15,7 +15,7 @@ import json
 import os
 from pathlib import Path
 
-from cloudcore.cli.render import pixel_count
+from cloudcore.cli.render import check_outputs, pixel_count, write_output
 from cloudcore.cli.settings_args import SWEEPABLE, add_settings_arguments, parse_sweep, settings_from
 from cloudcore.errors import SceneError
 from cloudcore.measure.benchmark import (
@@ -70,6 +70,7 @@ def add_parser(commands) -> None:
 
 
 def run(args) -> int:
+    check_outputs(args.json, args.plot)
     scene = load_scene(args.scene)
     if args.without_terrain:
         scene = dataclasses.replace(scene, terrain=None)
@@ -131,8 +132,7 @@ def run(args) -> int:
     report["scene"] = str(args.scene)
     report["without_terrain"] = args.without_terrain
     report["shading"] = [] if args.no_shading else shading_comparison(scene)
-    args.json.parent.mkdir(parents=True, exist_ok=True)
-    args.json.write_text(json.dumps(report, indent=2) + "\n")
+    write_output(args.json, lambda path: path.write_text(json.dumps(report, indent=2) + "\n"))
     reference = report["reference"]
     print(
         f"full 3D: {reference['frame_ms_mean']:.1f} ms mean, {reference['frame_ms_p95']:.1f} ms p95, "

@@ -8,6 +8,7 @@ and the exit status is 130.  The same arguments give the same frames.
 
 from __future__ import annotations
 
+import argparse
 import csv
 import math
 import os
@@ -17,7 +18,7 @@ from contextlib import ExitStack, contextmanager
 from pathlib import Path
 from types import SimpleNamespace
 
-from cloudcore.cli.render import add_scene_argument, pixel_count
+from cloudcore.cli.render import add_scene_argument, pixel_count, write_output
 from cloudcore.cli.settings_args import add_settings_arguments, settings_from
 from cloudcore.collector import freeze_what_is_set_up
 from cloudcore.errors import SceneError
@@ -30,7 +31,9 @@ def add_parser(commands) -> None:
     parser = commands.add_parser("record", help="render every frame of a camera path to a video and/or PNGs")
     add_scene_argument(parser)
     parser.add_argument("--camera-path", required=True, help="camera path of the scene to fly")
-    parser.add_argument("--out", type=Path, help="H.264 video to write (.mp4); needs an even width and height")
+    parser.add_argument(
+        "--out", type=video_path, help="H.264 video to write (.mp4, .mkv, .mov); needs an even width and height"
+    )
     parser.add_argument("--frames-dir", type=Path, help="folder to write frame_00000.png, frame_00001.png, ... into")
     parser.add_argument("--stats", type=Path, help="one row of frame statistics per frame (CSV)")
     parser.add_argument("--fps", type=frame_rate, default=30.0, help="frames per second (default 30)")
@@ -45,6 +48,19 @@ def add_parser(commands) -> None:
     # many frames: impostors pay off
     add_settings_arguments(parser, default_mode="auto")
     parser.set_defaults(run=run)
+
+
+#: the containers ffmpeg picks by a file's suffix that hold H.264
+VIDEO_SUFFIXES = (".mp4", ".m4v", ".mkv", ".mov")
+
+
+def video_path(text: str) -> Path:
+    """A video to write, its suffix a container of H.264: refused with the arguments (ffmpeg guesses the container
+    from the suffix, and without one it failed in a traceback, leaving an empty file)."""
+    path = Path(text)
+    if path.suffix.lower() not in VIDEO_SUFFIXES:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a video file name: end it in {', '.join(VIDEO_SUFFIXES)}")
+    return path
 
 
 def frame_rate(text: str) -> float:
@@ -76,7 +92,10 @@ def run(args) -> int:
     except KeyError as error:
         raise SceneError(args.scene, "camera_paths", error.args[0]) from None
     settings = settings_from(args)
-    times = frame_times(path.duration, args.fps, args.frames)
+    try:
+        times = frame_times(path.duration, args.fps, args.frames)
+    except ValueError as error:
+        raise SceneError(args.scene, f"camera_paths ({args.camera_path})", str(error)) from None
 
     # headless: EGL must be chosen before OpenGL is first imported
     os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
@@ -89,10 +108,12 @@ def run(args) -> int:
     with _stop_on_interrupt() as stop, ExitStack() as outputs:
         # every output is made before the renderer starts, so an unwritable one fails at once
         if args.out:
-            _output(args.out, lambda p: p.open("wb").close())
+            write_output(args.out, lambda p: p.open("wb").close())
         if args.frames_dir:
-            _output(args.frames_dir, lambda folder: folder.mkdir(exist_ok=True))
-        table = outputs.enter_context(_output(args.stats, lambda p: p.open("w", newline=""))) if args.stats else None
+            write_output(args.frames_dir, lambda folder: folder.mkdir(exist_ok=True))
+        table = (
+            outputs.enter_context(write_output(args.stats, lambda p: p.open("w", newline=""))) if args.stats else None
+        )
         rows = csv.DictWriter(table, COLUMNS) if table is not None else None
         if rows is not None:
             rows.writeheader()
@@ -164,12 +185,3 @@ def _video(path: Path, size: tuple[int, int], fps: float):
         yield writer
     finally:
         writer.close()  # ffmpeg encodes what it holds and writes the index
-
-
-def _output(path: Path, create):
-    """Create the parent folder, then `create(path)`; an unwritable path is a one-line error."""
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        return create(path)
-    except OSError as error:
-        raise SceneError(str(path), "output", error.strerror or str(error)) from None

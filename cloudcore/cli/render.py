@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import argparse
+import functools
 import json
+import math
 import os
 from pathlib import Path
 
@@ -20,13 +23,15 @@ from cloudcore.scenefile import load_scene
 def add_parser(commands) -> None:
     parser = commands.add_parser("render", help="render one frame to a PNG, headless")
     add_scene_argument(parser)
-    parser.add_argument("--out", required=True, type=Path, help="PNG to write")
+    parser.add_argument(
+        "--out", required=True, type=image_path, help="image to write (PNG; its suffix picks the format)"
+    )
     parser.add_argument("--width", type=pixel_count, default=640)
     parser.add_argument("--height", type=pixel_count, default=480)
     parser.add_argument("--time-of-day", type=float, help="time of day in hours, overriding the scene's")
     parser.add_argument("--camera-path", help="take the camera from this path of the scene")
     parser.add_argument("--path-time", type=float, default=0.0, help="seconds along --camera-path (default 0)")
-    parser.add_argument("--overdraw", type=Path, help="write the overdraw heat map here (PNG)")
+    parser.add_argument("--overdraw", type=image_path, help="write the overdraw heat map here (PNG)")
     parser.add_argument("--stats", type=Path, help="write frame statistics, overdraw included, here (JSON)")
     # one frame: the reference picture unless asked otherwise (impostors pay off over many frames)
     add_settings_arguments(parser, default_mode="full")
@@ -48,6 +53,36 @@ def pixel_count(text: str) -> int:
     return value
 
 
+def image_path(text: str) -> Path:
+    """An image to write, its suffix one of a format Pillow writes: refused with the arguments, before any work
+    (without one the picture was rendered and then lost, in a traceback)."""
+    path = Path(text)
+    if path.suffix.lower() not in _image_suffixes():
+        raise argparse.ArgumentTypeError(f"{text!r} is not an image file name: end it in .png (or .jpg, .tif, ...)")
+    return path
+
+
+@functools.cache
+def _image_suffixes() -> frozenset[str]:
+    from PIL import Image
+
+    Image.init()
+    return frozenset(suffix for suffix, format_ in Image.registered_extensions().items() if format_ in Image.SAVE)
+
+
+def check_outputs(*paths: Path | None) -> None:
+    """Before the work: every output given can be written, its folder made, and is not a folder itself (a
+    benchmark wrote its report to a folder after minutes of frames, and lost them in a traceback)."""
+    for path in paths:
+        if path is None:
+            continue
+        if path.is_dir():
+            raise SceneError(str(path), "output", "is a folder; name a file in it")
+        write_output(path, lambda _: None)  # makes its folder
+        if not os.access(path.parent, os.W_OK):
+            raise SceneError(str(path), "output", "its folder is not writable")
+
+
 def check_time_argument(hours: float | None) -> None:
     """--time-of-day, when given, is an hour of the day."""
     if hours is not None and not 0.0 <= hours <= 24.0:
@@ -62,10 +97,13 @@ def camera_argument(args, scene) -> Camera:
         path = scene.camera_path(args.camera_path)
     except KeyError as error:
         raise SceneError(args.scene, "camera_paths", error.args[0]) from None
+    if not math.isfinite(args.path_time):
+        raise SceneError("--path-time", "path_time", f"must be finite seconds, got {args.path_time}")
     return camera_on_path(path, args.path_time, scene.camera.fov_y_deg)
 
 
 def run(args) -> int:
+    check_outputs(args.out, args.overdraw, args.stats)
     scene = load_scene(args.scene)
     check_time_argument(args.time_of_day)
     settings = settings_from(args)
@@ -106,10 +144,11 @@ def run(args) -> int:
     return 0
 
 
-def write_output(path: Path, write) -> None:
-    """Create the parent folder, then write; an unwritable path is a one-line error."""
+def write_output(path: Path, write):
+    """Create the parent folder, then `write(path)` and return what it returns; an unwritable path is a one-line
+    error."""
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        write(path)
+        return write(path)
     except OSError as error:
         raise SceneError(str(path), "output", error.strerror or str(error)) from None

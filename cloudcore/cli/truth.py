@@ -18,7 +18,15 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from cloudcore.cli.render import add_scene_argument, camera_argument, check_time_argument, pixel_count, write_output
+from cloudcore.cli.render import (
+    add_scene_argument,
+    camera_argument,
+    check_outputs,
+    check_time_argument,
+    image_path,
+    pixel_count,
+    write_output,
+)
 from cloudcore.colour import linear_to_srgb8
 from cloudcore.errors import SceneError
 from cloudcore.light.lighting import scene_hour
@@ -57,7 +65,7 @@ def add_parser(commands) -> None:
         "truth", help="path trace a reference picture (Mitsuba 3) and compare the shading models with it"
     )
     add_scene_argument(parser)
-    parser.add_argument("--out", required=True, type=Path, help="PNG to write (sRGB, as cloudview render)")
+    parser.add_argument("--out", required=True, type=image_path, help="PNG to write (sRGB, as cloudview render)")
     # path tracing thick clouds is slow on a CPU: smaller than cloudview render's default frame
     parser.add_argument("--width", type=pixel_count, default=160)
     parser.add_argument("--height", type=pixel_count, default=120)
@@ -94,6 +102,7 @@ def run(args) -> int:
         raise SceneError("cloudview truth", "--variant", str(error)) from None
     import imageio.v3 as iio
 
+    check_outputs(args.out, args.json)
     scene = load_scene(args.scene)
     check_time_argument(args.time_of_day)
     camera = camera_argument(args, scene)

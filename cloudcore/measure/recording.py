@@ -33,6 +33,10 @@ COLUMNS = (
 )
 
 
+#: the most frames one recording may have (92 hours at 30 fps): a path of 1e12 s asked for 3e13 frame times
+MAX_RECORDED_FRAMES = 10_000_000
+
+
 def frame_times(duration: float, fps: float, frames: int | None = None) -> np.ndarray:
     """Seconds from the path's start of frame i = 0, 1, ...: i / fps, up to `duration` included.
 
@@ -42,10 +46,15 @@ def frame_times(duration: float, fps: float, frames: int | None = None) -> np.nd
     if not (math.isfinite(fps) and fps > 0):
         raise ValueError(f"fps must be finite and > 0, got {fps}")
     # rounded first: 1.16 s * 25 fps is 28.999999999999996 in floating point, and is 29 frame steps
-    count = math.floor(round(duration * fps, 9)) + 1
+    steps = round(duration * fps, 9)  # inf for a path of 1e12 s at 1e300 fps
     if frames is not None:
-        count = min(count, frames)
-    return np.arange(count) / fps
+        steps = min(steps, frames - 1)
+    if not steps < MAX_RECORDED_FRAMES:
+        raise ValueError(
+            f"a {duration:g} s path at {fps:g} fps is {steps + 1:.3g} frames, past the {MAX_RECORDED_FRAMES:,} a "
+            "recording may have: give fewer frames (--frames) or a lower frame rate"
+        )
+    return np.arange(math.floor(steps) + 1) / fps
 
 
 def frame_row(frame: int, time_s: float, stats: FrameStats) -> dict:
