@@ -24,11 +24,17 @@ def srgb_decode(encoded) -> np.ndarray:
 BAYER_4 = np.array([[0, 8, 2, 10], [12, 4, 14, 6], [3, 11, 1, 9], [15, 7, 13, 5]], dtype=np.float64)
 
 
-def dither_thresholds(height: int, width: int) -> np.ndarray:
-    """(height, width) rounding thresholds in (0, 1), indexed as GL's gl_FragCoord is: row 0 of the
-    image (its top) is the frame's last row, so the editor's shader and this agree pixel for pixel."""
-    rows = (height - 1 - np.arange(height)) % 4
-    return (BAYER_4[rows][:, np.arange(width) % 4] + 0.5) / 16.0
+#: the pixels `linear_to_srgb8` converts at once: its float64 temporaries of a whole 4096x4096 frame at once
+#: took 1.4 GB, and `cloudview render`'s peak 125 bytes a pixel (now 32 on a plain scene)
+CONVERTED_AT_ONCE = 1 << 20
+
+
+def dither_thresholds(height: int, width: int, rows: slice = slice(None)) -> np.ndarray:
+    """(height, width) rounding thresholds in (0, 1), or those of `rows` of them, indexed as GL's gl_FragCoord
+    is: row 0 of the image (its top) is the frame's last row, so the editor's shader and this agree pixel for
+    pixel."""
+    pattern_rows = (height - 1 - np.arange(height)[rows]) % 4
+    return (BAYER_4[pattern_rows][:, np.arange(width) % 4] + 0.5) / 16.0
 
 
 def linear_to_srgb8(linear) -> np.ndarray:
@@ -38,9 +44,17 @@ def linear_to_srgb8(linear) -> np.ndarray:
     only a few sRGB levels, and rounding every pixel the same way bands it; a per-pixel threshold
     keeps each 4x4 block's mean on the true value (within 1/32 of a level) for one level of noise.
     Values on a level stay exactly on it.  shaders/present.frag.glsl does the same for the editor.
+    Converted a band of rows at a time, each pixel the same way: the memory is the output's and a band's.
     """
-    encoded = srgb_encode(linear) * 255.0
-    thresholds = dither_thresholds(*encoded.shape[:2])
-    if encoded.ndim == 3:
-        thresholds = thresholds[:, :, None]
-    return np.clip(np.floor(encoded + thresholds), 0.0, 255.0).astype(np.uint8)
+    linear = np.asarray(linear)
+    height, width = linear.shape[:2]
+    srgb = np.empty(linear.shape, dtype=np.uint8)
+    band = max(1, CONVERTED_AT_ONCE // max(width, 1))
+    for first in range(0, height, band):
+        rows = slice(first, min(first + band, height))
+        encoded = srgb_encode(linear[rows]) * 255.0
+        thresholds = dither_thresholds(height, width, rows)
+        if encoded.ndim == 3:
+            thresholds = thresholds[:, :, None]
+        srgb[rows] = np.clip(np.floor(encoded + thresholds), 0.0, 255.0)
+    return srgb

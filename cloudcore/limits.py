@@ -26,12 +26,13 @@ MAX_LIGHTS = 8
 DRAWN_TERRAIN_KINDS = ("heightfield",)
 #: the largest side of a frame in pixels (llvmpipe's and most GPUs' largest renderbuffer)
 MAX_FRAME_SIDE = 16384
-#: the memory a frame of the headless commands takes, per pixel: the peak resident size of `cloudview render`
-#: on llvmpipe, whose targets are in the process's memory, was 0.35 GB at 1024x1024 and 2.31 GB at 4096x4096
-#: (2026-12-06), 125 bytes a pixel; a 16384x16384 frame, within MAX_FRAME_SIDE, was killed for memory at 24 GB
-FRAME_BYTES_PER_PIXEL = 125
-#: the memory a frame takes whatever its size (the process, its libraries, the scene)
-FRAME_BASE_BYTES = 350 * 2**20
+#: the memory a frame of the headless commands takes, per pixel and whatever its size: the peak resident size
+#: of `cloudview render` on llvmpipe, whose targets are in the process's memory, on the default scene in auto
+#: mode (its impostors' targets too) was 0.64, 1.16 and 3.06 GB at 2048, 4096 and 8192 pixels square
+#: (2026-12-06): 40-43 bytes a pixel over about 475 MB.  A 16384x16384 frame, within MAX_FRAME_SIDE, was
+#: killed for memory at 24 GB when the read-back's colour conversion took the whole frame at once
+FRAME_BYTES_PER_PIXEL = 48
+FRAME_BASE_BYTES = 512 * 2**20
 #: the largest magnitude of any number a scene holds (metres, seconds, optical depths, colours, intensities):
 #: the product of three such stays finite in float32 (3.4e38) on the GPU and in its half-float targets' sums,
 #: and a float64 position keeps a tenth of a millimetre.  A camera 1e20 m out made the view singular, a

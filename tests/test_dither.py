@@ -1,8 +1,10 @@
 """The one dither at the 8-bit output: no banding in dark gradients, and the editor's shader agrees with it."""
 
 import numpy as np
+import pytest
 from conftest import VALLEY
 
+from cloudcore import colour
 from cloudcore.colour import dither_thresholds, linear_to_srgb8, srgb_encode
 from cloudcore.scenefile import load_scene
 from cloudcore.settings import FULL_3D
@@ -38,6 +40,16 @@ def test_the_thresholds_are_every_sixteenth_once_per_block_counted_from_the_bott
     thresholds = dither_thresholds(6, 8)
     assert sorted(thresholds[2:6, 0:4].ravel() * 16 - 0.5) == list(range(16))
     assert thresholds[5, 0] == 0.5 / 16.0  # the bottom-left pixel is gl_FragCoord (0, 0): Bayer entry 0
+
+
+@pytest.mark.parametrize("at_once", [1, 7 * 13, 10**9])  # a row a band, 7 rows (bands across the pattern), all
+def test_converted_in_bands_every_pixel_is_what_the_whole_frame_at_once_gives(monkeypatch, at_once):
+    linear = np.random.default_rng(3).uniform(-0.1, 1.1, (30, 13, 3))
+    encoded = srgb_encode(linear) * 255.0 + dither_thresholds(30, 13)[:, :, None]
+    whole = np.clip(np.floor(encoded), 0, 255).astype(np.uint8)
+    monkeypatch.setattr(colour, "CONVERTED_AT_ONCE", at_once)
+    np.testing.assert_array_equal(linear_to_srgb8(linear), whole)
+    np.testing.assert_array_equal(linear_to_srgb8(linear[..., 0]), whole[..., 0])
 
 
 def test_the_editor_s_present_shader_dithers_as_the_read_back_does(renderer):
