@@ -11,6 +11,7 @@ is there and `recover` loads it.
 from __future__ import annotations
 
 import dataclasses
+import math
 import shutil
 import time
 from collections import deque
@@ -116,12 +117,15 @@ class Editor:
     @classmethod
     def open(cls, path: Path) -> Editor:
         editor = cls(load_scene(path), path)
-        if recovery_path(path).exists():
-            editor.messages.append(
-                f"a recovery file from an unsaved session exists: {recovery_path(path)} "
+        editor._mention_recovery()
+        return editor
+
+    def _mention_recovery(self) -> None:
+        if self.path is not None and recovery_path(self.path).exists():
+            self.messages.append(
+                f"a recovery file of unsaved edits exists: {recovery_path(self.path)} "
                 "(Scene panel: Recover unsaved edits)"
             )
-        return editor
 
     def recover(self) -> bool:
         """Load the recovery copy of the open scene as one undoable edit.
@@ -168,9 +172,14 @@ class Editor:
             self.messages.append("not applied: {}: {}".format(*problems[0]))
             return False
         self.history.apply(scene)
-        if self.selected_cloud is not None and self.selected_cloud >= len(scene.clouds):
-            self.selected_cloud = len(scene.clouds) - 1 if scene.clouds else None
+        self._keep_selection()
         return True
+
+    def _keep_selection(self) -> None:
+        """The selected cloud stays one the scene has: an edit, an undo or a redo may have removed it."""
+        clouds = len(self.scene.clouds)
+        if self.selected_cloud is None or self.selected_cloud >= clouds:
+            self.selected_cloud = min(self.selected_cloud or 0, clouds - 1) if clouds else None
 
     def change(self, make: Callable[[], Scene]) -> bool:
         """Build an edit of the current scene with `make` and apply it; an edit the editing
@@ -220,6 +229,9 @@ class Editor:
 
     def show_path_time(self, seconds: float) -> None:
         """Put the camera (and the scene clock) where the chosen camera path is `seconds` from its start."""
+        if not math.isfinite(seconds):
+            self.messages.append(f"a time along the path must be finite, got {seconds}")
+            return
         path = self.scene.camera_path(self.camera_path_name)
         self.path_time_s = min(max(float(seconds), 0.0), path.duration)
         self.camera = camera_on_path(path, self.path_time_s, self.camera.fov_y_deg)
@@ -251,17 +263,23 @@ class Editor:
     def undo(self) -> None:
         if not self.history.undo():
             self.messages.append("nothing to undo")
+        self._keep_selection()
 
     def redo(self) -> None:
         if not self.history.redo():
             self.messages.append("nothing to redo")
+        self._keep_selection()
 
     def open_file(self, path: Path) -> bool:
-        """Open another scene; a bad file leaves the current scene as it was and says why."""
+        """Open another scene; a bad file leaves the current scene as it was and says why.  Unsaved edits are
+        written to the recovery copy first (Recover brings them back when their scene is opened again); where
+        they cannot be, the scene stays open."""
         try:
             scene = load_scene(path)
         except SceneError as error:
             self.messages.append(f"could not open: {error}")
+            return False
+        if self.dirty and not self._keep_unsaved_edits():
             return False
         self.history.reset(scene)
         self.saved_scene, self.path, self.camera = scene, Path(path), scene.camera
@@ -270,6 +288,22 @@ class Editor:
         self.path_time_s, self.playing = 0.0, False
         self._remember(Path(path))
         self.messages.append(f"opened {path}")
+        self._mention_recovery()
+        return True
+
+    def _keep_unsaved_edits(self) -> bool:
+        """Write the unsaved edits to the recovery copy before another scene replaces them; False (and why)
+        where they cannot be kept."""
+        if self.path is None:
+            self.messages.append("not opened: the scene's unsaved edits have no file to be kept beside; Save as first")
+            return False
+        if self.scene is not self._recovered_scene and not self._write_recovery():
+            self.messages.append("not opened: save the unsaved edits first, or undo them")
+            return False
+        self.messages.append(
+            f"the unsaved edits to {self.path.name} are kept in {recovery_path(self.path)}: "
+            "open it again and Recover them"
+        )
         return True
 
     def save(self, path: Path | None = None) -> bool:
@@ -305,6 +339,9 @@ class Editor:
         ):
             return False
         self._last_recovery = now
+        return self._write_recovery()
+
+    def _write_recovery(self) -> bool:
         try:
             save_scene(dataclasses.replace(self.scene, camera=self.camera), recovery_path(self.path))
         except (OSError, SceneError, ValueError) as error:

@@ -284,9 +284,14 @@ def save_and_reopen(ctx, app: EditorUnderTest):
     use_window(ctx, "Lighting")
     ctx.item_input_value("Time of day", 6.0)
     CHECK(app.editor.dirty)
+    edited = app.editor.scene
     use_window(ctx, "Scene")
     ctx.item_click("Open")
     CHECK(app.editor.scene == saved and not app.editor.dirty)
+    # the edit opening dropped is in the recovery copy, and offered
+    CHECK(load_scene(recovery_path(target)).lighting == edited.lighting)
+    CHECK(any(str(recovery_path(target)) in message for message in app.editor.messages))
+    discard_recovery(target)
 
 
 def malformed_scene_keeps_the_current_one(ctx, app: EditorUnderTest):
@@ -370,6 +375,61 @@ def box_fill_adds_sprites(ctx, app: EditorUnderTest):
     CHECK(0 < added <= 150)
     undo(ctx)
     CHECK(app.editor.scene.particle_count == before)
+
+
+def a_box_fill_the_editor_refuses_keeps_the_selection(ctx, app: EditorUnderTest):
+    """A fill past the scene's limits (a box 2e12 m out) is refused, and neither said to be done nor selected."""
+    scene, selected = app.editor.scene, app.editor.selected_cloud
+    use_window(ctx, "Build")
+    ctx.item_input_value("Box centre (m)/$$0", 2e12)
+    ctx.item_click("Fill a new cloud")
+    CHECK(app.editor.scene is scene and app.editor.selected_cloud == selected)
+    CHECK(app.editor.messages[-1].startswith("not applied: clouds[") and "within +-1e+12" in app.editor.messages[-1])
+    ctx.item_click("Centre on the view")
+
+
+def typed_numbers_stay_within_the_sliders(ctx, app: EditorUnderTest):
+    """Ctrl+click typing past a slider's range gives its end: a brush rate of 0, a fly speed of 1e30 or a time
+    of day of 30 raised every frame or flung the camera out of the world."""
+    editor = app.editor
+    use_window(ctx, "Clouds")
+    ctx.item_input_value("Brush rate (per s)", 0.0)
+    ctx.item_input_value("Particle radius (m)", 1e30)
+    CHECK(editor.brush_rate == 1.0 and editor.particle_radius == 500.0)
+    ctx.item_input_value("Brush rate (per s)", 40.0)
+    ctx.item_input_value("Particle radius (m)", 60.0)
+    use_window(ctx, "Camera")
+    ctx.item_input_value("Fly speed (m\\/s)", 1e30)
+    ctx.item_input_value("Orbit step (deg)", 1e30)
+    CHECK(app.viewport.fly_speed == 3000.0 and app.panels.camera.orbit_step_deg == 10.0)
+    camera = editor.camera
+    ctx.item_click("Orbit left")
+    CHECK(bool(np.isfinite(editor.camera.position).all()) and editor.camera is not camera)
+    editor.camera = camera
+    ctx.item_input_value("Fly speed (m\\/s)", 300.0)
+    ctx.item_input_value("Orbit step (deg)", 1.0)
+    before = editor.scene
+    use_window(ctx, "Lighting")
+    ctx.item_input_value("Time of day", 30.0)
+    CHECK(editor.time_of_day == 24.0)
+    ctx.item_input_value("Albedo", 2.0)
+    CHECK(editor.scene.shading.albedo == 1.0)
+    undo(ctx)
+    undo(ctx)
+    CHECK(editor.scene is before)
+
+
+def undoing_a_new_cloud_keeps_a_selection_the_panels_can_draw(ctx, app: EditorUnderTest):
+    """Add cloud selects the new cloud; undone, the selection falls back to one the scene has (it stayed on the
+    removed one, and the Clouds panel and the Delete key raised IndexError)."""
+    scene = app.editor.scene
+    use_window(ctx, "Clouds")
+    ctx.item_click("Add cloud")
+    CHECK(app.editor.selected_cloud == len(scene.clouds))
+    undo(ctx)
+    use_window(ctx, "Clouds")
+    ctx.yield_(SETTLE)
+    CHECK(app.editor.scene is scene and app.editor.selected_cloud == len(scene.clouds) - 1)
 
 
 def move_cloud_by_dragging(ctx, app: EditorUnderTest):
@@ -697,6 +757,9 @@ GUI_TESTS = (
     place_on_the_cloud_surface,
     brush_stroke_is_one_undo_step,
     box_fill_adds_sprites,
+    a_box_fill_the_editor_refuses_keeps_the_selection,
+    typed_numbers_stay_within_the_sliders,
+    undoing_a_new_cloud_keeps_a_selection_the_panels_can_draw,
     move_cloud_by_dragging,
     delete_key_and_statistics_toggle,
     heat_map_changes_the_picture,

@@ -103,8 +103,13 @@ class ViewportTools:
         if editor.selected_cloud is None:
             editor.messages.append("select or add a cloud before brushing")
             return
+        try:
+            stroke = BrushStroke(editor.next_stroke_seed(), editor.brush_rate)
+        except ValueError as error:
+            editor.messages.append(f"cannot brush: {error}")
+            return
         editor.begin_gesture()
-        self._stroke, self._stroke_missed = BrushStroke(editor.next_stroke_seed(), editor.brush_rate), False
+        self._stroke, self._stroke_missed = stroke, False
         self._dab(ray, self._stroke.due(0.0))
 
     def _dab(self, ray, count: int) -> None:

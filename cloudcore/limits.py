@@ -12,12 +12,15 @@ such a scene first.  docs/scene-format.md lists them.
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Iterator
 
 import numpy as np
 
 from cloudcore.artist.artist_shading import default_group_size, shading_grid_fits
 from cloudcore.light.lighting import active_lights
+from cloudcore.light.phase import MAX_ABS_G
+from cloudcore.scene import Camera, Cloud, Light, Lighting, SceneObject, Shading, Terrain, View
 
 #: lights that shine on clouds at once: the compute shader keeps one incident term per light
 #: per particle (`incident[MAX_LIGHTS]` in gl/shaders/splat_shade.comp.glsl)
@@ -41,6 +44,29 @@ MAX_MAGNITUDE = 1.0e12
 #: the longest name of a cloud, object, camera path or view, in characters: names become file names (a
 #: cloud's particles, a view's golden), and a 240-character cloud name made every save fail
 MAX_NAME_LENGTH = 64
+#: the range of each bounded number of a scene, by record and field (a vector's by component): the scene loader
+#: reads each within it and the editor refuses an edit past it.  A typed albedo of 2 or time of day of 30 was
+#: applied, saved to a file that would not open again and failed the viewport's shading every frame
+FIELD_RANGES = {
+    (Camera, "fov_y_deg"): (1.0, 170.0),
+    (View, "fov_y_deg"): (1.0, 170.0),
+    (Lighting, "time_of_day"): (0.0, 24.0),
+    (View, "time_of_day"): (0.0, 24.0),
+    (Lighting, "ambient"): (0.0, math.inf),
+    (Light, "color"): (0.0, math.inf),
+    (Light, "intensity"): (0.0, math.inf),
+    (Shading, "albedo"): (0.0, 1.0),
+    (Shading, "optical_depth"): (0.0, math.inf),
+    (Shading, "g"): (-MAX_ABS_G, MAX_ABS_G),
+    (Cloud, "albedo"): (0.0, 1.0),
+    (Cloud, "optical_depth"): (0.0, math.inf),
+    (Cloud, "color"): (0.0, math.inf),
+    (Terrain, "height"): (0.0, math.inf),
+    (Terrain, "color"): (0.0, 1.0),
+    (SceneObject, "color"): (0.0, 1.0),
+    (View, "tolerance_psnr"): (0.0, math.inf),
+}
+_UNBOUNDED = (-math.inf, math.inf)
 #: where a record's field is not the scene file's key: an object's vertices come from its mesh file
 _FILE_KEYS = {"vertices": "mesh"}
 
@@ -76,6 +102,11 @@ def scene_limit_problems(scene, unchanged=None) -> list[tuple[str, str]]:
         if id(cloud) in previous:
             continue
         problems.extend(_out_of_bounds(f"clouds[{i}]", cloud))
+        not_positive = np.flatnonzero(~(cloud.radii > 0))
+        if not_positive.size:
+            field = "particles" if cloud.particles_file is None else "particles_file"
+            row = not_positive[0]
+            problems.append((f"clouds[{i}].{field}", f"radius must be > 0 (row {row} has {cloud.radii[row]})"))
         if cloud.artist is None or not len(cloud.particles):
             continue
         size = cloud.shading_group_size or default_group_size(cloud.radii)
@@ -91,9 +122,12 @@ def scene_limit_problems(scene, unchanged=None) -> list[tuple[str, str]]:
     return problems
 
 
-def _out_of_bounds(field: str, value) -> Iterator[tuple[str, str]]:
-    """(field, problem) for each finite number in `value` (a record, a tuple, an array) past MAX_MAGNITUDE and
-    each name past MAX_NAME_LENGTH; infinities are the records' own to allow (a ring radius) or refuse."""
+def _out_of_bounds(
+    field: str, value, bounds=(-math.inf, math.inf), infinite_allowed=False
+) -> Iterator[tuple[str, str]]:
+    """(field, problem) for each number in `value` (a record, a tuple, an array) that is not finite, past
+    MAX_MAGNITUDE or out of its FIELD_RANGES, and each name past MAX_NAME_LENGTH.  A view's settings may be
+    infinite (a ring radius): RenderSettings checks them."""
     if dataclasses.is_dataclass(value):
         for item in dataclasses.fields(value):
             name = _FILE_KEYS.get(item.name, item.name)
@@ -107,29 +141,38 @@ def _out_of_bounds(field: str, value) -> Iterator[tuple[str, str]]:
                 )
             elif item.name == "settings" and isinstance(inner, tuple):  # a view's (setting, value): keys of its table
                 for key, setting in inner:
-                    yield from _out_of_bounds(f"{field}.{key}", setting)
+                    yield from _out_of_bounds(f"{field}.{key}", setting, infinite_allowed=True)
             else:
-                yield from _out_of_bounds(f"{field}.{name}", inner)
+                inner_bounds = FIELD_RANGES.get((type(value), item.name), _UNBOUNDED)
+                yield from _out_of_bounds(f"{field}.{name}", inner, inner_bounds)
     elif isinstance(value, (tuple, list)) and value and all(dataclasses.is_dataclass(item) for item in value):
         for i, item in enumerate(value):
             yield from _out_of_bounds(f"{field}[{i}]", item)
     else:
-        largest = _largest_finite(value)
-        if largest > MAX_MAGNITUDE:
+        numbers = _floats(value)
+        if not numbers.size:
+            return
+        allowed = ~np.isnan(numbers) if infinite_allowed else np.isfinite(numbers)
+        low, high = bounds
+        if not allowed.all():
+            yield field, f"numbers must be finite, got {numbers[~allowed][0]}"
+        elif (largest := float(np.abs(numbers[np.isfinite(numbers)]).max(initial=0.0))) > MAX_MAGNITUDE:
             yield field, f"numbers must be within +-{MAX_MAGNITUDE:g}, got {largest:.3g}"
+        elif numbers.min() < low or numbers.max() > high:
+            outside = numbers[(numbers < low) | (numbers > high)][0]
+            yield field, f"must be within [{low:g}, {high:g}], got {outside:g}"
 
 
-def _largest_finite(value) -> float:
-    """The largest magnitude of the finite floats of a value: a number, a float array, or tuples of them nested
-    (0 where there is none; strings and integers are not magnitudes: names, choices, counts, seeds)."""
+def _floats(value) -> np.ndarray:
+    """The floats of a value, flat: a number, a float array, or tuples of them nested (none where there are none;
+    strings and integers are not magnitudes: names, choices, counts, seeds)."""
     if isinstance(value, np.ndarray):
-        finite = np.abs(value[np.isfinite(value)]) if value.dtype.kind == "f" else ()
-        return float(finite.max()) if len(finite) else 0.0
+        return value.ravel() if value.dtype.kind == "f" else np.empty(0)
     if isinstance(value, (tuple, list)):
-        return max((_largest_finite(item) for item in value), default=0.0)
-    if isinstance(value, (float, np.floating)) and np.isfinite(value):
-        return abs(float(value))
-    return 0.0
+        return np.concatenate([np.empty(0), *(_floats(item) for item in value)])
+    if isinstance(value, (float, np.floating)):
+        return np.array([float(value)])
+    return np.empty(0)
 
 
 def frame_memory_problem(width: int, height: int, available_bytes: int | None = None) -> str | None:

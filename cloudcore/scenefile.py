@@ -18,9 +18,9 @@ import tomlkit
 
 from cloudcore.artist.cloudgen import PRESETS
 from cloudcore.cloud_records import FACINGS, FORMATION_KINDS, MAX_SEED, ArtistShading, Formation, SpriteStyle
-from cloudcore.light.phase import MAX_ABS_G, PHASE_NAMES
+from cloudcore.light.phase import PHASE_NAMES
 from cloudcore.light.shading import EYE_PASSES, LIGHT_PASSES
-from cloudcore.limits import scene_limit_problems
+from cloudcore.limits import FIELD_RANGES, scene_limit_problems
 from cloudcore.particle_files import (
     atomic_write,
     open_particle_array,
@@ -85,6 +85,8 @@ def load_scene(path) -> Scene:
     """Read and validate a scene file; raise SceneError on any problem."""
     path = Path(path)
     source = str(path)
+    if path.exists() and not (path.is_file() or path.is_dir()):  # a folder is refused by the read below
+        raise field_error(source, "(file)", "not a regular file (a pipe or a device): reading it would wait forever")
     try:
         # utf-8-sig: a byte-order mark (Windows editors write one) is not part of the TOML
         data = tomllib.loads(path.read_text(encoding="utf-8-sig"))
@@ -128,6 +130,12 @@ def scene_from_dict(data: dict, source: str = "<scene>", base_dir=Path(".")) -> 
     if problems:
         raise field_error(source, *problems[0])
     return scene
+
+
+def _range(record, key: str) -> dict:
+    """The `low` and `high` keyword arguments of a Table read for the record's field (`FIELD_RANGES`)."""
+    low, high = FIELD_RANGES[(record, key)]
+    return {"low": low, "high": high}
 
 
 def _unique_names(root: Table, key: str, items) -> None:
@@ -175,14 +183,16 @@ def _view(t: Table, camera: Camera, paths: tuple[CameraPath, ...]) -> View:
         name=name,
         position=position,
         look_at=look_at,
-        fov_y_deg=t.number("fov_y_deg", None, low=1.0, high=170.0) if t.has("fov_y_deg") else None,
+        fov_y_deg=t.number("fov_y_deg", None, **_range(View, "fov_y_deg")) if t.has("fov_y_deg") else None,
         camera_path=camera_path,
         t=t_s,
-        time_of_day=t.number("time_of_day", None, low=0.0, high=24.0) if t.has("time_of_day") else None,
+        time_of_day=t.number("time_of_day", None, **_range(View, "time_of_day")) if t.has("time_of_day") else None,
         time_s=t.number("time_s", 0.0),
         mode=mode,
         settings=settings,
-        tolerance_psnr=t.number("tolerance_psnr", None, low=0.0) if t.has("tolerance_psnr") else None,
+        tolerance_psnr=t.number("tolerance_psnr", None, **_range(View, "tolerance_psnr"))
+        if t.has("tolerance_psnr")
+        else None,
         max_diff=t.integer("max_diff", None, low=0, high=255) if t.has("max_diff") else None,
     )
 
@@ -222,7 +232,7 @@ def _camera(t: Table) -> Camera:
     look_at = t.vector("look_at", default.look_at)
     if np.allclose(position, look_at, rtol=0, atol=0):
         t.fail("look_at", "must differ from position")
-    return Camera(position, look_at, t.number("fov_y_deg", default.fov_y_deg, low=1.0, high=170.0))
+    return Camera(position, look_at, t.number("fov_y_deg", default.fov_y_deg, **_range(Camera, "fov_y_deg")))
 
 
 def _lighting(t: Table) -> Lighting:
@@ -233,16 +243,16 @@ def _lighting(t: Table) -> Lighting:
         lights.append(
             Light(
                 lt.vector("direction", unit=True),
-                lt.vector("color", (1.0, 1.0, 1.0), low=0.0),
-                lt.number("intensity", 1.0, low=0.0),
+                lt.vector("color", (1.0, 1.0, 1.0), **_range(Light, "color")),
+                lt.number("intensity", 1.0, **_range(Light, "intensity")),
             )
         )
     # Explicit lights replace the sun and skylight; a time of day still sets the sky.
     if t.has("time_of_day"):
-        time_of_day = t.number("time_of_day", low=0.0, high=24.0)
+        time_of_day = t.number("time_of_day", **_range(Lighting, "time_of_day"))
     else:
         time_of_day = None if lights else Lighting().time_of_day
-    ambient = t.vector("ambient", None, low=0.0) if t.has("ambient") else None
+    ambient = t.vector("ambient", None, **_range(Lighting, "ambient")) if t.has("ambient") else None
     return Lighting(time_of_day, tuple(lights), ambient)
 
 
@@ -250,10 +260,10 @@ def _shading(t: Table) -> Shading:
     t.reject_unknown(TABLE_KEYS["shading"])
     d = Shading()
     return Shading(
-        albedo=t.number("albedo", d.albedo, low=0.0, high=1.0),
-        optical_depth=t.number("optical_depth", d.optical_depth, low=0.0),
+        albedo=t.number("albedo", d.albedo, **_range(Shading, "albedo")),
+        optical_depth=t.number("optical_depth", d.optical_depth, **_range(Shading, "optical_depth")),
         phase=t.string("phase", d.phase, choices=PHASE_NAMES),
-        g=t.number("g", d.g, low=-MAX_ABS_G, high=MAX_ABS_G),
+        g=t.number("g", d.g, **_range(Shading, "g")),
         eye_pass=t.string("eye_pass", d.eye_pass, choices=EYE_PASSES),
         light_pass=t.string("light_pass", d.light_pass, choices=LIGHT_PASSES),
     )
@@ -269,17 +279,15 @@ def _cloud(t: Table, base_dir: Path) -> Cloud:
     else:
         particles_file = t.string("particles_file")
         particles = _read_particles(t, base_dir / particles_file)
-    bad = np.flatnonzero(particles[:, 3] <= 0)
-    if bad.size:
-        field = "particles" if particles_file is None else "particles_file"
-        t.fail(field, f"radius must be > 0 (row {bad[0]} has {particles[bad[0], 3]})")
     return Cloud(
         name=name,
         particles=particles,
         particles_file=particles_file,
-        optical_depth=t.number("optical_depth", None, low=0.0) if t.has("optical_depth") else None,
-        albedo=t.number("albedo", None, low=0.0, high=1.0) if t.has("albedo") else None,
-        color=t.vector("color", (1.0, 1.0, 1.0), low=0.0),
+        optical_depth=t.number("optical_depth", None, **_range(Cloud, "optical_depth"))
+        if t.has("optical_depth")
+        else None,
+        albedo=t.number("albedo", None, **_range(Cloud, "albedo")) if t.has("albedo") else None,
+        color=t.vector("color", (1.0, 1.0, 1.0), **_range(Cloud, "color")),
         formation=t.table("formation", _formation),
         sprite=t.table("sprite", _sprite),
         artist=t.table("artist", _artist),
@@ -382,10 +390,10 @@ def _terrain(t: Table) -> Terrain:
         kind=kind,
         size=(sx.number("x", low=MIN_TERRAIN_SIDE_M), sx.number("z", low=MIN_TERRAIN_SIDE_M)),
         resolution=t.integer("resolution", d.resolution, low=2, high=4096),
-        height=t.number("height", d.height, low=0.0),
+        height=t.number("height", d.height, **_range(Terrain, "height")),
         seed=t.integer("seed", d.seed, low=0, high=2**31 - 1),
         mesh=t.string("mesh") if kind == "mesh" else None,
-        color=t.vector("color", d.color, low=0.0, high=1.0),
+        color=t.vector("color", d.color, **_range(Terrain, "color")),
     )
 
 
@@ -408,7 +416,7 @@ def _object(t: Table, base_dir: Path) -> SceneObject:
         scale=t.number("scale", 1.0, low=0.0, low_open=True),
         position=t.vector("position", (0.0, 0.0, 0.0)),
         path=path,
-        color=t.vector("color", SceneObject("").color, low=0.0, high=1.0),
+        color=t.vector("color", SceneObject("").color, **_range(SceneObject, "color")),
     )
 
 

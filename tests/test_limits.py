@@ -27,7 +27,7 @@ from cloudcore.limits import (
     frame_memory_problem,
     scene_limit_problems,
 )
-from cloudcore.scene import Camera, Cloud, Light, Lighting, Scene, Terrain
+from cloudcore.scene import Camera, Cloud, Light, Lighting, Scene, Shading, Terrain
 from cloudcore.scenefile import load_scene, save_scene
 
 pytestmark = pytest.mark.gl
@@ -93,6 +93,41 @@ LIMITS = [
         f"[lighting]\nambient = [{MAX_MAGNITUDE}, 1, 1]\n" + CLOUD,
     ),
     (
+        "albedo past one",
+        "[shading]\nalbedo = 2.0\n" + CLOUD,
+        "shading.albedo",
+        "must be within",
+        "[shading]\nalbedo = 1.0\n" + CLOUD,
+    ),
+    (
+        "time of day past 24",
+        "[lighting]\ntime_of_day = 30.0\n" + CLOUD,
+        "lighting.time_of_day",
+        "must be within",
+        "[lighting]\ntime_of_day = 24.0\n" + CLOUD,
+    ),
+    (
+        "negative optical depth",
+        CLOUD + "optical_depth = -1.0\n",
+        "clouds[0].optical_depth",
+        "must be within",
+        CLOUD + "optical_depth = 0.0\n",
+    ),
+    (
+        "g past the phase's limit",
+        "[shading]\ng = 1.0\n" + CLOUD,
+        "shading.g",
+        "must be within",
+        "[shading]\ng = 0.999\n" + CLOUD,
+    ),
+    (
+        "infinite radius",
+        '[[clouds]]\nname = "c"\nparticles = [[0, 800, 0, inf]]\n',
+        "clouds[0].particles",
+        "finite",
+        f'[[clouds]]\nname = "c"\nparticles = [[0, 800, 0, {MAX_MAGNITUDE}]]\n',
+    ),
+    (
         "long name",
         CLOUD.replace('"c"', f'"{"n" * (MAX_NAME_LENGTH + 1)}"'),
         "clouds[0].name",
@@ -116,6 +151,16 @@ def past_limit(name: str) -> Scene:
         return dataclasses.replace(base, clouds=(Cloud("c", np.array([[0, 800, 0, 50], [1e200, 850, 0, 60]])),))
     if name == "ambient past float32":
         return dataclasses.replace(base, lighting=Lighting(ambient=(1e39, 1e39, 1e39)))
+    if name == "albedo past one":
+        return dataclasses.replace(base, shading=Shading(albedo=2.0))
+    if name == "time of day past 24":
+        return dataclasses.replace(base, lighting=Lighting(time_of_day=30.0))
+    if name == "negative optical depth":
+        return dataclasses.replace(base, clouds=(dataclasses.replace(base.clouds[0], optical_depth=-1.0),))
+    if name == "g past the phase's limit":
+        return dataclasses.replace(base, shading=Shading(g=1.0))
+    if name == "infinite radius":
+        return dataclasses.replace(base, clouds=(Cloud("c", np.array([[0, 800, 0, np.inf]])),))
     if name == "long name":
         return dataclasses.replace(
             base, clouds=(dataclasses.replace(base.clouds[0], name="n" * (MAX_NAME_LENGTH + 1)),)
@@ -133,6 +178,12 @@ RENDERER_REFUSALS = {
     "shading groups": "too small for a cloud this large",
     "camera far out": "Singular matrix",  # the world pass inverts the view-projection
     "particle far out": "overflow",  # the shading's distances between particles
+    # a typed number past a slider's range was applied, and the viewport raised these every frame
+    "albedo past one": "albedo must be within",
+    "time of day past 24": "time of day must be within",
+    "negative optical depth": "optical_depth must be >= 0",
+    "g past the phase's limit": "phase asymmetry g must be finite and within",
+    "infinite radius": "radii must be finite",
 }
 
 

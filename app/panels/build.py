@@ -5,6 +5,7 @@ from __future__ import annotations
 from imgui_bundle import imgui
 
 from app.editor import Editor
+from app.panels.widgets import bounded_slider
 from cloudcore.artist.cloudgen import PRESETS, TYPICAL_CULL_FRACTION
 from cloudcore.editing import add_preset_cloud, fill_box, pick_ray, point_at_altitude
 
@@ -47,16 +48,16 @@ class BuildPanel:
         imgui.separator_text("Cloud presets")
         names = list(PRESETS)
         _, self.preset = imgui.combo("Preset", self.preset, names)
-        _, self.preset_scale = imgui.slider_float("Scale", self.preset_scale, 0.1, 3.0)
+        _, self.preset_scale = bounded_slider("Scale", self.preset_scale, 0.1, 3.0)
         if imgui.button("New cloud from preset"):
             try:
-                editor.edit(
-                    add_preset_cloud(
-                        editor.scene, names[self.preset], self.box_centre, self.preset_scale, self.box_seed
-                    )
+                scene = add_preset_cloud(
+                    editor.scene, names[self.preset], self.box_centre, self.preset_scale, self.box_seed
                 )
             except ValueError as error:
                 editor.messages.append(f"could not make a {names[self.preset]}: {error}")
+                return
+            if not editor.edit(scene):
                 return
             editor.selected_cloud = len(editor.scene.clouds) - 1
             editor.messages.append(f"added {editor.scene.clouds[-1].name}, base at the box centre")
@@ -80,7 +81,8 @@ class BuildPanel:
             return
         had = len(editor.scene.clouds[cloud_index].particles) if cloud_index is not None else 0
         added = len(scene.clouds[filled].particles) - had
-        editor.edit(scene)
+        if not editor.edit(scene):
+            return
         editor.selected_cloud = filled
         editor.messages.append(f"box fill: {added} of {self.box_count} sprites kept in {scene.clouds[filled].name}")
         self.box_seed += 1  # the next fill scatters differently

@@ -8,6 +8,7 @@ from pathlib import Path
 from imgui_bundle import imgui
 
 from app.editor import Editor
+from app.panels.widgets import bounded_slider
 from app.record_job import RecordJob
 from app.viewport import Viewport
 from cloudcore.errors import SceneError
@@ -28,11 +29,11 @@ class CameraPanel:
         editor = self.editor
         camera = editor.camera
         imgui.text("eye " + ", ".join(f"{v:.0f}" for v in camera.position))
-        changed, fov = imgui.slider_float("Field of view", camera.fov_y_deg, 5.0, 120.0)
+        changed, fov = bounded_slider("Field of view", camera.fov_y_deg, 5.0, 120.0)
         if changed:
             editor.camera = dataclasses.replace(camera, fov_y_deg=fov)
-        _, self.viewport.fly_speed = imgui.slider_float("Fly speed (m/s)", self.viewport.fly_speed, 10.0, 3000.0)
-        _, self.orbit_step_deg = imgui.slider_float("Orbit step (deg)", self.orbit_step_deg, 0.01, 10.0)
+        _, self.viewport.fly_speed = bounded_slider("Fly speed (m/s)", self.viewport.fly_speed, 10.0, 3000.0)
+        _, self.orbit_step_deg = bounded_slider("Orbit step (deg)", self.orbit_step_deg, 0.01, 10.0)
         if imgui.button("Orbit left"):
             editor.camera = orbited(editor.camera, -self.orbit_step_deg)
         imgui.same_line()
@@ -41,9 +42,7 @@ class CameraPanel:
         if imgui.button("Reset to the scene's camera"):
             editor.camera = editor.scene.camera
         if editor.scene_duration_s > 0.0:
-            _, editor.scene_time_s = imgui.slider_float(
-                "Scene time (s)", editor.scene_time_s, 0.0, editor.scene_duration_s
-            )
+            _, editor.scene_time_s = bounded_slider("Scene time (s)", editor.scene_time_s, 0.0, editor.scene_duration_s)
         self._camera_paths()
 
     def _camera_paths(self) -> None:
@@ -63,7 +62,7 @@ class CameraPanel:
         if imgui.button("Pause"):
             editor.playing = False
         duration = editor.scene.camera_path(editor.camera_path_name).duration
-        changed, seconds = imgui.slider_float("Path time (s)", editor.path_time_s, 0.0, duration, "%.2f")
+        changed, seconds = bounded_slider("Path time (s)", editor.path_time_s, 0.0, duration, "%.2f")
         if changed:
             editor.playing = False
             editor.show_path_time(seconds)

@@ -7,7 +7,7 @@ import dataclasses
 from imgui_bundle import imgui
 
 from app.editor import TOOLS, Editor
-from app.panels.widgets import ReleasedSliders
+from app.panels.widgets import ReleasedSliders, bounded_slider
 from cloudcore.editing import add_cloud, delete_cloud, replace_cloud, with_mean_radius
 
 
@@ -22,8 +22,7 @@ class CloudsPanel:
         names = [f"{c.name} ({len(c.particles)})" for c in scene.clouds]
         if names:
             _, editor.selected_cloud = imgui.combo("Cloud", editor.selected_cloud or 0, names)
-        if imgui.button("Add cloud"):
-            editor.edit(add_cloud(scene))
+        if imgui.button("Add cloud") and editor.edit(add_cloud(scene)):
             editor.selected_cloud = len(editor.scene.clouds) - 1
         if editor.selected_cloud is not None:
             imgui.same_line()
@@ -52,15 +51,15 @@ class CloudsPanel:
         imgui.same_line()
         if imgui.radio_button("On the cloud's surface", editor.on_cloud_surface):
             editor.on_cloud_surface = True
-        _, editor.placement_altitude = imgui.slider_float("Altitude (m)", editor.placement_altitude, 0.0, 5000.0)
-        _, editor.particle_radius = imgui.slider_float("Particle radius (m)", editor.particle_radius, 1.0, 500.0)
+        _, editor.placement_altitude = bounded_slider("Altitude (m)", editor.placement_altitude, 0.0, 5000.0)
+        _, editor.particle_radius = bounded_slider("Particle radius (m)", editor.particle_radius, 1.0, 500.0)
         if imgui.radio_button("Brush adds", not editor.brush_erases):
             editor.brush_erases = False
         imgui.same_line()
         if imgui.radio_button("Brush erases", editor.brush_erases):
             editor.brush_erases = True
-        _, editor.brush_radius = imgui.slider_float("Brush radius (m)", editor.brush_radius, 10.0, 3000.0, "%.0f")
-        _, editor.brush_rate = imgui.slider_float("Brush rate (per s)", editor.brush_rate, 1.0, 500.0, "%.0f")
+        _, editor.brush_radius = bounded_slider("Brush radius (m)", editor.brush_radius, 10.0, 3000.0, "%.0f")
+        _, editor.brush_rate = bounded_slider("Brush rate (per s)", editor.brush_rate, 1.0, 500.0, "%.0f")
         imgui.text_wrapped(
             "Move: drag in the viewport (Shift: in the screen's plane). Delete removes the picked "
             "particle, or else the selected cloud."

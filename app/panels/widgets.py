@@ -26,6 +26,16 @@ def labels_in_full() -> Iterator[None]:
         imgui.pop_item_width()
 
 
+def bounded_slider(label: str, value: float, low: float, high: float, fmt: str = "%.3f") -> tuple[bool, float]:
+    """imgui.slider_float whose value stays within [low, high] when a number is typed (ctrl+click): ImGui takes
+    any by default, and a typed brush rate of 0, a fly speed of 1e38 or an orbit step of 1e39 raised every frame
+    or flung the camera out of the world.  A number the clamp cannot place (NaN) leaves the value as it was."""
+    changed, typed = imgui.slider_float(label, value, low, high, fmt, imgui.SliderFlags_.always_clamp)
+    if not low <= typed <= high:
+        return False, value
+    return changed, typed
+
+
 class ReleasedSliders:
     """Sliders whose new value counts once, on release: dragging does not re-shade every frame or fill the
     undo history.  While one is dragged, `dragged` gives the value shown (the viewport can follow it)."""
@@ -35,14 +45,13 @@ class ReleasedSliders:
 
     def slider(self, label: str, value: float, low: float, high: float, fmt: str = "%.3f") -> float | None:
         """The slider `label`; returns the released value, or None."""
-        shown = self._dragging.get(label, value)
-        changed, shown = imgui.slider_float(label, shown, low, high, fmt)
+        changed, shown = bounded_slider(label, self._dragging.get(label, value), low, high, fmt)
         return self._released(label, changed, shown)
 
     def slider_int(self, label: str, value: int, low: int, high: int) -> int | None:
         """The integer slider `label`; returns the released value, or None."""
         shown = int(self._dragging.get(label, value))
-        changed, shown = imgui.slider_int(label, shown, low, high)
+        changed, shown = imgui.slider_int(label, shown, low, high, flags=imgui.SliderFlags_.always_clamp)
         released = self._released(label, changed, shown)
         return None if released is None else int(released)
 
