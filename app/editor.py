@@ -178,8 +178,12 @@ class Editor:
     def _keep_selection(self) -> None:
         """The selected cloud stays one the scene has: an edit, an undo or a redo may have removed it."""
         clouds = len(self.scene.clouds)
-        if self.selected_cloud is None or self.selected_cloud >= clouds:
-            self.selected_cloud = min(self.selected_cloud or 0, clouds - 1) if clouds else None
+        if not clouds:
+            self.selected_cloud = None
+        elif self.selected_cloud is None:
+            self.selected_cloud = 0
+        elif self.selected_cloud >= clouds:
+            self.selected_cloud = clouds - 1
 
     def change(self, make: Callable[[], Scene]) -> bool:
         """Build an edit of the current scene with `make` and apply it; an edit the editing

@@ -122,9 +122,7 @@ def scene_limit_problems(scene, unchanged=None) -> list[tuple[str, str]]:
     return problems
 
 
-def _out_of_bounds(
-    field: str, value, bounds=(-math.inf, math.inf), infinite_allowed=False
-) -> Iterator[tuple[str, str]]:
+def _out_of_bounds(field: str, value, bounds=_UNBOUNDED, infinite_allowed=False) -> Iterator[tuple[str, str]]:
     """(field, problem) for each number in `value` (a record, a tuple, an array) that is not finite, past
     MAX_MAGNITUDE or out of its FIELD_RANGES, and each name past MAX_NAME_LENGTH.  A view's settings may be
     infinite (a ring radius): RenderSettings checks them."""
@@ -152,11 +150,12 @@ def _out_of_bounds(
         numbers = _floats(value)
         if not numbers.size:
             return
-        allowed = ~np.isnan(numbers) if infinite_allowed else np.isfinite(numbers)
+        finite = np.isfinite(numbers)
+        allowed = ~np.isnan(numbers) if infinite_allowed else finite
         low, high = bounds
         if not allowed.all():
             yield field, f"numbers must be finite, got {numbers[~allowed][0]}"
-        elif (largest := float(np.abs(numbers[np.isfinite(numbers)]).max(initial=0.0))) > MAX_MAGNITUDE:
+        elif (largest := float(np.abs(numbers[finite]).max(initial=0.0))) > MAX_MAGNITUDE:
             yield field, f"numbers must be within +-{MAX_MAGNITUDE:g}, got {largest:.3g}"
         elif numbers.min() < low or numbers.max() > high:
             outside = numbers[(numbers < low) | (numbers > high)][0]
