@@ -1,135 +1,280 @@
-"""The frame planner's own time: `plan_frame` replayed alone on the inputs of real frames, per mode (JSON).
+"""The frame planner's own time, replayed without drawing, per mode and case (JSON); and whether a change plans alike.
 
-    python scripts/bench_plan.py [--cases flythrough] [--frames 300] [--against REV] [--json out/bench_plan.json]
+    python scripts/bench_plan.py [--cases flythrough,harris_circle_12800] [--frames 300] [--against REV]
+                                 [--json out/bench_plan.json]
 
-Each case of `bench_lod.py` is rendered once per mode (full 3D, impostor mode, auto), and every call of
-`plan_frame` keeps its inputs: the units, camera, settings, the state the frames before left, the objects
-and the particles.  The frames after the case's warm-up are then planned again, alone, in passes taking
-turns: a pass plans every frame once.  `--against REV` takes `cloudcore/lod/frameplan.py` of a git revision
-beside the working tree's, on the same inputs, the two taking turns pass by pass (what a change to the
-planner saves, without the noise of two runs; the other modules are the working tree's for both), and
-counts the frames whose plans differ between the two in any field (`plans_differing`: 0 for a change
-meant only to be faster).  Reports the median and the least of each way's passes, in ms a frame.  Nothing
-is drawn while it times: on the GPU's machine the planner is what auto mode costs over impostor mode
-(docs/performance.md).
+Each case (`bench_lod.cases`, and Harris's figure 8: `harris_circle_N` and `harris_through_N` for each of
+`harris_figure8.COUNTS`, `harris` for all of them) is planned frame by frame in a closed loop, as
+`cloudcore.gl.FrameRenderer` plans it but with nothing drawn: the units of the scene's clouds (and of its
+cloud field for the eye), the objects' poses, the clouds' lighting keys, the state each plan leaves fed into
+the next, and the frame's measured times replaced by the plan's own prediction, the cloud pass's 10% dearer
+(so the cost fit and auto mode's choice by measured frame times move as they do on a real run, and the same
+inputs give the same plans anywhere).  The frames after the case's warm-up are timed in `PASSES` passes.
+
+`--against REV` runs this very script again over `cloudcore` of git revision REV (a worktree in a temporary
+directory, on PYTHONPATH), the two taking turns case by case, and counts the frames whose plans differ in any
+field the GL side reads or the statistics report (`plans_differing`: 0 for a change meant only to be faster);
+the first difference of each case is printed.  Reports the median and the least of each way's passes, in ms a
+frame.
 """
 
 from __future__ import annotations
 
 import argparse
+import base64
+import dataclasses
+import hashlib
+import json
 import os
 import subprocess
 import sys
+import tempfile
 import time
-import types
+import zlib
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from bench_lod import cases  # noqa: E402  (a sibling script: the same scenes, views and sizes)
+import harris_figure8  # noqa: E402  (sibling scripts: the same scenes, views and sizes)
+from bench_lod import cases as lod_cases  # noqa: E402
 
-import cloudcore.gl.frame as frame_module  # noqa: E402
-from cloudcore.gl import FrameRenderer  # noqa: E402
-from cloudcore.lod import frameplan  # noqa: E402
-from cloudcore.measure.benchmark import machine, write_report  # noqa: E402
+from cloudcore.artist.formation import formation_state  # noqa: E402
+from cloudcore.field.state import FieldState, update_field  # noqa: E402
+from cloudcore.lod.frameplan import LodState, plan_frame  # noqa: E402
+from cloudcore.lod.units import lod_units  # noqa: E402
+from cloudcore.objects import object_poses  # noqa: E402
+from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
+from cloudcore.scenefile import load_scene  # noqa: E402
 from cloudcore.settings import RenderSettings  # noqa: E402
 
 MODES = ("full", "impostor", "auto")
-PASSES = 6
+PASSES = 5
+#: Harris's cases: the frames before the timed ones (the ring built and faded in, the impostors made)
+HARRIS_WARMUP = 20
 
 
-def captured_calls(scene, views, size, warmup: int, mode: str) -> list:
-    """The (arguments, keywords) of every `plan_frame` call after `warmup` frames of `views` in `mode`."""
-    calls = []
-
-    def keeping(*arguments, **keywords):
-        calls.append((arguments, keywords))
-        return frameplan.plan_frame(*arguments, **keywords)
-
-    frame_module.plan_frame = keeping
-    try:
-        with FrameRenderer(*size) as renderer:
-            for time_s, camera in views:
-                renderer.render(
-                    scene, camera=camera, time_s=time_s, settings=RenderSettings(mode=mode), read_back=False
-                )
-    finally:
-        frame_module.plan_frame = frameplan.plan_frame
-    return calls[warmup:]
+def harris_cases(names) -> list:
+    """(name, scene, views, size, warmup) of Harris's figure 8 asked for by `names`."""
+    world, chosen = None, []
+    for count in harris_figure8.COUNTS:
+        for path, views_of in (("circle", harris_figure8.circle_views), ("through", harris_figure8.through_views)):
+            name = f"harris_{path}_{count}"
+            if name in names or "harris" in names:
+                world = world or load_scene(DEFAULT_SCENE)
+                scene = harris_figure8.harris_scene(world, count)
+                chosen.append((name, scene, views_of(HARRIS_WARMUP + 300), (640, 480), HARRIS_WARMUP))
+    return chosen
 
 
-def planner_of(revision: str):
-    """`plan_frame` of `cloudcore/lod/frameplan.py` at git `revision`, importing the working tree's other modules."""
+def particles_of(clouds) -> SimpleNamespace:
+    """What `lod_units` and the plan read of a `ParticleBuffer`, without its light (nothing is drawn)."""
+    counts = np.array([len(c.particles) for c in clouds], dtype=np.int64)
+    spheres = [c.bounding_sphere() for c in clouds]
+    centres = np.concatenate([c.centres for c in clouds]).reshape(-1, 3) if clouds else np.zeros((0, 3))
+    radii = np.concatenate([c.radii for c in clouds]) if clouds else np.zeros(0)
+    starts = np.concatenate([[0], np.cumsum(counts)])
+    return SimpleNamespace(
+        cloud_starts=starts,
+        centres=centres,
+        radii=radii,
+        finest_radii=np.array([radii[a:b].min() if b > a else 0.0 for a, b in zip(starts[:-1], starts[1:])]),
+        bounding_centres=np.array([s[0] for s in spheres], dtype=np.float64).reshape(-1, 3),
+        bounding_radii=np.array([s[1] for s in spheres], dtype=np.float64),
+    )
+
+
+def planned_frames(scene, views, size, mode: str):
+    """Yield (plan, the call's arguments) of every frame of `views` planned in a closed loop in `mode`."""
+    settings = RenderSettings(mode=mode)
+    state, field_state, units_source = LodState(), FieldState(), None
+    spheres, serial_of = None, {}
+    for time_s, camera in views:
+        clouds, fades = scene.clouds, (1.0,) * len(scene.clouds)
+        if scene.cloud_field is not None:
+            frame, field_state = update_field(scene.cloud_field, camera.position, field_state)
+            clouds, fades = clouds + frame.clouds, fades + frame.fade_keys
+        if (clouds, settings.group_clouds) != units_source:
+            particles = particles_of(clouds)
+            units = lod_units(particles, settings.group_clouds, len(scene.clouds))
+            units_source = (clouds, settings.group_clouds)
+            spheres = None
+        # a serial per cloud in the order first seen, as the renderer's lighting keys (an id differs run to run;
+        # the cloud is held so that its id is not reused)
+        serials = [serial_of.setdefault(id(cloud), (len(serial_of), cloud))[0] for cloud in clouds]
+        keys = tuple((s, formation_state(c.formation, time_s), fade) for s, c, fade in zip(serials, clouds, fades))
+        if spheres is None and scene.objects:
+            from cloudcore.objects import mesh_sphere, object_mesh
+
+            spheres = [mesh_sphere(object_mesh(o)) for o in scene.objects]
+        poses = object_poses(scene.objects, time_s, spheres) if scene.objects else ()
+        arguments = (units, camera, size, settings, state, keys, poses)
+        keywords = {
+            "cloud_particles": lambda c, p=particles: p.centres[p.cloud_starts[c] : p.cloud_starts[c + 1]],
+            "cloud_splats": lambda c, p=particles: (
+                p.centres[p.cloud_starts[c] : p.cloud_starts[c + 1]],
+                p.radii[p.cloud_starts[c] : p.cloud_starts[c + 1]],
+            ),
+        }
+        plan = plan_frame(*arguments, **keywords)
+        yield plan, (arguments, keywords)
+        model = plan.costs
+        state = plan.state.measured(
+            [(plan.update_work, model.ms(plan.update_work)), (plan.cloud_work, 1.1 * model.ms(plan.cloud_work))],
+            fit=plan.priced,
+        )
+
+
+def canonical(plan) -> str:
+    """What of a plan the GL side reads or the statistics report, as text: two plans alike give the same."""
+    ring = plan.ring
+    ring_text = (
+        None
+        if ring is None
+        else (
+            ring.build_segment,
+            ring.build_piece,
+            ring.build_members,
+            [(sorted(g.members), g.segment_members, g.eye, g.texture_size, w) for g, w in ring.draws],
+        )
+    )
+    drawn = [tuple(plan.clouds[i]) for i in plan.draw_order]
+    kinds = [(c.index, c.kind, c.members) for c in plan.clouds]
+    stats = dataclasses.asdict(plan.stats())
+    state = plan.state
+    return repr(
+        (
+            drawn,
+            kinds,
+            plan.draw_items,
+            ring_text,
+            plan.inside_size,
+            plan.objects_with_world,
+            plan.update_work,
+            plan.cloud_work,
+            plan.priced,
+            plan.tolerance_deg,
+            plan.accepted_error,
+            sorted(stats.items()),
+            sorted(state.records.items()),
+            sorted(state.representations.items()),
+            (state.frame_choice, state.drawn_as, state.frames_drawn_as, state.frame_index, state.opened),
+        )
+    )
+
+
+def replay(names, frames: int) -> list[dict]:
+    """Per case and mode: the plans' digests frame by frame, and the timed passes."""
+    rows = []
+    chosen = lod_cases(names, quick=False) + harris_cases(names)
+    for name, scene, views, size, warmup in chosen:
+        views = views[: warmup + frames]
+        for mode in MODES:
+            calls, texts = [], []
+            for index, (plan, call) in enumerate(planned_frames(scene, views, size, mode)):
+                if index >= warmup:
+                    calls.append(call)
+                    texts.append(canonical(plan))
+            times = []
+            for _ in range(PASSES):
+                start = time.perf_counter()
+                for arguments, keywords in calls:
+                    plan_frame(*arguments, **keywords)
+                times.append(1e3 * (time.perf_counter() - start) / max(len(calls), 1))
+            rows.append(
+                {
+                    "case": name,
+                    "mode": mode,
+                    "clouds": len(scene.clouds),
+                    "frames": len(calls),
+                    "plan_ms_median": float(np.median(times)),
+                    "plan_ms_least": float(np.min(times)),
+                    "digests": [hashlib.sha1(text.encode()).hexdigest()[:16] for text in texts],
+                    "texts": base64.b64encode(zlib.compress("\n".join(texts).encode())).decode(),
+                }
+            )
+    return rows
+
+
+def against(revision: str, names: str, frames: int) -> list[dict]:
+    """This script's rows over `cloudcore` at git `revision` (a temporary worktree), in a child process."""
     root = Path(__file__).resolve().parent.parent
-    source = subprocess.run(
-        ["git", "show", f"{revision}:cloudcore/lod/frameplan.py"], cwd=root, capture_output=True, text=True, check=True
-    ).stdout
-    module = types.ModuleType(f"cloudcore.lod.frameplan_at_{revision}")
-    sys.modules[module.__name__] = module  # dataclasses look their module up by name
-    exec(compile(source, f"frameplan.py at {revision}", "exec"), module.__dict__)
-    return module.plan_frame
+    with tempfile.TemporaryDirectory() as folder:
+        tree = Path(folder) / "tree"
+        subprocess.run(
+            ["git", "worktree", "add", "--detach", str(tree), revision], cwd=root, check=True, capture_output=True
+        )
+        try:
+            out = Path(folder) / "rows.json"
+            env = {**os.environ, "PYTHONPATH": str(tree)}
+            subprocess.run(
+                [sys.executable, __file__, "--cases", names, "--frames", str(frames), "--rows", str(out)],
+                env=env,
+                check=True,
+            )
+            return json.loads(out.read_text())
+        finally:
+            subprocess.run(["git", "worktree", "remove", "--force", str(tree)], cwd=root, check=True)
 
 
-def timed_passes(planners: dict, calls: list) -> dict:
-    """Per planner, its passes' ms a frame, the planners taking turns pass by pass (each first as often)."""
-    times = {name: [] for name in planners}
-    names = list(planners)
-    for index in range(PASSES):
-        for name in names if index % 2 == 0 else reversed(names):
-            start = time.perf_counter()
-            for arguments, keywords in calls:
-                planners[name](*arguments, **keywords)
-            times[name].append(1e3 * (time.perf_counter() - start) / len(calls))
-    return times
-
-
-def plans_differing(planners: dict, calls: list) -> int:
-    """How many of `calls` the planners plan differently (their plans' reprs, every field, compared)."""
-    first, *others = planners.values()
-    differing = 0
-    for arguments, keywords in calls:
-        planned = repr(first(*arguments, **keywords))
-        differing += any(repr(other(*arguments, **keywords)) != planned for other in others)
-    return differing
+def first_difference(ours: str, theirs: str) -> str:
+    """Where the first frame two rows' plans differ starts to differ, in their text."""
+    ours, theirs = (zlib.decompress(base64.b64decode(t)).decode().split("\n") for t in (ours, theirs))
+    for frame, (a, b) in enumerate(zip(ours, theirs)):
+        if a != b:
+            at = next((i for i, (x, y) in enumerate(zip(a, b)) if x != y), min(len(a), len(b)))
+            return (
+                f"frame {frame}: ...{a[max(0, at - 120) : at + 200]}... against ...{b[max(0, at - 120) : at + 200]}..."
+            )
+    return ""
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cases", default="flythrough")
     parser.add_argument("--frames", type=int, default=300, help="frames planned per case after its warm-up")
-    parser.add_argument("--against", help="a git revision whose frameplan.py is timed beside the working tree's")
+    parser.add_argument("--against", help="a git revision whose cloudcore is replayed beside the working tree's")
     parser.add_argument("--json", type=Path)
+    parser.add_argument("--rows", type=Path, help=argparse.SUPPRESS)  # the child's rows, for --against
     args = parser.parse_args()
-    planners = {"working tree": frameplan.plan_frame}
-    if args.against:
-        planners[args.against] = planner_of(args.against)
-    rows = []
-    for name, scene, views, size, warmup in cases(set(args.cases.split(",")), quick=False):
-        views = views[: warmup + args.frames]
-        for mode in MODES:
-            calls = captured_calls(scene, views, size, warmup, mode)
-            differing = plans_differing(planners, calls) if args.against else None
-            for planner, times in timed_passes(planners, calls).items():
-                row = {
-                    "case": name,
-                    "mode": mode,
-                    "planner": planner,
-                    "frames": len(calls),
-                    "plan_ms_median": float(np.median(times)),
-                    "plan_ms_least": float(np.min(times)),
-                    "plans_differing": differing,
-                }
-                rows.append(row)
-                print(
-                    f"{name} {mode:8s} {planner}: {row['plan_ms_median']:.3f} ms a frame"
-                    f" (least {row['plan_ms_least']:.3f})" + (f", {differing} plans differ" if args.against else ""),
-                    file=sys.stderr,
-                    flush=True,
-                )
-    write_report({"machine": machine(), "date": time.strftime("%Y-%m-%d"), "rows": rows}, args.json, summary=rows)
+    names = set(args.cases.split(","))
+    rows = replay(names, args.frames)
+    if args.rows:
+        args.rows.write_text(json.dumps(rows))
+        return
+    theirs = against(args.against, args.cases, args.frames) if args.against else []
+    report = []
+    for row in rows:
+        other = next((r for r in theirs if (r["case"], r["mode"]) == (row["case"], row["mode"])), None)
+        line = {k: v for k, v in row.items() if k not in ("digests", "texts")}
+        if other is not None:
+            differing = sum(a != b for a, b in zip(row["digests"], other["digests"]))
+            line |= {
+                "against": args.against,
+                "against_plan_ms_median": other["plan_ms_median"],
+                "against_plan_ms_least": other["plan_ms_least"],
+                "plans_differing": differing,
+            }
+            if differing:
+                print(f"{row['case']} {row['mode']}: {first_difference(row['texts'], other['texts'])}", file=sys.stderr)
+        report.append(line)
+        print(
+            f"{row['case']} {row['mode']:8s} {row['clouds']} clouds: {line['plan_ms_median']:.3f} ms a frame"
+            + (
+                f" against {line['against_plan_ms_median']:.3f} at {args.against},"
+                f" {line['plans_differing']} plans differ"
+                if other is not None
+                else ""
+            ),
+            file=sys.stderr,
+            flush=True,
+        )
+    from cloudcore.measure.benchmark import machine, write_report
+
+    write_report({"machine": machine(), "date": time.strftime("%Y-%m-%d"), "rows": report}, args.json, summary=report)
 
 
 if __name__ == "__main__":

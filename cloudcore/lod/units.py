@@ -176,12 +176,14 @@ def interpenetrating_groups(
     """Clouds grouped by interpenetrating splats (connected components), each group's clouds ascending, groups
     ordered by their first cloud.  Only pairs whose bounding spheres meet are looked at."""
     clouds = len(sphere_radii)
-    gaps = np.linalg.norm(sphere_centres[:, None] - sphere_centres[None], axis=2)
-    candidates = np.argwhere(
-        np.triu(gaps < sphere_radii[:, None] + sphere_radii[None], k=1)
-        & (sphere_radii[:, None] > 0)
-        & (sphere_radii[None] > 0)
-    )
+    # the pairs of spheres that meet, from a tree of their centres: all pairs at once would take clouds^2 memory
+    # (3.9 GB for Harris's 12,800 clouds)
+    reach = 2.0 * float(np.max(sphere_radii, initial=0.0))
+    pairs = cKDTree(sphere_centres).query_pairs(reach, output_type="ndarray") if clouds else np.zeros((0, 2), int)
+    first, second = pairs[:, 0], pairs[:, 1]
+    gaps = np.linalg.norm(sphere_centres[first] - sphere_centres[second], axis=1)
+    meet = (gaps < sphere_radii[first] + sphere_radii[second]) & (sphere_radii[first] > 0) & (sphere_radii[second] > 0)
+    candidates = pairs[meet]
     trees: dict[int, cKDTree] = {}
 
     def tree(cloud: int) -> cKDTree:
