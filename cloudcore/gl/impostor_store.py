@@ -56,9 +56,8 @@ class ImpostorStore:
         units = plan.units
         renders = []  # (target, batch, view, projection, cleared first): all sorted, then all shaded, then drawn
         on_gpu = []  # (atlas image, eye, clouds, their depth ranges, view, projection): the GPU's way
-        for cloud in plan.clouds:
-            if cloud.regenerate is None:
-                continue
+        for index in sorted(plan.clouds.regenerate):
+            cloud = plan.clouds[index]
             record = plan.records[cloud.members]
             view = impostor_view(units.centres[cloud.index], units.radii[cloud.index], record.eye)
             targets = self._cloud_images(cloud.members, cloud.texture_size, len(record.splits) + 1)

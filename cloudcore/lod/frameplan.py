@@ -45,7 +45,6 @@ import dataclasses
 import math
 from collections.abc import Hashable, Mapping
 from dataclasses import dataclass, field
-from typing import NamedTuple
 
 import numpy as np
 
@@ -83,6 +82,20 @@ from cloudcore.lod.ring import (
     segment_texture_size,
 )
 from cloudcore.lod.splitting import layer_bounds, layer_sort_key, layers_hold, objects_reaching
+from cloudcore.lod.unit_plans import (
+    CROSSFADE,
+    CULLED,
+    DRAWN,
+    EMPTY,
+    FULL,
+    IMPOSTOR,
+    INSIDE,
+    KINDS,
+    RING,
+    TEXTURED,
+    UnitPlans,
+    kind_codes,
+)
 from cloudcore.lod.units import LodUnits
 from cloudcore.measure.frame_stats import PlanStats
 from cloudcore.measure.overdraw import splats_in_view
@@ -90,9 +103,6 @@ from cloudcore.scene import Camera
 from cloudcore.settings import RenderSettings
 from cloudcore.vectors import row_lengths
 
-KINDS = ("empty", "culled", "ring", "full", "crossfade", "impostor", "inside")
-#: kinds that draw from an impostor texture kept in the cache
-TEXTURED = ("crossfade", "impostor")
 #: an impostor predicted to last longer than this many frames is priced as if it lasted this long
 #: (a still eye would otherwise make any regeneration free)
 LONGEST_LIFETIME_FRAMES = 120.0
@@ -118,28 +128,6 @@ PLAUSIBLE_RATIO = 1.5
 SCENE_CHANGE_RATIO = 1.25
 #: the running mean of a choice's frame times weighs each new frame at least this much
 FRAME_TIME_FORGETTING = 0.1
-
-
-# a named tuple, not a frozen dataclass: hundreds a frame on a cloud field, made in 0.39 us against 1.49 (the
-# 1.2M field's plan: impostor mode 2.99 -> 2.31 ms, auto 4.04 -> 3.62, full 3.67 -> 3.18)
-class CloudPlan(NamedTuple):
-    index: int  # the unit's
-    kind: str
-    distance: float
-    full_weight: float = 0.0  # share of opacity drawn from particles (full, crossfade, inside)
-    impostor_weight: float = 0.0  # share drawn from the cached impostor
-    regenerate: str | None = None  # why the impostor is remade this frame
-    postponed: str | None = None  # why it would be, had the regeneration budget allowed it
-    texture_size: int = 0  # side of the impostor texture used
-    split_objects: tuple = ()  # indices of the objects inside it, far to near
-    splits: tuple = ()  # their distances from the eye: the layers' boundaries
-    members: tuple = ()  # the clouds of the unit
-    full_ms: float = 0.0  # predicted cost of full 3D this frame (0 in impostor mode, which never draws it)
-    impostor_ms: float = 0.0  # auto mode: predicted cost of the impostor per frame, its regeneration amortised
-
-    @property
-    def layers(self) -> int:
-        return len(self.splits) + 1
 
 
 @dataclass(frozen=True)
@@ -221,7 +209,7 @@ class FrameTime:
 
 @dataclass(frozen=True)
 class FramePlan:
-    clouds: tuple  # one CloudPlan per unit
+    clouds: UnitPlans  # per unit, what was decided: `clouds[i]` is unit i's CloudPlan
     draw_order: tuple  # indices of the units drawn individually, far to near
     ring: RingPlan | None
     state: LodState = LodState()  # to carry into the next frame
@@ -253,23 +241,23 @@ class FramePlan:
         return self.costs.ms(self.update_work + self.cloud_work)
 
     def of_kind(self, *kinds: str) -> list:
-        return [c for c in self.clouds if c.kind in kinds]
+        return [self.clouds[index] for index in self.clouds.indices_of(*kinds)]
 
     def stats(self) -> PlanStats:
-        clouds_by_kind = dict.fromkeys(KINDS, 0)
+        units = self.clouds
         reasons: dict = {}
-        for unit in self.clouds:
-            clouds_by_kind[unit.kind] += len(unit.members)
-            if unit.regenerate:
-                reasons[unit.regenerate] = reasons.get(unit.regenerate, 0) + 1
+        for index in sorted(units.regenerate):
+            reason = units.regenerate[index]
+            reasons[reason] = reasons.get(reason, 0) + 1
+        split = {index: len(splits) + 1 for index, splits in units.splits.items() if splits}
         return PlanStats(
-            clouds_by_kind=clouds_by_kind,
-            units=len(self.clouds),
-            units_grouped=sum(1 for unit in self.clouds if len(unit.members) > 1),
-            impostors_drawn=len(self.of_kind(*TEXTURED)) + len(self.of_kind("inside")),
+            clouds_by_kind=units.clouds_by_kind(),
+            units=len(units),
+            units_grouped=int(np.count_nonzero(units.member_counts > 1)),
+            impostors_drawn=units.count(*TEXTURED) + units.count("inside"),
             impostors_regenerated=sum(reasons.values()),
             regeneration_reasons=reasons,
-            regenerations_postponed=sum(1 for c in self.clouds if c.postponed),
+            regenerations_postponed=sum(1 for reason in units.postponed.values() if reason),
             ring_segments_built=int(
                 self.ring is not None
                 and self.ring.state.pending is not None
@@ -279,8 +267,8 @@ class FramePlan:
                 sum(len(g.occupied_segments) for g, _ in self.ring.draws) if self.ring is not None else 0
             ),
             objects_in_clouds=len(self.objects_between_layers),
-            layers_drawn=sum(c.layers for c in self.clouds if c.splits),
-            layers_rebuilt=sum(c.layers for c in self.clouds if c.splits and c.regenerate),
+            layers_drawn=sum(split.values()),
+            layers_rebuilt=sum(layers for index, layers in split.items() if units.regenerate.get(index)),
             predicted_ms=self.predicted_ms,
             priced=self.priced,
             tolerance_deg=self.tolerance_deg,
@@ -303,7 +291,13 @@ class FramePlan:
         ring_settled = self.ring is None or (
             self.ring.state.pending is None and all(weight == 1.0 for _, weight in self.ring.draws)
         )
-        return ring_settled and not any(c.regenerate or c.postponed or c.kind == "crossfade" for c in self.clouds)
+        units = self.clouds
+        return (
+            ring_settled
+            and not any(units.regenerate.values())
+            and not any(units.postponed.values())
+            and not units.count("crossfade")
+        )
 
     @property
     def objects_between_layers(self) -> tuple:
@@ -350,7 +344,7 @@ def plan_frame(
             costs,
             cloud_splats,
         )
-        drawn = {c.members: Representation("full", 1.0) for c in full_plan.clouds if c.kind == "full"}
+        drawn = {full_plan.clouds.members[i]: Representation("full", 1.0) for i in full_plan.clouds.indices_of("full")}
         return dataclasses.replace(
             full_plan,
             state=dataclasses.replace(
@@ -376,9 +370,9 @@ def plan_frame(
     plan = _plan_units(units, held, *arguments)
     # a group opens only where its own impostor is due anyway, so the switch steps no more than a regeneration
     due = frozenset(
-        cloud.members
-        for cloud in plan.clouds
-        if cloud.members in wanted - held and (cloud.regenerate or cloud.postponed)
+        members
+        for members in (plan.clouds.members[i] for i in {**plan.clouds.regenerate, **plan.clouds.postponed})
+        if members in wanted - held
     )
     return _plan_units(units, held | due, *arguments) if due else plan
 
@@ -534,19 +528,6 @@ def _plan_units(
             particles, particle_radii, record.eye, object_centres[cut], object_radii[cut], record.splits
         )
 
-    def in_full(index: int, distance: float, inside: tuple, splits: tuple, **prices) -> CloudPlan:
-        """The plan of a unit drawn in full 3D (split around the objects `inside` it at `splits`)."""
-        return CloudPlan(
-            index,
-            "full",
-            distance,
-            full_weight=1.0,
-            split_objects=inside,
-            splits=splits,
-            members=units.members[index],
-            **prices,
-        )
-
     held_near = state.near_work
     known_near = (
         held_near[3] if held_near and held_near[0] is units and held_near[1:3] == (camera, tuple(viewport)) else {}
@@ -584,27 +565,41 @@ def _plan_units(
         batches=1.0,
     )
     unit_prices = []
-    clouds, wanted = [], []  # wanted: (index, priority, work) of the impostors past their tolerance
+    wanted = []  # (index, priority, work) of the impostors past their tolerance
+    # what the plan decides per unit, as arrays (`UnitPlans`): a unit out of view or in the ring is one row
+    count = len(radii)
+    kinds = np.where(radii <= 0.0, EMPTY, np.where(individuals <= 0.0, RING, CULLED)).astype(np.int8)
+    full_weights, impostor_weights = np.zeros(count), np.zeros(count)
+    texture_sizes = np.zeros(count, dtype=np.int64)
+    full_prices, impostor_prices = np.zeros(count), np.zeros(count)
+    reasons, split_objects, split_distances = {}, {}, {}
+    drawable = np.flatnonzero((radii > 0.0) & (individuals > 0.0) & visible)
     may_be_textured = visible & (radii > 0.0) & (individuals > 0.0) & (distances >= INSIDE_RADII * radii)
     textured = (
         _impostor_textures(units, np.flatnonzero(may_be_textured), distances, height, camera.fov_y_deg, settings)
         if settings.mode != "full"
         else {}
     )
-    for index, (radius, distance, individual) in enumerate(zip(radii, distances, individuals)):
-        distance, members, individual = float(distance), units.members[index], float(individual)
-        if radius <= 0.0 or individual <= 0.0 or not visible[index]:
-            clouds.append(
-                CloudPlan(
-                    index,
-                    "empty" if radius <= 0.0 else "ring" if individual <= 0.0 else "culled",
-                    distance,
-                    members=members,
-                )
-            )
-            continue
+
+    def decided(index: int, kind: int, inside: tuple, splits: tuple, full_weight=0.0, full_ms=0.0, impostor_ms=0.0):
+        """Unit `index` drawn as `kind`, split around the objects `inside` it at `splits`."""
+        kinds[index], full_weights[index] = kind, full_weight
+        full_prices[index], impostor_prices[index] = full_ms, impostor_ms
+        if splits:
+            split_objects[index], split_distances[index] = inside, splits
+
+    if settings.mode == "full":
+        # every unit in view in full 3D, nothing priced: only the units holding objects are looked at one by one
+        kinds[drawable], full_weights[drawable] = FULL, 1.0
+        for index in sorted(holding.intersection(drawable.tolist())):
+            decided(index, FULL, *split_at(index, eye), full_weight=1.0)
+        drawable = ()
+    for index in drawable:
+        index = int(index)
+        radius, distance, members = radii[index], float(distances[index]), units.members[index]
+        individual = float(individuals[index])
         inside, splits = split_at(index, eye)
-        eye_inside = settings.mode != "full" and distance < INSIDE_RADII * radius
+        eye_inside = distance < INSIDE_RADII * radius
         # impostor mode draws no unit in full 3D but the one the eye is in: nothing else to price
         full = full_3d(index, radius, distance) if settings.mode != "impostor" or eye_inside else Work()
         everything_full += full
@@ -624,27 +619,11 @@ def _plan_units(
                 unit_prices.append((index, distance, full_ms, inside_ms))
                 representations[members] = Representation(target, 1.0)
                 if target == "full":
-                    clouds.append(in_full(index, distance, inside, splits, full_ms=full_ms, impostor_ms=inside_ms))
+                    decided(index, FULL, inside, splits, 1.0, full_ms, inside_ms)
                     cloud_work += full
                     continue
-            clouds.append(
-                CloudPlan(
-                    index,
-                    "inside",
-                    distance,
-                    full_weight=individual,
-                    split_objects=inside,
-                    splits=splits,
-                    members=members,
-                    full_ms=full_ms,
-                    impostor_ms=inside_ms,
-                )
-            )
+            decided(index, INSIDE, inside, splits, individual, full_ms, inside_ms)
             cloud_work += screen_impostor
-            continue
-        if settings.mode == "full":
-            clouds.append(in_full(index, distance, inside, splits))
-            cloud_work += full
             continue
         pixels, size, remake = textured[index]
         quad = quad_work(pixels, screen_pixels)
@@ -672,7 +651,7 @@ def _plan_units(
             representations[members] = representation
             weight = representation.full_weight
         if weight == 1.0:
-            clouds.append(in_full(index, distance, inside, splits, full_ms=full_ms, impostor_ms=impostor_ms))
+            decided(index, FULL, inside, splits, 1.0, full_ms, impostor_ms)
             cloud_work += full
             continue
         record = records.get(members)
@@ -684,23 +663,11 @@ def _plan_units(
             float(held_errors[index]),
             record is not None and layers_changed(index, record),
         )
-        kind = "crossfade" if weight > 0.0 else "impostor"
-        clouds.append(
-            CloudPlan(
-                index,
-                kind,
-                distance,
-                full_weight=weight * individual,
-                impostor_weight=(1.0 - weight) * individual,
-                regenerate=reason,
-                texture_size=size,
-                split_objects=inside,
-                splits=splits,
-                members=members,
-                full_ms=full_ms,
-                impostor_ms=impostor_ms,
-            )
-        )
+        kind = CROSSFADE if weight > 0.0 else IMPOSTOR
+        decided(index, kind, inside, splits, weight * individual, full_ms, impostor_ms)
+        impostor_weights[index], texture_sizes[index] = (1.0 - weight) * individual, size
+        if reason is not None:
+            reasons[index] = reason
         cloud_work += quad + (full + Work(quad_pixels=screen_pixels) if weight > 0.0 else Work())  # the layer
         if reason is not None:
             ratio = float(held_errors[index]) / max(tolerance, 1e-300)
@@ -715,27 +682,25 @@ def _plan_units(
             update_work += remake
     # the largest translation error drawn, over the tolerance
     accepted = 0.0 if chases_tolerance or ring is None or not ring.draws else ring_error / max(tolerance, 1e-300)
-    for index, cloud in enumerate(clouds):
-        if cloud.kind not in TEXTURED:
-            continue
-        record = records.get(cloud.members)
+    regenerate, postponed = {}, {}
+    for index in np.flatnonzero(np.isin(kinds, kind_codes(*TEXTURED))).tolist():
+        members = units.members[index]
+        record = records.get(members)
         if index not in served and record is not None:
             accepted = max(accepted, float(held_errors[index]) / max(tolerance, 1e-300))
         if index in served:
-            record = next_records[cloud.members] = ImpostorRecord(
+            record = next_records[members] = ImpostorRecord(
                 tuple(float(v) for v in eye),
-                cloud.texture_size,
+                int(texture_sizes[index]),
                 keys[index],
-                cloud.splits,
-                cloud.split_objects,
+                split_distances.get(index, ()),
+                split_objects.get(index, ()),
                 content_depth(centres[index], radii[index], eye, *splats_of(index)) if cloud_splats else None,
             )
-        regenerate, postponed = (cloud.regenerate, None) if index in served else (None, cloud.regenerate)
-        clouds[index] = cloud._replace(
-            regenerate=regenerate,
-            postponed=postponed,
-            texture_size=record.size,
-        )
+        reason = reasons.get(index)
+        if reason is not None:
+            (regenerate if index in served else postponed)[index] = reason
+        texture_sizes[index] = record.size
     if ring is not None:
         for generation, _ in ring.draws:
             shown = [index_of[m] for m in generation.members if m in index_of and visible[index_of[m]]]
@@ -744,13 +709,28 @@ def _plan_units(
         update_work += Work(
             particles=float(sum(units.particle_counts[index_of[u]] for u in piece)), regenerations=float(bool(piece))
         )
-    drawn = [c.index for c in clouds if c.kind in ("full", "crossfade", "impostor", "inside")]
-    draw_order = tuple(sorted(drawn, key=lambda i: -distances[i]))
+    plans = UnitPlans(
+        kinds,
+        distances,
+        units.members,
+        units.member_counts,
+        full_weights,
+        impostor_weights,
+        texture_sizes,
+        full_prices,
+        impostor_prices,
+        regenerate,
+        postponed,
+        split_objects,
+        split_distances,
+    )
+    drawn = np.flatnonzero(np.isin(kinds, kind_codes(*DRAWN)))
+    draw_order = tuple(drawn[np.argsort(-distances[drawn], kind="stable")].tolist())
     inside_size = tuple(max(1, math.ceil(side * settings.inside_resolution_scale)) for side in viewport)
-    items = _draw_items([clouds[i] for i in draw_order], radii, object_centres, objects_visible, eye)
-    screen_impostors = len(inside_runs(items, clouds))
+    items = _draw_items([plans[i] for i in draw_order], radii, object_centres, objects_visible, eye)
+    screen_impostors = len(inside_runs(items, plans))
     cloud_work += Work(
-        batches=float(_full_runs([clouds[i].kind for i in draw_order]) + screen_impostors),
+        batches=float(_full_runs([KINDS[kind] for kind in kinds[list(draw_order)]]) + screen_impostors),
         quad_pixels=screen_impostors * screen_pixels,
         quads=float(screen_impostors),
     )
@@ -781,7 +761,7 @@ def _plan_units(
         (units, camera, tuple(viewport), near_work) if near_work else None,
     )
     return FramePlan(
-        tuple(clouds),
+        plans,
         draw_order,
         ring,
         next_state,

@@ -121,6 +121,11 @@ class LodUnits:
         )
 
     @functools.cached_property
+    def member_counts(self) -> np.ndarray:
+        """Clouds per unit."""
+        return np.fromiter(map(len, self.members), dtype=np.int64, count=len(self.members))
+
+    @functools.cached_property
     def group_rows(self) -> np.ndarray:
         """The rows of the units of more than one cloud."""
         return np.array([row for row, members in enumerate(self.members) if len(members) > 1], dtype=np.int64)
