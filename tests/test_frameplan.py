@@ -600,9 +600,8 @@ def test_the_ring_builds_one_segment_a_frame_then_fades_in():
     assert weights == sorted(weights) and 0 < weights[0] < 1
     for p in fading:  # the individual impostor and the ring share each cloud's opacity
         in_view = [cloud for cloud in p.clouds if cloud.kind != "culled"]
-        assert in_view and all(
-            c.impostor_weight + p.ring.weights().get(c.members, 0.0) == pytest.approx(1.0) for c in in_view
-        )
+        shown_by_ring = p.ring.weights(p.units.members, p.units.row_of)
+        assert in_view and all(c.impostor_weight + shown_by_ring[c.index] == pytest.approx(1.0) for c in in_view)
     assert state.current is not None and state.pending is None
     assert plans[-1].stats().clouds_by_kind["ring"] == len(FAR_CLOUDS) and plans[-1].draw_order == ()
     # every cloud is rendered into the segments it reaches, and into no others

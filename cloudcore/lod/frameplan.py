@@ -417,10 +417,13 @@ def _plan_units(
         seen.lifetimes,
     )
     cloud_keys = lighting_key if isinstance(lighting_key, tuple) else (lighting_key,) * sum(map(len, units.members))
-    keys = tuple(tuple(cloud_keys[c] for c in members) for members in units.members)
+
+    def unit_key(index: int) -> tuple:
+        """What the colours of unit `index` were computed from: its clouds' keys."""
+        return tuple(cloud_keys[c] for c in units.members[index])
+
     records = state.records
-    present = set(units.members)
-    next_records = {members: record for members, record in records.items() if members in present}
+    next_records = {members: record for members, record in records.items() if members in units.member_set}
     objects_visible = spheres_in_frustum(planes, object_centres, object_radii)
     held_errors = _held_errors(units, records, translation_error, eye)
     # auto mode prices Wang's ring against drawing its clouds each as auto would (the cheaper of full 3D and
@@ -462,21 +465,21 @@ def _plan_units(
             )
         in_view = (in_view_particles[alone], in_view_fragments[alone])
         alone_ms = _alone_ms(units, seen, alone, in_view, focal_px, settings, costs)
-    index_of = {members: index for index, members in enumerate(units.members)} if settings.uses_ring else {}
     ring = plan_ring(
         state.ring,
         centres,
         radii,
         eye,
         settings,
-        keys,
+        np.fromiter(cloud_keys, dtype=object, count=len(cloud_keys)) if settings.uses_ring else None,
         units.members,
+        units.member_set,
         segment_texture_size(height, camera.fov_y_deg, settings),
         holds_clouds=settings.mode != "auto" or (not all_full and _ring_pays(state.ring, ring_ms, alone_ms)),
         past_tolerance=chases_tolerance and ring_error > tolerance,
         # a segment is priced as its update is (below), by its particles: what the segment's render takes on
         # llvmpipe (478,000 particles of the 1.2M field, 368 ms: 0.77 us a particle, the fit's prior 0.85)
-        build_ms=lambda members: costs.particles * float(units.particle_counts[index_of[members]]),
+        build_ms=lambda members: costs.particles * float(units.particle_counts[units.row_of[members]]),
     )
 
     def particles_of(index: int) -> np.ndarray:
@@ -544,20 +547,19 @@ def _plan_units(
             return Work(particles=float(units.particle_counts[index]), fragments=float(ball_fragments[index]))
         members = units.members[index]
         held = known_near.get(members)
-        if held is not None and held[0] == keys[index]:
+        if held is not None and held[0] == unit_key(index):
             near_work[members] = held
             return held[1]
         kept, overdraw = splats_in_view(*splats_of(index), view, projection)
         work = Work(particles=float(kept), fragments=screen_pixels * overdraw)
-        near_work[members] = (keys[index], work)
+        near_work[members] = (unit_key(index), work)
         return work
 
     representations = {}
     update_work, cloud_work = Work(), Work()
     # auto mode weighs the frame as planned unit by unit against every unit in full 3D in one sorted draw: splitting
     # the particles into many draws between impostors costs what no unit's own price shows
-    shown_by_ring = ring.weights() if ring is not None else {}
-    individuals = np.array([1.0 - shown_by_ring.get(members, 0.0) for members in units.members]).reshape(-1)
+    individuals = 1.0 - (ring.weights(units.members, units.row_of) if ring is not None else np.zeros(len(radii)))
     in_ring = (individuals <= 0.0) & (radii > 0.0) & visible
     everything_full = Work(
         particles=float(np.sum(in_view_particles[in_ring])),
@@ -658,7 +660,7 @@ def _plan_units(
         reason = regeneration_reason(
             record,
             size,
-            keys[index],
+            unit_key(index),
             tolerance,
             float(held_errors[index]),
             record is not None and layers_changed(index, record),
@@ -692,7 +694,7 @@ def _plan_units(
             record = next_records[members] = ImpostorRecord(
                 tuple(float(v) for v in eye),
                 int(texture_sizes[index]),
-                keys[index],
+                unit_key(index),
                 split_distances.get(index, ()),
                 split_objects.get(index, ()),
                 content_depth(centres[index], radii[index], eye, *splats_of(index)) if cloud_splats else None,
@@ -703,11 +705,13 @@ def _plan_units(
         texture_sizes[index] = record.size
     if ring is not None:
         for generation, _ in ring.draws:
-            shown = [index_of[m] for m in generation.members if m in index_of and visible[index_of[m]]]
+            rows = generation.rows_in(units.members, units.row_of)
+            shown = rows[visible[rows]]
             cloud_work += _ring_panels_work(len(generation.occupied_segments), quad_pixels_of[shown])
         piece = ring.build_members
         update_work += Work(
-            particles=float(sum(units.particle_counts[index_of[u]] for u in piece)), regenerations=float(bool(piece))
+            particles=float(sum(units.particle_counts[units.row_of[u]] for u in piece)),
+            regenerations=float(bool(piece)),
         )
     plans = UnitPlans(
         kinds,
@@ -1034,7 +1038,7 @@ def _held_errors(units: LodUnits, records: Mapping, translation_error, eye) -> n
     """Per unit, the translation error of the impostor held (inf: none); the parallax between the near and far
     points of what it holds (`ImpostorRecord.content`) where the record has them."""
     # only the units holding one are measured: most of a cloud field's units are in Wang's ring or out of view
-    rows = [index for index, members in enumerate(units.members) if members in records]
+    rows = sorted(units.row_of[members] for members in records if members in units.row_of)
     errors = np.full(len(units.members), math.inf)
     if not rows:
         return errors

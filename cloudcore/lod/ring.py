@@ -20,7 +20,7 @@ side renders what `RingPlan` says.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Hashable
+from collections.abc import Callable, Hashable, Mapping
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -41,13 +41,19 @@ RING_FRAME_MS = 10.0
 MIN_PANEL_DISTANCE = 10.0
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class RingGeneration:
-    """One ring: where and for which lights it was made, which clouds it holds, per segment."""
+    """One ring: where and for which lights it was made, which clouds it holds, per segment.
+
+    Compared and hashed by identity: a generation is made once and carried from frame to frame (the GL side
+    keys its segment textures by it)."""
 
     eye: tuple[float, float, float]
     radius: float
-    lighting_key: Hashable  # its members' lighting keys when it was made
+    #: the clouds of its members (the ids are tuples of cloud indices), and each one's lighting key when it was
+    #: made (an object array): a member relit, formed or blended since makes it stale
+    clouds: np.ndarray
+    cloud_keys: np.ndarray
     members: frozenset  # the ids of the clouds (or units) it holds (`plan_ring`'s `ids`)
     segment_members: tuple  # SEGMENTS tuples of member ids, each far to near from `eye` (the order they are drawn)
     texture_size: tuple = (0, 0)  # (width, height) of its segment textures
@@ -58,10 +64,25 @@ class RingGeneration:
     #: measures the panels' translation error from each frame, without looking its members up among the units
     spheres: tuple = field(default=(np.zeros((0, 3)), np.zeros(0)), compare=False, repr=False)
 
+    #: per tuple of ids a frame was planned with (by its id, with the tuple held): its members' rows in it, in the
+    #: members' own order; a memo, so that a ring of thousands is looked up once, not every frame
+    _rows: dict = field(default_factory=dict, repr=False)
+
     @property
     def occupied_segments(self) -> tuple[int, ...]:
         """The segments holding a cloud: only they are rendered and drawn."""
         return tuple(segment for segment, clouds in enumerate(self.segment_members) if clouds)
+
+    def rows_in(self, ids: tuple, row_of: Mapping) -> np.ndarray:
+        """The rows of its members present in `ids` (whose `row_of` maps an id to its row), in the order of
+        `members`."""
+        held = self._rows.get(id(ids))
+        if held is None or held[0] is not ids:
+            rows = np.array([row_of[m] for m in self.members if m in row_of], dtype=np.int64)
+            held = self._rows[id(ids)] = (ids, rows)
+            for key in [key for key, (other, _) in self._rows.items() if other is not ids]:
+                del self._rows[key]  # a memo of one: the units of the frame before are gone
+        return held[1]
 
 
 @dataclass(frozen=True)
@@ -97,13 +118,11 @@ class RingPlan:
             return ()
         return self.state.pending.segment_members[self.build_segment][slice(*self.build_piece)]
 
-    def weights(self) -> dict:
-        """The share of the opacity of each cloud (or unit) the ring shows this frame, by its id; at once, for a
-        field's hundreds."""
-        shown: dict = {}
+    def weights(self, ids: tuple, row_of: Mapping) -> np.ndarray:
+        """The share of the opacity of each unit of `ids` (`RingGeneration.rows_in`) the ring shows this frame."""
+        shown = np.zeros(len(ids))
         for generation, weight in self.draws:
-            for member in generation.members:
-                shown[member] = shown.get(member, 0.0) + weight
+            shown[generation.rows_in(ids, row_of)] += weight
         return shown
 
 
@@ -159,14 +178,16 @@ def segment_texture_size(viewport_height: int, fov_y_deg: float, settings: Rende
 
 
 def new_generation(
-    centres, radii, eye, settings: RenderSettings, keys: dict, ids: tuple, texture_size: tuple, holds_clouds=True
+    centres, radii, eye, settings: RenderSettings, cloud_keys, ids: tuple, texture_size: tuple, holds_clouds=True
 ) -> RingGeneration:
     in_ring = ring_members(centres, radii, eye, settings) & holds_clouds
     members = frozenset(ids[i] for i in np.flatnonzero(in_ring))
+    clouds = np.array([cloud for member in members for cloud in member], dtype=np.int64)
     generation = RingGeneration(
         tuple(float(v) for v in eye),
         float(settings.ring_radius),
-        _members_key(members, keys),
+        clouds,
+        cloud_keys[clouds],
         members,
         (),
         tuple(texture_size),
@@ -182,10 +203,13 @@ def new_generation(
     return replace(generation, segment_members=tuple(per_segment))
 
 
-def _members_key(members: frozenset, keys: dict) -> tuple:
-    """What the members' colours were computed from: a change to a cloud outside the ring leaves it be;
-    a member gone (its cloud removed, or regrouped) changes it."""
-    return tuple((member, keys.get(member)) for member in sorted(members))
+def _relit(generation: RingGeneration, cloud_keys: np.ndarray, present: frozenset) -> bool:
+    """Whether the colours of a member of `generation` changed since it was made (`cloud_keys`: each cloud's
+    lighting key now, an object array), or a member is gone (its cloud removed, or regrouped: not in
+    `present`); a change to a cloud outside the ring leaves it be."""
+    if not generation.members <= present:
+        return True
+    return bool(np.any(cloud_keys[generation.clouds] != generation.cloud_keys))
 
 
 def _wrong_size(generation: RingGeneration, texture_size: tuple) -> bool:
@@ -199,7 +223,8 @@ def _needs_rebuild(
     generation: RingGeneration,
     eye,
     settings: RenderSettings,
-    keys: dict,
+    cloud_keys: np.ndarray,
+    present: frozenset,
     texture_size: tuple,
     holds_clouds: bool,
     past_tolerance: bool,
@@ -211,7 +236,7 @@ def _needs_rebuild(
     moved = np.asarray(eye, dtype=np.float64) - np.asarray(generation.eye)
     return (
         past_tolerance
-        or generation.lighting_key != _members_key(generation.members, keys)
+        or _relit(generation, cloud_keys, present)
         or _wrong_size(generation, texture_size)
         or generation.radius != settings.ring_radius
         or math.hypot(moved[0], moved[2]) > settings.ring_rebuild_horizontal * settings.ring_radius
@@ -225,8 +250,9 @@ def plan_ring(
     radii,
     eye,
     settings: RenderSettings,
-    lighting_keys: tuple,
+    cloud_keys: np.ndarray,
     ids: tuple,
+    present: frozenset,
     texture_size: tuple,
     holds_clouds: bool = True,
     past_tolerance: bool = False,
@@ -234,9 +260,10 @@ def plan_ring(
 ) -> RingPlan | None:
     """Advance the ring by one frame: start a rebuild if needed, build one segment or step the fade.
 
-    `lighting_keys` has one key per sphere, `ids` one identity (a unit's member clouds): the ring
-    holds ids, so a scene whose spheres are renumbered (clouds regrouped, one removed) does not
-    mistake one cloud for another.  `texture_size` is the segment texture size the screen asks for
+    `cloud_keys` has each cloud's lighting key (an object array), `ids` one identity per sphere (a unit's
+    member clouds), and `present` is the set of `ids`: the ring holds ids, so a scene whose spheres are
+    renumbered (clouds regrouped, one removed) does not mistake one cloud for another.  `texture_size` is
+    the segment texture size the screen asks for
     (`segment_texture_size`).  `holds_clouds` False asks for a ring of no clouds (it does not pay for
     itself): the ring shown fades out as when it is rebuilt, with nothing to build.  `past_tolerance`: the
     ring shown holds a cloud whose translation error has passed the impostors' tolerance (auto mode keeps it
@@ -257,21 +284,20 @@ def plan_ring(
     if pending is not None and (
         pending.radius != settings.ring_radius
         or _wrong_size(pending, texture_size)
-        or not pending.members <= set(ids)  # a member gone (a cloud field's cell left): nothing to render it from
+        or not pending.members <= present  # a member gone (a cloud field's cell left): nothing to render it from
         or pending.holds_clouds != holds_clouds
     ):
         pending = None  # the ring it was being built for is gone: start again
-    keys = dict(zip(ids, lighting_keys))
     if pending is None and (
         (current is None and holds_clouds)
         or (
             current is not None
-            and _needs_rebuild(current, eye, settings, keys, texture_size, holds_clouds, past_tolerance)
+            and _needs_rebuild(current, eye, settings, cloud_keys, present, texture_size, holds_clouds, past_tolerance)
         )
     ):
         if current is not None or state.pending is not None:
             since_rebuild, rebuild_interval = 0, float(since_rebuild)
-        pending = new_generation(centres, radii, eye, settings, keys, ids, texture_size, holds_clouds)
+        pending = new_generation(centres, radii, eye, settings, cloud_keys, ids, texture_size, holds_clouds)
         built, fade_step = (0 if holds_clouds else SEGMENTS), 0  # a ring of nothing has nothing to build
     built_of_segment = state.built_of_segment if pending is state.pending else 0
     build_segment, build_piece = None, (0, 0)

@@ -126,6 +126,16 @@ class LodUnits:
         return np.fromiter(map(len, self.members), dtype=np.int64, count=len(self.members))
 
     @functools.cached_property
+    def member_set(self) -> frozenset:
+        """The units' members, as a set."""
+        return frozenset(self.members)
+
+    @functools.cached_property
+    def row_of(self) -> dict:
+        """Each unit's row, by its members."""
+        return {members: row for row, members in enumerate(self.members)}
+
+    @functools.cached_property
     def group_rows(self) -> np.ndarray:
         """The rows of the units of more than one cloud."""
         return np.array([row for row, members in enumerate(self.members) if len(members) > 1], dtype=np.int64)
