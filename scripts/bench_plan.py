@@ -91,7 +91,7 @@ def planned_frames(scene, views, size, mode: str):
     """Yield (plan, the call's arguments) of every frame of `views` planned in a closed loop in `mode`."""
     settings = RenderSettings(mode=mode)
     state, field_state, units_source = LodState(), FieldState(), None
-    spheres, serial_of = None, {}
+    spheres, serial_of, last_keys = None, {}, None
     for time_s, camera in views:
         clouds, fades = scene.clouds, (1.0,) * len(scene.clouds)
         if scene.cloud_field is not None:
@@ -106,6 +106,8 @@ def planned_frames(scene, views, size, mode: str):
         # the cloud is held so that its id is not reused)
         serials = [serial_of.setdefault(id(cloud), (len(serial_of), cloud))[0] for cloud in clouds]
         keys = tuple((s, formation_state(c.formation, time_s), fade) for s, c, fade in zip(serials, clouds, fades))
+        keys = last_keys if keys == last_keys else keys  # the renderer's keys are the same tuple while unchanged
+        last_keys = keys
         if spheres is None and scene.objects:
             from cloudcore.objects import mesh_sphere, object_mesh
 
@@ -149,7 +151,10 @@ def canonical(plan) -> str:
         (
             drawn,
             kinds,
-            plan.draw_items,
+            [
+                (i.kind, int(i.index), float(i.depth), int(i.layer), float(i.near), float(i.far))
+                for i in plan.draw_items
+            ],
             ring_text,
             plan.inside_size,
             plan.objects_with_world,

@@ -8,13 +8,13 @@ import pytest
 
 from cloudcore.camera import frustum_planes, projection_matrix, splats_in_frustum, view_matrix
 from cloudcore.lod.costs import CostModel, Work
+from cloudcore.lod.draw_items import inside_runs
 from cloudcore.lod.frameplan import (
     FRAME_SETTLE_FRAMES,
     PROBE_FRAMES,
     SWITCH_MARGIN,
     LodState,
     _in_view_work,
-    inside_runs,
     plan_frame,
 )
 from cloudcore.lod.impostors import content_depth, impostor_view, parallax_error_deg, translation_error_deg

@@ -54,7 +54,8 @@ from cloudcore.light.illumination import IlluminationCache
 from cloudcore.light.lighting import scene_hour, scene_lights, sky_colors
 from cloudcore.light.volume_blending import blending_path
 from cloudcore.lod.costs import CostModel
-from cloudcore.lod.frameplan import FramePlan, LodState, inside_runs, plan_frame
+from cloudcore.lod.draw_items import inside_runs
+from cloudcore.lod.frameplan import FramePlan, LodState, plan_frame
 from cloudcore.lod.impostors import cropped_corners, particle_extent
 from cloudcore.lod.measured_way import COMPOSITING_WAYS, MeasuredWay
 from cloudcore.lod.units import LodUnits, lod_units
@@ -109,6 +110,8 @@ class FrameRenderer:
         self._illumination = illumination if illumination is not None else IlluminationCache()
         #: per cloud, changes whenever that cloud's particle colours may have: its impostor is stale
         self._lighting_keys: tuple = ()
+        self._forming_clouds: tuple = ()  # the clouds that form or dissipate, whose colours follow the clock
+        self._cloud_keys_source, self._cloud_keys_made = None, ()
         self._key_serial = 0
         #: the level of detail's state between frames (impostor cache, ring, representations, costs)
         self.lod_state = LodState()
@@ -201,12 +204,7 @@ class FrameRenderer:
         particles.weigh(self._field_weights)
         poses = self._objects.poses(time_s) if self._objects is not None else ()
         starts = particles.cloud_starts
-        # a forming or dissipating cloud's colours change with the clock too, a field's cloud's with its
-        # blend weights: its impostor is stale meanwhile
-        cloud_keys = tuple(
-            (key, formation_state(cloud.formation, time_s), fade)
-            for key, cloud, fade in zip(self._lighting_keys, scene.clouds, fade_keys)
-        )
+        cloud_keys = self._cloud_keys(scene, fade_keys, time_s)
         # the units follow the particles' places and sizes, not their light: a relit scene keeps them
         if (scene.clouds, settings.group_clouds) != self._units_source:
             self._units = lod_units(particles, settings.group_clouds, authored_clouds)
@@ -386,8 +384,27 @@ class FrameRenderer:
         # by identity, not place: a cloud field's clouds that stay keep their keys when others come and go
         held = dict(zip(map(id, old_clouds), self._lighting_keys)) if same_lighting else {}
         self._lighting_keys = tuple(held.get(id(cloud)) or self._next_key() for cloud in scene.clouds)
+        self._forming_clouds = tuple(index for index, cloud in enumerate(scene.clouds) if cloud.formation is not None)
         self._particles_source = particles_source
         return 1e3 * (time.perf_counter() - start)
+
+    def _cloud_keys(self, scene: Scene, fade_keys: tuple, time_s: float) -> tuple:
+        """Per cloud, what its colours are made from this frame: its lighting key, and as a forming or
+        dissipating cloud's colours change with the clock and a field's cloud's with its blend weights, those
+        (its impostor is stale meanwhile).  The same tuple as the frame before while none changed: the plan
+        then finds its ring's clouds unchanged at once (`cloudcore.lod.ring`), with no cloud looked at."""
+        forming = tuple(
+            (index, formation_state(scene.clouds[index].formation, time_s)) for index in self._forming_clouds
+        )
+        source = (self._lighting_keys, fade_keys, forming)
+        if source != self._cloud_keys_source:
+            states = dict(forming)
+            self._cloud_keys_source = source
+            self._cloud_keys_made = tuple(
+                (key, states.get(index), fade)  # a cloud that neither forms nor dissipates: None
+                for index, (key, fade) in enumerate(zip(self._lighting_keys, fade_keys))
+            )
+        return self._cloud_keys_made
 
     def _next_key(self) -> int:
         self._key_serial += 1

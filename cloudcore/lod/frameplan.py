@@ -57,6 +57,7 @@ from cloudcore.camera import (
     view_matrix,
 )
 from cloudcore.lod.costs import CostEstimator, CostModel, Work, quad_work, regeneration_fragments, splat_fragments
+from cloudcore.lod.draw_items import DrawItems, draw_items, full_runs, inside_runs
 from cloudcore.lod.impostors import (
     INSIDE_RADII,
     TRANSLATION_METRICS,
@@ -81,7 +82,7 @@ from cloudcore.lod.ring import (
     ring_members,
     segment_texture_size,
 )
-from cloudcore.lod.splitting import layer_bounds, layer_sort_key, layers_hold, objects_reaching
+from cloudcore.lod.splitting import layers_hold, objects_reaching
 from cloudcore.lod.unit_plans import (
     CROSSFADE,
     CULLED,
@@ -90,7 +91,6 @@ from cloudcore.lod.unit_plans import (
     FULL,
     IMPOSTOR,
     INSIDE,
-    KINDS,
     RING,
     TEXTURED,
     UnitPlans,
@@ -128,18 +128,6 @@ PLAUSIBLE_RATIO = 1.5
 SCENE_CHANGE_RATIO = 1.25
 #: the running mean of a choice's frame times weighs each new frame at least this much
 FRAME_TIME_FORGETTING = 0.1
-
-
-@dataclass(frozen=True)
-class DrawItem:
-    """One step of the cloud pass: a layer of a unit, or an object drawn between layers."""
-
-    kind: str  # "cloud" or "object"
-    index: int
-    depth: float  # distance from the eye the pass is sorted by, far to near
-    layer: int = 0  # of the unit, 0 the farthest
-    near: float = -math.inf  # the layer holds the particles with near < distance from the eye <= far
-    far: float = math.inf
 
 
 @dataclass(frozen=True)
@@ -214,7 +202,7 @@ class FramePlan:
     ring: RingPlan | None
     state: LodState = LodState()  # to carry into the next frame
     inside_size: tuple = (0, 0)  # the screen impostor's texture size (width, height)
-    draw_items: tuple = ()  # the cloud pass, far to near (DrawItem)
+    draw_items: DrawItems | None = None  # the cloud pass, far to near
     objects_with_world: tuple = ()  # visible objects outside split clouds: drawn before the cloud pass
     update_work: Work = Work()  # predicted work of the impostor updates (regenerations, ring segment)
     cloud_work: Work = Work()  # predicted work of the cloud pass
@@ -302,7 +290,7 @@ class FramePlan:
     @property
     def objects_between_layers(self) -> tuple:
         """Objects drawn inside the cloud pass; the rest are drawn with the world."""
-        return tuple(item.index for item in self.draw_items if item.kind == "object")
+        return self.draw_items.objects
 
 
 def plan_frame(
@@ -425,7 +413,6 @@ def _plan_units(
     records = state.records
     next_records = {members: record for members, record in records.items() if members in units.member_set}
     objects_visible = spheres_in_frustum(planes, object_centres, object_radii)
-    held_errors = _held_errors(units, records, translation_error, eye)
     # auto mode prices Wang's ring against drawing its clouds each as auto would (the cheaper of full 3D and
     # an impostor): a sparse far field is cheaper drawn than its panels and their rebuilds
     ring_ms = alone_ms = ring_error = 0.0
@@ -471,7 +458,7 @@ def _plan_units(
         radii,
         eye,
         settings,
-        np.fromiter(cloud_keys, dtype=object, count=len(cloud_keys)) if settings.uses_ring else None,
+        cloud_keys,
         units.members,
         units.member_set,
         segment_texture_size(height, camera.fov_y_deg, settings),
@@ -576,6 +563,7 @@ def _plan_units(
     full_prices, impostor_prices = np.zeros(count), np.zeros(count)
     reasons, split_objects, split_distances = {}, {}, {}
     drawable = np.flatnonzero((radii > 0.0) & (individuals > 0.0) & visible)
+    held_errors = _held_errors(units, drawable, records, translation_error, eye) if settings.mode != "full" else None
     may_be_textured = visible & (radii > 0.0) & (individuals > 0.0) & (distances >= INSIDE_RADII * radii)
     textured = (
         _impostor_textures(units, np.flatnonzero(may_be_textured), distances, height, camera.fov_y_deg, settings)
@@ -731,14 +719,14 @@ def _plan_units(
     drawn = np.flatnonzero(np.isin(kinds, kind_codes(*DRAWN)))
     draw_order = tuple(drawn[np.argsort(-distances[drawn], kind="stable")].tolist())
     inside_size = tuple(max(1, math.ceil(side * settings.inside_resolution_scale)) for side in viewport)
-    items = _draw_items([plans[i] for i in draw_order], radii, object_centres, objects_visible, eye)
+    items = draw_items(plans, draw_order, radii, object_centres, objects_visible, eye)
     screen_impostors = len(inside_runs(items, plans))
     cloud_work += Work(
-        batches=float(_full_runs([KINDS[kind] for kind in kinds[list(draw_order)]]) + screen_impostors),
+        batches=float(full_runs(kinds[list(draw_order)]) + screen_impostors),
         quad_pixels=screen_impostors * screen_pixels,
         quads=float(screen_impostors),
     )
-    between = {item.index for item in items if item.kind == "object"}
+    between = set(items.objects)
     with_world = tuple(i for i in range(len(object_radii)) if objects_visible[i] and i not in between)
     drawn_as = frame_choice = None
     if settings.mode == "auto":
@@ -816,9 +804,9 @@ def _units_ms(unit_prices, ring_ms: float, alone_ms: float, candidates, costs: C
     for index, _, full_ms, other_ms in sorted(unit_prices, key=lambda price: -price[1]):
         if not candidates[index]:
             priced_ms += min(full_ms, other_ms)
-        kinds.append("full" if full_ms <= other_ms else "impostor")
+        kinds.append(FULL if full_ms <= other_ms else IMPOSTOR)
     ring_part = min(ring_ms, alone_ms) if candidates.any() else 0.0
-    return priced_ms + ring_part + costs.batches * _full_runs(kinds)
+    return priced_ms + ring_part + costs.batches * full_runs(np.array(kinds, dtype=np.int8))
 
 
 def _comparable(before: float, now: float) -> bool:
@@ -1034,11 +1022,11 @@ def _pricing(camera: Camera, viewport, settings, state: LodState, objects) -> tu
     )
 
 
-def _held_errors(units: LodUnits, records: Mapping, translation_error, eye) -> np.ndarray:
-    """Per unit, the translation error of the impostor held (inf: none); the parallax between the near and far
-    points of what it holds (`ImpostorRecord.content`) where the record has them."""
-    # only the units holding one are measured: most of a cloud field's units are in Wang's ring or out of view
-    rows = sorted(units.row_of[members] for members in records if members in units.row_of)
+def _held_errors(units: LodUnits, drawable, records: Mapping, translation_error, eye) -> np.ndarray:
+    """Per unit, the translation error of the impostor held (inf: none), measured for the units `drawable` (the
+    rest are not drawn on their own: out of view, or in the ring); the parallax between the near and far points
+    of what it holds (`ImpostorRecord.content`) where the record has them."""
+    rows = [row for row in drawable.tolist() if units.members[row] in records]
     errors = np.full(len(units.members), math.inf)
     if not rows:
         return errors
@@ -1170,49 +1158,3 @@ def _cheapest(held: str | None, prices: dict) -> str:
     if held in prices and prices[cheapest] >= (1.0 - SWITCH_MARGIN) * prices[held]:
         return held
     return cheapest
-
-
-def inside_runs(items, clouds) -> list[list]:
-    """The draw items of units the eye is inside, in runs that share one screen impostor: consecutive in
-    the cloud pass and drawn at the same weight (nothing is drawn between them, so one sorted batch and
-    one composite give the picture of each drawn in turn, with their particles sorted together)."""
-    runs, previous = [], None
-    for item in items:
-        cloud = clouds[item.index] if item.kind == "cloud" else None
-        if cloud is None or cloud.kind != "inside":
-            previous = None
-            continue
-        if previous is not None and previous.full_weight == cloud.full_weight:
-            runs[-1].append(item)
-        else:
-            runs.append([item])
-        previous = cloud
-    return runs
-
-
-def _full_runs(kinds) -> int:
-    """Splat draws of the cloud pass outside screen impostors: each run of consecutive full units is one,
-    each crossfading unit one."""
-    runs, previous = 0, None
-    for kind in kinds:
-        if kind == "crossfade" or (kind == "full" and previous != "full"):
-            runs += 1
-        previous = kind
-    return runs
-
-
-def _draw_items(drawn, radii, object_centres, objects_visible, eye) -> tuple:
-    """The cloud pass far to near: each drawn cloud's layers, and each split object once between them."""
-    items, objects = [], set()
-    for cloud in drawn:
-        for layer in range(cloud.layers):
-            near, far = layer_bounds(cloud.splits, layer)
-            depth = layer_sort_key(near, far, cloud.distance, radii[cloud.index]) if cloud.splits else cloud.distance
-            items.append(DrawItem("cloud", cloud.index, depth, layer, near, far))
-        objects.update(cloud.split_objects)
-    for index in sorted(i for i in objects if objects_visible[i]):
-        distance = float(np.linalg.norm(object_centres[index] - eye))
-        items.append(DrawItem("object", index, distance, near=distance, far=distance))
-    # far to near; at equal depth the layer reaching farther first, then objects before layers
-    items.sort(key=lambda item: (-item.depth, -item.far, item.kind != "object"))
-    return tuple(items)

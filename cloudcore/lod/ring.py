@@ -64,9 +64,10 @@ class RingGeneration:
     #: measures the panels' translation error from each frame, without looking its members up among the units
     spheres: tuple = field(default=(np.zeros((0, 3)), np.zeros(0)), compare=False, repr=False)
 
-    #: per tuple of ids a frame was planned with (by its id, with the tuple held): its members' rows in it, in the
-    #: members' own order; a memo, so that a ring of thousands is looked up once, not every frame
-    _rows: dict = field(default_factory=dict, repr=False)
+    #: what the frames before found of it, so that a ring of thousands is not walked every frame: "rows", the
+    #: tuple of ids last planned with and its members' rows in it; "keys", the clouds' lighting keys (the tuple a
+    #: frame was planned with) last found to leave it unchanged
+    _memo: dict = field(default_factory=dict, repr=False)
 
     @property
     def occupied_segments(self) -> tuple[int, ...]:
@@ -76,12 +77,9 @@ class RingGeneration:
     def rows_in(self, ids: tuple, row_of: Mapping) -> np.ndarray:
         """The rows of its members present in `ids` (whose `row_of` maps an id to its row), in the order of
         `members`."""
-        held = self._rows.get(id(ids))
+        held = self._memo.get("rows")
         if held is None or held[0] is not ids:
-            rows = np.array([row_of[m] for m in self.members if m in row_of], dtype=np.int64)
-            held = self._rows[id(ids)] = (ids, rows)
-            for key in [key for key, (other, _) in self._rows.items() if other is not ids]:
-                del self._rows[key]  # a memo of one: the units of the frame before are gone
+            held = self._memo["rows"] = (ids, np.array([row_of[m] for m in self.members if m in row_of], np.int64))
         return held[1]
 
 
@@ -187,7 +185,7 @@ def new_generation(
         tuple(float(v) for v in eye),
         float(settings.ring_radius),
         clouds,
-        cloud_keys[clouds],
+        np.fromiter(cloud_keys, dtype=object, count=len(cloud_keys))[clouds],
         members,
         (),
         tuple(texture_size),
@@ -203,13 +201,19 @@ def new_generation(
     return replace(generation, segment_members=tuple(per_segment))
 
 
-def _relit(generation: RingGeneration, cloud_keys: np.ndarray, present: frozenset) -> bool:
+def _relit(generation: RingGeneration, cloud_keys: tuple, present: frozenset) -> bool:
     """Whether the colours of a member of `generation` changed since it was made (`cloud_keys`: each cloud's
-    lighting key now, an object array), or a member is gone (its cloud removed, or regrouped: not in
-    `present`); a change to a cloud outside the ring leaves it be."""
+    lighting key now), or a member is gone (its cloud removed, or regrouped: not in `present`); a change to a
+    cloud outside the ring leaves it be."""
     if not generation.members <= present:
         return True
-    return bool(np.any(cloud_keys[generation.clouds] != generation.cloud_keys))
+    if generation._memo.get("keys") is cloud_keys:  # the very keys found unchanged before
+        return False
+    keys = np.fromiter(cloud_keys, dtype=object, count=len(cloud_keys))
+    relit = bool(np.any(keys[generation.clouds] != generation.cloud_keys))
+    if not relit:
+        generation._memo["keys"] = cloud_keys
+    return relit
 
 
 def _wrong_size(generation: RingGeneration, texture_size: tuple) -> bool:
@@ -223,7 +227,7 @@ def _needs_rebuild(
     generation: RingGeneration,
     eye,
     settings: RenderSettings,
-    cloud_keys: np.ndarray,
+    cloud_keys: tuple,
     present: frozenset,
     texture_size: tuple,
     holds_clouds: bool,
@@ -250,7 +254,7 @@ def plan_ring(
     radii,
     eye,
     settings: RenderSettings,
-    cloud_keys: np.ndarray,
+    cloud_keys: tuple,
     ids: tuple,
     present: frozenset,
     texture_size: tuple,
@@ -260,7 +264,7 @@ def plan_ring(
 ) -> RingPlan | None:
     """Advance the ring by one frame: start a rebuild if needed, build one segment or step the fade.
 
-    `cloud_keys` has each cloud's lighting key (an object array), `ids` one identity per sphere (a unit's
+    `cloud_keys` has each cloud's lighting key, `ids` one identity per sphere (a unit's
     member clouds), and `present` is the set of `ids`: the ring holds ids, so a scene whose spheres are
     renumbered (clouds regrouped, one removed) does not mistake one cloud for another.  `texture_size` is
     the segment texture size the screen asks for
