@@ -464,8 +464,8 @@ class FrameRenderer:
                     self.context, camera, poses, [item.index], write_depth=False, antialiased=antialiased
                 )
             elif kind == "inside":
-                if id(item) in screen_impostors:  # the rest of its run is in the same screen impostor
-                    target, particles_drawn, extent = screen_impostors[id(item)]
+                if item in screen_impostors:  # the rest of its run is in the same screen impostor
+                    target, particles_drawn, extent = screen_impostors[item]
                     self._draw_screen_quad(target.texture, plan.clouds[item.index].full_weight, extent)
                     drawn += particles_drawn
             elif kind == "impostors":
@@ -628,7 +628,7 @@ class FrameRenderer:
 
     def _screen_impostors(self, frame: _CloudPassFrame, runs, batches) -> dict:
         """Harris's screen impostors of the units the eye is in, before anything else of the cloud pass:
-        per run of consecutive draw items (keyed by id of its first), (target, particles drawn, the part of
+        per run of consecutive draw items (keyed by its first), (target, particles drawn, the part of
         the screen they can cover: the composite draws only that, 18% fewer fragments along the untuned
         cumulus field), their particles sorted together (`batches`, one a run) at the plan's reduced
         resolution.
@@ -643,7 +643,7 @@ class FrameRenderer:
             target.bind_cleared()
             self._splats.draw(batch, frame.view, frame.projection, point_sprites=frame.point_sprites)
             extent = particle_extent(frame.view, frame.projection, batch.centres, batch.radii, frame.plan.inside_size)
-            made[id(run[0])] = (target, len(batch), extent)
+            made[run[0]] = (target, len(batch), extent)
         self.context.bind_target()
         return made
 
