@@ -14,7 +14,10 @@ and one for each mode, taking turns frame by frame), default settings but for th
 - field: 1.2 million particles (`bench_many_particles.cloud_field`) orbiting 0.05 degrees a frame,
   120 frames, 640x480, after 20 frames still (Harris: 10-12 fps for his largest scenes);
 - untuned: two scenes the LOD was not tuned on, made here from a seed: a field of cumulus of another
-  density and a stratocumulus deck (the Wang presets), each flown through at 120 m/s at 30 fps.
+  density and a stratocumulus deck (the Wang presets), each flown through at 120 m/s at 30 fps;
+- harris_circle_N, harris_through_N (`harris` for all): Harris's figure 8 (`harris_figure8`), N of 100 to
+  12,800 clouds of 200 particles, the eye on his circle or straight through, 90 frames at 640x480 after
+  20 still ones.
 
 Auto's row gives its mean frame over the faster mode's, with a 95% interval (`ratio_interval`): one frame's
 time on llvmpipe varies by a fifth or more, and 30 frames left the ratio of two identical plans 5% either way.
@@ -37,7 +40,8 @@ import numpy as np
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from bench_many_particles import cloud_field  # noqa: E402  (a sibling script: the same 1.2M field)
+import harris_figure8  # noqa: E402  (sibling scripts: Harris's figure 8 and the same 1.2M field)
+from bench_many_particles import cloud_field  # noqa: E402
 
 from cloudcore.artist.cloudgen import preset_cloud  # noqa: E402
 from cloudcore.gl import FrameRenderer  # noqa: E402
@@ -62,6 +66,8 @@ MODES = (RenderSettings(mode="impostor"), RenderSettings())
 #: unmeasured frames before a still or slowly moving camera is timed: the impostors made, the ring's
 #: 8 segments built and faded in over 8 frames
 SETTLE_FRAMES = 20
+#: frames of each of Harris's cases (`harris_figure8`): 3 s of flight
+HARRIS_FRAMES = 90
 
 
 def flight(name: str, start, end, look_ahead_m: float = 2000.0, speed_m_s: float = 120.0) -> CameraPath:
@@ -123,6 +129,12 @@ def cases(names, quick: bool) -> list:
         for name, (scene, path) in untuned_scenes(valley).items():
             frames = int(scene.camera_path(path).duration * 30) + 1
             chosen.append((name, scene, path_views(scene, path, short(frames)), (640, 480), 0))
+    for count in harris_figure8.COUNTS:
+        for path, views_of in (("circle", harris_figure8.circle_views), ("through", harris_figure8.through_views)):
+            name = f"harris_{path}_{count}"
+            if name in names or "harris" in names:
+                scene = harris_figure8.harris_scene(valley, count)
+                chosen.append((name, scene, views_of(short(HARRIS_FRAMES)), (640, 480), SETTLE_FRAMES))
     return chosen
 
 

@@ -3,8 +3,8 @@
     python scripts/bench_plan.py [--cases flythrough,harris_circle_12800] [--frames 300] [--against REV]
                                  [--json out/bench_plan.json]
 
-Each case (`bench_lod.cases`, and Harris's figure 8: `harris_circle_N` and `harris_through_N` for each of
-`harris_figure8.COUNTS`, `harris` for all of them) is planned frame by frame in a closed loop, as
+Each case of `bench_lod.py` (Harris's figure 8 among them: `harris_circle_N`, `harris_through_N`, `harris`
+for all) is planned frame by frame in a closed loop, as
 `cloudcore.gl.FrameRenderer` plans it but with nothing drawn: the units of the scene's clouds (and of its
 cloud field for the eye), the objects' poses, the clouds' lighting keys, the state each plan leaves fed into
 the next, and the frame's measured times replaced by the plan's own prediction, the cloud pass's 10% dearer
@@ -39,35 +39,17 @@ import numpy as np
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-import harris_figure8  # noqa: E402  (sibling scripts: the same scenes, views and sizes)
-from bench_lod import cases as lod_cases  # noqa: E402
+from bench_lod import cases as lod_cases  # noqa: E402  (a sibling script: the same scenes, views and sizes)
 
 from cloudcore.artist.formation import formation_state  # noqa: E402
 from cloudcore.field.state import FieldState, update_field  # noqa: E402
 from cloudcore.lod.frameplan import LodState, plan_frame  # noqa: E402
 from cloudcore.lod.units import lod_units  # noqa: E402
 from cloudcore.objects import object_poses  # noqa: E402
-from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
-from cloudcore.scenefile import load_scene  # noqa: E402
 from cloudcore.settings import RenderSettings  # noqa: E402
 
 MODES = ("full", "impostor", "auto")
 PASSES = 5
-#: Harris's cases: the frames before the timed ones (the ring built and faded in, the impostors made)
-HARRIS_WARMUP = 20
-
-
-def harris_cases(names) -> list:
-    """(name, scene, views, size, warmup) of Harris's figure 8 asked for by `names`."""
-    world, chosen = None, []
-    for count in harris_figure8.COUNTS:
-        for path, views_of in (("circle", harris_figure8.circle_views), ("through", harris_figure8.through_views)):
-            name = f"harris_{path}_{count}"
-            if name in names or "harris" in names:
-                world = world or load_scene(DEFAULT_SCENE)
-                scene = harris_figure8.harris_scene(world, count)
-                chosen.append((name, scene, views_of(HARRIS_WARMUP + 300), (640, 480), HARRIS_WARMUP))
-    return chosen
 
 
 def particles_of(clouds) -> SimpleNamespace:
@@ -174,7 +156,7 @@ def canonical(plan) -> str:
 def replay(names, frames: int) -> list[dict]:
     """Per case and mode: the plans' digests frame by frame, and the timed passes."""
     rows = []
-    chosen = lod_cases(names, quick=False) + harris_cases(names)
+    chosen = lod_cases(names, quick=False)
     for name, scene, views, size, warmup in chosen:
         views = views[: warmup + frames]
         for mode in MODES:

@@ -12,6 +12,7 @@ values at the hour (`artist_uniforms`) and its vertical extent.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -44,9 +45,10 @@ class ParticleStyles:
     rotation: np.ndarray  # (n,) radians in the sprite's plane
     clouds: tuple[CloudStyle, ...]
 
-    @property
+    @functools.cached_property
     def sprite_clouds(self) -> tuple[int, ...]:
-        """Clouds of eye-facing sprites: the ones whose sprites lock their facing near the eye."""
+        """Clouds of eye-facing sprites: the ones whose sprites lock their facing near the eye (asked every
+        frame: found once)."""
         return tuple(i for i, c in enumerate(self.clouds) if c.facing == FACING_CAMERA)
 
     @property

@@ -411,7 +411,6 @@ def _plan_units(
         return tuple(cloud_keys[c] for c in units.members[index])
 
     records = state.records
-    next_records = {members: record for members, record in records.items() if members in units.member_set}
     objects_visible = spheres_in_frustum(planes, object_centres, object_radii)
     # auto mode prices Wang's ring against drawing its clouds each as auto would (the cheaper of full 3D and
     # an impostor): a sparse far field is cheaper drawn than its panels and their rebuilds
@@ -563,6 +562,15 @@ def _plan_units(
     full_prices, impostor_prices = np.zeros(count), np.zeros(count)
     reasons, split_objects, split_distances = {}, {}, {}
     drawable = np.flatnonzero((radii > 0.0) & (individuals > 0.0) & visible)
+    # the impostors kept are those of the units the ring does not show whole: a unit in the ring is drawn by its
+    # panel, and when the ring hands it back the eye has moved a rebuild's distance (15% of the ring's radius),
+    # past the tolerance of all but the largest clouds; its texture is freed meanwhile (at Harris's scale, a
+    # flight kept thousands)
+    next_records = {
+        members: record
+        for members, record in records.items()
+        if members in units.row_of and individuals[units.row_of[members]] > 0.0
+    }
     held_errors = _held_errors(units, drawable, records, translation_error, eye) if settings.mode != "full" else None
     may_be_textured = visible & (radii > 0.0) & (individuals > 0.0) & (distances >= INSIDE_RADII * radii)
     textured = (
