@@ -76,6 +76,7 @@ from cloudcore.lod.impostors import (
 from cloudcore.lod.ring import (
     RING_FRAME_MS,
     SEGMENT_DEG,
+    SEGMENTS,
     RingPlan,
     RingState,
     plan_ring,
@@ -451,6 +452,9 @@ def _plan_units(
             )
         in_view = (in_view_particles[alone], in_view_fragments[alone])
         alone_ms = _alone_ms(units, seen, alone, in_view, focal_px, settings, costs)
+        # a candidate drawn on its own until a ring being built takes it: an impostor made for it now lasts only
+        # that long (Harris's circle at 800 clouds made 136 impostors in its first frame for a ring in 16 frames)
+        lifetimes = np.where(candidates, np.minimum(lifetimes, _frames_until_ring(state.ring, settings)), lifetimes)
     ring = plan_ring(
         state.ring,
         centres,
@@ -855,6 +859,16 @@ def _frame_choice(state: LodState, drawn_as: str, predicted: dict) -> str:
     if _known(state, other):
         return _cheapest(drawn_as, {choice: state.frame_times[choice].mean_ms for choice in (drawn_as, other)})
     return other if predicted[other] < PLAUSIBLE_RATIO * predicted[drawn_as] else drawn_as
+
+
+def _frames_until_ring(state: RingState, settings: RenderSettings) -> float:
+    """Frames until the ring being built (or, with none yet, the first, begun this frame) shows its clouds
+    whole: its segments left, one a frame, then its fade (inf: no ring holding clouds is on its way)."""
+    if state.current is None and state.pending is None:
+        return float(SEGMENTS + settings.ring_fade_frames)
+    if state.pending is None or not state.pending.holds_clouds:
+        return math.inf
+    return float(SEGMENTS - state.built + settings.ring_fade_frames - state.fade_step)
 
 
 def _ring_panels_work(panels: int, quad_pixels) -> Work:
