@@ -43,7 +43,11 @@ from bench_lod import cases as lod_cases  # noqa: E402  (a sibling script: the s
 
 from cloudcore.artist.formation import formation_state  # noqa: E402
 from cloudcore.field.state import FieldState, update_field  # noqa: E402
-from cloudcore.lod.frameplan import LodState, plan_frame  # noqa: E402
+
+try:
+    from cloudcore.lod.plan import LodState, plan_frame
+except ImportError:  # --against a revision from before the plan was a package of stages
+    from cloudcore.lod.frameplan import LodState, plan_frame
 from cloudcore.lod.units import lod_units  # noqa: E402
 from cloudcore.objects import object_poses  # noqa: E402
 from cloudcore.settings import RenderSettings  # noqa: E402

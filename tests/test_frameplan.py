@@ -8,16 +8,9 @@ import pytest
 
 from cloudcore.camera import frustum_planes, projection_matrix, splats_in_frustum, view_matrix
 from cloudcore.lod.costs import CostModel, Work
-from cloudcore.lod.draw_items import inside_runs
-from cloudcore.lod.frameplan import (
-    FRAME_SETTLE_FRAMES,
-    PROBE_FRAMES,
-    SWITCH_MARGIN,
-    LodState,
-    _in_view_work,
-    plan_frame,
-)
 from cloudcore.lod.impostors import content_depth, impostor_view, parallax_error_deg, translation_error_deg
+from cloudcore.lod.plan import FRAME_SETTLE_FRAMES, PROBE_FRAMES, SWITCH_MARGIN, LodState, inside_runs, plan_frame
+from cloudcore.lod.plan.pricing import in_view_work
 from cloudcore.lod.ring import SEGMENTS, RingState
 from cloudcore.lod.units import LodUnits, SplatSample
 from cloudcore.scene import Camera
@@ -507,7 +500,7 @@ def test_a_far_unit_the_frustum_cuts_is_priced_by_its_splats_in_view_one_wholly_
     )
     focal_px, screen = 0.5 * VIEWPORT[1] / math.tan(math.radians(30.0)), float(VIEWPORT[0] * VIEWPORT[1])
     ball = np.array([1234.0, 5678.0])
-    particles, fragments = _in_view_work(units, np.array([True, True]), planes, np.zeros(3), focal_px, screen, ball)
+    particles, fragments = in_view_work(units, np.array([True, True]), planes, np.zeros(3), focal_px, screen, ball)
     assert particles[0] == 3000 and fragments[0] == ball[0]  # wholly in view: every splat, a ball of discs
     centres, radii = splats[1]
     seen = splats_in_frustum(planes, centres, radii)

@@ -17,7 +17,7 @@ from cloudcore.lod.costs import (
     regeneration_fragments,
     splat_fragments,
 )
-from cloudcore.lod.frameplan import SWITCH_MARGIN, LodState
+from cloudcore.lod.plan import SWITCH_MARGIN, LodState
 
 
 def test_splat_fragments_are_the_discs_areas_and_never_more_than_the_screen_each():

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from cloudcore.lod.costs import CostModel
-from cloudcore.lod.frameplan import LodState, plan_frame
 from cloudcore.lod.impostors import parallax_errors_deg
+from cloudcore.lod.plan import LodState, plan_frame
 from cloudcore.lod.units import SAMPLE_PER_CLOUD, LodUnits, SplatSample, interpenetrating_groups, lod_units
 from cloudcore.scene import Camera, splats_bounding_sphere
 from cloudcore.settings import RenderSettings

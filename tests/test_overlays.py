@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from cloudcore.editing import pick_ray
-from cloudcore.lod.frameplan import LodState, plan_frame
 from cloudcore.lod.impostors import screen_size_px
+from cloudcore.lod.plan import LodState, plan_frame
 from cloudcore.lod.units import LodUnits
 from cloudcore.measure.overlays import clip_to_near, impostor_outlines, ring_outlines, screen_polygon, to_pixels
 from cloudcore.scene import Camera

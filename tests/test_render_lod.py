@@ -16,7 +16,7 @@ from test_frameplan import FILL_BOUND, UPKEEP_BOUND
 from test_render_golden import inside_a_cloud, into_the_sun
 
 from cloudcore.lod.costs import LLVMPIPE_COSTS, CostModel
-from cloudcore.lod.frameplan import LodState
+from cloudcore.lod.plan import LodState
 from cloudcore.lod.ring import SEGMENTS
 from cloudcore.measure.imagecompare import compare
 from cloudcore.navigation import orbited

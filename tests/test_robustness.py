@@ -25,8 +25,8 @@ from cloudcore.errors import SceneError
 from cloudcore.gl.context import WindowContext
 from cloudcore.gl.frame import FrameRenderer
 from cloudcore.light.lighting import elevation_deg, scene_lights, sun_direction
+from cloudcore.lod.plan.unit_plans import TEXTURED
 from cloudcore.lod.ring import SEGMENTS
-from cloudcore.lod.unit_plans import TEXTURED
 from cloudcore.measure.frame_stats import FrameStats
 from cloudcore.scene import Camera, Cloud, Light, Lighting, Scene, Terrain
 from cloudcore.scenefile import scene_from_dict

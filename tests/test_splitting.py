@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from conftest import VALLEY
 
-from cloudcore.lod.frameplan import LodState, plan_frame
+from cloudcore.lod.plan import LodState, plan_frame
 from cloudcore.lod.splitting import layer_of
 from cloudcore.lod.units import LodUnits
 from cloudcore.objects import ObjectPose, object_poses

@@ -7,8 +7,8 @@ only when what it came from changes (a scene's cloud field adds its clouds
 for the eye after the scene's own first: `cloudcore.field.state`, whose
 state it holds too); what the level of detail carries from
 frame to frame (impostor cache, ring, representations, the fitted costs) is
-the pure `cloudcore.lod.frameplan.LodState` it holds.  Each frame it asks
-`cloudcore.lod.frameplan.plan_frame` what to do, executes exactly that, and
+the pure `cloudcore.lod.plan.LodState` it holds.  Each frame it asks
+`cloudcore.lod.plan.plan_frame` what to do, executes exactly that, and
 folds the two timed passes into the state's cost fit:
 
 1. the world (terrain depth and colour over the sky), and the objects
@@ -54,10 +54,10 @@ from cloudcore.light.illumination import IlluminationCache
 from cloudcore.light.lighting import scene_hour, scene_lights, sky_colors
 from cloudcore.light.volume_blending import blending_path
 from cloudcore.lod.costs import CostModel
-from cloudcore.lod.draw_items import inside_runs
-from cloudcore.lod.frameplan import FramePlan, LodState, plan_frame
 from cloudcore.lod.impostors import cropped_corners, particle_extent
 from cloudcore.lod.measured_way import COMPOSITING_WAYS, MeasuredWay
+from cloudcore.lod.plan import FramePlan, LodState, plan_frame
+from cloudcore.lod.plan.draw_items import inside_runs
 from cloudcore.lod.units import LodUnits, lod_units
 from cloudcore.measure.frame_stats import FrameStats
 from cloudcore.measure.overdraw import Overdraw, analytic_overdraw, overdraw_statistics

@@ -27,8 +27,8 @@ from cloudcore.gl.targets import TextureTarget
 from cloudcore.gl.texture_pool import TexturePool
 from cloudcore.light.eye_scattering import ParticleBuffer
 from cloudcore.lod.atlas import power_of_two_at_least
-from cloudcore.lod.frameplan import FramePlan
 from cloudcore.lod.impostors import ImpostorView, cropped_corners, impostor_view, particle_extent
+from cloudcore.lod.plan import FramePlan
 from cloudcore.lod.ring import RingGeneration, panel_corners, segment_camera
 from cloudcore.lod.splitting import layer_bounds
 from cloudcore.settings import RenderSettings

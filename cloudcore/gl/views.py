@@ -6,7 +6,7 @@ import numpy as np
 
 from cloudcore.gl.frame import FrameRenderer
 from cloudcore.lod.costs import LLVMPIPE_COSTS
-from cloudcore.lod.frameplan import LodState
+from cloudcore.lod.plan import LodState
 from cloudcore.measure.screenshot_check import view_camera, view_settings
 from cloudcore.scene import Scene, View
 

@@ -34,7 +34,7 @@ SEGMENTS = 8
 SEGMENT_DEG = 360.0 / SEGMENTS
 #: the ring's share of a frame, ms by the cost model: what its build may take (`plan_ring`'s `build_ms`: a dearer
 #: segment is built in pieces, a member at least each) and, in auto mode, what keeping it within the impostors'
-#: tolerance may cost a frame (`cloudcore.lod.frameplan`).  A third of a 30 fps frame on llvmpipe: the
+#: tolerance may cost a frame (`cloudcore.lod.plan`).  A third of a 30 fps frame on llvmpipe: the
 #: 1.2M-particle field's segments, 115 to 418 ms each, then take 12 to 42 frames
 RING_FRAME_MS = 10.0
 #: metres: the panels never come nearer than this, so a zero ring radius still has a drawable octagon
@@ -57,7 +57,7 @@ class RingGeneration:
     members: frozenset  # the ids of the clouds (or units) it holds (`plan_ring`'s `ids`)
     segment_members: tuple  # SEGMENTS tuples of member ids, each far to near from `eye` (the order they are drawn)
     texture_size: tuple = (0, 0)  # (width, height) of its segment textures
-    #: False: made while the ring did not pay for itself (`cloudcore.lod.frameplan`): it holds no cloud, and
+    #: False: made while the ring did not pay for itself (`cloudcore.lod.plan`): it holds no cloud, and
     #: fading it in hands the last ring's clouds back to the frame plan
     holds_clouds: bool = True
     #: (centres (M, 3), radii (M,)) of the members' bounding spheres as the panels were rendered: what auto mode

@@ -86,7 +86,7 @@ def layer_sort_key(near: float, far: float, cloud_distance: float, cloud_radius:
     """Where a layer sits among the frame's draws: the middle of its depth range within the cloud.
 
     Always within [near, far], so it sorts behind the objects in front of the layer and in
-    front of those behind it (ties are broken by `far`, see `cloudcore.lod.frameplan`).
+    front of those behind it (ties are broken by `far`, see `cloudcore.lod.plan`).
     """
     low = max(near, cloud_distance - cloud_radius)
     high = min(far, cloud_distance + cloud_radius)

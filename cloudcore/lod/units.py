@@ -20,7 +20,7 @@ A group costs motion: its sphere is larger than its clouds', so a moving eye
 remakes its impostor sooner, and every particle of it each time.  While the
 eye moves, auto mode plans a group apart (`LodUnits.apart_rows`), its clouds each
 a unit of its own, where their impostors cost less than the group's
-(`cloudcore.lod.frameplan`, docs/lod.md); with the eye still, or inside its
+(`cloudcore.lod.plan`, docs/lod.md); with the eye still, or inside its
 sphere, the group is whole.  Pure numpy and scipy.
 """
 

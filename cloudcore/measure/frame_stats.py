@@ -22,7 +22,7 @@ from cloudcore.measure.overdraw import Overdraw
 class PlanStats:
     """What the frame plan chose (`FramePlan.stats`); the defaults are an empty plan's."""
 
-    #: clouds (not units) per draw kind; `FramePlan.stats` names every kind of `frameplan.KINDS`
+    #: clouds (not units) per draw kind; `FramePlan.stats` names every kind of `cloudcore.lod.plan.KINDS`
     clouds_by_kind: dict[str, int] = field(default_factory=dict)
     units: int = 0
     units_grouped: int = 0  # units of several interpenetrating clouds
@@ -40,7 +40,7 @@ class PlanStats:
     tolerance_deg: float = 0.0
     accepted_error_tolerances: float = 0.0  # the largest error drawn, in tolerances
     #: auto mode: the frame drawn with its units each as priced ("units") or all in full 3D ("full"; "" in the
-    #: other modes), and the measured times of frames drawn each way (`lod.frameplan.FrameTime`; 0: not yet)
+    #: other modes), and the measured times of frames drawn each way (`cloudcore.lod.plan.FrameTime`; 0: not yet)
     drawn_as: str = ""
     measured_units_ms: float = 0.0
     measured_full_ms: float = 0.0

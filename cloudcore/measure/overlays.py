@@ -15,10 +15,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from cloudcore.camera import NEAR_PLANE_M, projection_matrix, view_matrix
-from cloudcore.lod.frameplan import FramePlan
 from cloudcore.lod.impostors import impostor_view
+from cloudcore.lod.plan import FramePlan
+from cloudcore.lod.plan.unit_plans import TEXTURED
 from cloudcore.lod.ring import SEGMENTS, panel_corners
-from cloudcore.lod.unit_plans import TEXTURED
 from cloudcore.scene import Camera
 
 #: a quad's corners (lower left, lower right, upper left, upper right) in the order that walks its edges

@@ -1,6 +1,6 @@
 """What the frame plan decided for each unit, as arrays: a unit costs Python time only where it is drawn.
 
-A plan holds one decision per unit of the scene, seen or not (`cloudcore.lod.frameplan`); most of a large
+A plan holds one decision per unit of the scene, seen or not (`cloudcore.lod.plan`); most of a large
 scene's units are out of view or in Wang's ring, and Harris's 12,800 clouds made 12,800 records a frame.
 `UnitPlans` keeps the decisions as arrays, one row per unit, and the few things only a regenerated or split
 unit has (why it is remade, the objects that split it) in small mappings by unit index.  Indexing it gives a

@@ -1,6 +1,6 @@
 """The cloud pass far to near, as arrays: the drawn units' layers and the objects between them.
 
-`draw_items` orders what the frame plan draws on its own (`cloudcore.lod.frameplan`): a unit drawn whole
+`draw_items` orders what the frame plan draws on its own (`cloudcore.lod.plan`): a unit drawn whole
 is one item at its distance, a unit that objects split is one item per layer, and each object inside a
 drawn unit is one item between its layers.  Full 3D draws every unit in view (thousands at Harris's scale),
 so the items are rows of arrays, ordered in one sort; `DrawItems[i]` gives the i-th as a `DrawItem`.
@@ -15,8 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from cloudcore.lod.plan.unit_plans import CROSSFADE, FULL, INSIDE, UnitPlans
 from cloudcore.lod.splitting import layer_bounds, layer_sort_key
-from cloudcore.lod.unit_plans import CROSSFADE, FULL, INSIDE, UnitPlans
 from cloudcore.lod.units import concatenated_ranges
 
 ITEM_KINDS = ("cloud", "object")

@@ -1,0 +1,177 @@
+"""Auto mode's choices: the cheaper representation of a unit within a margin, its crossfade, whether the ring
+pays, which groups are planned apart, and whether a frame is drawn as its units are priced or all in full 3D by the
+frames' measured times."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from cloudcore.lod.costs import CostModel
+from cloudcore.lod.impostors import (
+    INSIDE_RADII,
+)
+from cloudcore.lod.plan.draw_items import full_runs
+from cloudcore.lod.plan.pricing import LONGEST_LIFETIME_FRAMES, Seen, impostor_ms_of
+from cloudcore.lod.plan.state import (
+    FRAME_SETTLE_FRAMES,
+    MEASUREMENT_AGE_FRAMES,
+    PLAUSIBLE_RATIO,
+    PROBE_FRAMES,
+    LodState,
+    Representation,
+)
+from cloudcore.lod.plan.unit_plans import (
+    FULL,
+    IMPOSTOR,
+)
+from cloudcore.lod.ring import (
+    RingState,
+)
+from cloudcore.lod.units import LodUnits
+from cloudcore.settings import RenderSettings
+
+#: auto mode switches a unit's representation only when the other is cheaper by this fraction
+#: (costs measured frame to frame wobble; without it a unit near the break-even point would flicker
+#: between the two, paying for a crossfade each time)
+SWITCH_MARGIN = 0.25
+
+
+#: a scene whose particles changed by more than this factor (another scene opened, clouds added) is measured
+#: afresh
+SCENE_CHANGE_RATIO = 1.25
+
+
+def prices_units(settings: RenderSettings) -> bool:
+    """Whether the plan prices its units: full 3D draws every unit in view whatever it costs, so it does not."""
+    return settings.mode != "full"
+
+
+def cheapest(held: str | None, prices: dict) -> str:
+    """The name of the cheapest of `prices` (name -> ms; ties to the first), but the one `held` already
+    while no other is cheaper by `SWITCH_MARGIN`: costs measured frame to frame wobble, and a choice
+    near the break-even point would otherwise flicker, paying for a transition each time."""
+    cheapest = min(prices, key=prices.get)
+    if held in prices and prices[cheapest] >= (1.0 - SWITCH_MARGIN) * prices[held]:
+        return held
+    return cheapest
+
+
+def represent(
+    previous: Representation | None, full_ms: float, impostor_ms: float, transition_frames: int, close: dict
+) -> Representation:
+    """Auto mode's next step for a unit: aim at the cheaper representation (by `SWITCH_MARGIN` against the
+    one aimed at already), and move the full-3D weight one transition step toward it.
+
+    A unit seen for the first time starts at its target: there is nothing on screen to pop from; nor
+    does a switch to a representation that `close` says shows the same picture within half the
+    tolerance: it is made at once, and only a switch that would show a step crossfades.
+    """
+    prices = {"full": full_ms, "impostor": impostor_ms}
+    if previous is None:
+        cheaper = cheapest(None, prices)
+        return Representation(cheaper, 1.0 if cheaper == "full" else 0.0)
+    if previous.target == "inside":  # the eye has left the unit: its particles were on screen
+        previous = Representation("full", 1.0)
+    target = cheapest(previous.target, prices)
+    if target != previous.target and close[target] and previous.full_weight in (0.0, 1.0):
+        return Representation(target, 1.0 if target == "full" else 0.0)
+    step = 1.0 / transition_frames
+    weight = min(1.0, previous.full_weight + step) if target == "full" else max(0.0, previous.full_weight - step)
+    return Representation(target, weight)
+
+
+def ring_pays(state: RingState, ring_ms: float, alone_ms: float) -> bool:
+    """Whether the ring should hold its clouds: the cheaper of the two (`cheapest`: each switch rebuilds
+    the ring and crossfades it)."""
+    newest = state.pending or state.current
+    held = None if newest is None else "ring" if newest.holds_clouds else "alone"
+    return cheapest(held, {"ring": ring_ms, "alone": alone_ms}) == "ring"
+
+
+def groups_cheaper_apart(units: LodUnits, seen: Seen, settings, state: LodState, costs, focal_px: float) -> frozenset:
+    """The groups of interpenetrating clouds (their members) that auto mode would rather plan apart, each cloud a
+    unit of its own (`LodUnits.apart_rows`): while the eye moves, those whose clouds' impostors cost less than the
+    group's (`cheapest`, held apart while so).
+
+    A group's impostor is the picture without the blobs of clouds sorted whole (`cloudcore.lod.units`); a
+    moving eye remakes it every particle at a time, and sooner than its clouds' (its sphere is larger: more
+    parallax for the same step).  Moving, the blobs are the price of the time saved (`RenderSettings.
+    groups_apart_in_motion`); still (the group's impostor would outlast `LONGEST_LIFETIME_FRAMES`), or with
+    the eye in its sphere, a group is whole, whatever the prices: it closes, remade from that very eye.
+    `plan_frame` opens a group only where its own impostor is due anyway.  `seen`: the `seen_from` of
+    `units.and_clouds`.
+    """
+    rows = units.group_rows
+    groups, group_seen = units.take(rows), seen.take(rows)
+    # a group whose sphere holds the eye is whole: its screen impostor draws its particles sorted together, as
+    # full 3D does, and apart its clouds would cost as much (the particles near the eye are the screen
+    # impostor's cost, whatever holds them; under a stratocumulus deck apart was 1.7 times dearer)
+    outside = group_seen.distances >= INSIDE_RADII * groups.radii
+    moving = group_seen.lifetimes < LONGEST_LIFETIME_FRAMES
+    candidates = outside & moving
+    if not candidates.any():  # a still eye: nothing more to price
+        return frozenset()
+    part_seen = seen.take(slice(len(units.members), None))
+    group_ms = impostor_ms_of(groups, group_seen, candidates, focal_px, settings, costs)
+    # (a cloud whose own sphere holds the eye is priced as a quad over the whole screen: dear, so its group stays)
+    part_prices = impostor_ms_of(units.clouds, part_seen, slice(None), focal_px, settings, costs)
+    part_ms = dict(zip((members[0] for members in units.clouds.members), part_prices))
+    wanted = set()
+    for index, group_price in zip(np.flatnonzero(candidates), group_ms):
+        members = groups.members[index]
+        prices = {"group": float(group_price), "apart": sum(part_ms[cloud] for cloud in members)}
+        if cheapest("apart" if members in state.opened else "group", prices) == "apart":
+            wanted.add(members)
+    return frozenset(wanted)
+
+
+def units_ms(unit_prices, ring_ms: float, alone_ms: float, candidates, costs: CostModel) -> float:
+    """The predicted time of a frame of units each in the representation its own price picks.
+
+    The units' prices (`unit_prices`: (index, distance, full 3D ms, the other's ms) of the units planned
+    on their own) miss that full units between impostors are drawn in as many batches as there are
+    runs; the ring's candidates in view (`candidates`) count as the cheaper of the ring (`ring_ms`)
+    and their own prices (`alone_ms`).
+    """
+    priced_ms, kinds = 0.0, []
+    for index, _, full_ms, other_ms in sorted(unit_prices, key=lambda price: -price[1]):
+        if not candidates[index]:
+            priced_ms += min(full_ms, other_ms)
+        kinds.append(FULL if full_ms <= other_ms else IMPOSTOR)
+    ring_part = min(ring_ms, alone_ms) if candidates.any() else 0.0
+    return priced_ms + ring_part + costs.batches * full_runs(np.array(kinds, dtype=np.int8))
+
+
+def comparable(before: float, now: float) -> bool:
+    """Whether a scene of `now` particles is the one of `before` for what was measured of it."""
+    return before > 0.0 and now > 0.0 and max(before, now) <= SCENE_CHANGE_RATIO * min(before, now)
+
+
+def known(state: LodState, choice: str) -> bool:
+    """Whether the frames drawn as `choice` have been measured for long enough, recently enough, to choose by."""
+    time = state.frame_times.get(choice)
+    frame = state.frame_index + 1  # the frame being planned
+    return time is not None and time.frames >= PROBE_FRAMES and frame - time.last_frame <= MEASUREMENT_AGE_FRAMES
+
+
+def settled_in_full_3d(state: LodState) -> bool:
+    """Auto mode draws every unit in full 3D, settled there, and has measured the units' way freshly: the frame
+    can be planned as full mode plans it, without pricing a unit."""
+    return (
+        state.frame_choice == state.drawn_as == "full"
+        and state.frames_drawn_as > FRAME_SETTLE_FRAMES
+        and known(state, "units")
+    )
+
+
+def next_frame_choice(state: LodState, drawn_as: str, predicted: dict) -> str:
+    """How auto mode draws the next frame: "units" or "full" (`LodState.frame_choice`), by the measured times
+    of both (`cheapest`, within its margin), once both are measured and fresh; the way this frame was drawn
+    while it is being measured; the other, to measure it, where its `predicted` time is plausibly close.
+    The choice acts through each unit's representation and the ring, so a switch crossfades."""
+    other = "full" if drawn_as == "units" else "units"
+    if not known(state, drawn_as):
+        return drawn_as
+    if known(state, other):
+        return cheapest(drawn_as, {choice: state.frame_times[choice].mean_ms for choice in (drawn_as, other)})
+    return other if predicted[other] < PLAUSIBLE_RATIO * predicted[drawn_as] else drawn_as

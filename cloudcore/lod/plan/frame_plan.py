@@ -1,0 +1,121 @@
+"""A frame's plan: per unit what was decided, the cloud pass in order, the ring, the work predicted, and the
+state to carry into the next frame; its statistics."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from cloudcore.lod.costs import CostModel, Work
+from cloudcore.lod.plan.draw_items import DrawItems
+from cloudcore.lod.plan.state import LodState
+from cloudcore.lod.plan.unit_plans import (
+    TEXTURED,
+    UnitPlans,
+)
+from cloudcore.lod.ring import (
+    RingPlan,
+    RingState,
+)
+from cloudcore.lod.units import LodUnits
+from cloudcore.measure.frame_stats import PlanStats
+
+
+@dataclass(frozen=True)
+class FramePlan:
+    clouds: UnitPlans  # per unit, what was decided: `clouds[i]` is unit i's CloudPlan
+    draw_order: tuple  # indices of the units drawn individually, far to near
+    ring: RingPlan | None
+    state: LodState = LodState()  # to carry into the next frame
+    inside_size: tuple = (0, 0)  # the screen impostor's texture size (width, height)
+    draw_items: DrawItems | None = None  # the cloud pass, far to near
+    objects_with_world: tuple = ()  # visible objects outside split clouds: drawn before the cloud pass
+    update_work: Work = Work()  # predicted work of the impostor updates (regenerations, ring segment)
+    cloud_work: Work = Work()  # predicted work of the cloud pass
+    #: whether the works above were priced: full 3D draws every unit in view whatever it costs, so it prices
+    #: nothing (its works are empty and its frames fit no costs: `LodState.measured`)
+    priced: bool = True
+    costs: CostModel = CostModel()  # the model the plan priced its choices with
+    tolerance_deg: float = 0.0  # the translation tolerance in force
+    #: the largest translation error drawn, in tolerances (> 1: a budget postponed it, or auto kept Wang's ring by
+    #: Wang's rules, its upkeep within the tolerance past `RING_FRAME_MS`)
+    accepted_error: float = 0.0
+    units: LodUnits | None = None  # the frame's units, which `clouds` index: the groups planned apart opened
+
+    @property
+    def records(self) -> Mapping:
+        return self.state.records
+
+    @property
+    def ring_state(self) -> RingState:
+        return self.state.ring
+
+    @property
+    def predicted_ms(self) -> float:
+        return self.costs.ms(self.update_work + self.cloud_work)
+
+    def of_kind(self, *kinds: str) -> list:
+        return [self.clouds[index] for index in self.clouds.indices_of(*kinds)]
+
+    def stats(self) -> PlanStats:
+        units = self.clouds
+        reasons: dict = {}
+        for index in sorted(units.regenerate):
+            reason = units.regenerate[index]
+            reasons[reason] = reasons.get(reason, 0) + 1
+        split = {index: len(splits) + 1 for index, splits in units.splits.items() if splits}
+        return PlanStats(
+            clouds_by_kind=units.clouds_by_kind(),
+            units=len(units),
+            units_grouped=int(np.count_nonzero(units.member_counts > 1)),
+            impostors_drawn=units.count(*TEXTURED) + units.count("inside"),
+            impostors_regenerated=sum(reasons.values()),
+            regeneration_reasons=reasons,
+            regenerations_postponed=sum(1 for reason in units.postponed.values() if reason),
+            ring_segments_built=int(
+                self.ring is not None
+                and self.ring.state.pending is not None
+                and self.ring.build_segment in self.ring.state.pending.occupied_segments
+            ),
+            ring_panels_drawn=(
+                sum(len(g.occupied_segments) for g, _ in self.ring.draws) if self.ring is not None else 0
+            ),
+            objects_in_clouds=len(self.objects_between_layers),
+            layers_drawn=sum(split.values()),
+            layers_rebuilt=sum(layers for index, layers in split.items() if units.regenerate.get(index)),
+            predicted_ms=self.predicted_ms,
+            priced=self.priced,
+            tolerance_deg=self.tolerance_deg,
+            accepted_error_tolerances=self.accepted_error,
+            drawn_as=self.state.drawn_as or "",
+            measured_units_ms=self._measured_ms("units"),
+            measured_full_ms=self._measured_ms("full"),
+            costs=self.costs,
+        )
+
+    def _measured_ms(self, choice: str) -> float:
+        time = self.state.frame_times.get(choice)
+        return time.mean_ms if time is not None else 0.0
+
+    @property
+    def settled(self) -> bool:
+        """Whether this plan leaves nothing to converge: no impostor remade or postponed, no crossfade
+        and no ring being built or faded in.  The same inputs would then draw the same picture again;
+        the editor keeps it instead (`app.viewport`), leaving the cores to the relighting worker."""
+        ring_settled = self.ring is None or (
+            self.ring.state.pending is None and all(weight == 1.0 for _, weight in self.ring.draws)
+        )
+        units = self.clouds
+        return (
+            ring_settled
+            and not any(units.regenerate.values())
+            and not any(units.postponed.values())
+            and not units.count("crossfade")
+        )
+
+    @property
+    def objects_between_layers(self) -> tuple:
+        """Objects drawn inside the cloud pass; the rest are drawn with the world."""
+        return self.draw_items.objects

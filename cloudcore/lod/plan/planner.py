@@ -1,0 +1,591 @@
+"""`plan_frame`: one frame's plan from the units, the camera, the settings and the state the frame before left
+(the stages: `pricing`, `choice`, `schedule`, `draw_items`; see the package's own docstring)."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Hashable
+
+import numpy as np
+
+from cloudcore.camera import (
+    frustum_planes,
+    projection_matrix,
+    spheres_in_frustum,
+    view_matrix,
+)
+from cloudcore.lod.costs import CostModel, Work, quad_work
+from cloudcore.lod.impostors import (
+    INSIDE_RADII,
+    ImpostorRecord,
+    budgeted_regenerations,
+    content_depth,
+    regeneration_priority,
+    regeneration_reason,
+)
+from cloudcore.lod.plan.choice import (
+    cheapest,
+    comparable,
+    groups_cheaper_apart,
+    next_frame_choice,
+    prices_units,
+    represent,
+    ring_pays,
+    settled_in_full_3d,
+    units_ms,
+)
+from cloudcore.lod.plan.draw_items import draw_items, full_runs, inside_runs
+from cloudcore.lod.plan.frame_plan import FramePlan
+from cloudcore.lod.plan.pricing import (
+    NEAR_EXACT_RADII,
+    Pricing,
+    Seen,
+    frames_until_ring,
+    held_impostor_errors,
+    impostor_textures,
+    in_view_work,
+    ms_drawn_alone,
+    pricing_of,
+    ring_panels_work,
+    ring_translation_error,
+    ring_work,
+    seen_from,
+)
+from cloudcore.lod.plan.schedule import within_frame_budget
+from cloudcore.lod.plan.state import (
+    LodState,
+    Representation,
+)
+from cloudcore.lod.plan.unit_plans import (
+    CROSSFADE,
+    CULLED,
+    DRAWN,
+    EMPTY,
+    FULL,
+    IMPOSTOR,
+    INSIDE,
+    RING,
+    TEXTURED,
+    UnitPlans,
+    kind_codes,
+)
+from cloudcore.lod.ring import (
+    RING_FRAME_MS,
+    RingState,
+    plan_ring,
+    ring_members,
+    segment_texture_size,
+)
+from cloudcore.lod.splitting import layers_hold, objects_reaching
+from cloudcore.lod.units import LodUnits
+from cloudcore.measure.overdraw import splats_in_view
+from cloudcore.scene import Camera
+from cloudcore.settings import RenderSettings
+
+
+def plan_frame(
+    units: LodUnits,
+    camera: Camera,
+    viewport: tuple[int, int],
+    settings: RenderSettings,
+    state: LodState,
+    lighting_key: Hashable,
+    objects=(),
+    cloud_particles=None,
+    costs: CostModel | None = None,
+    cloud_splats=None,
+) -> FramePlan:
+    """Plan one frame of `units` (`cloudcore.lod.units.LodUnits`) seen by `camera`.
+
+    `lighting_key` identifies what the particles' colours were computed from: one key for
+    all clouds, or a tuple with one per cloud (the editor changes one cloud at a time, and
+    only its unit's impostor is stale).  `objects` are the opaque objects' bounding spheres
+    this frame (`cloudcore.objects.ObjectPose`); `cloud_particles(i)` gives cloud i's particle
+    centres, asked only for units with objects inside.  `costs` prices auto mode's choices;
+    by default the model `state.costs` has fitted to the frames so far.  `cloud_splats(i)` gives
+    cloud i's (particle centres, radii), asked for units near the eye to count their fragments.
+    """
+    scene_particles = float(np.sum(units.particle_counts))
+    if state.frame_times and not comparable(state.particles, scene_particles):
+        state = dataclasses.replace(state, frame_times={})  # another scene: what was measured says nothing of it
+    if settings.mode == "auto" and settled_in_full_3d(state):
+        # nothing to price: the choice is by measured times, and the units' measurement is fresh
+        full_plan = plan_frame(
+            units,
+            camera,
+            viewport,
+            dataclasses.replace(settings, mode="full"),
+            state,
+            lighting_key,
+            objects,
+            cloud_particles,
+            costs,
+            cloud_splats,
+        )
+        drawn = {full_plan.clouds.members[i]: Representation("full", 1.0) for i in full_plan.clouds.indices_of("full")}
+        return dataclasses.replace(
+            full_plan,
+            state=dataclasses.replace(
+                full_plan.state,
+                representations=drawn,
+                frame_choice=next_frame_choice(state, "full", {}),  # the units are measured: no prediction is asked
+                drawn_as="full",
+                frames_drawn_as=state.frames_drawn_as + 1,
+            ),
+        )
+    costs = state.costs.model() if costs is None else costs
+    pricing = pricing_of(camera, viewport, settings, state, objects)
+    groups_may_open = settings.mode == "auto" and settings.groups_apart_in_motion and units.clouds is not None
+    # the units and, where groups may be planned apart, their clouds, priced in one pass: a pass costs about
+    # 0.2 ms whatever its size (the field's groups priced apart 0.72 -> 0.15 ms a frame)
+    seen = seen_from(units.and_clouds if groups_may_open else units, pricing, priced=prices_units(settings))
+    arguments = {
+        "pricing": pricing,
+        "seen": seen,
+        "camera": camera,
+        "viewport": viewport,
+        "settings": settings,
+        "state": state,
+        "lighting_key": lighting_key,
+        "objects": objects,
+        "cloud_particles": cloud_particles,
+        "costs": costs,
+        "cloud_splats": cloud_splats,
+    }
+    if not groups_may_open:
+        return _plan_units(units, frozenset(), **arguments)
+    wanted = groups_cheaper_apart(units, seen, settings, state, costs, pricing.focal_px)
+    held = wanted & state.opened
+    plan = _plan_units(units, held, **arguments)
+    # a group opens only where its own impostor is due anyway, so the switch steps no more than a regeneration
+    due = frozenset(
+        members
+        for members in (plan.clouds.members[i] for i in {**plan.clouds.regenerate, **plan.clouds.postponed})
+        if members in wanted - held
+    )
+    return _plan_units(units, held | due, **arguments) if due else plan
+
+
+def _plan_units(
+    units: LodUnits,
+    opened: frozenset,
+    pricing: Pricing,
+    seen: Seen,
+    camera: Camera,
+    viewport: tuple[int, int],
+    settings: RenderSettings,
+    state: LodState,
+    lighting_key: Hashable,
+    objects,
+    cloud_particles,
+    costs: CostModel,
+    cloud_splats,
+) -> FramePlan:
+    """`plan_frame` with the groups `opened` planned apart, their clouds each a unit of its own; `pricing` is
+    `pricing_of`'s, `seen` the `seen_from` of the units (of `LodUnits.and_clouds` when groups may be opened)."""
+    scene_particles = float(np.sum(units.particle_counts))
+    if opened:
+        rows = units.apart_rows(opened)
+        units, seen = units.and_clouds.take(rows), seen.take(rows)
+    else:
+        seen = seen.take(slice(0, len(units.radii)))  # views: the units' own rows, first in `and_clouds`
+    width, height = viewport
+    priced = prices_units(settings)
+    eye, last_eye, translation_error, tolerance = (
+        pricing.eye,
+        pricing.last_eye,
+        pricing.translation_error,
+        pricing.tolerance,
+    )
+    focal_px, screen_pixels = pricing.focal_px, pricing.screen_pixels
+    centres, radii = units.centres, units.radii
+    view, projection = view_matrix(camera), projection_matrix(camera.fov_y_deg, width / height)
+    view_projection = projection @ view
+    planes = frustum_planes(view_projection)
+    visible = spheres_in_frustum(planes, centres, radii)
+    object_centres = np.array([o.centre for o in objects], dtype=np.float64).reshape(-1, 3)
+    object_radii = np.array([o.radius for o in objects], dtype=np.float64)
+    distances, ball_fragments, quad_pixels_of, lifetimes = (
+        seen.distances,
+        seen.ball_fragments,
+        seen.quad_pixels,
+        seen.lifetimes,
+    )
+    cloud_keys = lighting_key if isinstance(lighting_key, tuple) else (lighting_key,) * sum(map(len, units.members))
+
+    def unit_key(index: int) -> tuple:
+        """What the colours of unit `index` were computed from: its clouds' keys."""
+        return tuple(cloud_keys[c] for c in units.members[index])
+
+    records = state.records
+    objects_visible = spheres_in_frustum(planes, object_centres, object_radii)
+    # auto mode prices Wang's ring against drawing its clouds each as auto would (the cheaper of full 3D and
+    # an impostor): a sparse far field is cheaper drawn than its panels and their rebuilds
+    ring_ms = alone_ms = ring_error = 0.0
+    chases_tolerance = False
+    candidates = np.zeros(len(radii), dtype=bool)
+    # auto mode found the last frame cheaper drawn all in full 3D (`next_frame_choice`): every unit heads there
+    all_full = settings.mode == "auto" and state.frame_choice == "full"
+    # per unit, its full-3D work far off (particles, fragments): splat by splat for the ring's candidates in view
+    in_view_particles, in_view_fragments = units.particle_counts.astype(np.float64), ball_fragments.copy()
+    if settings.mode == "auto" and settings.uses_ring:
+        candidates = ring_members(centres, radii, eye, settings)
+        step = eye - last_eye if last_eye is not None else np.zeros(3)
+        alone = candidates & visible
+        ring_panels, ring_rebuild, moved_lifetime, tolerance_lifetime = ring_work(
+            units,
+            candidates,
+            centres,
+            eye,
+            step,
+            ball_fragments,
+            quad_pixels_of[alone],
+            lifetimes,
+            settings,
+            state.ring,
+        )
+        # the ring is kept within the tolerance (rebuilt once a cloud of it passes it: Wang's panels are impostors
+        # too) while that costs at most its share of a frame; past it, only by Wang's own rules, as impostor mode
+        # does, and the error it then shows is the plan's accepted error (the 1.2M field orbiting 0.05 degrees a
+        # frame: 18 ms a frame of rebuilds to keep it so, 1.1 s every 60 frames, for 1.2 dB)
+        chases_tolerance = costs.ms(ring_rebuild) / max(tolerance_lifetime, 1.0) <= RING_FRAME_MS
+        ring_lifetime = tolerance_lifetime if chases_tolerance else moved_lifetime
+        ring_ms = costs.ms(ring_panels + ring_rebuild.scaled(1.0 / max(ring_lifetime, 1.0)))
+        ring_error = ring_translation_error(state.ring.current, translation_error, eye)
+        if units.sample is not None:
+            in_view_particles[alone], in_view_fragments[alone] = in_view_work(
+                units, alone, planes, eye, focal_px, screen_pixels, ball_fragments
+            )
+        in_view = (in_view_particles[alone], in_view_fragments[alone])
+        alone_ms = ms_drawn_alone(units, seen, alone, in_view, focal_px, settings, costs)
+        # a candidate drawn on its own until a ring being built takes it: an impostor made for it now lasts only
+        # that long (Harris's circle at 800 clouds made 136 impostors in its first frame for a ring in 16 frames)
+        lifetimes = np.where(candidates, np.minimum(lifetimes, frames_until_ring(state.ring, settings)), lifetimes)
+    ring = plan_ring(
+        state.ring,
+        centres,
+        radii,
+        eye,
+        settings,
+        cloud_keys,
+        units.members,
+        units.member_set,
+        segment_texture_size(height, camera.fov_y_deg, settings),
+        holds_clouds=settings.mode != "auto" or (not all_full and ring_pays(state.ring, ring_ms, alone_ms)),
+        past_tolerance=chases_tolerance and ring_error > tolerance,
+        # a segment is priced as its update is (below), by its particles: what the segment's render takes on
+        # llvmpipe (478,000 particles of the 1.2M field, 368 ms: 0.77 us a particle, the fit's prior 0.85)
+        build_ms=lambda members: costs.particles * float(units.particle_counts[units.row_of[members]]),
+    )
+
+    def particles_of(index: int) -> np.ndarray:
+        members = units.members[index]
+        if len(members) == 1:
+            return cloud_particles(members[0])
+        return np.concatenate([cloud_particles(c) for c in members])
+
+    def splats_of(index: int) -> tuple[np.ndarray, np.ndarray]:
+        """The unit's particles' (centres, radii), of `cloud_splats`."""
+        members = units.members[index]
+        if len(members) == 1:
+            return cloud_splats(members[0])
+        splats = [cloud_splats(c) for c in members]
+        return np.concatenate([c for c, _ in splats]), np.concatenate([r for _, r in splats])
+
+    # most scenes have no objects: split_at is asked for every unit drawn, hundreds as a field's ring fades
+    reaching = (
+        objects_reaching(centres, radii, object_centres, object_radii)
+        if settings.split_objects and len(object_radii)
+        else None
+    )
+    # and most units hold none: a set answers for them without numpy (45 units a frame along the flythrough)
+    holding = frozenset(np.flatnonzero(np.any(reaching, axis=1)).tolist()) if reaching is not None else frozenset()
+
+    def split_at(index: int, from_eye) -> tuple[tuple, tuple]:
+        """(objects inside the unit far to near from `from_eye`, their distances: the layers' boundaries)."""
+        if index not in holding:
+            return (), ()
+        inside = np.flatnonzero(reaching[index])
+        gaps = np.linalg.norm(object_centres[inside] - np.asarray(from_eye, dtype=np.float64), axis=1)
+        order = np.argsort(-gaps, kind="stable")
+        return tuple(int(i) for i in inside[order]), tuple(float(g) for g in gaps[order])
+
+    def layers_changed(index: int, record: ImpostorRecord) -> bool:
+        """Whether the objects inside the unit would now cut the layers of its impostor `record` otherwise."""
+        inside, _ = split_at(index, record.eye)
+        if inside != record.split_objects:
+            return True
+        if not inside:
+            return False
+        if cloud_splats is None:  # only the particles' centres: points
+            particles = particles_of(index)
+            particle_radii = np.zeros(len(particles))
+        else:
+            particles, particle_radii = splats_of(index)
+        cut = list(inside)
+        return not layers_hold(
+            particles, particle_radii, record.eye, object_centres[cut], object_radii[cut], record.splits
+        )
+
+    held_near = state.near_work
+    known_near = (
+        held_near[3] if held_near and held_near[0] is units and held_near[1:3] == (camera, tuple(viewport)) else {}
+    )
+    near_work = {}  # members -> (keys, Work) of the units priced splat by splat this frame
+
+    def full_3d(index: int, radius: float, distance: float) -> Work:
+        """The unit drawn in full 3D: a ball of discs far off; near, splat by splat, only the splats in the
+        frustum (the renderer leaves out the rest), their discs clipped to the screen; a still eye's again
+        from last frame (auto mode's plan of the default view 4.65 -> 3.2 ms, best of 40)."""
+        if not priced:
+            return Work()
+        if cloud_splats is None or distance >= NEAR_EXACT_RADII * radius:
+            return Work(particles=float(units.particle_counts[index]), fragments=float(ball_fragments[index]))
+        members = units.members[index]
+        held = known_near.get(members)
+        if held is not None and held[0] == unit_key(index):
+            near_work[members] = held
+            return held[1]
+        kept, overdraw = splats_in_view(*splats_of(index), view, projection)
+        work = Work(particles=float(kept), fragments=screen_pixels * overdraw)
+        near_work[members] = (unit_key(index), work)
+        return work
+
+    representations = {}
+    update_work, cloud_work = Work(), Work()
+    # auto mode weighs the frame as planned unit by unit against every unit in full 3D in one sorted draw: splitting
+    # the particles into many draws between impostors costs what no unit's own price shows
+    individuals = 1.0 - (ring.weights(units.members, units.row_of) if ring is not None else np.zeros(len(radii)))
+    in_ring = (individuals <= 0.0) & (radii > 0.0) & visible
+    everything_full = Work(
+        particles=float(np.sum(in_view_particles[in_ring])),
+        fragments=float(np.sum(in_view_fragments[in_ring])),
+        batches=1.0,
+    )
+    unit_prices = []
+    wanted = []  # (index, priority, work) of the impostors past their tolerance
+    # what the plan decides per unit, as arrays (`UnitPlans`): a unit out of view or in the ring is one row
+    count = len(radii)
+    kinds = np.where(radii <= 0.0, EMPTY, np.where(individuals <= 0.0, RING, CULLED)).astype(np.int8)
+    full_weights, impostor_weights = np.zeros(count), np.zeros(count)
+    texture_sizes = np.zeros(count, dtype=np.int64)
+    full_prices, impostor_prices = np.zeros(count), np.zeros(count)
+    reasons, split_objects, split_distances = {}, {}, {}
+    drawable = np.flatnonzero((radii > 0.0) & (individuals > 0.0) & visible)
+    # the impostors kept are those of the units the ring does not show whole: a unit in the ring is drawn by its
+    # panel, and when the ring hands it back the eye has moved a rebuild's distance (15% of the ring's radius),
+    # past the tolerance of all but the largest clouds; its texture is freed meanwhile (at Harris's scale, a
+    # flight kept thousands)
+    next_records = {
+        members: record
+        for members, record in records.items()
+        if members in units.row_of and individuals[units.row_of[members]] > 0.0
+    }
+    held_errors = (
+        held_impostor_errors(units, drawable, records, translation_error, eye) if settings.mode != "full" else None
+    )
+    may_be_textured = visible & (radii > 0.0) & (individuals > 0.0) & (distances >= INSIDE_RADII * radii)
+    textured = (
+        impostor_textures(units, np.flatnonzero(may_be_textured), distances, height, camera.fov_y_deg, settings)
+        if settings.mode != "full"
+        else {}
+    )
+
+    def decided(index: int, kind: int, inside: tuple, splits: tuple, full_weight=0.0, full_ms=0.0, impostor_ms=0.0):
+        """Unit `index` drawn as `kind`, split around the objects `inside` it at `splits`."""
+        kinds[index], full_weights[index] = kind, full_weight
+        full_prices[index], impostor_prices[index] = full_ms, impostor_ms
+        if splits:
+            split_objects[index], split_distances[index] = inside, splits
+
+    if settings.mode == "full":
+        # every unit in view in full 3D, nothing priced: only the units holding objects are looked at one by one
+        kinds[drawable], full_weights[drawable] = FULL, 1.0
+        for index in sorted(holding.intersection(drawable.tolist())):
+            decided(index, FULL, *split_at(index, eye), full_weight=1.0)
+        drawable = ()
+    for index in drawable:
+        index = int(index)
+        radius, distance, members = radii[index], float(distances[index]), units.members[index]
+        individual = float(individuals[index])
+        inside, splits = split_at(index, eye)
+        eye_inside = distance < INSIDE_RADII * radius
+        # impostor mode draws no unit in full 3D but the one the eye is in: nothing else to price
+        full = full_3d(index, radius, distance) if settings.mode != "impostor" or eye_inside else Work()
+        everything_full += full
+        if eye_inside:
+            # a screen impostor has fewer fragments than the screen, not fewer particles; its composite
+            # over the screen is priced per run of inside units, below (here, for the choice, as one each)
+            screen_impostor = dataclasses.replace(full, fragments=full.fragments * settings.inside_resolution_scale**2)
+            full_ms, inside_ms = (
+                costs.ms(full),
+                costs.ms(screen_impostor + Work(quad_pixels=screen_pixels, quads=1, batches=1)),
+            )
+            if settings.mode == "auto" and individual == 1.0:
+                previous = state.representations.get(members)
+                held = previous.target if previous is not None and previous.full_weight == 1.0 else None
+                # the same particles either way
+                target = "full" if all_full else cheapest(held, {"full": full_ms, "inside": inside_ms})
+                unit_prices.append((index, distance, full_ms, inside_ms))
+                representations[members] = Representation(target, 1.0)
+                if target == "full":
+                    decided(index, FULL, inside, splits, 1.0, full_ms, inside_ms)
+                    cloud_work += full
+                    continue
+            decided(index, INSIDE, inside, splits, individual, full_ms, inside_ms)
+            cloud_work += screen_impostor
+            continue
+        pixels, size, remake = textured[index]
+        quad = quad_work(pixels, screen_pixels)
+        # a unit fading into or out of the ring is drawn as an impostor: one layer scales exactly
+        weight, full_ms, impostor_ms = 0.0, costs.ms(full), math.inf
+        if settings.mode == "auto" and individual == 1.0:
+            lifetime = float(lifetimes[index])
+            impostor_ms = costs.ms(quad) + costs.ms(remake.scaled(len(splits) + 1)) / max(lifetime, 1.0)
+            error = float(held_errors[index])
+            budgeted = bool(settings.regeneration_budget or settings.frame_budget_ms)
+            # an impostor within half its tolerance of the picture full 3D gives, or one remade from this very
+            # eye, differs from it by less than a regeneration's own step: the switch needs no crossfade
+            close = {
+                "impostor": error <= 0.5 * tolerance or (error > tolerance and not budgeted),
+                "full": error <= 0.5 * tolerance,
+            }
+            representation = represent(
+                state.representations.get(members),
+                full_ms,
+                math.inf if all_full else impostor_ms,
+                settings.transition_frames,
+                close,
+            )
+            unit_prices.append((index, distance, full_ms, impostor_ms))
+            representations[members] = representation
+            weight = representation.full_weight
+        if weight == 1.0:
+            decided(index, FULL, inside, splits, 1.0, full_ms, impostor_ms)
+            cloud_work += full
+            continue
+        record = records.get(members)
+        reason = regeneration_reason(
+            record,
+            size,
+            unit_key(index),
+            tolerance,
+            float(held_errors[index]),
+            record is not None and layers_changed(index, record),
+        )
+        kind = CROSSFADE if weight > 0.0 else IMPOSTOR
+        decided(index, kind, inside, splits, weight * individual, full_ms, impostor_ms)
+        impostor_weights[index], texture_sizes[index] = (1.0 - weight) * individual, size
+        if reason is not None:
+            reasons[index] = reason
+        cloud_work += quad + (full + Work(quad_pixels=screen_pixels) if weight > 0.0 else Work())  # the layer
+        if reason is not None:
+            ratio = float(held_errors[index]) / max(tolerance, 1e-300)
+            wanted.append(
+                (index, regeneration_priority(reason, ratio, bool(splits), pixels), remake.scaled(len(splits) + 1))
+            )
+    served = budgeted_regenerations([(index, priority) for index, priority, _ in wanted], settings.regeneration_budget)
+    if settings.frame_budget_ms > 0.0:
+        served &= within_frame_budget(wanted, settings.frame_budget_ms - costs.ms(cloud_work), costs)
+    for index, _, remake in wanted:
+        if index in served:
+            update_work += remake
+    # the largest translation error drawn, over the tolerance
+    accepted = 0.0 if chases_tolerance or ring is None or not ring.draws else ring_error / max(tolerance, 1e-300)
+    regenerate, postponed = {}, {}
+    for index in np.flatnonzero(np.isin(kinds, kind_codes(*TEXTURED))).tolist():
+        members = units.members[index]
+        record = records.get(members)
+        if index not in served and record is not None:
+            accepted = max(accepted, float(held_errors[index]) / max(tolerance, 1e-300))
+        if index in served:
+            record = next_records[members] = ImpostorRecord(
+                tuple(float(v) for v in eye),
+                int(texture_sizes[index]),
+                unit_key(index),
+                split_distances.get(index, ()),
+                split_objects.get(index, ()),
+                content_depth(centres[index], radii[index], eye, *splats_of(index)) if cloud_splats else None,
+            )
+        reason = reasons.get(index)
+        if reason is not None:
+            (regenerate if index in served else postponed)[index] = reason
+        texture_sizes[index] = record.size
+    if ring is not None:
+        for generation, _ in ring.draws:
+            rows = generation.rows_in(units.members, units.row_of)
+            shown = rows[visible[rows]]
+            cloud_work += ring_panels_work(len(generation.occupied_segments), quad_pixels_of[shown])
+        piece = ring.build_members
+        update_work += Work(
+            particles=float(sum(units.particle_counts[units.row_of[u]] for u in piece)),
+            regenerations=float(bool(piece)),
+        )
+    plans = UnitPlans(
+        kinds,
+        distances,
+        units.members,
+        units.member_counts,
+        full_weights,
+        impostor_weights,
+        texture_sizes,
+        full_prices,
+        impostor_prices,
+        regenerate,
+        postponed,
+        split_objects,
+        split_distances,
+    )
+    drawn = np.flatnonzero(np.isin(kinds, kind_codes(*DRAWN)))
+    draw_order = tuple(drawn[np.argsort(-distances[drawn], kind="stable")].tolist())
+    inside_size = tuple(max(1, math.ceil(side * settings.inside_resolution_scale)) for side in viewport)
+    items = draw_items(plans, draw_order, radii, object_centres, objects_visible, eye)
+    screen_impostors = len(inside_runs(items, plans))
+    cloud_work += Work(
+        batches=float(full_runs(kinds[list(draw_order)]) + screen_impostors),
+        quad_pixels=screen_impostors * screen_pixels,
+        quads=float(screen_impostors),
+    )
+    between = set(items.objects)
+    with_world = tuple(i for i in range(len(object_radii)) if objects_visible[i] and i not in between)
+    drawn_as = frame_choice = None
+    if settings.mode == "auto":
+        drawn_as = "full" if all_full else "units"
+        predicted = {
+            "units": units_ms(unit_prices, ring_ms, alone_ms, candidates, costs),
+            "full": costs.ms(everything_full),
+        }
+        frame_choice = next_frame_choice(state, drawn_as, predicted)
+    next_state = LodState(
+        records=next_records,
+        ring=ring.state if ring is not None else RingState(),
+        representations=representations,
+        eye=tuple(float(v) for v in eye),
+        costs=state.costs,
+        frame_choice=frame_choice,
+        drawn_as=drawn_as,
+        frames_drawn_as=state.frames_drawn_as + 1 if state.drawn_as == drawn_as else 1,
+        frame_index=state.frame_index + 1,
+        frame_times=state.frame_times,
+        particles=scene_particles,
+        opened=opened,
+        object_centres=tuple(tuple(float(v) for v in centre) for centre in object_centres),
+        near_work=(units, camera, tuple(viewport), near_work) if near_work else None,
+    )
+    return FramePlan(
+        clouds=plans,
+        draw_order=draw_order,
+        ring=ring,
+        state=next_state,
+        inside_size=inside_size,
+        draw_items=items,
+        objects_with_world=with_world,
+        update_work=update_work if priced else Work(),
+        cloud_work=cloud_work if priced else Work(),
+        priced=priced,
+        costs=costs,
+        tolerance_deg=tolerance,
+        accepted_error=accepted,
+        units=units,
+    )

@@ -1,0 +1,306 @@
+"""What the plan prices units by, from this frame's eye: their distances, fragments, impostor quads and
+lifetimes (`Seen`, for every unit at once), and the work of each representation: full 3D, an impostor, Wang's ring
+and the clouds it would hold drawn on their own."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import NamedTuple
+
+import numpy as np
+
+from cloudcore.camera import (
+    spheres_within_frustum,
+    splats_in_frustum,
+)
+from cloudcore.lod.costs import CostModel, Work, regeneration_fragments, splat_fragments
+from cloudcore.lod.impostors import (
+    TRANSLATION_METRICS,
+    detail_size_px,
+    parallax_errors_deg,
+    quad_half_side,
+    required_size,
+    screen_size_px,
+    tolerance_deg_for,
+)
+from cloudcore.lod.plan.state import LodState
+from cloudcore.lod.ring import (
+    SEGMENT_DEG,
+    SEGMENTS,
+    RingState,
+)
+from cloudcore.lod.units import LodUnits
+from cloudcore.scene import Camera
+from cloudcore.settings import RenderSettings
+from cloudcore.vectors import row_lengths
+
+#: an impostor predicted to last longer than this many frames is priced as if it lasted this long
+#: (a still eye would otherwise make any regeneration free)
+LONGEST_LIFETIME_FRAMES = 120.0
+
+
+#: bounding radii: a unit nearer than this has its full-3D fragments counted splat by splat, clipped to the
+#: screen (`cloudcore.measure.overdraw.splats_in_view`); a ball of discs overestimates a near cloud tenfold, the
+#: parts of it beside and behind the eye costing nothing
+NEAR_EXACT_RADII = 3.0
+
+
+@dataclass(frozen=True)
+class Seen:
+    """What the plan prices units by, per unit, from this frame's eye."""
+
+    distances: np.ndarray  # of the centre from the eye
+    ball_fragments: np.ndarray  # of full 3D, its splats a ball of discs (`splat_fragments`)
+    half_sides: np.ndarray  # of the impostor quad through the centre, metres
+    quad_pixels: np.ndarray  # of the impostor quad on the screen (all of it with the eye inside)
+    #: frames an impostor made now lasts at the eye's speed (and an object's moving inside it), at most
+    #: LONGEST_LIFETIME_FRAMES
+    lifetimes: np.ndarray
+    layers: np.ndarray  # textures of the impostor: one more than the objects inside
+
+    def take(self, rows) -> Seen:
+        """What is seen of the units at `rows`."""
+        return Seen(*(getattr(self, field.name)[rows] for field in dataclasses.fields(self)))
+
+
+def seen_from(units: LodUnits, pricing: Pricing, priced: bool = True) -> Seen:
+    """What is seen of `units` from this frame's eye (`pricing`).  Not `priced` (full 3D), only the distances:
+    every price zero."""
+    eye, last_eye, translation_error, tolerance = (
+        pricing.eye,
+        pricing.last_eye,
+        pricing.translation_error,
+        pricing.tolerance,
+    )
+    focal_px, screen_pixels = pricing.focal_px, pricing.screen_pixels
+    centres, radii = units.centres, units.radii
+    distances = np.linalg.norm(centres - eye, axis=1)
+    if not priced:
+        nothing = np.zeros(len(radii))
+        return Seen(distances, nothing, nothing, nothing, nothing, nothing + 1.0)
+    # the translation error of one frame at the eye's current speed
+    rates = translation_error(centres, radii, last_eye, eye) if last_eye is not None else np.zeros(len(radii))
+    object_centres, object_radii, depth_steps = pricing.splitting
+    reach = np.linalg.norm(centres[:, None] - object_centres[None], axis=2) < radii[:, None] + object_radii[None]
+    reach &= (radii > 0.0)[:, None]
+    # an object moving in depth inside a unit remakes its layers once it passes a particle it covers
+    # (`cloudcore.lod.splitting.layers_hold`): about every 2R / m metres of depth, m of the unit's particles
+    # overlapping it on screen, their share the area of a disc of its radius plus a typical particle's over the unit's
+    typical_radii = np.sqrt(units.radius_squares / np.maximum(units.particle_counts, 1.0))
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        covered_shares = np.minimum(((object_radii[None] + typical_radii[:, None]) / radii[:, None]) ** 2, 1.0)
+        spacings = 2.0 * radii[:, None] / np.maximum(units.particle_counts[:, None] * covered_shares, 1.0)
+        split_lifetimes = np.nan_to_num(spacings / depth_steps[None], nan=math.inf)
+    split_lifetimes = np.min(np.where(reach, split_lifetimes, math.inf), axis=1, initial=math.inf)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # the eye inside: the whole screen
+        half_sides = radii * distances / np.sqrt(np.maximum((distances - radii) * (distances + radii), 1e-300))
+        quad_pixels = np.nan_to_num(
+            np.minimum((2.0 * focal_px * half_sides / distances) ** 2, screen_pixels), nan=screen_pixels
+        )
+    return Seen(
+        distances,
+        splat_fragments(units.radius_squares, radii, distances, focal_px, units.particle_counts, screen_pixels),
+        half_sides,
+        quad_pixels,
+        np.minimum.reduce(
+            [
+                np.divide(tolerance, rates, out=np.full(len(radii), math.inf), where=rates > 0.0),
+                split_lifetimes,
+                np.full(len(radii), LONGEST_LIFETIME_FRAMES),
+            ]
+        ),
+        1.0 + np.count_nonzero(reach, axis=1),
+    )
+
+
+class Pricing(NamedTuple):
+    """What units are priced from this frame (`pricing_of`)."""
+
+    eye: np.ndarray
+    last_eye: np.ndarray | None  # last frame's, the speed that predicts an impostor's lifetime
+    translation_error: object  # the translation metric (`cloudcore.lod.impostors.TRANSLATION_METRICS`)
+    tolerance: float  # degrees
+    focal_px: float  # the focal length in pixels
+    screen_pixels: float
+    #: (centres, radii, depth steps) of the objects that split units into layers (none unless `split_objects`),
+    #: the steps how far each moved in depth since last frame
+    splitting: tuple
+
+
+def pricing_of(camera: Camera, viewport, settings, state: LodState, objects) -> Pricing:
+    """What `seen_from` prices units from this frame."""
+    width, height = viewport
+    centres = np.array([o.centre for o in objects], dtype=np.float64).reshape(-1, 3)
+    radii = np.array([o.radius for o in objects], dtype=np.float64)
+    last = np.array(state.object_centres, dtype=np.float64).reshape(-1, 3)
+    eye = np.asarray(camera.position, dtype=np.float64)
+    # how far each object moved in depth since last frame (inf with no last frame: as if it had jumped)
+    depth_steps = (
+        np.abs(np.linalg.norm(centres - eye, axis=1) - np.linalg.norm(last - eye, axis=1))
+        if len(last) == len(radii)
+        else np.full(len(radii), np.inf)
+    )
+    none = (np.zeros((0, 3)), np.zeros(0), np.zeros(0))
+    splitting = (centres, radii, depth_steps) if settings.split_objects else none
+    return Pricing(
+        eye=eye,
+        last_eye=None if state.eye is None else np.asarray(state.eye, dtype=np.float64),
+        translation_error=TRANSLATION_METRICS[settings.translation_metric],
+        tolerance=tolerance_deg_for(settings, camera.fov_y_deg, height),
+        focal_px=0.5 * height / math.tan(math.radians(camera.fov_y_deg) / 2.0),
+        screen_pixels=float(width * height),
+        splitting=splitting,
+    )
+
+
+def impostor_textures(units: LodUnits, rows, distances, height: int, fov_y_deg: float, settings) -> dict:
+    """Per unit of `rows`, (its quad's side on the screen in pixels, its impostor texture's side, the `Work` of
+    remaking it: every particle splatted into that texture), the fragments in one numpy pass (unit by unit, numpy's
+    overhead was 30 us a unit; the field's plan 5.06 -> 4.65 ms)."""
+    pixels, sizes, half_sides = [], [], []
+    for index in rows:
+        radius, distance = float(units.radii[index]), float(distances[index])
+        side = screen_size_px(radius, distance, height, fov_y_deg)
+        detail = detail_size_px(radius, distance, units.finest_radii[index], settings.impostor_detail_texels)
+        pixels.append(side)
+        sizes.append(required_size(min(side, detail), settings.impostor_min_size, settings.impostor_max_size))
+        half_sides.append(quad_half_side(radius, distance))
+    counts = units.particle_counts[rows]
+    fragments = regeneration_fragments(
+        counts, units.radius_squares[rows], units.radii[rows], distances[rows], np.array(half_sides), np.array(sizes)
+    )
+    return {
+        int(index): (side, size, Work(particles=float(count), texture_fragments=float(f), regenerations=1.0))
+        for index, side, size, count, f in zip(rows, pixels, sizes, counts, np.reshape(fragments, -1))
+    }
+
+
+def impostor_ms_of(units: LodUnits, seen: Seen, chosen, focal_px, settings, costs: CostModel) -> np.ndarray:
+    """Per unit of `chosen` (a mask or indices), its impostor a frame: the quad, and the regeneration (every
+    particle, into a texture as fine as the screen or the unit's detail asks) over the impostor's lifetime."""
+    half_sides, distances, fragments = seen.half_sides[chosen], seen.distances[chosen], seen.ball_fragments[chosen]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        sides = 2.0 * focal_px * half_sides / distances
+        detail = 2.0 * settings.impostor_detail_texels * half_sides / units.finest_radii[chosen]
+        detail = np.where(settings.impostor_detail_texels > 0.0, detail, np.inf)
+        texture = np.clip(np.minimum(sides, detail), settings.impostor_min_size, settings.impostor_max_size)
+        texture_fragments = fragments * np.nan_to_num((texture / sides) ** 2, nan=1.0)
+    remake = seen.layers[chosen] * (
+        costs.particles * units.particle_counts[chosen]
+        + costs.texture_fragments * texture_fragments
+        + costs.regenerations
+    )
+    return costs.quad_pixels * seen.quad_pixels[chosen] + costs.quads + remake / np.maximum(seen.lifetimes[chosen], 1.0)
+
+
+def held_impostor_errors(units: LodUnits, drawable, records: Mapping, translation_error, eye) -> np.ndarray:
+    """Per unit, the translation error of the impostor held (inf: none), measured for the units `drawable` (the
+    rest are not drawn on their own: out of view, or in the ring); the parallax between the near and far points
+    of what it holds (`ImpostorRecord.content`) where the record has them."""
+    rows = [row for row in drawable.tolist() if units.members[row] in records]
+    errors = np.full(len(units.members), math.inf)
+    if not rows:
+        return errors
+    held = [records[units.members[index]] for index in rows]
+    centres, radii = units.centres[rows], units.radii[rows]
+    if translation_error is parallax_errors_deg:
+        centres = np.array([c if h.content is None else h.content[0] for c, h in zip(centres, held)], dtype=np.float64)
+        radii = np.array([r if h.content is None else h.content[1] for r, h in zip(radii, held)], dtype=np.float64)
+    eyes = np.array([record.eye for record in held], dtype=np.float64)
+    errors[rows] = np.nan_to_num(translation_error(centres, radii, eyes, eye), nan=math.inf)
+    return errors
+
+
+def in_view_work(units: LodUnits, chosen, planes, eye, focal_px, screen_pixels, ball_fragments):
+    """(particles, fragments) per unit of `chosen` (mask) drawn in full 3D far from the eye.
+
+    A unit wholly in the frustum has all its splats in view, a ball of discs (`ball_fragments`); one its
+    planes cut (a cloud field's far units are kilometres across, and partly out of view) is counted splat by
+    splat, only the splats in the frustum, each a disc of pi (f r / z)^2 at most the screen, over the units'
+    `SplatSample`: the 1.2M-particle field's 416 candidates took 65 ms a frame counted splat by splat, every
+    one, 0.3 with the sample and the shortcut.
+    """
+    indices = np.flatnonzero(chosen)
+    particles = units.particle_counts[indices].astype(np.float64)
+    fragments = np.asarray(ball_fragments, dtype=np.float64)[indices]
+    cut = np.flatnonzero(~spheres_within_frustum(planes, units.centres[indices], units.radii[indices]))
+    particles[cut] = fragments[cut] = 0.0
+    clouds = [cloud for owner in cut for cloud in units.members[indices[owner]]]
+    if not clouds:
+        return particles, fragments
+    owners = [owner for owner in cut for _ in units.members[indices[owner]]]
+    owners, centres, radii, weights = units.sample.of_clouds(clouds, owners)
+    seen = np.flatnonzero(splats_in_frustum(planes, centres, radii))
+    owners, centres, radii, weights = owners[seen], centres[seen], radii[seen], weights[seen]
+    offsets = centres - eye
+    depths = np.maximum(row_lengths(offsets), radii)
+    discs = np.minimum(math.pi * np.square(focal_px * radii / depths), screen_pixels)
+    count = len(indices)
+    particles += np.bincount(owners, weights=weights, minlength=count)
+    fragments += np.bincount(owners, weights=weights * discs, minlength=count)
+    return particles, fragments
+
+
+def ms_drawn_alone(units: LodUnits, seen: Seen, chosen, in_view, focal_px, settings, costs) -> float:
+    """The units `chosen` (mask) drawn each on its own as auto mode would, far from the eye: per unit the
+    cheaper of full 3D (`in_view`: its particles and fragments in view) and an impostor (`impostor_ms_of`)."""
+    full = costs.particles * in_view[0] + costs.fragments * in_view[1]
+    return float(np.sum(np.minimum(full, impostor_ms_of(units, seen, chosen, focal_px, settings, costs))))
+
+
+def frames_until_ring(state: RingState, settings: RenderSettings) -> float:
+    """Frames until the ring being built (or, with none yet, the first, begun this frame) shows its clouds
+    whole: its segments left, one a frame, then its fade (inf: no ring holding clouds is on its way)."""
+    if state.current is None and state.pending is None:
+        return float(SEGMENTS + settings.ring_fade_frames)
+    if state.pending is None or not state.pending.holds_clouds:
+        return math.inf
+    return float(SEGMENTS - state.built + settings.ring_fade_frames - state.fade_step)
+
+
+def ring_panels_work(panels: int, quad_pixels) -> Work:
+    """Drawing `panels` ring panels (each a draw call) holding clouds whose own impostor quads would fill
+    `quad_pixels` on the screen: a panel is cropped to its clouds' extent, so it fills about what they would."""
+    return Work(quad_pixels=float(np.sum(quad_pixels)), quads=float(panels))
+
+
+def ring_work(
+    units: LodUnits, candidates, centres, eye, step, ball_fragments, quad_pixels, lifetimes, settings, state: RingState
+) -> tuple[Work, Work, float, float]:
+    """(panels, rebuild, moved, tolerated): Wang's ring holding the units `candidates` (mask).
+
+    Its panels drawn a frame (`quad_pixels`: the candidates in view's impostor quads), its rebuild (every
+    candidate splatted into the segments, whose textures have the screen's pixel density), and the frames
+    it lasts: until the eye's current `step` a frame carries it past a rebuild distance, or the frames the
+    last ring lasted when shorter (moved); and that or the frames its clouds' impostors would (`lifetimes`),
+    when shorter still (tolerated).
+    """
+    offsets = centres[candidates] - eye
+    azimuths = np.degrees(np.arctan2(offsets[:, 0], -offsets[:, 2])) % 360.0
+    panels = len(np.unique(np.floor(azimuths / SEGMENT_DEG)))
+    horizontal, vertical = math.hypot(step[0], step[2]), abs(step[1])
+    moved = min(
+        LONGEST_LIFETIME_FRAMES,
+        state.rebuild_interval,
+        settings.ring_rebuild_horizontal * settings.ring_radius / max(horizontal, 1e-300),
+        settings.ring_rebuild_vertical * settings.ring_radius / max(vertical, 1e-300),
+    )
+    rebuild = Work(
+        particles=float(np.sum(units.particle_counts[candidates])),
+        texture_fragments=float(np.sum(ball_fragments[candidates])),
+        regenerations=float(panels),
+    )
+    tolerated = min(moved, float(np.min(lifetimes[candidates], initial=math.inf)))
+    return ring_panels_work(panels, quad_pixels), rebuild, moved, tolerated
+
+
+def ring_translation_error(generation, translation_error, eye) -> float:
+    """The largest translation error of a cloud of the ring `generation` (None: no ring; 0: none) seen from
+    `eye`: Wang's panels are impostors too."""
+    if generation is None or not generation.members:
+        return 0.0
+    centres, radii = generation.spheres
+    return float(np.max(translation_error(centres, radii, generation.eye, eye), initial=0.0))

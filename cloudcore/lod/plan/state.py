@@ -1,0 +1,93 @@
+"""What the level of detail carries from one frame to the next: the impostors held, the ring, each unit's
+representation, the fitted costs, and auto mode's measured frame times (pure; the renderer holds one)."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+from cloudcore.lod.costs import CostEstimator
+from cloudcore.lod.ring import (
+    RingState,
+)
+
+#: auto mode's choice between a frame of units each as priced and one all in full 3D is by the frames' measured
+#: times (the cost model, fitted to what is drawn, predicts the other poorly): the frames after a switch that do
+#: not count (crossfades and the ring's fade), the measured frames a choice needs, the age in frames after which
+#: the other's measurement is stale, and how close its predicted time must come for the other to be tried at all
+#: (a scene where full 3D is predicted four times dearer never stalls to find out)
+FRAME_SETTLE_FRAMES = 16
+PROBE_FRAMES = 8
+MEASUREMENT_AGE_FRAMES = 300
+PLAUSIBLE_RATIO = 1.5
+
+
+#: the running mean of a choice's frame times weighs each new frame at least this much
+FRAME_TIME_FORGETTING = 0.1
+
+
+@dataclass(frozen=True)
+class Representation:
+    """Auto mode's choice for a unit: where it is heading and how far it has come (1 = all full 3D)."""
+
+    target: str  # "full" or "impostor"
+    full_weight: float
+
+
+@dataclass(frozen=True)
+class LodState:
+    """What the level of detail carries from one frame to the next (pure; the renderer holds one)."""
+
+    records: Mapping = field(default_factory=dict)  # unit members -> ImpostorRecord: the impostor cache
+    ring: RingState = RingState()
+    representations: Mapping = field(default_factory=dict)  # unit members -> Representation (auto mode)
+    eye: tuple | None = None  # last frame's eye: the speed that predicts an impostor's lifetime
+    costs: CostEstimator = CostEstimator()
+    #: auto mode draws a frame's units each as its price says ("units"), or every one in full 3D ("full"):
+    #: the choice for the next frame, the one this frame was drawn with and for how many frames in a row
+    frame_choice: str | None = None
+    drawn_as: str | None = None
+    frames_drawn_as: int = 0
+    frame_index: int = 0  # frames planned
+    frame_times: Mapping = field(default_factory=dict)  # choice -> FrameTime: how long its frames took, measured
+    #: the units' particles when last planned: a scene changed past `SCENE_CHANGE_RATIO` forgets `frame_times`
+    particles: float = 0.0
+    opened: frozenset = frozenset()  # the groups of clouds planned apart (`groups_cheaper_apart`)
+    object_centres: tuple = ()  # the objects' bounding-sphere centres: which of them move
+    #: the units near the eye priced splat by splat last frame, for the same view to ask again (a still eye):
+    #: (units, camera, viewport, {members: (their clouds' keys, Work)}), or None
+    near_work: tuple | None = None
+
+    def measured(self, measurements, fit: bool = True) -> LodState:
+        """The state with this frame's (predicted work, measured ms) pairs folded into the cost fit (unless not
+        `fit`: a frame planned without prices), and their sum into the measured time of the way the frame was
+        drawn (once the switch to it has settled)."""
+        frame_times = self.frame_times
+        total_ms = sum(ms for _, ms in measurements if math.isfinite(ms) and ms >= 0.0)
+        if self.drawn_as is not None and self.frames_drawn_as > FRAME_SETTLE_FRAMES:
+            held = frame_times.get(self.drawn_as)
+            running = held is not None and held.last_frame == self.frame_index - 1
+            frame_times = {
+                **frame_times,
+                self.drawn_as: FrameTime.after(held if running else None, total_ms, self.frame_index),
+            }
+        costs = self.costs.observe(measurements) if fit else self.costs
+        return dataclasses.replace(self, costs=costs, frame_times=frame_times)
+
+
+@dataclass(frozen=True)
+class FrameTime:
+    """The measured time of the frames drawn one way, in a running mean over its last run of frames."""
+
+    mean_ms: float
+    frames: int
+    last_frame: int  # `LodState.frame_index` of the last frame measured
+
+    @staticmethod
+    def after(previous: FrameTime | None, ms: float, frame: int) -> FrameTime:
+        if previous is None:
+            return FrameTime(ms, 1, frame)
+        weight = max(1.0 / (previous.frames + 1), FRAME_TIME_FORGETTING)
+        return FrameTime((1.0 - weight) * previous.mean_ms + weight * ms, previous.frames + 1, frame)

@@ -1,0 +1,146 @@
+"""The plan at scale: its decisions are arrays, a unit costs Python time only where it is drawn, and what the ring
+holds keeps no impostor of its own."""
+
+import math
+
+import numpy as np
+import pytest
+
+from cloudcore.camera import frustum_planes, projection_matrix, spheres_in_frustum, view_matrix
+from cloudcore.lod.plan import LodState, plan_frame
+from cloudcore.lod.plan.draw_items import DrawItem, draw_items
+from cloudcore.lod.plan.pricing import frames_until_ring
+from cloudcore.lod.plan.unit_plans import FULL, KINDS, UnitPlans
+from cloudcore.lod.ring import SEGMENTS, RingState, ring_members
+from cloudcore.lod.splitting import layer_bounds, layer_sort_key
+from cloudcore.lod.units import LodUnits
+from cloudcore.scene import Camera
+from cloudcore.settings import RenderSettings
+
+VIEWPORT = (640, 480)
+CAMERA = Camera((0.0, 1000.0, 0.0), (1000.0, 1000.0, 300.0), 60.0)
+
+
+def scattered_units(count: int, seed: int = 3) -> LodUnits:
+    """`count` clouds of 200 particles scattered over 40 km square at cloud height."""
+    rng = np.random.default_rng(seed)
+    centres = np.column_stack(
+        [rng.uniform(-20e3, 20e3, count), rng.uniform(850.0, 1150.0, count), rng.uniform(-20e3, 20e3, count)]
+    )
+    radii = rng.uniform(80.0, 160.0, count)
+    return LodUnits.of_spheres(centres, radii, radii / 8.0, [200.0] * count, 200.0 * (radii / 8.0) ** 2)
+
+
+class CountingKeys(tuple):
+    """Lighting keys that count the clouds whose key the plan looks up one by one."""
+
+    def __new__(cls, count):
+        keys = super().__new__(cls, ((cloud, None, 1.0) for cloud in range(count)))
+        keys.looked_up = set()
+        return keys
+
+    def __getitem__(self, cloud):
+        self.looked_up.add(cloud)
+        return super().__getitem__(cloud)
+
+
+@pytest.mark.parametrize("mode", ["full", "impostor", "auto"])
+def test_every_unit_s_kind_is_what_its_sphere_and_the_ring_say(mode):
+    units = scattered_units(3000)
+    settings = RenderSettings(mode=mode)
+    state = LodState()
+    for _ in range(SEGMENTS + settings.ring_fade_frames + 1):  # the ring built and faded in
+        frame = plan_frame(units, CAMERA, VIEWPORT, settings, state, 1)
+        state = frame.state
+    width, height = VIEWPORT
+    planes = frustum_planes(projection_matrix(60.0, width / height) @ view_matrix(CAMERA))
+    visible = spheres_in_frustum(planes, units.centres, units.radii)
+    in_ring = ring_members(units.centres, units.radii, np.array(CAMERA.position), settings) & (mode != "full")
+    kinds = np.array([cloud.kind for cloud in frame.clouds])
+    assert np.all(kinds[in_ring] == "ring")
+    assert np.all(kinds[~in_ring & ~visible] == "culled")
+    assert np.all(np.isin(kinds[~in_ring & visible], ("full", "impostor", "crossfade")))
+    assert in_ring.sum() > 2000 or mode == "full"  # most of the scene is in the ring, as at Harris's scale
+    by_kind = frame.stats().clouds_by_kind
+    assert by_kind == {kind: int(np.sum(kinds == kind)) for kind in KINDS}
+    assert sorted(frame.draw_order) == sorted(np.flatnonzero(np.isin(kinds, ("full", "impostor", "crossfade"))))
+
+
+@pytest.mark.parametrize("mode", ["full", "impostor", "auto"])
+def test_only_the_units_drawn_on_their_own_have_their_lighting_keys_looked_up(mode):
+    units = scattered_units(3000)
+    settings = RenderSettings(mode=mode)
+    state, looked_up = LodState(), set()
+    for _ in range(SEGMENTS + settings.ring_fade_frames + 3):
+        keys = CountingKeys(len(units.radii))
+        frame = plan_frame(units, CAMERA, VIEWPORT, settings, state, keys)
+        state, looked_up = frame.state, keys.looked_up
+    drawn = {cloud for index in frame.draw_order for cloud in units.members[index]}
+    assert looked_up <= drawn and (len(drawn) < 200 or mode == "full")  # the ring holds the rest
+
+
+def test_a_unit_the_ring_shows_whole_keeps_no_impostor_and_one_handed_back_is_made_anew():
+    units = scattered_units(400)
+    settings = RenderSettings(mode="impostor")
+    first = plan_frame(units, CAMERA, VIEWPORT, settings, LodState(), 1)
+    state = first.state
+    made_first = set(state.records)
+    for _ in range(SEGMENTS + settings.ring_fade_frames + 1):
+        frame = plan_frame(units, CAMERA, VIEWPORT, settings, state, 1)
+        state = frame.state
+    in_ring = {frame.clouds.members[i] for i in frame.clouds.indices_of("ring")}
+    assert in_ring & made_first, "the ring took clouds that had impostors of their own"
+    assert not in_ring & set(state.records)
+    # the ring off: every cloud is drawn on its own again, those it held from impostors made anew
+    handed_back = plan_frame(units, CAMERA, VIEWPORT, RenderSettings(mode="impostor", ring_radius=math.inf), state, 1)
+    reasons = {handed_back.clouds.members[i]: reason for i, reason in handed_back.clouds.regenerate.items()}
+    assert {reasons.get(members) for members in in_ring if members in reasons} == {"new"}
+
+
+def test_a_ring_candidate_s_impostor_lasts_until_the_ring_being_built_takes_it():
+    settings = RenderSettings()
+    assert frames_until_ring(RingState(), settings) == SEGMENTS + settings.ring_fade_frames
+    units = scattered_units(400)
+    frame = plan_frame(units, CAMERA, VIEWPORT, settings, LodState(), 1)
+    building = frame.state.ring
+    assert building.pending is not None and building.built == 1
+    assert frames_until_ring(building, settings) == SEGMENTS - 1 + settings.ring_fade_frames
+    assert frames_until_ring(RingState(current=building.pending), settings) == math.inf
+
+
+def test_the_draw_items_are_the_drawn_units_layers_and_objects_far_to_near_as_a_sort_of_records_would_give():
+    rng = np.random.default_rng(5)
+    count = 40
+    distances = np.round(rng.uniform(100.0, 500.0, count), 0)  # ties on purpose
+    radii = rng.uniform(20.0, 60.0, count)
+    object_centres = rng.uniform(-500.0, 500.0, (3, 3))
+    eye = np.zeros(3)
+    splits, split_objects = {}, {}
+    for index in (3, 7, 21):
+        objects = tuple(int(o) for o in rng.choice(3, size=2, replace=False))
+        splits[index] = tuple(sorted((float(np.linalg.norm(object_centres[o])) for o in objects), reverse=True))
+        split_objects[index] = objects
+    kinds = np.full(count, FULL, dtype=np.int8)
+    plans = UnitPlans(
+        kinds,
+        distances,
+        tuple((i,) for i in range(count)),
+        np.ones(count, int),
+        splits=splits,
+        split_objects=split_objects,
+    )
+    order = tuple(int(i) for i in np.argsort(-distances, kind="stable"))
+    items = draw_items(plans, order, radii, object_centres, np.ones(3, dtype=bool), eye)
+    expected = []
+    for index in order:
+        cut = splits.get(index, ())
+        for layer in range(len(cut) + 1):
+            near, far = layer_bounds(cut, layer)
+            depth = layer_sort_key(near, far, float(distances[index]), radii[index]) if cut else float(distances[index])
+            expected.append(DrawItem("cloud", index, float(depth), layer, near, far))
+    for o in sorted({o for objects in split_objects.values() for o in objects}):
+        distance = float(np.linalg.norm(object_centres[o] - eye))
+        expected.append(DrawItem("object", o, distance, near=distance, far=distance))
+    expected.sort(key=lambda item: (-item.depth, -item.far, item.kind != "object"))
+    assert list(items) == expected
+    assert items.objects == tuple(item.index for item in expected if item.kind == "object")
