@@ -161,7 +161,7 @@ def main(argv=None) -> int:
     except SceneError as error:
         print(f"cloudview: error: {error}", file=sys.stderr)
         return 2
-    viewport = Viewport(editor)
+    viewport = Viewport(editor, remember_costs=args.self_test is None and args.frames is None)
     panels = Panels(editor, viewport)
     params = runner_params(
         editor,

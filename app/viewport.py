@@ -44,8 +44,11 @@ _LEGEND_STEPS = 32
 
 
 class Viewport:
-    def __init__(self, editor: Editor):
+    def __init__(self, editor: Editor, remember_costs: bool = True):
+        """`remember_costs`: auto mode's cost model starts from the last session's on this machine, and this
+        one's is kept (`FrameRenderer`); off where runs must start alike (GUI tests, scripted frames)."""
         self.editor = editor
+        self.remember_costs = remember_costs
         self.tools = ViewportTools(editor)
         self.renderer: FrameRenderer | None = None
         self.fly_speed = 300.0  # metres per second
@@ -76,7 +79,11 @@ class Viewport:
         width, height = max(1, int(available.x)), max(1, int(available.y))
         if self.renderer is None:
             self.renderer = FrameRenderer(
-                width, height, context=WindowContext(width, height), illumination=self.relighting.cache
+                width,
+                height,
+                context=WindowContext(width, height),
+                illumination=self.relighting.cache,
+                remember_costs=self.remember_costs,
             )
         self.renderer.resize(width, height)
         start = time.perf_counter()

@@ -51,16 +51,24 @@ def load_or_build(kind: str, key: dict, build) -> tuple[dict[str, np.ndarray], b
     `build` returns a dict of numpy arrays.  A cache that cannot be written (a read-only home) costs the
     rebuild next time, not the result now.
     """
-    for directory in (shipped_directory(), cache_directory()):
-        held = _read(entry_path(kind, key, directory), key)
-        if held is not None:
-            return held, True
+    held = load(kind, key)
+    if held is not None:
+        return held, True
     arrays = build()
     try:
         store(kind, key, arrays)
     except OSError:
         pass
     return arrays, False
+
+
+def load(kind: str, key: dict) -> dict[str, np.ndarray] | None:
+    """The arrays of `key`, shipped or in the user's cache; None where neither holds them."""
+    for directory in (shipped_directory(), cache_directory()):
+        held = _read(entry_path(kind, key, directory), key)
+        if held is not None:
+            return held
+    return None
 
 
 def store(kind: str, key: dict, arrays: dict[str, np.ndarray], directory: Path | None = None) -> Path:

@@ -15,6 +15,9 @@ RENDER_WIDTH, RENDER_HEIGHT = 160, 120
 
 # PyOpenGL picks its platform on first import: the tests render headless through EGL.
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
+# every run of the editor or the command line a test starts plans from the same prior, not from a cost model a
+# run before it fitted (`cloudcore.lod.costs.remembered_prior`; tests of the memory turn it on themselves)
+os.environ["CLOUDVIEW_COST_MEMORY"] = "off"
 
 
 @pytest.fixture(scope="session", autouse=True)

@@ -7,17 +7,24 @@ import numpy as np
 import pytest
 from test_frameplan import FILL_BOUND, FINEST, NO_RING, RADIUS, camera_at, plan
 
+from cloudcore import disk_cache
 from cloudcore.lod.costs import (
+    FRAMES_TO_REMEMBER,
     LLVMPIPE_COSTS,
+    MEMORY_VARIABLE,
     CostEstimator,
     CostModel,
     Work,
     inverse_square_depth,
     quad_work,
     regeneration_fragments,
+    remember_fit,
+    remembered_prior,
     splat_fragments,
 )
 from cloudcore.lod.plan import SWITCH_MARGIN, LodState
+from cloudcore.resources import DEFAULT_SCENE
+from cloudcore.scenefile import load_scene
 
 
 def test_splat_fragments_are_the_discs_areas_and_never_more_than_the_screen_each():
@@ -161,3 +168,56 @@ def test_a_cost_model_prices_each_field_of_work_by_its_own_coefficient():
         assert model.ms(Work(**{name: 2.0})) == 2.0 * 10.0 ** (index + 1)
     assert (Work(particles=1.0, quads=2.0) + Work(quads=3.0)).scaled(2.0) == Work(particles=2.0, quads=10.0)
     assert Work(**{n: float(k) for k, n in enumerate(names)}).values() == tuple(map(float, range(len(names))))
+
+
+MACHINE = {"gl": "llvmpipe (test)", "processor": "x86_64", "cores": 2, "format": 1}
+
+
+def fitted_estimator(frames: int) -> CostEstimator:
+    """An estimator that has seen `frames` frames of particles costing three times the prior."""
+    estimator = CostEstimator()
+    for _ in range(frames):
+        work = Work(particles=5e4, fragments=1e6)
+        estimator = estimator.observe([(work, 3.0 * LLVMPIPE_COSTS.ms(work))])
+    return estimator
+
+
+def test_a_fitted_cost_model_is_remembered_for_the_next_run_on_the_same_machine(tmp_path, monkeypatch):
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    monkeypatch.setenv(MEMORY_VARIABLE, "on")
+    assert remembered_prior(MACHINE) is None
+    assert not remember_fit(MACHINE, fitted_estimator(FRAMES_TO_REMEMBER - 1))  # too few frames to go by
+    assert remembered_prior(MACHINE) is None
+    estimator = fitted_estimator(FRAMES_TO_REMEMBER)
+    assert remember_fit(MACHINE, estimator)
+    assert remembered_prior(MACHINE) == estimator.model() != LLVMPIPE_COSTS
+    # another GL, or the memory turned off, starts from the prior
+    assert remembered_prior({**MACHINE, "gl": "NVIDIA H200"}) is None
+    monkeypatch.setenv(MEMORY_VARIABLE, "off")
+    assert remembered_prior(MACHINE) is None and not remember_fit(MACHINE, estimator)
+
+
+def test_a_remembered_cost_model_that_is_not_a_model_is_not_used(tmp_path, monkeypatch):
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    monkeypatch.setenv(MEMORY_VARIABLE, "on")
+    for coefficients in ([1.0, 2.0], [math.nan] * 7, [0.0] * 7, [-1.0] * 7):
+        disk_cache.store("cost-model", MACHINE, {"coefficients": np.array(coefficients)})
+        assert remembered_prior(MACHINE) is None, coefficients
+
+
+@pytest.mark.gl
+def test_a_renderer_that_remembers_starts_from_the_fit_the_last_one_left(tmp_path, monkeypatch):
+    from cloudcore.gl import FrameRenderer
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    monkeypatch.setenv(MEMORY_VARIABLE, "on")
+    scene = load_scene(DEFAULT_SCENE)
+    with FrameRenderer(160, 120, remember_costs=True) as first:
+        for _ in range(FRAMES_TO_REMEMBER):
+            first.render(scene, read_back=False)
+        fitted = first.lod_state.costs.model()
+    assert fitted != LLVMPIPE_COSTS
+    with FrameRenderer(160, 120, remember_costs=True) as second:
+        assert second.lod_state.costs.prior == fitted and second.lod_state.costs.model() == fitted
+    with FrameRenderer(160, 120) as forgetful:  # the tests' and benchmarks' renderers start alike
+        assert forgetful.lod_state.costs.model() == LLVMPIPE_COSTS

@@ -117,7 +117,7 @@ def run(args) -> int:
         rows = csv.DictWriter(table, COLUMNS) if table is not None else None
         if rows is not None:
             rows.writeheader()
-        renderer = outputs.enter_context(FrameRenderer(args.width, args.height))
+        renderer = outputs.enter_context(FrameRenderer(args.width, args.height, remember_costs=True))
         video = outputs.enter_context(_video(args.out, (args.width, args.height), args.fps)) if args.out else None
         bar = outputs.enter_context(tqdm(total=len(times), unit="frame", desc="record"))
         for index, t in enumerate(times):

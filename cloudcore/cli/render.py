@@ -114,7 +114,7 @@ def run(args) -> int:
 
     from cloudcore.gl import FrameRenderer
 
-    with FrameRenderer(args.width, args.height) as renderer:
+    with FrameRenderer(args.width, args.height, remember_costs=True) as renderer:
         image, stats = renderer.render(scene, time_of_day=args.time_of_day, camera=camera, settings=settings)
         if args.overdraw or args.stats:
             counts, overdraw = renderer.measure_overdraw()

@@ -26,6 +26,8 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
+import os
+import platform
 import time
 from dataclasses import dataclass
 
@@ -53,7 +55,7 @@ from cloudcore.light.eye_scattering import ParticleBuffer
 from cloudcore.light.illumination import IlluminationCache
 from cloudcore.light.lighting import scene_hour, scene_lights, sky_colors
 from cloudcore.light.volume_blending import blending_path
-from cloudcore.lod.costs import CostModel
+from cloudcore.lod.costs import CostEstimator, CostModel, remember_fit, remembered_prior
 from cloudcore.lod.impostors import cropped_corners, particle_extent
 from cloudcore.lod.measured_way import COMPOSITING_WAYS, MeasuredWay
 from cloudcore.lod.plan import FramePlan, LodState, plan_frame
@@ -91,11 +93,21 @@ class _CloudPassFrame:
 class FrameRenderer:
     """Renders scenes headlessly at a fixed size; use as a context manager or call close()."""
 
-    def __init__(self, width: int, height: int, context=None, illumination: IlluminationCache | None = None):
+    def __init__(
+        self,
+        width: int,
+        height: int,
+        context=None,
+        illumination: IlluminationCache | None = None,
+        remember_costs: bool = False,
+    ):
         """A headless renderer, or with `context` (a `WindowContext`) one inside the current window.
 
         `illumination` holds the clouds' precomputed light between frames; the editor passes one
-        that a worker fills in the background (`cloudcore.light.relighting`)."""
+        that a worker fills in the background (`cloudcore.light.relighting`).  With `remember_costs`, auto
+        mode's cost model starts from the one the last such renderer on this machine and GL fitted, and the
+        one fitted here is kept for the next when it closes (`cloudcore.lod.costs.remembered_prior`): the
+        editor and the command line; the tests and benchmarks start from the same prior every time."""
         self.context = context if context is not None else HeadlessContext(width, height)
         self.context.make_current()
         self._splats = SplatPass()
@@ -115,6 +127,11 @@ class FrameRenderer:
         self._key_serial = 0
         #: the level of detail's state between frames (impostor cache, ring, representations, costs)
         self.lod_state = LodState()
+        self._remember_costs = remember_costs
+        if remember_costs:
+            prior = remembered_prior(self._machine)
+            if prior is not None:
+                self.lod_state = LodState(costs=CostEstimator(prior))
         self.splat_order = MeasuredWay()  # where draws and regenerations sort, measured (settings' "auto")
         #: per mode, what composites the GPU's plain full-3D splats, measured (settings' "auto"): on the H200 the
         #: compute pass won in full 3D and lost in auto mode, whose full-3D draws are a few near clouds
@@ -704,9 +721,21 @@ class FrameRenderer:
         self._overdraw_target = self._layer = self._display = None
         self._close_inside()
 
+    @property
+    def _machine(self) -> dict:
+        """What a cost model fitted here holds for: this GL on this processor (`remembered_prior`)."""
+        return {
+            "gl": self._volume.features.renderer,
+            "processor": platform.machine(),
+            "cores": os.cpu_count() or 0,
+            "format": 1,
+        }
+
     def close(self) -> None:
         if self.context.closed:
             return
+        if self._remember_costs:
+            remember_fit(self._machine, self.lod_state.costs)
         self.context.make_current()
         self._close_screen_targets()
         self._impostors.close()

@@ -21,10 +21,13 @@ count).  Pure numpy: plan tests pass fixed models.
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass, fields
 from functools import cached_property
 
 import numpy as np
+
+from cloudcore import disk_cache
 
 
 @dataclass(frozen=True, slots=True)
@@ -203,3 +206,40 @@ class CostEstimator:
         ratios = np.linalg.solve(self.normal + PRIOR_WEIGHT * np.eye(size), self.right + PRIOR_WEIGHT)
         ratios = np.clip(np.nan_to_num(ratios, nan=1.0), 1.0 / RATIO_LIMIT, RATIO_LIMIT)
         return CostModel(*(ratios * self.prior.vector()))
+
+
+#: fitted frames a model needs before it is remembered for the next run on the machine (`remember_fit`)
+FRAMES_TO_REMEMBER = 60
+_REMEMBERED = "cost-model"
+#: set to "off" to start every run from the prior and remember nothing (the test suite does: its runs must
+#: not depend on the ones before)
+MEMORY_VARIABLE = "CLOUDVIEW_COST_MEMORY"
+
+
+def _memory_on() -> bool:
+    return os.environ.get(MEMORY_VARIABLE, "on") != "off"
+
+
+def remembered_prior(machine: dict) -> CostModel | None:
+    """The model the last run on `machine` (its GL, processor and cores: `FrameRenderer`'s key) fitted, to
+    start this run's fit from instead of the llvmpipe prior; None if none was remembered, or a stored one is
+    unusable (every coefficient must be finite and > 0)."""
+    held = disk_cache.load(_REMEMBERED, machine) if _memory_on() else None
+    if held is None:
+        return None
+    coefficients = np.asarray(held.get("coefficients", ()), dtype=np.float64)
+    if coefficients.shape != (len(fields(CostModel)),) or not np.all(np.isfinite(coefficients) & (coefficients > 0)):
+        return None
+    return CostModel(*(float(c) for c in coefficients))
+
+
+def remember_fit(machine: dict, estimator: CostEstimator) -> bool:
+    """Keep `estimator`'s model for the next run on `machine` when it has fitted `FRAMES_TO_REMEMBER` frames;
+    whether it was kept (a cache that cannot be written keeps nothing, and says so)."""
+    if estimator.frames < FRAMES_TO_REMEMBER or not _memory_on():
+        return False
+    try:
+        disk_cache.store(_REMEMBERED, machine, {"coefficients": estimator.model().vector()})
+    except OSError:
+        return False
+    return True

@@ -65,8 +65,8 @@ class RingGeneration:
     spheres: tuple = field(default=(np.zeros((0, 3)), np.zeros(0)), compare=False, repr=False)
 
     #: what the frames before found of it, so that a ring of thousands is not walked every frame: "rows", the
-    #: tuple of ids last planned with and its members' rows in it; "keys", the clouds' lighting keys (the tuple a
-    #: frame was planned with) last found to leave it unchanged
+    #: tuple of ids last planned with and its members' rows in it; "unchanged", the clouds' lighting keys (the
+    #: tuple a frame was planned with) and the set of ids last found to leave it as it was made
     _memo: dict = field(default_factory=dict, repr=False)
 
     @property
@@ -205,14 +205,15 @@ def _relit(generation: RingGeneration, cloud_keys: tuple, present: frozenset) ->
     """Whether the colours of a member of `generation` changed since it was made (`cloud_keys`: each cloud's
     lighting key now), or a member is gone (its cloud removed, or regrouped: not in `present`); a change to a
     cloud outside the ring leaves it be."""
+    checked = generation._memo.get("unchanged")
+    if checked is not None and checked[0] is cloud_keys and checked[1] is present:  # found unchanged before
+        return False
     if not generation.members <= present:
         return True
-    if generation._memo.get("keys") is cloud_keys:  # the very keys found unchanged before
-        return False
     keys = np.fromiter(cloud_keys, dtype=object, count=len(cloud_keys))
     relit = bool(np.any(keys[generation.clouds] != generation.cloud_keys))
     if not relit:
-        generation._memo["keys"] = cloud_keys
+        generation._memo["unchanged"] = (cloud_keys, present)
     return relit
 
 
