@@ -15,6 +15,10 @@ and one for each mode, taking turns frame by frame), default settings but for th
   120 frames, 640x480, after 20 frames still (Harris: 10-12 fps for his largest scenes);
 - untuned: two scenes the LOD was not tuned on, made here from a seed: a field of cumulus of another
   density and a stratocumulus deck (the Wang presets), each flown through at 120 m/s at 30 fps;
+- wang_sparse, wang_scattered, wang_overcast (`wang` for all): Wang's three weathers by cloud-block overdraw
+  (`wang_scenarios`), 1024x768, 90 frames of flight from the first;
+- cumulus_line, popcorn_climb (`own` for both): two skies of our own (`wang_scenarios.own_scene`), 640x480,
+  90 frames from the first;
 - harris_circle_N, harris_through_N (`harris` for all): Harris's figure 8 (`harris_figure8`), N of 100 to
   12,800 clouds of 200 particles, the eye on his circle or straight through, 90 frames at 640x480 after
   20 still ones.
@@ -40,7 +44,8 @@ import numpy as np
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-import harris_figure8  # noqa: E402  (sibling scripts: Harris's figure 8 and the same 1.2M field)
+import harris_figure8  # noqa: E402  (sibling scripts: Harris's figure 8, Wang's scenarios, the same 1.2M field)
+import wang_scenarios  # noqa: E402
 from bench_many_particles import cloud_field  # noqa: E402
 
 from cloudcore.artist.cloudgen import preset_cloud  # noqa: E402
@@ -129,6 +134,16 @@ def cases(names, quick: bool) -> list:
         for name, (scene, path) in untuned_scenes(valley).items():
             frames = int(scene.camera_path(path).duration * 30) + 1
             chosen.append((name, scene, path_views(scene, path, short(frames)), (640, 480), 0))
+    for scenario in wang_scenarios.SCENARIOS:
+        if f"wang_{scenario}" in names or "wang" in names:
+            scene, _ = wang_scenarios.wang_scene(valley, scenario)
+            heights = wang_scenarios.SCENARIOS[scenario][2]
+            views = wang_scenarios.flight_views(short(HARRIS_FRAMES), *heights)
+            chosen.append((f"wang_{scenario}", scene, views, (1024, 768), 0))
+    for sky in ("cumulus_line", "popcorn_climb"):
+        if sky in names or "own" in names:
+            scene, views = wang_scenarios.own_scene(valley, sky, short(HARRIS_FRAMES))
+            chosen.append((sky, scene, views, (640, 480), 0))
     for count in harris_figure8.COUNTS:
         for path, views_of in (("circle", harris_figure8.circle_views), ("through", harris_figure8.through_views)):
             name = f"harris_{path}_{count}"
