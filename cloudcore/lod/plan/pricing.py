@@ -69,20 +69,14 @@ class Seen:
 def seen_from(units: LodUnits, pricing: Pricing, priced: bool = True) -> Seen:
     """What is seen of `units` from this frame's eye (`pricing`).  Not `priced` (full 3D), only the distances:
     every price zero."""
-    eye, last_eye, translation_error, tolerance = (
-        pricing.eye,
-        pricing.last_eye,
-        pricing.translation_error,
-        pricing.tolerance,
-    )
-    focal_px, screen_pixels = pricing.focal_px, pricing.screen_pixels
+    eye, last_eye, focal_px, screen_pixels = pricing.eye, pricing.last_eye, pricing.focal_px, pricing.screen_pixels
     centres, radii = units.centres, units.radii
     distances = np.linalg.norm(centres - eye, axis=1)
     if not priced:
         nothing = np.zeros(len(radii))
         return Seen(distances, nothing, nothing, nothing, nothing, nothing + 1.0)
     # the translation error of one frame at the eye's current speed
-    rates = translation_error(centres, radii, last_eye, eye) if last_eye is not None else np.zeros(len(radii))
+    rates = pricing.translation_error(centres, radii, last_eye, eye) if last_eye is not None else np.zeros(len(radii))
     object_centres, object_radii, depth_steps = pricing.splitting
     reach = np.linalg.norm(centres[:, None] - object_centres[None], axis=2) < radii[:, None] + object_radii[None]
     reach &= (radii > 0.0)[:, None]
@@ -107,7 +101,7 @@ def seen_from(units: LodUnits, pricing: Pricing, priced: bool = True) -> Seen:
         quad_pixels,
         np.minimum.reduce(
             [
-                np.divide(tolerance, rates, out=np.full(len(radii), math.inf), where=rates > 0.0),
+                np.divide(pricing.tolerance, rates, out=np.full(len(radii), math.inf), where=rates > 0.0),
                 split_lifetimes,
                 np.full(len(radii), LONGEST_LIFETIME_FRAMES),
             ]
