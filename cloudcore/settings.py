@@ -167,7 +167,7 @@ class RenderSettings:
         label="Group interpenetrating clouds",
     )
     #: auto mode plans a group apart, its clouds each a unit of its own, while the eye moves and their impostors
-    #: cost less than the group's (`cloudcore.lod.plan._groups_cheaper_apart`); still, or with the eye in its
+    #: cost less than the group's (`cloudcore.lod.plan.choice.groups_cheaper_apart`); still, or with the eye in its
     #: sphere, a group is whole.  Side by side along the default flythrough: 21.4 against 25.4 ms of clouds for
     #: 2.1 dB of mean PSNR (51.6 against 53.7; the worst frame 34.0 both); orbiting the default view 23.0
     #: against 54.4 ms for 9.3 dB (36.9 against 46.2): the blobs of clouds sorted whole, while the eye moves

@@ -27,9 +27,9 @@ with the measured `CostModel` (`cloudcore.lod.costs`): full 3D its particles
 and fragments, the impostor its quad plus its regeneration spread over the
 frames it is predicted to last at the eye's current speed.  The screen
 impostor is priced the same way against the particles drawn on the screen,
-and Wang's ring against its clouds drawn each on its own (`_ring_pays`).  What
+and Wang's ring against its clouds drawn each on its own (`choice.ring_pays`).  What
 per-unit prices miss (units drawn all in full 3D are one sorted draw) is
-settled by measurement: `_frame_choice` draws a frame all in full 3D where
+settled by measurement: `choice.next_frame_choice` draws a frame all in full 3D where
 that measured cheaper.  The GL side executes plans and nothing else;
 statistics come from the plan.
 
