@@ -12,10 +12,12 @@ the next, and the frame's measured times replaced by the plan's own prediction, 
 inputs give the same plans anywhere).  The frames after the case's warm-up are timed in `PASSES` passes.
 
 `--against REV` runs this very script again over `cloudcore` of git revision REV (a worktree in a temporary
-directory, on PYTHONPATH), the two taking turns case by case, and counts the frames whose plans differ in any
-field the GL side reads or the statistics report (`plans_differing`: 0 for a change meant only to be faster);
-the first difference of each case is printed.  Reports the median and the least of each way's passes, in ms a
-frame.
+directory, on PYTHONPATH) in a child process after this one's cases, and counts the frames whose plans differ
+in any field the GL side reads or the statistics report (`plans_differing`: 0 for a change meant only to be
+faster); the first difference of each case is printed.  REV must have the plan's package and
+`cloud_extents` (this script's own revision on); the planner before them is measured in docs/performance.md,
+"The plan at Harris's scale".  Reports the median and the least of each way's passes, in ms a frame.  The
+units' geometry is `ParticleBuffer`'s (`cloud_extents`), without its light.
 """
 
 from __future__ import annotations
@@ -42,14 +44,13 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_lod import cases as lod_cases  # noqa: E402  (a sibling script: the same scenes, views and sizes)
 
 from cloudcore.artist.formation import formation_state  # noqa: E402
+from cloudcore.artist.particle_styles import particle_styles  # noqa: E402
 from cloudcore.field.state import FieldState, update_field  # noqa: E402
-
-try:
-    from cloudcore.lod.plan import LodState, plan_frame
-except ImportError:  # --against a revision from before the plan was a package of stages
-    from cloudcore.lod.frameplan import LodState, plan_frame
+from cloudcore.light.eye_scattering import cloud_extents  # noqa: E402
+from cloudcore.lod.plan import LodState, plan_frame  # noqa: E402
 from cloudcore.lod.units import lod_units  # noqa: E402
 from cloudcore.objects import object_poses  # noqa: E402
+from cloudcore.scene import Lighting  # noqa: E402
 from cloudcore.settings import RenderSettings  # noqa: E402
 
 MODES = ("full", "impostor", "auto")
@@ -59,17 +60,17 @@ PASSES = 5
 def particles_of(clouds) -> SimpleNamespace:
     """What `lod_units` and the plan read of a `ParticleBuffer`, without its light (nothing is drawn)."""
     counts = np.array([len(c.particles) for c in clouds], dtype=np.int64)
-    spheres = [c.bounding_sphere() for c in clouds]
     centres = np.concatenate([c.centres for c in clouds]).reshape(-1, 3) if clouds else np.zeros((0, 3))
     radii = np.concatenate([c.radii for c in clouds]) if clouds else np.zeros(0)
     starts = np.concatenate([[0], np.cumsum(counts)])
+    finest, bounding_centres, bounding_radii = cloud_extents(clouds, radii, starts, particle_styles(clouds, Lighting()))
     return SimpleNamespace(
         cloud_starts=starts,
         centres=centres,
         radii=radii,
-        finest_radii=np.array([radii[a:b].min() if b > a else 0.0 for a, b in zip(starts[:-1], starts[1:])]),
-        bounding_centres=np.array([s[0] for s in spheres], dtype=np.float64).reshape(-1, 3),
-        bounding_radii=np.array([s[1] for s in spheres], dtype=np.float64),
+        finest_radii=finest,
+        bounding_centres=bounding_centres,
+        bounding_radii=bounding_radii,
     )
 
 

@@ -102,19 +102,12 @@ class ParticleBuffer:
         #: (n, lights): light that reached each particle, per light (Harris's light pass)
         self.incident = _concatenated(incident, (0, len(lights)))
 
-        # a sprite's detail is its texture's texel, a splat's the splat itself (a smooth Gaussian)
-        detail = np.where(self.styles.sprite_index >= 0, self.radii * (2.0 / CELL_PIXELS), self.radii)
         #: (clouds,) metres: the finest detail in each cloud (0 for an empty one), which bounds how
-        #: fine an impostor texture needs to be (`cloudcore.lod.impostors.detail_size_px`)
-        self.finest_radii = np.array(
-            [
-                detail[start:stop].min() if stop > start else 0.0
-                for start, stop in zip(self.cloud_starts[:-1], self.cloud_starts[1:])
-            ]
+        #: fine an impostor texture needs to be (`cloudcore.lod.impostors.detail_size_px`); each cloud's
+        #: bounding sphere
+        self.finest_radii, self.bounding_centres, self.bounding_radii = cloud_extents(
+            clouds, self.radii, self.cloud_starts, self.styles
         )
-        spheres = [c.bounding_sphere() for c in clouds]
-        self.bounding_centres = np.array([s[0] for s in spheres], dtype=np.float64).reshape(-1, 3)
-        self.bounding_radii = np.array([s[1] for s in spheres], dtype=np.float64)
         # only clouds that form or dissipate: (first particle, end, formation, core distances)
         self._forming = [
             (start, stop, c.formation, core_distances(c.centres))
@@ -210,6 +203,19 @@ class ParticleBuffer:
                 factors[start:stop] = opacity_factor(formation, distances, time_s)
             self._formation_memo = (time_s, factors)
         return self._formation_memo[1]
+
+
+def cloud_extents(clouds, radii: np.ndarray, cloud_starts: np.ndarray, styles: ParticleStyles) -> tuple:
+    """(finest detail per cloud in metres, bounding-sphere centres, their radii) of `clouds`, whose particles'
+    `radii` are concatenated at `cloud_starts`: a sprite's detail is its texture's texel, a splat's the splat
+    itself (a smooth Gaussian)."""
+    detail = np.where(styles.sprite_index >= 0, radii * (2.0 / CELL_PIXELS), radii)
+    finest = np.array(
+        [detail[start:stop].min() if stop > start else 0.0 for start, stop in zip(cloud_starts[:-1], cloud_starts[1:])]
+    )
+    spheres = [c.bounding_sphere() for c in clouds]
+    centres = np.array([s[0] for s in spheres], dtype=np.float64).reshape(-1, 3)
+    return finest, centres, np.array([s[1] for s in spheres], dtype=np.float64)
 
 
 def _concatenated(parts, empty_shape) -> np.ndarray:
