@@ -385,9 +385,9 @@ def _plan_units(
     held_errors = (
         held_impostor_errors(units, drawable, records, translation_error, eye) if settings.mode != "full" else None
     )
-    may_be_textured = visible & (radii > 0.0) & (individuals > 0.0) & (distances >= INSIDE_RADII * radii)
+    outside = drawable[distances[drawable] >= INSIDE_RADII * radii[drawable]]  # the units that may be impostors
     textured = (
-        impostor_textures(units, np.flatnonzero(may_be_textured), distances, height, camera.fov_y_deg, settings)
+        impostor_textures(units, outside, distances, height, camera.fov_y_deg, settings)
         if settings.mode != "full"
         else {}
     )
