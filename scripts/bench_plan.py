@@ -25,9 +25,10 @@ from __future__ import annotations
 import argparse
 import base64
 import dataclasses
-import hashlib
 import json
+import math
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -117,8 +118,16 @@ def planned_frames(scene, views, size, mode: str):
         )
 
 
+#: how far apart two numbers of plans alike may be, relatively: a change meant only to be faster may round
+#: differently in the last bits (a closed form in place of a difference of products), and the frames it plans after
+#: (the cost fit reads the plan's predictions) carry that on
+PLAN_TOLERANCE = 1e-9
+NUMBER = re.compile(r"((?<![\w.])-?\d+(?:\.\d*)?(?:e[-+]?\d+)?)")
+
+
 def canonical(plan) -> str:
-    """What of a plan the GL side reads or the statistics report, as text: two plans alike give the same."""
+    """What of a plan the GL side reads or the statistics report, as text: two plans alike give the same, or
+    numbers within `PLAN_TOLERANCE` (`differing_part`)."""
     ring = plan.ring
     ring_text = (
         None
@@ -159,7 +168,7 @@ def canonical(plan) -> str:
 
 
 def replay(names, frames: int) -> list[dict]:
-    """Per case and mode: the plans' digests frame by frame, and the timed passes."""
+    """Per case and mode: the plans' texts frame by frame (`canonical`), and the timed passes."""
     rows = []
     chosen = lod_cases(names, quick=False)
     for name, scene, views, size, warmup in chosen:
@@ -184,7 +193,6 @@ def replay(names, frames: int) -> list[dict]:
                     "frames": len(calls),
                     "plan_ms_median": float(np.median(times)),
                     "plan_ms_least": float(np.min(times)),
-                    "digests": [hashlib.sha1(text.encode()).hexdigest()[:16] for text in texts],
                     "texts": base64.b64encode(zlib.compress("\n".join(texts).encode())).decode(),
                 }
             )
@@ -212,12 +220,37 @@ def against(revision: str, names: str, frames: int) -> list[dict]:
             subprocess.run(["git", "worktree", "remove", "--force", str(tree)], cwd=root, check=True)
 
 
-def first_difference(ours: str, theirs: str) -> str:
+def _same_part(index: int, ours: str, theirs: str) -> bool:
+    """Whether the `index`th parts of two plans' texts split at their numbers (odd: a number) are alike."""
+    if index % 2 == 0:
+        return ours == theirs
+    return math.isclose(float(ours), float(theirs), rel_tol=PLAN_TOLERANCE, abs_tol=1e-300)
+
+
+def differing_part(ours: str, theirs: str) -> int | None:
+    """Where two plans' texts (`canonical`) first differ, as a character offset in `ours`, but for numbers within
+    `PLAN_TOLERANCE` of each other (None: alike)."""
+    if ours == theirs:
+        return None
+    our_parts, their_parts = NUMBER.split(ours), NUMBER.split(theirs)
+    offset = 0
+    for index, (a, b) in enumerate(zip(our_parts, their_parts)):
+        if not _same_part(index, a, b):
+            return offset
+        offset += len(a)
+    return None if len(our_parts) == len(their_parts) else offset
+
+
+def plan_texts(row: dict) -> list[str]:
+    """A row's plans' texts, frame by frame."""
+    return zlib.decompress(base64.b64decode(row["texts"])).decode().split("\n")
+
+
+def first_difference(ours: list[str], theirs: list[str]) -> str:
     """Where the first frame two rows' plans differ starts to differ, in their text."""
-    ours, theirs = (zlib.decompress(base64.b64decode(t)).decode().split("\n") for t in (ours, theirs))
     for frame, (a, b) in enumerate(zip(ours, theirs)):
-        if a != b:
-            at = next((i for i, (x, y) in enumerate(zip(a, b)) if x != y), min(len(a), len(b)))
+        at = differing_part(a, b)
+        if at is not None:
             return (
                 f"frame {frame}: ...{a[max(0, at - 120) : at + 200]}... against ...{b[max(0, at - 120) : at + 200]}..."
             )
@@ -241,9 +274,10 @@ def main() -> None:
     report = []
     for row in rows:
         other = next((r for r in theirs if (r["case"], r["mode"]) == (row["case"], row["mode"])), None)
-        line = {k: v for k, v in row.items() if k not in ("digests", "texts")}
+        line = {k: v for k, v in row.items() if k != "texts"}
         if other is not None:
-            differing = sum(a != b for a, b in zip(row["digests"], other["digests"]))
+            texts, their_texts = plan_texts(row), plan_texts(other)
+            differing = sum(differing_part(a, b) is not None for a, b in zip(texts, their_texts))
             line |= {
                 "against": args.against,
                 "against_plan_ms_median": other["plan_ms_median"],
@@ -251,7 +285,7 @@ def main() -> None:
                 "plans_differing": differing,
             }
             if differing:
-                print(f"{row['case']} {row['mode']}: {first_difference(row['texts'], other['texts'])}", file=sys.stderr)
+                print(f"{row['case']} {row['mode']}: {first_difference(texts, their_texts)}", file=sys.stderr)
         report.append(line)
         print(
             f"{row['case']} {row['mode']:8s} {row['clouds']} clouds: {line['plan_ms_median']:.3f} ms a frame"

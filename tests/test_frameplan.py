@@ -2,6 +2,7 @@
 
 import dataclasses
 import math
+from decimal import Decimal, getcontext
 
 import numpy as np
 import pytest
@@ -91,6 +92,24 @@ def test_the_parallax_error_is_the_centre_angle_times_the_sphere_s_depth_over_it
     assert parallax_error_deg((0, 0, 0), RADIUS, then, then) == 0.0
     # the eye has gone round to the far side: the quad shows the cloud from behind
     assert parallax_error_deg((0, 0, 0), RADIUS, orbit(1000.0, 0.0).position, orbit(1000.0, 100.0).position) == math.inf
+
+
+def test_the_parallax_error_of_a_far_cloud_is_exact_to_rounding():
+    """A cloud 100 km off seen after a step of 12 cm parts its near and far rays by a millionth of a degree: the
+    angle matches a 50-digit evaluation of the rays' own cross and dot products to 1e-12, where the rays' cross
+    product taken in floats was off by 6e-10 (their components cancel)."""
+    getcontext().prec = 50
+    centre, radius, then, now = (1.0e5, 2.0e3, -3.0e4), 700.0, (1.5, -2.0, 0.25), (1.6, -1.9, 0.3)
+    c, t, n, r = ([Decimal(v) for v in vector] for vector in (centre, then, now, (radius,)))
+    axis = [c[k] - t[k] for k in range(3)]
+    distance = sum(v * v for v in axis).sqrt()
+    near, far = ([t[k] + axis[k] / distance * (distance + side * r[0]) - n[k] for k in range(3)] for side in (-1, 1))
+    cross = [near[(k + 1) % 3] * far[(k + 2) % 3] - near[(k + 2) % 3] * far[(k + 1) % 3] for k in range(3)]
+    exact = math.degrees(
+        math.atan2(float(sum(v * v for v in cross).sqrt()), float(sum(a * b for a, b in zip(near, far))))
+    )
+    assert 0.0 < exact < 1e-5
+    assert parallax_error_deg(centre, radius, then, now) == pytest.approx(exact, rel=1e-12)
 
 
 def test_a_distant_cloud_tolerates_proportionally_more_motion():

@@ -71,24 +71,20 @@ def seen_from(units: LodUnits, pricing: Pricing, priced: bool = True) -> Seen:
     every price zero."""
     eye, last_eye, focal_px, screen_pixels = pricing.eye, pricing.last_eye, pricing.focal_px, pricing.screen_pixels
     centres, radii = units.centres, units.radii
-    distances = np.linalg.norm(centres - eye, axis=1)
+    distances = row_lengths(centres - eye)
     if not priced:
         nothing = np.zeros(len(radii))
         return Seen(distances, nothing, nothing, nothing, nothing, nothing + 1.0)
     # the translation error of one frame at the eye's current speed
     rates = pricing.translation_error(centres, radii, last_eye, eye) if last_eye is not None else np.zeros(len(radii))
     object_centres, object_radii, depth_steps = pricing.splitting
-    reach = np.linalg.norm(centres[:, None] - object_centres[None], axis=2) < radii[:, None] + object_radii[None]
-    reach &= (radii > 0.0)[:, None]
-    # an object moving in depth inside a unit remakes its layers once it passes a particle it covers
-    # (`cloudcore.lod.splitting.layers_hold`): about every 2R / m metres of depth, m of the unit's particles
-    # overlapping it on screen, their share the area of a disc of its radius plus a typical particle's over the unit's
-    typical_radii = np.sqrt(units.radius_squares / np.maximum(units.particle_counts, 1.0))
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        covered_shares = np.minimum(((object_radii[None] + typical_radii[:, None]) / radii[:, None]) ** 2, 1.0)
-        spacings = 2.0 * radii[:, None] / np.maximum(units.particle_counts[:, None] * covered_shares, 1.0)
-        split_lifetimes = np.nan_to_num(spacings / depth_steps[None], nan=math.inf)
-    split_lifetimes = np.min(np.where(reach, split_lifetimes, math.inf), axis=1, initial=math.inf)
+    if len(object_radii):
+        reach = np.linalg.norm(centres[:, None] - object_centres[None], axis=2) < radii[:, None] + object_radii[None]
+        reach &= (radii > 0.0)[:, None]
+        split_lifetimes = _split_lifetimes(units, reach, object_radii, depth_steps)
+        layers = 1.0 + np.count_nonzero(reach, axis=1)
+    else:  # most scenes: no object splits a unit
+        split_lifetimes, layers = np.full(len(radii), math.inf), np.ones(len(radii))
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # the eye inside: the whole screen
         half_sides = radii * distances / np.sqrt(np.maximum((distances - radii) * (distances + radii), 1e-300))
         quad_pixels = np.nan_to_num(
@@ -106,8 +102,22 @@ def seen_from(units: LodUnits, pricing: Pricing, priced: bool = True) -> Seen:
                 np.full(len(radii), LONGEST_LIFETIME_FRAMES),
             ]
         ),
-        1.0 + np.count_nonzero(reach, axis=1),
+        layers,
     )
+
+
+def _split_lifetimes(units: LodUnits, reach, object_radii, depth_steps) -> np.ndarray:
+    """Per unit, the frames until an object moving in depth inside it (`reach`: unit by object) remakes its
+    layers: once it passes a particle it covers (`cloudcore.lod.splitting.layers_hold`), about every 2R / m
+    metres of depth, m of the unit's particles overlapping it on screen, their share the area of a disc of its
+    radius plus a typical particle's over the unit's."""
+    radii = units.radii
+    typical_radii = np.sqrt(units.radius_squares / np.maximum(units.particle_counts, 1.0))
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        covered_shares = np.minimum(((object_radii[None] + typical_radii[:, None]) / radii[:, None]) ** 2, 1.0)
+        spacings = 2.0 * radii[:, None] / np.maximum(units.particle_counts[:, None] * covered_shares, 1.0)
+        split_lifetimes = np.nan_to_num(spacings / depth_steps[None], nan=math.inf)
+    return np.min(np.where(reach, split_lifetimes, math.inf), axis=1, initial=math.inf)
 
 
 class Pricing(NamedTuple):
