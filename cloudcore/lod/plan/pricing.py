@@ -284,7 +284,8 @@ def ring_work(
     """
     offsets = centres[candidates] - eye
     azimuths = np.degrees(np.arctan2(offsets[:, 0], -offsets[:, 2])) % 360.0
-    panels = len(np.unique(np.floor(azimuths / SEGMENT_DEG)))
+    segments = (azimuths // SEGMENT_DEG).astype(np.int64) % SEGMENTS  # a tiny negative azimuth % 360 gives 360
+    panels = int(np.count_nonzero(np.bincount(segments, minlength=SEGMENTS)))
     horizontal, vertical = math.hypot(step[0], step[2]), abs(step[1])
     moved = min(
         LONGEST_LIFETIME_FRAMES,
