@@ -635,6 +635,60 @@ def test_the_ring_is_rebuilt_after_15_percent_across_or_2_percent_up(move, rebui
     assert (moved[0].ring.build_segment == 0) is rebuilds
 
 
+def run_ring_flight(steps, state=None, lighting=1, ring_keys=None):
+    """The ring's plans as the eye moves by each of `steps` (x, y, z) in turn, from (0, 100, 0)."""
+    units = units_of(FAR_CLOUDS, (RADIUS,) * len(FAR_CLOUDS))
+    eye, state, plans = np.array([0.0, 100.0, 0.0]), state if state is not None else LodState(), []
+    for step in steps:
+        eye = eye + step
+        camera = camera_at(eye, look_at=eye + (0.0, 0.0, -1.0))
+        plans.append(plan_frame(units, camera, VIEWPORT, RING, state, lighting, ring_keys=ring_keys))
+        state = plans[-1].state
+    return plans
+
+
+SETTLED = [(0.0, 0.0, 0.0)] * (SEGMENTS + RING.ring_fade_frames + 1)
+
+
+@pytest.mark.parametrize(
+    "step_m, frames_to_show",
+    [
+        (1.0, SEGMENTS + RING.ring_fade_frames),  # 37 frames to a quarter of the rebuild distance: Wang's pace
+        (6.0, 6),  # 6.25 frames: 4 to build, two segments each, 2 to fade
+        (160.0, 1),  # past the rebuild distance in one frame: built and shown at once
+    ],
+)
+def test_the_ring_keeps_pace_with_the_eye(step_m, frames_to_show):
+    """A segment a frame and the fade would leave the ring shown far behind an eye that moves fast against its
+    radius (a cloud field's flight sampled 160 m a frame: panels 2.5 km behind, 24 dB): the rebuild takes at most
+    the frames the eye takes to move a quarter of a rebuild distance, several segments a frame, down to one frame."""
+    settled = run_ring_flight(SETTLED)[-1].state
+    approach = math.ceil(0.15 * RING.ring_radius / step_m) + 1  # frames until it is rebuilt, and then to show it
+    plans = run_ring_flight([(step_m, 0.0, 0.0)] * (approach + frames_to_show + 1), settled)
+    started = next(i for i, p in enumerate(plans) if p.ring.builds)
+    shown = next(i for i, p in enumerate(plans) if p.ring.draws[0][0] is not settled.ring.current)
+    fresh = plans[shown].ring.draws[0][0]
+    assert fresh.eye == plans[started].ring.building.eye and plans[shown].ring.draws[0][1] > 0.0
+    # shown (fading in) from the frame after its last segment, or that very frame when there is no frame to fade
+    shown_whole = next(i for i, p in enumerate(plans) if p.ring.draws == ((fresh, 1.0),))
+    assert shown_whole - started + 1 == frames_to_show
+    built = [segment for p in plans[started : shown_whole + 1] for segment, _ in p.ring.builds]
+    assert built == list(range(SEGMENTS))
+    assert plans[shown_whole].settled is (frames_to_show > 1)
+
+
+def test_the_ring_goes_stale_by_its_own_keys_where_they_are_given():
+    """A cloud field's blend weights change its clouds' keys as the eye moves (their impostors are remade), but
+    not the ring's keys: the eye's motion, which rebuilds the ring, bounds them; a change of colours does."""
+    settled = run_ring_flight(SETTLED)[-1].state
+    colours = (1,) * len(FAR_CLOUDS)
+    blended = [(1, 0.25 + 0.0625 * frame) for frame in range(len(FAR_CLOUDS))]
+    kept = run_ring_flight([(0.0, 0.0, 0.0)], settled, lighting=tuple(blended), ring_keys=colours)[0]
+    assert not kept.ring.builds and kept.ring.draws == ((settled.ring.current, 1.0),)
+    relit = run_ring_flight([(0.0, 0.0, 0.0)], settled, lighting=tuple(blended), ring_keys=(2,) * len(FAR_CLOUDS))
+    assert relit[0].ring.build_segment == 0
+
+
 def test_a_window_grown_from_a_tiny_first_frame_rebuilds_the_ring_at_the_new_resolution():
     """The editor's first frame has a tiny viewport: a ring built then has 16-texel panels, and must not
     stay so once the window has its size (issue 17's blurred smudges and seam)."""
@@ -772,6 +826,9 @@ def test_a_rebuilt_segment_dearer_than_the_ring_s_share_of_a_frame_is_built_in_p
     for _ in range(RING.ring_fade_frames):
         state = at((0.0, 100.0, 0.0), state).state
     shown = state.ring.current
+    # the eye comes to within a metre of the rebuild distance, then steps past it: rebuilt at Wang's pace (a jump
+    # past it would build the whole ring at once: `test_the_ring_keeps_pace_with_the_eye`)
+    state = at((149.0, 100.0, 0.0), state).state
     eye = np.array([151.0, 100.0, 0.0])  # past 15% of the ring's radius: rebuilt
     pieces = []
     for _ in range(4 * len(centres)):

@@ -101,3 +101,38 @@ def test_extreme_fields_render_in_every_mode(own_renderer, name):
             assert stats.clouds_drawn > 0 and np.abs(image.astype(int) - sky.astype(int)).mean() > 1.0
         if name == "a field far away":
             assert not renderer.field_state.cells and np.array_equal(image, sky)
+
+
+def test_the_field_s_ring_is_kept_while_only_blend_weights_change_and_keeps_up_with_a_jump():
+    """Wang's ring over the field: flown 12 m a frame within the rebuild distance, the ring's clouds blend (their
+    keys change, so their own impostors would be remade) but the ring shown is kept; after a jump of 2 km it is
+    built and shown in that very frame, close to full 3D (before: remade every frame the weights stepped, and
+    shown 16 frames behind the eye)."""
+    from cloudcore.field.state import update_field
+    from cloudcore.gl import FrameRenderer
+    from cloudcore.lod.ring import SEGMENTS
+    from cloudcore.measure.imagecompare import compare
+
+    settings = RenderSettings(mode="impostor", ring_radius=2000.0)
+    scene = Scene(camera=ABOVE, cloud_field=FIELD)
+
+    def at(x: float) -> Camera:  # just above the field, looking ahead: its far clouds within the ring's band
+        return dataclasses.replace(ABOVE, position=(x, 2200.0, 0.0), look_at=(x, 1600.0, -3000.0))
+
+    with FrameRenderer(160, 120) as impostors, FrameRenderer(160, 120) as full:
+        for _ in range(SEGMENTS + settings.ring_fade_frames + 1):
+            impostors.render(scene, camera=at(0.0), settings=settings)
+        shown = impostors.lod_state.ring.current
+        assert shown is not None and shown.members
+        for x in np.arange(12.0, 0.15 * settings.ring_radius, 12.0):
+            impostors.render(scene, camera=at(x), settings=settings)
+            assert impostors.lod_state.ring.current is shown and impostors.lod_state.ring.pending is None
+        before, _ = update_field(FIELD, at(0.0).position)
+        after, _ = update_field(FIELD, at(x).position)
+        assert before.fade_keys != after.fade_keys  # the ring's clouds blended on the way
+        image, stats = impostors.render(scene, camera=at(2000.0), settings=settings)
+        ring = impostors.lod_state.ring
+        assert ring.current.eye == at(2000.0).position and ring.pending is None
+        assert stats.plan.ring_segments_built > 0 and stats.plan.clouds_by_kind["ring"] > 0
+        reference, _ = full.render(scene, camera=at(2000.0), settings=FULL_3D)
+        assert compare(image, reference).psnr_db > 35.0

@@ -123,7 +123,7 @@ class FrameRenderer:
         #: per cloud, changes whenever that cloud's particle colours may have: its impostor is stale
         self._lighting_keys: tuple = ()
         self._forming_clouds: tuple = ()  # the clouds that form or dissipate, whose colours follow the clock
-        self._cloud_keys_source, self._cloud_keys_made = None, ()
+        self._cloud_keys_source, self._cloud_keys_made = None, ((), ())
         self._key_serial = 0
         #: the level of detail's state between frames (impostor cache, ring, representations, costs)
         self.lod_state = LodState()
@@ -221,7 +221,7 @@ class FrameRenderer:
         particles.weigh(self._field_weights)
         poses = self._objects.poses(time_s) if self._objects is not None else ()
         starts = particles.cloud_starts
-        cloud_keys = self._cloud_keys(scene, fade_keys, time_s)
+        cloud_keys, ring_keys = self._cloud_keys(scene, fade_keys, time_s)
         # the units follow the particles' places and sizes, not their light: a relit scene keeps them
         if (scene.clouds, settings.group_clouds) != self._units_source:
             self._units = lod_units(particles, settings.group_clouds, authored_clouds)
@@ -240,6 +240,7 @@ class FrameRenderer:
                 particles.centres[starts[cloud] : starts[cloud + 1]],
                 particles.radii[starts[cloud] : starts[cloud + 1]],
             ),
+            ring_keys,
         )
         self.last_plan = plan
 
@@ -405,21 +406,25 @@ class FrameRenderer:
         self._particles_source = particles_source
         return 1e3 * (time.perf_counter() - start)
 
-    def _cloud_keys(self, scene: Scene, fade_keys: tuple, time_s: float) -> tuple:
-        """Per cloud, what its colours are made from this frame: its lighting key, and as a forming or
+    def _cloud_keys(self, scene: Scene, fade_keys: tuple, time_s: float) -> tuple[tuple, tuple]:
+        """(per cloud, what its colours are made from this frame: its lighting key, and as a forming or
         dissipating cloud's colours change with the clock and a field's cloud's with its blend weights, those
-        (its impostor is stale meanwhile).  The same tuple as the frame before while none changed: the plan
-        then finds its ring's clouds unchanged at once (`cloudcore.lod.ring`), with no cloud looked at."""
+        (its impostor is stale meanwhile); the same less the blend weights, what Wang's ring goes stale by:
+        they follow the eye's place, which its rebuild distance bounds (`plan_frame`'s `ring_keys`)).  The same
+        tuples as the frame before while none changed: the plan then finds its ring's clouds unchanged at once
+        (`cloudcore.lod.ring`), with no cloud looked at."""
         forming = tuple(
             (index, formation_state(scene.clouds[index].formation, time_s)) for index in self._forming_clouds
         )
         source = (self._lighting_keys, fade_keys, forming)
         if source != self._cloud_keys_source:
             states = dict(forming)
+            colours = tuple((key, states.get(index)) for index, key in enumerate(self._lighting_keys))
             self._cloud_keys_source = source
-            self._cloud_keys_made = tuple(
-                (key, states.get(index), fade)  # a cloud that neither forms nor dissipates: None
-                for index, (key, fade) in enumerate(zip(self._lighting_keys, fade_keys))
+            held = self._cloud_keys_made[1]
+            self._cloud_keys_made = (
+                tuple((*colour, fade) for colour, fade in zip(colours, fade_keys)),  # unformed: state None
+                held if colours == held else colours,  # only blend weights changed: the ring's keys are as they were
             )
         return self._cloud_keys_made
 

@@ -77,13 +77,15 @@ class ImpostorStore:
             self._release(self._clouds.pop(index)[0])
 
         ring = plan.ring
-        if ring is not None and ring.build_members:
+        for segment, piece, members in ring.segment_builds() if ring is not None else ():
+            if not members:
+                continue
             # a piece of the segment, its clouds far to near (`cloudcore.lod.ring`): the first clears the texture,
             # the next are drawn over it
-            generation, segment, first = ring.state.pending, ring.build_segment, ring.build_piece[0] == 0
+            generation, first = ring.building, piece[0] == 0
             size = generation.texture_size
             view, projection = segment_camera(generation, segment, settings.ring_elevation_deg)
-            clouds = [cloud for unit in ring.build_members for cloud in unit]
+            clouds = [cloud for unit in members for cloud in unit]
             extent = _extent(particles, clouds, view, projection, size)
             if first:
                 target = self.pool.acquire(*size)

@@ -100,21 +100,38 @@ class RingState:
 
 @dataclass(frozen=True)
 class RingPlan:
-    """This frame's ring work: the segment to build (of `pending`), and the generations to draw with weights."""
+    """This frame's ring work: the segments to build (of `pending`), and the generations to draw with weights."""
 
-    build_segment: int | None
     draws: tuple = field(default_factory=tuple)  # ((generation, weight), ...)
     state: RingState = RingState()
-    #: (start, stop): the members of `build_segment` drawn this frame, far to near; from 0 the texture is cleared
-    #: first, after it they are drawn over what is there
-    build_piece: tuple = (0, 0)
+    #: ((segment, (start, stop)), ...): the members of `pending`'s segments drawn this frame, far to near; from 0 a
+    #: segment's texture is cleared first, after it they are drawn over what is there.  One segment (or a piece of
+    #: one) a frame, or several where the eye would outrun that (`rebuild_frames`)
+    builds: tuple = ()
+    #: the generation `builds` are of: `state.pending`, or `state.current` where it was finished and shown at once
+    building: RingGeneration | None = None
+
+    @property
+    def build_segment(self) -> int | None:
+        """The first segment built this frame (None: none)."""
+        return self.builds[0][0] if self.builds else None
+
+    @property
+    def build_piece(self) -> tuple:
+        """The members of `build_segment` drawn this frame, (start, stop)."""
+        return self.builds[0][1] if self.builds else (0, 0)
+
+    def segment_builds(self) -> tuple:
+        """((segment, piece, the ids of the members drawn into it this frame), ...)."""
+        if self.building is None:
+            return ()
+        members = self.building.segment_members
+        return tuple((segment, piece, members[segment][slice(*piece)]) for segment, piece in self.builds)
 
     @property
     def build_members(self) -> tuple:
-        """The ids of the members drawn into the segment this frame (none: no segment built)."""
-        if self.build_segment is None or self.state.pending is None:
-            return ()
-        return self.state.pending.segment_members[self.build_segment][slice(*self.build_piece)]
+        """The ids of the members drawn into segments this frame (none: no segment built)."""
+        return tuple(member for _, _, members in self.segment_builds() for member in members)
 
     def weights(self, ids: tuple, row_of: Mapping) -> np.ndarray:
         """The share of the opacity of each unit of `ids` (`RingGeneration.rows_in`) the ring shows this frame."""
@@ -262,6 +279,7 @@ def plan_ring(
     holds_clouds: bool = True,
     past_tolerance: bool = False,
     build_ms: Callable[[Hashable], float] | None = None,
+    step=None,
 ) -> RingPlan | None:
     """Advance the ring by one frame: start a rebuild if needed, build one segment or step the fade.
 
@@ -276,7 +294,10 @@ def plan_ring(
     the rebuild distance.
     `build_ms`: per id, the predicted ms of drawing it into a segment; a ring rebuilt while one holding clouds
     shows draws a segment's members far to near in pieces of at most `RING_FRAME_MS` (one member at least), each
-    over the last.  None, or no such ring shown: a segment a frame.
+    over the last.  None, or no such ring shown: a segment a frame.  `step`: the eye's motion since the last
+    frame (None: still), which sets the rebuild's pace (`rebuild_frames`): where a segment a frame and the fade
+    would take longer than the eye takes to move a quarter of a rebuild distance, the segments are built several
+    a frame, whole, and the fade is shortened, down to the whole ring built and shown in one frame.
 
     A ring being built when its members' keys change is finished first and rebuilt after: a cloud
     forming in the ring, whose key changes every frame, would otherwise keep the ring from ever
@@ -305,16 +326,38 @@ def plan_ring(
         pending = new_generation(centres, radii, eye, settings, cloud_keys, ids, texture_size, holds_clouds)
         built, fade_step = (0 if holds_clouds else SEGMENTS), 0  # a ring of nothing has nothing to build
     built_of_segment = state.built_of_segment if pending is state.pending else 0
-    build_segment, build_piece = None, (0, 0)
+    builds, building = (), pending
+    # the rebuild keeps pace with the eye: at flying speeds a segment a frame and then the fade, as Wang; where the
+    # eye would move more than its share of a rebuild distance meanwhile, in as many frames as that leaves (none: the
+    # whole ring at once, shown at once), else the ring shown lags its eye by the rebuild's frames and, the rebuild
+    # distance passed again before it is in, never catches up (the cumulus field's flight sampled 160 m a frame:
+    # panels 2.5 km behind the eye, 24 dB)
+    frames = rebuild_frames(step, settings)
+    paced = frames >= SEGMENTS + settings.ring_fade_frames
+    fade_frames = (
+        settings.ring_fade_frames
+        if paced
+        else int(frames * settings.ring_fade_frames / (SEGMENTS + settings.ring_fade_frames))
+    )
     if pending is not None:
         if built < SEGMENTS:
-            members = pending.segment_members[built]
-            shown = current is not None and current.holds_clouds  # else the clouds cost more until it is in
-            stop = _piece_end(members, built_of_segment, build_ms if shown else None)
-            build_segment, build_piece = built, (built_of_segment, stop)
-            built, built_of_segment = (built + 1, 0) if stop == len(members) else (built, stop)
+            if paced:
+                members = pending.segment_members[built]
+                shown = current is not None and current.holds_clouds  # else the clouds cost more until it is in
+                stop = _piece_end(members, built_of_segment, build_ms if shown else None)
+                builds = ((built, (built_of_segment, stop)),)
+                built, built_of_segment = (built + 1, 0) if stop == len(members) else (built, stop)
+            else:
+                count = math.ceil(SEGMENTS / max(int(frames) - fade_frames, 1))  # a share of the whole ring a frame
+                builds = tuple(
+                    (segment, (built_of_segment if segment == built else 0, len(pending.segment_members[segment])))
+                    for segment in range(built, min(built + count, SEGMENTS))
+                )
+                built, built_of_segment = built + len(builds), 0
+                if built == SEGMENTS and fade_frames == 0:
+                    fade_step = settings.ring_fade_frames  # no frame to fade in: shown this frame
         else:
-            fade_step += 1
+            fade_step += math.ceil(settings.ring_fade_frames / max(fade_frames, 1))
     draws = ()
     if pending is not None and fade_step >= settings.ring_fade_frames:
         current, pending, built, fade_step = pending, None, 0, 0
@@ -324,11 +367,31 @@ def plan_ring(
     elif current is not None:
         draws = ((current, 1.0),)
     return RingPlan(
-        build_segment,
         draws,
         RingState(current, pending, built, fade_step, since_rebuild, rebuild_interval, built_of_segment),
-        build_piece,
+        builds,
+        building if builds else None,
     )
+
+
+#: a rebuild takes at most the frames the eye takes to move this share of a rebuild distance: the ring shown is
+#: then never more than that past Wang's thresholds (a quarter: at 30 fps and 200 m/s, 22 frames for a 4 km
+#: ring, room for his segment a frame and the fade)
+REBUILD_PACE_SHARE = 0.25
+
+
+def rebuild_frames(step, settings: RenderSettings) -> float:
+    """Frames the eye, moving `step` (x, y, z) a frame, takes to move `REBUILD_PACE_SHARE` of a rebuild distance,
+    horizontally or vertically, whichever comes first (inf: a still eye)."""
+    step = np.zeros(3) if step is None else np.asarray(step, dtype=np.float64)
+    frames = math.inf
+    for moved, share in (
+        (math.hypot(step[0], step[2]), settings.ring_rebuild_horizontal),
+        (abs(step[1]), settings.ring_rebuild_vertical),
+    ):
+        if moved > 0.0:
+            frames = min(frames, REBUILD_PACE_SHARE * share * settings.ring_radius / moved)
+    return frames
 
 
 def _piece_end(members: tuple, start: int, build_ms: Callable[[Hashable], float] | None) -> int:

@@ -74,10 +74,8 @@ class FramePlan:
             impostors_regenerated=sum(reasons.values()),
             regeneration_reasons=reasons,
             regenerations_postponed=sum(1 for reason in units.postponed.values() if reason),
-            ring_segments_built=int(
-                self.ring is not None
-                and self.ring.state.pending is not None
-                and self.ring.build_segment in self.ring.state.pending.occupied_segments
+            ring_segments_built=(
+                sum(1 for _, _, members in self.ring.segment_builds() if members) if self.ring is not None else 0
             ),
             ring_panels_drawn=(
                 sum(len(g.occupied_segments) for g, _ in self.ring.draws) if self.ring is not None else 0
@@ -105,7 +103,9 @@ class FramePlan:
         and no ring being built or faded in.  The same inputs would then draw the same picture again;
         the editor keeps it instead (`app.viewport`), leaving the cores to the relighting worker."""
         ring_settled = self.ring is None or (
-            self.ring.state.pending is None and all(weight == 1.0 for _, weight in self.ring.draws)
+            self.ring.state.pending is None
+            and not self.ring.builds  # a ring built and shown in one frame (`cloudcore.lod.ring.rebuild_frames`)
+            and all(weight == 1.0 for _, weight in self.ring.draws)
         )
         units = self.clouds
         return (

@@ -95,6 +95,7 @@ def plan_frame(
     cloud_particles=None,
     costs: CostModel | None = None,
     cloud_splats=None,
+    ring_keys: tuple | None = None,
 ) -> FramePlan:
     """Plan one frame of `units` (`cloudcore.lod.units.LodUnits`) seen by `camera`.
 
@@ -105,6 +106,10 @@ def plan_frame(
     centres, asked only for units with objects inside.  `costs` prices auto mode's choices;
     by default the model `state.costs` has fitted to the frames so far.  `cloud_splats(i)` gives
     cloud i's (particle centres, radii), asked for units near the eye to count their fragments.
+    `ring_keys`, per cloud, is what Wang's ring goes stale by where that is less than `lighting_key`: a cloud
+    field's blend weights follow the eye's place, as parallax does, so the ring's rebuild distance bounds their
+    change in its panels, while a key that changed with them rebuilt a field's ring every frame (None: the
+    lighting keys).
     """
     scene_particles = float(np.sum(units.particle_counts))
     if state.frame_times and not comparable(state.particles, scene_particles):
@@ -122,6 +127,7 @@ def plan_frame(
             cloud_particles,
             costs,
             cloud_splats,
+            ring_keys,
         )
         drawn = {full_plan.clouds.members[i]: Representation("full", 1.0) for i in full_plan.clouds.indices_of("full")}
         return dataclasses.replace(
@@ -152,6 +158,7 @@ def plan_frame(
         "cloud_particles": cloud_particles,
         "costs": costs,
         "cloud_splats": cloud_splats,
+        "ring_keys": ring_keys,
     }
     if not groups_may_open:
         return _plan_units(units, frozenset(), **arguments)
@@ -181,6 +188,7 @@ def _plan_units(
     cloud_particles,
     costs: CostModel,
     cloud_splats,
+    ring_keys: tuple | None,
 ) -> FramePlan:
     """`plan_frame` with the groups `opened` planned apart, their clouds each a unit of its own; `pricing` is
     `pricing_of`'s, `seen` the `seen_from` of the units (of `LodUnits.and_clouds` when groups may be opened)."""
@@ -229,9 +237,9 @@ def _plan_units(
     all_full = settings.mode == "auto" and state.frame_choice == "full"
     # per unit, its full-3D work far off (particles, fragments): splat by splat for the ring's candidates in view
     in_view_particles, in_view_fragments = units.particle_counts.astype(np.float64), ball_fragments.copy()
+    step = eye - last_eye if last_eye is not None else np.zeros(3)
     if settings.mode == "auto" and settings.uses_ring:
         candidates = ring_members(centres, radii, eye, settings)
-        step = eye - last_eye if last_eye is not None else np.zeros(3)
         alone = candidates & visible
         ring_panels, ring_rebuild, moved_lifetime, tolerance_lifetime = ring_work(
             units,
@@ -268,7 +276,7 @@ def _plan_units(
         radii,
         eye,
         settings,
-        cloud_keys,
+        cloud_keys if ring_keys is None else ring_keys,
         units.members,
         units.member_set,
         segment_texture_size(height, camera.fov_y_deg, settings),
@@ -277,6 +285,7 @@ def _plan_units(
         # a segment is priced as its update is (below), by its particles: what the segment's render takes on
         # llvmpipe (478,000 particles of the 1.2M field, 368 ms: 0.77 us a particle, the fit's prior 0.85)
         build_ms=lambda members: costs.particles * float(units.particle_counts[units.row_of[members]]),
+        step=step,
     )
 
     def particles_of(index: int) -> np.ndarray:
@@ -517,10 +526,10 @@ def _plan_units(
             rows = generation.rows_in(units.members, units.row_of)
             shown = rows[visible[rows]]
             cloud_work += ring_panels_work(len(generation.occupied_segments), quad_pixels_of[shown])
-        piece = ring.build_members
+        builds = ring.segment_builds()
         update_work += Work(
-            particles=float(sum(units.particle_counts[units.row_of[u]] for u in piece)),
-            regenerations=float(bool(piece)),
+            particles=float(sum(units.particle_counts[units.row_of[u]] for _, _, piece in builds for u in piece)),
+            regenerations=float(sum(1 for _, _, piece in builds if piece)),
         )
     plans = UnitPlans(
         kinds,
