@@ -9,9 +9,8 @@ import pytest
 from cloudcore.camera import frustum_planes, projection_matrix, spheres_in_frustum, view_matrix
 from cloudcore.lod.plan import LodState, plan_frame
 from cloudcore.lod.plan.draw_items import DrawItem, draw_items
-from cloudcore.lod.plan.pricing import frames_until_ring
 from cloudcore.lod.plan.unit_plans import FULL, KINDS, UnitPlans
-from cloudcore.lod.ring import SEGMENTS, RingState, ring_members
+from cloudcore.lod.ring import SEGMENTS, RingState, frames_to_show, plan_ring, ring_members
 from cloudcore.lod.splitting import layer_bounds, layer_sort_key
 from cloudcore.lod.units import LodUnits
 from cloudcore.scene import Camera
@@ -99,13 +98,45 @@ def test_a_unit_the_ring_shows_whole_keeps_no_impostor_and_one_handed_back_is_ma
 
 def test_a_ring_candidate_s_impostor_lasts_until_the_ring_being_built_takes_it():
     settings = RenderSettings()
-    assert frames_until_ring(RingState(), settings) == SEGMENTS + settings.ring_fade_frames
+    still = np.zeros(3)
+    assert frames_to_show(RingState(), still, settings) == SEGMENTS + settings.ring_fade_frames
     units = scattered_units(400)
     frame = plan_frame(units, CAMERA, VIEWPORT, settings, LodState(), 1)
     building = frame.state.ring
     assert building.pending is not None and building.built == 1
-    assert frames_until_ring(building, settings) == SEGMENTS - 1 + settings.ring_fade_frames
-    assert frames_until_ring(RingState(current=building.pending), settings) == math.inf
+    assert frames_to_show(building, still, settings) == SEGMENTS - 1 + settings.ring_fade_frames
+    assert frames_to_show(RingState(current=building.pending), still, settings) == math.inf
+
+
+@pytest.mark.parametrize("metres_a_frame", [0.0, 5.0, 20.0, 60.0, 150.0, 400.0, 5000.0])
+def test_the_frames_a_ring_takes_to_show_are_those_plan_ring_takes_at_the_eye_s_pace(metres_a_frame):
+    """The candidates' impostor lifetimes are capped by `frames_to_show`: it counts the frames the ring's own
+    plan takes, at Wang's segment a frame and fade for a slow eye and faster for a fast one (down to one frame)."""
+    settings = RenderSettings()
+    units = scattered_units(300)
+    ids = units.members
+    step = np.array([metres_a_frame, 0.0, 0.0])
+    expected = frames_to_show(RingState(), step, settings)
+    state, frames = RingState(), 0
+    while state.current is None:
+        ring = plan_ring(
+            state,
+            units.centres,
+            units.radii,
+            CAMERA.position,
+            settings,
+            (1,) * len(ids),
+            ids,
+            frozenset(ids),
+            (256, 64),
+            step=step,
+        )
+        state, frames = ring.state, frames + 1
+        assert frames <= SEGMENTS + settings.ring_fade_frames
+    assert frames == expected
+    # a quarter of the 600 m rebuild distance over Wang's 16 frames: 9.4 m a frame
+    assert (frames == SEGMENTS + settings.ring_fade_frames) == (metres_a_frame <= 9.375)
+    assert (frames == 1) == (metres_a_frame >= 150.0)
 
 
 def test_the_draw_items_are_the_drawn_units_layers_and_objects_far_to_near_as_a_sort_of_records_would_give():

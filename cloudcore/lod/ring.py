@@ -22,6 +22,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Hashable, Mapping
 from dataclasses import dataclass, field, replace
+from typing import NamedTuple
 
 import numpy as np
 
@@ -327,37 +328,25 @@ def plan_ring(
         built, fade_step = (0 if holds_clouds else SEGMENTS), 0  # a ring of nothing has nothing to build
     built_of_segment = state.built_of_segment if pending is state.pending else 0
     builds, building = (), pending
-    # the rebuild keeps pace with the eye: at flying speeds a segment a frame and then the fade, as Wang; where the
-    # eye would move more than its share of a rebuild distance meanwhile, in as many frames as that leaves (none: the
-    # whole ring at once, shown at once), else the ring shown lags its eye by the rebuild's frames and, the rebuild
-    # distance passed again before it is in, never catches up (the cumulus field's flight sampled 160 m a frame:
-    # panels 2.5 km behind the eye, 24 dB)
-    frames = rebuild_frames(step, settings)
-    paced = frames >= SEGMENTS + settings.ring_fade_frames
-    fade_frames = (
-        settings.ring_fade_frames
-        if paced
-        else int(frames * settings.ring_fade_frames / (SEGMENTS + settings.ring_fade_frames))
-    )
+    pace = rebuild_pace(step, settings)
     if pending is not None:
         if built < SEGMENTS:
-            if paced:
+            if pace.in_pieces:
                 members = pending.segment_members[built]
                 shown = current is not None and current.holds_clouds  # else the clouds cost more until it is in
                 stop = _piece_end(members, built_of_segment, build_ms if shown else None)
                 builds = ((built, (built_of_segment, stop)),)
                 built, built_of_segment = (built + 1, 0) if stop == len(members) else (built, stop)
             else:
-                count = math.ceil(SEGMENTS / max(int(frames) - fade_frames, 1))  # a share of the whole ring a frame
                 builds = tuple(
                     (segment, (built_of_segment if segment == built else 0, len(pending.segment_members[segment])))
-                    for segment in range(built, min(built + count, SEGMENTS))
+                    for segment in range(built, min(built + pace.segments_a_frame, SEGMENTS))
                 )
                 built, built_of_segment = built + len(builds), 0
-                if built == SEGMENTS and fade_frames == 0:
+                if built == SEGMENTS and pace.fade_frames == 0:
                     fade_step = settings.ring_fade_frames  # no frame to fade in: shown this frame
         else:
-            fade_step += math.ceil(settings.ring_fade_frames / max(fade_frames, 1))
+            fade_step += pace.fade_step
     draws = ()
     if pending is not None and fade_step >= settings.ring_fade_frames:
         current, pending, built, fade_step = pending, None, 0, 0
@@ -392,6 +381,51 @@ def rebuild_frames(step, settings: RenderSettings) -> float:
         if moved > 0.0:
             frames = min(frames, REBUILD_PACE_SHARE * share * settings.ring_radius / moved)
     return frames
+
+
+class RebuildPace(NamedTuple):
+    """How fast a ring is rebuilt and faded in (`rebuild_pace`)."""
+
+    segments_a_frame: int
+    fade_frames: int  # frames the finished ring fades in over (0: shown the frame it is finished)
+    fade_step: int  # fade steps a frame, of `RenderSettings.ring_fade_frames`
+    #: Wang's pace: a segment a frame, or a piece of one where drawing it whole would take too long (`build_ms`)
+    in_pieces: bool
+
+
+def rebuild_pace(step, settings: RenderSettings) -> RebuildPace:
+    """The rebuild's pace for an eye moving `step` a frame: at flying speeds a segment a frame and then the fade,
+    as Wang; where the eye would move more than `REBUILD_PACE_SHARE` of a rebuild distance meanwhile, in as many
+    frames as that leaves (none: the whole ring at once, shown at once).  Else the ring shown lags its eye by the
+    rebuild's frames and, the rebuild distance passed again before it is in, never catches up (the cumulus field's
+    flight sampled 160 m a frame: panels 2.5 km behind the eye, 24 dB)."""
+    frames, fade = rebuild_frames(step, settings), settings.ring_fade_frames
+    if frames >= SEGMENTS + fade:
+        return RebuildPace(1, fade, 1, in_pieces=True)
+    fade_frames = int(frames * fade / (SEGMENTS + fade))
+    return RebuildPace(
+        math.ceil(SEGMENTS / max(int(frames) - fade_frames, 1)),  # a share of the whole ring a frame
+        fade_frames,
+        math.ceil(fade / max(fade_frames, 1)),
+        in_pieces=False,
+    )
+
+
+def frames_to_show(state: RingState, step, settings: RenderSettings) -> float:
+    """Frames until the ring being built (or, with none yet, the first, begun this frame) shows its clouds
+    whole at the eye's current `step` a frame: its segments left, then its fade (inf: no ring holding clouds is
+    on its way)."""
+    if state.current is None and state.pending is None:
+        built, fade_step = 0, 0
+    elif state.pending is None or not state.pending.holds_clouds:
+        return math.inf
+    else:
+        built, fade_step = state.built, state.fade_step
+    pace = rebuild_pace(step, settings)
+    building = math.ceil((SEGMENTS - built) / pace.segments_a_frame)
+    if pace.fade_frames == 0:
+        return float(building)
+    return float(building + math.ceil((settings.ring_fade_frames - fade_step) / pace.fade_step))
 
 
 def _piece_end(members: tuple, start: int, build_ms: Callable[[Hashable], float] | None) -> int:

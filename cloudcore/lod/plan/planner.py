@@ -41,7 +41,6 @@ from cloudcore.lod.plan.pricing import (
     NEAR_EXACT_RADII,
     Pricing,
     Seen,
-    frames_until_ring,
     held_impostor_errors,
     impostor_textures,
     in_view_work,
@@ -73,6 +72,7 @@ from cloudcore.lod.plan.unit_plans import (
 from cloudcore.lod.ring import (
     RING_FRAME_MS,
     RingState,
+    frames_to_show,
     plan_ring,
     ring_members,
     segment_texture_size,
@@ -269,7 +269,7 @@ def _plan_units(
         alone_ms = ms_drawn_alone(units, seen, alone, in_view, focal_px, settings, costs)
         # a candidate drawn on its own until a ring being built takes it: an impostor made for it now lasts only
         # that long (Harris's circle at 800 clouds made 136 impostors in its first frame for a ring in 16 frames)
-        lifetimes = np.where(candidates, np.minimum(lifetimes, frames_until_ring(state.ring, settings)), lifetimes)
+        lifetimes = np.where(candidates, np.minimum(lifetimes, frames_to_show(state.ring, step, settings)), lifetimes)
     ring = plan_ring(
         state.ring,
         centres,

@@ -34,7 +34,6 @@ from cloudcore.lod.ring import (
 )
 from cloudcore.lod.units import LodUnits
 from cloudcore.scene import Camera
-from cloudcore.settings import RenderSettings
 from cloudcore.vectors import row_lengths
 
 #: an impostor predicted to last longer than this many frames is priced as if it lasted this long
@@ -253,16 +252,6 @@ def ms_drawn_alone(units: LodUnits, seen: Seen, chosen, in_view, focal_px, setti
     cheaper of full 3D (`in_view`: its particles and fragments in view) and an impostor (`impostor_ms_of`)."""
     full = costs.particles * in_view[0] + costs.fragments * in_view[1]
     return float(np.sum(np.minimum(full, impostor_ms_of(units, seen, chosen, focal_px, settings, costs))))
-
-
-def frames_until_ring(state: RingState, settings: RenderSettings) -> float:
-    """Frames until the ring being built (or, with none yet, the first, begun this frame) shows its clouds
-    whole: its segments left, one a frame, then its fade (inf: no ring holding clouds is on its way)."""
-    if state.current is None and state.pending is None:
-        return float(SEGMENTS + settings.ring_fade_frames)
-    if state.pending is None or not state.pending.holds_clouds:
-        return math.inf
-    return float(SEGMENTS - state.built + settings.ring_fade_frames - state.fade_step)
 
 
 def ring_panels_work(panels: int, quad_pixels) -> Work:
