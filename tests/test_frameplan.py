@@ -653,15 +653,15 @@ SETTLED = [(0.0, 0.0, 0.0)] * (SEGMENTS + RING.ring_fade_frames + 1)
 @pytest.mark.parametrize(
     "step_m, frames_to_show",
     [
-        (1.0, SEGMENTS + RING.ring_fade_frames),  # 37 frames to a quarter of the rebuild distance: Wang's pace
-        (6.0, 6),  # 6.25 frames: 4 to build, two segments each, 2 to fade
-        (160.0, 1),  # past the rebuild distance in one frame: built and shown at once
+        (1.0, SEGMENTS + RING.ring_fade_frames),  # 75 frames to half the rebuild distance: Wang's pace
+        (12.0, 6),  # 6.25 frames: 4 to build, two segments each, 2 to fade
+        (160.0, 1),  # past half the rebuild distance in one frame: built and shown at once
     ],
 )
 def test_the_ring_keeps_pace_with_the_eye(step_m, frames_to_show):
     """A segment a frame and the fade would leave the ring shown far behind an eye that moves fast against its
     radius (a cloud field's flight sampled 160 m a frame: panels 2.5 km behind, 24 dB): the rebuild takes at most
-    the frames the eye takes to move a quarter of a rebuild distance, several segments a frame, down to one frame."""
+    the frames the eye takes to move half a rebuild distance, several segments a frame, down to one frame."""
     settled = run_ring_flight(SETTLED)[-1].state
     approach = math.ceil(0.15 * RING.ring_radius / step_m) + 1  # frames until it is rebuilt, and then to show it
     plans = run_ring_flight([(step_m, 0.0, 0.0)] * (approach + frames_to_show + 1), settled)

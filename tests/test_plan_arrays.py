@@ -134,9 +134,9 @@ def test_the_frames_a_ring_takes_to_show_are_those_plan_ring_takes_at_the_eye_s_
         state, frames = ring.state, frames + 1
         assert frames <= SEGMENTS + settings.ring_fade_frames
     assert frames == expected
-    # a quarter of the 600 m rebuild distance over Wang's 16 frames: 9.4 m a frame
-    assert (frames == SEGMENTS + settings.ring_fade_frames) == (metres_a_frame <= 9.375)
-    assert (frames == 1) == (metres_a_frame >= 150.0)
+    # half the 600 m rebuild distance over Wang's 16 frames: 18.75 m a frame
+    assert (frames == SEGMENTS + settings.ring_fade_frames) == (metres_a_frame <= 18.75)
+    assert (frames == 1) == (metres_a_frame > 150.0)  # half the rebuild distance in under two frames
 
 
 def test_the_draw_items_are_the_drawn_units_layers_and_objects_far_to_near_as_a_sort_of_records_would_give():

@@ -169,17 +169,17 @@ def panel_corners(generation: RingGeneration, segment: int, elevation_deg: float
 
 def ring_members(centres: np.ndarray, radii: np.ndarray, eye, settings: RenderSettings) -> np.ndarray:
     """Boolean (N,): clouds wholly beyond the ring radius and wholly inside its elevation band, seen from `eye`."""
-    offset = centres - np.asarray(eye, dtype=np.float64)
-    horizontal = np.hypot(offset[:, 0], offset[:, 2])
-    distance = np.linalg.norm(offset, axis=1)
-    elevation = np.degrees(np.arctan2(np.abs(offset[:, 1]), horizontal))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        angular_radius = np.degrees(np.arcsin(np.clip(radii / distance, 0.0, 1.0)))
-    return (
-        (radii > 0)
-        & (horizontal - radii > settings.ring_radius)
-        & (elevation + np.nan_to_num(angular_radius, nan=90.0) <= settings.ring_elevation_deg)
-    )
+    x, y, z = (np.asarray(centres, dtype=np.float64) - np.asarray(eye, dtype=np.float64)).T
+    horizontal_squared = x * x + z * z
+    horizontal = np.sqrt(horizontal_squared)
+    # the elevation of the centre plus the sphere's angular radius within the band, by their cosines (the planner
+    # asks of every cloud each frame): cos(elevation + angular radius) = (h sqrt(d^2 - r^2) - |y| r) / d^2,
+    # the sum at most 180 degrees, where the cosine falls
+    distance_squared = horizontal_squared + y * y
+    with np.errstate(invalid="ignore", divide="ignore"):
+        cosine = (horizontal * np.sqrt(distance_squared - radii * radii) - np.abs(y) * radii) / distance_squared
+    beyond = (radii > 0) & (horizontal - radii > settings.ring_radius)  # so wholly outside the eye's sphere too
+    return beyond & (cosine >= math.cos(math.radians(settings.ring_elevation_deg)))
 
 
 def segment_texture_size(viewport_height: int, fov_y_deg: float, settings: RenderSettings) -> tuple[int, int]:
@@ -363,10 +363,11 @@ def plan_ring(
     )
 
 
-#: a rebuild takes at most the frames the eye takes to move this share of a rebuild distance: the ring shown is
-#: then never more than that past Wang's thresholds (a quarter: at 30 fps and 200 m/s, 22 frames for a 4 km
-#: ring, room for his segment a frame and the fade)
-REBUILD_PACE_SHARE = 0.25
+#: a rebuild takes at most the frames the eye takes to move this share of a rebuild distance, so the ring shown is
+#: never more than that past Wang's thresholds: at aircraft speeds his segment a frame and fade fit in it (the pace
+#: is his wherever they do), and only an eye that would outrun them (a jump, a flight sampled sparsely) is built for
+#: faster (docs/lod.md, "The ring's pace")
+REBUILD_PACE_SHARE = 0.5
 
 
 def rebuild_frames(step, settings: RenderSettings) -> float:
