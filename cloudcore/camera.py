@@ -12,7 +12,6 @@ import math
 
 import numpy as np
 
-from cloudcore.light.kernel import SPLAT_REACH
 from cloudcore.scene import Camera
 
 #: metres; 1 m near and 100 km far keep 24-bit depth resolution near 0.5 m at 3 km.
@@ -131,15 +130,6 @@ def _plane_distances(planes: np.ndarray, centres: np.ndarray) -> np.ndarray:
     # plane by plane, each a contiguous row: numpy reduces rows of six slowly (0.67 against 0.04 ms for
     # 10,000 splats, which every draw near the eye tests)
     return planes[:, :3] @ np.asarray(centres, dtype=np.float64).reshape(-1, 3).T + planes[:, 3:]
-
-
-def splats_in_frustum(planes: np.ndarray, centres: np.ndarray, radii: np.ndarray) -> np.ndarray:
-    """Boolean (N,): which splats (billboards of half side `radii`, facing any way) can touch the frustum.
-
-    Next to the eye most of a cloud's particles are behind it or off to the side (along the default
-    flythrough, 82% of those of the cloud the eye is in): they cost vertices and set-up for nothing.
-    """
-    return spheres_in_frustum(planes, centres, SPLAT_REACH * np.asarray(radii, dtype=np.float64))
 
 
 def screen_box(centre, radius: float, camera: Camera, viewport: tuple[int, int]) -> tuple[slice, slice] | None:

@@ -18,7 +18,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, fields
 
-from cloudcore.lod.measured_way import COMPOSITING_WAYS, SPLAT_ORDER_WAYS
+from cloudcore.measured_way import COMPOSITING_WAYS, SPLAT_ORDER_WAYS
 
 MODES = ("auto", "full", "impostor")
 #: the names of `cloudcore.lod.impostors.TRANSLATION_METRICS` (kept here so settings import no geometry)
@@ -26,10 +26,10 @@ TRANSLATION_METRICS = ("parallax", "centre")
 #: how full-3D splats are composited (`cloudcore.light.volume_blending`)
 BLENDINGS = ("plain", "volume")
 #: where full-3D draws and impostor regenerations choose and order their particles (`cloudcore.gl.splats`; "auto":
-#: `cloudcore.lod.measured_way`)
+#: `cloudcore.measured_way`)
 SPLAT_ORDERS = ("auto", *SPLAT_ORDER_WAYS)
 #: what composites full 3D's plain splats chosen on the GPU: the raster, or a compute pass over screen tiles
-#: binned on the GPU (`cloudcore.gl.tile_binning`); "auto": `cloudcore.lod.measured_way`, per mode
+#: binned on the GPU (`cloudcore.gl.tile_binning`); "auto": `cloudcore.measured_way`, per mode
 COMPOSITINGS = ("auto", *COMPOSITING_WAYS)
 
 
@@ -234,7 +234,7 @@ class RenderSettings:
     #: "cpu": a draw's particles are chosen and sorted far to near in numpy and their order uploaded; "gpu":
     #: chosen, sorted and counted by compute shaders, drawn as quads by an indirect draw, so that the CPU's
     #: work for a draw does not grow with its particles; "auto": the one measured faster on this GL
-    #: (`cloudcore.lod.measured_way`: on llvmpipe the CPU's, whose sort is 5-9 times faster, the frame 1.32)
+    #: (`cloudcore.measured_way`: on llvmpipe the CPU's, whose sort is 5-9 times faster, the frame 1.32)
     splat_order: str = _setting(
         "auto",
         flag="--splat-order",

@@ -18,8 +18,8 @@ import imageio.v3 as iio
 import numpy as np
 
 from cloudcore.colour import linear_to_srgb8
-from cloudcore.light.truth import luminance
 from cloudcore.measure.imagecompare import load_rgb8
+from cloudcore.measure.truth_comparison import luminance
 
 GAP = 4
 

@@ -16,7 +16,7 @@ from cloudcore.artist.artist_shading import (
 from cloudcore.artist.cloudgen import preset_cloud
 from cloudcore.cloud_records import ArtistShading
 from cloudcore.errors import FieldError
-from cloudcore.light.lighting import sun_direction
+from cloudcore.sun import sun_direction
 
 LEVELS = (
     (0.0, 0.2, 0.3, 0.4, 1.0),

@@ -9,9 +9,10 @@ import numpy as np
 import pytest
 from conftest import VALLEY
 
+from cloudcore.lod.plan.plan_stats import PlanStats
 from cloudcore.measure import benchmark
 from cloudcore.measure.benchmark import bench_path, pareto_front, ratio_interval, turns
-from cloudcore.measure.frame_stats import FrameStats, PlanStats
+from cloudcore.measure.frame_stats import FrameStats
 from cloudcore.scenefile import load_scene
 from cloudcore.settings import FULL_3D, RenderSettings
 

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 from conftest import VALLEY
 
-from cloudcore.light.lighting import elevation_deg, sun_direction
 from cloudcore.paths import sample
 from cloudcore.scenefile import load_scene
+from cloudcore.sun import elevation_deg, sun_direction
 from cloudcore.terrain import heightfield_mesh
 
 

@@ -7,7 +7,7 @@ from decimal import Decimal, getcontext
 import numpy as np
 import pytest
 
-from cloudcore.camera import frustum_planes, projection_matrix, splats_in_frustum, view_matrix
+from cloudcore.camera import frustum_planes, projection_matrix, view_matrix
 from cloudcore.lod.costs import CostModel, Work
 from cloudcore.lod.impostors import content_depth, impostor_view, parallax_error_deg, translation_error_deg
 from cloudcore.lod.plan import FRAME_SETTLE_FRAMES, PROBE_FRAMES, SWITCH_MARGIN, LodState, inside_runs, plan_frame
@@ -16,6 +16,7 @@ from cloudcore.lod.ring import SEGMENTS, RingState
 from cloudcore.lod.units import LodUnits, SplatSample
 from cloudcore.scene import Camera
 from cloudcore.settings import RenderSettings
+from cloudcore.splat_coverage import splats_in_frustum
 
 RADIUS = 100.0
 NO_RING = RenderSettings(ring_radius=math.inf)

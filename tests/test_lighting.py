@@ -3,8 +3,9 @@
 import numpy as np
 import pytest
 
-from cloudcore.light.lighting import active_lights, daylight, elevation_deg, scene_lights, sky_colors, sun_direction
+from cloudcore.light.lighting import active_lights, daylight, scene_lights, sky_colors
 from cloudcore.scene import Light, Lighting
+from cloudcore.sun import elevation_deg, sun_direction
 
 
 def test_sun_rises_in_the_east_peaks_south_at_noon_and_sets_in_the_west():

@@ -3,7 +3,7 @@ faster."""
 
 import pytest
 
-from cloudcore.lod.measured_way import COMPOSITING_WAYS, TRIAL_FRAMES, MeasuredWay, software_rasterizer
+from cloudcore.measured_way import COMPOSITING_WAYS, TRIAL_FRAMES, MeasuredWay, software_rasterizer
 
 GPU = "NVIDIA H200/PCIe/SSE2"
 LLVMPIPE = "llvmpipe (LLVM 15.0.6, 256 bits)"

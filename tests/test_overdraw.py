@@ -3,17 +3,11 @@
 import numpy as np
 import pytest
 
-from cloudcore.camera import (
-    FAR_PLANE_M,
-    NEAR_PLANE_M,
-    frustum_planes,
-    projection_matrix,
-    splats_in_frustum,
-    view_matrix,
-)
-from cloudcore.measure.overdraw import Overdraw, analytic_overdraw, overdraw_statistics, splats_in_view
+from cloudcore.camera import FAR_PLANE_M, NEAR_PLANE_M, frustum_planes, projection_matrix, view_matrix
+from cloudcore.measure.overdraw import Overdraw, overdraw_statistics
 from cloudcore.scene import Camera, Cloud, Scene
 from cloudcore.settings import FULL_3D
+from cloudcore.splat_coverage import analytic_overdraw, splats_in_frustum, splats_in_view
 
 CAMERA = Camera((0.0, 0.0, 1000.0), (0.0, 0.0, 0.0), 60.0)
 

@@ -9,7 +9,6 @@ from cloudcore import disk_cache
 from cloudcore.light import precomputed
 from cloudcore.light.eye_scattering import ParticleBuffer
 from cloudcore.light.illumination import illuminate_direction
-from cloudcore.light.kernel import KERNEL_DIAMETER_INTEGRAL, splat_kernel
 from cloudcore.light.occlusion import occlusion_estimate
 from cloudcore.light.phase import phase_function
 from cloudcore.light.precomputed import (
@@ -23,6 +22,7 @@ from cloudcore.light.shading import eye_pass_coefficients, incident_light
 from cloudcore.resources import resource_path
 from cloudcore.scene import Cloud, Light, Scene, Shading
 from cloudcore.scenefile import load_scene, save_scene
+from cloudcore.splat_kernel import KERNEL_DIAMETER_INTEGRAL, splat_kernel
 
 #: small enough to build in about a second: for the tests of the cache, not of accuracy
 TINY = TableResolution(

@@ -6,7 +6,8 @@ import math
 import numpy as np
 import pytest
 
-from cloudcore.measure.frame_stats import FrameStats, PlanStats
+from cloudcore.lod.plan.plan_stats import PlanStats
+from cloudcore.measure.frame_stats import FrameStats
 from cloudcore.measure.overdraw import Overdraw
 from cloudcore.measure.recording import COLUMNS, MAX_RECORDED_FRAMES, frame_row, frame_times
 

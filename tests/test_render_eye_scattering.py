@@ -12,8 +12,8 @@ import pytest
 from cloudcore.camera import projection_matrix, view_matrix
 from cloudcore.cloud_records import Formation
 from cloudcore.light.eye_scattering import ParticleBuffer
-from cloudcore.light.kernel import splat_kernel
 from cloudcore.scene import Camera, Cloud, Light, Shading
+from cloudcore.splat_kernel import splat_kernel
 
 WIDTH, HEIGHT = 160, 120
 CAMERA = Camera((0.0, 0.0, 0.0), (0.0, 0.0, -1.0), 60.0)
@@ -100,8 +100,8 @@ def test_the_shader_colours_artist_clouds_as_the_reference_does(renderer):
     from cloudcore.cloud_records import ArtistShading
     from cloudcore.gl.splats import SplatPass, splat_batch
     from cloudcore.gl.targets import TextureTarget
-    from cloudcore.light.lighting import sun_direction
     from cloudcore.scene import Lighting
+    from cloudcore.sun import sun_direction
 
     particles_xyzr = np.array([[0.0, -20.0, -100.0, 40.0], [0.0, 20.0, -100.0, 40.0], [30.0, 0.0, -160.0, 40.0]])
     cloud = Cloud("artist", particles_xyzr, artist=ArtistShading(), shading_group_size=1000.0)
@@ -165,9 +165,10 @@ def test_a_sprite_the_eye_stands_in_keeps_its_facing_and_fades_as_the_eye_circle
 
 def test_splats_left_out_by_the_frustum_change_no_pixel(renderer):
     """A cloud around the eye: most of its splats are behind it or off screen, and leaving them out is exact."""
-    from cloudcore.camera import frustum_planes, splats_in_frustum
+    from cloudcore.camera import frustum_planes
     from cloudcore.gl.splats import SplatPass, splat_batch
     from cloudcore.gl.targets import TextureTarget
+    from cloudcore.splat_coverage import splats_in_frustum
 
     rng = np.random.default_rng(5)
     around = np.column_stack([rng.uniform(-300.0, 300.0, (2000, 3)), rng.uniform(4.0, 40.0, 2000)])

@@ -5,12 +5,12 @@ import pytest
 from conftest import VALLEY
 from goldens import MAX_ABS, MIN_PSNR_DB, check_golden
 
-from cloudcore.light.lighting import sun_direction
 from cloudcore.measure.imagecompare import compare, diff_image
 from cloudcore.paths import sample
 from cloudcore.scene import Camera, Scene
 from cloudcore.scenefile import load_scene
 from cloudcore.settings import FULL_3D
+from cloudcore.sun import sun_direction
 
 
 @pytest.fixture(scope="module")

@@ -11,21 +11,12 @@ import pytest
 
 from cloudcore.camera import pixel_rays, projection_matrix, view_matrix
 from cloudcore.colour import srgb_decode, srgb_encode
-from cloudcore.light.kernel import SPLAT_SHARPNESS
 from cloudcore.light.lighting import sky_gradient
 from cloudcore.light.phase import phase_function
-from cloudcore.light.truth import (
-    KERNEL_DIAMETER_INTEGRAL,
-    luminance,
-    medium_grids,
-    optical_depths,
-    peak_extinction,
-    phase_description,
-    region_errors,
-    resolution_gain,
-    truth_regions,
-)
+from cloudcore.light.truth import medium_grids, optical_depths, peak_extinction, phase_description, resolution_gain
+from cloudcore.measure.truth_comparison import luminance, region_errors, truth_regions
 from cloudcore.scene import Camera, Cloud, Scene, Shading
+from cloudcore.splat_kernel import KERNEL_DIAMETER_INTEGRAL, SPLAT_SHARPNESS
 
 
 def one_particle(tau, radius=50.0, centre=(0.0, 1000.0, 0.0), albedo=0.9) -> Scene:

@@ -29,21 +29,13 @@ from cloudcore.cli.render import (
 )
 from cloudcore.colour import linear_to_srgb8
 from cloudcore.errors import SceneError
-from cloudcore.light.lighting import scene_hour
 from cloudcore.light.shading import EYE_PASSES, METHODS
-from cloudcore.light.truth import (
-    BODY_ALPHA,
-    CLOUD_ALPHA,
-    DEFAULT_VOXELS_PER_RADIUS,
-    VARIANTS,
-    mitsuba_variant,
-    region_errors,
-    render_truth,
-    truth_regions,
-)
+from cloudcore.light.truth import DEFAULT_VOXELS_PER_RADIUS, VARIANTS, mitsuba_variant, render_truth
 from cloudcore.measure.benchmark import PSNR_CAP_DB
 from cloudcore.measure.imagecompare import compare, diff_image
+from cloudcore.measure.truth_comparison import BODY_ALPHA, CLOUD_ALPHA, region_errors, truth_regions
 from cloudcore.scenefile import load_scene
+from cloudcore.sun import scene_hour
 
 REGION_DEFINITION = (
     f"from the truth: sky where its alpha (1 - transmittance along the pixel's central ray) < {CLOUD_ALPHA}, "

@@ -17,7 +17,7 @@ from OpenGL import GL
 
 from cloudcore.gl.prefix_sum import GpuPrefixSum
 from cloudcore.gl.programs import build_compute_program, gl_renderer, uniform_locations
-from cloudcore.lod.measured_way import software_rasterizer
+from cloudcore.measured_way import software_rasterizer
 
 #: bits of the key a pass sorts by; see the shader for why four
 DIGIT_BITS = 4

@@ -53,18 +53,20 @@ from cloudcore.gl.volume_blending import GpuFeatures, VolumeBlendingPass
 from cloudcore.gl.world import WorldPass
 from cloudcore.light.eye_scattering import ParticleBuffer
 from cloudcore.light.illumination import IlluminationCache
-from cloudcore.light.lighting import scene_hour, scene_lights, sky_colors
+from cloudcore.light.lighting import scene_lights, sky_colors
 from cloudcore.light.volume_blending import blending_path
 from cloudcore.lod.costs import CostEstimator, CostModel, remember_fit, remembered_prior
 from cloudcore.lod.impostors import cropped_corners, particle_extent
-from cloudcore.lod.measured_way import COMPOSITING_WAYS, MeasuredWay
 from cloudcore.lod.plan import FramePlan, LodState, plan_frame
 from cloudcore.lod.plan.draw_items import inside_runs
 from cloudcore.lod.units import LodUnits, lod_units
 from cloudcore.measure.frame_stats import FrameStats
-from cloudcore.measure.overdraw import Overdraw, analytic_overdraw, overdraw_statistics
+from cloudcore.measure.overdraw import Overdraw, overdraw_statistics
+from cloudcore.measured_way import COMPOSITING_WAYS, MeasuredWay
 from cloudcore.scene import Camera, Lighting, Scene
 from cloudcore.settings import FULL_3D, RenderSettings
+from cloudcore.splat_coverage import analytic_overdraw
+from cloudcore.sun import scene_hour
 
 
 @dataclass(frozen=True)

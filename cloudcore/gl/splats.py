@@ -32,7 +32,6 @@ from OpenGL import GL
 from cloudcore.artist.facing import FacingState
 from cloudcore.artist.particle_styles import FACING_SPLAT, ParticleStyles
 from cloudcore.artist.sprites import ATLAS_MAX_MIP_LEVEL, load_atlas
-from cloudcore.camera import splats_in_frustum
 from cloudcore.cloud_records import ATLAS_GRID
 from cloudcore.gl.blending import cloud_blending
 from cloudcore.gl.depth_sort import GpuDepthSort, key_bits_for
@@ -45,11 +44,12 @@ from cloudcore.gl.programs import (
     uniform_locations,
 )
 from cloudcore.light.eye_scattering import FADE_END_RADII, FADE_START_RADII, ParticleBuffer
-from cloudcore.light.kernel import SPLAT_REACH, SPLAT_SHARPNESS
 from cloudcore.light.phase import PHASE_NAMES
 from cloudcore.limits import MAX_LIGHTS
 from cloudcore.lod.depth_order import far_to_near
 from cloudcore.point_sprites import draw_runs, guard_band, plain_splats, point_sprite_mask
+from cloudcore.splat_coverage import splats_in_frustum
+from cloudcore.splat_kernel import SPLAT_REACH, SPLAT_SHARPNESS
 from cloudcore.vectors import row_lengths
 
 #: two triangles over a particle's four corners (lower left, lower right, upper left, upper right)

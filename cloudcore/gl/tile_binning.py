@@ -50,7 +50,7 @@ from cloudcore.gl.programs import (
 )
 from cloudcore.gl.splats import INSTANCE_BYTES, reallocate_storage
 from cloudcore.light.volume_blending import TILE_PIXELS
-from cloudcore.lod.measured_way import software_rasterizer
+from cloudcore.measured_way import software_rasterizer
 
 #: the storage bindings of tile_bin.comp.glsl (instances and command as the splat pass binds them)
 _INSTANCES, _COMMAND, _TOTALS, _PAIR_SLOTS, _PAIR_TILES, _TILE_STARTS, _PAIR_STARTS = 3, 6, 9, 10, 11, 12, 13

@@ -23,13 +23,13 @@ from cloudcore.gl.programs import build_compute_program, gl_renderer, set_vec3
 from cloudcore.gl.splats import SplatBatch
 from cloudcore.gl.targets import blit_depth
 from cloudcore.gl.tile_binning import DISCS_BINDING, OCCUPIED_BINDING, BinnedTiles, GpuTileBinning
-from cloudcore.light.kernel import SPLAT_SHARPNESS
 from cloudcore.light.volume_blending import (
     FINISHED_TRANSMITTANCE,
     MAX_OPTICAL_DEPTH,
     TILE_PIXELS,
     Splats,
 )
+from cloudcore.splat_kernel import SPLAT_SHARPNESS
 
 _TILE_STARTS_BINDING, _TILE_ENTRIES_BINDING = 6, 7
 #: volume_blend.comp.glsl's constants, both variants'

@@ -1,9 +1,4 @@
-"""Time of day to lights: sun direction and colour, skylight, ambient.
-
-The sun follows the standard solar-position formula at a fixed latitude and
-declination (mid-latitude late spring), so 12:00 is due south and highest,
-sunrise and sunset are near 05:15 and 18:45, and midnight is well below the
-horizon.  World axes: x east, y up, z south (north is -z).
+"""Time of day to lights: sun colour, skylight, ambient; the sun's direction is `cloudcore.sun`'s.
 
 Sun colour is the direct beam after Rayleigh-like extinction over the air mass
 (Kasten and Young 1989), so it turns golden low in the sky and red at the
@@ -18,34 +13,13 @@ import numpy as np
 
 from cloudcore.ramps import smoothstep
 from cloudcore.scene import Light, Lighting
+from cloudcore.sun import elevation_deg, scene_hour, sun_direction
 
-LATITUDE_DEG = 45.0
-DECLINATION_DEG = 12.0
 #: extinction per unit air mass, RGB: blue is scattered out first.
 BEAM_EXTINCTION = np.array([0.035, 0.075, 0.19])
 #: below this elevation (degrees) the sun is gone.
 SUN_FADE_DEG = -4.0
 NIGHT_AMBIENT = np.array([0.012, 0.016, 0.035])
-
-
-def check_time_of_day(hours: float) -> None:
-    if not np.isfinite(hours) or not 0.0 <= hours <= 24.0:
-        raise ValueError(f"time of day must be within [0, 24] hours, got {hours}")
-
-
-def sun_direction(hours: float) -> np.ndarray:
-    """Unit vector from the scene toward the sun at `hours` (0-24)."""
-    check_time_of_day(hours)
-    lat, dec = np.radians(LATITUDE_DEG), np.radians(DECLINATION_DEG)
-    hour_angle = np.radians(15.0 * (hours - 12.0))
-    up = np.sin(lat) * np.sin(dec) + np.cos(lat) * np.cos(dec) * np.cos(hour_angle)
-    east = -np.cos(dec) * np.sin(hour_angle)
-    north = np.cos(lat) * np.sin(dec) - np.sin(lat) * np.cos(dec) * np.cos(hour_angle)
-    return np.array([east, up, -north])
-
-
-def elevation_deg(direction) -> float:
-    return float(np.degrees(np.arcsin(np.clip(direction[1], -1.0, 1.0))))
 
 
 def air_mass(elevation: float) -> float:
@@ -104,12 +78,6 @@ def daylight(hours: float) -> tuple[tuple[Light, ...], np.ndarray]:
     )
     ambient = NIGHT_AMBIENT + 0.25 * (zenith + horizon) * 0.5
     return lights, ambient
-
-
-def scene_hour(lighting: Lighting) -> float:
-    """The hour a scene's sky (and artist-shaded clouds) follow: its time of day, or the default one
-    where explicit lights replace the sun."""
-    return Lighting().time_of_day if lighting.time_of_day is None else lighting.time_of_day
 
 
 def scene_lights(lighting: Lighting) -> tuple[tuple[Light, ...], np.ndarray]:

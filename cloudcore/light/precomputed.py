@@ -56,8 +56,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from cloudcore import disk_cache
-from cloudcore.light.kernel import KERNEL_DIAMETER_INTEGRAL, splat_kernel
 from cloudcore.light.phase import check_phase, phase_function
+from cloudcore.splat_kernel import KERNEL_DIAMETER_INTEGRAL, splat_kernel
 
 #: bump when what the tables hold or how they are computed changes: older cache entries are rebuilt
 FORMAT_VERSION = 1

@@ -1,6 +1,6 @@
 """Ground truth for the shading models: the clouds as a heterogeneous medium, path traced by Mitsuba 3.
 
-Each particle becomes a blob of extinction with the splat kernel's profile (`cloudcore.light.kernel`),
+Each particle becomes a blob of extinction with the splat kernel's profile (`cloudcore.splat_kernel`),
 
     sigma_t(x) = c_i K(|x - p_i| / r_i),    c_i = tau_i / (r_i * KERNEL_DIAMETER_INTEGRAL),
 
@@ -29,15 +29,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from cloudcore.camera import FAR_PLANE_M, NEAR_PLANE_M, camera_pose, pixel_rays
-from cloudcore.colour import srgb_decode
 from cloudcore.light.illumination import cloud_optics
-from cloudcore.light.kernel import KERNEL_DIAMETER_INTEGRAL, splat_kernel
-from cloudcore.light.lighting import active_lights, scene_hour, scene_lights, sky_colors, sky_gradient
+from cloudcore.light.lighting import active_lights, scene_lights, sky_colors, sky_gradient
 from cloudcore.light.phase import phase_function
-from cloudcore.measure.benchmark import PSNR_CAP_DB
-from cloudcore.measure.imagecompare import compare
 from cloudcore.scene import Camera, Scene
 from cloudcore.segments import concatenated_ranges
+from cloudcore.splat_kernel import KERNEL_DIAMETER_INTEGRAL, splat_kernel
+from cloudcore.sun import scene_hour
 
 #: voxels across the scene's median particle radius: the line integral through a particle's centre is
 #: within 1% of its tau at 3 (tests/test_truth.py); the default scene then has about 10 million voxels
@@ -517,58 +515,3 @@ def _sun_depths(grids, eye, rays, unit_distance, lighting) -> np.ndarray:
         toward = np.broadcast_to(np.asarray(lights[0].direction, dtype=np.float64), points.shape)
         depth[seen] = optical_depths(grids, points, toward)[0]
     return depth
-
-
-# ---------------------------------------------------------------- comparing a model with the truth
-
-#: Rec. 709 weights of linear RGB in relative luminance
-LUMINANCE_WEIGHTS = np.array([0.2126, 0.7152, 0.0722])
-#: a pixel is cloud where the truth's alpha is at least the first, the cloud's body (no longer its
-#: silhouette) from the second: a view-ray optical depth of 2.3
-CLOUD_ALPHA, BODY_ALPHA = 0.02, 0.9
-REGIONS = ("image", "sky", "silhouette", "lit", "shadowed")
-
-
-def truth_regions(alpha: np.ndarray, sun_depth: np.ndarray) -> dict[str, np.ndarray]:
-    """Boolean masks (height, width) of the regions errors are split into, from the truth alone.
-
-    sky: alpha < CLOUD_ALPHA; silhouette: CLOUD_ALPHA <= alpha < BODY_ALPHA; the body splits into lit,
-    where the sun reaches the point the eye sees (where the view ray's optical depth reaches 1) through
-    an optical depth below 1, and shadowed, the rest (everything, without a sun).
-    """
-    cloud = alpha >= CLOUD_ALPHA
-    body = alpha >= BODY_ALPHA
-    lit = body & (sun_depth < 1.0)
-    return {
-        "image": np.ones(alpha.shape, dtype=bool),
-        "sky": ~cloud,
-        "silhouette": cloud & ~body,
-        "lit": lit,
-        "shadowed": body & ~lit,
-    }
-
-
-def luminance(srgb8: np.ndarray) -> np.ndarray:
-    """Relative luminance (linear) of 8-bit sRGB pixels (..., 3)."""
-    return srgb_decode(np.asarray(srgb8, dtype=np.float64) / 255.0) @ LUMINANCE_WEIGHTS
-
-
-def region_errors(truth8: np.ndarray, model8: np.ndarray, regions: dict[str, np.ndarray]) -> dict[str, dict]:
-    """Per region: pixels, PSNR of the 8-bit images (capped at PSNR_CAP_DB), the truth's mean luminance,
-    mean luminance error (model - truth, linear: negative is too dark) and mean absolute luminance error."""
-    truth_luminance = luminance(truth8)
-    difference = luminance(model8) - truth_luminance
-    errors = {}
-    for name, mask in regions.items():
-        pixels = int(mask.sum())
-        if pixels == 0:
-            errors[name] = {"pixels": 0}
-            continue
-        errors[name] = {
-            "pixels": pixels,
-            "psnr_db": min(compare(truth8[mask], model8[mask]).psnr_db, PSNR_CAP_DB),
-            "truth_luminance": float(truth_luminance[mask].mean()),
-            "mean_luminance_error": float(difference[mask].mean()),
-            "mean_abs_luminance_error": float(np.abs(difference[mask]).mean()),
-        }
-    return errors

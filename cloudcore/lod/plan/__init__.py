@@ -41,9 +41,9 @@ no particle is looked at.
 The stages, one module each: `pricing` (what is seen of every unit from the eye, and the work of each
 representation), `choice` (auto mode's choices by price and by measured frame times), `schedule` (the
 regenerations within the frame's budget), `draw_items` (the cloud pass far to near); `unit_plans` holds what was
-decided per unit as arrays, `state` what persists between frames, `frame_plan` the result, and `planner` runs the
-stages (`plan_frame`).  A unit out of view or held by the ring is a row of arrays; Python looks at a unit one by one
-only where it is drawn on its own (docs/lod.md, "The plan at Harris's scale").
+decided per unit as arrays, `state` what persists between frames, `frame_plan` the result, `plan_stats` its
+statistics, and `planner` runs the stages (`plan_frame`).  A unit out of view or held by the ring is a row of arrays;
+Python looks at a unit one by one only where it is drawn on its own (docs/lod.md, "The plan at Harris's scale").
 """
 
 from cloudcore.lod.plan.choice import SWITCH_MARGIN

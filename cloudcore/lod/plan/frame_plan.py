@@ -1,5 +1,5 @@
 """A frame's plan: per unit what was decided, the cloud pass in order, the ring, the work predicted, and the
-state to carry into the next frame; its statistics."""
+state to carry into the next frame; its statistics (`plan_stats`)."""
 
 from __future__ import annotations
 
@@ -10,6 +10,7 @@ import numpy as np
 
 from cloudcore.lod.costs import CostModel, Work
 from cloudcore.lod.plan.draw_items import DrawItems
+from cloudcore.lod.plan.plan_stats import PlanStats
 from cloudcore.lod.plan.state import LodState
 from cloudcore.lod.plan.unit_plans import (
     TEXTURED,
@@ -20,7 +21,6 @@ from cloudcore.lod.ring import (
     RingState,
 )
 from cloudcore.lod.units import LodUnits
-from cloudcore.measure.frame_stats import PlanStats
 
 
 @dataclass(frozen=True)

@@ -79,9 +79,9 @@ from cloudcore.lod.ring import (
 )
 from cloudcore.lod.splitting import layers_hold, objects_reaching
 from cloudcore.lod.units import LodUnits
-from cloudcore.measure.overdraw import splats_in_view
 from cloudcore.scene import Camera
 from cloudcore.settings import RenderSettings
+from cloudcore.splat_coverage import splats_in_view
 
 
 def plan_frame(

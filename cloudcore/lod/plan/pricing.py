@@ -12,10 +12,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from cloudcore.camera import (
-    spheres_within_frustum,
-    splats_in_frustum,
-)
+from cloudcore.camera import spheres_within_frustum
 from cloudcore.lod.costs import CostModel, Work, regeneration_fragments, splat_fragments
 from cloudcore.lod.impostors import (
     TRANSLATION_METRICS,
@@ -34,6 +31,7 @@ from cloudcore.lod.ring import (
 )
 from cloudcore.lod.units import LodUnits
 from cloudcore.scene import Camera
+from cloudcore.splat_coverage import splats_in_frustum
 from cloudcore.vectors import row_lengths
 
 #: an impostor predicted to last longer than this many frames is priced as if it lasted this long
@@ -42,7 +40,7 @@ LONGEST_LIFETIME_FRAMES = 120.0
 
 
 #: bounding radii: a unit nearer than this has its full-3D fragments counted splat by splat, clipped to the
-#: screen (`cloudcore.measure.overdraw.splats_in_view`); a ball of discs overestimates a near cloud tenfold, the
+#: screen (`cloudcore.splat_coverage.splats_in_view`); a ball of discs overestimates a near cloud tenfold, the
 #: parts of it beside and behind the eye costing nothing
 NEAR_EXACT_RADII = 3.0
 
