@@ -398,8 +398,8 @@ def rebuild_pace(step, settings: RenderSettings) -> RebuildPace:
     """The rebuild's pace for an eye moving `step` a frame: at flying speeds a segment a frame and then the fade,
     as Wang; where the eye would move more than `REBUILD_PACE_SHARE` of a rebuild distance meanwhile, in as many
     frames as that leaves (none: the whole ring at once, shown at once).  Else the ring shown lags its eye by the
-    rebuild's frames and, the rebuild distance passed again before it is in, never catches up (the cumulus field's
-    flight sampled 160 m a frame: panels 2.5 km behind the eye, 24 dB)."""
+    rebuild's frames and, the rebuild distance passed again before it is in, never catches up (docs/lod.md, "The
+    ring's pace")."""
     frames, fade = rebuild_frames(step, settings), settings.ring_fade_frames
     if frames >= SEGMENTS + fade:
         return RebuildPace(1, fade, 1, in_pieces=True)
