@@ -174,6 +174,15 @@ def required_size(pixels: float, smallest: int, largest: int) -> int:
     return int(min(4 * math.ceil(side / 4 - 1e-9), largest))
 
 
+def required_sizes(pixels: np.ndarray, smallest: int, largest: int) -> np.ndarray:
+    """`required_size` of each of `pixels` (an array), as int64."""
+    pixels = np.asarray(pixels, dtype=np.float64)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        steps = np.ceil(SIZE_STEPS_PER_OCTAVE * np.log2(np.minimum(pixels, 2.0**30) / smallest) - 1e-9)
+        sides = np.minimum(4.0 * np.ceil(smallest * 2.0 ** (steps / SIZE_STEPS_PER_OCTAVE) / 4.0 - 1e-9), largest)
+    return np.where(pixels > smallest, sides, smallest).astype(np.int64)
+
+
 def _angles_deg(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Angles between the rows of two (n, 3) arrays; atan2 of |a x b| and a.b stays accurate for tiny angles,
     where acos does not."""

@@ -15,7 +15,7 @@ from cloudcore.camera import (
     spheres_in_frustum,
     view_matrix,
 )
-from cloudcore.lod.costs import CostModel, Work, quad_work
+from cloudcore.lod.costs import CostModel, Work
 from cloudcore.lod.impostors import (
     INSIDE_RADII,
     ImpostorRecord,
@@ -394,12 +394,8 @@ def _plan_units(
     held_errors = (
         held_impostor_errors(units, drawable, records, translation_error, eye) if settings.mode != "full" else None
     )
-    outside = drawable[distances[drawable] >= INSIDE_RADII * radii[drawable]]  # the units that may be impostors
-    textured = (
-        impostor_textures(units, outside, distances, height, camera.fov_y_deg, settings)
-        if settings.mode != "full"
-        else {}
-    )
+    eye_in = distances[drawable] < INSIDE_RADII * radii[drawable]
+    holders, outside = drawable[eye_in], drawable[~eye_in]  # the units the eye is in; those that may be impostors
 
     def decided(index: int, kind: int, inside: tuple, splits: tuple, full_weight=0.0, full_ms=0.0, impostor_ms=0.0):
         """Unit `index` drawn as `kind`, split around the objects `inside` it at `splits`."""
@@ -413,87 +409,142 @@ def _plan_units(
         kinds[drawable], full_weights[drawable] = FULL, 1.0
         for index in sorted(holding.intersection(drawable.tolist())):
             decided(index, FULL, *split_at(index, eye), full_weight=1.0)
-        drawable = ()
-    for index in drawable:
-        index = int(index)
+        holders = outside = np.zeros(0, dtype=np.int64)
+    for index in holders.tolist():
+        # the eye inside: a screen impostor has fewer fragments than the screen, not fewer particles; its composite
+        # over the screen is priced per run of inside units, below (here, for the choice, as one each)
         radius, distance, members = radii[index], float(distances[index]), units.members[index]
         individual = float(individuals[index])
         inside, splits = split_at(index, eye)
-        eye_inside = distance < INSIDE_RADII * radius
-        # impostor mode draws no unit in full 3D but the one the eye is in: nothing else to price
-        full = full_3d(index, radius, distance) if settings.mode != "impostor" or eye_inside else Work()
+        full = full_3d(index, radius, distance)
         everything_full += full
-        if eye_inside:
-            # a screen impostor has fewer fragments than the screen, not fewer particles; its composite
-            # over the screen is priced per run of inside units, below (here, for the choice, as one each)
-            screen_impostor = dataclasses.replace(full, fragments=full.fragments * settings.inside_resolution_scale**2)
-            full_ms, inside_ms = (
-                costs.ms(full),
-                costs.ms(screen_impostor + Work(quad_pixels=screen_pixels, quads=1, batches=1)),
-            )
-            if settings.mode == "auto" and individual == 1.0:
-                previous = state.representations.get(members)
-                held = previous.target if previous is not None and previous.full_weight == 1.0 else None
-                # the same particles either way
-                target = "full" if all_full else cheapest(held, {"full": full_ms, "inside": inside_ms})
-                unit_prices.append((index, distance, full_ms, inside_ms))
-                representations[members] = Representation(target, 1.0)
-                if target == "full":
-                    decided(index, FULL, inside, splits, 1.0, full_ms, inside_ms)
-                    cloud_work += full
-                    continue
-            decided(index, INSIDE, inside, splits, individual, full_ms, inside_ms)
-            cloud_work += screen_impostor
-            continue
-        pixels, size, remake = textured[index]
-        quad = quad_work(pixels, screen_pixels)
-        # a unit fading into or out of the ring is drawn as an impostor: one layer scales exactly
-        weight, full_ms, impostor_ms = 0.0, costs.ms(full), math.inf
-        if settings.mode == "auto" and individual == 1.0:
-            lifetime = float(lifetimes[index])
-            impostor_ms = costs.ms(quad) + costs.ms(remake.scaled(len(splits) + 1)) / max(lifetime, 1.0)
-            error = float(held_errors[index])
-            budgeted = bool(settings.regeneration_budget or settings.frame_budget_ms)
-            # an impostor within half its tolerance of the picture full 3D gives, or one remade from this very
-            # eye, differs from it by less than a regeneration's own step: the switch needs no crossfade
-            close = {
-                "impostor": error <= 0.5 * tolerance or (error > tolerance and not budgeted),
-                "full": error <= 0.5 * tolerance,
-            }
-            representation = represent(
-                state.representations.get(members),
-                full_ms,
-                math.inf if all_full else impostor_ms,
-                settings.transition_frames,
-                close,
-            )
-            unit_prices.append((index, distance, full_ms, impostor_ms))
-            representations[members] = representation
-            weight = representation.full_weight
-        if weight == 1.0:
-            decided(index, FULL, inside, splits, 1.0, full_ms, impostor_ms)
-            cloud_work += full
-            continue
-        record = records.get(members)
-        reason = regeneration_reason(
-            record,
-            size,
-            unit_key(index),
-            tolerance,
-            float(held_errors[index]),
-            record is not None and layers_changed(index, record),
+        screen_impostor = dataclasses.replace(full, fragments=full.fragments * settings.inside_resolution_scale**2)
+        full_ms, inside_ms = (
+            costs.ms(full),
+            costs.ms(screen_impostor + Work(quad_pixels=screen_pixels, quads=1, batches=1)),
         )
-        kind = CROSSFADE if weight > 0.0 else IMPOSTOR
-        decided(index, kind, inside, splits, weight * individual, full_ms, impostor_ms)
-        impostor_weights[index], texture_sizes[index] = (1.0 - weight) * individual, size
-        if reason is not None:
-            reasons[index] = reason
-        cloud_work += quad + (full + Work(quad_pixels=screen_pixels) if weight > 0.0 else Work())  # the layer
-        if reason is not None:
-            ratio = float(held_errors[index]) / max(tolerance, 1e-300)
-            wanted.append(
-                (index, regeneration_priority(reason, ratio, bool(splits), pixels), remake.scaled(len(splits) + 1))
+        if settings.mode == "auto" and individual == 1.0:
+            previous = state.representations.get(members)
+            held = previous.target if previous is not None and previous.full_weight == 1.0 else None
+            # the same particles either way
+            target = "full" if all_full else cheapest(held, {"full": full_ms, "inside": inside_ms})
+            unit_prices.append((index, distance, full_ms, inside_ms))
+            representations[members] = Representation(target, 1.0)
+            if target == "full":
+                decided(index, FULL, inside, splits, 1.0, full_ms, inside_ms)
+                cloud_work += full
+                continue
+        decided(index, INSIDE, inside, splits, individual, full_ms, inside_ms)
+        cloud_work += screen_impostor
+    if len(outside):
+        # the units that may be impostors, priced together: full 3D's work (a ball of discs; near, splat by splat, as
+        # `full_3d`), the impostor's quad and its remaking over its lifetime (one texture a layer)
+        textures = impostor_textures(units, outside, distances, height, camera.fov_y_deg, settings)
+        splits_of = {index: split_at(index, eye) for index in holding.intersection(outside.tolist())}
+        layers = np.array(
+            [len(splits_of[i][1]) + 1 if i in splits_of else 1 for i in outside.tolist()], dtype=np.float64
+        )
+        if settings.mode == "impostor":  # nothing drawn in full 3D but the units the eye is in: nothing else to price
+            full_particles, full_fragments = np.zeros(len(outside)), np.zeros(len(outside))
+        else:
+            full_particles = units.particle_counts[outside].astype(np.float64)
+            full_fragments = np.asarray(ball_fragments[outside], dtype=np.float64).copy()
+            if cloud_splats is not None:
+                for k in np.flatnonzero(distances[outside] < NEAR_EXACT_RADII * radii[outside]).tolist():
+                    index = int(outside[k])
+                    near = full_3d(index, radii[index], float(distances[index]))
+                    full_particles[k], full_fragments[k] = near.particles, near.fragments
+        quad_pixels = np.minimum(textures.pixels * textures.pixels, screen_pixels)
+        remake_particles = units.particle_counts[outside] * layers
+        remake_fragments = textures.fragments * layers
+        full_ms = costs.particles * full_particles + costs.fragments * full_fragments
+        priced_alone = settings.mode == "auto" and individuals[outside] == 1.0  # a unit fading into or out of the ring
+        with np.errstate(invalid="ignore"):
+            impostor_ms = np.where(
+                priced_alone,
+                (costs.quad_pixels * quad_pixels + costs.quads)
+                + (
+                    costs.particles * remake_particles
+                    + costs.texture_fragments * remake_fragments
+                    + costs.regenerations * layers
+                )
+                / np.maximum(lifetimes[outside], 1.0),
+                math.inf,
             )
+        full_weight_of = np.zeros(
+            len(outside)
+        )  # a unit fading into or out of the ring is an impostor: one layer scales
+        if settings.mode == "auto":
+            errors = held_errors[outside]
+            budgeted = bool(settings.regeneration_budget or settings.frame_budget_ms)
+            # an impostor within half its tolerance of the picture full 3D gives, or one remade from this very eye,
+            # differs from it by less than a regeneration's own step: the switch needs no crossfade
+            close_impostor = ((errors <= 0.5 * tolerance) | ((errors > tolerance) & (not budgeted))).tolist()
+            close_full = (errors <= 0.5 * tolerance).tolist()
+            for k, index, full_price, impostor_price, distance in zip(
+                range(len(outside)),
+                outside.tolist(),
+                full_ms.tolist(),
+                impostor_ms.tolist(),
+                distances[outside].tolist(),
+            ):
+                if not priced_alone[k]:
+                    continue
+                members = units.members[index]
+                representation = represent(
+                    state.representations.get(members),
+                    full_price,
+                    math.inf if all_full else impostor_price,
+                    settings.transition_frames,
+                    {"impostor": close_impostor[k], "full": close_full[k]},
+                )
+                unit_prices.append((index, distance, full_price, impostor_price))
+                representations[members] = representation
+                full_weight_of[k] = representation.full_weight
+        everything_full += Work(particles=float(np.sum(full_particles)), fragments=float(np.sum(full_fragments)))
+        whole = full_weight_of == 1.0
+        fading = (full_weight_of > 0.0) & ~whole
+        shown = outside[~whole]  # as impostors, crossfading or not
+        kinds[outside[whole]], full_weights[outside[whole]] = FULL, 1.0
+        kinds[shown] = np.where(fading[~whole], CROSSFADE, IMPOSTOR)
+        full_weights[shown] = (full_weight_of * individuals[outside])[~whole]
+        impostor_weights[shown] = ((1.0 - full_weight_of) * individuals[outside])[~whole]
+        texture_sizes[shown] = textures.sizes[~whole]
+        full_prices[outside], impostor_prices[outside] = full_ms, impostor_ms
+        for index, (inside, splits) in splits_of.items():
+            if splits:
+                split_objects[index], split_distances[index] = inside, splits
+        cloud_work += Work(
+            particles=float(np.sum(full_particles[whole | fading])),
+            fragments=float(np.sum(full_fragments[whole | fading])),
+            quad_pixels=float(np.sum(quad_pixels[~whole]) + screen_pixels * np.count_nonzero(fading)),  # fades' layer
+            quads=float(np.count_nonzero(~whole)),
+        )
+        for k in np.flatnonzero(~whole).tolist():
+            index = int(outside[k])
+            members = units.members[index]
+            record = records.get(members)
+            reason = regeneration_reason(
+                record,
+                int(textures.sizes[k]),
+                unit_key(index),
+                tolerance,
+                float(held_errors[index]),
+                record is not None and layers_changed(index, record),
+            )
+            if reason is not None:
+                reasons[index] = reason
+                ratio = float(held_errors[index]) / max(tolerance, 1e-300)
+                splits = splits_of.get(index, ((), ()))[1]
+                remake = Work(
+                    particles=float(remake_particles[k]),
+                    texture_fragments=float(remake_fragments[k]),
+                    regenerations=float(layers[k]),
+                )
+                wanted.append(
+                    (index, regeneration_priority(reason, ratio, bool(splits), float(textures.pixels[k])), remake)
+                )
+    unit_prices.sort(key=lambda price: price[0])  # by index, as the units are numbered
     served = budgeted_regenerations([(index, priority) for index, priority, _ in wanted], settings.regeneration_budget)
     if settings.frame_budget_ms > 0.0:
         served &= within_frame_budget(wanted, settings.frame_budget_ms - costs.ms(cloud_work), costs)

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import sys
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import NamedTuple
@@ -16,11 +17,8 @@ from cloudcore.camera import spheres_within_frustum
 from cloudcore.lod.costs import CostModel, Work, regeneration_fragments, splat_fragments
 from cloudcore.lod.impostors import (
     TRANSLATION_METRICS,
-    detail_size_px,
     parallax_errors_deg,
-    quad_half_side,
-    required_size,
-    screen_size_px,
+    required_sizes,
     tolerance_deg_for,
 )
 from cloudcore.lod.plan.state import LodState
@@ -157,26 +155,30 @@ def pricing_of(camera: Camera, viewport, settings, state: LodState, objects) -> 
     )
 
 
-def impostor_textures(units: LodUnits, rows, distances, height: int, fov_y_deg: float, settings) -> dict:
-    """Per unit of `rows`, (its quad's side on the screen in pixels, its impostor texture's side, the `Work` of
-    remaking it: every particle splatted into that texture), the fragments in one numpy pass (unit by unit, numpy's
-    overhead was 30 us a unit; the field's plan 5.06 -> 4.65 ms)."""
-    pixels, sizes, half_sides = [], [], []
-    for index in rows:
-        radius, distance = float(units.radii[index]), float(distances[index])
-        side = screen_size_px(radius, distance, height, fov_y_deg)
-        detail = detail_size_px(radius, distance, units.finest_radii[index], settings.impostor_detail_texels)
-        pixels.append(side)
-        sizes.append(required_size(min(side, detail), settings.impostor_min_size, settings.impostor_max_size))
-        half_sides.append(quad_half_side(radius, distance))
-    counts = units.particle_counts[rows]
+class ImpostorTextures(NamedTuple):
+    """Per unit of some rows (`impostor_textures`), its impostor's texture and what remaking it costs."""
+
+    pixels: np.ndarray  # the quad's side on the screen
+    sizes: np.ndarray  # the texture's side (int)
+    fragments: np.ndarray  # of every particle splatted into the texture (`regeneration_fragments`)
+
+
+def impostor_textures(units: LodUnits, rows, distances, height: int, fov_y_deg: float, settings) -> ImpostorTextures:
+    """The impostor textures of the units at `rows` (indices) seen from `distances`: each as fine as the screen
+    or the unit's detail asks, in `required_size`'s steps, and the fragments of remaking it."""
+    radii, distance = units.radii[rows], distances[rows]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        tangents = radii / np.sqrt(np.maximum((distance - radii) * (distance + radii), sys.float_info.min))
+    pixels = height * tangents / math.tan(math.radians(fov_y_deg) / 2.0)
+    half_sides = tangents * distance
+    texels, finest = settings.impostor_detail_texels, units.finest_radii[rows]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        detail = np.where((texels > 0.0) & (finest > 0.0), 2.0 * texels * half_sides / finest, math.inf)
+    sizes = required_sizes(np.minimum(pixels, detail), settings.impostor_min_size, settings.impostor_max_size)
     fragments = regeneration_fragments(
-        counts, units.radius_squares[rows], units.radii[rows], distances[rows], np.array(half_sides), np.array(sizes)
+        units.particle_counts[rows], units.radius_squares[rows], radii, distance, half_sides, sizes
     )
-    return {
-        int(index): (side, size, Work(particles=float(count), texture_fragments=float(f), regenerations=1.0))
-        for index, side, size, count, f in zip(rows, pixels, sizes, counts, np.reshape(fragments, -1))
-    }
+    return ImpostorTextures(pixels, sizes, np.reshape(fragments, -1))
 
 
 def impostor_ms_of(units: LodUnits, seen: Seen, chosen, focal_px, settings, costs: CostModel) -> np.ndarray:
