@@ -45,6 +45,7 @@ from cloudcore.lod.plan.pricing import (
     impostor_textures,
     in_view_work,
     ms_drawn_alone,
+    panel_pixels,
     pricing_of,
     ring_panels_work,
     ring_translation_error,
@@ -248,7 +249,7 @@ def _plan_units(
             eye,
             step,
             ball_fragments,
-            quad_pixels_of[alone],
+            panel_pixels(centres[alone], eye, quad_pixels_of[alone], view_projection, viewport),
             lifetimes,
             settings,
             state.ring,
@@ -576,7 +577,8 @@ def _plan_units(
         for generation, _ in ring.draws:
             rows = generation.rows_in(units.members, units.row_of)
             shown = rows[visible[rows]]
-            cloud_work += ring_panels_work(len(generation.occupied_segments), quad_pixels_of[shown])
+            pixels = panel_pixels(centres[shown], generation.eye, quad_pixels_of[shown], view_projection, viewport)
+            cloud_work += ring_panels_work(len(generation.occupied_segments), pixels)
         builds = ring.segment_builds()
         update_work += Work(
             particles=float(sum(units.particle_counts[units.row_of[u]] for _, _, piece in builds for u in piece)),

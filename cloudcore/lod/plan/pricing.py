@@ -254,27 +254,67 @@ def ms_drawn_alone(units: LodUnits, seen: Seen, chosen, in_view, focal_px, setti
     return float(np.sum(np.minimum(full, impostor_ms_of(units, seen, chosen, focal_px, settings, costs))))
 
 
-def ring_panels_work(panels: int, quad_pixels) -> Work:
-    """Drawing `panels` ring panels (each a draw call) holding clouds whose own impostor quads would fill
-    `quad_pixels` on the screen: a panel is cropped to its clouds' extent, so it fills about what they would."""
-    return Work(quad_pixels=float(np.sum(quad_pixels)), quads=float(panels))
+def segments_of(centres, eye) -> np.ndarray:
+    """The ring segment (0 to `SEGMENTS` - 1) each of `centres` lies in, by its azimuth about `eye`."""
+    offsets = np.asarray(centres, dtype=np.float64).reshape(-1, 3) - np.asarray(eye, dtype=np.float64)
+    azimuths = np.degrees(np.arctan2(offsets[:, 0], -offsets[:, 2])) % 360.0
+    return (azimuths // SEGMENT_DEG).astype(np.int64) % SEGMENTS  # a tiny negative azimuth % 360 gives 360
+
+
+def panel_pixels(centres, eye, quad_pixels, view_projection: np.ndarray, viewport) -> float:
+    """Pixels on the screen of the ring panels (a ring made at `eye`) that show the clouds in view at `centres`,
+    whose own impostor quads would fill `quad_pixels`.
+
+    A panel is cropped to the part its clouds cover and is one layer however many of them overlap: per
+    segment, the box on the screen around its clouds' quads, within the screen, and at most their sum (a few
+    clouds far apart fill less than their box).  Far clouds overlap on the horizon: their quads summed would
+    price a scattered sky's panels at a screen or more where they fill a strip.
+    """
+    quad_pixels = np.asarray(quad_pixels, dtype=np.float64)
+    if not len(quad_pixels):
+        return 0.0
+    width, height = viewport
+    centres = np.asarray(centres, dtype=np.float64).reshape(-1, 3)
+    clip = centres @ view_projection[:3, :3].T + view_projection[:3, 3]
+    w = centres @ view_projection[3, :3] + view_projection[3, 3]
+    ahead = w > 0.0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        x = (0.5 + 0.5 * clip[:, 0] / w) * width
+        y = (0.5 + 0.5 * clip[:, 1] / w) * height
+    half_sides = 0.5 * np.sqrt(quad_pixels)
+    segments = segments_of(centres, eye)
+    total = 0.0
+    for segment in np.unique(segments).tolist():
+        rows = segments == segment
+        summed = float(np.sum(quad_pixels[rows]))
+        if not np.all(ahead[rows]):  # a cloud beside or behind the eye: its quad's box is unbounded
+            total += min(summed, float(width * height))
+            continue
+        left = max(float(np.min(x[rows] - half_sides[rows])), 0.0)
+        right = min(float(np.max(x[rows] + half_sides[rows])), float(width))
+        bottom = max(float(np.min(y[rows] - half_sides[rows])), 0.0)
+        top = min(float(np.max(y[rows] + half_sides[rows])), float(height))
+        total += min(summed, max(right - left, 0.0) * max(top - bottom, 0.0))
+    return total
+
+
+def ring_panels_work(panels: int, pixels: float) -> Work:
+    """Drawing `panels` ring panels (each a draw call) that fill `pixels` on the screen (`panel_pixels`)."""
+    return Work(quad_pixels=float(pixels), quads=float(panels))
 
 
 def ring_work(
-    units: LodUnits, candidates, centres, eye, step, ball_fragments, quad_pixels, lifetimes, settings, state: RingState
+    units: LodUnits, candidates, centres, eye, step, ball_fragments, pixels, lifetimes, settings, state: RingState
 ) -> tuple[Work, Work, float, float]:
     """(panels, rebuild, moved, tolerated): Wang's ring holding the units `candidates` (mask).
 
-    Its panels drawn a frame (`quad_pixels`: the candidates in view's impostor quads), its rebuild (every
+    Its panels drawn a frame (`pixels`: what they fill on the screen, `panel_pixels`), its rebuild (every
     candidate splatted into the segments, whose textures have the screen's pixel density), and the frames
     it lasts: until the eye's current `step` a frame carries it past a rebuild distance, or the frames the
     last ring lasted when shorter (moved); and that or the frames its clouds' impostors would (`lifetimes`),
     when shorter still (tolerated).
     """
-    offsets = centres[candidates] - eye
-    azimuths = np.degrees(np.arctan2(offsets[:, 0], -offsets[:, 2])) % 360.0
-    segments = (azimuths // SEGMENT_DEG).astype(np.int64) % SEGMENTS  # a tiny negative azimuth % 360 gives 360
-    panels = int(np.count_nonzero(np.bincount(segments, minlength=SEGMENTS)))
+    panels = int(np.count_nonzero(np.bincount(segments_of(centres[candidates], eye), minlength=SEGMENTS)))
     horizontal, vertical = math.hypot(step[0], step[2]), abs(step[1])
     moved = min(
         LONGEST_LIFETIME_FRAMES,
@@ -288,7 +328,7 @@ def ring_work(
         regenerations=float(panels),
     )
     tolerated = min(moved, float(np.min(lifetimes[candidates], initial=math.inf)))
-    return ring_panels_work(panels, quad_pixels), rebuild, moved, tolerated
+    return ring_panels_work(panels, pixels), rebuild, moved, tolerated
 
 
 def ring_translation_error(generation, translation_error, eye) -> float:
