@@ -232,15 +232,17 @@ def test_the_popping_test_can_fail_without_the_blend():
     assert (np.abs(np.diff(values)) / values.max()).max() > 0.1
 
 
-def test_a_cloud_s_fade_key_is_its_mean_weight_in_steps_and_exactly_1_when_it_does_not_blend():
+def test_a_cloud_s_fade_key_is_its_mean_weight_rounded_up_to_a_step_and_exactly_1_when_it_does_not_blend():
     frame, state = update_field(FIELD, EYE)
     starts = state.cloud_starts
     for index, key in enumerate(frame.fade_keys):
         weights = frame.weights[starts[index] : starts[index + 1]]
+        assert frame.mean_weights[index] == pytest.approx(weights.mean() if len(weights) else 1.0, abs=1e-12)
         if np.all(weights == 1.0):
             assert key == 1.0
         else:
-            assert abs(key - weights.mean()) <= 0.5 / FADE_KEY_STEPS + 1e-12
+            assert weights.mean() <= key < weights.mean() + 1.0 / FADE_KEY_STEPS + 1e-12
+            assert (key == 0.0) == (weights.mean() == 0.0)  # an empty impostor is never scaled up
     assert 1.0 in frame.fade_keys and min(frame.fade_keys) < 1.0
 
 

@@ -136,3 +136,39 @@ def test_the_field_s_ring_is_kept_while_only_blend_weights_change_and_keeps_up_w
         assert stats.plan.ring_segments_built > 0 and stats.plan.clouds_by_kind["ring"] > 0
         reference, _ = full.render(scene, camera=at(2000.0), settings=FULL_3D)
         assert compare(image, reference).psnr_db > 35.0
+
+
+def test_a_field_cloud_s_impostor_follows_its_fade_by_its_opacity_between_its_key_s_steps():
+    """Flown 20 m a frame, the field's clouds blend: an impostor is remade only when its cloud's mean weight leaves
+    its step (`FADE_KEY_STEPS`); in between it is drawn with its opacity scaled by the mean weight now over the one
+    it was made at."""
+    from cloudcore.field.state import update_field
+    from cloudcore.gl import FrameRenderer
+
+    settings = RenderSettings(mode="impostor", ring_radius=np.inf)
+    scene = Scene(camera=ABOVE, cloud_field=FIELD)
+    scaled = 0
+    with FrameRenderer(160, 120) as renderer:
+        drawn = []
+        draw_instanced = renderer._quads.draw_instanced
+        renderer._quads.draw_instanced = lambda instances, *a, **k: (
+            drawn.append(instances[:, 20].copy()),
+            draw_instanced(instances, *a, **k),
+        )
+        for x in np.arange(0.0, 400.0, 20.0):
+            camera = dataclasses.replace(ABOVE, position=(x, 5000.0, 0.0), look_at=(x, 1200.0, -3000.0))
+            drawn.clear()
+            renderer.render(scene, camera=camera, settings=settings)
+            plan = renderer.last_plan
+            items = [i for i in plan.draw_items if i.kind == "cloud" and plan.clouds[i.index].kind == "impostor"]
+            units = [plan.clouds[i.index].members for i in items]
+            made_at = renderer._impostors.cloud_impostors([(m, i.layer) for m, i in zip(units, items)])[3]
+            # the field as the renderer placed it (an entering cell takes a place a leaving one freed)
+            mean_weights = update_field(FIELD, camera.position, renderer.field_state)[0].mean_weights
+            now = np.array([mean_weights[list(members)].mean() for members in units])
+            expected = np.array([plan.clouds[i.index].impostor_weight for i in items]) * np.where(
+                made_at > 0.0, now / np.where(made_at > 0.0, made_at, 1.0), 0.0
+            )
+            np.testing.assert_allclose(np.concatenate(drawn), expected, rtol=1e-6, atol=1e-7)
+            scaled += int(np.count_nonzero(np.abs(now - made_at) > 1e-3))
+    assert scaled > 20

@@ -30,9 +30,11 @@ from cloudcore.scene import Cloud, CloudField
 CellKey = tuple[int, int, int]
 #: the place of a cell that left, until an entering one takes it: no particles, nothing drawn
 HOLE = Cloud("field_hole")
-#: a cloud's blend weight is told to the frame plan in steps of 1 / FADE_KEY_STEPS (its impostor is remade
-#: at each step while it blends: finer would remake it every frame, coarser would show the steps)
-FADE_KEY_STEPS = 16
+#: a cloud's blend weight is told to the frame plan in steps of 1 / FADE_KEY_STEPS: its impostor is remade at each
+#: step while it blends and drawn meanwhile with its opacity scaled by its mean weight now over its mean weight when
+#: made (`FrameRenderer`), which holds the picture as close to full 3D as 1/16 steps without the scaling did with a
+#: quarter of the remakes (docs/performance.md, "Impostors that follow a field's fade")
+FADE_KEY_STEPS = 4
 
 
 @dataclass(frozen=True)
@@ -52,11 +54,13 @@ class FieldState:
 
 @dataclass(frozen=True)
 class FieldFrame:
-    """The field's clouds for one eye: the clouds in their places, each particle's weight, each cloud's key."""
+    """The field's clouds for one eye: the clouds in their places, each particle's weight, each cloud's mean weight
+    and key."""
 
     clouds: tuple  # of Cloud (HOLE where a place is free)
     weights: np.ndarray  # (particles of `clouds`,) blend weights in [0, 1]
-    fade_keys: tuple  # per cloud: changes whenever its weights change enough to show
+    mean_weights: np.ndarray  # (len(clouds),) each cloud's particles' mean weight (1 for a hole)
+    fade_keys: tuple  # per cloud: changes whenever its weights change by more than scaling its impostor hides
 
     @property
     def particle_count(self) -> int:
@@ -79,7 +83,7 @@ def update_field(field: CloudField, eye, state: FieldState = FieldState()) -> tu
         state = dataclasses.replace(state, made=(), dropped=0)
     clouds = tuple(HOLE if key is None else state.cells[key] for key in state.slots)
     weights = level_weights(field, state.particle_levels, state.particle_xz[:, 0], state.particle_xz[:, 1], eye)
-    return FieldFrame(clouds, weights, _fade_keys(weights, state.cloud_starts)), state
+    return FieldFrame(clouds, weights, *_cloud_weights(weights, state.cloud_starts)), state
 
 
 def _placed(field: CloudField, cells: dict, slots: tuple, made: tuple, dropped: int) -> FieldState:
@@ -112,14 +116,16 @@ def _placed(field: CloudField, cells: dict, slots: tuple, made: tuple, dropped: 
     )
 
 
-def _fade_keys(weights: np.ndarray, starts: np.ndarray) -> tuple:
-    """Per cloud, its mean weight in steps of 1 / FADE_KEY_STEPS (a cloud wholly at weight 1, or empty: exactly 1)."""
+def _cloud_weights(weights: np.ndarray, starts: np.ndarray) -> tuple[np.ndarray, tuple]:
+    """(per cloud its particles' mean weight, its fade key): the mean rounded up to a step of 1 / FADE_KEY_STEPS,
+    so that only a cloud at weight 0 has key 0 (its impostor, empty, is never scaled up); a cloud wholly at
+    weight 1, or empty: exactly 1."""
     counts = np.diff(starts)
-    keys = np.ones(len(counts))
+    means, keys = np.ones(len(counts)), np.ones(len(counts))
     filled = counts > 0
     if filled.any():
         firsts = starts[:-1][filled]
-        means = np.add.reduceat(weights, firsts) / counts[filled]
-        blending = np.minimum.reduceat(weights, firsts) < 1.0
-        keys[np.flatnonzero(filled)[blending]] = np.round(means[blending] * FADE_KEY_STEPS) / FADE_KEY_STEPS
-    return tuple(float(key) for key in keys)
+        means[filled] = np.add.reduceat(weights, firsts) / counts[filled]
+        blending = np.flatnonzero(filled)[np.minimum.reduceat(weights, firsts) < 1.0]
+        keys[blending] = np.ceil(means[blending] * FADE_KEY_STEPS) / FADE_KEY_STEPS
+    return means, tuple(float(key) for key in keys)

@@ -139,9 +139,11 @@ class FrameRenderer:
         #: compute pass won in full 3D and lost in auto mode, whose full-3D draws are a few near clouds
         self.compositing: dict[str, MeasuredWay] = {}
         self._compositable = 0  # this frame's particles in draws either way could composite
-        #: the cloud field's cells made for the last eye, and its particles' blend weights (None: no field)
+        #: the cloud field's cells made for the last eye, its particles' blend weights and every cloud's mean weight
+        #: (None: no field)
         self.field_state = FieldState()
         self._field_weights: np.ndarray | None = None
+        self._cloud_weights: np.ndarray | None = None
         self._units: LodUnits | None = None
         self._units_source = None
         self._layer = None  # screen-sized, sharing the frame's depth: crossfading clouds' full-3D image
@@ -271,7 +273,7 @@ class FrameRenderer:
                         self.context, camera, poses, plan.objects_with_world, write_depth=True, antialiased=antialiased
                     )
             with clock.timed("impostor updates"):
-                rendered = self._impostors.update(plan, particles, settings, time_s, way)
+                rendered = self._impostors.update(plan, particles, settings, time_s, way, self._unit_weights)
             with clock.timed("clouds"):
                 self.context.bind_target()
                 drawn = self._draw_clouds(
@@ -356,11 +358,12 @@ class FrameRenderer:
         """The scene with its cloud field's clouds for this eye after its own (`cloudcore.field.state`), and
         per cloud the key of its blend weights; the field's weights are held for the particle buffer."""
         if scene.cloud_field is None:
-            self.field_state, self._field_weights = FieldState(), None
+            self.field_state, self._field_weights, self._cloud_weights = FieldState(), None, None
             return scene, (1.0,) * len(scene.clouds)
         frame, self.field_state = update_field(scene.cloud_field, camera.position, self.field_state)
         authored = scene.particle_count
         self._field_weights = np.concatenate([np.ones(authored), frame.weights])
+        self._cloud_weights = np.concatenate([np.ones(len(scene.clouds)), frame.mean_weights])
         return (
             dataclasses.replace(scene, clouds=scene.clouds + frame.clouds),
             (1.0,) * len(scene.clouds) + frame.fade_keys,
@@ -429,6 +432,25 @@ class FrameRenderer:
                 held if colours == held else colours,  # only blend weights changed: the ring's keys are as they were
             )
         return self._cloud_keys_made
+
+    def _unit_weights(self, units: list) -> np.ndarray:
+        """The mean blend weight of the particles of each unit's members (tuples of cloud indices) of `units`."""
+        if self._cloud_weights is None or not units:
+            return np.ones(len(units))
+        clouds = np.fromiter(itertools.chain.from_iterable(units), dtype=np.int64)
+        firsts = np.cumsum([0] + [len(members) for members in units[:-1]])
+        counts = np.diff(self._particles.cloud_starts)[clouds]
+        particles = np.add.reduceat(counts, firsts)
+        weighted = np.add.reduceat(self._cloud_weights[clouds] * counts, firsts)
+        return np.divide(weighted, particles, out=np.ones(len(units)), where=particles > 0)
+
+    def _faded(self, units: list, made_at: np.ndarray) -> np.ndarray:
+        """What scales each impostor of `units` made at mean blend weights `made_at`: a cloud field's fade moves
+        its units' weights between the steps of their keys (`cloudcore.field.state.FADE_KEY_STEPS`), and the
+        impostor follows by its opacity, in proportion.  One made at weight 0 is empty, and its key holds only
+        while the weight stays 0."""
+        now = self._unit_weights(units)
+        return np.divide(now, made_at, out=np.zeros(len(units)), where=made_at > 0.0)
 
     def _next_key(self) -> int:
         self._key_serial += 1
@@ -615,10 +637,11 @@ class FrameRenderer:
         """Units' impostors (a layer each, when split around objects), consecutive in the pass: one instanced
         draw from the atlas (two, where larger impostors than its layers' side need one of their own)."""
         clouds = [frame.plan.clouds[item.index] for item in items]
-        images, corners, extents = self._impostors.cloud_impostors(
+        images, corners, extents, made_at = self._impostors.cloud_impostors(
             [(cloud.members, item.layer) for cloud, item in zip(clouds, items)]
         )
-        weights = np.array([cloud.impostor_weight for cloud in clouds])
+        faded = self._faded([cloud.members for cloud in clouds], made_at)
+        weights = np.array([cloud.impostor_weight for cloud in clouds]) * faded
         for _, run in itertools.groupby(range(len(images)), key=lambda i: id(images[i].atlas)):  # one atlas a run
             run = list(run)
             instances = atlas_instances([images[i] for i in run], corners[run], weights[run], extents[run])
@@ -639,12 +662,13 @@ class FrameRenderer:
     def _draw_crossfade(self, frame: _CloudPassFrame, item, cloud, batch: SplatBatch) -> int:
         """A unit between its impostor and full 3D: its splats (`batch`) into a screen layer, mixed with the
         impostor."""
-        image, corners, extent = self._impostors.cloud_impostor(cloud.members, item.layer)
+        image, corners, extent, made_at = self._impostors.cloud_impostor(cloud.members, item.layer)
+        faded = self._faded([cloud.members], np.array([made_at]))
         layer = self._screen_layer()
         layer.bind_cleared()
         drawn = self._draw_splats(frame, batch, layer.texture)
         self.context.bind_target()
-        instance = atlas_instances([image], corners[None], [cloud.impostor_weight], extent[None])
+        instance = atlas_instances([image], corners[None], cloud.impostor_weight * faded, extent[None])
         self._draw_instanced(
             frame, image.atlas.texture, instance, layer_texture=layer.texture, layer_weight=cloud.full_weight
         )

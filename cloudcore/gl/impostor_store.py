@@ -18,6 +18,8 @@ their particles.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 from OpenGL import GL
 
@@ -43,20 +45,30 @@ class ImpostorStore:
         self.pool = TexturePool()
         self._atlases: dict[int, ImpostorAtlas] = {}  # layer side -> atlas
         #: unit members -> (images of its layers far to near, the view they were made with, the part of
-        #: the images its particles can cover: only that part of the quad is drawn)
-        self._clouds: dict[tuple, tuple[list[AtlasImage], ImpostorView, tuple]] = {}
+        #: the images its particles can cover: only that part of the quad is drawn, the unit's mean blend
+        #: weight they were made at: a cloud field's fade scales them from there)
+        self._clouds: dict[tuple, tuple[list[AtlasImage], ImpostorView, tuple, float]] = {}
         self._ring: dict[tuple[RingGeneration, int], tuple[TextureTarget, tuple]] = {}  # (texture, extent)
 
     def update(
-        self, plan: FramePlan, particles: ParticleBuffer, settings: RenderSettings, time_s: float, splat_order: str
+        self,
+        plan: FramePlan,
+        particles: ParticleBuffer,
+        settings: RenderSettings,
+        time_s: float,
+        splat_order: str,
+        unit_weights: Callable[[list], np.ndarray],
     ) -> int:
         """Render this frame's regenerations and ring segment at scene time `time_s`, the regenerations' particles
-        chosen and sorted the way `splat_order` says ("cpu" or "gpu": `_cells_on_gpu`); returns the particles
-        rendered, but not those the GPU chose (`SplatPass.take_selected` counts those)."""
+        chosen and sorted the way `splat_order` says ("cpu" or "gpu": `_cells_on_gpu`); `unit_weights` gives the
+        mean blend weights of a list of units' members, held with their images.  Returns the particles rendered,
+        but not those the GPU chose (`SplatPass.take_selected` counts those)."""
         units = plan.units
         renders = []  # (target, batch, view, projection, cleared first): all sorted, then all shaded, then drawn
         on_gpu = []  # (atlas image, eye, clouds, their depth ranges, view, projection): the GPU's way
-        for index in sorted(plan.clouds.regenerate):
+        regenerated = sorted(plan.clouds.regenerate)
+        made_at = unit_weights([plan.clouds[index].members for index in regenerated])
+        for index, weight in zip(regenerated, made_at):
             cloud = plan.clouds[index]
             record = plan.records[cloud.members]
             view = impostor_view(units.centres[cloud.index], units.radii[cloud.index], record.eye)
@@ -65,6 +77,7 @@ class ImpostorStore:
                 targets,
                 view,
                 _extent(particles, cloud.members, view.view, view.projection, (cloud.texture_size,) * 2),
+                float(weight),
             )
             for layer, target in enumerate(targets):
                 depth_ranges = (layer_bounds(record.splits, layer),) * len(cloud.members)
@@ -158,18 +171,22 @@ class ImpostorStore:
         """GPU memory of the atlases and of the ring's textures, in use and idle."""
         return self.pool.bytes_total + sum(atlas.nbytes for atlas in self._atlases.values())
 
-    def cloud_impostor(self, members: tuple, layer: int = 0) -> tuple[AtlasImage, np.ndarray, np.ndarray]:
+    def cloud_impostor(self, members: tuple, layer: int = 0) -> tuple[AtlasImage, np.ndarray, np.ndarray, float]:
         """(image of layer `layer` of the unit of clouds `members`, the world corners of the part of its
-        quad that can show particles, the part of the image they cover (u0, v0, u1, v1))."""
-        images, corners, extents = self.cloud_impostors([(members, layer)])
-        return images[0], corners[0], extents[0]
+        quad that can show particles, the part of the image they cover (u0, v0, u1, v1), the unit's mean
+        blend weight it was made at)."""
+        images, corners, extents, made_at = self.cloud_impostors([(members, layer)])
+        return images[0], corners[0], extents[0], float(made_at[0])
 
-    def cloud_impostors(self, keys) -> tuple[list[AtlasImage], np.ndarray, np.ndarray]:
-        """`cloud_impostor` of each (members, layer) of `keys`, the corners (n, 4, 3) and parts (n, 4) as arrays."""
+    def cloud_impostors(self, keys) -> tuple[list[AtlasImage], np.ndarray, np.ndarray, np.ndarray]:
+        """`cloud_impostor` of each (members, layer) of `keys`, the corners (n, 4, 3), parts (n, 4) and weights
+        (n,) as arrays."""
         held = [(self._clouds[members], layer) for members, layer in keys]
-        corners = np.array([view.corners for (_, view, _), _ in held], dtype=np.float64).reshape(-1, 4, 3)
-        extents = np.array([extent for (_, _, extent), _ in held], dtype=np.float64).reshape(-1, 4)
-        return [targets[layer] for (targets, _, _), layer in held], cropped_corners(corners, extents), extents
+        corners = np.array([view.corners for (_, view, _, _), _ in held], dtype=np.float64).reshape(-1, 4, 3)
+        extents = np.array([extent for (_, _, extent, _), _ in held], dtype=np.float64).reshape(-1, 4)
+        made_at = np.array([weight for (*_, weight), _ in held], dtype=np.float64)
+        images = [targets[layer] for (targets, *_), layer in held]
+        return images, cropped_corners(corners, extents), extents, made_at
 
     def ring_panel(
         self, generation: RingGeneration, segment: int, elevation_deg: float
