@@ -21,7 +21,9 @@ from cloudcore.lod.impostors import (
     required_sizes,
     tolerance_deg_for,
 )
+from cloudcore.lod.plan.draw_items import full_runs
 from cloudcore.lod.plan.state import LodState
+from cloudcore.lod.plan.unit_plans import FULL, IMPOSTOR
 from cloudcore.lod.ring import (
     SEGMENT_DEG,
     SEGMENTS,
@@ -249,9 +251,14 @@ def in_view_work(units: LodUnits, chosen, planes, eye, focal_px, screen_pixels, 
 
 def ms_drawn_alone(units: LodUnits, seen: Seen, chosen, in_view, focal_px, settings, costs) -> float:
     """The units `chosen` (mask) drawn each on its own as auto mode would, far from the eye: per unit the
-    cheaper of full 3D (`in_view`: its particles and fragments in view) and an impostor (`impostor_ms_of`)."""
+    cheaper of full 3D (`in_view`: its particles and fragments in view) and an impostor (`impostor_ms_of`), and
+    a splat draw for each run of them in full 3D between impostors, far to near (a sparse sky's small clouds
+    drawn alone are many runs, each a draw of the cloud pass that the ring's panels do not make)."""
     full = costs.particles * in_view[0] + costs.fragments * in_view[1]
-    return float(np.sum(np.minimum(full, impostor_ms_of(units, seen, chosen, focal_px, settings, costs))))
+    impostor = impostor_ms_of(units, seen, chosen, focal_px, settings, costs)
+    far_to_near = np.argsort(-seen.distances[chosen], kind="stable")
+    kinds = np.where(full <= impostor, FULL, IMPOSTOR).astype(np.int8)[far_to_near]
+    return float(np.sum(np.minimum(full, impostor))) + costs.batches * full_runs(kinds)
 
 
 def segments_of(centres, eye) -> np.ndarray:
