@@ -4,6 +4,9 @@ frames' measured times."""
 
 from __future__ import annotations
 
+import math
+from collections.abc import Mapping
+
 import numpy as np
 
 from cloudcore.lod.costs import CostModel
@@ -78,6 +81,46 @@ def represent(
     step = 1.0 / transition_frames
     weight = min(1.0, previous.full_weight + step) if target == "full" else max(0.0, previous.full_weight - step)
     return Representation(target, weight)
+
+
+def represent_units(
+    members: tuple,
+    rows,
+    distances,
+    priced,
+    prices,
+    previous: Mapping,
+    held_errors,
+    tolerance: float,
+    all_full: bool,
+    settings,
+) -> tuple[np.ndarray, dict, list]:
+    """Auto mode's step (`represent`) for each unit at `rows` (at `distances`) that it prices on its own (`priced`,
+    a mask of the rows; the others, fading into or out of the ring, are impostors: weight 0) by `prices` (a
+    `RepresentationPrices`): (their full-3D weights, their representations by members, their (index, distance,
+    full ms, impostor ms)).  `previous`: the representations of the last frame; `held_errors`: of the impostors
+    held, per row; `all_full`: the frame heads all to full 3D (`next_frame_choice`)."""
+    weights = np.zeros(len(rows))
+    chosen, prices_of = {}, []
+    budgeted = bool(settings.regeneration_budget or settings.frame_budget_ms)
+    # an impostor within half its tolerance of the picture full 3D gives, or one remade from this very eye, differs
+    # from it by less than a regeneration's own step: the switch needs no crossfade
+    close_impostor = ((held_errors <= 0.5 * tolerance) | ((held_errors > tolerance) & (not budgeted))).tolist()
+    close_full = (held_errors <= 0.5 * tolerance).tolist()
+    full_ms, impostor_ms, distances = prices.full_ms.tolist(), prices.impostor_ms.tolist(), distances.tolist()
+    for row in np.flatnonzero(priced).tolist():
+        index = int(rows[row])
+        representation = represent(
+            previous.get(members[index]),
+            full_ms[row],
+            math.inf if all_full else impostor_ms[row],
+            settings.transition_frames,
+            {"impostor": close_impostor[row], "full": close_full[row]},
+        )
+        prices_of.append((index, distances[row], full_ms[row], impostor_ms[row]))
+        chosen[members[index]] = representation
+        weights[row] = representation.full_weight
+    return weights, chosen, prices_of
 
 
 def ring_pays(state: RingState, ring_ms: float, alone_ms: float) -> bool:

@@ -30,7 +30,7 @@ from cloudcore.lod.plan.choice import (
     groups_cheaper_apart,
     next_frame_choice,
     prices_units,
-    represent,
+    represent_units,
     ring_pays,
     settled_in_full_3d,
     units_ms,
@@ -42,11 +42,11 @@ from cloudcore.lod.plan.pricing import (
     Pricing,
     Seen,
     held_impostor_errors,
-    impostor_textures,
     in_view_work,
     ms_drawn_alone,
     panel_pixels,
     pricing_of,
+    representation_prices,
     ring_panels_work,
     ring_translation_error,
     ring_work,
@@ -438,71 +438,51 @@ def _plan_units(
         decided(index, INSIDE, inside, splits, individual, full_ms, inside_ms)
         cloud_work += screen_impostor
     if len(outside):
-        # the units that may be impostors, priced together: full 3D's work (a ball of discs; near, splat by splat, as
-        # `full_3d`), the impostor's quad and its remaking over its lifetime (one texture a layer)
-        textures = impostor_textures(units, outside, distances, height, camera.fov_y_deg, settings)
         splits_of = {index: split_at(index, eye) for index in holding.intersection(outside.tolist())}
         layers = np.array(
             [len(splits_of[i][1]) + 1 if i in splits_of else 1 for i in outside.tolist()], dtype=np.float64
         )
-        if settings.mode == "impostor":  # nothing drawn in full 3D but the units the eye is in: nothing else to price
-            full_particles, full_fragments = np.zeros(len(outside)), np.zeros(len(outside))
-        else:
-            full_particles = units.particle_counts[outside].astype(np.float64)
-            full_fragments = np.asarray(ball_fragments[outside], dtype=np.float64).copy()
-            if cloud_splats is not None:
-                for k in np.flatnonzero(distances[outside] < NEAR_EXACT_RADII * radii[outside]).tolist():
-                    index = int(outside[k])
-                    near = full_3d(index, radii[index], float(distances[index]))
-                    full_particles[k], full_fragments[k] = near.particles, near.fragments
-        quad_pixels = np.minimum(textures.pixels * textures.pixels, screen_pixels)
-        remake_particles = units.particle_counts[outside] * layers
-        remake_fragments = textures.fragments * layers
-        full_ms = costs.particles * full_particles + costs.fragments * full_fragments
-        priced_alone = settings.mode == "auto" and individuals[outside] == 1.0  # a unit fading into or out of the ring
-        with np.errstate(invalid="ignore"):
-            impostor_ms = np.where(
-                priced_alone,
-                (costs.quad_pixels * quad_pixels + costs.quads)
-                + (
-                    costs.particles * remake_particles
-                    + costs.texture_fragments * remake_fragments
-                    + costs.regenerations * layers
-                )
-                / np.maximum(lifetimes[outside], 1.0),
-                math.inf,
-            )
+        near = (
+            np.flatnonzero(distances[outside] < NEAR_EXACT_RADII * radii[outside])
+            if cloud_splats is not None and settings.mode != "impostor"
+            else np.zeros(0, dtype=np.int64)
+        )
+        alone = settings.mode == "auto" and individuals[outside] == 1.0  # not fading into or out of the ring
+        prices = representation_prices(
+            units,
+            outside,
+            seen,
+            lifetimes,
+            layers,
+            {int(k): full_3d(int(outside[k]), radii[outside[k]], float(distances[outside[k]])) for k in near.tolist()},
+            alone,
+            pricing,
+            settings,
+            costs,
+            height,
+            camera.fov_y_deg,
+        )
         full_weight_of = np.zeros(
             len(outside)
         )  # a unit fading into or out of the ring is an impostor: one layer scales
         if settings.mode == "auto":
-            errors = held_errors[outside]
-            budgeted = bool(settings.regeneration_budget or settings.frame_budget_ms)
-            # an impostor within half its tolerance of the picture full 3D gives, or one remade from this very eye,
-            # differs from it by less than a regeneration's own step: the switch needs no crossfade
-            close_impostor = ((errors <= 0.5 * tolerance) | ((errors > tolerance) & (not budgeted))).tolist()
-            close_full = (errors <= 0.5 * tolerance).tolist()
-            for k, index, full_price, impostor_price, distance in zip(
-                range(len(outside)),
-                outside.tolist(),
-                full_ms.tolist(),
-                impostor_ms.tolist(),
-                distances[outside].tolist(),
-            ):
-                if not priced_alone[k]:
-                    continue
-                members = units.members[index]
-                representation = represent(
-                    state.representations.get(members),
-                    full_price,
-                    math.inf if all_full else impostor_price,
-                    settings.transition_frames,
-                    {"impostor": close_impostor[k], "full": close_full[k]},
-                )
-                unit_prices.append((index, distance, full_price, impostor_price))
-                representations[members] = representation
-                full_weight_of[k] = representation.full_weight
-        everything_full += Work(particles=float(np.sum(full_particles)), fragments=float(np.sum(full_fragments)))
+            full_weight_of, chosen, priced_units = represent_units(
+                units.members,
+                outside,
+                distances[outside],
+                alone,
+                prices,
+                state.representations,
+                held_errors[outside],
+                tolerance,
+                all_full,
+                settings,
+            )
+            representations.update(chosen)
+            unit_prices += priced_units
+        everything_full += Work(
+            particles=float(np.sum(prices.full_particles)), fragments=float(np.sum(prices.full_fragments))
+        )
         whole = full_weight_of == 1.0
         fading = (full_weight_of > 0.0) & ~whole
         shown = outside[~whole]  # as impostors, crossfading or not
@@ -510,24 +490,24 @@ def _plan_units(
         kinds[shown] = np.where(fading[~whole], CROSSFADE, IMPOSTOR)
         full_weights[shown] = (full_weight_of * individuals[outside])[~whole]
         impostor_weights[shown] = ((1.0 - full_weight_of) * individuals[outside])[~whole]
-        texture_sizes[shown] = textures.sizes[~whole]
-        full_prices[outside], impostor_prices[outside] = full_ms, impostor_ms
+        texture_sizes[shown] = prices.textures.sizes[~whole]
+        full_prices[outside], impostor_prices[outside] = prices.full_ms, prices.impostor_ms
         for index, (inside, splits) in splits_of.items():
             if splits:
                 split_objects[index], split_distances[index] = inside, splits
         cloud_work += Work(
-            particles=float(np.sum(full_particles[whole | fading])),
-            fragments=float(np.sum(full_fragments[whole | fading])),
-            quad_pixels=float(np.sum(quad_pixels[~whole]) + screen_pixels * np.count_nonzero(fading)),  # fades' layer
+            particles=float(np.sum(prices.full_particles[whole | fading])),
+            fragments=float(np.sum(prices.full_fragments[whole | fading])),
+            # the impostors' quads, and a crossfade's screen layer
+            quad_pixels=float(np.sum(prices.quad_pixels[~whole]) + screen_pixels * np.count_nonzero(fading)),
             quads=float(np.count_nonzero(~whole)),
         )
         for k in np.flatnonzero(~whole).tolist():
             index = int(outside[k])
-            members = units.members[index]
-            record = records.get(members)
+            record = records.get(units.members[index])
             reason = regeneration_reason(
                 record,
-                int(textures.sizes[k]),
+                int(prices.textures.sizes[k]),
                 unit_key(index),
                 tolerance,
                 float(held_errors[index]),
@@ -536,15 +516,9 @@ def _plan_units(
             if reason is not None:
                 reasons[index] = reason
                 ratio = float(held_errors[index]) / max(tolerance, 1e-300)
-                splits = splits_of.get(index, ((), ()))[1]
-                remake = Work(
-                    particles=float(remake_particles[k]),
-                    texture_fragments=float(remake_fragments[k]),
-                    regenerations=float(layers[k]),
-                )
-                wanted.append(
-                    (index, regeneration_priority(reason, ratio, bool(splits), float(textures.pixels[k])), remake)
-                )
+                split = bool(splits_of.get(index, ((), ()))[1])
+                priority = regeneration_priority(reason, ratio, split, float(prices.textures.pixels[k]))
+                wanted.append((index, priority, prices.remake(k)))
     unit_prices.sort(key=lambda price: price[0])  # by index, as the units are numbered
     served = budgeted_regenerations([(index, priority) for index, priority, _ in wanted], settings.regeneration_budget)
     if settings.frame_budget_ms > 0.0:

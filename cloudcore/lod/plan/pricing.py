@@ -183,6 +183,82 @@ def impostor_textures(units: LodUnits, rows, distances, height: int, fov_y_deg: 
     return ImpostorTextures(pixels, sizes, np.reshape(fragments, -1))
 
 
+class RepresentationPrices(NamedTuple):
+    """Per unit of some rows (`representation_prices`), the work and the price of it drawn in full 3D and as an
+    impostor."""
+
+    textures: ImpostorTextures
+    layers: np.ndarray  # textures of its impostor: one more than the objects inside
+    full_particles: np.ndarray  # full 3D's (none in impostor mode, which draws no such unit in full 3D)
+    full_fragments: np.ndarray
+    quad_pixels: np.ndarray  # of its impostor's quad on the screen
+    remake_particles: np.ndarray  # of remaking its impostor, every layer
+    remake_fragments: np.ndarray
+    full_ms: np.ndarray
+    impostor_ms: np.ndarray  # a frame, its remaking over its lifetime (inf: not priced)
+
+    def remake(self, row: int) -> Work:
+        """Remaking the impostor of the unit at `row` of these."""
+        return Work(
+            particles=float(self.remake_particles[row]),
+            texture_fragments=float(self.remake_fragments[row]),
+            regenerations=float(self.layers[row]),
+        )
+
+
+def representation_prices(
+    units: LodUnits,
+    rows,
+    seen: Seen,
+    lifetimes,
+    layers,
+    near_work: dict,
+    priced,
+    pricing: Pricing,
+    settings,
+    costs,
+    height,
+    fov_y_deg,
+) -> RepresentationPrices:
+    """What the units at `rows` (indices), seen from afar, cost in full 3D and as impostors: full 3D a ball of discs
+    (`Seen.ball_fragments`), or `near_work` (row of these -> `Work`) for the near ones counted splat by splat; an
+    impostor its quad and its remaking (one texture a layer, `layers`) over its lifetime (`lifetimes`, per unit: a ring
+    candidate's impostor lasts until the ring takes it), where `priced` (a mask of these rows, or one for all: auto
+    mode's units drawn on their own)."""
+    count = len(rows)
+    textures = impostor_textures(units, rows, seen.distances, height, fov_y_deg, settings)
+    if settings.mode == "impostor":  # nothing drawn in full 3D but the units the eye is in: nothing else to price
+        full_particles, full_fragments = np.zeros(count), np.zeros(count)
+    else:
+        full_particles = units.particle_counts[rows].astype(np.float64)
+        full_fragments = np.asarray(seen.ball_fragments[rows], dtype=np.float64).copy()
+        for row, work in near_work.items():
+            full_particles[row], full_fragments[row] = work.particles, work.fragments
+    quad_pixels = np.minimum(textures.pixels * textures.pixels, pricing.screen_pixels)
+    remake_particles = units.particle_counts[rows] * layers
+    remake_fragments = textures.fragments * layers
+    remake_ms = (
+        costs.particles * remake_particles + costs.texture_fragments * remake_fragments + costs.regenerations * layers
+    )
+    with np.errstate(invalid="ignore"):
+        impostor_ms = np.where(
+            priced,
+            costs.quad_pixels * quad_pixels + costs.quads + remake_ms / np.maximum(lifetimes[rows], 1.0),
+            math.inf,
+        )
+    return RepresentationPrices(
+        textures,
+        layers,
+        full_particles,
+        full_fragments,
+        quad_pixels,
+        remake_particles,
+        remake_fragments,
+        costs.particles * full_particles + costs.fragments * full_fragments,
+        impostor_ms,
+    )
+
+
 def impostor_ms_of(units: LodUnits, seen: Seen, chosen, focal_px, settings, costs: CostModel) -> np.ndarray:
     """Per unit of `chosen` (a mask or indices), its impostor a frame: the quad, and the regeneration (every
     particle, into a texture as fine as the screen or the unit's detail asks) over the impostor's lifetime."""
