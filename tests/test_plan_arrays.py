@@ -9,7 +9,7 @@ import pytest
 from cloudcore.camera import frustum_planes, projection_matrix, spheres_in_frustum, view_matrix
 from cloudcore.lod.plan import LodState, plan_frame
 from cloudcore.lod.plan.draw_items import DrawItem, draw_items
-from cloudcore.lod.plan.pricing import panel_pixels
+from cloudcore.lod.plan.pricing import panel_pixels, segments_of
 from cloudcore.lod.plan.unit_plans import FULL, KINDS, UnitPlans
 from cloudcore.lod.ring import SEGMENTS, RingState, frames_to_show, plan_ring, ring_members
 from cloudcore.lod.splitting import layer_bounds, layer_sort_key
@@ -187,11 +187,11 @@ def test_ring_panels_fill_the_box_of_their_clouds_on_the_screen_not_the_sum_of_t
     view_projection = projection_matrix(camera.fov_y_deg, 640 / 480) @ view_matrix(camera)
     crowd = np.column_stack([np.linspace(1700.0, 2300.0, 20), np.full(20, 150.0), np.full(20, -6000.0)])  # 16-21 deg
     quads = np.full(20, 60.0**2)  # each 60 px across, overlapping their neighbours
-    strip = panel_pixels(crowd, eye, quads, view_projection, (640, 480))
+    strip = panel_pixels(crowd, segments_of(crowd, eye), quads, view_projection, (640, 480))
     assert strip < 0.5 * np.sum(quads)
     # 600 m across at 6 km is 41.6 px on this screen: their box is that and a quad's side across, a quad high
     assert strip == pytest.approx((41.57 + 60.0) * 60.0, rel=1e-3)
     apart = np.array([[-2500.0, 150.0, -6000.0], [2500.0, 150.0, -6000.0]])  # two segments, one cloud each
-    assert panel_pixels(apart, eye, [900.0, 900.0], view_projection, (640, 480)) == 1800.0
+    assert panel_pixels(apart, segments_of(apart, eye), [900.0, 900.0], view_projection, (640, 480)) == 1800.0
     behind = np.array([[0.0, 0.0, 6000.0]])
-    assert panel_pixels(behind, eye, [1e9], view_projection, (640, 480)) == 640 * 480
+    assert panel_pixels(behind, segments_of(behind, eye), [1e9], view_projection, (640, 480)) == 640 * 480

@@ -51,6 +51,7 @@ from cloudcore.lod.plan.pricing import (
     ring_translation_error,
     ring_work,
     seen_from,
+    segments_of,
 )
 from cloudcore.lod.plan.schedule import within_frame_budget
 from cloudcore.lod.plan.state import (
@@ -242,14 +243,15 @@ def _plan_units(
     if settings.mode == "auto" and settings.uses_ring:
         candidates = ring_members(centres, radii, eye, settings)
         alone = candidates & visible
+        segments = segments_of(centres[candidates], eye)
+        seen_alone = visible[candidates]
         ring_panels, ring_rebuild, moved_lifetime, tolerance_lifetime = ring_work(
             units,
             candidates,
-            centres,
-            eye,
+            segments,
             step,
             ball_fragments,
-            panel_pixels(centres[alone], eye, quad_pixels_of[alone], view_projection, viewport),
+            panel_pixels(centres[alone], segments[seen_alone], quad_pixels_of[alone], view_projection, viewport),
             lifetimes,
             settings,
             state.ring,
@@ -411,9 +413,14 @@ def _plan_units(
         for index in sorted(holding.intersection(drawable.tolist())):
             decided(index, FULL, *split_at(index, eye), full_weight=1.0)
         holders = outside = np.zeros(0, dtype=np.int64)
+    # the eye inside: a screen impostor has fewer fragments than the screen, not fewer particles; its composite over
+    # the screen is priced per run of inside units, below, and here, for the choice, as each unit's share of the
+    # composites of the runs the units the eye is in would make, far to near (a sky flown through holds the eye in
+    # tens of units, composited in a few runs: one composite each priced their particles always cheaper in full 3D)
+    ordered = eye_in[np.argsort(-distances[drawable], kind="stable")]
+    composites = np.count_nonzero(ordered & ~np.concatenate([[False], ordered[:-1]]))
+    composite = Work(quad_pixels=screen_pixels, quads=1, batches=1).scaled(composites / max(len(holders), 1))
     for index in holders.tolist():
-        # the eye inside: a screen impostor has fewer fragments than the screen, not fewer particles; its composite
-        # over the screen is priced per run of inside units, below (here, for the choice, as one each)
         radius, distance, members = radii[index], float(distances[index]), units.members[index]
         individual = float(individuals[index])
         inside, splits = split_at(index, eye)
@@ -422,7 +429,7 @@ def _plan_units(
         screen_impostor = dataclasses.replace(full, fragments=full.fragments * settings.inside_resolution_scale**2)
         full_ms, inside_ms = (
             costs.ms(full),
-            costs.ms(screen_impostor + Work(quad_pixels=screen_pixels, quads=1, batches=1)),
+            costs.ms(screen_impostor + composite),
         )
         if settings.mode == "auto" and individual == 1.0:
             previous = state.representations.get(members)
@@ -551,7 +558,8 @@ def _plan_units(
         for generation, _ in ring.draws:
             rows = generation.rows_in(units.members, units.row_of)
             shown = rows[visible[rows]]
-            pixels = panel_pixels(centres[shown], generation.eye, quad_pixels_of[shown], view_projection, viewport)
+            shown_segments = segments_of(centres[shown], generation.eye)
+            pixels = panel_pixels(centres[shown], shown_segments, quad_pixels_of[shown], view_projection, viewport)
             cloud_work += ring_panels_work(len(generation.occupied_segments), pixels)
         builds = ring.segment_builds()
         update_work += Work(

@@ -344,9 +344,9 @@ def segments_of(centres, eye) -> np.ndarray:
     return (azimuths // SEGMENT_DEG).astype(np.int64) % SEGMENTS  # a tiny negative azimuth % 360 gives 360
 
 
-def panel_pixels(centres, eye, quad_pixels, view_projection: np.ndarray, viewport) -> float:
-    """Pixels on the screen of the ring panels (a ring made at `eye`) that show the clouds in view at `centres`,
-    whose own impostor quads would fill `quad_pixels`.
+def panel_pixels(centres, segments, quad_pixels, view_projection: np.ndarray, viewport) -> float:
+    """Pixels on the screen of the ring panels that show the clouds in view at `centres`, in the ring's
+    `segments` (`segments_of`), whose own impostor quads would fill `quad_pixels`.
 
     A panel is cropped to the part its clouds cover and is one layer however many of them overlap: per
     segment, the box on the screen around its clouds' quads, within the screen, and at most their sum (a few
@@ -360,25 +360,22 @@ def panel_pixels(centres, eye, quad_pixels, view_projection: np.ndarray, viewpor
     centres = np.asarray(centres, dtype=np.float64).reshape(-1, 3)
     clip = centres @ view_projection[:3, :3].T + view_projection[:3, 3]
     w = centres @ view_projection[3, :3] + view_projection[3, 3]
-    ahead = w > 0.0
-    with np.errstate(divide="ignore", invalid="ignore"):
-        x = (0.5 + 0.5 * clip[:, 0] / w) * width
-        y = (0.5 + 0.5 * clip[:, 1] / w) * height
     half_sides = 0.5 * np.sqrt(quad_pixels)
-    segments = segments_of(centres, eye)
-    total = 0.0
-    for segment in np.unique(segments).tolist():
-        rows = segments == segment
-        summed = float(np.sum(quad_pixels[rows]))
-        if not np.all(ahead[rows]):  # a cloud beside or behind the eye: its quad's box is unbounded
-            total += min(summed, float(width * height))
-            continue
-        left = max(float(np.min(x[rows] - half_sides[rows])), 0.0)
-        right = min(float(np.max(x[rows] + half_sides[rows])), float(width))
-        bottom = max(float(np.min(y[rows] - half_sides[rows])), 0.0)
-        top = min(float(np.max(y[rows] + half_sides[rows])), float(height))
-        total += min(summed, max(right - left, 0.0) * max(top - bottom, 0.0))
-    return total
+    with np.errstate(divide="ignore", invalid="ignore"):
+        x, y = (0.5 + 0.5 * clip[:, 0] / w) * width, (0.5 + 0.5 * clip[:, 1] / w) * height
+    # segment by segment in one pass: the rows sorted by segment, each segment's extremes reduced at its start
+    order = np.argsort(segments, kind="stable")
+    starts = np.flatnonzero(np.concatenate([[True], np.diff(segments[order]) != 0]))
+    x, y, half_sides, ahead = x[order], y[order], half_sides[order], (w > 0.0)[order]
+    summed = np.add.reduceat(quad_pixels[order], starts)
+    left = np.maximum(np.minimum.reduceat(x - half_sides, starts), 0.0)
+    right = np.minimum(np.maximum.reduceat(x + half_sides, starts), float(width))
+    bottom = np.maximum(np.minimum.reduceat(y - half_sides, starts), 0.0)
+    top = np.minimum(np.maximum.reduceat(y + half_sides, starts), float(height))
+    boxes = np.maximum(right - left, 0.0) * np.maximum(top - bottom, 0.0)
+    # a cloud beside or behind the eye: its quad's box is unbounded, the screen at most
+    boxes = np.where(np.logical_and.reduceat(ahead, starts), boxes, float(width * height))
+    return float(np.sum(np.minimum(summed, boxes)))
 
 
 def ring_panels_work(panels: int, pixels: float) -> Work:
@@ -387,9 +384,9 @@ def ring_panels_work(panels: int, pixels: float) -> Work:
 
 
 def ring_work(
-    units: LodUnits, candidates, centres, eye, step, ball_fragments, pixels, lifetimes, settings, state: RingState
+    units: LodUnits, candidates, segments, step, ball_fragments, pixels, lifetimes, settings, state: RingState
 ) -> tuple[Work, Work, float, float]:
-    """(panels, rebuild, moved, tolerated): Wang's ring holding the units `candidates` (mask).
+    """(panels, rebuild, moved, tolerated): Wang's ring holding the units `candidates` (mask), in `segments`.
 
     Its panels drawn a frame (`pixels`: what they fill on the screen, `panel_pixels`), its rebuild (every
     candidate splatted into the segments, whose textures have the screen's pixel density), and the frames
@@ -397,7 +394,7 @@ def ring_work(
     last ring lasted when shorter (moved); and that or the frames its clouds' impostors would (`lifetimes`),
     when shorter still (tolerated).
     """
-    panels = int(np.count_nonzero(np.bincount(segments_of(centres[candidates], eye), minlength=SEGMENTS)))
+    panels = int(np.count_nonzero(np.bincount(segments, minlength=SEGMENTS)))
     horizontal, vertical = math.hypot(step[0], step[2]), abs(step[1])
     moved = min(
         LONGEST_LIFETIME_FRAMES,
