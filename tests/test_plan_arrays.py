@@ -1,17 +1,19 @@
 """The plan at scale: its decisions are arrays, a unit costs Python time only where it is drawn, and what the ring
 holds keeps no impostor of its own."""
 
+import dataclasses
 import math
 
 import numpy as np
 import pytest
 
 from cloudcore.camera import frustum_planes, projection_matrix, spheres_in_frustum, view_matrix
+from cloudcore.lod.impostors import parallax_errors_deg
 from cloudcore.lod.plan import LodState, plan_frame
 from cloudcore.lod.plan.draw_items import DrawItem, draw_items
-from cloudcore.lod.plan.pricing import panel_pixels, segments_of
+from cloudcore.lod.plan.pricing import panel_pixels, ring_translation_error, segments_of
 from cloudcore.lod.plan.unit_plans import FULL, KINDS, UnitPlans
-from cloudcore.lod.ring import SEGMENTS, RingState, frames_to_show, plan_ring, ring_members
+from cloudcore.lod.ring import SEGMENTS, RingGeneration, RingState, frames_to_show, plan_ring, ring_members
 from cloudcore.lod.splitting import layer_bounds, layer_sort_key
 from cloudcore.lod.units import LodUnits
 from cloudcore.scene import Camera
@@ -195,3 +197,36 @@ def test_ring_panels_fill_the_box_of_their_clouds_on_the_screen_not_the_sum_of_t
     assert panel_pixels(apart, segments_of(apart, eye), [900.0, 900.0], view_projection, (640, 480)) == 1800.0
     behind = np.array([[0.0, 0.0, 6000.0]])
     assert panel_pixels(behind, segments_of(behind, eye), [1e9], view_projection, (640, 480)) == 640 * 480
+
+
+def test_the_ring_s_largest_parallax_error_is_its_whole_ring_s_whatever_the_step():
+    """`ring_translation_error` measures the clouds whose error grows fastest and bounds the rest: over a ring of
+    2,000 clouds and steps from centimetres to past the nearest cloud, it is the maximum over every cloud."""
+    rng = np.random.default_rng(11)
+    count = 2000
+    angles, ranges = rng.uniform(0.0, 2.0 * np.pi, count), rng.uniform(4000.0, 30000.0, count)
+    centres = np.column_stack([ranges * np.sin(angles), rng.uniform(800.0, 2500.0, count), -ranges * np.cos(angles)])
+    radii = rng.uniform(50.0, 900.0, count)
+    eye = (0.0, 1000.0, 0.0)
+    generation = RingGeneration(
+        eye, 4000.0, np.arange(count), np.zeros(count, object), frozenset(), (), spheres=(centres, radii)
+    )
+    generation = dataclasses.replace(generation, members=frozenset((i,) for i in range(count)))
+    # and one whose fastest clouds (large, near, due north) see a step due north end on: the largest error is
+    # another cloud's, which only the bound can send the measure to
+    north = np.column_stack([rng.uniform(-50.0, 50.0, 100), np.full(100, 1000.0), rng.uniform(-5000.0, -4500.0, 100)])
+    lined_up = RingGeneration(
+        eye,
+        4000.0,
+        np.arange(count + 100),
+        np.zeros(count + 100, object),
+        frozenset((i,) for i in range(count + 100)),
+        (),
+        spheres=(np.concatenate([north, centres]), np.concatenate([np.full(100, 1500.0), radii])),
+    )
+    for ring, directions in ((generation, rng.normal(size=(4, 3))), (lined_up, [(0.0, 0.0, -1.0)])):
+        for step in (0.0, 0.05, 3.0, 120.0, 2500.0, 6000.0):
+            for direction in directions:
+                now = np.asarray(eye) + step * np.asarray(direction) / np.linalg.norm(direction)
+                whole = float(np.max(parallax_errors_deg(*ring.spheres, eye, now)))
+                assert ring_translation_error(ring, parallax_errors_deg, now) == whole

@@ -67,13 +67,30 @@ class RingGeneration:
 
     #: what the frames before found of it, so that a ring of thousands is not walked every frame: "rows", the
     #: tuple of ids last planned with and its members' rows in it; "unchanged", the clouds' lighting keys (the
-    #: tuple a frame was planned with) and the set of ids last found to leave it as it was made
+    #: tuple a frame was planned with) and the set of ids last found to leave it as it was made; "parallax", the
+    #: spheres whose parallax error grows fastest (`fastest_parallax`)
     _memo: dict = field(default_factory=dict, repr=False)
 
     @property
     def occupied_segments(self) -> tuple[int, ...]:
         """The segments holding a cloud: only they are rendered and drawn."""
         return tuple(segment for segment, clouds in enumerate(self.segment_members) if clouds)
+
+    def fastest_parallax(self, count: int) -> tuple[np.ndarray, float, float]:
+        """(the rows of `spheres` of the `count` whose parallax error grows fastest as the eye steps from `eye`,
+        by the rate 2r / ((d - r)(d + r)) (inf: `eye` inside), the largest rate of the others, and their nearest
+        near point d - r), found once."""
+        held = self._memo.get("parallax")
+        if held is None:
+            centres, radii = self.spheres
+            distances = np.linalg.norm(centres - np.asarray(self.eye, dtype=np.float64), axis=1)
+            near, far = distances - radii, distances + radii
+            with np.errstate(divide="ignore", invalid="ignore"):
+                rates = np.where(near > 0.0, 2.0 * radii / (near * far), math.inf)
+            order = np.argpartition(-rates, count)
+            others = order[count:]
+            held = self._memo["parallax"] = (order[:count], float(np.max(rates[others])), float(np.min(near[others])))
+        return held
 
     def rows_in(self, ids: tuple, row_of: Mapping) -> np.ndarray:
         """The rows of its members present in `ids` (whose `row_of` maps an id to its row), in the order of

@@ -411,10 +411,30 @@ def ring_work(
     return ring_panels_work(panels, pixels), rebuild, moved, tolerated
 
 
+#: the members of a ring whose parallax error is measured each frame; the rest are bounded (`ring_translation_error`)
+RING_ERROR_WATCHED = 64
+
+
 def ring_translation_error(generation, translation_error, eye) -> float:
     """The largest translation error of a cloud of the ring `generation` (None: no ring; 0: none) seen from
-    `eye`: Wang's panels are impostors too."""
+    `eye`: Wang's panels are impostors too.
+
+    By the parallax metric, measured for the `RING_ERROR_WATCHED` clouds whose error grows fastest with the
+    eye's step from where the ring was made (`RingGeneration.fastest_parallax`), and for the rest
+    only where their bound passes those: each parts its near and far rays by at most s 2r / ((d - r - s)(d + r -
+    s)) radians after a step s shorter than d - r, so none of them passes s k (a / (a - s))^2, k the largest rate
+    and a the nearest near point among them: a ring of thousands is measured whole only where that bound does
+    not settle it.
+    """
     if generation is None or not generation.members:
         return 0.0
     centres, radii = generation.spheres
-    return float(np.max(translation_error(centres, radii, generation.eye, eye), initial=0.0))
+    then, now = np.asarray(generation.eye, dtype=np.float64), np.asarray(eye, dtype=np.float64)
+    if translation_error is not parallax_errors_deg or len(radii) <= RING_ERROR_WATCHED:
+        return float(np.max(translation_error(centres, radii, then, now), initial=0.0))
+    rows, rest_rate, rest_near = generation.fastest_parallax(RING_ERROR_WATCHED)
+    largest = float(np.max(parallax_errors_deg(centres[rows], radii[rows], then, now)))
+    step = float(np.linalg.norm(now - then))
+    if rest_near > step and math.degrees(step * rest_rate * (rest_near / (rest_near - step)) ** 2) <= largest:
+        return largest
+    return float(np.max(parallax_errors_deg(centres, radii, then, now), initial=0.0))
