@@ -11,11 +11,15 @@ import imageio_ffmpeg
 import pytest
 from conftest import VALLEY
 
+from cloudcore.measure.imagecompare import compare
 from cloudcore.measure.recording import COLUMNS
 
 pytestmark = pytest.mark.gl
 
 SIZE = ["--width", "64", "--height", "48"]
+#: two auto runs of the same path: a unit drawn otherwise moves a frame less than auto's frames are from full 3D's
+#: (34 dB at worst along the default flythrough); a pass left in another state would break the picture
+SAME_FRAME_DB = 30.0
 
 
 def run_cli(*args):
@@ -81,7 +85,10 @@ def test_one_csv_row_and_one_png_per_frame(flythrough):
 
 
 def test_the_same_inputs_give_the_same_frames(flythrough, tmp_path):
-    """Measuring overdraw (done in the first run, not here) leaves the frames alone too."""
+    """Measuring overdraw (done in the first run, not here) leaves the frames alone too.
+
+    Auto mode chooses by the pass times it measures, so on a loaded machine a unit may be drawn otherwise (an
+    impostor where the first run drew its particles): the frames are the same within `SAME_FRAME_DB`."""
     result = run_cli(
         "--camera-path",
         "flythrough",
@@ -101,7 +108,8 @@ def test_the_same_inputs_give_the_same_frames(flythrough, tmp_path):
     again = sorted((tmp_path / "f").iterdir())
     assert len(again) == 4
     for png in again:
-        assert png.read_bytes() == (flythrough / "frames" / png.name).read_bytes(), png.name
+        psnr = compare(iio.imread(png), iio.imread(flythrough / "frames" / png.name)).psnr_db
+        assert psnr >= SAME_FRAME_DB, f"{png.name}: {psnr:.1f} dB from the first run's"
 
 
 def test_ctrl_c_keeps_a_playable_video_of_the_frames_so_far(tmp_path):
