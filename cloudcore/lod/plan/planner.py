@@ -69,7 +69,7 @@ from cloudcore.lod.plan.unit_plans import (
     RING,
     TEXTURED,
     UnitPlans,
-    kind_codes,
+    of_kinds,
 )
 from cloudcore.lod.ring import (
     RING_FRAME_MS,
@@ -536,7 +536,7 @@ def _plan_units(
     # the largest translation error drawn, over the tolerance
     accepted = 0.0 if chases_tolerance or ring is None or not ring.draws else ring_error / max(tolerance, 1e-300)
     regenerate, postponed = {}, {}
-    for index in np.flatnonzero(np.isin(kinds, kind_codes(*TEXTURED))).tolist():
+    for index in np.flatnonzero(of_kinds(kinds, *TEXTURED)).tolist():
         members = units.members[index]
         record = records.get(members)
         if index not in served and record is not None:
@@ -581,7 +581,7 @@ def _plan_units(
         split_objects,
         split_distances,
     )
-    drawn = np.flatnonzero(np.isin(kinds, kind_codes(*DRAWN)))
+    drawn = np.flatnonzero(of_kinds(kinds, *DRAWN))
     draw_order = tuple(drawn[np.argsort(-distances[drawn], kind="stable")].tolist())
     inside_size = tuple(max(1, math.ceil(side * settings.inside_resolution_scale)) for side in viewport)
     items = draw_items(plans, draw_order, radii, object_centres, objects_visible, eye)
