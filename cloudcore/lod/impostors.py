@@ -128,24 +128,24 @@ def cropped_corners(corners: np.ndarray, extent) -> np.ndarray:
     return origin + u * right + v * up
 
 
-def _tangent(radius: float, distance: float) -> float:
-    """Half side of the impostor quad of a sphere seen from `distance` (> radius), over that distance."""
-    # the smallest normal float (np.finfo's tiny) from sys: np.finfo builds an object per call, and the planner
-    # asks for every unit it draws
-    return radius / math.sqrt(max((distance - radius) * (distance + radius), sys.float_info.min))
+def _tangent(radius, distance):
+    """Half side of the impostor quad of a sphere seen from `distance` (> radius), over that distance (scalars,
+    or arrays element by element)."""
+    # the smallest normal float (np.finfo's tiny) from sys: np.finfo builds an object per call
+    return radius / np.sqrt(np.maximum((distance - radius) * (distance + radius), sys.float_info.min))
 
 
-def quad_half_side(radius: float, distance: float) -> float:
+def quad_half_side(radius, distance):
     """Half side in metres of the impostor quad through the centre of a sphere seen from `distance` (> radius)."""
     return _tangent(radius, distance) * distance
 
 
-def screen_size_px(radius: float, distance: float, viewport_height: int, fov_y_deg: float) -> float:
+def screen_size_px(radius, distance, viewport_height: int, fov_y_deg: float):
     """Side in pixels of the impostor quad of a sphere seen from `distance` (> radius)."""
     return viewport_height * _tangent(radius, distance) / math.tan(math.radians(fov_y_deg) / 2.0)
 
 
-def detail_size_px(radius: float, distance: float, finest_radius: float, texels: float) -> float:
+def detail_size_px(radius, distance, finest_radius, texels: float):
     """Texture side that gives a particle of `finest_radius` `texels` texels of radius on the quad.
 
     A cloud of Gaussian splats holds no detail finer than its smallest splat, so a
@@ -153,9 +153,10 @@ def detail_size_px(radius: float, distance: float, finest_radius: float, texels:
     sample the kernel's spectrum down to 8-bit quantisation; docs/lod.md).  Inf when
     there is no limit (`texels` 0, or a zero `finest_radius`).
     """
-    if not (texels > 0.0 and finest_radius > 0.0):
-        return math.inf
-    return 2.0 * texels * quad_half_side(radius, distance) / finest_radius
+    finest_radius = np.asarray(finest_radius, dtype=np.float64)
+    limited = (texels > 0.0) & (finest_radius > 0.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(limited, 2.0 * texels * quad_half_side(radius, distance) / finest_radius, math.inf)
 
 
 #: texture sides come in this many geometric steps per doubling: rounding up to the next power of two
@@ -164,23 +165,15 @@ def detail_size_px(radius: float, distance: float, finest_radius: float, texels:
 SIZE_STEPS_PER_OCTAVE = 4
 
 
-def required_size(pixels: float, smallest: int, largest: int) -> int:
+def required_size(pixels, smallest: int, largest: int):
     """The smallest texture side >= `pixels` of the form `smallest` * 2^(k / SIZE_STEPS_PER_OCTAVE) (rounded
-    up to a multiple of 4 texels), within [smallest, largest]."""
-    if not pixels > smallest:
-        return smallest
-    steps = math.ceil(SIZE_STEPS_PER_OCTAVE * math.log2(min(pixels, 2.0**30) / smallest) - 1e-9)
-    side = smallest * 2.0 ** (steps / SIZE_STEPS_PER_OCTAVE)
-    return int(min(4 * math.ceil(side / 4 - 1e-9), largest))
-
-
-def required_sizes(pixels: np.ndarray, smallest: int, largest: int) -> np.ndarray:
-    """`required_size` of each of `pixels` (an array), as int64."""
+    up to a multiple of 4 texels), within [smallest, largest]: an int, or an int64 array for an array."""
     pixels = np.asarray(pixels, dtype=np.float64)
     with np.errstate(divide="ignore", invalid="ignore"):
         steps = np.ceil(SIZE_STEPS_PER_OCTAVE * np.log2(np.minimum(pixels, 2.0**30) / smallest) - 1e-9)
         sides = np.minimum(4.0 * np.ceil(smallest * 2.0 ** (steps / SIZE_STEPS_PER_OCTAVE) / 4.0 - 1e-9), largest)
-    return np.where(pixels > smallest, sides, smallest).astype(np.int64)
+    sizes = np.where(pixels > smallest, sides, smallest).astype(np.int64)
+    return int(sizes) if sizes.ndim == 0 else sizes
 
 
 def _angles_deg(a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -363,7 +363,7 @@ def plan_ring(
                 if built == SEGMENTS and pace.fade_frames == 0:
                     fade_step = settings.ring_fade_frames  # no frame to fade in: shown this frame
         else:
-            fade_step += pace.fade_step
+            fade_step += pace.fade_steps_a_frame
     draws = ()
     if pending is not None and fade_step >= settings.ring_fade_frames:
         current, pending, built, fade_step = pending, None, 0, 0
@@ -406,7 +406,7 @@ class RebuildPace(NamedTuple):
 
     segments_a_frame: int
     fade_frames: int  # frames the finished ring fades in over (0: shown the frame it is finished)
-    fade_step: int  # fade steps a frame, of `RenderSettings.ring_fade_frames`
+    fade_steps_a_frame: int  # of `RenderSettings.ring_fade_frames`
     #: Wang's pace: a segment a frame, or a piece of one where drawing it whole would take too long (`build_ms`)
     in_pieces: bool
 
@@ -443,7 +443,7 @@ def frames_to_show(state: RingState, step, settings: RenderSettings) -> float:
     building = math.ceil((SEGMENTS - built) / pace.segments_a_frame)
     if pace.fade_frames == 0:
         return float(building)
-    return float(building + math.ceil((settings.ring_fade_frames - fade_step) / pace.fade_step))
+    return float(building + math.ceil((settings.ring_fade_frames - fade_step) / pace.fade_steps_a_frame))
 
 
 def _piece_end(members: tuple, start: int, build_ms: Callable[[Hashable], float] | None) -> int:

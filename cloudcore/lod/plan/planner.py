@@ -446,15 +446,16 @@ def _plan_units(
         cloud_work += screen_impostor
     if len(outside):
         splits_of = {index: split_at(index, eye) for index in holding.intersection(outside.tolist())}
-        layers = np.array(
-            [len(splits_of[i][1]) + 1 if i in splits_of else 1 for i in outside.tolist()], dtype=np.float64
-        )
+        layers = np.ones(len(outside))  # textures of an impostor: one more than the objects that cut it
+        for index, (_, splits) in splits_of.items():
+            layers[np.searchsorted(outside, index)] = len(splits) + 1
         near = (
             np.flatnonzero(distances[outside] < NEAR_EXACT_RADII * radii[outside])
             if cloud_splats is not None and settings.mode != "impostor"
             else np.zeros(0, dtype=np.int64)
         )
-        alone = settings.mode == "auto" and individuals[outside] == 1.0  # not fading into or out of the ring
+        # the units auto mode prices on their own: not fading into or out of the ring
+        priced_each = settings.mode == "auto" and individuals[outside] == 1.0
         prices = representation_prices(
             units,
             outside,
@@ -462,22 +463,21 @@ def _plan_units(
             lifetimes,
             layers,
             {int(k): full_3d(int(outside[k]), radii[outside[k]], float(distances[outside[k]])) for k in near.tolist()},
-            alone,
+            priced_each,
             pricing,
             settings,
             costs,
             height,
             camera.fov_y_deg,
         )
-        full_weight_of = np.zeros(
-            len(outside)
-        )  # a unit fading into or out of the ring is an impostor: one layer scales
+        # a unit fading into or out of the ring is an impostor: one layer scales
+        full_weight_of = np.zeros(len(outside))
         if settings.mode == "auto":
             full_weight_of, chosen, priced_units = represent_units(
                 units.members,
                 outside,
                 distances[outside],
-                alone,
+                priced_each,
                 prices,
                 state.representations,
                 held_errors[outside],

@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import sys
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import NamedTuple
@@ -17,8 +16,11 @@ from cloudcore.camera import spheres_within_frustum
 from cloudcore.lod.costs import CostModel, Work, regeneration_fragments, splat_fragments
 from cloudcore.lod.impostors import (
     TRANSLATION_METRICS,
+    detail_size_px,
     parallax_errors_deg,
-    required_sizes,
+    quad_half_side,
+    required_size,
+    screen_size_px,
     tolerance_deg_for,
 )
 from cloudcore.lod.plan.draw_items import full_runs
@@ -169,14 +171,10 @@ def impostor_textures(units: LodUnits, rows, distances, height: int, fov_y_deg: 
     """The impostor textures of the units at `rows` (indices) seen from `distances`: each as fine as the screen
     or the unit's detail asks, in `required_size`'s steps, and the fragments of remaking it."""
     radii, distance = units.radii[rows], distances[rows]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        tangents = radii / np.sqrt(np.maximum((distance - radii) * (distance + radii), sys.float_info.min))
-    pixels = height * tangents / math.tan(math.radians(fov_y_deg) / 2.0)
-    half_sides = tangents * distance
-    texels, finest = settings.impostor_detail_texels, units.finest_radii[rows]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        detail = np.where((texels > 0.0) & (finest > 0.0), 2.0 * texels * half_sides / finest, math.inf)
-    sizes = required_sizes(np.minimum(pixels, detail), settings.impostor_min_size, settings.impostor_max_size)
+    pixels = screen_size_px(radii, distance, height, fov_y_deg)
+    detail = detail_size_px(radii, distance, units.finest_radii[rows], settings.impostor_detail_texels)
+    sizes = required_size(np.minimum(pixels, detail), settings.impostor_min_size, settings.impostor_max_size)
+    half_sides = quad_half_side(radii, distance)
     fragments = regeneration_fragments(
         units.particle_counts[rows], units.radius_squares[rows], radii, distance, half_sides, sizes
     )
