@@ -12,6 +12,7 @@ from cloudcore.lod.costs import CostModel, Work
 from cloudcore.lod.impostors import content_depth, impostor_view, parallax_error_deg, translation_error_deg
 from cloudcore.lod.plan import FRAME_SETTLE_FRAMES, PROBE_FRAMES, SWITCH_MARGIN, LodState, inside_runs, plan_frame
 from cloudcore.lod.plan.pricing import in_view_work
+from cloudcore.lod.plan.state import RING_PRICE_FRAMES, RING_PRICE_TURN_DEG
 from cloudcore.lod.ring import SEGMENTS, RingState
 from cloudcore.lod.units import LodUnits, SplatSample
 from cloudcore.scene import Camera
@@ -880,6 +881,38 @@ def test_a_ring_that_stops_paying_fades_its_clouds_back_to_the_plan():
     # and it stays handed back: a ring holding nothing is not rebuilt
     later, _ = run_auto_ring(3, regeneration_heavy(10.0), state)
     assert all(p.ring.build_segment is None and p.ring.draws[0][0].members == frozenset() for p in later)
+
+
+def ring_prices_along(looks_at, costs_of=lambda frame: regeneration_heavy(200.0)):
+    """The frame each plan's ring prices were made in, auto mode over the far field from a still eye looking at
+    `looks_at[i]` in frame i, priced by `costs_of(i)`."""
+    settings, state, made = dataclasses.replace(RING, mode="auto"), LodState(), []
+    for frame, look_at in enumerate(looks_at):
+        camera = camera_at((0.0, 100.0, 0.0), look_at=look_at)
+        state = plan(
+            camera, settings, centres=FAR_FIELD, radii=(RADIUS,) * len(FAR_FIELD), state=state, costs=costs_of(frame)
+        ).state
+        made.append(state.ring_prices.frame_index)
+    return made
+
+
+def test_the_ring_is_priced_again_only_when_the_view_or_the_costs_have_moved():
+    """Pricing the ring against its clouds drawn alone is most of auto mode's plan where the ring holds thousands:
+    the prices stand while the ring, the view, its clouds in view and the cost model stay near those priced."""
+    ahead = (0.0, 100.0, -1.0)
+    still = ring_prices_along([ahead] * (2 * RING_PRICE_FRAMES + 1))
+    # a ring building is a new generation where the first frame had none: priced then, then every RING_PRICE_FRAMES
+    assert sorted(set(still)) == [0, 1, 1 + RING_PRICE_FRAMES]
+    # the eye turning by more than RING_PRICE_TURN_DEG between two frames: priced at once
+    turn = math.radians(1.5 * RING_PRICE_TURN_DEG)
+    turned = ring_prices_along([ahead] * 4 + [(math.sin(turn), 100.0, -math.cos(turn))] * 2)
+    assert turned[4] == 4 and turned[5] == 4
+    # a turn of a tenth as much is not
+    turn = math.radians(0.15 * RING_PRICE_TURN_DEG)
+    assert ring_prices_along([ahead] * 4 + [(math.sin(turn), 100.0, -math.cos(turn))] * 2)[4:] == [1, 1]
+    # nor a model of the same coefficients, while another is priced at once
+    assert ring_prices_along([ahead] * 6, lambda frame: regeneration_heavy(200.0))[4] == 1
+    assert ring_prices_along([ahead] * 6, lambda frame: regeneration_heavy(200.0 if frame < 4 else 10.0))[4] == 4
 
 
 def test_the_ring_decision_keeps_its_choice_within_the_switch_margin():

@@ -5,7 +5,7 @@ frames' measured times."""
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 
 import numpy as np
 
@@ -20,8 +20,13 @@ from cloudcore.lod.plan.state import (
     MEASUREMENT_AGE_FRAMES,
     PLAUSIBLE_RATIO,
     PROBE_FRAMES,
+    RING_PRICE_CHANGE_SHARE,
+    RING_PRICE_FRAMES,
+    RING_PRICE_MOVE_SHARE,
+    RING_PRICE_TURN_DEG,
     LodState,
     Representation,
+    RingPrices,
 )
 from cloudcore.lod.plan.unit_plans import (
     FULL,
@@ -131,6 +136,34 @@ def ring_pays(state: RingState, ring_ms: float, alone_ms: float) -> bool:
     return cheapest(held, {"ring": ring_ms, "alone": alone_ms}) == "ring"
 
 
+def ring_prices_hold(
+    prices: RingPrices | None, eye, back, in_view: int, state: LodState, settings, costs: CostModel
+) -> bool:
+    """Whether the ring's last `prices` still stand for the frame seen from `eye` looking along -`back` (the view's
+    third row), `in_view` of its clouds in view, priced by `costs`: the same ring newest, priced fewer than
+    `RING_PRICE_FRAMES` frames ago, the count in view and each coefficient of the model within
+    `RING_PRICE_CHANGE_SHARE` of theirs then, and the view near the one priced (turned less than
+    `RING_PRICE_TURN_DEG`, moved less than `RING_PRICE_MOVE_SHARE` of a rebuild distance).
+    The ring's clouds are beyond its radius: what they cost drawn either way changes slowly with the view, and
+    the choice between the two has a margin; pricing them is most of what auto mode's plan adds to impostor
+    mode's where the ring holds thousands of clouds."""
+    if (
+        prices is None
+        or prices.generation is not (state.ring.pending or state.ring.current)
+        or state.frame_index - prices.frame_index >= RING_PRICE_FRAMES
+        or abs(in_view - prices.in_view) > RING_PRICE_CHANGE_SHARE * prices.in_view
+        or np.any(np.abs(costs.vector() - prices.costs.vector()) > RING_PRICE_CHANGE_SHARE * prices.costs.vector())
+    ):
+        return False
+    moved = np.asarray(eye, dtype=np.float64) - prices.eye
+    turned = float(np.dot(back, prices.back)) < math.cos(math.radians(RING_PRICE_TURN_DEG))
+    return not turned and (
+        math.hypot(moved[0], moved[2])
+        <= RING_PRICE_MOVE_SHARE * settings.ring_rebuild_horizontal * settings.ring_radius
+        and abs(moved[1]) <= RING_PRICE_MOVE_SHARE * settings.ring_rebuild_vertical * settings.ring_radius
+    )
+
+
 def groups_cheaper_apart(units: LodUnits, seen: Seen, settings, state: LodState, costs, focal_px: float) -> frozenset:
     """The groups of interpenetrating clouds (their members) that auto mode would rather plan apart, each cloud a
     unit of its own (`LodUnits.apart_rows`): while the eye moves, those whose clouds' impostors cost less than the
@@ -207,14 +240,16 @@ def settled_in_full_3d(state: LodState) -> bool:
     )
 
 
-def next_frame_choice(state: LodState, drawn_as: str, predicted: dict) -> str:
+def next_frame_choice(state: LodState, drawn_as: str, predicted: Callable[[], dict]) -> str:
     """How auto mode draws the next frame: "units" or "full" (`LodState.frame_choice`), by the measured times
     of both (`cheapest`, within its margin), once both are measured and fresh; the way this frame was drawn
     while it is being measured; the other, to measure it, where its `predicted` time is plausibly close.
-    The choice acts through each unit's representation and the ring, so a switch crossfades."""
+    The choice acts through each unit's representation and the ring, so a switch crossfades; `predicted()`
+    gives the predicted times of both, asked only for the last."""
     other = "full" if drawn_as == "units" else "units"
     if not known(state, drawn_as):
         return drawn_as
     if known(state, other):
         return cheapest(drawn_as, {choice: state.frame_times[choice].mean_ms for choice in (drawn_as, other)})
-    return other if predicted[other] < PLAUSIBLE_RATIO * predicted[drawn_as] else drawn_as
+    times = predicted()
+    return other if times[other] < PLAUSIBLE_RATIO * times[drawn_as] else drawn_as

@@ -32,6 +32,7 @@ from cloudcore.lod.plan.choice import (
     prices_units,
     represent_units,
     ring_pays,
+    ring_prices_hold,
     settled_in_full_3d,
     units_ms,
 )
@@ -57,6 +58,7 @@ from cloudcore.lod.plan.schedule import within_frame_budget
 from cloudcore.lod.plan.state import (
     LodState,
     Representation,
+    RingPrices,
 )
 from cloudcore.lod.plan.unit_plans import (
     CROSSFADE,
@@ -137,7 +139,7 @@ def plan_frame(
             state=dataclasses.replace(
                 full_plan.state,
                 representations=drawn,
-                frame_choice=next_frame_choice(state, "full", {}),  # the units are measured: no prediction is asked
+                frame_choice=next_frame_choice(state, "full", dict),  # the units are measured: no prediction is asked
                 drawn_as="full",
                 frames_drawn_as=state.frames_drawn_as + 1,
             ),
@@ -240,36 +242,53 @@ def _plan_units(
     # per unit, its full-3D work far off (particles, fragments): splat by splat for the ring's candidates in view
     in_view_particles, in_view_fragments = units.particle_counts.astype(np.float64), ball_fragments.copy()
     step = eye - last_eye if last_eye is not None else np.zeros(3)
+    ring_prices, counted_in_view = None, False
     if settings.mode == "auto" and settings.uses_ring:
         candidates = ring_members(centres, radii, eye, settings)
         alone = candidates & visible
-        segments = segments_of(centres[candidates], eye)
-        seen_alone = visible[candidates]
-        ring_panels, ring_rebuild, moved_lifetime, tolerance_lifetime = ring_work(
-            units,
-            candidates,
-            segments,
-            step,
-            ball_fragments,
-            panel_pixels(centres[alone], segments[seen_alone], quad_pixels_of[alone], view_projection, viewport),
-            lifetimes,
-            settings,
-            state.ring,
-        )
-        # the ring is kept within the tolerance (rebuilt once a cloud of it passes it: Wang's panels are impostors
-        # too) while that costs at most its share of a frame; past it, only by Wang's own rules, as impostor mode
-        # does, and the error it then shows is the plan's accepted error (the 1.2M field orbiting 0.05 degrees a
-        # frame: 18 ms a frame of rebuilds to keep it so, 1.1 s every 60 frames, for 1.2 dB)
-        chases_tolerance = costs.ms(ring_rebuild) / max(tolerance_lifetime, 1.0) <= RING_FRAME_MS
-        ring_lifetime = tolerance_lifetime if chases_tolerance else moved_lifetime
-        ring_ms = costs.ms(ring_panels + ring_rebuild.scaled(1.0 / max(ring_lifetime, 1.0)))
-        ring_error = ring_translation_error(state.ring.current, translation_error, eye)
-        if units.sample is not None:
-            in_view_particles[alone], in_view_fragments[alone] = in_view_work(
-                units, alone, planes, eye, focal_px, screen_pixels, ball_fragments
+        ring_prices = state.ring_prices
+        in_view_count = int(np.count_nonzero(alone))
+        if not ring_prices_hold(ring_prices, eye, view[2, :3], in_view_count, state, settings, costs):
+            segments = segments_of(centres[candidates], eye)
+            seen_alone = visible[candidates]
+            ring_panels, ring_rebuild, moved_lifetime, tolerance_lifetime = ring_work(
+                units,
+                candidates,
+                segments,
+                step,
+                ball_fragments,
+                panel_pixels(centres[alone], segments[seen_alone], quad_pixels_of[alone], view_projection, viewport),
+                lifetimes,
+                settings,
+                state.ring,
             )
-        in_view = (in_view_particles[alone], in_view_fragments[alone])
-        alone_ms = ms_drawn_alone(units, seen, alone, in_view, focal_px, settings, costs)
+            # the ring is kept within the tolerance (rebuilt once a cloud of it passes it: Wang's panels are
+            # impostors too) while that costs at most its share of a frame; past it, only by Wang's own rules, as
+            # impostor mode does, and the error it then shows is the plan's accepted error (the 1.2M field
+            # orbiting 0.05 degrees a frame: 18 ms a frame of rebuilds to keep it so, 1.1 s every 60 frames, for
+            # 1.2 dB)
+            chases = costs.ms(ring_rebuild) / max(tolerance_lifetime, 1.0) <= RING_FRAME_MS
+            lifetime = tolerance_lifetime if chases else moved_lifetime
+            if units.sample is not None:
+                in_view_particles[alone], in_view_fragments[alone] = in_view_work(
+                    units, alone, planes, eye, focal_px, screen_pixels, ball_fragments
+                )
+                counted_in_view = True
+            in_view = (in_view_particles[alone], in_view_fragments[alone])
+            ring_prices = RingPrices(
+                eye=tuple(float(v) for v in eye),
+                back=tuple(float(v) for v in view[2, :3]),
+                frame_index=state.frame_index,
+                generation=state.ring.pending or state.ring.current,
+                costs=costs,
+                in_view=in_view_count,
+                ring_ms=costs.ms(ring_panels + ring_rebuild.scaled(1.0 / max(lifetime, 1.0))),
+                alone_ms=ms_drawn_alone(units, seen, alone, in_view, focal_px, settings, costs),
+                chases_tolerance=chases,
+            )
+        ring_ms, alone_ms = ring_prices.ring_ms, ring_prices.alone_ms
+        chases_tolerance = ring_prices.chases_tolerance
+        ring_error = ring_translation_error(state.ring.current, translation_error, eye)
         # a candidate drawn on its own until a ring being built takes it: an impostor made for it now lasts only
         # that long (Harris's circle at 800 clouds made 136 impostors in its first frame for a ring in 16 frames)
         lifetimes = np.where(candidates, np.minimum(lifetimes, frames_to_show(state.ring, step, settings)), lifetimes)
@@ -370,11 +389,7 @@ def _plan_units(
     # the particles into many draws between impostors costs what no unit's own price shows
     individuals = 1.0 - (ring.weights(units.members, units.row_of) if ring is not None else np.zeros(len(radii)))
     in_ring = (individuals <= 0.0) & (radii > 0.0) & visible
-    everything_full = Work(
-        particles=float(np.sum(in_view_particles[in_ring])),
-        fragments=float(np.sum(in_view_fragments[in_ring])),
-        batches=1.0,
-    )
+    everything_full = Work(batches=1.0)  # and the units in the ring, counted only where asked (`predicted`)
     unit_prices = []
     wanted = []  # (index, priority, work) of the impostors past their tolerance
     # what the plan decides per unit, as arrays (`UnitPlans`): a unit out of view or in the ring is one row
@@ -596,10 +611,23 @@ def _plan_units(
     drawn_as = frame_choice = None
     if settings.mode == "auto":
         drawn_as = "full" if all_full else "units"
-        predicted = {
-            "units": units_ms(unit_prices, ring_ms, alone_ms, candidates, costs),
-            "full": costs.ms(everything_full),
-        }
+
+        def predicted() -> dict:
+            """The predicted ms of this frame's units each as priced and of every unit in full 3D: asked only while
+            one of the two ways is not measured (the units in the ring counted splat by splat where their spheres
+            leave the frustum, unless their ring was priced so this frame)."""
+            if units.sample is not None and not counted_in_view:
+                in_view_particles[in_ring], in_view_fragments[in_ring] = in_view_work(
+                    units, in_ring, planes, eye, focal_px, screen_pixels, ball_fragments
+                )
+            ring_full = Work(
+                particles=float(np.sum(in_view_particles[in_ring])), fragments=float(np.sum(in_view_fragments[in_ring]))
+            )
+            return {
+                "units": units_ms(unit_prices, ring_ms, alone_ms, candidates, costs),
+                "full": costs.ms(everything_full + ring_full),
+            }
+
         frame_choice = next_frame_choice(state, drawn_as, predicted)
     next_state = LodState(
         records=next_records,
@@ -614,6 +642,7 @@ def _plan_units(
         frame_times=state.frame_times,
         particles=scene_particles,
         opened=opened,
+        ring_prices=ring_prices,
         object_centres=tuple(tuple(float(v) for v in centre) for centre in object_centres),
         near_work=(units, camera, tuple(viewport), near_work) if near_work else None,
     )

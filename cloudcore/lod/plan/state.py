@@ -8,7 +8,7 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
-from cloudcore.lod.costs import CostEstimator
+from cloudcore.lod.costs import CostEstimator, CostModel
 from cloudcore.lod.ring import (
     RingState,
 )
@@ -24,6 +24,16 @@ MEASUREMENT_AGE_FRAMES = 300
 PLAUSIBLE_RATIO = 1.5
 
 
+#: auto mode prices Wang's ring against its clouds drawn alone (`choice.ring_prices_hold`) again after this many
+#: frames (the cost fit moves), or sooner once the eye has turned this far or moved this share of a rebuild distance,
+#: or the count of its clouds in view or a coefficient of the cost model has changed by this share (the choice's
+#: margin, `choice.SWITCH_MARGIN`, is 25%)
+RING_PRICE_FRAMES = 16
+RING_PRICE_TURN_DEG = 2.0
+RING_PRICE_MOVE_SHARE = 0.25
+RING_PRICE_CHANGE_SHARE = 0.1
+
+
 #: the running mean of a choice's frame times weighs each new frame at least this much
 FRAME_TIME_FORGETTING = 0.1
 
@@ -34,6 +44,21 @@ class Representation:
 
     target: str  # "full" or "impostor"
     full_weight: float
+
+
+@dataclass(frozen=True)
+class RingPrices:
+    """Auto mode's pricing of Wang's ring against its clouds drawn each on their own, and the view it was made for."""
+
+    eye: tuple
+    back: tuple  # the view matrix's third row: the eye looks along its negative
+    frame_index: int  # `LodState.frame_index` when priced
+    generation: object  # the ring's newest generation then (`RingState.pending` or `current`)
+    costs: CostModel  # the model that priced it
+    in_view: int  # the ring's clouds in view then
+    ring_ms: float  # its panels a frame and its rebuild amortised over its lifetime
+    alone_ms: float  # its clouds in view drawn each as auto would (`pricing.ms_drawn_alone`)
+    chases_tolerance: bool  # kept within the impostors' tolerance (its rebuilds cost at most `RING_FRAME_MS`)
 
 
 @dataclass(frozen=True)
@@ -55,6 +80,7 @@ class LodState:
     #: the units' particles when last planned: a scene changed past `SCENE_CHANGE_RATIO` forgets `frame_times`
     particles: float = 0.0
     opened: frozenset = frozenset()  # the groups of clouds planned apart (`groups_cheaper_apart`)
+    ring_prices: RingPrices | None = None  # auto mode's last pricing of the ring (`choice.ring_prices_hold`)
     object_centres: tuple = ()  # the objects' bounding-sphere centres: which of them move
     #: the units near the eye priced splat by splat last frame, for the same view to ask again (a still eye):
     #: (units, camera, viewport, {members: (their clouds' keys, Work)}), or None
