@@ -1,11 +1,12 @@
 """Units of the level of detail without GL: interpenetrating clouds grouped, and one impostor for a group."""
 
 import dataclasses
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
-from cloudcore.lod.costs import CostModel
+from cloudcore.lod.costs import SPRITE_FRAGMENT_COST, CostModel
 from cloudcore.lod.impostors import parallax_errors_deg
 from cloudcore.lod.plan import LodState, plan_frame
 from cloudcore.lod.units import SAMPLE_PER_CLOUD, LodUnits, SplatSample, interpenetrating_groups, lod_units
@@ -23,7 +24,8 @@ def blob(centre, count=300, spread=40.0, radius=12.0):
 class Packed:
     """The parts of a `ParticleBuffer` that `lod_units` reads."""
 
-    def __init__(self, blobs):
+    def __init__(self, blobs, sprites=()):
+        """`sprites`: the blobs drawn as atlas sprites, the rest Gaussian splats."""
         self.centres = np.concatenate([b[0] for b in blobs])
         self.radii = np.concatenate([b[1] for b in blobs])
         self.cloud_starts = np.concatenate([[0], np.cumsum([len(b[1]) for b in blobs])])
@@ -31,6 +33,8 @@ class Packed:
         self.bounding_centres = np.array([s[0] for s in spheres])
         self.bounding_radii = np.array([s[1] for s in spheres])
         self.finest_radii = np.array([b[1].min() for b in blobs])
+        cells = [np.full(len(b[1]), 0 if i in sprites else -1, dtype=np.int32) for i, b in enumerate(blobs)]
+        self.styles = SimpleNamespace(sprite_index=np.concatenate(cells))
 
 
 # two clouds whose particles mingle, one whose bounding sphere grazes theirs but whose splats stay apart,
@@ -176,3 +180,24 @@ def test_the_units_of_a_buffer_carry_its_sample_into_their_groups_clouds_and_row
     assert units.sample is not None and units.clouds.sample is units.sample
     assert units.and_clouds.take([0]).sample is units.sample
     assert np.sum(units.sample.weights) == pytest.approx(len(CLOUDS.radii), rel=1e-12)
+
+
+def test_a_sprite_s_fragments_are_priced_at_what_they_cost_against_a_kernel_splat_s():
+    """An atlas sprite's fragment fetches a texel (`SPRITE_FRAGMENT_COST` kernel fragments): a unit's fragments
+    are weighted by its splats' areas, so a group of a sprite cloud and a splat cloud costs between the two, and
+    the plan prices a sprite cloud's full 3D by as much more."""
+    packed = Packed([blob((0, 0, 0)), blob((60, 0, 0), radius=24.0), blob((3000, 0, 0))], sprites=(1,))
+    units = lod_units(packed)
+    assert units.members == ((0, 1), (2,))
+    sprite_share = 24.0**2 / (12.0**2 + 24.0**2)
+    assert units.fragment_costs == pytest.approx([1.0 + sprite_share * (SPRITE_FRAGMENT_COST - 1.0), 1.0])
+    assert units.clouds.fragment_costs == pytest.approx([1.0, SPRITE_FRAGMENT_COST])
+    camera = Camera(position=(1500.0, 0.0, 4000.0), look_at=(1500.0, 0.0, 0.0), fov_y_deg=40.0)
+    settings = RenderSettings(mode="auto", ring_radius=float("inf"), groups_apart_in_motion=False)
+    costs = CostModel(particles=1e-9, fragments=1e-4)
+    sprites = plan_frame(units, camera, (640, 480), settings, LodState(), 1, costs=costs)
+    plain = plan_frame(
+        dataclasses.replace(units, fragment_costs=np.ones(2)), camera, (640, 480), settings, LodState(), 1, costs=costs
+    )
+    assert sprites.clouds[0].full_ms / plain.clouds[0].full_ms == pytest.approx(units.fragment_costs[0], rel=1e-6)
+    assert sprites.clouds[1].full_ms == pytest.approx(plain.clouds[1].full_ms, rel=1e-12)

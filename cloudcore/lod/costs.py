@@ -103,6 +103,13 @@ class CostModel:
         )
 
 
+#: a fragment of an atlas sprite (`cloudcore.artist.sprites`) costs this many of a Gaussian kernel splat's: its
+#: texture fetch, before the sprite's transparent texels are discarded (`scripts/bench_sprite_fragments.py`,
+#: docs/performance.md, "What a sprite's fragment costs"); the plan counts a unit's fragments so weighted
+#: (`LodUnits.fragment_costs`), where one coefficient fitted to scenes of both would price neither
+SPRITE_FRAGMENT_COST = 3.1
+
+
 #: the prior: coefficients measured on llvmpipe, 2 cores (docs/performance.md, "The cost model"): a
 #: particle's shading, vertices and sort 0.85 us; a splat fragment 8 ns on the screen or in a texture
 #: (RGBA16F, blended); a regeneration's target switch, clear and draw 0.5 ms; a quad's draw call 44 us

@@ -35,6 +35,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
+from cloudcore.lod.costs import SPRITE_FRAGMENT_COST
 from cloudcore.scene import splats_bounding_sphere
 
 #: two splats interpenetrate when their centres are closer than this times the sum of their radii
@@ -99,6 +100,9 @@ class LodUnits:
     particle_counts: np.ndarray  # (units,) particles
     radius_squares: np.ndarray  # (units,) sum of the particles' squared radii, m^2: their splats' area
     finest_radii: np.ndarray  # (units,) metres: the finest detail in the unit (0: unknown)
+    #: (units,) what a fragment of the unit's splats costs, in fragments of Gaussian kernel splats (area-weighted:
+    #: an atlas sprite's is `cloudcore.lod.costs.SPRITE_FRAGMENT_COST`)
+    fragment_costs: np.ndarray
     #: a unit of its own for each cloud of a group, for a group planned apart (`apart_rows`; None: no groups)
     clouds: LodUnits | None = None
     sample: SplatSample | None = None  # of every cloud's splats (None: only the spheres are known)
@@ -117,6 +121,7 @@ class LodUnits:
             np.concatenate([u.particle_counts for u in parts]),
             np.concatenate([u.radius_squares for u in parts]),
             np.concatenate([u.finest_radii for u in parts]),
+            np.concatenate([u.fragment_costs for u in parts]),
             sample=self.sample,
         )
 
@@ -162,6 +167,7 @@ class LodUnits:
             self.particle_counts[rows],
             self.radius_squares[rows],
             self.finest_radii[rows],
+            self.fragment_costs[rows],
             sample=self.sample,
         )
 
@@ -178,6 +184,7 @@ class LodUnits:
             zeros if particle_counts is None else np.asarray(particle_counts, dtype=np.float64),
             zeros if radius_squares is None else np.asarray(radius_squares, dtype=np.float64),
             zeros if finest_radii is None else np.asarray(finest_radii, dtype=np.float64),
+            np.ones(count),
         )
 
 
@@ -256,7 +263,8 @@ def _units_of(particles, members: tuple) -> LodUnits:
     """The units of `particles` whose clouds are `members` (one tuple of cloud indices per unit)."""
     starts = particles.cloud_starts
     sphere_centres, sphere_radii = particles.bounding_centres, particles.bounding_radii
-    centres, radii, counts, squares, finest = [], [], [], [], []
+    centres, radii, counts, squares, finest, fragment_costs = [], [], [], [], [], []
+    fill_costs = np.where(particles.styles.sprite_index >= 0, SPRITE_FRAGMENT_COST, 1.0)
     for clouds in members:
         ranges = [np.arange(starts[c], starts[c + 1]) for c in clouds]
         indices = np.concatenate(ranges)
@@ -267,7 +275,9 @@ def _units_of(particles, members: tuple) -> LodUnits:
         centres.append(centre)
         radii.append(radius)
         counts.append(len(indices))
-        squares.append(float(np.sum(particles.radii[indices] ** 2)))
+        areas = particles.radii[indices] ** 2
+        squares.append(float(np.sum(areas)))
+        fragment_costs.append(float(np.dot(areas, fill_costs[indices]) / squares[-1]) if squares[-1] > 0.0 else 1.0)
         detail = [particles.finest_radii[c] for c in clouds if particles.finest_radii[c] > 0.0]
         finest.append(min(detail) if detail else 0.0)
     return LodUnits(
@@ -277,4 +287,5 @@ def _units_of(particles, members: tuple) -> LodUnits:
         np.array(counts, dtype=np.float64),
         np.array(squares, dtype=np.float64),
         np.array(finest, dtype=np.float64),
+        np.array(fragment_costs, dtype=np.float64),
     )

@@ -379,7 +379,7 @@ def _plan_units(
             near_work[members] = held
             return held[1]
         kept, overdraw = splats_in_view(*splats_of(index), view, projection)
-        work = Work(particles=float(kept), fragments=screen_pixels * overdraw)
+        work = Work(particles=float(kept), fragments=screen_pixels * overdraw * units.fragment_costs[index])
         near_work[members] = (unit_key(index), work)
         return work
 

@@ -91,7 +91,8 @@ def seen_from(units: LodUnits, pricing: Pricing, priced: bool = True) -> Seen:
         )
     return Seen(
         distances,
-        splat_fragments(units.radius_squares, radii, distances, focal_px, units.particle_counts, screen_pixels),
+        units.fragment_costs
+        * splat_fragments(units.radius_squares, radii, distances, focal_px, units.particle_counts, screen_pixels),
         half_sides,
         quad_pixels,
         np.minimum.reduce(
@@ -175,7 +176,7 @@ def impostor_textures(units: LodUnits, rows, distances, height: int, fov_y_deg: 
     detail = detail_size_px(radii, distance, units.finest_radii[rows], settings.impostor_detail_texels)
     sizes = required_size(np.minimum(pixels, detail), settings.impostor_min_size, settings.impostor_max_size)
     half_sides = quad_half_side(radii, distance)
-    fragments = regeneration_fragments(
+    fragments = units.fragment_costs[rows] * regeneration_fragments(
         units.particle_counts[rows], units.radius_squares[rows], radii, distance, half_sides, sizes
     )
     return ImpostorTextures(pixels, sizes, np.reshape(fragments, -1))
@@ -319,7 +320,7 @@ def in_view_work(units: LodUnits, chosen, planes, eye, focal_px, screen_pixels, 
     discs = np.minimum(math.pi * np.square(focal_px * radii / depths), screen_pixels)
     count = len(indices)
     particles += np.bincount(owners, weights=weights, minlength=count)
-    fragments += np.bincount(owners, weights=weights * discs, minlength=count)
+    fragments += units.fragment_costs[indices] * np.bincount(owners, weights=weights * discs, minlength=count)
     return particles, fragments
 
 
