@@ -64,8 +64,10 @@ def particles_of(clouds) -> SimpleNamespace:
     centres = np.concatenate([c.centres for c in clouds]).reshape(-1, 3) if clouds else np.zeros((0, 3))
     radii = np.concatenate([c.radii for c in clouds]) if clouds else np.zeros(0)
     starts = np.concatenate([[0], np.cumsum(counts)])
-    finest, bounding_centres, bounding_radii = cloud_extents(clouds, radii, starts, particle_styles(clouds, Lighting()))
+    styles = particle_styles(clouds, Lighting())
+    finest, bounding_centres, bounding_radii = cloud_extents(clouds, radii, starts, styles)
     return SimpleNamespace(
+        styles=styles,
         cloud_starts=starts,
         centres=centres,
         radii=radii,

@@ -884,14 +884,13 @@ def test_a_ring_that_stops_paying_fades_its_clouds_back_to_the_plan():
 
 
 def ring_prices_along(looks_at, costs_of=lambda frame: regeneration_heavy(200.0)):
-    """The frame each plan's ring prices were made in, auto mode over the far field from a still eye looking at
-    `looks_at[i]` in frame i, priced by `costs_of(i)`."""
+    """The frame each plan's ring prices were made in, auto mode over the far field (the same units each frame,
+    as the renderer keeps them) from a still eye looking at `looks_at[i]` in frame i, priced by `costs_of(i)`."""
     settings, state, made = dataclasses.replace(RING, mode="auto"), LodState(), []
+    units = units_of(FAR_FIELD, (RADIUS,) * len(FAR_FIELD))
     for frame, look_at in enumerate(looks_at):
         camera = camera_at((0.0, 100.0, 0.0), look_at=look_at)
-        state = plan(
-            camera, settings, centres=FAR_FIELD, radii=(RADIUS,) * len(FAR_FIELD), state=state, costs=costs_of(frame)
-        ).state
+        state = plan_frame(units, camera, VIEWPORT, settings, state, 1, costs=costs_of(frame)).state
         made.append(state.ring_prices.frame_index)
     return made
 
@@ -913,6 +912,13 @@ def test_the_ring_is_priced_again_only_when_the_view_or_the_costs_have_moved():
     # nor a model of the same coefficients, while another is priced at once
     assert ring_prices_along([ahead] * 6, lambda frame: regeneration_heavy(200.0))[4] == 1
     assert ring_prices_along([ahead] * 6, lambda frame: regeneration_heavy(200.0 if frame < 4 else 10.0))[4] == 4
+    settings, state = dataclasses.replace(RING, mode="auto"), LodState()
+    camera, costs = camera_at((0.0, 100.0, 0.0), look_at=ahead), regeneration_heavy(200.0)
+    for frame in range(3):  # a scene whose units are made again each frame (a cloud field's cells coming and going)
+        state = plan_frame(
+            units_of(FAR_FIELD, (RADIUS,) * len(FAR_FIELD)), camera, VIEWPORT, settings, state, 1, costs=costs
+        ).state
+        assert state.ring_prices.frame_index == frame
 
 
 def test_the_ring_decision_keeps_its_choice_within_the_switch_margin():

@@ -137,11 +137,11 @@ def ring_pays(state: RingState, ring_ms: float, alone_ms: float) -> bool:
 
 
 def ring_prices_hold(
-    prices: RingPrices | None, eye, back, in_view: int, state: LodState, settings, costs: CostModel
+    prices: RingPrices | None, units, eye, back, in_view: int, state: LodState, settings, costs: CostModel
 ) -> bool:
-    """Whether the ring's last `prices` still stand for the frame seen from `eye` looking along -`back` (the view's
-    third row), `in_view` of its clouds in view, priced by `costs`: the same ring newest, priced fewer than
-    `RING_PRICE_FRAMES` frames ago, the count in view and each coefficient of the model within
+    """Whether the ring's last `prices` still stand for the frame of `units` seen from `eye` looking along -`back`
+    (the view's third row), `in_view` of its clouds in view, priced by `costs`: the same units and ring newest,
+    priced fewer than `RING_PRICE_FRAMES` frames ago, the count in view and each coefficient of the model within
     `RING_PRICE_CHANGE_SHARE` of theirs then, and the view near the one priced (turned less than
     `RING_PRICE_TURN_DEG`, moved less than `RING_PRICE_MOVE_SHARE` of a rebuild distance).
     The ring's clouds are beyond its radius: what they cost drawn either way changes slowly with the view, and
@@ -149,6 +149,7 @@ def ring_prices_hold(
     mode's where the ring holds thousands of clouds."""
     if (
         prices is None
+        or prices.units is not units
         or prices.generation is not (state.ring.pending or state.ring.current)
         or state.frame_index - prices.frame_index >= RING_PRICE_FRAMES
         or abs(in_view - prices.in_view) > RING_PRICE_CHANGE_SHARE * prices.in_view

@@ -248,7 +248,10 @@ def _plan_units(
         alone = candidates & visible
         ring_prices = state.ring_prices
         in_view_count = int(np.count_nonzero(alone))
-        if not ring_prices_hold(ring_prices, eye, view[2, :3], in_view_count, state, settings, costs):
+        if ring_prices_hold(ring_prices, units, eye, view[2, :3], in_view_count, state, settings, costs):
+            # the candidates' work in view as counted then: what the frame all in full 3D is predicted with
+            (in_view_particles, in_view_fragments), counted_in_view = ring_prices.in_view_work, True
+        else:
             segments = segments_of(centres[candidates], eye)
             seen_alone = visible[candidates]
             ring_panels, ring_rebuild, moved_lifetime, tolerance_lifetime = ring_work(
@@ -281,7 +284,9 @@ def _plan_units(
                 frame_index=state.frame_index,
                 generation=state.ring.pending or state.ring.current,
                 costs=costs,
+                units=units,
                 in_view=in_view_count,
+                in_view_work=(in_view_particles, in_view_fragments),
                 ring_ms=costs.ms(ring_panels + ring_rebuild.scaled(1.0 / max(lifetime, 1.0))),
                 alone_ms=ms_drawn_alone(units, seen, alone, in_view, focal_px, settings, costs),
                 chases_tolerance=chases,
@@ -379,7 +384,7 @@ def _plan_units(
             near_work[members] = held
             return held[1]
         kept, overdraw = splats_in_view(*splats_of(index), view, projection)
-        work = Work(particles=float(kept), fragments=screen_pixels * overdraw * units.fragment_costs[index])
+        work = Work(particles=float(kept), fragments=float(screen_pixels * overdraw * units.fragment_costs[index]))
         near_work[members] = (unit_key(index), work)
         return work
 

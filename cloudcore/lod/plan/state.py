@@ -55,7 +55,11 @@ class RingPrices:
     frame_index: int  # `LodState.frame_index` when priced
     generation: object  # the ring's newest generation then (`RingState.pending` or `current`)
     costs: CostModel  # the model that priced it
+    units: object  # the `LodUnits` priced
     in_view: int  # the ring's clouds in view then
+    #: per unit, its (particles, fragments) drawn in full 3D far off, the ring's candidates in view counted splat
+    #: by splat (`pricing.in_view_work`), for the prediction of the frame all in full 3D
+    in_view_work: tuple
     ring_ms: float  # its panels a frame and its rebuild amortised over its lifetime
     alone_ms: float  # its clouds in view drawn each as auto would (`pricing.ms_drawn_alone`)
     chases_tolerance: bool  # kept within the impostors' tolerance (its rebuilds cost at most `RING_FRAME_MS`)
