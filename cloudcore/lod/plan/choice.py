@@ -190,16 +190,16 @@ def groups_cheaper_apart(units: LodUnits, seen: Seen, settings, state: LodState,
         return frozenset()
     part_seen = seen.take(slice(len(units.members), None))
     group_ms = impostor_ms_of(groups, group_seen, candidates, focal_px, settings, costs)
-    # (a cloud whose own sphere holds the eye is priced as a quad over the whole screen: dear, so its group stays)
-    part_prices = impostor_ms_of(units.clouds, part_seen, slice(None), focal_px, settings, costs)
-    part_ms = dict(zip((members[0] for members in units.clouds.members), part_prices))
-    wanted = set()
-    for index, group_price in zip(np.flatnonzero(candidates), group_ms):
-        members = groups.members[index]
-        prices = {"group": float(group_price), "apart": sum(part_ms[cloud] for cloud in members)}
-        if cheapest("apart" if members in state.opened else "group", prices) == "apart":
-            wanted.add(members)
-    return frozenset(wanted)
+    # (a cloud whose own sphere holds the eye is priced as a quad over the whole screen: dear, so its group stays);
+    # the clouds' units are the groups' members in order
+    part_ms = impostor_ms_of(units.clouds, part_seen, slice(None), focal_px, settings, costs)
+    apart_ms = np.add.reduceat(part_ms, np.cumsum(groups.member_counts) - groups.member_counts)[candidates]
+    indices = np.flatnonzero(candidates).tolist()
+    held_apart = np.fromiter((groups.members[i] in state.opened for i in indices), dtype=bool, count=len(indices))
+    # `cheapest` of the two, group by group: the way held unless the other is cheaper by the margin
+    keep = 1.0 - SWITCH_MARGIN
+    apart = np.where(held_apart, group_ms >= keep * apart_ms, apart_ms < keep * group_ms)
+    return frozenset(groups.members[i] for i in np.asarray(indices, dtype=np.int64)[apart].tolist())
 
 
 def units_ms(unit_prices, ring_ms: float, alone_ms: float, candidates, costs: CostModel) -> float:
