@@ -20,8 +20,8 @@ from cloudcore.atmosphere.table_sampling import sub_uv_to_unit, texel_centres
 MULTIPLE_SCATTERING_TABLE_SIZE = 32
 #: directions over the sphere: this squared
 SQRT_DIRECTIONS = 8
-#: samples on each side of a ray's lowest point
-MULTIPLE_SCATTERING_STEPS = 16
+#: samples a ray (Hillaire: 20)
+MULTIPLE_SCATTERING_SAMPLES = 20
 #: the lowest and highest texels sit this far inside the air (Hillaire's PLANET_RADIUS_OFFSET)
 _INSIDE_M = 10.0
 
@@ -45,7 +45,7 @@ def build_multiple_scattering_table(params: AtmosphereParameters, transmittance_
     distance = distance_to_boundary(r, mu, params.bottom_radius_m, params.top_radius_m)
     ground = ray_hits_ground(r, mu, params.bottom_radius_m)
     second_order, f_ms = isotropic_in_scattering(
-        params, transmittance_table, r, mu, mu_s, nu, distance, MULTIPLE_SCATTERING_STEPS, ground
+        params, transmittance_table, r, mu, mu_s, nu, distance, MULTIPLE_SCATTERING_SAMPLES, ground
     )
     second_order, f_ms = second_order.mean(axis=-2), f_ms.mean(axis=-2)
     return second_order / (1.0 - np.minimum(f_ms, 0.999))

@@ -55,13 +55,13 @@ class RayMarch:
         return np.einsum("...sc,...sc->...c", self.throughput * step_share, source)
 
 
-def march(params: AtmosphereParameters, transmittance_table, r, mu, mu_s, nu, distance, steps: int) -> RayMarch:
+def march(params: AtmosphereParameters, transmittance_table, r, mu, mu_s, nu, distance, samples: int) -> RayMarch:
     """Sample the rays from radius `r` at cosine `mu` to the up, sun cosine `mu_s` to the up and `nu` to the
     ray, over `distance` (all broadcast together)."""
     r, mu, mu_s, nu, distance = np.broadcast_arrays(
         *(np.asarray(v, dtype=np.float64) for v in (r, mu, mu_s, nu, distance))
     )
-    t, dt = ray_samples(r, mu, distance, steps)
+    t, dt = ray_samples(r, mu, distance, samples)
     radius = radius_along(r[..., None], mu[..., None], t)
     altitude = radius - params.bottom_radius_m
     sun_cosine = sun_cosine_along(r[..., None], mu_s[..., None], nu[..., None], t, radius)
@@ -108,13 +108,13 @@ def in_scattering(
     mu_s,
     nu,
     distance,
-    steps: int,
+    samples: int,
     ground=False,
 ) -> tuple[np.ndarray, np.ndarray]:
     """(radiance (..., 3), transmittance (..., 3)) over `distance` along the rays (`march`), per unit solar
     irradiance: the sun's single scattering by Rayleigh and Mie, every higher order through psi_ms, and where
     `ground` (...) is true the ground at the ray's end seen through the air."""
-    ray = march(params, transmittance_table, r, mu, mu_s, nu, distance, steps)
+    ray = march(params, transmittance_table, r, mu, mu_s, nu, distance, samples)
     scattering_cosine = np.asarray(nu, dtype=np.float64)[..., None, None]
     single = ray.sunlight * (
         ray.rayleigh * rayleigh_phase(scattering_cosine)
@@ -127,11 +127,11 @@ def in_scattering(
     ), ray.transmittance
 
 
-def isotropic_in_scattering(params, transmittance_table, r, mu, mu_s, nu, distance, steps, ground):
+def isotropic_in_scattering(params, transmittance_table, r, mu, mu_s, nu, distance, samples, ground):
     """(second-order source L (..., 3), f_ms (..., 3)) along the rays for Hillaire's psi_ms (his eqs. 5-7):
     the sun's light scattered once isotropically toward the start, the lit ground at the end included, and
     the scattering integrated with unit phase (the share of light the air sends back as a next order)."""
-    ray = march(params, transmittance_table, r, mu, mu_s, nu, distance, steps)
+    ray = march(params, transmittance_table, r, mu, mu_s, nu, distance, samples)
     scattering = ray.rayleigh + ray.mie
     radiance = ray.integrate(ray.sunlight * scattering * ISOTROPIC_PHASE)
     radiance = radiance + _seen_ground(params, transmittance_table, ray, r, mu, mu_s, nu, distance, ground)

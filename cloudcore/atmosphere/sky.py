@@ -23,7 +23,7 @@ from cloudcore.atmosphere.sun_disc import visible_fraction
 #: the disk cache's name for the transmittance and multiple-scattering tables (`cloudcore.disk_cache`)
 CACHE_KIND = "atmosphere"
 #: bump when what the tables hold or how they are computed changes: older cache entries are rebuilt
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
 
 
 @dataclass(frozen=True, eq=False)
@@ -43,11 +43,11 @@ def cache_key(params: AtmosphereParameters) -> dict:
     return {
         "format": FORMAT_VERSION,
         "params": dataclasses.asdict(params),
-        "transmittance": [transmittance.TRANSMITTANCE_TABLE_SIZE, transmittance.TRANSMITTANCE_STEPS],
+        "transmittance": [transmittance.TRANSMITTANCE_TABLE_SIZE, transmittance.TRANSMITTANCE_SAMPLES],
         "multiple_scattering": [
             multiple_scattering.MULTIPLE_SCATTERING_TABLE_SIZE,
             multiple_scattering.SQRT_DIRECTIONS,
-            multiple_scattering.MULTIPLE_SCATTERING_STEPS,
+            multiple_scattering.MULTIPLE_SCATTERING_SAMPLES,
         ],
     }
 

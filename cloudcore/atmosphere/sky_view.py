@@ -18,8 +18,8 @@ from cloudcore.atmosphere.table_sampling import sample_bilinear, sub_uv_to_unit,
 
 #: (width over the azimuth, height over the zenith angle): Hillaire's 192 x 108
 SKY_VIEW_TABLE_SIZE = (192, 108)
-#: samples on each side of a ray's lowest point
-SKY_VIEW_STEPS = 20
+#: samples a ray (Hillaire: 4 to 14 by its length, in his real-time sky view; 30 in his reference)
+SKY_VIEW_SAMPLES = 24
 
 
 def horizon_angles(params: AtmosphereParameters, r) -> tuple[np.ndarray, np.ndarray]:
@@ -80,7 +80,7 @@ def build_sky_view_table(
         mu_s,
         nu,
         distance,
-        SKY_VIEW_STEPS,
+        SKY_VIEW_SAMPLES,
         ground=ray_hits_ground(r, mu, params.bottom_radius_m),
     )
     return radiance

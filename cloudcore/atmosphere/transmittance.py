@@ -20,13 +20,13 @@ from cloudcore.atmosphere.table_sampling import sample_bilinear, sub_uv_to_unit,
 
 #: (width over the direction, height over the altitude): Hillaire's 256 x 64
 TRANSMITTANCE_TABLE_SIZE = (256, 64)
-#: samples on each side of a ray's lowest point (`ray_samples`)
-TRANSMITTANCE_STEPS = 48
+#: samples a ray (`ray_samples`)
+TRANSMITTANCE_SAMPLES = 64
 
 
-def optical_depth(params: AtmosphereParameters, r, mu, distance, steps: int = TRANSMITTANCE_STEPS) -> np.ndarray:
+def optical_depth(params: AtmosphereParameters, r, mu, distance, samples: int = TRANSMITTANCE_SAMPLES) -> np.ndarray:
     """(..., 3): the extinction integrated over `distance` along rays from radius `r` at cosine `mu`."""
-    t, dt = ray_samples(r, mu, distance, steps)
+    t, dt = ray_samples(r, mu, distance, samples)
     altitude = radius_along(np.asarray(r)[..., None], np.asarray(mu)[..., None], t) - params.bottom_radius_m
     return np.einsum("...sc,...s->...c", extinction_coefficient(params, altitude), dt)
 
