@@ -14,7 +14,14 @@ from cloudcore.atmosphere.geometry import ray_hits_ground
 from cloudcore.atmosphere.sky import SkyView
 from cloudcore.atmosphere.sky_view import eye_radius
 from cloudcore.atmosphere.sun_disc import disc_radiance
-from cloudcore.light.lighting import PHYSICAL_EXPOSURE, physical_sky, physical_sun, sky_colors, sky_gradient
+from cloudcore.light.lighting import (
+    NIGHT_AMBIENT,
+    PHYSICAL_EXPOSURE,
+    physical_sky,
+    physical_sun,
+    sky_colors,
+    sky_gradient,
+)
 from cloudcore.scene import Lighting
 from cloudcore.sun import scene_hour
 
@@ -22,6 +29,9 @@ from cloudcore.sun import scene_hour
 #: 16-bit float targets' blending rounds a cloud's 1 - alpha to 2^-11, so a brighter disc would show through
 #: an opaque cloud (32 * 2^-11 = 1.6% of white at most); it is still far past what 8 bits can show
 SUN_DISC_PEAK = 32.0
+#: the night's sky under the moon and the stars, which the atmosphere (the sun's light alone) leaves black: the
+#: gradient's night zenith, as the ambient keeps its night floor (`lighting.NIGHT_AMBIENT`)
+NIGHT_SKY = 0.8 * NIGHT_AMBIENT
 
 
 @dataclass(frozen=True, eq=False)
@@ -39,8 +49,8 @@ class SkyBackground:
         return self.view is not None
 
     def table(self) -> np.ndarray:
-        """(108, 192, 3): the sky-view table in the renderer's values."""
-        return np.pi * PHYSICAL_EXPOSURE * self.view.table
+        """(108, 192, 3): the sky-view table in the renderer's values, the night's sky under it."""
+        return np.pi * PHYSICAL_EXPOSURE * self.view.table + NIGHT_SKY
 
     def sun_disc_scale(self) -> np.ndarray:
         """(3,): the disc's colour per unit of `disc_radiance`, lowered as a whole where its centre would pass
@@ -55,7 +65,7 @@ class SkyBackground:
         directions = np.asarray(directions, dtype=np.float64)
         if not self.physical:
             return sky_gradient(directions, self.zenith, self.horizon)
-        sky = np.pi * PHYSICAL_EXPOSURE * self.view.radiance(directions)
+        sky = np.pi * PHYSICAL_EXPOSURE * self.view.radiance(directions) + NIGHT_SKY
         params = self.view.tables.params
         r = eye_radius(params, self.view.altitude_m)
         above = ~ray_hits_ground(r, directions[..., 1], params.bottom_radius_m)
