@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from cloudcore.atmosphere.sky import atmosphere_tables, sky_seen_from, sun_transmittance
+from cloudcore.atmosphere.sky import atmosphere_tables, sky_irradiance, sun_transmittance
 from cloudcore.light.lighting import (
     PHYSICAL_EXPOSURE,
     active_lights,
@@ -61,7 +61,7 @@ def test_the_physical_sky_s_lights_are_the_atmosphere_s_beam_and_irradiance_at_t
     beam = sun_transmittance(atmosphere_tables(params), 800.0, sun_direction(hours))
     np.testing.assert_allclose(np.array(sun.color) * sun.intensity, PHYSICAL_EXPOSURE * beam, rtol=1e-12)
     assert skylight.direction == (0.0, 1.0, 0.0)
-    sky = sky_seen_from(params, 800.0, sun_direction(hours)).upward_irradiance()
+    sky = sky_irradiance(atmosphere_tables(params), 800.0, sun_direction(hours))
     np.testing.assert_allclose(np.array(skylight.color) * skylight.intensity, PHYSICAL_EXPOSURE * sky, rtol=1e-12)
     # a brighter ground lights the clouds' undersides more
     assert (daylight(hours, Air(ground_albedo=0.8))[1] > daylight(hours, Air(ground_albedo=0.1))[1]).all()

@@ -122,9 +122,9 @@ def in_scattering(
     )
     multiple = multiple_scattering_lookup(params, multiple_scattering_table, ray.radius, ray.sun_cosine)
     radiance = ray.integrate(single + multiple * (ray.rayleigh + ray.mie))
-    return radiance + _seen_ground(
-        params, transmittance_table, ray, r, mu, mu_s, nu, distance, ground
-    ), ray.transmittance
+    if np.any(ground):
+        radiance = radiance + _seen_ground(params, transmittance_table, ray, r, mu, mu_s, nu, distance, ground)
+    return radiance, ray.transmittance
 
 
 def isotropic_in_scattering(params, transmittance_table, r, mu, mu_s, nu, distance, samples, ground):

@@ -26,8 +26,9 @@ def sub_uv_to_unit(u, size: int) -> np.ndarray:
 def sample_bilinear(table: np.ndarray, u, v) -> np.ndarray:
     """(..., channels): `table` (height, width, channels) at (u, v) (...), bilinear, clamped to the edge texels."""
     height, width, channels = table.shape
-    x = np.clip(np.nan_to_num(np.asarray(u, dtype=np.float64)) * width - 0.5, 0.0, width - 1.0)
-    y = np.clip(np.nan_to_num(np.asarray(v, dtype=np.float64)) * height - 0.5, 0.0, height - 1.0)
+    u, v = np.broadcast_arrays(np.asarray(u, dtype=np.float64), np.asarray(v, dtype=np.float64))
+    x = np.clip(np.nan_to_num(u) * width - 0.5, 0.0, width - 1.0)
+    y = np.clip(np.nan_to_num(v) * height - 0.5, 0.0, height - 1.0)
     x0 = np.minimum(x.astype(np.int64), max(width - 2, 0))
     y0 = np.minimum(y.astype(np.int64), max(height - 2, 0))
     fx, fy = (x - x0).ravel(), (y - y0).ravel()

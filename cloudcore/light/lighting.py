@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from cloudcore.atmosphere.parameters import EARTH, AtmosphereParameters
-from cloudcore.atmosphere.sky import SkyView, atmosphere_tables, sky_seen_from, sun_transmittance
+from cloudcore.atmosphere.sky import SkyView, atmosphere_tables, sky_irradiance, sky_seen_from, sun_transmittance
 from cloudcore.ramps import smoothstep
 from cloudcore.scene import Air, Light, Lighting
 from cloudcore.sun import elevation_deg, scene_hour, sun_direction
@@ -120,7 +120,8 @@ def _physical_daylight(hours: float, air: Air) -> tuple[tuple[Light, ...], np.nd
     tops their share of the sky, the ambient their undersides theirs of the ground."""
     direction = sun_direction(hours)
     sun = physical_sun(hours, air)
-    sky = PHYSICAL_EXPOSURE * physical_sky(hours, air).upward_irradiance()
+    tables = atmosphere_tables(atmosphere_parameters(air))
+    sky = PHYSICAL_EXPOSURE * sky_irradiance(tables, air.origin_altitude_m, direction)
     ground_irradiance = sun * max(float(direction[1]), 0.0) + sky
     ambient = NIGHT_AMBIENT + 0.5 * air.ground_albedo * ground_irradiance
     lights = (_light(direction, sun), _light((0.0, 1.0, 0.0), sky))
