@@ -38,7 +38,9 @@ def build_multiple_scattering_table(params: AtmosphereParameters, transmittance_
     size = MULTIPLE_SCATTERING_TABLE_SIZE
     u, v = np.meshgrid(sub_uv_to_unit(texel_centres(size), size), sub_uv_to_unit(texel_centres(size), size))
     mu_s = np.clip(2.0 * u - 1.0, -1.0, 1.0)[..., None]
-    r = (params.bottom_radius_m + np.clip(v * params.thickness_m, _INSIDE_M, params.thickness_m - _INSIDE_M))[..., None]
+    # a ray depends on the altitude and its direction, not the sun: one march a row serves every sun of the row
+    altitude = np.clip(v[:, :1] * params.thickness_m, _INSIDE_M, params.thickness_m - _INSIDE_M)
+    r = (params.bottom_radius_m + altitude)[..., None]
     mu, sin_theta, azimuth = sphere_directions()
     # the sun in the plane of the up and the azimuth's zero
     nu = mu * mu_s + sin_theta * np.cos(azimuth) * np.sqrt(np.maximum(1.0 - mu_s * mu_s, 0.0))

@@ -33,55 +33,63 @@ _LEAST_EXTINCTION = 1e-30
 
 @dataclass(frozen=True)
 class RayMarch:
-    """A ray's samples: where they are, what the air there does, and what reaches them."""
+    """A ray's samples: where they are, what the air there does, what reaches them from the start.  The sun has
+    no part in it, so one march serves every sun direction around the ray (`sunlight_along` adds the sun's)."""
 
+    t: np.ndarray  # (..., S)
     dt: np.ndarray  # (..., S)
     radius: np.ndarray  # (..., S)
-    sun_cosine: np.ndarray  # (..., S)
     rayleigh: np.ndarray  # (..., S, 3) scattering coefficients
     mie: np.ndarray  # (..., S, 3)
     extinction: np.ndarray  # (..., S, 3)
     #: the transmittance from the ray's start to each step's start (..., S, 3), and over the whole ray (..., 3)
     throughput: np.ndarray
     transmittance: np.ndarray
-    #: the sun's transmittance to each sample, 0 in the ground's shadow (..., S, 3)
-    sunlight: np.ndarray
 
     def integrate(self, source) -> np.ndarray:
-        """(..., 3): the sum over steps of the source (..., S, 3, per metre) integrated over each step and
-        attenuated on the way back to the start."""
+        """(..., 3): the sum over steps of the source (..., S, 3, per metre; broadcast against the ray's
+        samples) integrated over each step and attenuated on the way back to the start."""
         extinction = np.maximum(self.extinction, _LEAST_EXTINCTION)
         step_share = -np.expm1(-extinction * self.dt[..., None]) / extinction
         return np.einsum("...sc,...sc->...c", self.throughput * step_share, source)
 
 
-def march(params: AtmosphereParameters, transmittance_table, r, mu, mu_s, nu, distance, samples: int) -> RayMarch:
-    """Sample the rays from radius `r` at cosine `mu` to the up, sun cosine `mu_s` to the up and `nu` to the
-    ray, over `distance` (all broadcast together)."""
-    r, mu, mu_s, nu, distance = np.broadcast_arrays(
-        *(np.asarray(v, dtype=np.float64) for v in (r, mu, mu_s, nu, distance))
-    )
+def march(params: AtmosphereParameters, r, mu, distance, samples: int) -> RayMarch:
+    """Sample the rays from radius `r` at cosine `mu` to the up over `distance` (broadcast together)."""
+    r, mu, distance = np.broadcast_arrays(*(np.asarray(v, dtype=np.float64) for v in (r, mu, distance)))
     t, dt = ray_samples(r, mu, distance, samples)
     radius = radius_along(r[..., None], mu[..., None], t)
     altitude = radius - params.bottom_radius_m
-    sun_cosine = sun_cosine_along(r[..., None], mu_s[..., None], nu[..., None], t, radius)
     rayleigh, mie = scattering_coefficients(params, altitude)
     extinction = extinction_coefficient(params, altitude)
     step_depth = extinction * dt[..., None]
     depth_before = np.cumsum(step_depth, axis=-2) - step_depth
-    lit = ~ray_hits_ground(radius, sun_cosine, params.bottom_radius_m)
-    sunlight = transmittance_to_top(params, transmittance_table, radius, sun_cosine) * lit[..., None]
     return RayMarch(
+        t=t,
         dt=dt,
         radius=radius,
-        sun_cosine=sun_cosine,
         rayleigh=rayleigh,
         mie=mie,
         extinction=extinction,
         throughput=np.exp(-depth_before),
         transmittance=np.exp(-step_depth.sum(axis=-2)),
-        sunlight=sunlight,
     )
+
+
+def sunlight_along(params: AtmosphereParameters, transmittance_table, ray: RayMarch, r, mu_s, nu):
+    """(the sun's cosine to the up at each sample (..., S), its transmittance there, 0 in the ground's shadow
+    (..., S, 3)) for the sun at cosine `mu_s` to the up at the rays' start and `nu` to the rays (broadcast
+    against the rays' own shape: a march of (rows, 1) serves suns of (rows, columns))."""
+    sun_cosine = sun_cosine_along(
+        np.asarray(r, dtype=np.float64)[..., None],
+        np.asarray(mu_s, dtype=np.float64)[..., None],
+        np.asarray(nu, dtype=np.float64)[..., None],
+        ray.t,
+        ray.radius,
+    )
+    radius = np.broadcast_to(ray.radius, sun_cosine.shape)
+    lit = ~ray_hits_ground(radius, sun_cosine, params.bottom_radius_m)
+    return sun_cosine, transmittance_to_top(params, transmittance_table, radius, sun_cosine) * lit[..., None]
 
 
 def multiple_scattering_lookup(params: AtmosphereParameters, table: np.ndarray, r, mu_s) -> np.ndarray:
@@ -114,13 +122,14 @@ def in_scattering(
     """(radiance (..., 3), transmittance (..., 3)) over `distance` along the rays (`march`), per unit solar
     irradiance: the sun's single scattering by Rayleigh and Mie, every higher order through psi_ms, and where
     `ground` (...) is true the ground at the ray's end seen through the air."""
-    ray = march(params, transmittance_table, r, mu, mu_s, nu, distance, samples)
+    ray = march(params, r, mu, distance, samples)
+    sun_cosine, sunlight = sunlight_along(params, transmittance_table, ray, r, mu_s, nu)
     scattering_cosine = np.asarray(nu, dtype=np.float64)[..., None, None]
-    single = ray.sunlight * (
+    single = sunlight * (
         ray.rayleigh * rayleigh_phase(scattering_cosine)
         + ray.mie * cornette_shanks_phase(scattering_cosine, params.mie_g)
     )
-    multiple = multiple_scattering_lookup(params, multiple_scattering_table, ray.radius, ray.sun_cosine)
+    multiple = multiple_scattering_lookup(params, multiple_scattering_table, ray.radius, sun_cosine)
     radiance = ray.integrate(single + multiple * (ray.rayleigh + ray.mie))
     if np.any(ground):
         radiance = radiance + _seen_ground(params, transmittance_table, ray, r, mu, mu_s, nu, distance, ground)
@@ -131,9 +140,10 @@ def isotropic_in_scattering(params, transmittance_table, r, mu, mu_s, nu, distan
     """(second-order source L (..., 3), f_ms (..., 3)) along the rays for Hillaire's psi_ms (his eqs. 5-7):
     the sun's light scattered once isotropically toward the start, the lit ground at the end included, and
     the scattering integrated with unit phase (the share of light the air sends back as a next order)."""
-    ray = march(params, transmittance_table, r, mu, mu_s, nu, distance, samples)
+    ray = march(params, r, mu, distance, samples)
+    _, sunlight = sunlight_along(params, transmittance_table, ray, r, mu_s, nu)
     scattering = ray.rayleigh + ray.mie
-    radiance = ray.integrate(ray.sunlight * scattering * ISOTROPIC_PHASE)
+    radiance = ray.integrate(sunlight * scattering * ISOTROPIC_PHASE)
     radiance = radiance + _seen_ground(params, transmittance_table, ray, r, mu, mu_s, nu, distance, ground)
     return radiance, ray.integrate(scattering)
 

@@ -70,18 +70,20 @@ def build_sky_view_table(
     mu, light_view_cosine = sky_view_directions(params, r)
     mu_s = float(np.clip(sun_cosine, -1.0, 1.0))
     nu = mu * mu_s + np.sqrt(np.maximum(1.0 - mu * mu, 0.0)) * np.sqrt(1.0 - mu_s * mu_s) * light_view_cosine
-    distance = distance_to_boundary(r, mu, params.bottom_radius_m, params.top_radius_m)
+    # a row's rays differ by their azimuth from the sun alone: one march a row (its first column) serves them all
+    row_mu = mu[:, :1]
+    distance = distance_to_boundary(r, row_mu, params.bottom_radius_m, params.top_radius_m)
     radiance, _ = in_scattering(
         params,
         transmittance_table,
         multiple_scattering_table,
         r,
-        mu,
+        row_mu,
         mu_s,
         nu,
         distance,
         SKY_VIEW_SAMPLES,
-        ground=ray_hits_ground(r, mu, params.bottom_radius_m),
+        ground=ray_hits_ground(r, row_mu, params.bottom_radius_m),
     )
     return radiance
 
