@@ -84,18 +84,19 @@ class SkyView:
         return sky_view.sky_view_lookup(self.tables.params, self.table, self.altitude_m, directions, self.sun_direction)
 
 
-def sky_seen_from(params: AtmosphereParameters, altitude_m: float, sun_direction) -> SkyView:
-    """The sky of `params` from `altitude_m` with the sun toward unit `sun_direction` (y up); the last few are
-    kept in memory, since a scene asks for its sky again whenever its light is remade."""
-    return _sky_view(params, float(altitude_m), tuple(float(c) for c in sun_direction))
+def sky_seen_from(params: AtmosphereParameters, altitude_m: float, sun_direction, preview: bool = False) -> SkyView:
+    """The sky of `params` from `altitude_m` with the sun toward unit `sun_direction` (y up), its table coarser
+    for a `preview`; the last few are kept in memory, since a scene asks for its sky again whenever its light
+    is remade."""
+    return _sky_view(params, float(altitude_m), tuple(float(c) for c in sun_direction), preview)
 
 
 @functools.lru_cache(maxsize=16)
-def _sky_view(params: AtmosphereParameters, altitude_m: float, sun_direction: tuple) -> SkyView:
+def _sky_view(params: AtmosphereParameters, altitude_m: float, sun_direction: tuple, preview: bool) -> SkyView:
     tables = atmosphere_tables(params)
     sun = np.asarray(sun_direction, dtype=np.float64)
     table = sky_view.build_sky_view_table(
-        params, tables.transmittance, tables.multiple_scattering, altitude_m, float(sun[1])
+        params, tables.transmittance, tables.multiple_scattering, altitude_m, float(sun[1]), preview
     )
     return SkyView(tables, altitude_m, sun, table)
 

@@ -20,6 +20,10 @@ from cloudcore.atmosphere.table_sampling import sample_bilinear, sub_uv_to_unit,
 SKY_VIEW_TABLE_SIZE = (192, 108)
 #: samples a ray (Hillaire: 4 to 14 by its length, in his real-time sky view; 30 in his reference)
 SKY_VIEW_SAMPLES = 24
+#: the preview's table, while a slider is dragged in the editor (as the clouds' light is a coarse raster then):
+#: an eighth of the work, its rays a few per cent off near the horizon
+PREVIEW_TABLE_SIZE = (96, 54)
+PREVIEW_SAMPLES = 12
 
 
 def horizon_angles(params: AtmosphereParameters, r) -> tuple[np.ndarray, np.ndarray]:
@@ -30,10 +34,12 @@ def horizon_angles(params: AtmosphereParameters, r) -> tuple[np.ndarray, np.ndar
     return beta, np.pi - beta
 
 
-def sky_view_uv(params: AtmosphereParameters, r, mu, light_view_cosine) -> tuple[np.ndarray, np.ndarray]:
-    """The table's (u, v) of a view of cosine `mu` to the up and `light_view_cosine` of its azimuth from the
-    sun's, seen from radius `r` (`SkyViewLutParamsToUv`)."""
-    width, height = SKY_VIEW_TABLE_SIZE
+def sky_view_uv(
+    params: AtmosphereParameters, r, mu, light_view_cosine, size=SKY_VIEW_TABLE_SIZE
+) -> tuple[np.ndarray, np.ndarray]:
+    """The (u, v) in a table of `size` (width, height) of a view of cosine `mu` to the up and `light_view_cosine`
+    of its azimuth from the sun's, seen from radius `r` (`SkyViewLutParamsToUv`)."""
+    width, height = size
     beta, zenith_horizon = horizon_angles(params, r)
     zenith_angle = np.arccos(np.clip(mu, -1.0, 1.0))
     above = np.clip(1.0 - zenith_angle / zenith_horizon, 0.0, 1.0)
@@ -45,9 +51,12 @@ def sky_view_uv(params: AtmosphereParameters, r, mu, light_view_cosine) -> tuple
     return unit_to_sub_uv(u, width), unit_to_sub_uv(v, height)
 
 
-def sky_view_directions(params: AtmosphereParameters, r: float) -> tuple[np.ndarray, np.ndarray]:
-    """(mu, light_view_cosine) (108, 192) of the table's texels from radius `r` (`UvToSkyViewLutParams`)."""
-    width, height = SKY_VIEW_TABLE_SIZE
+def sky_view_directions(
+    params: AtmosphereParameters, r: float, size=SKY_VIEW_TABLE_SIZE
+) -> tuple[np.ndarray, np.ndarray]:
+    """(mu, light_view_cosine) (height, width) of the texels of a table of `size` from radius `r`
+    (`UvToSkyViewLutParams`)."""
+    width, height = size
     u, v = np.meshgrid(sub_uv_to_unit(texel_centres(width), width), sub_uv_to_unit(texel_centres(height), height))
     beta, zenith_horizon = horizon_angles(params, r)
     above = 1.0 - (1.0 - np.clip(2.0 * v, 0.0, 1.0)) ** 2
@@ -62,12 +71,18 @@ def eye_radius(params: AtmosphereParameters, altitude_m: float) -> float:
 
 
 def build_sky_view_table(
-    params: AtmosphereParameters, transmittance_table, multiple_scattering_table, altitude_m: float, sun_cosine: float
+    params: AtmosphereParameters,
+    transmittance_table,
+    multiple_scattering_table,
+    altitude_m: float,
+    sun_cosine: float,
+    preview: bool = False,
 ) -> np.ndarray:
     """(108, 192, 3): the sky's radiance per unit solar irradiance seen from `altitude_m` with the sun at
-    cosine `sun_cosine` to the up."""
+    cosine `sun_cosine` to the up; (54, 96, 3) with fewer samples for a `preview`."""
+    size, samples = (PREVIEW_TABLE_SIZE, PREVIEW_SAMPLES) if preview else (SKY_VIEW_TABLE_SIZE, SKY_VIEW_SAMPLES)
     r = eye_radius(params, altitude_m)
-    mu, light_view_cosine = sky_view_directions(params, r)
+    mu, light_view_cosine = sky_view_directions(params, r, size)
     mu_s = float(np.clip(sun_cosine, -1.0, 1.0))
     nu = mu * mu_s + np.sqrt(np.maximum(1.0 - mu * mu, 0.0)) * np.sqrt(1.0 - mu_s * mu_s) * light_view_cosine
     # a row's rays differ by their azimuth from the sun alone: one march a row (its first column) serves them all
@@ -82,7 +97,7 @@ def build_sky_view_table(
         mu_s,
         nu,
         distance,
-        SKY_VIEW_SAMPLES,
+        samples,
         ground=ray_hits_ground(r, row_mu, params.bottom_radius_m),
     )
     return radiance
@@ -102,7 +117,12 @@ def sky_view_lookup(params: AtmosphereParameters, table, altitude_m: float, dire
     """(..., 3): the sky's radiance along unit `directions` (..., 3; y up) from the table built for this
     altitude and the sun at unit `sun_direction`."""
     directions = np.asarray(directions, dtype=np.float64)
+    height, width = table.shape[:2]
     u, v = sky_view_uv(
-        params, eye_radius(params, altitude_m), directions[..., 1], light_view_cosines(directions, sun_direction)
+        params,
+        eye_radius(params, altitude_m),
+        directions[..., 1],
+        light_view_cosines(directions, sun_direction),
+        (width, height),
     )
     return sample_bilinear(table, u, v)

@@ -16,7 +16,7 @@ import trimesh
 from OpenGL import GL
 
 from cloudcore.atmosphere.geometry import horizon_cosine
-from cloudcore.atmosphere.sky_view import SKY_VIEW_TABLE_SIZE, eye_radius, horizon_angles
+from cloudcore.atmosphere.sky_view import eye_radius, horizon_angles
 from cloudcore.camera import FAR_PLANE_M, NEAR_PLANE_M, camera_pose
 from cloudcore.colour import srgb_encode
 from cloudcore.gl.context import HeadlessContext
@@ -115,6 +115,8 @@ class WorldPass:
         GL.glActiveTexture(GL.GL_TEXTURE1)
         GL.glBindTexture(GL.GL_TEXTURE_2D, self._sky_view_texture)
         GL.glUniform1i(GL.glGetUniformLocation(program, "sky_view_table"), 1)
+        height, width = sky.view.table.shape[:2]
+        GL.glUniform2f(GL.glGetUniformLocation(program, "sky_view_size"), float(width), float(height))
         GL.glUniform1f(GL.glGetUniformLocation(program, "horizon_beta"), float(beta))
         GL.glUniform1f(GL.glGetUniformLocation(program, "zenith_horizon_angle"), float(zenith_horizon))
         GL.glUniform1f(
@@ -140,7 +142,6 @@ class WorldPass:
 def _sky_view_texture(sky: SkyBackground) -> int:
     """The sky-view table in the renderer's values as a float texture, sampled linearly and clamped to its edge
     texels as `cloudcore.atmosphere.table_sampling` reads it."""
-    width, height = SKY_VIEW_TABLE_SIZE
     texture = GL.glGenTextures(1)
     GL.glBindTexture(GL.GL_TEXTURE_2D, texture)
     for parameter, value in (
@@ -152,6 +153,7 @@ def _sky_view_texture(sky: SkyBackground) -> int:
         GL.glTexParameteri(GL.GL_TEXTURE_2D, parameter, value)
     # row 0 of the table is v's first texel: GL's first row, so the shader reads it with the numpy side's (u, v)
     pixels = np.ascontiguousarray(sky.table(), dtype=np.float32)
+    height, width = pixels.shape[:2]
     GL.glTexImage2D(GL.GL_TEXTURE_2D, 0, GL.GL_RGB32F, width, height, 0, GL.GL_RGB, GL.GL_FLOAT, pixels)
     GL.glBindTexture(GL.GL_TEXTURE_2D, 0)
     return texture

@@ -83,9 +83,9 @@ def atmosphere_parameters(air: Air) -> AtmosphereParameters:
     return EARTH.with_air(air.mie_density_scale, air.ground_albedo)
 
 
-def physical_sky(hours: float, air: Air) -> SkyView:
-    """The atmosphere's sky over the scene's origin at `hours`."""
-    return sky_seen_from(atmosphere_parameters(air), air.origin_altitude_m, sun_direction(hours))
+def physical_sky(hours: float, air: Air, preview: bool = False) -> SkyView:
+    """The atmosphere's sky over the scene's origin at `hours` (a coarser table for a `preview`)."""
+    return sky_seen_from(atmosphere_parameters(air), air.origin_altitude_m, sun_direction(hours), preview)
 
 
 def physical_sun(hours: float, air: Air) -> np.ndarray:

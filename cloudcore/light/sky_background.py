@@ -49,7 +49,7 @@ class SkyBackground:
         return self.view is not None
 
     def table(self) -> np.ndarray:
-        """(108, 192, 3): the sky-view table in the renderer's values, the night's sky under it."""
+        """(height, width, 3): the sky-view table in the renderer's values, the night's sky under it."""
         return np.pi * PHYSICAL_EXPOSURE * self.view.table + NIGHT_SKY
 
     def sun_disc_scale(self) -> np.ndarray:
@@ -76,9 +76,11 @@ class SkyBackground:
         return sky + disc
 
 
-def scene_sky(lighting: Lighting) -> SkyBackground:
-    """The sky a scene's lighting draws."""
+def scene_sky(lighting: Lighting, preview: bool = False) -> SkyBackground:
+    """The sky a scene's lighting draws; the physical one's table coarser for a `preview` (a dragged slider)."""
     hours = scene_hour(lighting)
     if lighting.air.sky == "physical":
-        return SkyBackground(view=physical_sky(hours, lighting.air), sun_irradiance=physical_sun(hours, lighting.air))
+        return SkyBackground(
+            view=physical_sky(hours, lighting.air, preview), sun_irradiance=physical_sun(hours, lighting.air)
+        )
     return SkyBackground(*sky_colors(hours))

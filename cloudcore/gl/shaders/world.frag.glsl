@@ -14,6 +14,7 @@ uniform vec3 zenith_colour;
 uniform vec3 horizon_colour;
 // the atmosphere: its sky-view table (cloudcore/atmosphere/sky_view.py) seen from the scene's origin
 uniform sampler2D sky_view_table;
+uniform vec2 sky_view_size;          // its (width, height): 192 x 108, 96 x 54 for a preview
 uniform float horizon_beta;          // the horizon's angle below the horizontal
 uniform float zenith_horizon_angle;  // pi - horizon_beta
 uniform float horizon_cosine;        // the cosine to the up of the ray grazing the ground
@@ -21,7 +22,6 @@ uniform vec3 sun_direction;
 uniform vec3 sun_disc_scale;         // the disc's colour per unit of its normalised radiance
 uniform float pixel_angle;           // radians a pixel spans: the disc's rim is spread over it
 
-const vec2 SKY_VIEW_SIZE = vec2(192.0, 108.0);
 const float SUN_ANGULAR_RADIUS = 0.004651302;  // radians(0.533 / 2), cloudcore/atmosphere/sun_disc.py
 const float LIMB_DARKENING = 0.6;
 const float PI = 3.14159265358979;
@@ -60,7 +60,7 @@ vec2 sky_view_uv(vec3 ray, bool below_horizon)
     float light_view_cosine = lengths > 1e-12 ? clamp(dot(ray.xz, sun_direction.xz) / lengths, -1.0, 1.0) : 1.0;
     float u = sqrt(clamp(0.5 - 0.5 * light_view_cosine, 0.0, 1.0));
     // table_sampling.py's unit_to_sub_uv
-    return (vec2(u, v) + 0.5 / SKY_VIEW_SIZE) * (SKY_VIEW_SIZE / (SKY_VIEW_SIZE + 1.0));
+    return (vec2(u, v) + 0.5 / sky_view_size) * (sky_view_size / (sky_view_size + 1.0));
 }
 
 vec3 sun_disc(vec3 ray)
