@@ -48,11 +48,6 @@ def radius_along(r, mu, t) -> np.ndarray:
     return np.sqrt(np.maximum(t * t + 2.0 * r * mu * t + r * r, 0.0))
 
 
-def cosine_along(r, mu, t, radius_there) -> np.ndarray:
-    """The ray's cosine to the local up at the point `t` along it (whose radius is `radius_there`)."""
-    return np.clip((np.asarray(r) * mu + t) / np.maximum(radius_there, 1.0), -1.0, 1.0)
-
-
 def sun_cosine_along(r, mu_s, nu, t, radius_there) -> np.ndarray:
     """The cosine of the sun to the up at the point `t` along a ray whose cosine with the sun is `nu`."""
     return np.clip((np.asarray(r) * mu_s + t * np.asarray(nu)) / np.maximum(radius_there, 1.0), -1.0, 1.0)
