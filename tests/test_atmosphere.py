@@ -23,7 +23,10 @@ from cloudcore.atmosphere.scattering import in_scattering, multiple_scattering_l
 from cloudcore.atmosphere.sky import atmosphere_tables, sky_irradiance, sky_seen_from, sun_transmittance
 from cloudcore.atmosphere.sun_disc import SUN_ANGULAR_RADIUS, disc_radiance, visible_fraction
 from cloudcore.atmosphere.transmittance import optical_depth, transmittance_to_top
+from cloudcore.light.lighting import PHYSICAL_EXPOSURE
 from cloudcore.light.phase import phase_function
+from cloudcore.light.sky_background import NIGHT_SKY, scene_sky
+from cloudcore.scene import Lighting
 
 R, TOP = EARTH.bottom_radius_m, EARTH.top_radius_m
 
@@ -313,3 +316,17 @@ def test_other_air_is_built_once_and_then_read_from_the_user_s_cache(monkeypatch
     second = sky.atmosphere_tables(params)
     assert not first.cached and second.cached and first.build_s > 0
     np.testing.assert_array_equal(first.multiple_scattering, second.multiple_scattering)
+
+
+def test_below_the_horizon_the_sky_is_the_air_at_the_horizon_not_the_table_s_grey_ground():
+    """Past the terrain's edge a ray below the horizon meets the planet's ground of one grey albedo in the
+    table: the sky drawn there is the air just over the horizon at the same azimuth, as a far terrain fades."""
+    background = scene_sky(Lighting(time_of_day=12.0))
+    level = np.array([[0.6, 0.0, -0.8]])
+    down = np.array([[0.6 * np.cos(0.2), -np.sin(0.2), -0.8 * np.cos(0.2)]])
+    below, at_horizon = background.radiance(down, 1e-3), background.radiance(level, 1e-3)
+    np.testing.assert_allclose(below, at_horizon, rtol=0.02)
+    ground = np.pi * PHYSICAL_EXPOSURE * background.view.radiance(down) + NIGHT_SKY
+    assert np.max(np.abs(ground - below) / below) > 0.1  # the table's ground is not what is drawn
+    straight_down = background.radiance(np.array([[0.0, -1.0, 0.0]]), 1e-3)
+    assert np.all(np.isfinite(straight_down)) and np.all(straight_down > 0.0)

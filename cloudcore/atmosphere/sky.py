@@ -54,7 +54,7 @@ def cache_key(params: AtmosphereParameters) -> dict:
 
 
 def build_tables(params: AtmosphereParameters) -> dict[str, np.ndarray]:
-    """The tables' arrays, computed (about 2 s on two cores: `atmosphere_tables` caches them)."""
+    """The tables' arrays, computed (a quarter of a second on two cores: `atmosphere_tables` caches them)."""
     transmittance_table = transmittance.build_transmittance_table(params)
     return {
         "transmittance": transmittance_table,

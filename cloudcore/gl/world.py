@@ -111,13 +111,12 @@ class WorldPass:
             return
         params = sky.view.tables.params
         r = eye_radius(params, sky.view.altitude_m)
-        beta, zenith_horizon = horizon_angles(params, r)
+        _, zenith_horizon = horizon_angles(params, r)
         GL.glActiveTexture(GL.GL_TEXTURE1)
         GL.glBindTexture(GL.GL_TEXTURE_2D, self._sky_view_texture)
         GL.glUniform1i(GL.glGetUniformLocation(program, "sky_view_table"), 1)
         height, width = sky.view.table.shape[:2]
         GL.glUniform2f(GL.glGetUniformLocation(program, "sky_view_size"), float(width), float(height))
-        GL.glUniform1f(GL.glGetUniformLocation(program, "horizon_beta"), float(beta))
         GL.glUniform1f(GL.glGetUniformLocation(program, "zenith_horizon_angle"), float(zenith_horizon))
         GL.glUniform1f(
             GL.glGetUniformLocation(program, "horizon_cosine"), float(horizon_cosine(r, params.bottom_radius_m))

@@ -24,7 +24,7 @@ from cloudcore.sun import elevation_deg, scene_hour, sun_direction
 SKIES = ("physical", "gradient")
 #: the exposure of the physical sky: the renderer's light intensity for the sun's irradiance at the top of the
 #: air, so a white Lambertian surface facing the unattenuated sun is this linear white, and a radiance L (per
-#: unit of that irradiance) is pi * PHYSICAL_EXPOSURE * L.  1 keeps the default scene's noon near its
+#: unit of that irradiance) is pi * PHYSICAL_EXPOSURE * L.  1.5 keeps the default scene's noon near its
 #: brightness under the gradient's heuristics, whose noon sun was 0.94 (docs/atmosphere.md)
 PHYSICAL_EXPOSURE = 1.5
 #: the dimmest light the physical sky gives: a third of the darkest step of 8-bit sRGB (1 / 255 / 12.92)

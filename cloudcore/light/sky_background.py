@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cloudcore.atmosphere.geometry import ray_hits_ground
+from cloudcore.atmosphere.geometry import horizon_cosine, ray_hits_ground
 from cloudcore.atmosphere.sky import SkyView
 from cloudcore.atmosphere.sky_view import eye_radius
 from cloudcore.atmosphere.sun_disc import disc_radiance
@@ -29,6 +29,24 @@ from cloudcore.sun import scene_hour
 #: 16-bit float targets' blending rounds a cloud's 1 - alpha to 2^-11, so a brighter disc would show through
 #: an opaque cloud (32 * 2^-11 = 1.6% of white at most); it is still far past what 8 bits can show
 SUN_DISC_PEAK = 32.0
+#: how far above the ray grazing the planet the sky at and below the horizon is looked up (a cosine): a row of
+#: the sky-view table above the ground's half, which filtering would otherwise blend in
+HORIZON_MARGIN = 1e-3
+
+
+def over_the_horizon(directions, horizon: float) -> np.ndarray:
+    """Unit `directions` (..., 3) raised to just over the `horizon` (the cosine to the up of the ray grazing the
+    planet), each keeping its azimuth.  Below the horizon the terrain stands for the planet's ground: where it
+    does not reach (past the world's edge), the air at the horizon is drawn, as a far terrain would fade into
+    it, not the table's grey ground of one albedo (world.frag.glsl does the same)."""
+    directions = np.asarray(directions, dtype=np.float64)
+    up = horizon + HORIZON_MARGIN
+    across = np.linalg.norm(directions[..., [0, 2]], axis=-1, keepdims=True)
+    scale = np.sqrt(1.0 - up * up) / np.maximum(across, 1e-300)
+    level = np.where(across > 1e-12, directions[..., [0, 2]] * scale, [np.sqrt(1.0 - up * up), 0.0])
+    return np.stack([level[..., 0], np.full(directions.shape[:-1], up), level[..., 1]], axis=-1)
+
+
 #: the night's sky under the moon and the stars, which the atmosphere (the sun's light alone) leaves black: the
 #: gradient's night zenith, as the ambient keeps its night floor (`lighting.NIGHT_AMBIENT`)
 NIGHT_SKY = 0.8 * NIGHT_AMBIENT
@@ -65,10 +83,13 @@ class SkyBackground:
         directions = np.asarray(directions, dtype=np.float64)
         if not self.physical:
             return sky_gradient(directions, self.zenith, self.horizon)
-        sky = np.pi * PHYSICAL_EXPOSURE * self.view.radiance(directions) + NIGHT_SKY
         params = self.view.tables.params
         r = eye_radius(params, self.view.altitude_m)
         above = ~ray_hits_ground(r, directions[..., 1], params.bottom_radius_m)
+        horizon = float(horizon_cosine(r, params.bottom_radius_m))
+        low = directions[..., 1:2] < horizon + HORIZON_MARGIN
+        seen = np.where(low, over_the_horizon(directions, horizon), directions)
+        sky = np.pi * PHYSICAL_EXPOSURE * self.view.radiance(seen) + NIGHT_SKY
         # the angle from the sun's centre by its chord, exact near 0 where acos is not
         chord = np.linalg.norm(directions - self.view.sun_direction, axis=-1)
         angle = 2.0 * np.arcsin(np.clip(0.5 * chord, 0.0, 1.0))

@@ -15,8 +15,7 @@ uniform vec3 horizon_colour;
 // the atmosphere: its sky-view table (cloudcore/atmosphere/sky_view.py) seen from the scene's origin
 uniform sampler2D sky_view_table;
 uniform vec2 sky_view_size;          // its (width, height): 192 x 108, 96 x 54 for a preview
-uniform float horizon_beta;          // the horizon's angle below the horizontal
-uniform float zenith_horizon_angle;  // pi - horizon_beta
+uniform float zenith_horizon_angle;  // pi less the horizon's angle below the horizontal
 uniform float horizon_cosine;        // the cosine to the up of the ray grazing the ground
 uniform vec3 sun_direction;
 uniform vec3 sun_disc_scale;         // the disc's colour per unit of its normalised radiance
@@ -49,13 +48,12 @@ vec3 gradient_sky(vec3 ray)
     return mix(horizon_colour, zenith_colour, sqrt(clamp(ray.y, 0.0, 1.0)));
 }
 
-vec2 sky_view_uv(vec3 ray, bool below_horizon)
+vec2 sky_view_uv(vec3 ray)
 {
-    // sky_view.py's sky_view_uv: the zenith angle squared toward the horizon, the azimuth toward the sun
+    // sky_view.py's sky_view_uv over the horizon (the ground's half of the table is not drawn, `sky`): the zenith
+    // angle squared toward the horizon, the azimuth toward the sun
     float zenith_angle = acos(clamp(ray.y, -1.0, 1.0));
-    float v = below_horizon
-        ? 0.5 * sqrt(clamp((zenith_angle - zenith_horizon_angle) / max(horizon_beta, 1e-12), 0.0, 1.0)) + 0.5
-        : 0.5 * (1.0 - sqrt(clamp(1.0 - zenith_angle / zenith_horizon_angle, 0.0, 1.0)));
+    float v = 0.5 * (1.0 - sqrt(clamp(1.0 - zenith_angle / zenith_horizon_angle, 0.0, 1.0)));
     float lengths = length(ray.xz) * length(sun_direction.xz);
     float light_view_cosine = lengths > 1e-12 ? clamp(dot(ray.xz, sun_direction.xz) / lengths, -1.0, 1.0) : 1.0;
     float u = sqrt(clamp(0.5 - 0.5 * light_view_cosine, 0.0, 1.0));
@@ -82,9 +80,16 @@ vec3 sky(vec3 ray)
 {
     if (!physical_sky)
         return gradient_sky(ray);
-    bool below_horizon = ray.y < 0.0 && ray.y <= horizon_cosine;
-    vec3 radiance = texture(sky_view_table, sky_view_uv(ray, below_horizon)).rgb;
-    return below_horizon ? radiance : radiance + sun_disc(ray);
+    // below the horizon the terrain stands for the ground: past the world's edge the air at the horizon is
+    // drawn, as sky_background.py's over_the_horizon does (HORIZON_MARGIN), not the table's grey ground
+    float up = horizon_cosine + 1e-3;
+    if (ray.y < up) {
+        float across = length(ray.xz);
+        vec2 level = across > 1e-12 ? ray.xz * (sqrt(1.0 - up * up) / across) : vec2(sqrt(1.0 - up * up), 0.0);
+        vec3 air = texture(sky_view_table, sky_view_uv(vec3(level.x, up, level.y))).rgb;
+        return ray.y <= horizon_cosine ? air : air + sun_disc(ray);
+    }
+    return texture(sky_view_table, sky_view_uv(ray)).rgb + sun_disc(ray);
 }
 
 void main()
