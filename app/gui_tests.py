@@ -141,8 +141,10 @@ def time_of_day_changes_the_picture(ctx, app: EditorUnderTest):
 
 def shading_pictures(ctx, app: EditorUnderTest, field: str, choice: str) -> tuple[np.ndarray, np.ndarray]:
     """The viewport relit with Harris's shading, then with `choice` picked in the Lighting panel's combo of
-    the `Shading` field `field` (the edit undone afterwards)."""
+    the `Shading` field `field` (the edit undone afterwards), in the afternoon: the light passes shade the sun's
+    light, and under the physical sky the sun of the hour the test before left (19:00) has set."""
     use_window(ctx, "Lighting")
+    ctx.item_input_value("Time of day", 15.5)
     app.relit(ctx)
     before = app.capture(ctx)
     ctx.combo_click(f"{field.replace('_', ' ').capitalize()}/{choice}")

@@ -20,7 +20,7 @@ import numpy as np
 from cloudcore.artist.artist_shading import default_group_size, shading_grid_fits
 from cloudcore.light.lighting import active_lights
 from cloudcore.light.phase import MAX_ABS_G
-from cloudcore.scene import Camera, Cloud, Light, Lighting, SceneObject, Shading, Terrain, View
+from cloudcore.scene import Air, Camera, Cloud, Light, Lighting, SceneObject, Shading, Terrain, View
 
 #: lights that shine on clouds at once: the compute shader keeps one incident term per light
 #: per particle (`incident[MAX_LIGHTS]` in gl/shaders/splat_shade.comp.glsl)
@@ -54,6 +54,14 @@ FIELD_RANGES = {
     (View, "time_of_day"): (0.0, 24.0),
     (Lighting, "ambient"): (0.0, math.inf),
     (Light, "color"): (0.0, math.inf),
+    # Earth's clear aerosols (Mie optical depth 0.005) to 100 times them (0.53, thick haze): there the sky's tables
+    # were checked against a fine march (within 3%, as for clear air); denser is fog, whose light the tables'
+    # 40 samples a ray and single scattering with psi_ms were not checked for (docs/atmosphere.md)
+    (Air, "mie_density_scale"): (0.0, 100.0),
+    (Air, "ground_albedo"): (0.0, 1.0),
+    # the ground of the planet (sea level) to 50 km, well inside the air's 100 km: the sky is the one seen from
+    # the origin, and the clouds stand above it
+    (Air, "origin_altitude_m"): (0.0, 50_000.0),
     (Light, "intensity"): (0.0, math.inf),
     (Shading, "albedo"): (0.0, 1.0),
     (Shading, "optical_depth"): (0.0, math.inf),

@@ -61,12 +61,27 @@ class Light:
 
 
 @dataclass(frozen=True)
+class Air:
+    """The air over a scene (docs/atmosphere.md): `sky` "physical" takes the sky and the sun's and the sky's
+    light from Hillaire's atmosphere (`cloudcore.atmosphere`), "gradient" the two-colour sky and the
+    heuristic light of before (older pictures made again); the aerosols' density as a multiple of Earth's
+    clear air, the ground's albedo, and the altitude of the scene's origin above sea level."""
+
+    sky: str = "physical"
+    mie_density_scale: float = 1.0
+    ground_albedo: float = 0.3
+    origin_altitude_m: float = 0.0
+
+
+@dataclass(frozen=True)
 class Lighting:
-    """Either a time of day (sun, skylight and ambient follow) or explicit lights."""
+    """Either a time of day (sun, skylight and ambient follow) or explicit lights; the air the sky and the
+    sun's light come through."""
 
     time_of_day: float | None = 15.5
     lights: tuple[Light, ...] = ()
     ambient: Vec3 | None = None
+    air: Air = Air()
 
 
 @dataclass(frozen=True)

@@ -18,6 +18,7 @@ import tomlkit
 
 from cloudcore.artist.cloudgen import PRESETS
 from cloudcore.cloud_records import FACINGS, FORMATION_KINDS, MAX_SEED, ArtistShading, Formation, SpriteStyle
+from cloudcore.light.lighting import SKIES
 from cloudcore.light.phase import PHASE_NAMES
 from cloudcore.light.shading import EYE_PASSES, LIGHT_PASSES
 from cloudcore.limits import FIELD_RANGES, scene_limit_problems
@@ -31,6 +32,7 @@ from cloudcore.scene import (
     DEFAULT_VIEW_NAME,
     MAX_LAYERS,
     MAX_RINGS,
+    Air,
     Camera,
     CameraPath,
     Cloud,
@@ -67,6 +69,7 @@ TABLE_KEYS = {
     "camera": record_keys(Camera),
     "lighting": record_keys(Lighting),
     "lighting.lights": record_keys(Light),
+    "lighting.air": record_keys(Air),
     "shading": record_keys(Shading),
     "clouds": record_keys(Cloud),
     "clouds.formation": record_keys(Formation),
@@ -253,7 +256,18 @@ def _lighting(t: Table) -> Lighting:
     else:
         time_of_day = None if lights else Lighting().time_of_day
     ambient = t.vector("ambient", None, **_range(Lighting, "ambient")) if t.has("ambient") else None
-    return Lighting(time_of_day, tuple(lights), ambient)
+    return Lighting(time_of_day, tuple(lights), ambient, t.table("air", _air) or Air())
+
+
+def _air(t: Table) -> Air:
+    t.reject_unknown(TABLE_KEYS["lighting.air"])
+    d = Air()
+    return Air(
+        sky=t.string("sky", d.sky, choices=SKIES),
+        mie_density_scale=t.number("mie_density_scale", d.mie_density_scale, **_range(Air, "mie_density_scale")),
+        ground_albedo=t.number("ground_albedo", d.ground_albedo, **_range(Air, "ground_albedo")),
+        origin_altitude_m=t.number("origin_altitude_m", d.origin_altitude_m, **_range(Air, "origin_altitude_m")),
+    )
 
 
 def _shading(t: Table) -> Shading:
@@ -473,6 +487,8 @@ def scene_to_dict(scene: Scene) -> dict:
             {"direction": list(light.direction), "color": list(light.color), "intensity": light.intensity}
             for light in scene.lighting.lights
         ]
+    if scene.lighting.air != Air():
+        lighting["air"] = dataclasses.asdict(scene.lighting.air)
     data["lighting"] = lighting
     data["shading"] = {"albedo": s.albedo, "optical_depth": s.optical_depth, "phase": s.phase, "g": s.g}
     for key in ("eye_pass", "light_pass"):  # files that keep Harris's passes stay as they were

@@ -13,7 +13,7 @@ from cloudcore.cli import main
 from cloudcore.measure.overlays import to_pixels
 from cloudcore.measure.screenshot_check import Tolerance, check_view, encode_png, view_camera
 from cloudcore.resources import resource_path
-from cloudcore.scene import Camera, CameraPath, Cloud, Lighting, Scene, View
+from cloudcore.scene import Air, Camera, CameraPath, Cloud, Lighting, Scene, View
 from cloudcore.scenefile import load_scene, save_scene
 
 pytestmark = pytest.mark.gl
@@ -33,10 +33,12 @@ def blob(centre, count, seed) -> np.ndarray:
 
 
 def sky_scene() -> Scene:
-    """Two small clouds apart in an empty sky, with three views besides the default."""
+    """Two small clouds apart in an empty sky, with three views besides the default; the gradient sky, whose colour
+    is the same from 09:00 to 14:00 (the atmosphere's follows the sun), so a changed time of day changes the
+    clouds alone."""
     return Scene(
         camera=Camera((0.0, 800.0, 1600.0), (0.0, 800.0, 0.0), 50.0),
-        lighting=Lighting(14.0),
+        lighting=Lighting(14.0, air=Air(sky="gradient")),
         clouds=(Cloud("left", blob([-400, 800, 0], 12, 1)), Cloud("right", blob([400, 800, 0], 12, 2))),
         camera_paths=(CameraPath("pass", np.array([[0, -300, 700, 2000, 0, 800, 0], [4, 300, 900, 1600, 0, 800, 0]])),),
         views=(
@@ -119,7 +121,7 @@ def test_update_writes_the_goldens_then_every_view_passes(tmp_path, capsys):
 def test_a_changed_time_of_day_fails_the_views_that_take_it_until_updated(project, capsys):
     scene_file = project / "scenes" / "sky.toml"
     scene = load_scene(scene_file)
-    save_scene(dataclasses.replace(scene, lighting=Lighting(9.0)), scene_file)
+    save_scene(dataclasses.replace(scene, lighting=dataclasses.replace(scene.lighting, time_of_day=9.0)), scene_file)
     assert check(project, "--report", str(project / "report")) == 1
     verdicts = {line.split(": ")[0]: line.split(": ")[1] for line in lines(capsys)[:-2]}
     # the dusk view has a time of its own: the scene's does not reach it

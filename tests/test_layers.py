@@ -20,8 +20,9 @@ MODEL_MAY_IMPORT = ("cloudcore.cloud_records", "cloudcore.errors")
 LAYERS = (
     # the scene model
     ("errors", "cloud_records", "scene"),
-    # what knows no feature: maths of the camera, the sun and the splats, files, settings, small tools
+    # what knows no feature: maths of the camera, the sun, the air and the splats, files, settings, small tools
     (
+        "atmosphere",
         "camera",
         "collector",
         "colour",

@@ -10,7 +10,6 @@ from test_cli_check import sky_scene
 # The user's pytest runs in this process (pytester), which forgets the modules that run imported; numpy's
 # extension modules cannot load twice, so what the plugin renders with is imported here first.
 import cloudcore.gl.views  # noqa: F401
-from cloudcore.scene import Lighting
 from cloudcore.scenefile import load_scene, save_scene
 
 pytest_plugins = ["pytester"]
@@ -54,7 +53,8 @@ def test_the_plugin_writes_goldens_then_passes_then_catches_a_change(user_projec
     user_project.runpytest().assert_outcomes(passed=2)
 
     scene_file = project / "scenes" / "sky.toml"
-    save_scene(dataclasses.replace(load_scene(scene_file), lighting=Lighting(9.0)), scene_file)
+    scene = load_scene(scene_file)
+    save_scene(dataclasses.replace(scene, lighting=dataclasses.replace(scene.lighting, time_of_day=9.0)), scene_file)
     report = project / "report"
     changed = user_project.runpytest("--cloudview-report", str(report))
     changed.assert_outcomes(failed=1, passed=1)  # the dusk view has its own time of day

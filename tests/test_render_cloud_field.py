@@ -9,7 +9,17 @@ from cloudcore.artist.cloudgen import preset_cloud
 from cloudcore.field.grid import level_reach
 from cloudcore.light.illumination import IlluminationCache
 from cloudcore.light.lighting import active_lights, scene_lights
-from cloudcore.scene import MAX_CELL_SIZE, MAX_LAYERS, MAX_RINGS, MIN_CELL_SIZE, Camera, CloudField, Scene
+from cloudcore.scene import (
+    MAX_CELL_SIZE,
+    MAX_LAYERS,
+    MAX_RINGS,
+    MIN_CELL_SIZE,
+    Air,
+    Camera,
+    CloudField,
+    Lighting,
+    Scene,
+)
 from cloudcore.settings import FULL_3D, RenderSettings
 
 pytestmark = pytest.mark.gl
@@ -56,8 +66,11 @@ def test_the_field_draws_beside_authored_clouds_and_lights_only_the_cells_that_e
 
 def _flight_means(renderer, settings) -> np.ndarray:
     """The frame's mean level as the eye moves 3 inner cells in steps of a twentieth of a cell, past the edges of the
-    inner and middle rings (cells enter and leave both)."""
-    scene = Scene(camera=ABOVE, cloud_field=FIELD)
+    inner and middle rings (cells enter and leave both).  Under the gradient sky the thresholds below were measured
+    against: under the atmosphere the clouds lift the frame's mean 30 levels above its clear frame's (the ground seen
+    from 5 km is dark), under the gradient 4 below it, so the same smooth change of coverage moves the mean 7 times
+    as much (0.08 levels a step, growing smoothly, no step)."""
+    scene = Scene(camera=ABOVE, cloud_field=FIELD, lighting=Lighting(air=Air(sky="gradient")))
     means = []
     for step in np.arange(0.0, 3.0, 0.05):
         x = step * FIELD.cell_size

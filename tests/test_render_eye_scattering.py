@@ -146,18 +146,18 @@ def test_a_sprite_the_eye_stands_in_keeps_its_facing_and_fades_as_the_eye_circle
 
     cloud = Cloud("sprite", [[0.0, 0.0, 0.0, 100.0]], sprite=SpriteStyle(rows=(PUFFY,), rotation_deg=(0.0, 0.0)))
     scene = Scene(lighting=Lighting(12.0), clouds=(cloud,))
-    sky = renderer.render(
-        dataclasses.replace(scene, clouds=()), camera=Camera((0.0, 0.0, 30.0), (0.0, 0.0, 0.0)), settings=FULL_3D
-    )[0].astype(float)
+    angles = np.radians(np.arange(0, 130, 10))
+    cameras = [Camera((30.0 * np.sin(angle), 0.0, 30.0 * np.cos(angle)), (0.0, 0.0, 0.0)) for angle in angles]
+    # the clear sky seen each way, first: the atmosphere's changes with the azimuth, and a frame without the
+    # sprite between two with it would forget its locked facing
+    skies = [renderer.render(dataclasses.replace(scene, clouds=()), camera=c, settings=FULL_3D)[0] for c in cameras]
 
-    def visible(angle_deg: float) -> float:
-        """Mean brightness the sprite adds, seen from 30 m (0.3 radii) at `angle_deg` around it."""
-        angle = np.radians(angle_deg)
-        eye = 30.0 * np.array([np.sin(angle), 0.0, np.cos(angle)])
-        image = renderer.render(scene, camera=Camera(tuple(eye), (0.0, 0.0, 0.0)), settings=FULL_3D)[0]
-        return float(np.abs(image.astype(float) - sky).mean())
+    def visible(camera: Camera, sky: np.ndarray) -> float:
+        """Mean brightness the sprite adds, seen from 30 m (0.3 radii) by `camera`, over the clear `sky`."""
+        image = renderer.render(scene, camera=camera, settings=FULL_3D)[0]
+        return float(np.abs(image.astype(float) - sky.astype(float)).mean())
 
-    seen = [visible(angle) for angle in range(0, 130, 10)]
+    seen = [visible(camera, sky) for camera, sky in zip(cameras, skies, strict=True)]
     assert seen[0] > 10.0, seen  # locked at first sight, in full view
     assert all(later <= earlier + 0.5 for earlier, later in zip(seen, seen[1:])), seen
     assert seen[9] < 0.5 and seen[-1] < 0.5, seen  # edge-on at 90 degrees and beyond: gone

@@ -11,7 +11,10 @@ from conftest import RENDER_HEIGHT as HEIGHT
 from conftest import RENDER_WIDTH as WIDTH
 from conftest import VALLEY
 
-from cloudcore.scene import Camera
+from cloudcore.camera import pixel_rays
+from cloudcore.colour import linear_to_srgb8
+from cloudcore.light.sky_background import scene_sky
+from cloudcore.scene import Air, Camera, Lighting
 from cloudcore.scenefile import load_scene
 from cloudcore.settings import FULL_3D
 
@@ -64,7 +67,19 @@ def test_the_frame_time_holds_the_planning_and_the_passes(afternoon):
 
 
 def test_sky_at_the_top_is_blue(afternoon):
+    """The atmosphere's blue, as bright as the model says (its zenith a deeper blue than the gradient's)."""
     r, g, b = afternoon[0][0, WIDTH // 2].astype(int)
+    assert b > g > r
+    camera = load_scene(VALLEY).camera
+    ray = pixel_rays(camera, WIDTH, HEIGHT)[0, WIDTH // 2]
+    expected = linear_to_srgb8(scene_sky(Lighting(time_of_day=15.5)).radiance(ray, 1e-3).reshape(1, 1, 3))[0, 0]
+    expected = expected.astype(int)
+    assert np.abs([r, g, b] - expected).max() <= 2, expected
+
+
+def test_the_gradient_sky_at_the_top_is_the_pale_blue_of_before(renderer, valley):
+    scene = dataclasses.replace(valley, lighting=dataclasses.replace(valley.lighting, air=Air(sky="gradient")))
+    r, g, b = renderer.render(scene, time_of_day=15.5, settings=FULL_3D)[0][0, WIDTH // 2].astype(int)
     assert b > g > r and b > 150
 
 

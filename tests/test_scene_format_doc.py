@@ -9,7 +9,7 @@ from cloudcore.scenefile import TABLE_KEYS
 
 DOC = Path(__file__).resolve().parents[1] / "docs" / "scene-format.md"
 #: tables documented inside another's section, or under a heading other than their TOML name
-SECTION_OF = {"": "Top level", "lighting.lights": "`[lighting]`"}
+SECTION_OF = {"": "Top level", "lighting.lights": "`[lighting]`", "lighting.air": "`[lighting]`"}
 
 
 def sections(text: str) -> dict[str, str]:

@@ -4,6 +4,7 @@ import os
 import subprocess
 import sys
 import tomllib
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -11,7 +12,7 @@ from conftest import VALLEY
 
 import cloudcore.scenefile as scenefile
 from cloudcore.errors import SceneError
-from cloudcore.scene import MAX_LAYERS, MAX_RINGS, Scene, Shading
+from cloudcore.scene import MAX_LAYERS, MAX_RINGS, Air, Scene, Shading
 from cloudcore.scenefile import load_scene, save_scene, scene_to_dict
 
 
@@ -71,6 +72,41 @@ MALFORMED = [
     ("time_of_day = 14.0", "time_of_day = 25.0", "lighting.time_of_day", "within"),
     ("time_of_day = 14.0", 'time_of_day = "noon"', "lighting.time_of_day", "expected a number"),
     ("time_of_day = 14.0", "time_of_day = inf", "lighting.time_of_day", "finite"),
+    # the air (docs/atmosphere.md)
+    ("time_of_day = 14.0", 'time_of_day = 14.0\nair = { sky = "blue" }', "lighting.air.sky", "physical"),
+    (
+        "time_of_day = 14.0",
+        "time_of_day = 14.0\nair = { mie_density_scale = 101.0 }",
+        "lighting.air.mie_density_scale",
+        "within [0.0, 100.0]",
+    ),
+    (
+        "time_of_day = 14.0",
+        "time_of_day = 14.0\nair = { mie_density_scale = -1.0 }",
+        "lighting.air.mie_density_scale",
+        "within",
+    ),
+    (
+        "time_of_day = 14.0",
+        "time_of_day = 14.0\nair = { ground_albedo = 1.5 }",
+        "lighting.air.ground_albedo",
+        "within [0.0, 1.0]",
+    ),
+    ("time_of_day = 14.0", "time_of_day = 14.0\nair = { ground_albedo = nan }", "lighting.air.ground_albedo", "finite"),
+    (
+        "time_of_day = 14.0",
+        "time_of_day = 14.0\nair = { origin_altitude_m = -10.0 }",
+        "lighting.air.origin_altitude_m",
+        "within [0.0, 50000.0]",
+    ),
+    (
+        "time_of_day = 14.0",
+        "time_of_day = 14.0\nair = { origin_altitude_m = 60000.0 }",
+        "lighting.air.origin_altitude_m",
+        "within",
+    ),
+    ("time_of_day = 14.0", "time_of_day = 14.0\nair = { turbidity = 2.0 }", "lighting.air.turbidity", "unknown key"),
+    ("time_of_day = 14.0", "time_of_day = 14.0\nair = 3", "lighting.air", "expected a table"),
     ("[lighting]", '[shading]\nphase = "mie"\n[lighting]', "shading.phase", "rayleigh"),
     ("[lighting]", "[shading]\ng = 1.0\n[lighting]", "shading.g", "within"),
     ("[lighting]", "[shading]\noptical_depth = -8.0\n[lighting]", "shading.optical_depth", "within"),
@@ -287,6 +323,15 @@ def test_failed_save_leaves_the_previous_file_intact(tmp_path, small_scene, monk
         save_scene(small_scene, path)
     assert path.read_bytes() == before
     assert [p.name for p in tmp_path.iterdir() if p.suffix == ".tmp"] == []
+
+
+def test_the_air_round_trips_and_a_file_without_it_gets_the_physical_sky(tmp_path, small_scene):
+    assert small_scene.lighting.air == Air() and Air().sky == "physical"
+    air = Air(sky="gradient", mie_density_scale=3.0, ground_albedo=0.1, origin_altitude_m=1500.0)
+    scene = replace(small_scene, lighting=replace(small_scene.lighting, air=air))
+    save_scene(scene, tmp_path / "air.toml")
+    assert load_scene(tmp_path / "air.toml").lighting.air == air
+    assert "air" not in scene_to_dict(small_scene)["lighting"]  # files of the default air stay as they were
 
 
 def test_saved_document_is_plain_toml(tmp_path, small_scene):

@@ -53,7 +53,9 @@ from cloudcore.gl.volume_blending import GpuFeatures, VolumeBlendingPass
 from cloudcore.gl.world import WorldPass
 from cloudcore.light.eye_scattering import ParticleBuffer
 from cloudcore.light.illumination import IlluminationCache
-from cloudcore.light.lighting import scene_lights, sky_colors
+from cloudcore.light.lighting import scene_lights
+from cloudcore.light.relighting import PREVIEW_METHOD
+from cloudcore.light.sky_background import scene_sky
 from cloudcore.light.volume_blending import blending_path
 from cloudcore.lod.costs import CostEstimator, CostModel, remember_fit, remembered_prior
 from cloudcore.lod.impostors import cropped_corners, particle_extent
@@ -66,7 +68,6 @@ from cloudcore.measured_way import COMPOSITING_WAYS, MeasuredWay
 from cloudcore.scene import Camera, Lighting, Scene
 from cloudcore.settings import FULL_3D, RenderSettings
 from cloudcore.splat_coverage import analytic_overdraw
-from cloudcore.sun import scene_hour
 
 
 @dataclass(frozen=True)
@@ -372,12 +373,14 @@ class FrameRenderer:
     def _prepare(self, scene: Scene, lighting: Lighting, illumination_method: str) -> float:
         """Rebuild the world pass and the particle illumination where their inputs changed; ms spent shading."""
         lights, ambient = scene_lights(lighting)
-        world_source = (scene.terrain, lighting)
+        # a dragged slider's look (the editor's preview) draws the coarse sky, as its clouds are a coarse raster
+        preview = illumination_method == PREVIEW_METHOD
+        world_source = (scene.terrain, lighting, preview)
         if world_source != self._world_source:
             self.context.make_current()
             if self._world is not None:
                 self._world.close()
-            self._world = WorldPass(scene.terrain, lights, ambient, *sky_colors(scene_hour(lighting)))
+            self._world = WorldPass(scene.terrain, lights, ambient, scene_sky(lighting, preview))
             self._world_source = world_source
         objects_source = (scene.objects, lights, tuple(ambient), self.size)
         if objects_source != self._objects_source:

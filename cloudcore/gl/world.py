@@ -15,12 +15,15 @@ import numpy as np
 import trimesh
 from OpenGL import GL
 
+from cloudcore.atmosphere.geometry import horizon_cosine
+from cloudcore.atmosphere.sky_view import eye_radius, horizon_angles
 from cloudcore.camera import FAR_PLANE_M, NEAR_PLANE_M, camera_pose
 from cloudcore.colour import srgb_encode
 from cloudcore.gl.context import HeadlessContext
 from cloudcore.gl.programs import build_program, set_matrix, set_vec3
 from cloudcore.gl.pyrender_compat import pyrender
 from cloudcore.light.lighting import active_lights
+from cloudcore.light.sky_background import SkyBackground
 from cloudcore.limits import DRAWN_TERRAIN_KINDS
 from cloudcore.scene import Camera, Terrain
 from cloudcore.terrain import heightfield_mesh
@@ -46,10 +49,10 @@ def terrain_vertex_colours(normals, base_colour, lights, ambient) -> np.ndarray:
 class WorldPass:
     """Terrain and sky for one terrain and one lighting; rebuild it when either changes."""
 
-    def __init__(self, terrain: Terrain | None, lights, ambient, sky_zenith, sky_horizon):
-        self._sky_zenith = np.asarray(sky_zenith, dtype=np.float64)
-        self._sky_horizon = np.asarray(sky_horizon, dtype=np.float64)
+    def __init__(self, terrain: Terrain | None, lights, ambient, sky: SkyBackground):
+        self._sky = sky
         self._composite_program = build_program("world")
+        self._sky_view_texture = _sky_view_texture(sky) if sky.physical else None
         # core profile draws nothing without a vertex array, even one with no attributes
         self._fullscreen_vertex_array = GL.glGenVertexArrays(1)
         self._scene = None
@@ -91,8 +94,7 @@ class WorldPass:
         GL.glBindTexture(GL.GL_TEXTURE_2D, context.world_texture)
         GL.glUniform1i(GL.glGetUniformLocation(program, "world_texture"), 0)
         set_matrix(program, "inverse_view_projection", np.linalg.inv(view_projection))
-        set_vec3(program, "zenith_colour", self._sky_zenith)
-        set_vec3(program, "horizon_colour", self._sky_horizon)
+        self._set_sky_uniforms(program, camera)
         GL.glDisable(GL.GL_BLEND)
         GL.glDisable(GL.GL_CULL_FACE)
         GL.glDisable(GL.GL_DEPTH_TEST)  # colour everywhere; the depth pyrender wrote stays
@@ -100,7 +102,57 @@ class WorldPass:
         GL.glDrawArrays(GL.GL_TRIANGLES, 0, 3)
         GL.glBindVertexArray(0)
 
+    def _set_sky_uniforms(self, program: int, camera: Camera) -> None:
+        sky = self._sky
+        GL.glUniform1i(GL.glGetUniformLocation(program, "physical_sky"), int(sky.physical))
+        if not sky.physical:
+            set_vec3(program, "zenith_colour", sky.zenith)
+            set_vec3(program, "horizon_colour", sky.horizon)
+            return
+        params = sky.view.tables.params
+        r = eye_radius(params, sky.view.altitude_m)
+        _, zenith_horizon = horizon_angles(params, r)
+        GL.glActiveTexture(GL.GL_TEXTURE1)
+        GL.glBindTexture(GL.GL_TEXTURE_2D, self._sky_view_texture)
+        GL.glUniform1i(GL.glGetUniformLocation(program, "sky_view_table"), 1)
+        height, width = sky.view.table.shape[:2]
+        GL.glUniform2f(GL.glGetUniformLocation(program, "sky_view_size"), float(width), float(height))
+        GL.glUniform1f(GL.glGetUniformLocation(program, "zenith_horizon_angle"), float(zenith_horizon))
+        GL.glUniform1f(
+            GL.glGetUniformLocation(program, "horizon_cosine"), float(horizon_cosine(r, params.bottom_radius_m))
+        )
+        set_vec3(program, "sun_direction", sky.view.sun_direction)
+        set_vec3(program, "sun_disc_scale", sky.sun_disc_scale())
+        viewport_height = int(GL.glGetIntegerv(GL.GL_VIEWPORT)[3])
+        GL.glUniform1f(
+            GL.glGetUniformLocation(program, "pixel_angle"),
+            float(np.radians(camera.fov_y_deg) / max(viewport_height, 1)),
+        )
+        GL.glActiveTexture(GL.GL_TEXTURE0)
+
     def close(self) -> None:
         """Free the GL objects (the context must be current); pyrender frees the mesh with its context."""
+        if self._sky_view_texture is not None:
+            GL.glDeleteTextures([self._sky_view_texture])
         GL.glDeleteProgram(self._composite_program)
         GL.glDeleteVertexArrays(1, [self._fullscreen_vertex_array])
+
+
+def _sky_view_texture(sky: SkyBackground) -> int:
+    """The sky-view table in the renderer's values as a float texture, sampled linearly and clamped to its edge
+    texels as `cloudcore.atmosphere.table_sampling` reads it."""
+    texture = GL.glGenTextures(1)
+    GL.glBindTexture(GL.GL_TEXTURE_2D, texture)
+    for parameter, value in (
+        (GL.GL_TEXTURE_MIN_FILTER, GL.GL_LINEAR),
+        (GL.GL_TEXTURE_MAG_FILTER, GL.GL_LINEAR),
+        (GL.GL_TEXTURE_WRAP_S, GL.GL_CLAMP_TO_EDGE),
+        (GL.GL_TEXTURE_WRAP_T, GL.GL_CLAMP_TO_EDGE),
+    ):
+        GL.glTexParameteri(GL.GL_TEXTURE_2D, parameter, value)
+    # row 0 of the table is v's first texel: GL's first row, so the shader reads it with the numpy side's (u, v)
+    pixels = np.ascontiguousarray(sky.table(), dtype=np.float32)
+    height, width = pixels.shape[:2]
+    GL.glTexImage2D(GL.GL_TEXTURE_2D, 0, GL.GL_RGB32F, width, height, 0, GL.GL_RGB, GL.GL_FLOAT, pixels)
+    GL.glBindTexture(GL.GL_TEXTURE_2D, 0)
+    return texture

@@ -15,7 +15,8 @@ scene's.
 The light is the model's: the sun and the skylight as directional emitters with the irradiance the
 model gives them, and the ambient term as a constant environment of that radiance (a cloud of albedo 1
 in it returns exactly the model's ambient * (1 - T)).  The emitters are hidden from camera rays; the
-background, the sky gradient the renderer draws (terrain left out), is added behind the clouds with
+background, the sky the renderer draws (`cloudcore.light.sky_background`: the atmosphere's with the sun's disc,
+or the gradient; terrain left out), is added behind the clouds with
 their transmittance T, computed here by marching the same grid.  Mitsuba is imported only inside the
 functions that need it (`cloudview[truth]`), so importing this module never needs it.
 """
@@ -30,12 +31,12 @@ import numpy as np
 
 from cloudcore.camera import FAR_PLANE_M, NEAR_PLANE_M, camera_pose, pixel_rays
 from cloudcore.light.illumination import cloud_optics
-from cloudcore.light.lighting import active_lights, scene_lights, sky_colors, sky_gradient
+from cloudcore.light.lighting import active_lights, scene_lights
 from cloudcore.light.phase import phase_function
+from cloudcore.light.sky_background import scene_sky
 from cloudcore.scene import Camera, Scene
 from cloudcore.segments import concatenated_ranges
 from cloudcore.splat_kernel import KERNEL_DIAMETER_INTEGRAL, splat_kernel
-from cloudcore.sun import scene_hour
 
 #: voxels across the scene's median particle radius: the line integral through a particle's centre is
 #: within 1% of its tau at 3 (tests/test_truth.py); the default scene then has about 10 million voxels
@@ -489,7 +490,7 @@ def render_truth(
     eye = np.broadcast_to(np.asarray(camera.position, dtype=np.float64), rays.shape)
     view_depth, unit_distance = optical_depths(grids, eye, rays)
     transmittance = np.exp(-view_depth).reshape(height, width)
-    sky = sky_gradient(rays, *sky_colors(scene_hour(lighting))).reshape(height, width, 3)
+    sky = scene_sky(lighting).radiance(rays, np.radians(camera.fov_y_deg) / height).reshape(height, width, 3)
     radiance = np.nan_to_num(radiance, nan=0.0, posinf=0.0, neginf=0.0)
     return Truth(
         linear=radiance + transmittance[..., None] * sky,

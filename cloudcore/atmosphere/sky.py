@@ -1,0 +1,131 @@
+"""What the renderer asks of the air: the tables for its parameters (cached on disk), the sky seen from an
+altitude, the sun's light where it reaches that altitude, and the sky's irradiance on an upward surface.
+
+Radiances and irradiances are per unit of the sun's irradiance at the top of the air.  World directions
+are y up; the scene's origin stands at `altitude_m` on the planet, and the sky is the one seen from there.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from cloudcore import disk_cache
+from cloudcore.atmosphere import multiple_scattering, sky_view, transmittance
+from cloudcore.atmosphere.geometry import distance_to_top, horizon_cosine
+from cloudcore.atmosphere.parameters import AtmosphereParameters
+from cloudcore.atmosphere.scattering import in_scattering
+from cloudcore.atmosphere.sun_disc import visible_fraction
+
+#: the disk cache's name for the transmittance and multiple-scattering tables (`cloudcore.disk_cache`)
+CACHE_KIND = "atmosphere"
+#: bump when what the tables hold or how they are computed changes: older cache entries are rebuilt
+FORMAT_VERSION = 2
+
+
+@dataclass(frozen=True, eq=False)
+class AtmosphereTables:
+    """The tables that depend on the air alone."""
+
+    params: AtmosphereParameters
+    transmittance: np.ndarray  # (64, 256, 3)
+    multiple_scattering: np.ndarray  # (32, 32, 3)
+    #: seconds the build took (0 when read from the cache), and whether it was read from the cache
+    build_s: float = 0.0
+    cached: bool = False
+
+
+def cache_key(params: AtmosphereParameters) -> dict:
+    """Every parameter the tables depend on, as the disk cache keys them."""
+    return {
+        "format": FORMAT_VERSION,
+        "params": dataclasses.asdict(params),
+        "transmittance": [transmittance.TRANSMITTANCE_TABLE_SIZE, transmittance.TRANSMITTANCE_SAMPLES],
+        "multiple_scattering": [
+            multiple_scattering.MULTIPLE_SCATTERING_TABLE_SIZE,
+            multiple_scattering.SQRT_DIRECTIONS,
+            multiple_scattering.MULTIPLE_SCATTERING_SAMPLES,
+        ],
+    }
+
+
+def build_tables(params: AtmosphereParameters) -> dict[str, np.ndarray]:
+    """The tables' arrays, computed (a quarter of a second on two cores: `atmosphere_tables` caches them)."""
+    transmittance_table = transmittance.build_transmittance_table(params)
+    return {
+        "transmittance": transmittance_table,
+        "multiple_scattering": multiple_scattering.build_multiple_scattering_table(params, transmittance_table),
+    }
+
+
+@functools.lru_cache(maxsize=8)
+def atmosphere_tables(params: AtmosphereParameters) -> AtmosphereTables:
+    """The tables of `params`: from memory, from the disk cache (shipped for the default air), or built."""
+    start = time.perf_counter()
+    arrays, cached = disk_cache.load_or_build(CACHE_KIND, cache_key(params), lambda: build_tables(params))
+    return AtmosphereTables(params, **arrays, build_s=0.0 if cached else time.perf_counter() - start, cached=cached)
+
+
+@dataclass(frozen=True, eq=False)
+class SkyView:
+    """The sky seen from one altitude under one sun: its sky-view table and the lookup into it."""
+
+    tables: AtmosphereTables
+    altitude_m: float
+    sun_direction: np.ndarray  # (3,) unit, toward the sun
+    table: np.ndarray  # (108, 192, 3)
+
+    def radiance(self, directions) -> np.ndarray:
+        """(..., 3): the sky's radiance along unit `directions` (..., 3), the ground's below the horizon."""
+        return sky_view.sky_view_lookup(self.tables.params, self.table, self.altitude_m, directions, self.sun_direction)
+
+
+def sky_seen_from(params: AtmosphereParameters, altitude_m: float, sun_direction, preview: bool = False) -> SkyView:
+    """The sky of `params` from `altitude_m` with the sun toward unit `sun_direction` (y up), its table coarser
+    for a `preview`; the last few are kept in memory, since a scene asks for its sky again whenever its light
+    is remade."""
+    return _sky_view(params, float(altitude_m), tuple(float(c) for c in sun_direction), preview)
+
+
+@functools.lru_cache(maxsize=16)
+def _sky_view(params: AtmosphereParameters, altitude_m: float, sun_direction: tuple, preview: bool) -> SkyView:
+    tables = atmosphere_tables(params)
+    sun = np.asarray(sun_direction, dtype=np.float64)
+    table = sky_view.build_sky_view_table(
+        params, tables.transmittance, tables.multiple_scattering, altitude_m, float(sun[1]), preview
+    )
+    return SkyView(tables, altitude_m, sun, table)
+
+
+def sky_irradiance(tables: AtmosphereTables, altitude_m: float, sun_direction, rings: int = 16, sectors: int = 16):
+    """(3,): the irradiance the sky gives a horizontal surface facing up at `altitude_m`, the sun's direct beam
+    left out: the in-scattered radiance of rays over the upper hemisphere (the midpoints of `rings` in the cosine
+    and `sectors` of the azimuth on one side of the sun's vertical plane, the sky being symmetric about it),
+    weighted by the cosine.  Marched directly, not read from a sky-view table: the lights need these 256 rays,
+    not the table's 20,736."""
+    params = tables.params
+    r = sky_view.eye_radius(params, altitude_m)
+    mu = ((np.arange(rings) + 0.5) / rings)[:, None]
+    azimuth = (np.pi * (np.arange(sectors) + 0.5) / sectors)[None, :]
+    sun = np.asarray(sun_direction, dtype=np.float64)
+    mu_s = float(np.clip(sun[1], -1.0, 1.0))
+    nu = mu * mu_s + np.sqrt(1.0 - mu * mu) * np.sqrt(1.0 - mu_s * mu_s) * np.cos(azimuth)
+    distance = distance_to_top(r, mu, params.top_radius_m)
+    radiance, _ = in_scattering(
+        params, tables.transmittance, tables.multiple_scattering, r, mu, mu_s, nu, distance, sky_view.SKY_VIEW_SAMPLES
+    )
+    return np.einsum("rsc,rs->c", radiance, np.broadcast_to(mu, nu.shape)) * (1.0 / rings) * (2.0 * np.pi / sectors)
+
+
+def sun_transmittance(tables: AtmosphereTables, altitude_m: float, sun_direction) -> np.ndarray:
+    """(3,): the share of the sun's irradiance that reaches `altitude_m`: the air's transmittance toward it
+    times the share of its disc above the horizon (so it sets smoothly, and is 0 once it has set)."""
+    params = tables.params
+    r = sky_view.eye_radius(params, altitude_m)
+    sun_cosine = float(np.clip(np.asarray(sun_direction, dtype=np.float64)[1], -1.0, 1.0))
+    through_air = transmittance.transmittance_to_top(params, tables.transmittance, r, sun_cosine)
+    return through_air * visible_fraction(sun_cosine, horizon_cosine(r, params.bottom_radius_m))

@@ -1,0 +1,107 @@
+"""The sky behind everything, in the renderer's linear values: the two-colour gradient of before, or the
+atmosphere's sky (its sky-view table) with the sun's disc, limb darkened, its radiance the beam that reaches
+the scene.  The world pass draws the same (gl/shaders/world.frag.glsl, `sky`); the path-traced truth
+composites this one behind its clouds.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from cloudcore.atmosphere.geometry import horizon_cosine, ray_hits_ground
+from cloudcore.atmosphere.sky import SkyView
+from cloudcore.atmosphere.sky_view import eye_radius
+from cloudcore.atmosphere.sun_disc import disc_radiance
+from cloudcore.light.lighting import (
+    NIGHT_AMBIENT,
+    PHYSICAL_EXPOSURE,
+    physical_sky,
+    physical_sun,
+    sky_colors,
+    sky_gradient,
+)
+from cloudcore.scene import Lighting
+from cloudcore.sun import scene_hour
+
+#: the brightest the sun's disc is drawn, in the renderer's linear values (its physical peak is about 4e4): the
+#: 16-bit float targets' blending rounds a cloud's 1 - alpha to 2^-11, so a brighter disc would show through
+#: an opaque cloud (32 * 2^-11 = 1.6% of white at most); it is still far past what 8 bits can show
+SUN_DISC_PEAK = 32.0
+#: how far above the ray grazing the planet the sky at and below the horizon is looked up (a cosine): a row of
+#: the sky-view table above the ground's half, which filtering would otherwise blend in
+HORIZON_MARGIN = 1e-3
+
+
+def over_the_horizon(directions, horizon: float) -> np.ndarray:
+    """Unit `directions` (..., 3) raised to just over the `horizon` (the cosine to the up of the ray grazing the
+    planet), each keeping its azimuth.  Below the horizon the terrain stands for the planet's ground: where it
+    does not reach (past the world's edge), the air at the horizon is drawn, as a far terrain would fade into
+    it, not the table's grey ground of one albedo (world.frag.glsl does the same)."""
+    directions = np.asarray(directions, dtype=np.float64)
+    up = horizon + HORIZON_MARGIN
+    across = np.linalg.norm(directions[..., [0, 2]], axis=-1, keepdims=True)
+    scale = np.sqrt(1.0 - up * up) / np.maximum(across, 1e-300)
+    level = np.where(across > 1e-12, directions[..., [0, 2]] * scale, [np.sqrt(1.0 - up * up), 0.0])
+    return np.stack([level[..., 0], np.full(directions.shape[:-1], up), level[..., 1]], axis=-1)
+
+
+#: the night's sky under the moon and the stars, which the atmosphere (the sun's light alone) leaves black: the
+#: gradient's night zenith, as the ambient keeps its night floor (`lighting.NIGHT_AMBIENT`)
+NIGHT_SKY = 0.8 * NIGHT_AMBIENT
+
+
+@dataclass(frozen=True, eq=False)
+class SkyBackground:
+    """The gradient's (zenith, horizon) colours, or the physical sky: its view and the sun's light."""
+
+    zenith: np.ndarray | None = None
+    horizon: np.ndarray | None = None
+    view: SkyView | None = None
+    #: (3,) the sun's irradiance reaching the scene, renderer values (`lighting.physical_sun`)
+    sun_irradiance: np.ndarray | None = None
+
+    @property
+    def physical(self) -> bool:
+        return self.view is not None
+
+    def table(self) -> np.ndarray:
+        """(height, width, 3): the sky-view table in the renderer's values, the night's sky under it."""
+        return np.pi * PHYSICAL_EXPOSURE * self.view.table + NIGHT_SKY
+
+    def sun_disc_scale(self) -> np.ndarray:
+        """(3,): the disc's colour per unit of `disc_radiance`, lowered as a whole where its centre would pass
+        SUN_DISC_PEAK."""
+        scale = np.pi * self.sun_irradiance
+        peak = float(scale.max()) * float(disc_radiance(0.0, 1.0))
+        return scale * min(1.0, SUN_DISC_PEAK / peak) if peak > 0.0 else scale
+
+    def radiance(self, directions, pixel_angle: float) -> np.ndarray:
+        """(..., 3): the sky along unit `directions` (..., 3), the sun's disc with its rim spread over
+        `pixel_angle` (radians, a pixel's side)."""
+        directions = np.asarray(directions, dtype=np.float64)
+        if not self.physical:
+            return sky_gradient(directions, self.zenith, self.horizon)
+        params = self.view.tables.params
+        r = eye_radius(params, self.view.altitude_m)
+        above = ~ray_hits_ground(r, directions[..., 1], params.bottom_radius_m)
+        horizon = float(horizon_cosine(r, params.bottom_radius_m))
+        low = directions[..., 1:2] < horizon + HORIZON_MARGIN
+        seen = np.where(low, over_the_horizon(directions, horizon), directions)
+        sky = np.pi * PHYSICAL_EXPOSURE * self.view.radiance(seen) + NIGHT_SKY
+        # the angle from the sun's centre by its chord, exact near 0 where acos is not
+        chord = np.linalg.norm(directions - self.view.sun_direction, axis=-1)
+        angle = 2.0 * np.arcsin(np.clip(0.5 * chord, 0.0, 1.0))
+        disc = (above * disc_radiance(angle, pixel_angle))[..., None] * self.sun_disc_scale()
+        return sky + disc
+
+
+def scene_sky(lighting: Lighting, preview: bool = False) -> SkyBackground:
+    """The sky a scene's lighting draws; the physical one's table coarser for a `preview` (a dragged slider)."""
+    hours = scene_hour(lighting)
+    if lighting.air.sky == "physical":
+        return SkyBackground(
+            view=physical_sky(hours, lighting.air, preview), sun_irradiance=physical_sun(hours, lighting.air)
+        )
+    return SkyBackground(*sky_colors(hours))
