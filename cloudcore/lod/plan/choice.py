@@ -64,28 +64,8 @@ def cheapest(held: str | None, prices: dict) -> str:
     return cheapest
 
 
-def represent(
-    previous: Representation | None, full_ms: float, impostor_ms: float, transition_frames: int, close: dict
-) -> Representation:
-    """Auto mode's next step for a unit: aim at the cheaper representation (by `SWITCH_MARGIN` against the
-    one aimed at already), and move the full-3D weight one transition step toward it.
-
-    A unit seen for the first time starts at its target: there is nothing on screen to pop from; nor
-    does a switch to a representation that `close` says shows the same picture within half the
-    tolerance: it is made at once, and only a switch that would show a step crossfades.
-    """
-    prices = {"full": full_ms, "impostor": impostor_ms}
-    if previous is None:
-        cheaper = cheapest(None, prices)
-        return Representation(cheaper, 1.0 if cheaper == "full" else 0.0)
-    if previous.target == "inside":  # the eye has left the unit: its particles were on screen
-        previous = Representation("full", 1.0)
-    target = cheapest(previous.target, prices)
-    if target != previous.target and close[target] and previous.full_weight in (0.0, 1.0):
-        return Representation(target, 1.0 if target == "full" else 0.0)
-    step = 1.0 / transition_frames
-    weight = min(1.0, previous.full_weight + step) if target == "full" else max(0.0, previous.full_weight - step)
-    return Representation(target, weight)
+#: `represent_units`' codes for a representation's target
+_NONE, _FULL, _IMPOSTOR = -1, 0, 1
 
 
 def represent_units(
@@ -100,31 +80,60 @@ def represent_units(
     all_full: bool,
     settings,
 ) -> tuple[np.ndarray, dict, list]:
-    """Auto mode's step (`represent`) for each unit at `rows` (at `distances`) that it prices on its own (`priced`,
-    a mask of the rows; the others, fading into or out of the ring, are impostors: weight 0) by `prices` (a
+    """Auto mode's next step for each unit at `rows` (at `distances`) that it prices on its own (`priced`, a
+    mask of the rows; the others, fading into or out of the ring, are impostors: weight 0) by `prices` (a
     `RepresentationPrices`): (their full-3D weights, their representations by members, their (index, distance,
     full ms, impostor ms)).  `previous`: the representations of the last frame; `held_errors`: of the impostors
-    held, per row; `all_full`: the frame heads all to full 3D (`next_frame_choice`)."""
+    held, per row; `all_full`: the frame heads all to full 3D (`next_frame_choice`).
+
+    Each unit aims at the cheaper representation (`cheapest`: by `SWITCH_MARGIN` against the one aimed at
+    already) and moves its full-3D weight one transition step toward it.  A unit seen for the first time starts
+    at its target: there is nothing on screen to pop from; nor does a switch to a representation that shows the
+    same picture within half the tolerance (an impostor within half its tolerance of full 3D, or one remade from
+    this very eye): it is made at once, and only a switch that would show a step crossfades.
+    """
     weights = np.zeros(len(rows))
-    chosen, prices_of = {}, []
+    at = np.flatnonzero(priced)
+    units = [members[int(rows[row])] for row in at.tolist()]
+    held = [previous.get(unit) for unit in units]
+    # the eye has left a unit it was inside: its particles were on screen, as full 3D's
+    was = np.array(
+        [_NONE if h is None else _IMPOSTOR if h.target == "impostor" else _FULL for h in held], dtype=np.int64
+    )
+    was_weight = np.array([0.0 if h is None else 1.0 if h.target == "inside" else h.full_weight for h in held])
+    full_ms, impostor_ms = prices.full_ms[at], np.full(len(at), math.inf) if all_full else prices.impostor_ms[at]
+    keep = 1.0 - SWITCH_MARGIN
+    target = np.where(
+        was == _NONE,
+        np.where(full_ms <= impostor_ms, _FULL, _IMPOSTOR),
+        np.where(
+            was == _FULL,
+            np.where(impostor_ms < keep * full_ms, _IMPOSTOR, _FULL),
+            np.where(full_ms < keep * impostor_ms, _FULL, _IMPOSTOR),
+        ),
+    )
     budgeted = bool(settings.regeneration_budget or settings.frame_budget_ms)
-    # an impostor within half its tolerance of the picture full 3D gives, or one remade from this very eye, differs
-    # from it by less than a regeneration's own step: the switch needs no crossfade
-    close_impostor = ((held_errors <= 0.5 * tolerance) | ((held_errors > tolerance) & (not budgeted))).tolist()
-    close_full = (held_errors <= 0.5 * tolerance).tolist()
-    full_ms, impostor_ms, distances = prices.full_ms.tolist(), prices.impostor_ms.tolist(), distances.tolist()
-    for row in np.flatnonzero(priced).tolist():
-        index = int(rows[row])
-        representation = represent(
-            previous.get(members[index]),
-            full_ms[row],
-            math.inf if all_full else impostor_ms[row],
-            settings.transition_frames,
-            {"impostor": close_impostor[row], "full": close_full[row]},
+    errors = held_errors[at]
+    close = np.where(
+        target == _FULL,
+        errors <= 0.5 * tolerance,
+        (errors <= 0.5 * tolerance) | ((errors > tolerance) & (not budgeted)),
+    )
+    at_once = (was == _NONE) | ((target != was) & close & ((was_weight == 0.0) | (was_weight == 1.0)))
+    step = 1.0 / settings.transition_frames
+    stepped = np.where(target == _FULL, np.minimum(1.0, was_weight + step), np.maximum(0.0, was_weight - step))
+    weight = np.where(at_once, np.where(target == _FULL, 1.0, 0.0), stepped)
+    weights[at] = weight
+    names = np.where(target == _FULL, "full", "impostor").tolist()
+    chosen = {unit: Representation(name, w) for unit, name, w in zip(units, names, weight.tolist())}
+    prices_of = list(
+        zip(
+            rows[at].tolist(),
+            distances[at].tolist(),
+            prices.full_ms[at].tolist(),
+            prices.impostor_ms[at].tolist(),
         )
-        prices_of.append((index, distances[row], full_ms[row], impostor_ms[row]))
-        chosen[members[index]] = representation
-        weights[row] = representation.full_weight
+    )
     return weights, chosen, prices_of
 
 
