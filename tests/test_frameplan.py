@@ -12,7 +12,7 @@ from cloudcore.lod.costs import CostModel, Work
 from cloudcore.lod.impostors import content_depth, impostor_view, parallax_error_deg, translation_error_deg
 from cloudcore.lod.plan import FRAME_SETTLE_FRAMES, PROBE_FRAMES, SWITCH_MARGIN, LodState, inside_runs, plan_frame
 from cloudcore.lod.plan.pricing import in_view_work
-from cloudcore.lod.plan.state import RING_PRICE_FRAMES, RING_PRICE_TURN_DEG
+from cloudcore.lod.plan.state import RING_PRICE_FRAMES, RING_PRICE_TURN_DEG, FrameTime
 from cloudcore.lod.ring import SEGMENTS, RingState
 from cloudcore.lod.units import LodUnits, SplatSample
 from cloudcore.scene import Camera
@@ -1031,22 +1031,26 @@ RING_AFFORDABLE = CostModel(particles=5e-4, fragments=1e-9, texture_fragments=1e
 
 
 @pytest.mark.parametrize(
-    "mode, across_m, costs, rebuilds",
+    "mode, across_m, costs, measured_ms, rebuilds",
     [
-        ("auto", 300.0, RING_AFFORDABLE, False),
-        ("auto", 500.0, RING_AFFORDABLE, True),
-        ("impostor", 500.0, RING_AFFORDABLE, False),
-        ("auto", 500.0, regeneration_heavy(200.0), False),  # 2.6 s a rebuild: 160 ms a frame to keep it so
+        ("auto", 300.0, RING_AFFORDABLE, None, False),
+        ("auto", 500.0, RING_AFFORDABLE, None, True),
+        ("impostor", 500.0, RING_AFFORDABLE, None, False),
+        ("auto", 500.0, regeneration_heavy(200.0), None, False),  # 2.6 s a rebuild: 160 ms a frame to keep it so
+        # frames measured at 200 ms: the 7 ms a frame within RING_CHASE_SHARE of them; at 20 ms, past it
+        ("auto", 500.0, RING_AFFORDABLE, 200.0, True),
+        ("auto", 500.0, RING_AFFORDABLE, 20.0, False),
     ],
 )
 def test_auto_mode_rebuilds_a_ring_whose_clouds_passed_the_tolerance_where_it_can_afford_to(
-    mode, across_m, costs, rebuilds
+    mode, across_m, costs, measured_ms, rebuilds
 ):
     """Wang's panels are impostors: in auto mode a ring cloud's parallax past the tolerance (0.5 degrees: about
     390 m across for these clouds, 3 km off) rebuilds the ring, short of the ring's own rebuild distance (90% of
-    the radius here), where that costs at most `RING_FRAME_MS` a frame; impostor mode keeps Wang's rule alone,
-    and so does auto mode where keeping it within the tolerance would cost more, reporting the error it shows.
-    The eye moves 25 m a frame."""
+    the radius here), where that costs at most `RING_FRAME_MS` a frame and adds at most `RING_CHASE_SHARE` of
+    the frames measured (`measured_ms`, None: none yet) to Wang's rebuilds; impostor mode keeps Wang's rule
+    alone, and so does auto mode where keeping it within the tolerance would cost more, reporting the error it
+    shows.  The eye moves 25 m a frame."""
     settings = dataclasses.replace(RING, mode=mode, ring_rebuild_horizontal=0.9)
 
     def at(x: float, state: LodState):
@@ -1063,6 +1067,10 @@ def test_auto_mode_rebuilds_a_ring_whose_clouds_passed_the_tolerance_where_it_ca
     for _ in range(SETTLE):
         state = at(0.0, state).state
     assert state.ring.current is not None and state.ring.current.holds_clouds
+    if measured_ms is not None:  # and the frame all in full 3D measured ten times dearer: the units are drawn
+        measured = {"units": measured_ms, "full": 10.0 * measured_ms}
+        frame_times = {way: FrameTime(ms, 100, state.frame_index) for way, ms in measured.items()}
+        state = dataclasses.replace(state, frame_times=frame_times)
     started = []
     for x in np.arange(25.0, across_m + 1.0, 25.0):
         frame = at(x, state)
