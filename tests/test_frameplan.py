@@ -9,9 +9,15 @@ import pytest
 
 from cloudcore.camera import frustum_planes, projection_matrix, view_matrix
 from cloudcore.lod.costs import CostModel, Work
-from cloudcore.lod.impostors import content_depth, impostor_view, parallax_error_deg, translation_error_deg
+from cloudcore.lod.impostors import (
+    INSIDE_RADII,
+    content_depth,
+    impostor_view,
+    parallax_error_deg,
+    translation_error_deg,
+)
 from cloudcore.lod.plan import FRAME_SETTLE_FRAMES, PROBE_FRAMES, SWITCH_MARGIN, LodState, inside_runs, plan_frame
-from cloudcore.lod.plan.pricing import in_view_work
+from cloudcore.lod.plan.pricing import in_view_work, pricing_of, seen_from
 from cloudcore.lod.plan.state import RING_PRICE_FRAMES, RING_PRICE_TURN_DEG, FrameTime
 from cloudcore.lod.ring import SEGMENTS, RingState
 from cloudcore.lod.units import LodUnits, SplatSample
@@ -427,6 +433,16 @@ def test_the_eye_inside_a_cloud_gets_the_screen_impostor(position):
     assert cloud_plan.clouds[0].kind == "inside" and cloud_plan.clouds[0].full_weight == 1.0
     assert cloud_plan.inside_size == (160, 120)
     assert cloud_plan.clouds[0].regenerate is None  # a screen impostor is redrawn every frame, not cached
+
+
+def test_an_impostor_quad_past_the_screen_is_priced_as_the_screen():
+    """Just outside its sphere's inside band the eye sees a cloud's quad wider than the screen: it fills the screen."""
+    near = camera_at((0.0, 0.0, 1.1 * RADIUS), look_at=(0.0, 0.0, 0.0))
+    seen = seen_from(units_of(((0.0, 0.0, 0.0),), (RADIUS,)), pricing_of(near, VIEWPORT, NO_RING, LodState(), ()))
+    assert seen.distances[0] > INSIDE_RADII * RADIUS and seen.quad_pixels[0] == VIEWPORT[0] * VIEWPORT[1]
+    far = camera_at((0.0, 0.0, 20.0 * RADIUS), look_at=(0.0, 0.0, 0.0))
+    seen = seen_from(units_of(((0.0, 0.0, 0.0),), (RADIUS,)), pricing_of(far, VIEWPORT, NO_RING, LodState(), ()))
+    assert 0.0 < seen.quad_pixels[0] < 0.1 * VIEWPORT[0] * VIEWPORT[1]
 
 
 def test_units_the_eye_is_in_at_once_share_one_screen_impostor():

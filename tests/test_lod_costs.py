@@ -16,7 +16,6 @@ from cloudcore.lod.costs import (
     CostModel,
     Work,
     inverse_square_depth,
-    quad_work,
     regeneration_fragments,
     remember_fit,
     remembered_prior,
@@ -51,7 +50,6 @@ def test_remaking_an_impostor_costs_its_particles_and_a_fill_that_grows_with_the
     assert large == pytest.approx(16 * small)
     # one pixel-sized texture: each splat fills it at most
     assert regeneration_fragments(1000, 1000 * 25.0, 100.0, 101.0, 1e-300, 1) == pytest.approx(1000.0)
-    assert quad_work(1e5, 640 * 480).quad_pixels == 640 * 480  # a quad past the screen fills the screen
 
 
 def test_the_estimator_recovers_the_coefficients_that_made_the_times():

@@ -161,11 +161,6 @@ def regeneration_fragments(particles, radius_squares, radius, distance, quad_hal
     return splat_fragments(radius_squares, radius, distance, focal_texels, particles, size * size)
 
 
-def quad_work(side_px: float, screen_pixels: float) -> Work:
-    """An impostor quad of `side_px` on screen (at most the screen)."""
-    return Work(quad_pixels=min(side_px * side_px, screen_pixels), quads=1.0)
-
-
 #: how much the fitted coefficients remember of each frame: 0.97 is about the last 30 frames
 FORGETTING = 0.97
 #: weight of the prior, in squared milliseconds of evidence: a term worth 10 ms a frame outweighs it within

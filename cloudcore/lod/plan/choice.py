@@ -126,14 +126,7 @@ def represent_units(
     weights[at] = weight
     names = np.where(target == _FULL, "full", "impostor").tolist()
     chosen = {unit: Representation(name, w) for unit, name, w in zip(units, names, weight.tolist())}
-    prices_of = list(
-        zip(
-            rows[at].tolist(),
-            distances[at].tolist(),
-            prices.full_ms[at].tolist(),
-            prices.impostor_ms[at].tolist(),
-        )
-    )
+    prices_of = list(zip(rows[at].tolist(), distances[at].tolist(), full_ms.tolist(), prices.impostor_ms[at].tolist()))
     return weights, chosen, prices_of
 
 
