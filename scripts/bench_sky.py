@@ -30,6 +30,7 @@ from cloudcore.gl.frame import FrameRenderer  # noqa: E402
 from cloudcore.gl.world import WorldPass  # noqa: E402
 from cloudcore.light.lighting import atmosphere_parameters, scene_lights  # noqa: E402
 from cloudcore.light.sky_background import scene_sky  # noqa: E402
+from cloudcore.light.terrain_light import terrain_light  # noqa: E402
 from cloudcore.measure.benchmark import machine, write_report  # noqa: E402
 from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
 from cloudcore.scene import Air  # noqa: E402
@@ -81,13 +82,16 @@ def world_pass_ms(context, world, camera, repeat: int) -> list[float]:
 def world_costs(scene, width: int, height: int, repeat: int) -> dict:
     """The world pass's median time under each sky, drawn in turns in one context: with the scene's terrain, and
     without (the sky on every pixel: its whole cost)."""
-    lights, ambient = scene_lights(scene.lighting)
-    skies = {sky: scene_sky(dataclasses.replace(scene.lighting, air=Air(sky=sky))) for sky in ("gradient", "physical")}
+    lightings = {sky: dataclasses.replace(scene.lighting, air=Air(sky=sky)) for sky in ("gradient", "physical")}
+    skies = {sky: (lighting, scene_sky(lighting)) for sky, lighting in lightings.items()}
     row = {"size": f"{width}x{height}"}
     with FrameRenderer(width, height) as renderer:
         context = renderer.context
         for terrain, label in ((scene.terrain, "terrain_and_sky"), (None, "sky_alone")):
-            passes = {sky: WorldPass(terrain, lights, ambient, background) for sky, background in skies.items()}
+            passes = {
+                sky: WorldPass(terrain, terrain_light(lighting, *scene_lights(lighting)), background)
+                for sky, (lighting, background) in skies.items()
+            }
             times = {sky: [] for sky in passes}
             for _ in range(repeat):
                 for sky, world in passes.items():

@@ -56,6 +56,7 @@ from cloudcore.light.illumination import IlluminationCache
 from cloudcore.light.lighting import scene_lights
 from cloudcore.light.relighting import PREVIEW_METHOD
 from cloudcore.light.sky_background import scene_sky
+from cloudcore.light.terrain_light import terrain_light
 from cloudcore.light.volume_blending import blending_path
 from cloudcore.lod.costs import CostEstimator, CostModel, remember_fit, remembered_prior
 from cloudcore.lod.impostors import cropped_corners, particle_extent
@@ -380,7 +381,9 @@ class FrameRenderer:
             self.context.make_current()
             if self._world is not None:
                 self._world.close()
-            self._world = WorldPass(scene.terrain, lights, ambient, scene_sky(lighting, preview))
+            self._world = WorldPass(
+                scene.terrain, terrain_light(lighting, lights, ambient), scene_sky(lighting, preview)
+            )
             self._world_source = world_source
         objects_source = (scene.objects, lights, tuple(ambient), self.size)
         if objects_source != self._objects_source:

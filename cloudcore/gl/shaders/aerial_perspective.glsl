@@ -1,0 +1,28 @@
+// The air between the eye and a point: cloudcore/atmosphere/aerial_perspective.py's volume, read as its
+// volume_uvw and cloudcore/light/air_between.py's seen_through do (cloudcore/gl/air_volume.py binds it).
+uniform sampler3D air_in_scattered;   // the light added, the renderer's values
+uniform sampler3D air_transmittance;
+uniform vec3 air_sun_direction;
+uniform vec3 air_volume_size;         // (azimuth, cosine to the up, distance) texels
+uniform float air_max_distance;       // metres, the last slice's
+
+vec3 air_uvw(vec3 from_eye)
+{
+    float distance = length(from_eye);
+    vec3 direction = from_eye / max(distance, 1e-6);
+    float lengths = length(direction.xz) * length(air_sun_direction.xz);
+    float light_view_cosine = lengths > 1e-12 ? clamp(dot(direction.xz, air_sun_direction.xz) / lengths, -1.0, 1.0) : 1.0;
+    float azimuth = sqrt(clamp(0.5 - 0.5 * light_view_cosine, 0.0, 1.0));
+    float mu = clamp(direction.y, -1.0, 1.0);
+    float up = 0.5 + 0.5 * sign(mu) * sqrt(abs(mu));
+    float slice_position = sqrt(clamp(distance / air_max_distance, 0.0, 1.0));
+    // table_sampling.py's unit_to_sub_uv: the unit range onto the first to the last texel's centre
+    return (vec3(azimuth, up, slice_position) + 0.5 / air_volume_size) * (air_volume_size / (air_volume_size + 1.0));
+}
+
+// premultiplied `colour` of opacity `alpha` at `from_eye` (the point less the eye, metres) seen through the air
+vec3 seen_through_air(vec3 colour, float alpha, vec3 from_eye)
+{
+    vec3 uvw = air_uvw(from_eye);
+    return colour * texture(air_transmittance, uvw).rgb + alpha * texture(air_in_scattered, uvw).rgb;
+}
