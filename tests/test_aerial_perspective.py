@@ -2,9 +2,11 @@
 against the march it tables, what the air does to a surface with distance, the world pass against its numpy
 twin, and nothing but finite values at the extremes."""
 
+import dataclasses
+
 import numpy as np
 import pytest
-from conftest import RENDER_HEIGHT, RENDER_WIDTH
+from conftest import RENDER_HEIGHT, RENDER_WIDTH, VALLEY
 
 from cloudcore.atmosphere.aerial_perspective import MAX_DISTANCE_M, build_aerial_perspective, volume_texels
 from cloudcore.atmosphere.parameters import EARTH
@@ -17,7 +19,10 @@ from cloudcore.colour import srgb_decode, srgb_encode
 from cloudcore.light.air_between import air_between
 from cloudcore.light.lighting import PHYSICAL_EXPOSURE
 from cloudcore.light.sky_background import scene_sky
+from cloudcore.measure.imagecompare import compare
 from cloudcore.scene import Air, Camera, Light, Lighting, Scene, Terrain
+from cloudcore.scenefile import load_scene
+from cloudcore.settings import FULL_3D, RenderSettings
 from cloudcore.sun import sun_direction
 
 TABLES = atmosphere_tables(EARTH)
@@ -126,3 +131,46 @@ def test_the_world_pass_draws_the_terrain_through_the_numpy_air(renderer):
     # the air shows: the far terrain is measurably not its own colour
     far = on_terrain & (distances > 3000.0)
     assert np.abs(drawn[far] - colour).max(axis=-1).mean() > 0.02
+
+
+@pytest.mark.gl
+def test_a_far_cloud_gets_the_same_air_in_full_3d_and_as_an_impostor(renderer):
+    """One cloud 15 km away under a narrow view: full 3D takes the air per particle, the impostor at its quad
+    when drawn (never in its texture).  Measured: 57.7 dB, the cloud's mean colour within 0.04 of a level; the
+    impostor drawn without the air: 43.0 dB, its mean 2.7 levels off."""
+    valley = load_scene(VALLEY)
+    cloud = valley.clouds[5]
+    centre, _ = cloud.bounding_sphere()
+    eye = centre + 15000.0 * np.array([0.6, 0.05, 0.8])
+    camera = Camera(tuple(eye), tuple(centre), 4.0)
+    scene = dataclasses.replace(valley, clouds=(cloud,), terrain=None, camera=camera)
+    full, _ = renderer.render(scene, settings=FULL_3D)
+    impostor_settings = dataclasses.replace(RenderSettings(mode="impostor"), ring_radius=np.inf)
+    for _ in range(3):
+        impostor, stats = renderer.render(scene, settings=impostor_settings)
+    assert stats.plan.impostors_drawn == 1
+    difference = compare(impostor, full)
+    assert difference.psnr_db >= 50.0, difference
+    sky = scene_sky(scene.lighting).radiance(pixel_rays(camera, RENDER_WIDTH, RENDER_HEIGHT), 1e-3)
+    on_cloud = np.abs(full.astype(float) - np.round(255.0 * srgb_encode(sky))).max(axis=-1) > 8
+    assert on_cloud.mean() > 0.05
+    means = [image[on_cloud].astype(float).mean(axis=0) for image in (full, impostor)]
+    assert np.abs(means[0] - means[1]).max() < 0.5, means
+
+
+def test_a_dragged_slider_s_coarse_air_is_near_the_full_one():
+    """The preview's 16^3 volume at 8 samples (5 ms to build against 133) against the full one, 1.5 km up at
+    18:15: measured p99 0.0045 in the light added, 0.0091 in the transmittance."""
+    rng = np.random.default_rng(5)
+    sun = sun_direction(18.25)
+    full = build_aerial_perspective(TABLES, 1500.0, sun)
+    coarse = build_aerial_perspective(TABLES, 1500.0, sun, preview=True)
+    assert coarse.in_scattered.shape == (16, 16, 16, 3)
+    directions = rng.normal(size=(3000, 3))
+    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+    distances = MAX_DISTANCE_M * rng.random(3000) ** 2
+    (full_radiance, full_transmittance), (radiance, transmittance) = (
+        volume.radiance_and_transmittance(directions, distances) for volume in (full, coarse)
+    )
+    assert np.percentile(np.pi * PHYSICAL_EXPOSURE * np.abs(radiance - full_radiance), 99) < 0.01
+    assert np.percentile(np.abs(transmittance - full_transmittance), 99) < 0.015

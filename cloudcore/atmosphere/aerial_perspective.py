@@ -40,6 +40,9 @@ MAX_DISTANCE_M = 64000.0
 SAMPLES = 16
 #: the eye's altitude is rounded to this for its volume: within it the volume is reused
 ALTITUDE_STEP_M = 100.0
+#: the preview's volume, while a slider is dragged in the editor (as its sky-view table is coarser then)
+PREVIEW_VOLUME_SIZE = (16, 16, 16)
+PREVIEW_SAMPLES = 8
 
 
 @dataclass(frozen=True, eq=False)
@@ -56,17 +59,19 @@ class AerialPerspective:
     def radiance_and_transmittance(self, directions, distances) -> tuple[np.ndarray, np.ndarray]:
         """(in-scattered radiance (..., 3), transmittance (..., 3)) toward unit `directions` (..., 3; y up) over
         `distances` (..., metres) from the eye."""
-        u, v, w = volume_uvw(directions, distances, self.sun_direction)
+        depth, height, width = self.in_scattered.shape[:3]
+        u, v, w = volume_uvw(directions, distances, self.sun_direction, (width, height, depth))
         return (
             sample_trilinear(self.in_scattered, u, v, w),
             sample_trilinear(self.transmittance, u, v, w),
         )
 
 
-def volume_uvw(directions, distances, sun_direction) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The volume's texture coordinates (u, v, w) of unit `directions` (..., 3) at `distances` (...)."""
+def volume_uvw(directions, distances, sun_direction, size=VOLUME_SIZE) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The texture coordinates (u, v, w) in a volume of `size` (width, height, depth) of unit `directions` (..., 3)
+    at `distances` (...)."""
     directions = np.asarray(directions, dtype=np.float64)
-    width, height, depth = VOLUME_SIZE
+    width, height, depth = size
     azimuth = np.sqrt(np.clip(0.5 - 0.5 * light_view_cosines(directions, sun_direction), 0.0, 1.0))
     mu = np.clip(directions[..., 1], -1.0, 1.0)
     up = 0.5 + 0.5 * np.sign(mu) * np.sqrt(np.abs(mu))
@@ -74,9 +79,9 @@ def volume_uvw(directions, distances, sun_direction) -> tuple[np.ndarray, np.nda
     return unit_to_sub_uv(azimuth, width), unit_to_sub_uv(up, height), unit_to_sub_uv(slice_position, depth)
 
 
-def volume_texels() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(light_view_cosine (width,), mu (height,), distance (depth,)) at the volume's texel centres."""
-    width, height, depth = VOLUME_SIZE
+def volume_texels(size=VOLUME_SIZE) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(light_view_cosine (width,), mu (height,), distance (depth,)) at the texel centres of a volume of `size`."""
+    width, height, depth = size
     azimuth = sub_uv_to_unit(texel_centres(width), width)
     light_view_cosine = 1.0 - 2.0 * azimuth**2
     up = 2.0 * sub_uv_to_unit(texel_centres(height), height) - 1.0
@@ -85,18 +90,21 @@ def volume_texels() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return light_view_cosine, mu, distance
 
 
-def build_aerial_perspective(tables: AtmosphereTables, altitude_m: float, sun_direction) -> AerialPerspective:
-    """The volume from `altitude_m` with the sun toward unit `sun_direction` (y up)."""
+def build_aerial_perspective(
+    tables: AtmosphereTables, altitude_m: float, sun_direction, preview: bool = False
+) -> AerialPerspective:
+    """The volume from `altitude_m` with the sun toward unit `sun_direction` (y up); coarser for a `preview`."""
+    size, samples = (PREVIEW_VOLUME_SIZE, PREVIEW_SAMPLES) if preview else (VOLUME_SIZE, SAMPLES)
     params = tables.params
     r = eye_radius(params, altitude_m)
     sun = np.asarray(sun_direction, dtype=np.float64)
     mu_s = float(np.clip(sun[1], -1.0, 1.0))
-    light_view_cosine, mu, distance = volume_texels()
+    light_view_cosine, mu, distance = volume_texels(size)
     # one march a row (a cosine to the up) and slice serves every azimuth of that row: (height, 1, depth)
     row_mu = mu[:, None, None]
     nu = row_mu * mu_s + np.sqrt(1.0 - row_mu**2) * np.sqrt(1.0 - mu_s**2) * light_view_cosine[None, :, None]
     radiance, transmittance = in_scattering(
-        params, tables.transmittance, tables.multiple_scattering, r, row_mu, mu_s, nu, distance[None, None, :], SAMPLES
+        params, tables.transmittance, tables.multiple_scattering, r, row_mu, mu_s, nu, distance[None, None, :], samples
     )
     # to (depth, height, width, 3), the layout of a 3D texture
     return AerialPerspective(
@@ -108,13 +116,18 @@ def build_aerial_perspective(tables: AtmosphereTables, altitude_m: float, sun_di
     )
 
 
-def aerial_perspective_from(tables: AtmosphereTables, eye_altitude_m: float, sun_direction) -> AerialPerspective:
-    """The volume for an eye at `eye_altitude_m` (rounded to `ALTITUDE_STEP_M`, at least 0): the last few are kept,
-    so an eye flying level or turning reuses one and a frame asks again at no cost."""
+def aerial_perspective_from(
+    tables: AtmosphereTables, eye_altitude_m: float, sun_direction, preview: bool = False
+) -> AerialPerspective:
+    """The volume for an eye at `eye_altitude_m` (rounded to `ALTITUDE_STEP_M`, at least 0), coarser for a
+    `preview`: the last few are kept, so an eye flying level or turning reuses one and a frame asks again at no
+    cost."""
     altitude = ALTITUDE_STEP_M * round(max(float(eye_altitude_m), 0.0) / ALTITUDE_STEP_M)
-    return _aerial_perspective(tables, altitude, tuple(float(c) for c in sun_direction))
+    return _aerial_perspective(tables, altitude, tuple(float(c) for c in sun_direction), preview)
 
 
 @functools.lru_cache(maxsize=8)
-def _aerial_perspective(tables: AtmosphereTables, altitude_m: float, sun_direction: tuple) -> AerialPerspective:
-    return build_aerial_perspective(tables, altitude_m, sun_direction)
+def _aerial_perspective(
+    tables: AtmosphereTables, altitude_m: float, sun_direction: tuple, preview: bool
+) -> AerialPerspective:
+    return build_aerial_perspective(tables, altitude_m, sun_direction, preview)

@@ -7,12 +7,13 @@ from __future__ import annotations
 import numpy as np
 from OpenGL import GL
 
-from cloudcore.atmosphere.aerial_perspective import MAX_DISTANCE_M, VOLUME_SIZE
+from cloudcore.atmosphere.aerial_perspective import MAX_DISTANCE_M
 from cloudcore.gl.programs import set_vec3
 from cloudcore.light.air_between import AirBetween
 
-#: the lookup's samplers (shaders/aerial_perspective.glsl), bound to consecutive units
-AIR_SAMPLERS = ("air_in_scattered", "air_transmittance")
+#: the texture units of the lookup's samplers, the light added and the transmittance, as
+#: shaders/aerial_perspective.glsl declares them
+AIR_UNITS = (3, 4)
 
 
 class AirVolume:
@@ -42,15 +43,15 @@ class AirVolume:
         GL.glBindTexture(GL.GL_TEXTURE_3D, 0)
         self._volume = air.volume
 
-    def bind(self, program: int, first_unit: int) -> None:
-        """Bind the textures to units `first_unit` and the next, and set the lookup's uniforms of `program`."""
-        for offset, (texture, name) in enumerate(zip(self._textures, AIR_SAMPLERS, strict=True)):
-            GL.glActiveTexture(GL.GL_TEXTURE0 + first_unit + offset)
+    def bind(self, program: int) -> None:
+        """Bind the textures to `AIR_UNITS` and set the lookup's uniforms of `program` (in use)."""
+        for texture, unit in zip(self._textures, AIR_UNITS, strict=True):
+            GL.glActiveTexture(GL.GL_TEXTURE0 + unit)
             GL.glBindTexture(GL.GL_TEXTURE_3D, texture)
-            GL.glUniform1i(GL.glGetUniformLocation(program, name), first_unit + offset)
         GL.glActiveTexture(GL.GL_TEXTURE0)
         set_vec3(program, "air_sun_direction", self._volume.sun_direction)
-        set_vec3(program, "air_volume_size", np.asarray(VOLUME_SIZE, dtype=np.float64))
+        depth, height, width = self._volume.in_scattered.shape[:3]
+        set_vec3(program, "air_volume_size", np.array([width, height, depth], dtype=np.float64))
         GL.glUniform1f(GL.glGetUniformLocation(program, "air_max_distance"), MAX_DISTANCE_M)
 
     def close(self) -> None:

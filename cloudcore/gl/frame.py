@@ -40,6 +40,7 @@ from cloudcore.artist.particle_styles import particle_styles
 from cloudcore.camera import NEAR_PLANE_M, frustum_planes, projection_matrix, view_matrix
 from cloudcore.colour import linear_to_srgb8
 from cloudcore.field.state import FieldState, update_field
+from cloudcore.gl.air_volume import AirVolume
 from cloudcore.gl.context import HeadlessContext, WindowContext, check_frame_size
 from cloudcore.gl.impostor_atlas import atlas_instances
 from cloudcore.gl.impostor_store import ImpostorStore
@@ -88,6 +89,8 @@ class _CloudPassFrame:
     blending: str  # the setting: full-3D splats as billboards ("plain") or as volumes ("volume")
     splat_order: str  # splats chosen and sorted on the "cpu" or the "gpu" (the setting, "auto" resolved)
     compositing: str  # the GPU's plain full-3D splats blended by the "raster" or by "compute" ("auto" resolved)
+    #: the air's volume uploaded for this eye, and the eye, that world-space quads are seen through; None: no air
+    air: tuple[AirVolume, np.ndarray] | None
 
     @property
     def eye(self) -> np.ndarray:
@@ -493,7 +496,10 @@ class FrameRenderer:
             settings.blending,
             splat_order,
             compositing,
+            None if self._world.air_volume is None else (self._world.air_volume, np.asarray(camera.position, float)),
         )
+        # the world pass uploaded the air for this eye: the cloud pass's splats take it per particle
+        self._splats.air = self._world.air_volume
         self._replay, self._screen_batches = [], []
         steps = self._cloud_pass_steps(frame)
         runs = inside_runs(plan.draw_items, plan.clouds)
@@ -557,13 +563,16 @@ class FrameRenderer:
         and they are blended as billboards (volume blending reads its batch on the CPU)."""
         if frame.splat_order == "gpu" and frame.blending == "plain":
             clouds, depth_ranges = self._members_and_ranges(frame, items)
-            return SplatSelection(frame.particles, clouds, frame.eye, depth_ranges, frame.time_s, frame.frustum)
+            return SplatSelection(
+                frame.particles, clouds, frame.eye, depth_ranges, frame.time_s, frame.frustum, through_air=True
+            )
         return self._batch_of(frame, items)
 
     def _batch_of(self, frame: _CloudPassFrame, items) -> SplatBatch:
-        """The splats of the units of draw `items`, each within its item's depth range, sorted together."""
+        """The splats of the units of draw `items`, each within its item's depth range, sorted together, seen
+        through the air from the eye (their screen layers and screen impostors are made for this eye alone)."""
         clouds, depth_ranges = self._members_and_ranges(frame, items)
-        return splat_batch(frame.particles, clouds, frame.eye, depth_ranges, frame.time_s, frame.frustum)
+        return splat_batch(frame.particles, clouds, frame.eye, depth_ranges, frame.time_s, frame.frustum, True)
 
     @staticmethod
     def _members_and_ranges(frame: _CloudPassFrame, items) -> tuple[tuple, tuple]:
@@ -655,14 +664,14 @@ class FrameRenderer:
 
     def _draw_instanced(self, frame: _CloudPassFrame, atlas_texture: int, instances: np.ndarray, **crossfade) -> None:
         """Quads from the atlas (`QuadPass.draw_instanced`), depth-tested, in one draw."""
-        self._quads.draw_instanced(instances, frame.view_projection, atlas_texture, **crossfade)
+        self._quads.draw_instanced(instances, frame.view_projection, atlas_texture, air=frame.air, **crossfade)
         self._replay.append(
             lambda: self._quads.draw_instanced(instances, frame.view_projection, atlas_texture, counting=True)
         )
 
     def _draw_quad_run(self, frame: _CloudPassFrame, quads) -> None:
         """World-space quads (corners, texture, weight, uv_rect), depth-tested, one after the other."""
-        self._quads.draw_run(quads, frame.view_projection)
+        self._quads.draw_run(quads, frame.view_projection, air=frame.air)
         self._replay.append(lambda: self._quads.draw_run(quads, frame.view_projection, counting=True))
 
     def _draw_crossfade(self, frame: _CloudPassFrame, item, cloud, batch: SplatBatch) -> int:

@@ -21,7 +21,7 @@ from cloudcore.atmosphere.geometry import horizon_cosine
 from cloudcore.atmosphere.sky_view import eye_radius, horizon_angles
 from cloudcore.camera import FAR_PLANE_M, NEAR_PLANE_M, camera_pose
 from cloudcore.colour import srgb_encode
-from cloudcore.gl.air_volume import AIR_SAMPLERS, AirVolume
+from cloudcore.gl.air_volume import AirVolume
 from cloudcore.gl.context import HeadlessContext
 from cloudcore.gl.programs import build_program, set_matrix, set_vec3
 from cloudcore.gl.pyrender_compat import pyrender
@@ -32,9 +32,9 @@ from cloudcore.limits import DRAWN_TERRAIN_KINDS
 from cloudcore.scene import Camera, Terrain
 from cloudcore.terrain import heightfield_mesh
 
-#: texture units: the world's colour 0, the sky-view table 1, the terrain's depth, then the air's volume (two)
+#: the terrain's depth's texture unit, as world.frag.glsl declares it (the world's colour 0, the sky-view table 1,
+#: the air's volume `AIR_UNITS`)
 _DEPTH_UNIT = 2
-_AIR_UNIT = 3
 
 
 @functools.lru_cache(maxsize=2)
@@ -62,8 +62,9 @@ class WorldPass:
         self._scene = None
         if terrain is not None:
             self._scene, self._camera_node = self._terrain_scene(terrain, light)
-        # the terrain's depth and the air's volume, where the terrain is seen through the air
-        self._air_volume = AirVolume() if sky.physical and terrain is not None else None
+        # the air's volume under the physical sky (the cloud pass reads it too: `air_volume`), and the terrain's
+        # depth, which the terrain is seen through it by
+        self._air_volume = AirVolume() if sky.physical else None
         self._depth_copy, self._depth_copy_size = None, None
 
     @staticmethod
@@ -99,7 +100,6 @@ class WorldPass:
         GL.glUseProgram(program)
         GL.glActiveTexture(GL.GL_TEXTURE0)
         GL.glBindTexture(GL.GL_TEXTURE_2D, context.world_texture)
-        GL.glUniform1i(GL.glGetUniformLocation(program, "world_texture"), 0)
         set_matrix(program, "inverse_view_projection", np.linalg.inv(view_projection))
         self._set_sky_uniforms(program, camera)
         self._set_air_uniforms(program, context, camera)
@@ -122,7 +122,6 @@ class WorldPass:
         _, zenith_horizon = horizon_angles(params, r)
         GL.glActiveTexture(GL.GL_TEXTURE1)
         GL.glBindTexture(GL.GL_TEXTURE_2D, self._sky_view_texture)
-        GL.glUniform1i(GL.glGetUniformLocation(program, "sky_view_table"), 1)
         height, width = sky.view.table.shape[:2]
         GL.glUniform2f(GL.glGetUniformLocation(program, "sky_view_size"), float(width), float(height))
         GL.glUniform1f(GL.glGetUniformLocation(program, "zenith_horizon_angle"), float(zenith_horizon))
@@ -139,19 +138,23 @@ class WorldPass:
         GL.glActiveTexture(GL.GL_TEXTURE0)
 
     def _set_air_uniforms(self, program: int, context: HeadlessContext, camera: Camera) -> None:
-        GL.glUniform1i(GL.glGetUniformLocation(program, "through_air"), int(self._air_volume is not None))
-        # samplers of different kinds may not share a unit even where the shader skips them
-        GL.glUniform1i(GL.glGetUniformLocation(program, "world_depth"), _DEPTH_UNIT)
-        for offset, name in enumerate(AIR_SAMPLERS):
-            GL.glUniform1i(GL.glGetUniformLocation(program, name), _AIR_UNIT + offset)
+        terrain_through_air = self._air_volume is not None and self._scene is not None
+        GL.glUniform1i(GL.glGetUniformLocation(program, "through_air"), int(terrain_through_air))
         if self._air_volume is None:
             return
         self._air_volume.upload(air_between(self._sky, camera.position))
-        self._air_volume.bind(program, _AIR_UNIT)
+        if not terrain_through_air:
+            return
+        self._air_volume.bind(program)
         GL.glActiveTexture(GL.GL_TEXTURE0 + _DEPTH_UNIT)
         GL.glBindTexture(GL.GL_TEXTURE_2D, self._copy_depth(context))
         GL.glActiveTexture(GL.GL_TEXTURE0)
         set_vec3(program, "eye_position", camera.position)
+
+    @property
+    def air_volume(self) -> AirVolume | None:
+        """The air's volume as the last `draw` uploaded it, for its eye; None under the gradient sky."""
+        return self._air_volume
 
     def _copy_depth(self, context: HeadlessContext) -> int:
         """The depth pyrender wrote, copied into a texture of the target's size (made at the first draw and

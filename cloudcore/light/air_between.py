@@ -48,4 +48,4 @@ def air_between(sky: SkyBackground, eye_position) -> AirBetween | None:
         return None
     view = sky.view
     eye_altitude = view.altitude_m + float(np.asarray(eye_position, dtype=np.float64)[1])
-    return AirBetween(aerial_perspective_from(view.tables, eye_altitude, view.sun_direction))
+    return AirBetween(aerial_perspective_from(view.tables, eye_altitude, view.sun_direction, view.preview))

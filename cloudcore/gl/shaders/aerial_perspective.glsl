@@ -1,7 +1,9 @@
 // The air between the eye and a point: cloudcore/atmosphere/aerial_perspective.py's volume, read as its
-// volume_uvw and cloudcore/light/air_between.py's seen_through do (cloudcore/gl/air_volume.py binds it).
-uniform sampler3D air_in_scattered;   // the light added, the renderer's values
-uniform sampler3D air_transmittance;
+// volume_uvw and cloudcore/light/air_between.py's seen_through do (cloudcore/gl/air_volume.py binds it to the
+// units here, AIR_UNITS: declared, so that no program that includes it has two kinds of sampler on one unit).
+// GLSL 4.20 at least.
+layout(binding = 3) uniform sampler3D air_in_scattered;   // the light added, the renderer's values
+layout(binding = 4) uniform sampler3D air_transmittance;
 uniform vec3 air_sun_direction;
 uniform vec3 air_volume_size;         // (azimuth, cosine to the up, distance) texels
 uniform float air_max_distance;       // metres, the last slice's
@@ -20,9 +22,10 @@ vec3 air_uvw(vec3 from_eye)
     return (vec3(azimuth, up, slice_position) + 0.5 / air_volume_size) * (air_volume_size / (air_volume_size + 1.0));
 }
 
-// premultiplied `colour` of opacity `alpha` at `from_eye` (the point less the eye, metres) seen through the air
+// premultiplied `colour` of opacity `alpha` at `from_eye` (the point less the eye, metres) seen through the air;
+// textureLod, as a compute shader has no derivatives to choose a level by
 vec3 seen_through_air(vec3 colour, float alpha, vec3 from_eye)
 {
     vec3 uvw = air_uvw(from_eye);
-    return colour * texture(air_transmittance, uvw).rgb + alpha * texture(air_in_scattered, uvw).rgb;
+    return colour * textureLod(air_transmittance, uvw, 0.0).rgb + alpha * textureLod(air_in_scattered, uvw, 0.0).rgb;
 }

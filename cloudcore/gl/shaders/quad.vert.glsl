@@ -6,7 +6,8 @@
 // (u0, v0, u1, v1): the part of the texture the corners cover.  The corners
 // and uv_rect are uniforms, one quad a draw; with ATLAS they come per
 // instance, a run of impostors from the atlas (cloudcore.gl.impostor_atlas)
-// one draw, with the rectangle of its cell to clamp to and its layer.
+// one draw, with the rectangle of its cell to clamp to and its layer.  AIR: world-space
+// quads seen through the air from where the eye is now (quad.frag.glsl).
 
 #ifdef ATLAS
 layout(location = 0) in vec3 corner_0;
@@ -23,6 +24,10 @@ uniform vec3 corners[4];
 uniform vec4 uv_rect;
 #endif
 uniform mat4 view_projection;
+#ifdef AIR
+uniform vec3 eye_position;
+out vec3 from_eye;  // the quad's point less the eye: the air between them, read in quad.frag.glsl
+#endif
 
 out vec2 uv;
 
@@ -36,4 +41,7 @@ void main()
 #endif
     uv = mix(uv_rect.xy, uv_rect.zw, vec2(gl_VertexID & 1, gl_VertexID >> 1));
     gl_Position = view_projection * vec4(corners[gl_VertexID], 1.0);
+#ifdef AIR
+    from_eye = corners[gl_VertexID] - eye_position;
+#endif
 }

@@ -1,4 +1,4 @@
-#version 330 core
+#version 420 core
 // The world in linear RGB: pyrender's terrain over the sky, the atmosphere's or a vertical gradient; under the
 // atmosphere the terrain is seen through the air between it and the eye.
 //
@@ -7,14 +7,14 @@
 // resolve averaged them with it: a pixel holds (coverage * colour, coverage).
 // The sky reads its tables as cloudcore/light/sky_background.py does.
 
-uniform sampler2D world_texture;
+layout(binding = 0) uniform sampler2D world_texture;
 uniform mat4 inverse_view_projection;
 uniform bool physical_sky;
 // the gradient
 uniform vec3 zenith_colour;
 uniform vec3 horizon_colour;
 // the atmosphere: its sky-view table (cloudcore/atmosphere/sky_view.py) seen from the scene's origin
-uniform sampler2D sky_view_table;
+layout(binding = 1) uniform sampler2D sky_view_table;
 uniform vec2 sky_view_size;          // its (width, height): 192 x 108, 96 x 54 for a preview
 uniform float zenith_horizon_angle;  // pi less the horizon's angle below the horizontal
 uniform float horizon_cosine;        // the cosine to the up of the ray grazing the ground
@@ -23,7 +23,7 @@ uniform vec3 sun_disc_scale;         // the disc's colour per unit of its normal
 uniform float pixel_angle;           // radians a pixel spans: the disc's rim is spread over it
 // aerial perspective on the terrain (the physical sky alone): its depth, copied after pyrender drew it
 uniform bool through_air;
-uniform sampler2D world_depth;
+layout(binding = 2) uniform sampler2D world_depth;
 uniform vec3 eye_position;
 #include "aerial_perspective.glsl"
 
