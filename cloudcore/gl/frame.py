@@ -272,7 +272,13 @@ class FrameRenderer:
         with clock.frame():
             with clock.timed("world"):
                 antialiased = settings.world_antialiasing
-                self._world.draw(self.context, camera, projection @ view, antialiased=antialiased)
+                self._world.draw(
+                    self.context,
+                    camera,
+                    projection @ view,
+                    antialiased=antialiased,
+                    through_air=settings.aerial_perspective,
+                )
                 if plan.objects_with_world:
                     self._objects.draw(
                         self.context, camera, poses, plan.objects_with_world, write_depth=True, antialiased=antialiased
@@ -482,6 +488,7 @@ class FrameRenderer:
         full-3D draws sorted the way `splat_order` ("cpu" or "gpu"), the GPU's plain ones composited the way
         `compositing` ("raster" or "compute"); returns the particles drawn."""
         view_projection = projection @ view
+        air = self._world.air_volume if settings.aerial_perspective else None
         frame = _CloudPassFrame(
             plan,
             particles,
@@ -496,10 +503,10 @@ class FrameRenderer:
             settings.blending,
             splat_order,
             compositing,
-            None if self._world.air_volume is None else (self._world.air_volume, np.asarray(camera.position, float)),
+            None if air is None else (air, np.asarray(camera.position, float)),
         )
         # the world pass uploaded the air for this eye: the cloud pass's splats take it per particle
-        self._splats.air = self._world.air_volume
+        self._splats.air = air
         self._replay, self._screen_batches = [], []
         steps = self._cloud_pass_steps(frame)
         runs = inside_runs(plan.draw_items, plan.clouds)

@@ -85,10 +85,16 @@ class WorldPass:
         return scene, scene.add(camera)
 
     def draw(
-        self, context: HeadlessContext, camera: Camera, view_projection: np.ndarray, *, antialiased: bool = False
+        self,
+        context: HeadlessContext,
+        camera: Camera,
+        view_projection: np.ndarray,
+        *,
+        antialiased: bool = False,
+        through_air: bool = True,
     ) -> None:
         """Fill the render target: terrain colour and depth where there is terrain, sky elsewhere (the terrain
-        multisampled 4x when `antialiased`)."""
+        multisampled 4x when `antialiased`, seen through the air under the physical sky when `through_air`)."""
         if self._scene is None:
             context.clear_world()
         else:
@@ -102,7 +108,7 @@ class WorldPass:
         GL.glBindTexture(GL.GL_TEXTURE_2D, context.world_texture)
         set_matrix(program, "inverse_view_projection", np.linalg.inv(view_projection))
         self._set_sky_uniforms(program, camera)
-        self._set_air_uniforms(program, context, camera)
+        self._set_air_uniforms(program, context, camera, through_air)
         GL.glDisable(GL.GL_BLEND)
         GL.glDisable(GL.GL_CULL_FACE)
         GL.glDisable(GL.GL_DEPTH_TEST)  # colour everywhere; the depth pyrender wrote stays
@@ -137,10 +143,10 @@ class WorldPass:
         )
         GL.glActiveTexture(GL.GL_TEXTURE0)
 
-    def _set_air_uniforms(self, program: int, context: HeadlessContext, camera: Camera) -> None:
-        terrain_through_air = self._air_volume is not None and self._scene is not None
+    def _set_air_uniforms(self, program: int, context: HeadlessContext, camera: Camera, through_air: bool) -> None:
+        terrain_through_air = through_air and self._air_volume is not None and self._scene is not None
         GL.glUniform1i(GL.glGetUniformLocation(program, "through_air"), int(terrain_through_air))
-        if self._air_volume is None:
+        if self._air_volume is None or not through_air:
             return
         self._air_volume.upload(air_between(self._sky, camera.position))
         if not terrain_through_air:

@@ -22,10 +22,19 @@ vec3 air_uvw(vec3 from_eye)
     return (vec3(azimuth, up, slice_position) + 0.5 / air_volume_size) * (air_volume_size / (air_volume_size + 1.0));
 }
 
-// premultiplied `colour` of opacity `alpha` at `from_eye` (the point less the eye, metres) seen through the air;
-// textureLod, as a compute shader has no derivatives to choose a level by
-vec3 seen_through_air(vec3 colour, float alpha, vec3 from_eye)
+// the air's transmittance and the light it adds between the eye and `from_eye` (the point less the eye, metres);
+// textureLod, as a compute or vertex shader has no derivatives to choose a level by
+void air_toward(vec3 from_eye, out vec3 transmittance, out vec3 in_scattered)
 {
     vec3 uvw = air_uvw(from_eye);
-    return colour * textureLod(air_transmittance, uvw, 0.0).rgb + alpha * textureLod(air_in_scattered, uvw, 0.0).rgb;
+    transmittance = textureLod(air_transmittance, uvw, 0.0).rgb;
+    in_scattered = textureLod(air_in_scattered, uvw, 0.0).rgb;
+}
+
+// premultiplied `colour` of opacity `alpha` at `from_eye` seen through the air
+vec3 seen_through_air(vec3 colour, float alpha, vec3 from_eye)
+{
+    vec3 transmittance, in_scattered;
+    air_toward(from_eye, transmittance, in_scattered);
+    return colour * transmittance + alpha * in_scattered;
 }
