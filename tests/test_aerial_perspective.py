@@ -20,7 +20,7 @@ from cloudcore.light.air_between import air_between
 from cloudcore.light.lighting import PHYSICAL_EXPOSURE
 from cloudcore.light.sky_background import scene_sky
 from cloudcore.measure.imagecompare import compare
-from cloudcore.scene import Air, Camera, Light, Lighting, Scene, Terrain
+from cloudcore.scene import Air, Camera, Light, Lighting, Scene, SceneObject, Terrain
 from cloudcore.scenefile import load_scene
 from cloudcore.settings import FULL_3D, RenderSettings
 from cloudcore.sun import sun_direction
@@ -174,3 +174,31 @@ def test_a_dragged_slider_s_coarse_air_is_near_the_full_one():
     )
     assert np.percentile(np.pi * PHYSICAL_EXPOSURE * np.abs(radiance - full_radiance), 99) < 0.01
     assert np.percentile(np.abs(transmittance - full_transmittance), 99) < 0.015
+
+
+@pytest.mark.gl
+def test_an_object_far_away_is_seen_through_the_air(renderer):
+    """A 600 m box 6 km away, drawn with the air and without (`RenderSettings.aerial_perspective`): with it, each of
+    its pixels is `AirBetween.seen_through` of the pixel without it, at the pixel's depth."""
+    camera = Camera((0.0, 300.0, 6000.0), (0.0, 300.0, 0.0), 20.0)
+    scene = Scene(
+        camera=camera,
+        lighting=Lighting(time_of_day=15.5),
+        objects=(SceneObject("box", primitive="box", scale=600.0, position=(0.0, 300.0, 0.0)),),
+    )
+    drawn = {}
+    for air in (True, False):
+        settings = dataclasses.replace(FULL_3D, aerial_perspective=air)
+        renderer.render(scene, settings=settings, read_back=False)
+        drawn[air] = renderer.context.read_linear_rgb().astype(np.float64)
+    depth = renderer.context.read_depth().astype(np.float64)
+    on_box = depth < 1.0
+    assert on_box.mean() > 0.05
+    ndc = 2.0 * depth - 1.0
+    eye_depth = 2.0 * FAR_PLANE_M * NEAR_PLANE_M / (FAR_PLANE_M + NEAR_PLANE_M - ndc * (FAR_PLANE_M - NEAR_PLANE_M))
+    rays = pixel_rays(camera, RENDER_WIDTH, RENDER_HEIGHT)
+    distances = eye_depth / (rays @ -camera_pose(camera)[:3, 2])
+    expected = air_between(scene_sky(scene.lighting), camera.position).seen_through(drawn[False], rays, distances)
+    close = np.abs(drawn[True] - expected) <= 0.01 * expected + 2e-3
+    assert close.all(axis=-1)[on_box].mean() > 0.99
+    assert np.abs(drawn[True] - drawn[False]).max(axis=-1)[on_box].mean() > 0.01

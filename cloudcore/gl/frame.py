@@ -281,7 +281,13 @@ class FrameRenderer:
                 )
                 if plan.objects_with_world:
                     self._objects.draw(
-                        self.context, camera, poses, plan.objects_with_world, write_depth=True, antialiased=antialiased
+                        self.context,
+                        camera,
+                        poses,
+                        plan.objects_with_world,
+                        write_depth=True,
+                        antialiased=antialiased,
+                        air=self._world.air_volume if settings.aerial_perspective else None,
                     )
             with clock.timed("impostor updates"):
                 rendered = self._impostors.update(plan, particles, settings, time_s, way, self._unit_weights)
@@ -526,7 +532,13 @@ class FrameRenderer:
             elif kind == "object":
                 antialiased = settings.world_antialiasing
                 self._objects.draw(
-                    self.context, camera, poses, [item.index], write_depth=False, antialiased=antialiased
+                    self.context,
+                    camera,
+                    poses,
+                    [item.index],
+                    write_depth=False,
+                    antialiased=antialiased,
+                    air=None if frame.air is None else frame.air[0],
                 )
             elif kind == "inside":
                 if item in screen_impostors:  # the rest of its run is in the same screen impostor

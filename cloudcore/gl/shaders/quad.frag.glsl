@@ -1,4 +1,4 @@
-#version 330 core
+#version 420 core
 // Premultiplied colour from an impostor texture, scaled by its share of the
 // cloud's opacity, plus (in a crossfade) the full-3D image of the same cloud
 // from a screen-sized layer scaled by the rest: a linear mix of two
@@ -8,9 +8,8 @@
 // quad that never took it (7% of the flythrough's clouds, docs/performance.md).
 // ATLAS samples a layer of the impostor atlas within the instance's cell, its
 // weight per instance.  COUNT_FRAGMENTS writes 1 instead.  AIR adds the air between the eye
-// and the quad's plane now (at its corners, quad.vert.glsl) to the impostor's part (aerial perspective: never
-// in an impostor's texture, which is seen from elsewhere; the crossfade's layer has it already, per particle,
-// from this eye).
+// and the quad's plane now to the impostor's part (aerial perspective: never in an impostor's texture, which is
+// seen from elsewhere; the crossfade's layer has it already, per particle, from this eye).
 
 #ifdef ATLAS
 uniform sampler2DArray impostor;
@@ -23,8 +22,8 @@ uniform float impostor_weight;
 uniform sampler2D layer;
 uniform float layer_weight;
 #ifdef AIR
-in vec3 air_transmittance_seen;  // quad.vert.glsl's, at the corners
-in vec3 air_added;
+#include "aerial_perspective.glsl"
+in vec3 from_eye;
 #endif
 
 in vec2 uv;
@@ -41,7 +40,7 @@ void main()
     vec4 colour = impostor_weight * texture(impostor, uv);
 #endif
 #ifdef AIR
-    colour.rgb = colour.rgb * air_transmittance_seen + colour.a * air_added;
+    colour.rgb = seen_through_air(colour.rgb, colour.a, from_eye);
 #endif
 #ifdef CROSSFADE
     colour += layer_weight * texelFetch(layer, ivec2(gl_FragCoord.xy), 0);

@@ -1,4 +1,4 @@
-#version 420 core
+#version 330 core
 // A textured quad from four corners (no vertex buffer): impostors and ring
 // panels in world space, screen impostors in clip space (with an identity
 // view_projection).  Triangle-strip order: lower left, lower right, upper
@@ -25,12 +25,8 @@ uniform vec4 uv_rect;
 #endif
 uniform mat4 view_projection;
 #ifdef AIR
-#include "aerial_perspective.glsl"
 uniform vec3 eye_position;
-// the air between the eye and each corner, interpolated over the quad (the air changes little across a cloud:
-// read per fragment it cost 8 of the default view's 12 ms of impostors at 640x480, docs/atmosphere.md)
-out vec3 air_transmittance_seen;
-out vec3 air_added;
+out vec3 from_eye;  // the quad's point less the eye: the air between them, read in quad.frag.glsl
 #endif
 
 out vec2 uv;
@@ -46,6 +42,6 @@ void main()
     uv = mix(uv_rect.xy, uv_rect.zw, vec2(gl_VertexID & 1, gl_VertexID >> 1));
     gl_Position = view_projection * vec4(corners[gl_VertexID], 1.0);
 #ifdef AIR
-    air_toward(corners[gl_VertexID] - eye_position, air_transmittance_seen, air_added);
+    from_eye = corners[gl_VertexID] - eye_position;
 #endif
 }
