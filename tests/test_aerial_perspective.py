@@ -3,6 +3,7 @@ against the march it tables, what the air does to a surface with distance, the w
 twin, and nothing but finite values at the extremes."""
 
 import dataclasses
+import time
 
 import numpy as np
 import pytest
@@ -16,8 +17,9 @@ from cloudcore.atmosphere.sky_view import eye_radius
 from cloudcore.atmosphere.transmittance import optical_depth
 from cloudcore.camera import FAR_PLANE_M, NEAR_PLANE_M, camera_pose, pixel_rays
 from cloudcore.colour import srgb_decode, srgb_encode
-from cloudcore.light.air_between import air_between
+from cloudcore.light.air_between import AIR_CELL_ANGLE, AIR_MAX_CELLS, air_between, air_cells
 from cloudcore.light.lighting import PHYSICAL_EXPOSURE
+from cloudcore.light.live_air import LiveAir
 from cloudcore.light.sky_background import scene_sky
 from cloudcore.measure.imagecompare import compare
 from cloudcore.scene import Air, Camera, Light, Lighting, Scene, SceneObject, Terrain
@@ -174,6 +176,46 @@ def test_a_dragged_slider_s_coarse_air_is_near_the_full_one():
     )
     assert np.percentile(np.pi * PHYSICAL_EXPOSURE * np.abs(radiance - full_radiance), 99) < 0.01
     assert np.percentile(np.abs(transmittance - full_transmittance), 99) < 0.015
+
+
+def _square(centre, side):
+    """The corners (4, 3) of a square of `side` facing +z about `centre`: lower left, lower right, upper left,
+    upper right."""
+    steps = 0.5 * side * np.array([[-1, -1, 0], [1, -1, 0], [-1, 1, 0], [1, 1, 0]], dtype=np.float64)
+    return np.asarray(centre, dtype=np.float64) + steps
+
+
+def test_a_quad_is_cut_into_cells_by_the_angle_it_spans():
+    """The air is read at the corners of a quad's cells: one cell for a far quad, cells of at most
+    `AIR_CELL_ANGLE` for a near one, the most for a quad the eye is inside the sphere of."""
+    eye = np.zeros(3)
+    far, near, around = _square((0, 0, -20000.0), 500.0), _square((0, 0, -1000.0), 300.0), _square((0, 0, -1.0), 50.0)
+    cells = air_cells(np.stack([far, near, around]), eye)
+    assert cells[0] == 1 and cells[2] == AIR_MAX_CELLS
+    half_diagonal = 150.0 * np.sqrt(2.0)
+    span = 2.0 * np.arctan(half_diagonal / (1000.0 - half_diagonal))
+    assert cells[1] == int(np.ceil(span / AIR_CELL_ANGLE)) and 1 < cells[1] < AIR_MAX_CELLS
+
+
+def test_a_new_altitude_s_air_is_coarse_until_its_exact_volume_is_built():
+    """The editor's air (`LiveAir`): a frame at a new altitude gets the coarse volume at once while the exact one
+    is built in the background, then the exact one, the very volume a headless frame waits for."""
+    sky = scene_sky(Lighting(time_of_day=11.75))
+    eye = (0.0, 3456.0, 0.0)  # an altitude no other test draws from, so no volume of it is cached
+    live = LiveAir()
+    try:
+        first = live(sky, eye)
+        assert first.volume.in_scattered.shape == (16, 16, 16, 3)
+        for _ in range(400):
+            if live.built:
+                break
+            time.sleep(0.05)
+        assert live.built == 1
+        exact = live(sky, eye)
+        assert exact.volume is air_between(sky, eye).volume and exact.volume.in_scattered.shape == (32, 32, 32, 3)
+        assert live(sky, (0.0, 3460.0, 0.0)) is exact, "an eye within the same altitude step draws the same volume"
+    finally:
+        live.close()
 
 
 @pytest.mark.gl

@@ -122,8 +122,12 @@ def aerial_perspective_from(
     """The volume for an eye at `eye_altitude_m` (rounded to `ALTITUDE_STEP_M`, at least 0), coarser for a
     `preview`: the last few are kept, so an eye flying level or turning reuses one and a frame asks again at no
     cost."""
-    altitude = ALTITUDE_STEP_M * round(max(float(eye_altitude_m), 0.0) / ALTITUDE_STEP_M)
-    return _aerial_perspective(tables, altitude, tuple(float(c) for c in sun_direction), preview)
+    return _aerial_perspective(tables, volume_altitude(eye_altitude_m), tuple(float(c) for c in sun_direction), preview)
+
+
+def volume_altitude(eye_altitude_m: float) -> float:
+    """The altitude of the volume an eye at `eye_altitude_m` draws: rounded to `ALTITUDE_STEP_M`, at least 0."""
+    return ALTITUDE_STEP_M * round(max(float(eye_altitude_m), 0.0) / ALTITUDE_STEP_M)
 
 
 @functools.lru_cache(maxsize=8)

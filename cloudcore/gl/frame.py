@@ -52,9 +52,11 @@ from cloudcore.gl.splats import SplatBatch, SplatPass, SplatSelection, splat_bat
 from cloudcore.gl.targets import TextureTarget, blit_depth, depth_renderbuffer
 from cloudcore.gl.volume_blending import GpuFeatures, VolumeBlendingPass
 from cloudcore.gl.world import WorldPass
+from cloudcore.light.air_between import air_between
 from cloudcore.light.eye_scattering import ParticleBuffer
 from cloudcore.light.illumination import IlluminationCache
 from cloudcore.light.lighting import scene_lights
+from cloudcore.light.live_air import LiveAir
 from cloudcore.light.relighting import PREVIEW_METHOD
 from cloudcore.light.sky_background import scene_sky
 from cloudcore.light.terrain_light import terrain_light
@@ -107,6 +109,7 @@ class FrameRenderer:
         context=None,
         illumination: IlluminationCache | None = None,
         remember_costs: bool = False,
+        air: LiveAir | None = None,
     ):
         """A headless renderer, or with `context` (a `WindowContext`) one inside the current window.
 
@@ -114,7 +117,11 @@ class FrameRenderer:
         that a worker fills in the background (`cloudcore.light.relighting`).  With `remember_costs`, auto
         mode's cost model starts from the one the last such renderer on this machine and GL fitted, and the
         one fitted here is kept for the next when it closes (`cloudcore.lod.costs.remembered_prior`): the
-        editor and the command line; the tests and benchmarks start from the same prior every time."""
+        editor and the command line; the tests and benchmarks start from the same prior every time.
+
+        `air`: the editor's, which gives a coarse aerial-perspective volume while the exact one for a new
+        altitude is built in the background (`cloudcore.light.live_air`); without it a frame waits for the
+        exact one."""
         self.context = context if context is not None else HeadlessContext(width, height)
         self.context.make_current()
         self._splats = SplatPass()
@@ -127,6 +134,7 @@ class FrameRenderer:
         self._particles, self._particles_source = None, None
         self._facings: CloudFacings | None = None
         self._illumination = illumination if illumination is not None else IlluminationCache()
+        self._air_for = air if air is not None else air_between
         #: per cloud, changes whenever that cloud's particle colours may have: its impostor is stale
         self._lighting_keys: tuple = ()
         self._forming_clouds: tuple = ()  # the clouds that form or dissipate, whose colours follow the clock
@@ -397,7 +405,7 @@ class FrameRenderer:
             if self._world is not None:
                 self._world.close()
             self._world = WorldPass(
-                scene.terrain, terrain_light(lighting, lights, ambient), scene_sky(lighting, preview)
+                scene.terrain, terrain_light(lighting, lights, ambient), scene_sky(lighting, preview), self._air_for
             )
             self._world_source = world_source
         objects_source = (scene.objects, lights, tuple(ambient), self.size)

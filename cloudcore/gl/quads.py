@@ -12,6 +12,7 @@ from cloudcore.gl.air_volume import AirVolume
 from cloudcore.gl.blending import cloud_blending
 from cloudcore.gl.impostor_atlas import INSTANCE_FLOATS
 from cloudcore.gl.programs import build_program, set_matrix_at, set_vec3, uniform_locations
+from cloudcore.light.air_between import air_cells
 
 #: clip-space corners of the whole screen, for screen impostors
 SCREEN_CORNERS = np.array([[-1, -1, 0], [1, -1, 0], [-1, 1, 0], [1, 1, 0]], dtype=np.float64)
@@ -43,7 +44,7 @@ class QuadPass:
             GL.glUniform1i(GL.glGetUniformLocation(program, "impostor"), 0)
             GL.glUniform1i(GL.glGetUniformLocation(program, "layer"), 1)
             self._uniforms[program] = uniform_locations(
-                program, ("corners", "uv_rect", "view_projection", "impostor_weight", "layer_weight")
+                program, ("corners", "uv_rect", "view_projection", "impostor_weight", "layer_weight", "air_cells")
             )
         #: core profile draws nothing without a vertex array, even one with no attributes; shared
         #: with the other attribute-less passes
@@ -94,14 +95,18 @@ class QuadPass:
         self._see_through(program, air, counting)
         GL.glActiveTexture(GL.GL_TEXTURE0)
         corners_at, uv_at, weight_at = uniforms["corners"], uniforms["uv_rect"], uniforms["impostor_weight"]
+        cells = air_cells(np.array([quad[0] for quad in quads]), air[1]) if air is not None and not counting else None
         with cloud_blending(depth_test, counting):
             GL.glBindVertexArray(self.vertex_array)
-            for corners, texture, weight, (u0, v0, u1, v1) in quads:
+            for i, (corners, texture, weight, (u0, v0, u1, v1)) in enumerate(quads):
                 GL.glUniform3fv(corners_at, 4, np.ascontiguousarray(corners, dtype=np.float32))
                 GL.glUniform4f(uv_at, u0, v0, u1, v1)
                 GL.glUniform1f(weight_at, weight)
                 GL.glBindTexture(GL.GL_TEXTURE_2D, texture)
-                GL.glDrawArrays(GL.GL_TRIANGLE_STRIP, 0, 4)
+                if cells is None:
+                    GL.glDrawArrays(GL.GL_TRIANGLE_STRIP, 0, 4)
+                else:
+                    _draw_cells(uniforms["air_cells"], int(cells[i]), 1)
             GL.glBindVertexArray(0)
 
     def draw_instanced(
@@ -136,8 +141,22 @@ class QuadPass:
         GL.glBufferData(GL.GL_ARRAY_BUFFER, data.nbytes, data, GL.GL_STREAM_DRAW)
         with cloud_blending(True, counting):
             GL.glBindVertexArray(self._instance_array)
-            GL.glDrawArraysInstanced(GL.GL_TRIANGLE_STRIP, 0, 4, len(data))
+            if through_air:
+                self._draw_instances_in_cells(uniforms["air_cells"], instances, air[1])
+            else:
+                GL.glDrawArraysInstanced(GL.GL_TRIANGLE_STRIP, 0, 4, len(data))
             GL.glBindVertexArray(0)
+
+    @staticmethod
+    def _draw_instances_in_cells(cells_at: int, instances: np.ndarray, eye: np.ndarray) -> None:
+        """The bound instances seen through the air, in two draws that keep their order: those before the first
+        that needs more than one cell (`air_cells`) whole, the rest cut as finely as the widest of them needs.
+        Sorted far to near, the wide ones are the last few."""
+        cells = air_cells(np.asarray(instances, dtype=np.float64)[:, :12], eye)
+        first_cut = int(np.argmax(cells > 1)) if np.any(cells > 1) else len(cells)
+        _draw_cells(cells_at, 1, first_cut)
+        if first_cut < len(cells):
+            _draw_cells(cells_at, int(cells[first_cut:].max()), len(cells) - first_cut, first_cut)
 
     @staticmethod
     def _see_through(program: int, air: tuple[AirVolume, np.ndarray] | None, counting: bool) -> None:
@@ -153,3 +172,12 @@ class QuadPass:
             GL.glDeleteProgram(program)
         GL.glDeleteVertexArrays(2, [self.vertex_array, self._instance_array])
         GL.glDeleteBuffers(1, [self._instance_buffer])
+
+
+def _draw_cells(cells_at: int, cells: int, count: int, first_instance: int = 0) -> None:
+    """Draw `count` quads (instances from `first_instance`, or the one of the uniforms) each cut into `cells` x
+    `cells` cells of two triangles (shaders/quad.vert.glsl's AIR)."""
+    if count == 0:
+        return
+    GL.glUniform1i(cells_at, cells)
+    GL.glDrawArraysInstancedBaseInstance(GL.GL_TRIANGLES, 0, 6 * cells * cells, count, first_instance)

@@ -12,6 +12,7 @@ terrain's depth from a copy (the target's depth is a renderbuffer, shared with t
 from __future__ import annotations
 
 import functools
+from collections.abc import Callable
 
 import numpy as np
 import trimesh
@@ -25,7 +26,7 @@ from cloudcore.gl.air_volume import AirVolume
 from cloudcore.gl.context import HeadlessContext
 from cloudcore.gl.programs import build_program, set_matrix, set_vec3
 from cloudcore.gl.pyrender_compat import pyrender
-from cloudcore.light.air_between import air_between
+from cloudcore.light.air_between import AirBetween, air_between
 from cloudcore.light.sky_background import SkyBackground
 from cloudcore.light.terrain_light import TerrainLight
 from cloudcore.limits import DRAWN_TERRAIN_KINDS
@@ -53,8 +54,15 @@ def terrain_vertex_colours(normals, base_colour, light: TerrainLight) -> np.ndar
 class WorldPass:
     """Terrain and sky for one terrain and one lighting; rebuild it when either changes."""
 
-    def __init__(self, terrain: Terrain | None, light: TerrainLight, sky: SkyBackground):
-        self._sky = sky
+    def __init__(
+        self,
+        terrain: Terrain | None,
+        light: TerrainLight,
+        sky: SkyBackground,
+        air_for: Callable[[SkyBackground, np.ndarray], AirBetween | None] = air_between,
+    ):
+        """`air_for(sky, eye)`: the air an eye sees through (`air_between`, or the editor's `LiveAir`)."""
+        self._sky, self._air_for = sky, air_for
         self._composite_program = build_program("world")
         self._sky_view_texture = _sky_view_texture(sky) if sky.physical else None
         # core profile draws nothing without a vertex array, even one with no attributes
@@ -148,7 +156,7 @@ class WorldPass:
         GL.glUniform1i(GL.glGetUniformLocation(program, "through_air"), int(terrain_through_air))
         if self._air_volume is None or not through_air:
             return
-        self._air_volume.upload(air_between(self._sky, camera.position))
+        self._air_volume.upload(self._air_for(self._sky, camera.position))
         if not terrain_through_air:
             return
         self._air_volume.bind(program)

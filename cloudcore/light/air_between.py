@@ -41,11 +41,38 @@ class AirBetween:
         )
 
 
-def air_between(sky: SkyBackground, eye_position) -> AirBetween | None:
+def air_between(sky: SkyBackground, eye_position, coarse: bool = False) -> AirBetween | None:
     """The air an eye at `eye_position` (scene metres, y up over the scene's origin) sees through, under `sky`;
-    None under the gradient."""
+    None under the gradient.  The preview's coarse volume where `coarse` or the sky is a preview's."""
     if not sky.physical:
         return None
     view = sky.view
-    eye_altitude = view.altitude_m + float(np.asarray(eye_position, dtype=np.float64)[1])
-    return AirBetween(aerial_perspective_from(view.tables, eye_altitude, view.sun_direction, view.preview))
+    preview = coarse or view.preview
+    return AirBetween(
+        aerial_perspective_from(view.tables, eye_altitude_m(sky, eye_position), view.sun_direction, preview)
+    )
+
+
+def eye_altitude_m(sky: SkyBackground, eye_position) -> float:
+    """The altitude over the sea of an eye at `eye_position` in a scene under the physical `sky`."""
+    return sky.view.altitude_m + float(np.asarray(eye_position, dtype=np.float64)[1])
+
+
+#: the widest angle (radians) one cell of a quad seen through the air spans from the eye: the air is read at the
+#: cells' corners and interpolated between them (shaders/quad.vert.glsl), which is exact only where it changes
+#: linearly; chosen by the split impostor against full 3D (docs/atmosphere.md#aerial-perspective)
+AIR_CELL_ANGLE = np.radians(10.0)
+#: a side's cells at most: a quad around the eye is cut into this many squared
+AIR_MAX_CELLS = 8
+
+
+def air_cells(corners, eye) -> np.ndarray:
+    """(n,) int: the cells a side each quad of `corners` (n, 4, 3: lower left, lower right, upper left, upper
+    right) is cut into so that none spans more than `AIR_CELL_ANGLE` from `eye`, at most `AIR_MAX_CELLS`."""
+    corners = np.asarray(corners, dtype=np.float64).reshape(-1, 4, 3)
+    half_diagonal = 0.5 * np.maximum(
+        np.linalg.norm(corners[:, 3] - corners[:, 0], axis=-1), np.linalg.norm(corners[:, 2] - corners[:, 1], axis=-1)
+    )
+    nearest = np.linalg.norm(corners.mean(axis=1) - np.asarray(eye, dtype=np.float64), axis=-1) - half_diagonal
+    span = np.where(nearest > 0.0, 2.0 * np.arctan2(half_diagonal, np.maximum(nearest, 0.0)), np.pi)
+    return np.clip(np.ceil(span / AIR_CELL_ANGLE), 1, AIR_MAX_CELLS).astype(np.int64)

@@ -8,7 +8,7 @@
 // quad that never took it (7% of the flythrough's clouds, docs/performance.md).
 // ATLAS samples a layer of the impostor atlas within the instance's cell, its
 // weight per instance.  COUNT_FRAGMENTS writes 1 instead.  AIR adds the air between the eye
-// and the quad's plane now to the impostor's part (aerial perspective: never in an impostor's texture, which is
+// and the quad now (quad.vert.glsl's, interpolated) to the impostor's part (aerial perspective: never in an impostor's texture, which is
 // seen from elsewhere; the crossfade's layer has it already, per particle, from this eye).
 
 #ifdef ATLAS
@@ -22,8 +22,8 @@ uniform float impostor_weight;
 uniform sampler2D layer;
 uniform float layer_weight;
 #ifdef AIR
-#include "aerial_perspective.glsl"
-in vec3 from_eye;
+in vec3 air_transmittance_at;  // quad.vert.glsl's, at the corners of the quad's cells
+in vec3 air_in_scattered_at;
 #endif
 
 in vec2 uv;
@@ -40,7 +40,7 @@ void main()
     vec4 colour = impostor_weight * texture(impostor, uv);
 #endif
 #ifdef AIR
-    colour.rgb = seen_through_air(colour.rgb, colour.a, from_eye);
+    colour.rgb = colour.rgb * air_transmittance_at + colour.a * air_in_scattered_at;
 #endif
 #ifdef CROSSFADE
     colour += layer_weight * texelFetch(layer, ivec2(gl_FragCoord.xy), 0);

@@ -205,6 +205,12 @@ void shade(uint invocation)
 #else
     vec4 colour = harris_colour(p, view_ray) * fade;
 #endif
+#ifdef AIR
+    // the air in front of the particle, by its centre, added where it covers what is behind
+    // (cloudcore.light.air_between): read once for its four corners
+    vec3 air_transmittance, air_in_scattered;
+    air_toward(offset, air_transmittance, air_in_scattered);
+#endif
     for (int k = 0; k < 4; ++k) {
         vec3 corner = offset + radius * (CORNERS[k].x * right + CORNERS[k].y * up);
         instances[slot].corners[k] = vec4(corner, p.sprite.x);
@@ -214,8 +220,7 @@ void shade(uint invocation)
         vec4 seen = colour;
 #endif
 #ifdef AIR
-        // the air in front of the particle, added where it covers what is behind (cloudcore.light.air_between)
-        seen.rgb = seen_through_air(seen.rgb, seen.a, offset);
+        seen.rgb = seen.rgb * air_transmittance + seen.a * air_in_scattered;
 #endif
         instances[slot].colours[k] = seen;
     }
