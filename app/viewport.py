@@ -27,6 +27,7 @@ from cloudcore.gl.context import WindowContext
 from cloudcore.gl.frame import FrameRenderer
 from cloudcore.gl.image_texture import ImageTexture
 from cloudcore.light.illumination import IlluminationCache
+from cloudcore.light.live_air import LiveAir
 from cloudcore.light.relighting import EXACT_METHOD, PREVIEW_METHOD, LiveIllumination, Look
 from cloudcore.measure.heatmap import heat_image, ramp_colours
 from cloudcore.measure.overlays import impostor_outlines, ring_outlines, to_pixels
@@ -62,6 +63,7 @@ class Viewport:
         self.regenerations_total = 0
         self.relighting = LiveIllumination(IlluminationCache())
         self.relighting.start()
+        self.air = LiveAir()
         self._last_inputs, self._last_stats = None, None  # what the picture shown was drawn from, and its stats
         #: the last frame showed the picture before it again and no path is playing: nothing moves on its own
         self.at_rest = False
@@ -84,11 +86,14 @@ class Viewport:
                 context=WindowContext(width, height),
                 illumination=self.relighting.cache,
                 remember_costs=self.remember_costs,
+                air=self.air,
             )
         self.renderer.resize(width, height)
         start = time.perf_counter()
         scene, method = self._scene_as_shown()
-        inputs = (scene, method, editor.camera, editor.settings, editor.scene_time_s, (width, height))
+        # an exact aerial-perspective volume built since (`LiveAir`) draws the picture again
+        air_built = self.air.built
+        inputs = (scene, method, editor.camera, editor.settings, editor.scene_time_s, (width, height), air_built)
         plan = self.renderer.last_plan
         if (
             inputs == self._last_inputs
@@ -269,3 +274,4 @@ class Viewport:
             self.renderer.close()
             self.renderer = None
         self.relighting.close()
+        self.air.close()

@@ -218,6 +218,15 @@ class RenderSettings:
         help="multisample the terrain and objects 4x: smooth edges against the sky, for twice the world pass's time",
         label="Antialiased world",
     )
+    #: under the physical sky, the air between the eye and the terrain, objects' ground and clouds
+    #: (`cloudcore.light.air_between`, docs/atmosphere.md); off, everything is drawn as if the air were empty in
+    #: front of it, as before (for comparison and its cost: scripts/bench_aerial.py)
+    aerial_perspective: bool = _setting(
+        True,
+        flag="--no-aerial-perspective",
+        help="under the physical sky, draw the terrain and the clouds through the air between them and the eye",
+        label="Aerial perspective",
+    )
     #: "plain": premultiplied billboards (ONE, ONE_MINUS_SRC_ALPHA); "volume": Yusov's volume-aware
     #: blending (HPG 2014, 5.5), intersecting particles composited as volumes by a tiled compute pass
     #: where the GL has compute shaders (plain otherwise).  Plain by default: the goldens are its
@@ -302,7 +311,14 @@ class RenderSettings:
             problems.append(f"ring_elevation_deg must be within (0, 90), got {self.ring_elevation_deg}")
         if not (isinstance(self.ring_fade_frames, int) and self.ring_fade_frames >= 1):
             problems.append(f"ring_fade_frames must be an integer >= 1, got {self.ring_fade_frames!r}")
-        for name in ("split_objects", "group_clouds", "groups_apart_in_motion", "point_sprites", "world_antialiasing"):
+        for name in (
+            "split_objects",
+            "group_clouds",
+            "groups_apart_in_motion",
+            "point_sprites",
+            "world_antialiasing",
+            "aerial_perspective",
+        ):
             if not isinstance(getattr(self, name), bool):
                 problems.append(f"{name} must be true or false, got {getattr(self, name)!r}")
         if problems:

@@ -3,8 +3,9 @@
     python scripts/bench_sky.py [SCENE] [--sizes 640x480,1280x800] [--repeat 15] [--json out/bench_sky.json]
 
 The tables: the transmittance and multiple-scattering tables (built once per air, shipped for the default
-one), the sky-view table (built when the sun or the air changes: each new time of day) and a new sky's
-upward irradiance, each the best of three builds.  The world pass of the scene's view at each size, under the
+one), the sky-view table (built when the sun or the air changes: each new time of day), a new sky's
+upward irradiance, and the aerial-perspective volume for the view's eye (each new sun, air or eye altitude) and
+its preview, each the best of three builds.  The world pass of the scene's view at each size, under the
 two skies in turns (so both see the same machine load), the median of 2 * --repeat draws each: with the
 scene's terrain (the sky is skipped where the terrain covers the pixel) and without (the sky on every
 pixel); the physical sky's cost is the difference.
@@ -24,12 +25,14 @@ os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 
 from OpenGL import GL  # noqa: E402  (after the platform above)
 
-from cloudcore.atmosphere import multiple_scattering, sky_view, transmittance  # noqa: E402
+from cloudcore.atmosphere import aerial_perspective, multiple_scattering, sky_view, transmittance  # noqa: E402
+from cloudcore.atmosphere.sky import atmosphere_tables  # noqa: E402
 from cloudcore.camera import projection_matrix, view_matrix  # noqa: E402
 from cloudcore.gl.frame import FrameRenderer  # noqa: E402
 from cloudcore.gl.world import WorldPass  # noqa: E402
 from cloudcore.light.lighting import atmosphere_parameters, scene_lights  # noqa: E402
 from cloudcore.light.sky_background import scene_sky  # noqa: E402
+from cloudcore.light.terrain_light import terrain_light  # noqa: E402
 from cloudcore.measure.benchmark import machine, write_report  # noqa: E402
 from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
 from cloudcore.scene import Air  # noqa: E402
@@ -58,10 +61,16 @@ def table_costs(scene) -> dict:
     sky_view_ms, table = best_of(
         lambda: sky_view.build_sky_view_table(params, transmittance_table, multiple_table, altitude, sun[1])
     )
+    tables = atmosphere_tables(params)
+    eye_altitude = altitude + scene.camera.position[1]
+    aerial_ms, _ = best_of(lambda: aerial_perspective.build_aerial_perspective(tables, eye_altitude, sun))
+    preview_ms, _ = best_of(lambda: aerial_perspective.build_aerial_perspective(tables, eye_altitude, sun, True))
     return {
         "transmittance_table_ms": transmittance_ms,
         "multiple_scattering_table_ms": multiple_ms,
         "sky_view_table_ms": sky_view_ms,
+        "aerial_perspective_volume_ms": aerial_ms,
+        "aerial_perspective_preview_volume_ms": preview_ms,
     }
 
 
@@ -81,13 +90,16 @@ def world_pass_ms(context, world, camera, repeat: int) -> list[float]:
 def world_costs(scene, width: int, height: int, repeat: int) -> dict:
     """The world pass's median time under each sky, drawn in turns in one context: with the scene's terrain, and
     without (the sky on every pixel: its whole cost)."""
-    lights, ambient = scene_lights(scene.lighting)
-    skies = {sky: scene_sky(dataclasses.replace(scene.lighting, air=Air(sky=sky))) for sky in ("gradient", "physical")}
+    lightings = {sky: dataclasses.replace(scene.lighting, air=Air(sky=sky)) for sky in ("gradient", "physical")}
+    skies = {sky: (lighting, scene_sky(lighting)) for sky, lighting in lightings.items()}
     row = {"size": f"{width}x{height}"}
     with FrameRenderer(width, height) as renderer:
         context = renderer.context
         for terrain, label in ((scene.terrain, "terrain_and_sky"), (None, "sky_alone")):
-            passes = {sky: WorldPass(terrain, lights, ambient, background) for sky, background in skies.items()}
+            passes = {
+                sky: WorldPass(terrain, terrain_light(lighting, *scene_lights(lighting)), background)
+                for sky, (lighting, background) in skies.items()
+            }
             times = {sky: [] for sky in passes}
             for _ in range(repeat):
                 for sky, world in passes.items():

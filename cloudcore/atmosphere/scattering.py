@@ -58,7 +58,9 @@ def march(params: AtmosphereParameters, r, mu, distance, samples: int) -> RayMar
     """Sample the rays from radius `r` at cosine `mu` to the up over `distance` (broadcast together)."""
     r, mu, distance = np.broadcast_arrays(*(np.asarray(v, dtype=np.float64) for v in (r, mu, distance)))
     t, dt = ray_samples(r, mu, distance, samples)
-    radius = radius_along(r[..., None], mu[..., None], t)
+    # a ray marched past the ground (aerial perspective's toward a surface over the curved planet's horizon)
+    # meets the air at the ground's density there, not an exponential's extrapolation
+    radius = np.maximum(radius_along(r[..., None], mu[..., None], t), params.bottom_radius_m)
     altitude = radius - params.bottom_radius_m
     rayleigh, mie = scattering_coefficients(params, altitude)
     extinction = extinction_coefficient(params, altitude)

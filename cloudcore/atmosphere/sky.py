@@ -78,6 +78,8 @@ class SkyView:
     altitude_m: float
     sun_direction: np.ndarray  # (3,) unit, toward the sun
     table: np.ndarray  # (108, 192, 3)
+    #: a dragged slider's coarser sky (`sky_seen_from`), whose air between the eye and what it sees is coarser too
+    preview: bool = False
 
     def radiance(self, directions) -> np.ndarray:
         """(..., 3): the sky's radiance along unit `directions` (..., 3), the ground's below the horizon."""
@@ -98,7 +100,7 @@ def _sky_view(params: AtmosphereParameters, altitude_m: float, sun_direction: tu
     table = sky_view.build_sky_view_table(
         params, tables.transmittance, tables.multiple_scattering, altitude_m, float(sun[1]), preview
     )
-    return SkyView(tables, altitude_m, sun, table)
+    return SkyView(tables, altitude_m, sun, table, preview)
 
 
 def sky_irradiance(tables: AtmosphereTables, altitude_m: float, sun_direction, rings: int = 16, sectors: int = 16):

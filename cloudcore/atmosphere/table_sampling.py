@@ -42,3 +42,20 @@ def sample_bilinear(table: np.ndarray, u, v) -> np.ndarray:
         for offset, weight in zip((0, step_x, step_y, step_x + step_y), weights, strict=True)
     )
     return result.reshape(*x.shape, channels)
+
+
+def sample_trilinear(volume: np.ndarray, u, v, w) -> np.ndarray:
+    """(..., channels): `volume` (depth, height, width, channels) at (u, v, w) (...), trilinear, clamped to the
+    edge texels as a GPU samples a 3D texture: the two slices around w bilinear, then mixed."""
+    depth = volume.shape[0]
+    z = np.clip(np.nan_to_num(np.asarray(w, dtype=np.float64)) * depth - 0.5, 0.0, depth - 1.0)
+    z0 = np.minimum(z.astype(np.int64), max(depth - 2, 0))
+    fz = (z - z0)[..., None]
+    z1 = np.minimum(z0 + 1, depth - 1)
+    # the slices as one table of stacked rows: slice k's row y is row k * height + y
+    height = volume.shape[1]
+    stacked = volume.reshape(depth * height, *volume.shape[2:])
+    v = np.clip(np.nan_to_num(np.asarray(v, dtype=np.float64)), 0.5 / height, 1.0 - 0.5 / height)
+    near = sample_bilinear(stacked, u, (z0 * height + v * height) / (depth * height))
+    far = sample_bilinear(stacked, u, (z1 * height + v * height) / (depth * height))
+    return (1.0 - fz) * near + fz * far

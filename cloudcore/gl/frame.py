@@ -40,6 +40,7 @@ from cloudcore.artist.particle_styles import particle_styles
 from cloudcore.camera import NEAR_PLANE_M, frustum_planes, projection_matrix, view_matrix
 from cloudcore.colour import linear_to_srgb8
 from cloudcore.field.state import FieldState, update_field
+from cloudcore.gl.air_volume import AirVolume
 from cloudcore.gl.context import HeadlessContext, WindowContext, check_frame_size
 from cloudcore.gl.impostor_atlas import atlas_instances
 from cloudcore.gl.impostor_store import ImpostorStore
@@ -51,11 +52,14 @@ from cloudcore.gl.splats import SplatBatch, SplatPass, SplatSelection, splat_bat
 from cloudcore.gl.targets import TextureTarget, blit_depth, depth_renderbuffer
 from cloudcore.gl.volume_blending import GpuFeatures, VolumeBlendingPass
 from cloudcore.gl.world import WorldPass
+from cloudcore.light.air_between import air_between
 from cloudcore.light.eye_scattering import ParticleBuffer
 from cloudcore.light.illumination import IlluminationCache
 from cloudcore.light.lighting import scene_lights
+from cloudcore.light.live_air import LiveAir
 from cloudcore.light.relighting import PREVIEW_METHOD
 from cloudcore.light.sky_background import scene_sky
+from cloudcore.light.terrain_light import terrain_light
 from cloudcore.light.volume_blending import blending_path
 from cloudcore.lod.costs import CostEstimator, CostModel, remember_fit, remembered_prior
 from cloudcore.lod.impostors import cropped_corners, particle_extent
@@ -87,6 +91,8 @@ class _CloudPassFrame:
     blending: str  # the setting: full-3D splats as billboards ("plain") or as volumes ("volume")
     splat_order: str  # splats chosen and sorted on the "cpu" or the "gpu" (the setting, "auto" resolved)
     compositing: str  # the GPU's plain full-3D splats blended by the "raster" or by "compute" ("auto" resolved)
+    #: the air's volume uploaded for this eye, and the eye, that world-space quads are seen through; None: no air
+    air: tuple[AirVolume, np.ndarray] | None
 
     @property
     def eye(self) -> np.ndarray:
@@ -103,6 +109,7 @@ class FrameRenderer:
         context=None,
         illumination: IlluminationCache | None = None,
         remember_costs: bool = False,
+        air: LiveAir | None = None,
     ):
         """A headless renderer, or with `context` (a `WindowContext`) one inside the current window.
 
@@ -110,7 +117,11 @@ class FrameRenderer:
         that a worker fills in the background (`cloudcore.light.relighting`).  With `remember_costs`, auto
         mode's cost model starts from the one the last such renderer on this machine and GL fitted, and the
         one fitted here is kept for the next when it closes (`cloudcore.lod.costs.remembered_prior`): the
-        editor and the command line; the tests and benchmarks start from the same prior every time."""
+        editor and the command line; the tests and benchmarks start from the same prior every time.
+
+        `air`: the editor's, which gives a coarse aerial-perspective volume while the exact one for a new
+        altitude is built in the background (`cloudcore.light.live_air`); without it a frame waits for the
+        exact one."""
         self.context = context if context is not None else HeadlessContext(width, height)
         self.context.make_current()
         self._splats = SplatPass()
@@ -123,6 +134,7 @@ class FrameRenderer:
         self._particles, self._particles_source = None, None
         self._facings: CloudFacings | None = None
         self._illumination = illumination if illumination is not None else IlluminationCache()
+        self._air_for = air if air is not None else air_between
         #: per cloud, changes whenever that cloud's particle colours may have: its impostor is stale
         self._lighting_keys: tuple = ()
         self._forming_clouds: tuple = ()  # the clouds that form or dissipate, whose colours follow the clock
@@ -268,10 +280,22 @@ class FrameRenderer:
         with clock.frame():
             with clock.timed("world"):
                 antialiased = settings.world_antialiasing
-                self._world.draw(self.context, camera, projection @ view, antialiased=antialiased)
+                self._world.draw(
+                    self.context,
+                    camera,
+                    projection @ view,
+                    antialiased=antialiased,
+                    through_air=settings.aerial_perspective,
+                )
                 if plan.objects_with_world:
                     self._objects.draw(
-                        self.context, camera, poses, plan.objects_with_world, write_depth=True, antialiased=antialiased
+                        self.context,
+                        camera,
+                        poses,
+                        plan.objects_with_world,
+                        write_depth=True,
+                        antialiased=antialiased,
+                        air=self._world.air_volume if settings.aerial_perspective else None,
                     )
             with clock.timed("impostor updates"):
                 rendered = self._impostors.update(plan, particles, settings, time_s, way, self._unit_weights)
@@ -380,7 +404,9 @@ class FrameRenderer:
             self.context.make_current()
             if self._world is not None:
                 self._world.close()
-            self._world = WorldPass(scene.terrain, lights, ambient, scene_sky(lighting, preview))
+            self._world = WorldPass(
+                scene.terrain, terrain_light(lighting, lights, ambient), scene_sky(lighting, preview), self._air_for
+            )
             self._world_source = world_source
         objects_source = (scene.objects, lights, tuple(ambient), self.size)
         if objects_source != self._objects_source:
@@ -476,6 +502,7 @@ class FrameRenderer:
         full-3D draws sorted the way `splat_order` ("cpu" or "gpu"), the GPU's plain ones composited the way
         `compositing` ("raster" or "compute"); returns the particles drawn."""
         view_projection = projection @ view
+        air = self._world.air_volume if settings.aerial_perspective else None
         frame = _CloudPassFrame(
             plan,
             particles,
@@ -490,7 +517,10 @@ class FrameRenderer:
             settings.blending,
             splat_order,
             compositing,
+            None if air is None else (air, np.asarray(camera.position, float)),
         )
+        # the world pass uploaded the air for this eye: the cloud pass's splats take it per particle
+        self._splats.air = air
         self._replay, self._screen_batches = [], []
         steps = self._cloud_pass_steps(frame)
         runs = inside_runs(plan.draw_items, plan.clouds)
@@ -510,7 +540,13 @@ class FrameRenderer:
             elif kind == "object":
                 antialiased = settings.world_antialiasing
                 self._objects.draw(
-                    self.context, camera, poses, [item.index], write_depth=False, antialiased=antialiased
+                    self.context,
+                    camera,
+                    poses,
+                    [item.index],
+                    write_depth=False,
+                    antialiased=antialiased,
+                    air=None if frame.air is None else frame.air[0],
                 )
             elif kind == "inside":
                 if item in screen_impostors:  # the rest of its run is in the same screen impostor
@@ -554,13 +590,16 @@ class FrameRenderer:
         and they are blended as billboards (volume blending reads its batch on the CPU)."""
         if frame.splat_order == "gpu" and frame.blending == "plain":
             clouds, depth_ranges = self._members_and_ranges(frame, items)
-            return SplatSelection(frame.particles, clouds, frame.eye, depth_ranges, frame.time_s, frame.frustum)
+            return SplatSelection(
+                frame.particles, clouds, frame.eye, depth_ranges, frame.time_s, frame.frustum, through_air=True
+            )
         return self._batch_of(frame, items)
 
     def _batch_of(self, frame: _CloudPassFrame, items) -> SplatBatch:
-        """The splats of the units of draw `items`, each within its item's depth range, sorted together."""
+        """The splats of the units of draw `items`, each within its item's depth range, sorted together, seen
+        through the air from the eye (their screen layers and screen impostors are made for this eye alone)."""
         clouds, depth_ranges = self._members_and_ranges(frame, items)
-        return splat_batch(frame.particles, clouds, frame.eye, depth_ranges, frame.time_s, frame.frustum)
+        return splat_batch(frame.particles, clouds, frame.eye, depth_ranges, frame.time_s, frame.frustum, True)
 
     @staticmethod
     def _members_and_ranges(frame: _CloudPassFrame, items) -> tuple[tuple, tuple]:
@@ -652,14 +691,14 @@ class FrameRenderer:
 
     def _draw_instanced(self, frame: _CloudPassFrame, atlas_texture: int, instances: np.ndarray, **crossfade) -> None:
         """Quads from the atlas (`QuadPass.draw_instanced`), depth-tested, in one draw."""
-        self._quads.draw_instanced(instances, frame.view_projection, atlas_texture, **crossfade)
+        self._quads.draw_instanced(instances, frame.view_projection, atlas_texture, air=frame.air, **crossfade)
         self._replay.append(
             lambda: self._quads.draw_instanced(instances, frame.view_projection, atlas_texture, counting=True)
         )
 
     def _draw_quad_run(self, frame: _CloudPassFrame, quads) -> None:
         """World-space quads (corners, texture, weight, uv_rect), depth-tested, one after the other."""
-        self._quads.draw_run(quads, frame.view_projection)
+        self._quads.draw_run(quads, frame.view_projection, air=frame.air)
         self._replay.append(lambda: self._quads.draw_run(quads, frame.view_projection, counting=True))
 
     def _draw_crossfade(self, frame: _CloudPassFrame, item, cloud, batch: SplatBatch) -> int:

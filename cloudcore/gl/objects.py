@@ -17,8 +17,9 @@ import math
 import numpy as np
 from OpenGL import GL
 
-from cloudcore.camera import FAR_PLANE_M, NEAR_PLANE_M, camera_pose
-from cloudcore.gl.programs import build_program
+from cloudcore.camera import FAR_PLANE_M, NEAR_PLANE_M, camera_pose, projection_matrix, view_matrix
+from cloudcore.gl.air_volume import AirVolume
+from cloudcore.gl.programs import build_program, set_matrix, set_vec3
 from cloudcore.gl.pyrender_compat import pyrender
 from cloudcore.light.lighting import active_lights
 from cloudcore.objects import mesh_sphere, object_mesh, object_poses
@@ -54,9 +55,19 @@ class ObjectPass:
     def poses(self, time_s: float):
         return object_poses(self.objects, time_s, self._spheres)
 
-    def draw(self, context, camera: Camera, poses, which, *, write_depth: bool, antialiased: bool = False) -> None:
+    def draw(
+        self,
+        context,
+        camera: Camera,
+        poses,
+        which,
+        *,
+        write_depth: bool,
+        antialiased: bool = False,
+        air: AirVolume | None = None,
+    ) -> None:
         """Composite the objects `which` (indices) at `poses` into the bound frame target (multisampled 4x
-        when `antialiased`)."""
+        when `antialiased`), seen through `air` (uploaded for `camera`'s eye) where there is one."""
         which = set(which)
         for index, (node, pose) in enumerate(zip(self._nodes, poses)):
             node.mesh.is_visible = index in which
@@ -67,11 +78,17 @@ class ObjectPass:
             self._scene, pyrender.RenderFlags.NONE, self._framebuffer, antialiased=antialiased
         )
         GL.glUseProgram(self._program)
-        for unit, (texture, name) in enumerate(((self._colour, "object_colour"), (self._depth, "object_depth"))):
+        # the units objects.frag.glsl declares
+        for unit, texture in enumerate((self._colour, self._depth)):
             GL.glActiveTexture(GL.GL_TEXTURE0 + unit)
             GL.glBindTexture(GL.GL_TEXTURE_2D, texture)
-            GL.glUniform1i(GL.glGetUniformLocation(self._program, name), unit)
         GL.glActiveTexture(GL.GL_TEXTURE0)
+        GL.glUniform1i(GL.glGetUniformLocation(self._program, "through_air"), int(air is not None))
+        if air is not None:
+            air.bind(self._program)
+            view_projection = projection_matrix(camera.fov_y_deg, context.width / context.height) @ view_matrix(camera)
+            set_matrix(self._program, "inverse_view_projection", np.linalg.inv(view_projection))
+            set_vec3(self._program, "eye_position", camera.position)
         GL.glEnable(GL.GL_DEPTH_TEST)
         GL.glDepthFunc(GL.GL_LESS)
         GL.glDepthMask(GL.GL_TRUE if write_depth else GL.GL_FALSE)

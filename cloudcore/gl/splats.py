@@ -33,6 +33,7 @@ from cloudcore.artist.facing import FacingState
 from cloudcore.artist.particle_styles import FACING_SPLAT, ParticleStyles
 from cloudcore.artist.sprites import ATLAS_MAX_MIP_LEVEL, load_atlas
 from cloudcore.cloud_records import ATLAS_GRID
+from cloudcore.gl.air_volume import AirVolume
 from cloudcore.gl.blending import cloud_blending
 from cloudcore.gl.depth_sort import GpuDepthSort, key_bits_for
 from cloudcore.gl.programs import (
@@ -106,6 +107,9 @@ class SplatBatch:
     order: np.ndarray  # (n,) uint32
     eye: np.ndarray
     time_s: float | None
+    #: whether its colours take the air between `eye` and each particle (`SplatPass.air`): the cloud pass's
+    #: draws, not an impostor's, whose texture is seen from elsewhere
+    through_air: bool = False
 
     def __len__(self) -> int:
         return len(self.order)
@@ -145,6 +149,7 @@ class SplatSelection:
     time_s: float | None
     frustum: np.ndarray | None
     cells: tuple | None = None
+    through_air: bool = False  # as `SplatBatch.through_air`
 
     def __post_init__(self):
         if self.cells is not None and (
@@ -177,7 +182,9 @@ class SplatSelection:
 
     def on_cpu(self) -> SplatBatch:
         """The same particles chosen and sorted on the CPU, for what reads them there (overdraw's estimate)."""
-        return splat_batch(self.particles, self.clouds, self.eye, self.depth_ranges, self.time_s, self.frustum)
+        return splat_batch(
+            self.particles, self.clouds, self.eye, self.depth_ranges, self.time_s, self.frustum, self.through_air
+        )
 
 
 def splat_batch(
@@ -187,6 +194,7 @@ def splat_batch(
     depth_ranges=None,
     time_s: float | None = None,
     frustum: np.ndarray | None = None,
+    through_air: bool = False,
 ) -> SplatBatch:
     """The visible particles of `clouds` (indices), sorted far to near from `eye`.
 
@@ -195,6 +203,7 @@ def splat_batch(
     `time_s`, the scene clock, fades forming and dissipating clouds (`ParticleBuffer.seen_from`), and
     the buffer's blend weights fade a cloud field's rings.
     `frustum`, the draw's planes (`cloudcore.camera.frustum_planes`), leaves out the splats outside it.
+    `through_air`: `SplatBatch.through_air`.
     """
     starts = particles.cloud_starts
     # a cloud's particles are contiguous: slices gather them faster than an index array does
@@ -214,7 +223,7 @@ def splat_batch(
         radii = np.concatenate([particles.radii[piece] for piece in pieces]) if pieces else np.zeros(0)
         kept &= splats_in_frustum(frustum, centres, radii)
     indices, distances = indices[kept], distances[kept]
-    return SplatBatch(particles, indices[far_to_near(distances)].astype(np.uint32), eye, time_s)
+    return SplatBatch(particles, indices[far_to_near(distances)].astype(np.uint32), eye, time_s, through_air)
 
 
 #: a batch's instances start at a multiple of this many slots: 256 bytes, the largest offset alignment of a
@@ -229,7 +238,7 @@ def _slots(count: int) -> int:
 
 #: splat_shade.comp.glsl's optional code, in the order of a variant's key: sprites that do not lie in the
 #: image plane, Wang's artist colours, Yusov's eye-pass profiles
-_SHADE_FEATURES = ("FACING", "ARTIST", "PROFILES")
+_SHADE_FEATURES = ("FACING", "ARTIST", "PROFILES", "AIR")
 
 
 class SplatPass:
@@ -259,6 +268,9 @@ class SplatPass:
         #: the compute shader's variants by the features a batch has (`_SHADE_FEATURES`), made when first
         #: needed: (program, its uniforms' locations, the particles its light uniforms are of)
         self._shade_programs: dict[tuple, list] = {}
+        #: the frame's air (`cloudcore.gl.air_volume`), uploaded for its eye, which batches `through_air` take;
+        #: None: no air (the gradient sky)
+        self.air: AirVolume | None = None
         self._vertex_array = GL.glGenVertexArrays(1)
         (
             self._corner_index_buffer,
@@ -692,6 +704,8 @@ class SplatPass:
         program, uniforms = self._shade_program(features)
         first, end = run[0][2], run[-1][2] + run[-1][0].slots
         GL.glUseProgram(program)
+        if features[_SHADE_FEATURES.index("AIR")]:
+            self.air.bind(program)
         GL.glUniform1ui(uniforms["first"], first)
         GL.glUniform1ui(uniforms["slot_count"], end - first)
         GL.glUniform1ui(uniforms["batch_count"], len(rows))
@@ -831,16 +845,16 @@ class SplatPass:
             _store(self._drawn_bits_buffer, np.append(particles.drawn_bits, np.uint32(0)))
             self._resident, self._formation_time = particles, None
 
-    def _features(self, batch: SplatBatch | SplatSelection) -> tuple[bool, bool, bool]:
+    def _features(self, batch: SplatBatch | SplatSelection) -> tuple[bool, bool, bool, bool]:
         """The shader features (`_SHADE_FEATURES`) `batch`'s particles need."""
         self._make_resident(batch.particles)
         if isinstance(batch, SplatSelection):
             bits = int(np.bitwise_or.reduce(self._cloud_feature_bits[list(batch.clouds)]))
         else:
             bits = int(np.bitwise_or.reduce(self._feature_bits[batch.order])) if len(batch) else 0
-        return bool(bits & 1), bool(bits & 2), self._profiled
+        return bool(bits & 1), bool(bits & 2), self._profiled, batch.through_air and self.air is not None
 
-    def _shade_program(self, features: tuple[bool, bool, bool]) -> tuple[int, dict]:
+    def _shade_program(self, features: tuple[bool, bool, bool, bool]) -> tuple[int, dict]:
         """The compute shader variant with `features`, its light uniforms those of the resident particles; and
         its uniforms' locations."""
         if features not in self._shade_programs:

@@ -1,15 +1,18 @@
-"""The world pass: terrain through pyrender (flat, lighting baked per vertex) over the sky.
+"""The world pass: terrain through pyrender (flat, its light baked per vertex) over the sky, seen through the air.
 
 pyrender's PBR shader costs 70-90 ms a frame on llvmpipe; baking the lights into
 vertex colours and drawing with RenderFlags.FLAT costs about a quarter of that
 (measured: /work/shared/ENVIRONMENT.md).  pyrender writes the depth buffer the
 cloud pass tests against; one full-screen pass then composites its colour over
-the sky gradient into the linear target (shaders/world.frag.glsl).
+the sky into the linear target (shaders/world.frag.glsl).  Under the physical sky that pass also
+adds the air between the eye and the terrain (aerial perspective, `cloudcore.light.air_between`): it reads the
+terrain's depth from a copy (the target's depth is a renderbuffer, shared with the cloud passes' targets).
 """
 
 from __future__ import annotations
 
 import functools
+from collections.abc import Callable
 
 import numpy as np
 import trimesh
@@ -19,14 +22,20 @@ from cloudcore.atmosphere.geometry import horizon_cosine
 from cloudcore.atmosphere.sky_view import eye_radius, horizon_angles
 from cloudcore.camera import FAR_PLANE_M, NEAR_PLANE_M, camera_pose
 from cloudcore.colour import srgb_encode
+from cloudcore.gl.air_volume import AirVolume
 from cloudcore.gl.context import HeadlessContext
 from cloudcore.gl.programs import build_program, set_matrix, set_vec3
 from cloudcore.gl.pyrender_compat import pyrender
-from cloudcore.light.lighting import active_lights
+from cloudcore.light.air_between import AirBetween, air_between
 from cloudcore.light.sky_background import SkyBackground
+from cloudcore.light.terrain_light import TerrainLight
 from cloudcore.limits import DRAWN_TERRAIN_KINDS
 from cloudcore.scene import Camera, Terrain
 from cloudcore.terrain import heightfield_mesh
+
+#: the terrain's depth's texture unit, as world.frag.glsl declares it (the world's colour 0, the sky-view table 1,
+#: the air's volume `AIR_UNITS`)
+_DEPTH_UNIT = 2
 
 
 @functools.lru_cache(maxsize=2)
@@ -37,34 +46,41 @@ def terrain_geometry(terrain: Terrain) -> tuple[np.ndarray, np.ndarray, np.ndarr
     return vertices, faces, trimesh.Trimesh(vertices, faces, process=False).vertex_normals
 
 
-def terrain_vertex_colours(normals, base_colour, lights, ambient) -> np.ndarray:
-    """Linear RGB per vertex: base * (ambient + sum over lights of colour * intensity * max(0, n.l))."""
-    irradiance = np.broadcast_to(np.asarray(ambient, dtype=np.float64), (len(normals), 3)).copy()
-    for light in active_lights(lights):
-        cosine = np.maximum(normals @ np.asarray(light.direction, dtype=np.float64), 0.0)
-        irradiance += cosine[:, None] * np.asarray(light.color) * light.intensity
-    return np.asarray(base_colour, dtype=np.float64) * irradiance
+def terrain_vertex_colours(normals, base_colour, light: TerrainLight) -> np.ndarray:
+    """Linear RGB per vertex: base * the irradiance `light` gives each vertex's normal."""
+    return np.asarray(base_colour, dtype=np.float64) * light.irradiance(normals)
 
 
 class WorldPass:
     """Terrain and sky for one terrain and one lighting; rebuild it when either changes."""
 
-    def __init__(self, terrain: Terrain | None, lights, ambient, sky: SkyBackground):
-        self._sky = sky
+    def __init__(
+        self,
+        terrain: Terrain | None,
+        light: TerrainLight,
+        sky: SkyBackground,
+        air_for: Callable[[SkyBackground, np.ndarray], AirBetween | None] = air_between,
+    ):
+        """`air_for(sky, eye)`: the air an eye sees through (`air_between`, or the editor's `LiveAir`)."""
+        self._sky, self._air_for = sky, air_for
         self._composite_program = build_program("world")
         self._sky_view_texture = _sky_view_texture(sky) if sky.physical else None
         # core profile draws nothing without a vertex array, even one with no attributes
         self._fullscreen_vertex_array = GL.glGenVertexArrays(1)
         self._scene = None
         if terrain is not None:
-            self._scene, self._camera_node = self._terrain_scene(terrain, lights, ambient)
+            self._scene, self._camera_node = self._terrain_scene(terrain, light)
+        # the air's volume under the physical sky (the cloud pass reads it too: `air_volume`), and the terrain's
+        # depth, which the terrain is seen through it by
+        self._air_volume = AirVolume() if sky.physical else None
+        self._depth_copy, self._depth_copy_size = None, None
 
     @staticmethod
-    def _terrain_scene(terrain: Terrain, lights, ambient):
+    def _terrain_scene(terrain: Terrain, light: TerrainLight):
         if terrain.kind not in DRAWN_TERRAIN_KINDS:  # the scene loader refuses these first (cloudcore.limits)
             raise ValueError(f"the GL prototype draws heightfield terrain only, not {terrain.kind!r}")
         vertices, faces, normals = terrain_geometry(terrain)
-        colours = terrain_vertex_colours(normals, terrain.color, lights, ambient)
+        colours = terrain_vertex_colours(normals, terrain.color, light)
         # encoded, because pyrender's 8-bit framebuffer would band linear colour in the shadows
         primitive = pyrender.Primitive(
             positions=vertices.astype(np.float32),
@@ -77,10 +93,16 @@ class WorldPass:
         return scene, scene.add(camera)
 
     def draw(
-        self, context: HeadlessContext, camera: Camera, view_projection: np.ndarray, *, antialiased: bool = False
+        self,
+        context: HeadlessContext,
+        camera: Camera,
+        view_projection: np.ndarray,
+        *,
+        antialiased: bool = False,
+        through_air: bool = True,
     ) -> None:
         """Fill the render target: terrain colour and depth where there is terrain, sky elsewhere (the terrain
-        multisampled 4x when `antialiased`)."""
+        multisampled 4x when `antialiased`, seen through the air under the physical sky when `through_air`)."""
         if self._scene is None:
             context.clear_world()
         else:
@@ -92,9 +114,9 @@ class WorldPass:
         GL.glUseProgram(program)
         GL.glActiveTexture(GL.GL_TEXTURE0)
         GL.glBindTexture(GL.GL_TEXTURE_2D, context.world_texture)
-        GL.glUniform1i(GL.glGetUniformLocation(program, "world_texture"), 0)
         set_matrix(program, "inverse_view_projection", np.linalg.inv(view_projection))
         self._set_sky_uniforms(program, camera)
+        self._set_air_uniforms(program, context, camera, through_air)
         GL.glDisable(GL.GL_BLEND)
         GL.glDisable(GL.GL_CULL_FACE)
         GL.glDisable(GL.GL_DEPTH_TEST)  # colour everywhere; the depth pyrender wrote stays
@@ -114,7 +136,6 @@ class WorldPass:
         _, zenith_horizon = horizon_angles(params, r)
         GL.glActiveTexture(GL.GL_TEXTURE1)
         GL.glBindTexture(GL.GL_TEXTURE_2D, self._sky_view_texture)
-        GL.glUniform1i(GL.glGetUniformLocation(program, "sky_view_table"), 1)
         height, width = sky.view.table.shape[:2]
         GL.glUniform2f(GL.glGetUniformLocation(program, "sky_view_size"), float(width), float(height))
         GL.glUniform1f(GL.glGetUniformLocation(program, "zenith_horizon_angle"), float(zenith_horizon))
@@ -130,10 +151,50 @@ class WorldPass:
         )
         GL.glActiveTexture(GL.GL_TEXTURE0)
 
+    def _set_air_uniforms(self, program: int, context: HeadlessContext, camera: Camera, through_air: bool) -> None:
+        terrain_through_air = through_air and self._air_volume is not None and self._scene is not None
+        GL.glUniform1i(GL.glGetUniformLocation(program, "through_air"), int(terrain_through_air))
+        if self._air_volume is None or not through_air:
+            return
+        self._air_volume.upload(self._air_for(self._sky, camera.position))
+        if not terrain_through_air:
+            return
+        self._air_volume.bind(program)
+        GL.glActiveTexture(GL.GL_TEXTURE0 + _DEPTH_UNIT)
+        GL.glBindTexture(GL.GL_TEXTURE_2D, self._copy_depth(context))
+        GL.glActiveTexture(GL.GL_TEXTURE0)
+        set_vec3(program, "eye_position", camera.position)
+
+    @property
+    def air_volume(self) -> AirVolume | None:
+        """The air's volume as the last `draw` uploaded it, for its eye; None under the gradient sky."""
+        return self._air_volume
+
+    def _copy_depth(self, context: HeadlessContext) -> int:
+        """The depth pyrender wrote, copied into a texture of the target's size (made at the first draw and
+        whenever that size changes); the target stays bound."""
+        size = (context.width, context.height)
+        if self._depth_copy_size != size:
+            if self._depth_copy is not None:
+                GL.glDeleteTextures([self._depth_copy])
+            self._depth_copy = GL.glGenTextures(1)
+            GL.glBindTexture(GL.GL_TEXTURE_2D, self._depth_copy)
+            GL.glTexStorage2D(GL.GL_TEXTURE_2D, 1, GL.GL_DEPTH_COMPONENT24, *size)
+            GL.glTexParameteri(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_MIN_FILTER, GL.GL_NEAREST)
+            GL.glTexParameteri(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_MAG_FILTER, GL.GL_NEAREST)
+            self._depth_copy_size = size
+        GL.glBindTexture(GL.GL_TEXTURE_2D, self._depth_copy)
+        GL.glCopyTexSubImage2D(GL.GL_TEXTURE_2D, 0, 0, 0, 0, 0, *size)
+        return self._depth_copy
+
     def close(self) -> None:
         """Free the GL objects (the context must be current); pyrender frees the mesh with its context."""
         if self._sky_view_texture is not None:
             GL.glDeleteTextures([self._sky_view_texture])
+        if self._air_volume is not None:
+            self._air_volume.close()
+        if self._depth_copy is not None:
+            GL.glDeleteTextures([self._depth_copy])
         GL.glDeleteProgram(self._composite_program)
         GL.glDeleteVertexArrays(1, [self._fullscreen_vertex_array])
 

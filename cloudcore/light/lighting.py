@@ -113,17 +113,27 @@ def daylight(hours: float, air: Air = Air()) -> tuple[tuple[Light, ...], np.ndar
     return lights, ambient
 
 
+def physical_irradiances(hours: float, air: Air) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(the sun's direction, its irradiance reaching the scene's origin, the sky's on an upward surface there)
+    at `hours`, each (3,), irradiances in the renderer's values."""
+    direction = sun_direction(hours)
+    tables = atmosphere_tables(atmosphere_parameters(air))
+    sky = PHYSICAL_EXPOSURE * sky_irradiance(tables, air.origin_altitude_m, direction)
+    return direction, physical_sun(hours, air), sky
+
+
+def ground_irradiance(direction, sun, sky) -> np.ndarray:
+    """(3,): the irradiance on the level ground under the sun toward `direction` and the sky."""
+    return sun * max(float(direction[1]), 0.0) + sky
+
+
 def _physical_daylight(hours: float, air: Air) -> tuple[tuple[Light, ...], np.ndarray]:
     """The atmosphere's light: the sun's beam, the sky's irradiance on an upward surface as the skylight
     from the zenith, and as the ambient the light the ground reflects (a Lambertian ground of the air's
     albedo under both) spread over the whole sphere, half of it below: the skylight gives the clouds'
     tops their share of the sky, the ambient their undersides theirs of the ground."""
-    direction = sun_direction(hours)
-    sun = physical_sun(hours, air)
-    tables = atmosphere_tables(atmosphere_parameters(air))
-    sky = PHYSICAL_EXPOSURE * sky_irradiance(tables, air.origin_altitude_m, direction)
-    ground_irradiance = sun * max(float(direction[1]), 0.0) + sky
-    ambient = NIGHT_AMBIENT + 0.5 * air.ground_albedo * ground_irradiance
+    direction, sun, sky = physical_irradiances(hours, air)
+    ambient = NIGHT_AMBIENT + 0.5 * air.ground_albedo * ground_irradiance(direction, sun, sky)
     lights = (_light(direction, sun), _light((0.0, 1.0, 0.0), sky))
     return lights, ambient
 

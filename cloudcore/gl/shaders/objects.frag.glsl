@@ -1,12 +1,17 @@
-#version 330 core
+#version 420 core
 // pyrender's picture of some objects, composited into the linear frame at their own depth.
 //
 // pyrender wrote pow(linear, 1/2.2) over transparent black and multisample
 // resolve averaged it with the background: a pixel holds (coverage * encoded,
-// coverage).  The depth test (against the frame's depth) keeps terrain in front.
+// coverage).  The depth test (against the frame's depth) keeps terrain in front.  Under the physical sky
+// they are seen through the air between them and the eye (aerial_perspective.glsl), as the terrain is.
 
-uniform sampler2D object_colour;
-uniform sampler2D object_depth;
+layout(binding = 0) uniform sampler2D object_colour;
+layout(binding = 1) uniform sampler2D object_depth;
+uniform bool through_air;
+uniform mat4 inverse_view_projection;
+uniform vec3 eye_position;
+#include "aerial_perspective.glsl"
 
 in vec2 ndc;
 out vec4 frag_colour;
@@ -17,7 +22,13 @@ void main()
     vec4 objects = texelFetch(object_colour, texel, 0);
     if (objects.a <= 0.0)
         discard;
-    gl_FragDepth = texelFetch(object_depth, texel, 0).r;
+    float depth = texelFetch(object_depth, texel, 0).r;
+    gl_FragDepth = depth;
     // premultiplied by coverage, as the blend expects
-    frag_colour = vec4(pow(objects.rgb / objects.a, vec3(2.2)) * objects.a, objects.a);
+    vec3 colour = pow(objects.rgb / objects.a, vec3(2.2)) * objects.a;
+    if (through_air) {
+        vec4 point = inverse_view_projection * vec4(ndc, 2.0 * depth - 1.0, 1.0);
+        colour = seen_through_air(colour, objects.a, point.xyz / point.w - eye_position);
+    }
+    frag_colour = vec4(colour, objects.a);
 }

@@ -1,4 +1,4 @@
-#version 330 core
+#version 420 core
 // Premultiplied colour from an impostor texture, scaled by its share of the
 // cloud's opacity, plus (in a crossfade) the full-3D image of the same cloud
 // from a screen-sized layer scaled by the rest: a linear mix of two
@@ -7,7 +7,9 @@
 // layer: behind a branch on a uniform, llvmpipe paid for the fetch on every
 // quad that never took it (7% of the flythrough's clouds, docs/performance.md).
 // ATLAS samples a layer of the impostor atlas within the instance's cell, its
-// weight per instance.  COUNT_FRAGMENTS writes 1 instead.
+// weight per instance.  COUNT_FRAGMENTS writes 1 instead.  AIR adds the air between the eye
+// and the quad now (quad.vert.glsl's, interpolated) to the impostor's part (aerial perspective: never in an impostor's texture, which is
+// seen from elsewhere; the crossfade's layer has it already, per particle, from this eye).
 
 #ifdef ATLAS
 uniform sampler2DArray impostor;
@@ -19,6 +21,10 @@ uniform float impostor_weight;
 #endif
 uniform sampler2D layer;
 uniform float layer_weight;
+#ifdef AIR
+in vec3 air_transmittance_at;  // quad.vert.glsl's, at the corners of the quad's cells
+in vec3 air_in_scattered_at;
+#endif
 
 in vec2 uv;
 out vec4 frag_colour;
@@ -32,6 +38,9 @@ void main()
     vec4 colour = weight_layer.x * texture(impostor, vec3(clamp(uv, clamp_rect.xy, clamp_rect.zw), weight_layer.y));
 #else
     vec4 colour = impostor_weight * texture(impostor, uv);
+#endif
+#ifdef AIR
+    colour.rgb = colour.rgb * air_transmittance_at + colour.a * air_in_scattered_at;
 #endif
 #ifdef CROSSFADE
     colour += layer_weight * texelFetch(layer, ivec2(gl_FragCoord.xy), 0);

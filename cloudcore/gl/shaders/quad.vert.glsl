@@ -1,4 +1,4 @@
-#version 330 core
+#version 420 core
 // A textured quad from four corners (no vertex buffer): impostors and ring
 // panels in world space, screen impostors in clip space (with an identity
 // view_projection).  Triangle-strip order: lower left, lower right, upper
@@ -6,7 +6,10 @@
 // (u0, v0, u1, v1): the part of the texture the corners cover.  The corners
 // and uv_rect are uniforms, one quad a draw; with ATLAS they come per
 // instance, a run of impostors from the atlas (cloudcore.gl.impostor_atlas)
-// one draw, with the rectangle of its cell to clamp to and its layer.
+// one draw, with the rectangle of its cell to clamp to and its layer.  AIR: world-space
+// quads seen through the air from where the eye is now, read at the corners of air_cells x air_cells
+// cells cut from the quad (6 vertices a cell, as triangles) and interpolated: a wide quad's corners are
+// farther than its middle, so a near one takes more cells (cloudcore.light.air_between.air_cells).
 
 #ifdef ATLAS
 layout(location = 0) in vec3 corner_0;
@@ -23,6 +26,15 @@ uniform vec3 corners[4];
 uniform vec4 uv_rect;
 #endif
 uniform mat4 view_projection;
+#ifdef AIR
+#include "aerial_perspective.glsl"
+uniform vec3 eye_position;
+uniform int air_cells;
+out vec3 air_transmittance_at;  // the air between the eye and the vertex, applied in quad.frag.glsl
+out vec3 air_in_scattered_at;
+// a cell's two triangles, as (column, row) steps from its lower left corner
+const vec2 CELL_CORNERS[6] = vec2[6](vec2(0, 0), vec2(1, 0), vec2(0, 1), vec2(0, 1), vec2(1, 0), vec2(1, 1));
+#endif
 
 out vec2 uv;
 
@@ -34,6 +46,15 @@ void main()
     clamp_rect = instance_clamp_rect;
     weight_layer = instance_weight_layer;
 #endif
-    uv = mix(uv_rect.xy, uv_rect.zw, vec2(gl_VertexID & 1, gl_VertexID >> 1));
-    gl_Position = view_projection * vec4(corners[gl_VertexID], 1.0);
+#ifdef AIR
+    int cell = gl_VertexID / 6;
+    vec2 along = (vec2(cell % air_cells, cell / air_cells) + CELL_CORNERS[gl_VertexID % 6]) / float(air_cells);
+    vec3 point = mix(mix(corners[0], corners[1], along.x), mix(corners[2], corners[3], along.x), along.y);
+    air_toward(point - eye_position, air_transmittance_at, air_in_scattered_at);
+#else
+    vec2 along = vec2(gl_VertexID & 1, gl_VertexID >> 1);
+    vec3 point = corners[gl_VertexID];
+#endif
+    uv = mix(uv_rect.xy, uv_rect.zw, along);
+    gl_Position = view_projection * vec4(point, 1.0);
 }

@@ -25,8 +25,10 @@
 // by their rotation.  Corners are written relative to the eye, so float32
 // keeps tiny particles far from the origin their size.
 //
-// Variants: FACING (sprites not in the image plane), ARTIST (Wang's colours)
-// and PROFILES (Yusov's eye pass) compile their code in only for batches that
+// Variants: FACING (sprites not in the image plane), ARTIST (Wang's colours),
+// PROFILES (Yusov's eye pass) and AIR (aerial perspective by the particle's
+// distance from the eye, for the cloud pass's batches, never an impostor's,
+// whose texture is seen from elsewhere) compile their code in only for batches that
 // have them: llvmpipe paid for the code behind the branches, so a batch of Harris's
 // splats paid for the artist colours of every corner.
 //
@@ -83,6 +85,9 @@ uniform vec3 light_radiance[MAX_LIGHTS];
 uniform int phase_kind;  // cloudcore.light.phase.PHASE_NAMES order
 uniform float g;
 uniform int profile_samples;
+#ifdef AIR
+#include "aerial_perspective.glsl"
+#endif
 
 const int FACING_SPLAT = 0;
 const int FACING_HORIZONTAL = 2;
@@ -200,15 +205,24 @@ void shade(uint invocation)
 #else
     vec4 colour = harris_colour(p, view_ray) * fade;
 #endif
+#ifdef AIR
+    // the air in front of the particle, by its centre, added where it covers what is behind
+    // (cloudcore.light.air_between): read once for its four corners
+    vec3 air_transmittance, air_in_scattered;
+    air_toward(offset, air_transmittance, air_in_scattered);
+#endif
     for (int k = 0; k < 4; ++k) {
         vec3 corner = offset + radius * (CORNERS[k].x * right + CORNERS[k].y * up);
         instances[slot].corners[k] = vec4(corner, p.sprite.x);
 #ifdef ARTIST
-        instances[slot].colours[k] = artist ? artist_colour(style, corner + eye, p.group_cloud.xyz) * fade
-                                            : colour;
+        vec4 seen = artist ? artist_colour(style, corner + eye, p.group_cloud.xyz) * fade : colour;
 #else
-        instances[slot].colours[k] = colour;
+        vec4 seen = colour;
 #endif
+#ifdef AIR
+        seen.rgb = seen.rgb * air_transmittance + seen.a * air_in_scattered;
+#endif
+        instances[slot].colours[k] = seen;
     }
 }
 

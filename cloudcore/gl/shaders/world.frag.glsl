@@ -1,25 +1,31 @@
-#version 330 core
-// The world in linear RGB: pyrender's terrain over the sky, the atmosphere's or a vertical gradient.
+#version 420 core
+// The world in linear RGB: pyrender's terrain over the sky, the atmosphere's or a vertical gradient; under the
+// atmosphere the terrain is seen through the air between it and the eye.
 //
 // pyrender drew sRGB-encoded vertex colours (8 bits are too coarse for linear
 // colour in the shadows) over a transparent black background, and multisample
 // resolve averaged them with it: a pixel holds (coverage * colour, coverage).
 // The sky reads its tables as cloudcore/light/sky_background.py does.
 
-uniform sampler2D world_texture;
+layout(binding = 0) uniform sampler2D world_texture;
 uniform mat4 inverse_view_projection;
 uniform bool physical_sky;
 // the gradient
 uniform vec3 zenith_colour;
 uniform vec3 horizon_colour;
 // the atmosphere: its sky-view table (cloudcore/atmosphere/sky_view.py) seen from the scene's origin
-uniform sampler2D sky_view_table;
+layout(binding = 1) uniform sampler2D sky_view_table;
 uniform vec2 sky_view_size;          // its (width, height): 192 x 108, 96 x 54 for a preview
 uniform float zenith_horizon_angle;  // pi less the horizon's angle below the horizontal
 uniform float horizon_cosine;        // the cosine to the up of the ray grazing the ground
 uniform vec3 sun_direction;
 uniform vec3 sun_disc_scale;         // the disc's colour per unit of its normalised radiance
 uniform float pixel_angle;           // radians a pixel spans: the disc's rim is spread over it
+// aerial perspective on the terrain (the physical sky alone): its depth, copied after pyrender drew it
+uniform bool through_air;
+layout(binding = 2) uniform sampler2D world_depth;
+uniform vec3 eye_position;
+#include "aerial_perspective.glsl"
 
 const float SUN_ANGULAR_RADIUS = 0.004651302;  // radians(0.533 / 2), cloudcore/atmosphere/sun_disc.py
 const float LIMB_DARKENING = 0.6;
@@ -96,6 +102,10 @@ void main()
 {
     vec4 world = texelFetch(world_texture, ivec2(gl_FragCoord.xy), 0);
     vec3 terrain = world.a > 0.0 ? srgb_decode(world.rgb / world.a) : vec3(0.0);
+    if (through_air && world.a > 0.0) {
+        float depth = texelFetch(world_depth, ivec2(gl_FragCoord.xy), 0).r;
+        terrain = seen_through_air(terrain, 1.0, unproject(2.0 * depth - 1.0) - eye_position);
+    }
     // where the terrain covers the pixel the sky is not seen: its lookups skipped
     vec3 background = world.a < 1.0 ? sky(normalize(unproject(1.0) - unproject(-1.0))) : vec3(0.0);
     frag_colour = vec4(mix(background, terrain, world.a), 1.0);
