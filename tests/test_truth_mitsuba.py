@@ -1,16 +1,19 @@
 """The path-traced truth (Mitsuba 3, `cloudview[truth]`): transmittance, determinism, orientation, the CLI."""
 
+import dataclasses
 import json
 import subprocess
 import sys
 
+import imageio.v3 as iio
 import numpy as np
 import pytest
 
+from cloudcore.camera import pixel_rays
 from cloudcore.light.phase import phase_function
 from cloudcore.light.shading import scattering_coefficient
 from cloudcore.light.truth import medium_grids, mitsuba_scene_description, mitsuba_variant, optical_depths, render_truth
-from cloudcore.scene import Camera, Cloud, Light, Lighting, Scene, Shading
+from cloudcore.scene import Camera, Cloud, Light, Lighting, Scene, Shading, Terrain
 from cloudcore.scenefile import save_scene
 
 mi = pytest.importorskip("mitsuba")
@@ -89,6 +92,26 @@ def test_cloudview_truth_writes_the_picture(tmp_path):
     assert out.exists() and "8 spp" in result.stdout
 
 
+def test_cloudview_truth_path_traces_the_terrain_when_asked_and_refuses_to_compare_it(tmp_path):
+    """--terrain: the ground under the particle fills the picture's bottom rows, which show the sky without it;
+    with --json, one line and exit 2 (the models draw no terrain)."""
+    terrain = Terrain(size=(12000.0, 12000.0), resolution=9, height=0.0, color=(0.5, 0.5, 0.5))
+    save_scene(dataclasses.replace(particle_scene(4.0), terrain=terrain), tmp_path / "s.toml")
+    command = [sys.executable, "-m", "cloudcore.cli", "truth", str(tmp_path / "s.toml")]
+    command += ["--width", "16", "--height", "12", "--spp", "4"]
+    for name, extra in (("ground.png", ["--terrain"]), ("sky.png", [])):
+        result = subprocess.run(command + ["--out", str(tmp_path / name)] + extra, capture_output=True, text=True)
+        assert result.returncode == 0, result.stderr
+    ground, sky = (iio.imread(tmp_path / name).astype(float) for name in ("ground.png", "sky.png"))
+    assert np.abs(ground[-1] - sky[-1]).mean() > 20 and np.abs(ground[0] - sky[0]).max() <= 1
+    refused = subprocess.run(
+        command + ["--terrain", "--out", str(tmp_path / "r.png"), "--json", str(tmp_path / "r.json")],
+        capture_output=True,
+        text=True,
+    )
+    assert refused.returncode == 2 and len(refused.stderr.strip().splitlines()) == 1 and "--terrain" in refused.stderr
+
+
 @pytest.mark.gl
 def test_the_report_compares_every_shading_method_region_by_region(tmp_path):
     save_scene(particle_scene(4.0, ambient=(0.1, 0.1, 0.12)), tmp_path / "s.toml")
@@ -132,3 +155,38 @@ def test_in_the_ambient_light_alone_a_white_cloud_returns_the_model_s_ambient_te
     camera = Camera((0.0, 1000.0, 300.0), CENTRE, 2.0)
     truth = render_truth(scene, 4, 4, camera=camera, spp=1024, voxels_per_radius=6.0)
     assert truth.radiance.mean() == pytest.approx(0.5 * truth.alpha.mean(), rel=0.01)
+
+
+def test_a_cloud_s_shadow_falls_where_the_sun_s_rays_through_it_meet_the_ground():
+    """One thick particle 600 m over a flat grey terrain, the sun 32 degrees from the zenith, seen from straight
+    above: the ground is darkest, with the cloud taken away lit evenly, where the sun's ray through the cloud's
+    centre meets the ground; the terrain's pixels show no sky."""
+    sun = np.array([0.5, 0.8, 0.0]) / np.linalg.norm([0.5, 0.8, 0.0])
+    centre = np.array([0.0, 600.0, 0.0])
+    scene = Scene(
+        camera=Camera((0.0, 3000.0, 1.0), (0.0, 0.0, 0.0), 60.0),
+        lighting=Lighting(time_of_day=None, lights=(Light(tuple(sun), (1.0, 1.0, 1.0), 1.0),), ambient=(0.1,) * 3),
+        shading=Shading(albedo=0.9, optical_depth=6.0),
+        clouds=(Cloud("one", [[*centre, 250.0]]),),
+        terrain=Terrain(size=(6000.0, 6000.0), resolution=9, height=0.0, color=(0.5, 0.5, 0.5)),
+    )
+    size = 48
+    shaded, bare = (
+        render_truth(s, size, size, spp=32, seed=2, terrain=True)
+        for s in (scene, dataclasses.replace(scene, clouds=()))
+    )
+    assert np.isfinite(shaded.ground_distance).all() and np.isfinite(bare.ground_distance).all()
+    ground = bare.linear.mean(axis=-1)
+    # lit ground: albedo E cos / pi plus the ambient's albedo * L
+    lit = 0.5 * sun[1] / np.pi + 0.5 * 0.1
+    assert ground.mean() == pytest.approx(lit, rel=0.03)
+    clear = shaded.alpha < 0.02
+    light = shaded.linear.mean(axis=-1)
+    blurred = sum(np.roll(light, (dy, dx), axis=(0, 1)) for dy in (-1, 0, 1) for dx in (-1, 0, 1)) / 9.0
+    darkest = np.unravel_index(np.argmin(np.where(clear, blurred, np.inf)), clear.shape)
+    shadow = centre - centre[1] / sun[1] * sun  # on the ground, y = 0
+    toward = (shadow - scene.camera.position) / np.linalg.norm(shadow - scene.camera.position)
+    rays = pixel_rays(scene.camera, size, size)
+    expected = np.unravel_index(np.argmax(rays @ toward), clear.shape)
+    assert np.hypot(*np.subtract(darkest, expected)) <= 1.5, (darkest, expected)
+    assert blurred[darkest] < 0.5 * lit

@@ -3,7 +3,8 @@
 The models are Harris's with each of his illumination methods of `cloudcore.light.shading` and the saturated
 eye pass with the exact one, or those --models names (any eye pass with any illumination method).  The
 truth and the models both show the clouds over the sky, the terrain and objects left out
-(`cloudcore.light.truth` says what the medium and the lights are).  The report renders the truth again
+(`cloudcore.light.truth` says what the medium and the lights are); --terrain path traces the terrain too, the
+clouds' shadows on it, for a picture alone.  The report renders the truth again
 with the next seed, for its own noise, and each model through the GL renderer in full 3D.
 """
 
@@ -73,6 +74,12 @@ def add_parser(commands) -> None:
         help=f"voxels across the median particle radius (default {DEFAULT_VOXELS_PER_RADIUS:g})",
     )
     parser.add_argument("--variant", choices=VARIANTS, help="Mitsuba variant (default: the first that loads)")
+    parser.add_argument(
+        "--terrain",
+        action="store_true",
+        help="path trace the scene's terrain too, the clouds' shadows on it (a picture: not with --json, whose "
+        "models are the clouds over the sky)",
+    )
     parser.add_argument("--json", type=Path, help="compare the shading models with the truth; write the report here")
     parser.add_argument("--model-images", type=Path, help="with --json: write each model's picture and diff here")
     parser.add_argument(
@@ -95,6 +102,8 @@ def run(args) -> int:
     import imageio.v3 as iio
 
     check_outputs(args.out, args.json)
+    if args.terrain and args.json is not None:
+        raise SceneError("cloudview truth", "--terrain", "compares no models: the models draw no terrain (drop --json)")
     scene = load_scene(args.scene)
     check_time_argument(args.time_of_day)
     camera = camera_argument(args, scene)
@@ -176,6 +185,7 @@ def _render(scene, camera, args, seed: int):
                 voxels_per_radius=args.voxels_per_radius,
                 variant=args.variant,
                 progress=lambda done, total: bar.update(done - bar.n),
+                terrain=args.terrain,
             )
         except ValueError as error:
             raise SceneError(args.scene, "truth", str(error)) from None

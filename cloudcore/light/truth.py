@@ -16,8 +16,15 @@ The light is the model's: the sun and the skylight as directional emitters with 
 model gives them, and the ambient term as a constant environment of that radiance (a cloud of albedo 1
 in it returns exactly the model's ambient * (1 - T)).  The emitters are hidden from camera rays; the
 background, the sky the renderer draws (`cloudcore.light.sky_background`: the atmosphere's with the sun's disc,
-or the gradient; terrain left out), is added behind the clouds with
-their transmittance T, computed here by marching the same grid.  Mitsuba is imported only inside the
+or the gradient), is added behind the clouds with their transmittance T, computed here by marching the same
+grid, where the pixel's ray misses the terrain.
+
+With `render_truth(terrain=True)` the scene's heightfield terrain is a Lambertian mesh of its colour: the
+clouds shadow it, it sends light back up into them, and what the eye sees of it is path traced with the clouds
+in front of it.  Its radiance is a physical surface's, albedo E cos / pi, where the renderer's terrain colour
+is albedo E (the renderer's values): compare the ground's light with and without the clouds, not its level.
+
+Mitsuba is imported only inside the
 functions that need it (`cloudview[truth]`), so importing this module never needs it.
 """
 
@@ -34,9 +41,10 @@ from cloudcore.light.illumination import cloud_optics
 from cloudcore.light.lighting import active_lights, scene_lights
 from cloudcore.light.phase import phase_function
 from cloudcore.light.sky_background import scene_sky
-from cloudcore.scene import Camera, Scene
+from cloudcore.scene import Camera, Scene, Terrain
 from cloudcore.segments import concatenated_ranges
 from cloudcore.splat_kernel import KERNEL_DIAMETER_INTEGRAL, splat_kernel
+from cloudcore.terrain import heightfield_mesh
 
 #: voxels across the scene's median particle radius: the line integral through a particle's centre is
 #: within 1% of its tau at 3 (tests/test_truth.py); the default scene then has about 10 million voxels
@@ -229,10 +237,15 @@ def _splatted(
 
 
 def optical_depths(
-    grids: list[MediumGrid], origins: np.ndarray, directions: np.ndarray, chunk_rays: int = 2048
+    grids: list[MediumGrid],
+    origins: np.ndarray,
+    directions: np.ndarray,
+    chunk_rays: int = 2048,
+    stops: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """(total optical depth (n,), distance (n,) at which it first reaches 1, inf where it never does)
-    along rays from `origins` (n, 3) in unit `directions` (n, 3), marched through every grid.
+    along rays from `origins` (n, 3) in unit `directions` (n, 3), marched through every grid, each to its
+    distance of `stops` (n,: where it meets the terrain; inf, the default, through everything).
 
     Midpoint rule with a step of `MARCH_STEP_VOXELS` voxels on one lattice of distances shared by all
     grids, so the depths of the grids a ray crosses add up in the order it meets them.
@@ -244,10 +257,14 @@ def optical_depths(
     if not grids or n == 0:
         return total, unit_distance
     step = MARCH_STEP_VOXELS * min(grid.voxel for grid in grids)
+    stops = np.full(n, np.inf) if stops is None else np.asarray(stops, dtype=np.float64).reshape(n)
     for start in range(0, n, chunk_rays):
         rays = slice(start, min(start + chunk_rays, n))
         o, d = origins[rays], directions[rays]
-        segments = [_ray_box(o, d, grid.box_low, grid.box_high) for grid in grids]
+        segments = [
+            (t0, np.minimum(t1, stops[rays]))
+            for t0, t1 in (_ray_box(o, d, grid.box_low, grid.box_high) for grid in grids)
+        ]
         far = max(float(np.max(np.where(t1 > t0, t1, 0.0))) for t0, t1 in segments)
         columns = int(np.ceil(far / step)) + 1
         depth = np.zeros((len(o), columns))
@@ -317,8 +334,10 @@ def mitsuba_scene_description(
     *,
     time_of_day: float | None = None,
     max_depth: int = -1,
+    ground=None,
 ) -> dict:
-    """The `mi.load_dict` description: the grids in null-bounded cubes, the model's lights, the camera.
+    """The `mi.load_dict` description: the grids in null-bounded cubes, the model's lights, the camera, and
+    `ground` (`terrain_shape`'s) when given.
 
     Call `mitsuba_variant` first (the dictionary holds Mitsuba objects of that variant).
     """
@@ -348,7 +367,26 @@ def mitsuba_scene_description(
             # named so that a sensor inside the box can start in it
             "interior": _medium(mi, grid, phase) | {"id": f"cloud_{number}_medium"},
         }
+    if ground is not None:
+        description["terrain"] = ground
     return description
+
+
+def terrain_shape(terrain: Terrain):
+    """The heightfield `terrain` as a Mitsuba mesh (the renderer's: `cloudcore.terrain.heightfield_mesh`),
+    Lambertian of its colour, its faces up.  Call `mitsuba_variant` first."""
+    import mitsuba as mi
+
+    vertices, faces = heightfield_mesh(terrain)
+    mesh = mi.Mesh("terrain", len(vertices), len(faces), has_vertex_normals=False, has_vertex_texcoords=False)
+    parameters = mi.traverse(mesh)
+    parameters["vertex_positions"] = np.ascontiguousarray(vertices, dtype=np.float32).ravel()
+    parameters["faces"] = np.ascontiguousarray(faces, dtype=np.uint32).ravel()
+    parameters.update()
+    mesh.set_bsdf(
+        mi.load_dict({"type": "diffuse", "reflectance": {"type": "rgb", "value": list(map(float, terrain.color))}})
+    )
+    return mesh
 
 
 def _medium(mi, grid: MediumGrid, phase: dict) -> dict:
@@ -434,6 +472,9 @@ class Truth:
     #: (height, width): optical depth toward the sun from the point where the view ray's reaches 1
     #: (inf where it never does, or without a sun)
     sun_depth: np.ndarray
+    #: (height, width): the distance along each pixel's central ray to the terrain (inf where it misses it, or
+    #: without one)
+    ground_distance: np.ndarray
     seconds: float
     variant: str
     voxels: int
@@ -454,8 +495,10 @@ def render_truth(
     variant: str | None = None,
     max_depth: int = -1,
     progress=None,
+    terrain: bool = False,
 ) -> Truth:
-    """Path trace `scene` (its clouds and sky; no terrain, no objects) from `camera` (the scene's).
+    """Path trace `scene` (its clouds, sky and, with `terrain`, its heightfield terrain; no objects) from
+    `camera` (the scene's).
 
     `spp` samples per pixel in passes of `SAMPLES_PER_PASS`, pass k seeded with (seed << 16) + k, so a
     seed gives the same picture every time and two seeds share no samples.  `progress(done, total)`
@@ -469,8 +512,9 @@ def render_truth(
     start = time.perf_counter()
     used_variant = mitsuba_variant(variant)
     grids = medium_grids(scene, voxels_per_radius)
+    ground = terrain_shape(scene.terrain) if terrain and scene.terrain is not None else None
     description = mitsuba_scene_description(
-        grids, scene, camera, width, height, time_of_day=time_of_day, max_depth=max_depth
+        grids, scene, camera, width, height, time_of_day=time_of_day, max_depth=max_depth, ground=ground
     )
     mitsuba_scene = mi.load_dict(description)
     passes = -(-spp // SAMPLES_PER_PASS)
@@ -488,21 +532,45 @@ def render_truth(
     lighting = scene.lighting if time_of_day is None else dataclasses.replace(scene.lighting, time_of_day=time_of_day)
     rays = pixel_rays(camera, width, height).reshape(-1, 3)
     eye = np.broadcast_to(np.asarray(camera.position, dtype=np.float64), rays.shape)
-    view_depth, unit_distance = optical_depths(grids, eye, rays)
+    ground_distance = _ground_distances(ground, eye, rays)
+    view_depth, unit_distance = optical_depths(grids, eye, rays, stops=ground_distance)
     transmittance = np.exp(-view_depth).reshape(height, width)
     sky = scene_sky(lighting).radiance(rays, np.radians(camera.fov_y_deg) / height).reshape(height, width, 3)
+    sky[np.isfinite(ground_distance).reshape(height, width)] = 0.0  # the terrain's light is path traced
     radiance = np.nan_to_num(radiance, nan=0.0, posinf=0.0, neginf=0.0)
     return Truth(
         linear=radiance + transmittance[..., None] * sky,
         radiance=radiance,
         alpha=1.0 - transmittance,
         sun_depth=_sun_depths(grids, eye, rays, unit_distance, lighting).reshape(height, width),
+        ground_distance=ground_distance.reshape(height, width),
         seconds=time.perf_counter() - start,
         variant=used_variant,
         voxels=sum(grid.extinction.size for grid in grids),
         spp=spp,
         seed=seed,
     )
+
+
+def _ground_distances(ground, eye, rays) -> np.ndarray:
+    """(n,): the distance along each of `rays` from `eye` (n, 3 each) to the `ground` mesh (`terrain_shape`'s;
+    inf where it misses, or without one), traced by Mitsuba ray by ray (its scalar variant's way)."""
+    distances = np.full(len(rays), np.inf)
+    if ground is None:
+        return distances
+    import mitsuba as mi
+
+    alone = mi.load_dict({"type": "scene", "terrain": ground})
+    # Mitsuba's float32 ray-triangle test is not watertight: a central ray through an edge of the mesh can slip
+    # between its two triangles, so a miss is traced again from a millimetre aside before it counts
+    aside = np.array([1e-3, 0.0, 1e-3])
+    for i, (origin, direction) in enumerate(zip(eye, rays, strict=True)):
+        for start in (origin, origin + aside):
+            hit = alone.ray_intersect(mi.Ray3f(mi.Point3f(start.tolist()), mi.Vector3f(direction.tolist())))
+            if bool(hit.is_valid()):
+                distances[i] = float(hit.t)
+                break
+    return distances
 
 
 def _sun_depths(grids, eye, rays, unit_distance, lighting) -> np.ndarray:
