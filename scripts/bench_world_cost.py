@@ -1,15 +1,16 @@
 """The world pass's time, this tree's against other revisions', side by side in one run, and each picture's error.
 
     python scripts/bench_world_cost.py [--sizes 640x480,880x680,1280x800] [--rounds 12]
-        [--against uncut=aerial --against main_gradient=main --against plain=2d46b6e^1] [--json out/bench_world_cost.json]
+        [--against uncut=aerial --against main_gradient=main --against plain=2d46b6e^1]
+        [--json out/bench_world_cost.json]
 
 Each way is a worker process drawing the default view in auto mode (`RenderSettings()`) through its own
 revision's `cloudcore` (a temporary worktree on its PYTHONPATH): this tree on the patch of the revisions
 before it (the default scene without `relief` and `reach`), this tree on its default scene (the valley's
 mountains and the ground to 40 km), the same with tiles split four times as far (nearly the uncut terrain),
 and each `--against` revision on its own default scene (a NAME ending in `_gradient`: under the gradient sky
-without aerial perspective, the plain world pass of a revision with the atmosphere).  The workers take turns, a few frames each, round
-after round, so that all see the same machine load; the medians of `FrameStats.world_ms` after the warm-up are
+without aerial perspective, the plain world pass of a revision with the atmosphere).  The workers take turns,
+a few frames each, round after round, so that all see the same machine load; the medians of `FrameStats.world_ms` after the warm-up are
 reported, and the PSNR of each picture against the one it cuts (`cloudview compare`'s).
 """
 
