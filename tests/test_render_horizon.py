@@ -14,8 +14,8 @@ pytestmark = pytest.mark.gl
 
 
 def terrain_rows_under_the_horizon(renderer, terrain) -> float:
-    """The share of the pixels 3 to 6 degrees under the horizontal (the ground 18 to 36 km away) that the terrain covers, looking level
-    down the valley from 1.9 km (above its hills: only the far ground is seen there)."""
+    """The share of the pixels 3 to 6 degrees under the horizontal (the ground 18 to 36 km away) that the
+    terrain covers, looking level down the valley from 1.9 km (above its hills: only the far ground is seen)."""
     scene = load_scene(VALLEY)
     eye = (0.0, 1900.0, 5000.0)
     camera = Camera(eye, (0.0, 1900.0, -5000.0), 40.0)
