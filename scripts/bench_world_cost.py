@@ -11,7 +11,8 @@ mountains and the ground to 40 km), the same with tiles split four times as far 
 and each `--against` revision on its own default scene (a NAME ending in `_gradient`: under the gradient sky
 without aerial perspective, the plain world pass of a revision with the atmosphere).  The workers take turns,
 a few frames each, round after round, so that all see the same machine load; the medians of
-`FrameStats.world_ms` after the warm-up are reported, and the PSNR of each picture against the one it cuts (`cloudview compare`'s).
+`FrameStats.world_ms` after the warm-up are reported, and the PSNR of each picture against the one it cuts
+(`cloudview compare`'s).
 """
 
 from __future__ import annotations
