@@ -61,8 +61,6 @@ class TerrainMesh:
             GL.glVertexAttribPointer(location, 3, GL.GL_FLOAT, GL.GL_FALSE, stride, ctypes.c_void_p(12 * location))
         GL.glBindBuffer(GL.GL_ELEMENT_ARRAY_BUFFER, self._index_buffer)
         GL.glBindVertexArray(0)
-        #: triangles drawn by the last `draw` (the tiles in view, skirts and all)
-        self.drawn_triangles = 0
 
     def _upload(self) -> None:
         tiles = self.tiles
@@ -86,7 +84,6 @@ class TerrainMesh:
         if self.tiles.update(camera.position):
             self._upload()
         in_view = np.flatnonzero(self.tiles.in_view(frustum_planes(view_projection)))
-        self.drawn_triangles = len(in_view) * len(TILE_FACES)
         if not len(in_view):
             return
         program = self._program(air is not None)
@@ -134,11 +131,6 @@ class WorldPass:
         self._terrain = TerrainMesh(terrain, light) if terrain is not None else None
         # the air's volume under the physical sky (the cloud pass reads it too: `air_volume`)
         self._air_volume = AirVolume() if sky.physical else None
-
-    @property
-    def terrain(self) -> TerrainMesh | None:
-        """The terrain's mesh on the GPU (None without terrain)."""
-        return self._terrain
 
     def draw(
         self,
