@@ -1,7 +1,4 @@
-"""Colour management, stated once: all maths in linear RGB; one sRGB transfer (IEC 61966-2-1) to 8 bits.
-
-shaders/world.frag.glsl has the decoding side in GLSL.
-"""
+"""Colour management, stated once: all maths in linear RGB; one sRGB transfer (IEC 61966-2-1) to 8 bits."""
 
 from __future__ import annotations
 
@@ -15,7 +12,7 @@ def srgb_encode(linear) -> np.ndarray:
 
 
 def srgb_decode(encoded) -> np.ndarray:
-    """sRGB-encoded [0, 1] to linear [0, 1] (the inverse of `srgb_encode`; world.frag.glsl's `srgb_decode`)."""
+    """sRGB-encoded [0, 1] to linear [0, 1] (the inverse of `srgb_encode`)."""
     c = np.clip(np.asarray(encoded, dtype=np.float64), 0.0, 1.0)
     return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
 

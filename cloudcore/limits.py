@@ -18,6 +18,7 @@ from collections.abc import Iterator
 import numpy as np
 
 from cloudcore.artist.artist_shading import default_group_size, shading_grid_fits
+from cloudcore.atmosphere.aerial_perspective import MAX_DISTANCE_M
 from cloudcore.light.lighting import active_lights
 from cloudcore.light.phase import MAX_ABS_G
 from cloudcore.scene import Air, Camera, Cloud, Light, Lighting, SceneObject, Shading, Terrain, View
@@ -70,6 +71,10 @@ FIELD_RANGES = {
     (Cloud, "optical_depth"): (0.0, math.inf),
     (Cloud, "color"): (0.0, math.inf),
     (Terrain, "height"): (0.0, math.inf),
+    # mountains up to 8 km: the aerial-perspective volume and the sky's tables stop short of the air's top
+    (Terrain, "relief"): (0.0, 8000.0),
+    # to the aerial-perspective volume's last slice (`MAX_DISTANCE_M`): the air past it is not looked up
+    (Terrain, "reach"): (0.0, MAX_DISTANCE_M),
     (Terrain, "color"): (0.0, 1.0),
     (SceneObject, "color"): (0.0, 1.0),
     (View, "tolerance_psnr"): (0.0, math.inf),

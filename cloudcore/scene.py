@@ -170,6 +170,10 @@ class Terrain:
     seed: int = 7
     mesh: str | None = None
     color: Vec3 = (0.32, 0.42, 0.22)
+    #: metres the mountains beyond the valley's sides rise (0: none, the valley's hills alone)
+    relief: float = 0.0
+    #: metres from the origin the ground is drawn to, at least the half of `size` (0: the patch of `size` alone)
+    reach: float = 0.0
 
 
 @dataclass(frozen=True, eq=False)

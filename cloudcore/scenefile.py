@@ -408,6 +408,8 @@ def _terrain(t: Table) -> Terrain:
         seed=t.integer("seed", d.seed, low=0, high=2**31 - 1),
         mesh=t.string("mesh") if kind == "mesh" else None,
         color=t.vector("color", d.color, **_range(Terrain, "color")),
+        relief=t.number("relief", d.relief, **_range(Terrain, "relief")),
+        reach=t.number("reach", d.reach, **_range(Terrain, "reach")),
     )
 
 
@@ -504,6 +506,9 @@ def scene_to_dict(scene: Scene) -> dict:
             "seed": t.seed,
             "color": list(t.color),
         }
+        for key in ("relief", "reach"):  # files without them stay as they were
+            if getattr(t, key) != getattr(Terrain(), key):
+                terrain[key] = getattr(t, key)
         if t.mesh is not None:
             terrain["mesh"] = t.mesh
         data["terrain"] = terrain

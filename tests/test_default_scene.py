@@ -7,7 +7,7 @@ from conftest import VALLEY
 from cloudcore.paths import sample
 from cloudcore.scenefile import load_scene
 from cloudcore.sun import elevation_deg, sun_direction
-from cloudcore.terrain import heightfield_mesh
+from cloudcore.terrain import height_at, heightfield_mesh
 
 
 @pytest.fixture(scope="module")
@@ -30,10 +30,14 @@ def test_after_harris_figure_3(valley):
     assert 12 < valley.lighting.time_of_day < 18
 
 
-def test_clouds_hang_above_the_terrain(valley):
-    vertices, _ = heightfield_mesh(valley.terrain)
-    lowest_cloud = min(float((c.centres[:, 1] - c.radii).min()) for c in valley.clouds)
-    assert lowest_cloud > vertices[:, 1].max() * 0.9
+def test_clouds_hang_low_over_the_valley_between_mountains(valley):
+    """Harris's figure 3: the valley's floor under every cloud, mountains beside it higher than the clouds."""
+    for cloud in valley.clouds:
+        under = height_at(valley.terrain, cloud.centres[:, 0], cloud.centres[:, 2])
+        assert np.all(cloud.centres[:, 1] - cloud.radii > under + 200.0), cloud.name
+    highest_cloud = max(float((c.centres[:, 1] + c.radii).max()) for c in valley.clouds)
+    x, z = np.meshgrid(np.linspace(-12_000.0, 12_000.0, 97), np.linspace(-12_000.0, 12_000.0, 97))
+    assert height_at(valley.terrain, x, z).max() > 1.3 * highest_cloud
 
 
 def test_flythrough_lasts_about_30_s_and_passes_through_two_clouds(valley):

@@ -41,6 +41,7 @@ LAYERS = (
         "splat_kernel",
         "sun",
         "terrain",
+        "terrain_tiles",
         "toml_table",
         "vectors",
     ),

@@ -64,7 +64,8 @@ def test_a_pass_gpu_time_covers_its_raster_work(renderer, clock):
 
     from cloudcore.gl.programs import build_program
 
-    program = build_program("world")  # one triangle over the screen, from gl_VertexID alone
+    # one triangle over the screen, from gl_VertexID alone, coloured by the gradient sky
+    program = build_program("sky", {"PHYSICAL_SKY": 0}, vertex="world")
     vertex_array = GL.glGenVertexArrays(1)
     try:
         with clock.frame():

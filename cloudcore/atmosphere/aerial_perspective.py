@@ -11,7 +11,7 @@ alone, so it is remade when the eye climbs or sinks past `ALTITUDE_STEP_M`, not 
 Each texel is `scattering.in_scattering` over its distance, marched on its own; a ray into the planet goes on
 through air of the ground's density (`scattering.march`), as a flat terrain standing over the curved ground's
 horizon sees: stopping it there made neighbouring rows of the volume disagree by 5% in transmittance.
-The shaders (world.frag.glsl, the splats' and quads') read it as `radiance_and_transmittance` does.
+The shaders (terrain.vert.glsl, the splats' and quads') read it as `radiance_and_transmittance` does.
 """
 
 from __future__ import annotations

@@ -1,11 +1,11 @@
 """Where frames are drawn: our render targets inside either a headless EGL context or the GUI's window.
 
 The frame is composed in linear light in an RGBA16F colour texture with a
-24-bit depth buffer (`RenderTargets`).  pyrender draws the world's colour
-(8 bits, sRGB-encoded) into `world_texture` and its depth into that same depth
-buffer, which the cloud passes then test against.  In both contexts a
-`pyrender.Renderer` draws straight into our framebuffer, so the editor and the
-headless tools make the same picture:
+24-bit depth buffer (`RenderTargets`).  The world pass draws the terrain and the
+sky into it (`cloudcore.gl.world`), and the terrain's depth, which the cloud
+passes then test against.  In both contexts a `pyrender.Renderer` draws the
+objects straight into a framebuffer of ours, so the editor and the headless
+tools make the same picture:
 
 - `HeadlessContext` (tools, tests): pyrender's EGL `OffscreenRenderer` owns
   the context (we never call its `render`, which draws with 4x multisampling
@@ -13,9 +13,9 @@ headless tools make the same picture:
   calls `make_current()` first.
 - `WindowContext` (the editor): the window's context is current already.
 
-Multisampling the world is a choice per frame (`render_pyrender_scene`'s
-`antialiased`): on llvmpipe it doubles the world pass for 47.4-49.1 dB
-(docs/performance.md), so the frame's default is without.
+Multisampling the world is a choice per frame (`multisampled_target`, and
+`render_pyrender_scene`'s `antialiased`): on llvmpipe it doubles the world pass
+for 47.4-49.1 dB (docs/performance.md), so the frame's default is without.
 """
 
 from __future__ import annotations
@@ -36,7 +36,7 @@ def check_frame_size(width: int, height: int) -> None:
 
 
 class RenderTargets:
-    """The linear colour + depth target of one frame size and the world's colour beside it."""
+    """The linear colour + depth target of one frame size."""
 
     def __init__(self, width: int, height: int):
         check_frame_size(width, height)
@@ -46,15 +46,12 @@ class RenderTargets:
         GL.glRenderbufferStorage(GL.GL_RENDERBUFFER, GL.GL_DEPTH_COMPONENT24, self.width, self.height)
         self.colour_texture = _texture(self.width, self.height, GL.GL_RGBA16F)
         self.framebuffer = _framebuffer(self.colour_texture, self.depth_renderbuffer)
-        self.world_texture = _texture(self.width, self.height, GL.GL_RGBA8)
-        self.world_framebuffer = _framebuffer(self.world_texture, self.depth_renderbuffer)
-        # the world's scene and the objects' each have a pyrender renderer: a renderer frees the meshes of every
-        # scene but the one it draws (`Renderer._update_context`), so one renderer for both deleted and uploaded
-        # the terrain and the objects again every frame
+        # the objects' scene's renderer, its own: a renderer frees the meshes of every scene but the one it
+        # draws (`Renderer._update_context`)
         self._pyrender = _RendererIntoFramebuffer(self.width, self.height)
-        self._pyrender_objects = _RendererIntoFramebuffer(self.width, self.height)
-        #: (framebuffer, colour and depth renderbuffers) with 4 samples, made by the first antialiased render
-        self._multisampled: tuple[int, list[int]] | None = None
+        #: (framebuffer, colour and depth renderbuffers) with 4 samples, 8-bit for pyrender's objects and linear
+        #: for the world, each made by the first antialiased draw that needs it
+        self._multisampled: dict[int, tuple[int, list[int]]] = {}
 
     def make_current(self) -> None:
         """Make the GL context current (a no-op where the owner keeps it current)."""
@@ -65,42 +62,38 @@ class RenderTargets:
         GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, self.framebuffer)
         GL.glViewport(0, 0, self.width, self.height)
 
-    def clear_world(self) -> None:
-        """The state pyrender leaves for an empty scene: nothing in the world colour, far depth."""
-        self.make_current()
-        GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, self.world_framebuffer)
-        GL.glViewport(0, 0, self.width, self.height)
-        GL.glDepthMask(GL.GL_TRUE)
-        GL.glClearColor(0.0, 0.0, 0.0, 0.0)
-        GL.glClearDepth(1.0)
-        GL.glClear(GL.GL_COLOR_BUFFER_BIT | GL.GL_DEPTH_BUFFER_BIT)
-        self.bind_target()
-
-    def render_pyrender_scene(self, scene, flags, framebuffer: int | None = None, *, antialiased: bool = False):
-        """Render a pyrender scene: its depth into the target's depth, its colour into `world_texture`.
-
-        Or both into `framebuffer` (colour RGBA8, depth DEPTH_COMPONENT24), the objects' target, by the objects'
-        own pyrender renderer (the world's scene and theirs would evict each other's meshes from one).  With
-        `antialiased`, into a 4x multisampled framebuffer first, resolved into the destination (the
-        depth takes one sample per pixel, as a resolve of depth does).
+    def render_pyrender_scene(self, scene, flags, framebuffer: int, *, antialiased: bool = False):
+        """Render a pyrender scene into `framebuffer` (colour RGBA8, depth DEPTH_COMPONENT24), the objects'
+        target.  With `antialiased`, into a 4x multisampled framebuffer first, resolved into the destination
+        (the depth takes one sample per pixel, as a resolve of depth does).
         """
         self.make_current()
-        destination = self.world_framebuffer if framebuffer is None else framebuffer
-        drawn_into = self._multisampled_framebuffer() if antialiased else destination
-        renderer = self._pyrender if framebuffer is None else self._pyrender_objects
-        renderer.target_framebuffer = drawn_into
-        renderer.render(scene, flags)
+        drawn_into = self._multisampled_framebuffer(GL.GL_RGBA8) if antialiased else framebuffer
+        self._pyrender.target_framebuffer = drawn_into
+        self._pyrender.render(scene, flags)
         if antialiased:
-            GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, drawn_into)
-            GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, destination)
-            w, h = self.width, self.height
-            GL.glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL.GL_COLOR_BUFFER_BIT | GL.GL_DEPTH_BUFFER_BIT, GL.GL_NEAREST)
+            self._resolve(drawn_into, framebuffer)
         self.bind_target()
 
-    def _multisampled_framebuffer(self) -> int:
-        if self._multisampled is None:
+    def multisampled_target(self) -> int:
+        """A 4x multisampled framebuffer of the target's formats (linear RGBA16F, depth), for the world."""
+        self.make_current()
+        return self._multisampled_framebuffer(GL.GL_RGBA16F)
+
+    def resolve_multisampled_target(self) -> None:
+        """Resolve `multisampled_target` into the render target: colour averaged, depth one sample a pixel."""
+        self._resolve(self._multisampled_framebuffer(GL.GL_RGBA16F), self.framebuffer)
+
+    def _resolve(self, multisampled: int, destination: int) -> None:
+        GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, multisampled)
+        GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, destination)
+        w, h = self.width, self.height
+        GL.glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL.GL_COLOR_BUFFER_BIT | GL.GL_DEPTH_BUFFER_BIT, GL.GL_NEAREST)
+
+    def _multisampled_framebuffer(self, colour_format: int) -> int:
+        if colour_format not in self._multisampled:
             renderbuffers = [int(r) for r in GL.glGenRenderbuffers(2)]
-            for renderbuffer, internal_format in zip(renderbuffers, (GL.GL_RGBA8, GL.GL_DEPTH_COMPONENT24)):
+            for renderbuffer, internal_format in zip(renderbuffers, (colour_format, GL.GL_DEPTH_COMPONENT24)):
                 GL.glBindRenderbuffer(GL.GL_RENDERBUFFER, renderbuffer)
                 GL.glRenderbufferStorageMultisample(
                     GL.GL_RENDERBUFFER, WORLD_SAMPLES, internal_format, self.width, self.height
@@ -109,9 +102,9 @@ class RenderTargets:
             GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, framebuffer)
             for attachment, renderbuffer in zip((GL.GL_COLOR_ATTACHMENT0, GL.GL_DEPTH_ATTACHMENT), renderbuffers):
                 GL.glFramebufferRenderbuffer(GL.GL_FRAMEBUFFER, attachment, GL.GL_RENDERBUFFER, renderbuffer)
-            _check_complete("multisampled world")
-            self._multisampled = (framebuffer, renderbuffers)
-        return self._multisampled[0]
+            _check_complete("multisampled")
+            self._multisampled[colour_format] = (framebuffer, renderbuffers)
+        return self._multisampled[colour_format][0]
 
     def read_linear_rgb(self) -> np.ndarray:
         """The render target as float32 (height, width, 3), top row first: a read-only view of the pixels read
@@ -132,15 +125,13 @@ class RenderTargets:
 
     def close_targets(self) -> None:
         self._pyrender.delete()
-        self._pyrender_objects.delete()
-        GL.glDeleteFramebuffers(2, [self.framebuffer, self.world_framebuffer])
+        GL.glDeleteFramebuffers(1, [self.framebuffer])
         GL.glDeleteRenderbuffers(1, [self.depth_renderbuffer])
-        GL.glDeleteTextures([self.colour_texture, self.world_texture])
-        if self._multisampled is not None:
-            framebuffer, renderbuffers = self._multisampled
+        GL.glDeleteTextures([self.colour_texture])
+        for framebuffer, renderbuffers in self._multisampled.values():
             GL.glDeleteFramebuffers(1, [framebuffer])
             GL.glDeleteRenderbuffers(len(renderbuffers), renderbuffers)
-            self._multisampled = None
+        self._multisampled = {}
 
 
 class HeadlessContext(RenderTargets):

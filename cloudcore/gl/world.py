@@ -1,54 +1,122 @@
-"""The world pass: terrain through pyrender (flat, its light baked per vertex) over the sky, seen through the air.
+"""The world pass: the terrain's tiles, lit per vertex and seen through the air, then the sky where they leave it.
 
-pyrender's PBR shader costs 70-90 ms a frame on llvmpipe; baking the lights into
-vertex colours and drawing with RenderFlags.FLAT costs about a quarter of that
-(measured: /work/shared/ENVIRONMENT.md).  pyrender writes the depth buffer the
-cloud pass tests against; one full-screen pass then composites its colour over
-the sky into the linear target (shaders/world.frag.glsl).  Under the physical sky that pass also
-adds the air between the eye and the terrain (aerial perspective, `cloudcore.light.air_between`): it reads the
-terrain's depth from a copy (the target's depth is a renderbuffer, shared with the cloud passes' targets).
+The terrain is drawn straight into the linear target with its depth (shaders/terrain.*.glsl): its tiles
+follow the eye (`cloudcore.terrain_tiles`), their light is baked per vertex (`TerrainLight`, the sun's part
+apart), and under the physical sky the air between the eye and each vertex is read per vertex.  The sky
+follows, a full-screen triangle at the far plane that the depth test keeps off the terrain (shaders/sky.frag.glsl,
+compiled for the sky it draws).  Where each millisecond went before, and what this cut: docs/performance.md,
+"The world pass: where its time goes".
 """
 
 from __future__ import annotations
 
-import functools
+import ctypes
 from collections.abc import Callable
 
 import numpy as np
-import trimesh
 from OpenGL import GL
 
 from cloudcore.atmosphere.geometry import horizon_cosine
 from cloudcore.atmosphere.sky_view import eye_radius, horizon_angles
-from cloudcore.camera import FAR_PLANE_M, NEAR_PLANE_M, camera_pose
-from cloudcore.colour import srgb_encode
+from cloudcore.camera import frustum_planes
 from cloudcore.gl.air_volume import AirVolume
 from cloudcore.gl.context import HeadlessContext
 from cloudcore.gl.programs import build_program, set_matrix, set_vec3
-from cloudcore.gl.pyrender_compat import pyrender
 from cloudcore.light.air_between import AirBetween, air_between
 from cloudcore.light.sky_background import SkyBackground
 from cloudcore.light.terrain_light import TerrainLight
 from cloudcore.limits import DRAWN_TERRAIN_KINDS
 from cloudcore.scene import Camera, Terrain
-from cloudcore.terrain import heightfield_mesh
+from cloudcore.terrain_tiles import TILE_FACES, TerrainTiles
 
-#: the terrain's depth's texture unit, as world.frag.glsl declares it (the world's colour 0, the sky-view table 1,
-#: the air's volume `AIR_UNITS`)
-_DEPTH_UNIT = 2
-
-
-@functools.lru_cache(maxsize=2)
-def terrain_geometry(terrain: Terrain) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(vertices, faces, vertex normals) of a heightfield terrain: kept across lighting changes, which
-    rebuild the world pass (the editor's time of day) and would rebuild these for 25 ms each time."""
-    vertices, faces = heightfield_mesh(terrain)
-    return vertices, faces, trimesh.Trimesh(vertices, faces, process=False).vertex_normals
+#: floats a terrain vertex carries: its position, the sun's light and the sky's (terrain.vert.glsl)
+_VERTEX_FLOATS = 9
 
 
-def terrain_vertex_colours(normals, base_colour, light: TerrainLight) -> np.ndarray:
-    """Linear RGB per vertex: base * the irradiance `light` gives each vertex's normal."""
-    return np.asarray(base_colour, dtype=np.float64) * light.irradiance(normals)
+def terrain_vertex_light(normals, base_colour, light: TerrainLight) -> tuple[np.ndarray, np.ndarray]:
+    """Linear RGB per vertex of unit `normals`: base * the sun's irradiance, and base * the rest (the sky's dome,
+    the ground's bounce, the floor), which `light` gives each normal."""
+    base = np.asarray(base_colour, dtype=np.float64)
+    unshadowed = light.irradiance(normals)
+    sky = light.irradiance(normals, sun_visibility=0.0)
+    return base * (unshadowed - sky), base * sky
+
+
+class TerrainMesh:
+    """The terrain's tiles on the GPU for one terrain and one light: uploaded again when the eye's move changes
+    the tiles, drawn tile by tile where a tile's box meets the view."""
+
+    def __init__(self, terrain: Terrain, light: TerrainLight):
+        if terrain.kind not in DRAWN_TERRAIN_KINDS:  # the scene loader refuses these first (cloudcore.limits)
+            raise ValueError(f"the GL prototype draws heightfield terrain only, not {terrain.kind!r}")
+        self._terrain, self._light = terrain, light
+        self.tiles = TerrainTiles(terrain)
+        self._programs: dict[bool, int] = {}
+        self._vertex_array = GL.glGenVertexArrays(1)
+        self._vertex_buffer, self._index_buffer = (int(b) for b in GL.glGenBuffers(2))
+        GL.glBindVertexArray(self._vertex_array)
+        GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self._vertex_buffer)
+        stride = _VERTEX_FLOATS * 4
+        for location in range(3):
+            GL.glEnableVertexAttribArray(location)
+            GL.glVertexAttribPointer(location, 3, GL.GL_FLOAT, GL.GL_FALSE, stride, ctypes.c_void_p(12 * location))
+        GL.glBindBuffer(GL.GL_ELEMENT_ARRAY_BUFFER, self._index_buffer)
+        GL.glBindVertexArray(0)
+
+    def _upload(self) -> None:
+        tiles = self.tiles
+        sun, sky = terrain_vertex_light(tiles.normals, self._terrain.color, self._light)
+        vertices = np.ascontiguousarray(np.concatenate([tiles.positions, sun, sky], axis=1), dtype=np.float32)
+        GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self._vertex_buffer)
+        GL.glBufferData(GL.GL_ARRAY_BUFFER, vertices.nbytes, vertices, GL.GL_STATIC_DRAW)
+        indices = np.ascontiguousarray(tiles.faces, dtype=np.uint32)
+        GL.glBindVertexArray(self._vertex_array)
+        GL.glBufferData(GL.GL_ELEMENT_ARRAY_BUFFER, indices.nbytes, indices, GL.GL_STATIC_DRAW)
+        GL.glBindVertexArray(0)
+
+    def _program(self, through_air: bool) -> int:
+        if through_air not in self._programs:
+            self._programs[through_air] = build_program("terrain", {"THROUGH_AIR": int(through_air)})
+        return self._programs[through_air]
+
+    def draw(self, camera: Camera, view_projection: np.ndarray, air: AirVolume | None) -> None:
+        """Draw the tiles in view for `camera` into the bound target, depth tested and written, seen through
+        `air` (bound for `camera`'s eye) where there is one."""
+        if self.tiles.update(camera.position):
+            self._upload()
+        in_view = np.flatnonzero(self.tiles.in_view(frustum_planes(view_projection)))
+        if not len(in_view):
+            return
+        program = self._program(air is not None)
+        GL.glUseProgram(program)
+        set_matrix(program, "view_projection", view_projection)
+        if air is not None:
+            air.bind(program)
+            set_vec3(program, "eye_position", camera.position)
+        GL.glEnable(GL.GL_DEPTH_TEST)
+        GL.glDepthFunc(GL.GL_LESS)
+        GL.glDepthMask(GL.GL_TRUE)
+        GL.glBindVertexArray(self._vertex_array)
+        # a tile's triangles are contiguous: one draw of each run of tiles in view
+        starts = np.concatenate([[0], np.flatnonzero(np.diff(in_view) != 1) + 1])
+        ends = np.concatenate([starts[1:], [len(in_view)]])
+        per_tile = 3 * len(TILE_FACES)
+        counts = np.ascontiguousarray((ends - starts) * per_tile, dtype=np.int32)
+        offsets = np.ascontiguousarray(in_view[starts] * per_tile * 4, dtype=np.intp)
+        GL.glMultiDrawElements(
+            GL.GL_TRIANGLES,
+            counts,
+            GL.GL_UNSIGNED_INT,
+            (ctypes.c_void_p * len(offsets))(*offsets.tolist()),
+            len(counts),
+        )
+        GL.glBindVertexArray(0)
+
+    def close(self) -> None:
+        for program in self._programs.values():
+            GL.glDeleteProgram(program)
+        GL.glDeleteBuffers(2, [self._vertex_buffer, self._index_buffer])
+        GL.glDeleteVertexArrays(1, [self._vertex_array])
 
 
 class WorldPass:
@@ -63,34 +131,14 @@ class WorldPass:
     ):
         """`air_for(sky, eye)`: the air an eye sees through (`air_between`, or the editor's `LiveAir`)."""
         self._sky, self._air_for = sky, air_for
-        self._composite_program = build_program("world")
+        # at the far plane (the window depth 1), drawn where the depth is still the clear's
+        self._sky_program = build_program("sky", {"PHYSICAL_SKY": int(sky.physical), "DEPTH": 1.0}, vertex="world")
         self._sky_view_texture = _sky_view_texture(sky) if sky.physical else None
         # core profile draws nothing without a vertex array, even one with no attributes
         self._fullscreen_vertex_array = GL.glGenVertexArrays(1)
-        self._scene = None
-        if terrain is not None:
-            self._scene, self._camera_node = self._terrain_scene(terrain, light)
-        # the air's volume under the physical sky (the cloud pass reads it too: `air_volume`), and the terrain's
-        # depth, which the terrain is seen through it by
+        self._terrain = TerrainMesh(terrain, light) if terrain is not None else None
+        # the air's volume under the physical sky (the cloud pass reads it too: `air_volume`)
         self._air_volume = AirVolume() if sky.physical else None
-        self._depth_copy, self._depth_copy_size = None, None
-
-    @staticmethod
-    def _terrain_scene(terrain: Terrain, light: TerrainLight):
-        if terrain.kind not in DRAWN_TERRAIN_KINDS:  # the scene loader refuses these first (cloudcore.limits)
-            raise ValueError(f"the GL prototype draws heightfield terrain only, not {terrain.kind!r}")
-        vertices, faces, normals = terrain_geometry(terrain)
-        colours = terrain_vertex_colours(normals, terrain.color, light)
-        # encoded, because pyrender's 8-bit framebuffer would band linear colour in the shadows
-        primitive = pyrender.Primitive(
-            positions=vertices.astype(np.float32),
-            indices=faces.astype(np.uint32),
-            color_0=srgb_encode(colours).astype(np.float32),
-        )
-        scene = pyrender.Scene(bg_color=(0.0, 0.0, 0.0, 0.0))
-        scene.add(pyrender.Mesh([primitive]))
-        camera = pyrender.PerspectiveCamera(yfov=np.radians(60.0), znear=NEAR_PLANE_M, zfar=FAR_PLANE_M)
-        return scene, scene.add(camera)
 
     def draw(
         self,
@@ -101,32 +149,41 @@ class WorldPass:
         antialiased: bool = False,
         through_air: bool = True,
     ) -> None:
-        """Fill the render target: terrain colour and depth where there is terrain, sky elsewhere (the terrain
-        multisampled 4x when `antialiased`, seen through the air under the physical sky when `through_air`)."""
-        if self._scene is None:
-            context.clear_world()
-        else:
-            # the aspect ratio comes from the viewport, as in our projection_matrix
-            self._camera_node.camera.yfov = np.radians(camera.fov_y_deg)
-            self._scene.set_pose(self._camera_node, camera_pose(camera))
-            context.render_pyrender_scene(self._scene, pyrender.RenderFlags.FLAT, antialiased=antialiased)
-        program = self._composite_program
-        GL.glUseProgram(program)
-        GL.glActiveTexture(GL.GL_TEXTURE0)
-        GL.glBindTexture(GL.GL_TEXTURE_2D, context.world_texture)
-        set_matrix(program, "inverse_view_projection", np.linalg.inv(view_projection))
-        self._set_sky_uniforms(program, camera)
-        self._set_air_uniforms(program, context, camera, through_air)
+        """Fill the render target: terrain colour and depth where there is terrain, sky elsewhere (both
+        multisampled 4x when `antialiased`, the terrain seen through the air under the physical sky when
+        `through_air`)."""
+        framebuffer = context.multisampled_target() if antialiased else context.framebuffer
+        GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, framebuffer)
+        GL.glViewport(0, 0, context.width, context.height)
+        GL.glDepthMask(GL.GL_TRUE)
+        GL.glClearDepth(1.0)
+        GL.glClear(GL.GL_DEPTH_BUFFER_BIT)  # every colour is drawn: the terrain's, else the sky's
         GL.glDisable(GL.GL_BLEND)
-        GL.glDisable(GL.GL_CULL_FACE)
-        GL.glDisable(GL.GL_DEPTH_TEST)  # colour everywhere; the depth pyrender wrote stays
+        GL.glDisable(GL.GL_CULL_FACE)  # the skirts face either way
+        air = None
+        if self._air_volume is not None and through_air:
+            self._air_volume.upload(self._air_for(self._sky, camera.position))
+            air = self._air_volume
+        if self._terrain is not None:
+            self._terrain.draw(camera, view_projection, air)
+        program = self._sky_program
+        GL.glUseProgram(program)
+        set_matrix(program, "inverse_view_projection", np.linalg.inv(view_projection))
+        self._set_sky_uniforms(program, camera, context.height)
+        GL.glEnable(GL.GL_DEPTH_TEST)
+        GL.glDepthFunc(GL.GL_LEQUAL)
+        GL.glDepthMask(GL.GL_FALSE)
         GL.glBindVertexArray(self._fullscreen_vertex_array)
         GL.glDrawArrays(GL.GL_TRIANGLES, 0, 3)
         GL.glBindVertexArray(0)
+        GL.glDepthMask(GL.GL_TRUE)
+        GL.glDepthFunc(GL.GL_LESS)
+        if antialiased:
+            context.resolve_multisampled_target()
+        context.bind_target()
 
-    def _set_sky_uniforms(self, program: int, camera: Camera) -> None:
+    def _set_sky_uniforms(self, program: int, camera: Camera, viewport_height: int) -> None:
         sky = self._sky
-        GL.glUniform1i(GL.glGetUniformLocation(program, "physical_sky"), int(sky.physical))
         if not sky.physical:
             set_vec3(program, "zenith_colour", sky.zenith)
             set_vec3(program, "horizon_colour", sky.horizon)
@@ -144,58 +201,26 @@ class WorldPass:
         )
         set_vec3(program, "sun_direction", sky.view.sun_direction)
         set_vec3(program, "sun_disc_scale", sky.sun_disc_scale())
-        viewport_height = int(GL.glGetIntegerv(GL.GL_VIEWPORT)[3])
         GL.glUniform1f(
             GL.glGetUniformLocation(program, "pixel_angle"),
             float(np.radians(camera.fov_y_deg) / max(viewport_height, 1)),
         )
         GL.glActiveTexture(GL.GL_TEXTURE0)
 
-    def _set_air_uniforms(self, program: int, context: HeadlessContext, camera: Camera, through_air: bool) -> None:
-        terrain_through_air = through_air and self._air_volume is not None and self._scene is not None
-        GL.glUniform1i(GL.glGetUniformLocation(program, "through_air"), int(terrain_through_air))
-        if self._air_volume is None or not through_air:
-            return
-        self._air_volume.upload(self._air_for(self._sky, camera.position))
-        if not terrain_through_air:
-            return
-        self._air_volume.bind(program)
-        GL.glActiveTexture(GL.GL_TEXTURE0 + _DEPTH_UNIT)
-        GL.glBindTexture(GL.GL_TEXTURE_2D, self._copy_depth(context))
-        GL.glActiveTexture(GL.GL_TEXTURE0)
-        set_vec3(program, "eye_position", camera.position)
-
     @property
     def air_volume(self) -> AirVolume | None:
         """The air's volume as the last `draw` uploaded it, for its eye; None under the gradient sky."""
         return self._air_volume
 
-    def _copy_depth(self, context: HeadlessContext) -> int:
-        """The depth pyrender wrote, copied into a texture of the target's size (made at the first draw and
-        whenever that size changes); the target stays bound."""
-        size = (context.width, context.height)
-        if self._depth_copy_size != size:
-            if self._depth_copy is not None:
-                GL.glDeleteTextures([self._depth_copy])
-            self._depth_copy = GL.glGenTextures(1)
-            GL.glBindTexture(GL.GL_TEXTURE_2D, self._depth_copy)
-            GL.glTexStorage2D(GL.GL_TEXTURE_2D, 1, GL.GL_DEPTH_COMPONENT24, *size)
-            GL.glTexParameteri(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_MIN_FILTER, GL.GL_NEAREST)
-            GL.glTexParameteri(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_MAG_FILTER, GL.GL_NEAREST)
-            self._depth_copy_size = size
-        GL.glBindTexture(GL.GL_TEXTURE_2D, self._depth_copy)
-        GL.glCopyTexSubImage2D(GL.GL_TEXTURE_2D, 0, 0, 0, 0, 0, *size)
-        return self._depth_copy
-
     def close(self) -> None:
-        """Free the GL objects (the context must be current); pyrender frees the mesh with its context."""
+        """Free the GL objects (the context must be current)."""
         if self._sky_view_texture is not None:
             GL.glDeleteTextures([self._sky_view_texture])
         if self._air_volume is not None:
             self._air_volume.close()
-        if self._depth_copy is not None:
-            GL.glDeleteTextures([self._depth_copy])
-        GL.glDeleteProgram(self._composite_program)
+        if self._terrain is not None:
+            self._terrain.close()
+        GL.glDeleteProgram(self._sky_program)
         GL.glDeleteVertexArrays(1, [self._fullscreen_vertex_array])
 
 

@@ -72,7 +72,7 @@ def sky_gradient(directions, zenith, horizon) -> np.ndarray:
 
     The horizon colour at and below the horizon line, the zenith colour straight up, and between them
     by the square root of the ray's height, which keeps the pale band near the horizon narrow; the
-    world pass draws the same (shaders/world.frag.glsl, `sky`).
+    world pass draws the same (shaders/sky.frag.glsl, `sky`).
     """
     height = np.sqrt(np.clip(np.asarray(directions, dtype=np.float64)[..., 1:2], 0.0, 1.0))
     return (1.0 - height) * np.asarray(horizon, dtype=np.float64) + height * np.asarray(zenith, dtype=np.float64)

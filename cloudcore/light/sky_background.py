@@ -1,6 +1,6 @@
 """The sky behind everything, in the renderer's linear values: the two-colour gradient of before, or the
 atmosphere's sky (its sky-view table) with the sun's disc, limb darkened, its radiance the beam that reaches
-the scene.  The world pass draws the same (gl/shaders/world.frag.glsl, `sky`); the path-traced truth
+the scene.  The world pass draws the same (gl/shaders/sky.frag.glsl, `sky`); the path-traced truth
 composites this one behind its clouds.
 """
 
@@ -38,7 +38,7 @@ def over_the_horizon(directions, horizon: float) -> np.ndarray:
     """Unit `directions` (..., 3) raised to just over the `horizon` (the cosine to the up of the ray grazing the
     planet), each keeping its azimuth.  Below the horizon the terrain stands for the planet's ground: where it
     does not reach (past the world's edge), the air at the horizon is drawn, as a far terrain would fade into
-    it, not the table's grey ground of one albedo (world.frag.glsl does the same)."""
+    it, not the table's grey ground of one albedo (sky.frag.glsl does the same)."""
     directions = np.asarray(directions, dtype=np.float64)
     up = horizon + HORIZON_MARGIN
     across = np.linalg.norm(directions[..., [0, 2]], axis=-1, keepdims=True)

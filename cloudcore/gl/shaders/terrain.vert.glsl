@@ -1,0 +1,33 @@
+#version 420 core
+// The terrain's tiles (cloudcore/terrain_tiles.py) lit as cloudcore/light/terrain_light.py lights them, per
+// vertex: the sun's part apart from the sky's (a shadow dims the sun's alone).  With THROUGH_AIR the air between
+// the eye and each vertex is read here, per vertex, not per pixel: a pixel's lookups cost llvmpipe more than
+// the vertices' (docs/performance.md, "The world pass: where its time goes").
+
+layout(location = 0) in vec3 position;
+layout(location = 1) in vec3 sun_light;  // albedo x the sun's irradiance, linear RGB
+layout(location = 2) in vec3 sky_light;  // albedo x the sky's dome, the ground's bounce and the floor
+uniform mat4 view_projection;
+uniform vec3 eye_position;
+
+out vec3 sun_lit;
+out vec3 sky_lit;
+out vec3 air_let_through;
+out vec3 air_added;
+
+#if THROUGH_AIR
+#include "aerial_perspective.glsl"
+#endif
+
+void main()
+{
+    gl_Position = view_projection * vec4(position, 1.0);
+    sun_lit = sun_light;
+    sky_lit = sky_light;
+#if THROUGH_AIR
+    air_toward(position - eye_position, air_let_through, air_added);
+#else
+    air_let_through = vec3(1.0);
+    air_added = vec3(0.0);
+#endif
+}
