@@ -14,6 +14,7 @@ hangs a skirt from its edges, `SKIRT_CELLS` of its cells deep, which closes the 
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -156,6 +157,13 @@ def tile_meshes(terrain: Terrain, frame: TileFrame, tiles: np.ndarray) -> tuple[
     return np.concatenate([grid, skirt], axis=1), np.concatenate([normals, normals[:, _PERIMETER]], axis=1)
 
 
+@functools.lru_cache(maxsize=2)
+def _meshes_of(terrain: Terrain) -> dict[tuple[int, int, int], tuple[np.ndarray, np.ndarray]]:
+    """The meshes of `terrain`'s tiles drawn last, by tile: shared by its `TerrainTiles`, so that a new light,
+    which makes the world pass again (every look of a dragged time-of-day slider), meshes no tile again."""
+    return {}
+
+
 class TerrainTiles:
     """The tiles drawn for the last eye and their meshes, kept from frame to frame: `update` meshes only the
     tiles the eye's move brings in."""
@@ -164,7 +172,7 @@ class TerrainTiles:
         self.terrain = terrain
         self.frame = tile_frame(terrain)
         self.tiles = np.zeros((0, 3), dtype=np.int64)
-        self._meshes: dict[tuple[int, int, int], tuple[np.ndarray, np.ndarray]] = {}
+        self._meshes = _meshes_of(terrain)
         self.positions = np.zeros((0, 3))
         self.normals = np.zeros((0, 3))
         self.faces = np.zeros((0, 3), dtype=np.int64)
@@ -182,7 +190,9 @@ class TerrainTiles:
         if missing:
             positions, normals = tile_meshes(self.terrain, self.frame, tiles[missing])
             held.update({keys[index]: pair for index, pair in zip(missing, zip(positions, normals))})
-        self._meshes = held  # the tiles left behind are dropped: a cache of what is drawn
+        # the tiles left behind are dropped: a cache of what is drawn
+        self._meshes.clear()
+        self._meshes.update(held)
         self.tiles = tiles
         self.positions = np.concatenate([held[key][0] for key in keys])
         self.normals = np.concatenate([held[key][1] for key in keys])

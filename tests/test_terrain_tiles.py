@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from conftest import VALLEY
 
+from cloudcore import terrain_tiles
 from cloudcore.camera import frustum_planes, projection_matrix, view_matrix
 from cloudcore.scene import Camera, Terrain
 from cloudcore.scenefile import load_scene
@@ -107,15 +108,27 @@ def test_the_skirts_close_every_gap_between_neighbouring_tiles(eye):
     assert checked > 20
 
 
-def test_moving_the_eye_meshes_only_the_new_tiles_and_a_still_eye_nothing():
-    tiles = TerrainTiles(VALLEY_TERRAIN)
+def test_moving_the_eye_meshes_only_the_new_tiles_and_a_still_eye_nothing(monkeypatch):
+    meshed = []
+    original = terrain_tiles.tile_meshes
+    monkeypatch.setattr(
+        terrain_tiles,
+        "tile_meshes",
+        lambda terrain, frame, tiles: meshed.append(len(tiles)) or original(terrain, frame, tiles),
+    )
+    terrain = dataclasses.replace(VALLEY_TERRAIN, seed=VALLEY_TERRAIN.seed + 1)  # no other test's tiles
+    tiles = TerrainTiles(terrain)
     assert tiles.update(EYES[0])
+    assert meshed == [len(tiles.tiles)]
+    # a new light makes the world pass again, with tiles of its own: none is meshed again
+    assert TerrainTiles(terrain).update(EYES[0]) and meshed == [len(tiles.tiles)]
     first = dict(zip(map(tuple, tiles.tiles.tolist()), tiles.positions.reshape(len(tiles.tiles), -1, 3)))
     assert not tiles.update(EYES[0])
     assert tiles.update((EYES[0][0], EYES[0][1], EYES[0][2] - 1500.0))
     again = dict(zip(map(tuple, tiles.tiles.tolist()), tiles.positions.reshape(len(tiles.tiles), -1, 3)))
     kept = set(first) & set(again)
     assert kept and len(kept) < len(again)
+    assert meshed[1:] == [len(again) - len(kept)]
     for key in kept:
         np.testing.assert_array_equal(first[key], again[key])
     assert len(tiles.faces) == len(tiles.tiles) * len(TILE_FACES)
