@@ -32,11 +32,12 @@ from cloudcore.light.truth import peak_extinction
 from cloudcore.noise import hash01
 from cloudcore.splat_kernel import KERNEL_DIAMETER_INTEGRAL, KERNEL_VOLUME_INTEGRAL, splat_kernel
 
-#: the particle radius, in block sides, of a block whose integral is the REFERENCE_QUANTILE of the blocks':
-#: neighbours overlap so that a uniform region stays smooth.  Of 1, 1.5, 2 and 2.5 sides and quantiles 0.7,
-#: 0.8, 0.9 and 1, 2 and 0.9 left the least error over a sphere and a noise cloud at budgets of 500 to 16,000
-#: (measured on the grids of `cloudcore.interop.example_grids` while this was written); a larger radius blurs edges, a smaller one ripples between particles
-FULL_BLOCK_RADIUS = 2.0
+#: the particle radii, in block sides, tried for a block whose integral is the REFERENCE_QUANTILE of the blocks'
+#: (one per choice of the cloud's optical depth), the one leaving the least error kept.  A cloud has one optical
+#: depth, and a particle's integral grows as its radius squared: a larger radius smooths a uniform region (2 was
+#: best over the ball and the noise of `cloudcore.interop.example_grids`), a smaller one keeps the peaks of a
+#: grid made of particles (1 was best over an exported scene's clouds); 0.9 as the quantile beat 0.7, 0.8 and 1
+FULL_BLOCK_RADII = (0.7, 1.0, 1.4, 2.0)
 REFERENCE_QUANTILE = 0.9
 #: the smallest block side in voxels: a particle of a radius near one voxel is a spike at the voxel centre it
 #: sits on and missed by the others (at 1.2 voxels a block the error doubled over 2)
@@ -81,28 +82,26 @@ def fit_particles(grid: DensityGrid, max_particles: int, extinction_scale: float
     centres = np.column_stack([np.bincount(labels, density * points[:, axis]) for axis in range(3)])
     centres /= target[:, None] / volume
     block_side = block * np.cbrt(volume)
-    tau = float(
-        np.quantile(target, REFERENCE_QUANTILE)
-        / block_side**2
-        * KERNEL_DIAMETER_INTEGRAL
-        / (KERNEL_VOLUME_INTEGRAL * FULL_BLOCK_RADIUS**2)
-    )
-    smallest = particle_integral(MIN_RADIUS * block_side, tau)
     chance = hash01(blocks[:, 0], blocks[:, 1] * 2**21 + blocks[:, 2], 0)
     tree = cKDTree(points)
-    held = target.copy()
     best = None
-    for _ in range(REFINEMENTS + 1):
-        # a block too thin for a particle of MIN_RADIUS gets one with the chance that keeps its integral on average
-        kept = np.maximum(held, smallest) * (chance < held / smallest)
-        chosen = kept > 0.0
-        radii = _radii(kept[chosen], tau)
-        sampled = sampled_density(tree, centres[chosen], radii, tau, volume)
-        l1, l2 = _errors(density, sampled, volume, kept[chosen])
-        if best is None or l1 < best.relative_l1:
-            best = ParticleFit(np.column_stack([centres[chosen], radii]), tau, block, l1, l2)
-        inside = np.bincount(labels, sampled, len(target)) * volume
-        held = held * np.clip(target / np.maximum(inside, 1e-300), 1.0 / MAX_PASS_SCALE, MAX_PASS_SCALE)
+    for full_radius in FULL_BLOCK_RADII:
+        # the optical depth at which a block holding the REFERENCE_QUANTILE of the integrals gets full_radius
+        reference = np.quantile(target, REFERENCE_QUANTILE)
+        tau = float(reference / (full_radius * block_side) ** 2 * KERNEL_DIAMETER_INTEGRAL / KERNEL_VOLUME_INTEGRAL)
+        smallest = particle_integral(MIN_RADIUS * block_side, tau)
+        held = target.copy()
+        for _ in range(REFINEMENTS + 1):
+            # a block too thin for a particle of MIN_RADIUS gets one by chance, keeping its integral on average
+            kept = np.maximum(held, smallest) * (chance < held / smallest)
+            chosen = kept > 0.0
+            radii = _radii(kept[chosen], tau)
+            sampled = sampled_density(tree, centres[chosen], radii, tau, volume)
+            l1, l2 = _errors(density, sampled, volume, kept[chosen])
+            if best is None or l1 < best.relative_l1:
+                best = ParticleFit(np.column_stack([centres[chosen], radii]), tau, block, l1, l2)
+            inside = np.bincount(labels, sampled, len(target)) * volume
+            held = held * np.clip(target / np.maximum(inside, 1e-300), 1.0 / MAX_PASS_SCALE, MAX_PASS_SCALE)
     return best
 
 
