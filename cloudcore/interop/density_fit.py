@@ -6,14 +6,14 @@ of extinction times volume.  A cloud has one optical depth tau for all its parti
 so a particle's share of the density is set by its radius alone.
 
 The fit, after Yusov's particle generation (2014, section 5.2: one particle per non-empty cell of a grid,
-sized by the cloud's density in the cell): the grid's voxels are gathered into cubic blocks of `block`
-voxels a side, the smallest blocks that give at most the particle budget; each block with density becomes
-one particle at its density's centroid, holding the block's integral of density.  tau is chosen so that a
-block of the grid's highest mean density gets a radius of FULL_BLOCK_RADIUS block sides (neighbouring splats
-overlap, so a uniform region stays smooth); thinner blocks get smaller radii.  A splat spreads its density
-over its whole radius, which blurs the grid; `REFINEMENTS` passes then scale each particle's integral by
-what its block holds over what the particles put there (a multiplicative deconvolution, each pass's result
-kept only where it lowers the error).
+sized by the cloud's density in the cell): the grid's voxels are gathered into cubic blocks, the smallest (at
+least MIN_BLOCK_VOXELS a side) that give at most the particle budget; each block with density becomes one
+particle at its density's centroid, holding the block's integral of density.  tau is chosen so that a block
+holding the REFERENCE_QUANTILE of the integrals gets a radius of one of FULL_BLOCK_RADII block sides (each
+tried, the least error kept); thinner blocks get smaller radii, down to MIN_RADIUS.  A splat spreads its density
+over its whole radius, which blurs the grid; REFINEMENTS passes then scale each particle's integral by what its
+block holds over what the particles put there (a multiplicative deconvolution, a pass's result kept only where
+it lowers the error).  docs/interop.md has the errors measured.
 
 The error is measured against the grid: the particles' extinction sampled at every active voxel's centre
 (`sampled_density`), and the integral the particles put outside the active voxels counted as error too:
