@@ -21,6 +21,7 @@ from pathlib import Path
 
 from cloudcore.editing import History, delete_cloud, delete_particles
 from cloudcore.errors import SceneError
+from cloudcore.interop.vdb_clouds import DEFAULT_PARTICLES, export_vdb, import_vdb_clouds
 from cloudcore.limits import scene_limit_problems
 from cloudcore.measure.frame_stats import FrameStats
 from cloudcore.particle_files import particles_folder
@@ -293,6 +294,32 @@ class Editor:
         self._remember(Path(path))
         self.messages.append(f"opened {path}")
         self._mention_recovery()
+        return True
+
+    def import_vdb(self, path: Path, max_particles: int = DEFAULT_PARTICLES) -> bool:
+        """Add a cloud for each density grid of the OpenVDB file at `path`, as one undoable edit; a file that
+        cannot be imported leaves the scene as it was and says why."""
+        try:
+            imported = import_vdb_clouds(path, max_particles, taken_names=[cloud.name for cloud in self.scene.clouds])
+        except SceneError as error:
+            self.messages.append(f"could not import: {error}")
+            return False
+        clouds = tuple(item.cloud for item in imported)
+        if not self.edit(dataclasses.replace(self.scene, clouds=self.scene.clouds + clouds)):
+            return False
+        self.selected_cloud = len(self.scene.clouds) - 1
+        errors = ", ".join(f"{item.cloud.name} L1 {100 * item.fit.relative_l1:.0f}%" for item in imported)
+        self.messages.append(f"imported {len(clouds)} cloud(s) from {Path(path).name} (density error {errors})")
+        return True
+
+    def export_vdb(self, path: Path) -> bool:
+        """Write the scene's clouds to the OpenVDB file at `path`, one extinction grid a cloud."""
+        try:
+            grids = export_vdb(self.scene, path)
+        except (OSError, SceneError) as error:
+            self.messages.append(f"could not export {path}: {error}")
+            return False
+        self.messages.append(f"exported {len(grids)} grid(s) to {path}")
         return True
 
     def _keep_unsaved_edits(self) -> bool:

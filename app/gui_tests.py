@@ -21,6 +21,8 @@ from imgui_bundle.imgui.test_engine_checks import CHECK
 
 from app.editor import discard_recovery, recovery_path
 from cloudcore.editing import add_cloud
+from cloudcore.interop.example_grids import sphere_grid
+from cloudcore.interop.vdb import write_density_grids
 from cloudcore.measure.imagecompare import compare
 from cloudcore.measure.overlays import to_pixels
 from cloudcore.navigation import orbited
@@ -306,6 +308,34 @@ def malformed_scene_keeps_the_current_one(ctx, app: EditorUnderTest):
     ctx.yield_()
     CHECK(app.editor.scene is current)
     CHECK(any("could not open" in m and "malformed.toml" in m for m in app.editor.messages))
+
+
+def importing_a_vdb_adds_its_cloud_and_a_bad_one_keeps_the_scene(ctx, app: EditorUnderTest):
+    """Import VDB... adds the grid's cloud (one undoable edit); a truncated file leaves the scene as it was, with
+    a message naming the file; Export VDB... writes the clouds' grids."""
+    good = app.results_path.with_name("ball.vdb")
+    write_density_grids(good, [sphere_grid(side=16, voxel=40.0, centre=(0.0, 900.0, -2000.0), name="ball")])
+    before = app.editor.scene
+    use_window(ctx, "Scene")
+    ctx.item_input_value("VDB file", str(good))
+    ctx.item_click("Import VDB...")
+    ctx.yield_(SETTLE)
+    CHECK(len(app.editor.scene.clouds) == len(before.clouds) + 1)
+    CHECK(app.editor.scene.clouds[-1].name == "ball" and len(app.editor.scene.clouds[-1].particles) > 0)
+    imported = app.editor.scene
+    bad = app.results_path.with_name("truncated.vdb")
+    bad.write_bytes(good.read_bytes()[:200])
+    ctx.item_input_value("VDB file", str(bad))
+    ctx.item_click("Import VDB...")
+    ctx.yield_()
+    CHECK(app.editor.scene is imported)
+    CHECK(any("could not import" in m and "truncated.vdb" in m for m in app.editor.messages))
+    exported = app.results_path.with_name("exported.vdb")
+    ctx.item_input_value("VDB file", str(exported))
+    ctx.item_click("Export VDB...")
+    CHECK(exported.exists() and f"exported {len(imported.clouds)} grid(s) to {exported}" in app.editor.messages)
+    ctx.item_click("Undo")
+    CHECK(app.editor.scene is before)
 
 
 def recovery_is_offered_and_restores_the_edits(ctx, app: EditorUnderTest):
@@ -755,6 +785,7 @@ GUI_TESTS = (
     tolerance_drives_regeneration,
     save_and_reopen,
     malformed_scene_keeps_the_current_one,
+    importing_a_vdb_adds_its_cloud_and_a_bad_one_keeps_the_scene,
     recovery_is_offered_and_restores_the_edits,
     place_on_the_cloud_surface,
     brush_stroke_is_one_undo_step,

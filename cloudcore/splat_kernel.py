@@ -36,3 +36,16 @@ def _kernel_diameter_integral(points: int = 64) -> float:
 #: path-traced truth's particles, `cloudcore.light.truth`, and Yusov's reference particle,
 #: `cloudcore.light.precomputed`)
 KERNEL_DIAMETER_INTEGRAL = _kernel_diameter_integral()
+
+
+def _kernel_volume_integral(points: int = 64) -> float:
+    """The integral of K(|u|) over the unit ball, 4 pi times that of K(d) d^2 over d in [0, 1] (Gauss-Legendre
+    as `_kernel_diameter_integral`)."""
+    nodes, weights = np.polynomial.legendre.leggauss(points)
+    d = 0.5 * (nodes + 1.0)
+    return float(4.0 * np.pi * 0.5 * np.sum(weights * splat_kernel(d) * d * d))
+
+
+#: a blob of extinction c K(|x - p| / r) holds c r^3 times this of extinction times volume: what a particle
+#: fitted to a density grid (`cloudcore.interop.density_fit`) carries of the grid's integral
+KERNEL_VOLUME_INTEGRAL = _kernel_volume_integral()

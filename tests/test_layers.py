@@ -51,8 +51,9 @@ LAYERS = (
     ("light", "lod", "point_sprites"),
     # measurement
     ("measure",),
-    # scenes coming in and changed: the files, what the renderer can draw, the artist's edits
-    ("editing", "limits", "scenefile"),
+    # scenes coming in and changed: the files, what the renderer can draw, the artist's edits, clouds from and to
+    # other tools' files
+    ("editing", "limits", "scenefile", "interop"),
     # OpenGL
     ("gl",),
     # the command and the pytest plugin

@@ -1,4 +1,4 @@
-"""The Scene panel: open, save, undo, recover, and the editor's messages."""
+"""The Scene panel: open, save, undo, recover, import and export OpenVDB clouds, and the editor's messages."""
 
 from __future__ import annotations
 
@@ -13,6 +13,7 @@ class ScenePanel:
     def __init__(self, editor: Editor):
         self.editor = editor
         self.file_field = str(editor.path or "")
+        self.vdb_field = ""
 
     def draw(self) -> None:
         editor = self.editor
@@ -40,6 +41,14 @@ class ScenePanel:
             if imgui.button("Recover unsaved edits"):
                 editor.recover()
             imgui.set_item_tooltip(f"load {recovery_path(editor.path)}, written before the last session ended")
+        _, self.vdb_field = imgui.input_text("VDB file", self.vdb_field)
+        if imgui.button("Import VDB..."):
+            editor.import_vdb(Path(self.vdb_field))
+        imgui.set_item_tooltip("add a cloud for each density grid of the OpenVDB file")
+        imgui.same_line()
+        if imgui.button("Export VDB..."):
+            editor.export_vdb(Path(self.vdb_field))
+        imgui.set_item_tooltip("write the clouds to the OpenVDB file, one extinction grid a cloud")
         for path in editor.recent[1:]:
             if imgui.small_button(f"recent: {path.name}##{path}"):
                 self.file_field = str(path)

@@ -36,7 +36,7 @@ def version_line() -> str:
 
 
 def build_parser() -> tuple[argparse.ArgumentParser, argparse._SubParsersAction]:
-    from cloudcore.cli import bench, check, compare, record, render, shade, truth
+    from cloudcore.cli import bench, check, compare, record, render, shade, truth, vdb_export, vdb_import
 
     # raw text: the version stays one line however narrow the terminal
     parser = _OneLineParser(
@@ -53,6 +53,8 @@ def build_parser() -> tuple[argparse.ArgumentParser, argparse._SubParsersAction]
     bench.add_parser(commands)
     record.add_parser(commands)
     truth.add_parser(commands)
+    vdb_import.add_parser(commands)
+    vdb_export.add_parser(commands)
     return parser, commands
 
 
@@ -95,7 +97,7 @@ def _editor(argv: list[str]) -> int:
         print(
             "cloudview: error: the editor needs a display (none is set); on a headless machine try "
             "`xvfb-run -a cloudview`, or the headless commands: "
-            "cloudview render|record|bench|compare|check|truth --help",
+            "cloudview render|record|bench|compare|check|truth|import|export --help",
             file=sys.stderr,
         )
         return 2

@@ -140,6 +140,15 @@ def medium_grids(
         return []
     centres, radii, tau, albedo = (np.concatenate(column) for column in zip(*parts))
     voxel = float(np.median(radii)) / voxels_per_radius
+    low, shape_xyz = splat_grid_box(centres, radii, voxel)
+    peak = peak_extinction(tau, radii) * resolution_gain(radii / voxel)
+    extinction, albedo_grid = splatted_extinction(low, voxel, shape_xyz, centres, radii, peak, albedo)
+    return _bricks(low, voxel, extinction, albedo_grid, brick_voxels)
+
+
+def splat_grid_box(centres, radii, voxel: float) -> tuple[np.ndarray, np.ndarray]:
+    """(low corner, shape (x, y, z) in voxels) of a grid of cubic `voxel`s over the particles' reach with one
+    empty voxel around it, so that the grid is zero at its faces; ValueError past MAX_VOXELS."""
     low = (centres - radii[:, None]).min(axis=0) - voxel
     high = (centres + radii[:, None]).max(axis=0) + voxel
     shape_xyz = np.maximum(np.ceil((high - low) / voxel).astype(np.int64), 2)
@@ -148,8 +157,7 @@ def medium_grids(
             f"the medium would need {int(np.prod(shape_xyz)):,} voxels (at most {MAX_VOXELS:,}): "
             "ask for fewer voxels per radius"
         )
-    extinction, albedo_grid = _splatted(low, voxel, shape_xyz, centres, radii, tau, albedo)
-    return _bricks(low, voxel, extinction, albedo_grid, brick_voxels)
+    return low, shape_xyz
 
 
 def _bricks(low, voxel, extinction, albedo, brick_voxels: int) -> list[MediumGrid]:
@@ -198,15 +206,15 @@ def resolution_gain(radii_in_voxels) -> np.ndarray:
     return 1.0 + RESOLUTION_GAIN_FIT[0] / q**2 + RESOLUTION_GAIN_FIT[1] / q**4
 
 
-def _splatted(
-    low, voxel, shape_xyz, centres, radii, tau, albedo, chunk_entries: int = 2_000_000
+def splatted_extinction(
+    low, voxel, shape_xyz, centres, radii, peak, albedo, chunk_entries: int = 2_000_000
 ) -> tuple[np.ndarray, np.ndarray]:
-    """(extinction, albedo) [z, y, x]: every particle's c_i K(d) summed at the voxel centres it reaches,
-    c_i times the resolution gain; the albedo weighted by extinction."""
+    """(extinction, albedo) [z, y, x]: every particle's `peak` K(d) summed at the centres of the voxels it
+    reaches, voxel (i, j, k) centred at low + (i + 0.5, j + 0.5, k + 0.5) * voxel; the albedo weighted by
+    extinction."""
     count = int(np.prod(shape_xyz))
     extinction = np.zeros(count)
     scattering = np.zeros(count)
-    peak = peak_extinction(tau, radii) * resolution_gain(radii / voxel)
     first = np.clip(np.floor((centres - radii[:, None] - low) / voxel - 0.5).astype(np.int64), 0, shape_xyz - 1)
     last = np.clip(np.ceil((centres + radii[:, None] - low) / voxel - 0.5).astype(np.int64), 0, shape_xyz - 1)
     spans = (last - first + 1).max(axis=1)

@@ -1,0 +1,1 @@
+"""Clouds in and out of the files other tools keep volumes in: OpenVDB density grids."""
