@@ -6,12 +6,16 @@ vertex colours and drawing with RenderFlags.FLAT costs about a quarter of that
 cloud pass tests against; one full-screen pass then composites its colour over
 the sky into the linear target (shaders/world.frag.glsl).  Under the physical sky that pass also
 adds the air between the eye and the terrain (aerial perspective, `cloudcore.light.air_between`): it reads the
-terrain's depth from a copy (the target's depth is a renderbuffer, shared with the cloud passes' targets).
+terrain's depth from a copy (the target's depth is a renderbuffer, shared with the cloud passes' targets).  Where
+the clouds shadow the terrain (`sun_apart`) the vertex colours hold the light less the sun's, and the sun's part
+(per heightfield vertex, a texture over the terrain) is added per pixel times the clouds' transmittance map at the
+pixel's place (`cloudcore.gl.shadow_map`).
 """
 
 from __future__ import annotations
 
 import functools
+from dataclasses import dataclass
 
 import numpy as np
 import trimesh
@@ -25,6 +29,7 @@ from cloudcore.gl.air_volume import AirVolume
 from cloudcore.gl.context import HeadlessContext
 from cloudcore.gl.programs import build_program, set_matrix, set_vec3
 from cloudcore.gl.pyrender_compat import pyrender
+from cloudcore.gl.shadow_map import CloudShadowMap
 from cloudcore.light.air_between import air_between
 from cloudcore.light.sky_background import SkyBackground
 from cloudcore.light.terrain_light import TerrainLight
@@ -32,9 +37,9 @@ from cloudcore.limits import DRAWN_TERRAIN_KINDS
 from cloudcore.scene import Camera, Terrain
 from cloudcore.terrain import heightfield_mesh
 
-#: the terrain's depth's texture unit, as world.frag.glsl declares it (the world's colour 0, the sky-view table 1,
-#: the air's volume `AIR_UNITS`)
-_DEPTH_UNIT = 2
+#: the terrain's depth's and its sun's part's texture units, as world.frag.glsl declares them (the world's colour 0,
+#: the sky-view table 1, the air's volume `AIR_UNITS`, the clouds' shadows `SHADOW_UNITS`)
+_DEPTH_UNIT, _SUN_UNIT = 2, 7
 
 
 @functools.lru_cache(maxsize=2)
@@ -45,34 +50,40 @@ def terrain_geometry(terrain: Terrain) -> tuple[np.ndarray, np.ndarray, np.ndarr
     return vertices, faces, trimesh.Trimesh(vertices, faces, process=False).vertex_normals
 
 
-def terrain_vertex_colours(normals, base_colour, light: TerrainLight) -> np.ndarray:
-    """Linear RGB per vertex: base * the irradiance `light` gives each vertex's normal."""
-    return np.asarray(base_colour, dtype=np.float64) * light.irradiance(normals)
+def terrain_vertex_colours(normals, base_colour, light: TerrainLight, sun_apart: bool = False) -> np.ndarray:
+    """Linear RGB per vertex: base * the irradiance `light` gives each vertex's normal (less the sun's part when
+    `sun_apart`)."""
+    return np.asarray(base_colour, dtype=np.float64) * light.irradiance(normals, 0.0 if sun_apart else 1.0)
 
 
 class WorldPass:
     """Terrain and sky for one terrain and one lighting; rebuild it when either changes."""
 
-    def __init__(self, terrain: Terrain | None, light: TerrainLight, sky: SkyBackground):
+    def __init__(self, terrain: Terrain | None, light: TerrainLight, sky: SkyBackground, sun_apart: bool = False):
+        """`sun_apart`: the terrain's sun's part apart from the rest, for the clouds' shadows to scale (`draw`'s
+        `shadows`)."""
         self._sky = sky
         self._composite_program = build_program("world")
         self._sky_view_texture = _sky_view_texture(sky) if sky.physical else None
         # core profile draws nothing without a vertex array, even one with no attributes
         self._fullscreen_vertex_array = GL.glGenVertexArrays(1)
         self._scene = None
+        self._sun_texture = None  # the terrain's sun's part per heightfield vertex, where it is apart
         if terrain is not None:
-            self._scene, self._camera_node = self._terrain_scene(terrain, light)
+            self._scene, self._camera_node = self._terrain_scene(terrain, light, sun_apart)
+            self._sun_texture = _terrain_sun_texture(terrain, light) if sun_apart else None
         # the air's volume under the physical sky (the cloud pass reads it too: `air_volume`), and the terrain's
         # depth, which the terrain is seen through it by
         self._air_volume = AirVolume() if sky.physical else None
         self._depth_copy, self._depth_copy_size = None, None
+        self._depth_copied = False  # this draw's depth is in the copy
 
     @staticmethod
-    def _terrain_scene(terrain: Terrain, light: TerrainLight):
+    def _terrain_scene(terrain: Terrain, light: TerrainLight, sun_apart: bool):
         if terrain.kind not in DRAWN_TERRAIN_KINDS:  # the scene loader refuses these first (cloudcore.limits)
             raise ValueError(f"the GL prototype draws heightfield terrain only, not {terrain.kind!r}")
         vertices, faces, normals = terrain_geometry(terrain)
-        colours = terrain_vertex_colours(normals, terrain.color, light)
+        colours = terrain_vertex_colours(normals, terrain.color, light, sun_apart)
         # encoded, because pyrender's 8-bit framebuffer would band linear colour in the shadows
         primitive = pyrender.Primitive(
             positions=vertices.astype(np.float32),
@@ -92,9 +103,12 @@ class WorldPass:
         *,
         antialiased: bool = False,
         through_air: bool = True,
+        shadows: CloudShadowMap | None = None,
     ) -> None:
         """Fill the render target: terrain colour and depth where there is terrain, sky elsewhere (the terrain
-        multisampled 4x when `antialiased`, seen through the air under the physical sky when `through_air`)."""
+        multisampled 4x when `antialiased`, seen through the air under the physical sky when `through_air`, its
+        sun's part, where apart, in the clouds' `shadows` where given)."""
+        self._depth_copied = False
         if self._scene is None:
             context.clear_world()
         else:
@@ -109,6 +123,7 @@ class WorldPass:
         set_matrix(program, "inverse_view_projection", np.linalg.inv(view_projection))
         self._set_sky_uniforms(program, camera)
         self._set_air_uniforms(program, context, camera, through_air)
+        self._set_sun_uniforms(program, context, shadows)
         GL.glDisable(GL.GL_BLEND)
         GL.glDisable(GL.GL_CULL_FACE)
         GL.glDisable(GL.GL_DEPTH_TEST)  # colour everywhere; the depth pyrender wrote stays
@@ -157,6 +172,23 @@ class WorldPass:
         GL.glActiveTexture(GL.GL_TEXTURE0)
         set_vec3(program, "eye_position", camera.position)
 
+    def _set_sun_uniforms(self, program: int, context: HeadlessContext, shadows: CloudShadowMap | None) -> None:
+        sun_apart = self._sun_texture is not None
+        GL.glUniform1i(GL.glGetUniformLocation(program, "sun_apart"), int(sun_apart))
+        if not sun_apart:
+            return
+        GL.glActiveTexture(GL.GL_TEXTURE0 + _SUN_UNIT)
+        GL.glBindTexture(GL.GL_TEXTURE_2D, self._sun_texture.texture)
+        GL.glActiveTexture(GL.GL_TEXTURE0 + _DEPTH_UNIT)
+        GL.glBindTexture(GL.GL_TEXTURE_2D, self._copy_depth(context))
+        GL.glActiveTexture(GL.GL_TEXTURE0)
+        GL.glUniform2f(GL.glGetUniformLocation(program, "terrain_sun_origin"), *self._sun_texture.origin)
+        GL.glUniform2f(GL.glGetUniformLocation(program, "terrain_sun_spacing"), *self._sun_texture.spacing)
+        if shadows is None:
+            GL.glUniform1i(GL.glGetUniformLocation(program, "cloud_shadows"), 0)
+        else:
+            shadows.bind(program)
+
     @property
     def air_volume(self) -> AirVolume | None:
         """The air's volume as the last `draw` uploaded it, for its eye; None under the gradient sky."""
@@ -164,8 +196,11 @@ class WorldPass:
 
     def _copy_depth(self, context: HeadlessContext) -> int:
         """The depth pyrender wrote, copied into a texture of the target's size (made at the first draw and
-        whenever that size changes); the target stays bound."""
+        whenever that size changes; copied once a draw, however many read it); the target stays bound."""
         size = (context.width, context.height)
+        if self._depth_copied:
+            return self._depth_copy
+        self._depth_copied = True
         if self._depth_copy_size != size:
             if self._depth_copy is not None:
                 GL.glDeleteTextures([self._depth_copy])
@@ -187,6 +222,8 @@ class WorldPass:
             self._air_volume.close()
         if self._depth_copy is not None:
             GL.glDeleteTextures([self._depth_copy])
+        if self._sun_texture is not None:
+            GL.glDeleteTextures([self._sun_texture.texture])
         GL.glDeleteProgram(self._composite_program)
         GL.glDeleteVertexArrays(1, [self._fullscreen_vertex_array])
 
@@ -209,3 +246,36 @@ def _sky_view_texture(sky: SkyBackground) -> int:
     GL.glTexImage2D(GL.GL_TEXTURE_2D, 0, GL.GL_RGB32F, width, height, 0, GL.GL_RGB, GL.GL_FLOAT, pixels)
     GL.glBindTexture(GL.GL_TEXTURE_2D, 0)
     return texture
+
+
+@dataclass(frozen=True)
+class _TerrainSun:
+    """The terrain's sun's part, linear RGB per heightfield vertex, as a texture over the terrain: vertex (i, j) at
+    `origin` + (i, j) `spacing` (x, z) is texel (i, j)'s centre."""
+
+    texture: int
+    origin: tuple[float, float]
+    spacing: tuple[float, float]
+
+
+def _terrain_sun_texture(terrain: Terrain, light: TerrainLight) -> _TerrainSun:
+    """base * the sun's irradiance on each vertex of the heightfield (`heightfield_mesh`'s grid: rows along z),
+    read linearly between vertices as the vertex colours are."""
+    vertices, _, normals = terrain_geometry(terrain)
+    n = terrain.resolution
+    sun = np.asarray(terrain.color, dtype=np.float64) * light.sun_irradiance(normals)
+    texture = GL.glGenTextures(1)
+    GL.glBindTexture(GL.GL_TEXTURE_2D, texture)
+    for parameter, value in (
+        (GL.GL_TEXTURE_MIN_FILTER, GL.GL_LINEAR),
+        (GL.GL_TEXTURE_MAG_FILTER, GL.GL_LINEAR),
+        (GL.GL_TEXTURE_WRAP_S, GL.GL_CLAMP_TO_EDGE),
+        (GL.GL_TEXTURE_WRAP_T, GL.GL_CLAMP_TO_EDGE),
+    ):
+        GL.glTexParameteri(GL.GL_TEXTURE_2D, parameter, value)
+    pixels = np.ascontiguousarray(sun.reshape(n, n, 3), dtype=np.float32)
+    GL.glTexImage2D(GL.GL_TEXTURE_2D, 0, GL.GL_RGB32F, n, n, 0, GL.GL_RGB, GL.GL_FLOAT, pixels)
+    GL.glBindTexture(GL.GL_TEXTURE_2D, 0)
+    corner = vertices[0]
+    spacing = (vertices[1, 0] - corner[0], vertices[n, 2] - corner[2])
+    return _TerrainSun(int(texture), (float(corner[0]), float(corner[2])), tuple(float(v) for v in spacing))

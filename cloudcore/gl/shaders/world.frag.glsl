@@ -26,6 +26,13 @@ uniform bool through_air;
 layout(binding = 2) uniform sampler2D world_depth;
 uniform vec3 eye_position;
 #include "aerial_perspective.glsl"
+// the sun's part of the terrain's light, apart from the vertex colours' where the clouds shadow it: per heightfield
+// vertex, vertex (i, j) at terrain_sun_origin + (i, j) terrain_sun_spacing (x, z), scaled by the clouds' map
+uniform bool sun_apart;
+layout(binding = 7) uniform sampler2D terrain_sun;
+uniform vec2 terrain_sun_origin;
+uniform vec2 terrain_sun_spacing;
+#include "cloud_shadow.glsl"
 
 const float SUN_ANGULAR_RADIUS = 0.004651302;  // radians(0.533 / 2), cloudcore/atmosphere/sun_disc.py
 const float LIMB_DARKENING = 0.6;
@@ -102,9 +109,14 @@ void main()
 {
     vec4 world = texelFetch(world_texture, ivec2(gl_FragCoord.xy), 0);
     vec3 terrain = world.a > 0.0 ? srgb_decode(world.rgb / world.a) : vec3(0.0);
-    if (through_air && world.a > 0.0) {
-        float depth = texelFetch(world_depth, ivec2(gl_FragCoord.xy), 0).r;
-        terrain = seen_through_air(terrain, 1.0, unproject(2.0 * depth - 1.0) - eye_position);
+    if ((through_air || sun_apart) && world.a > 0.0) {
+        vec3 point = unproject(2.0 * texelFetch(world_depth, ivec2(gl_FragCoord.xy), 0).r - 1.0);
+        if (sun_apart) {
+            vec2 uv = ((point.xz - terrain_sun_origin) / terrain_sun_spacing + 0.5) / vec2(textureSize(terrain_sun, 0));
+            terrain += texture(terrain_sun, uv).rgb * cloud_shadow_transmittance(point);
+        }
+        if (through_air)
+            terrain = seen_through_air(terrain, 1.0, point - eye_position);
     }
     // where the terrain covers the pixel the sky is not seen: its lookups skipped
     vec3 background = world.a < 1.0 ? sky(normalize(unproject(1.0) - unproject(-1.0))) : vec3(0.0);
