@@ -582,6 +582,7 @@ class FrameRenderer:
                     write_depth=False,
                     antialiased=antialiased,
                     air=None if frame.air is None else frame.air[0],
+                    shadows=self._shadows,
                 )
             elif kind == "inside":
                 if item in screen_impostors:  # the rest of its run is in the same screen impostor
