@@ -12,7 +12,7 @@ import dataclasses
 
 import numpy as np
 
-from cloudcore.light.cloud_shadows import BETWEEN_CLOUDS_RESOLUTION, beam_opacity, between_clouds_transmittance
+from cloudcore.light.cloud_shadows import beam_opacity, between_clouds_transmittance
 from cloudcore.light.lighting import active_lights
 from cloudcore.light.shading import DEFAULT_RASTER_RESOLUTION, incident_light
 from cloudcore.scene import Cloud, Shading
@@ -47,7 +47,7 @@ def illuminate_clouds(
         for i, cloud in enumerate(clouds)
     ]
     sun = shadowing_sun(lights) if between_clouds else None
-    return incident if sun is None else _dimmed(incident, sun_through_others(clouds, shading, sun, method))
+    return incident if sun is None else _dimmed(incident, sun_through_others(clouds, shading, sun))
 
 
 def shadowing_sun(lights) -> tuple[float, ...] | None:
@@ -57,12 +57,7 @@ def shadowing_sun(lights) -> tuple[float, ...] | None:
     return light_directions(lights[:1])[0] if lights and active_lights(lights[:1]) else None
 
 
-#: the map's texels across the clouds for the light pass's methods: the editor's preview (a dragged slider) reads
-#: a coarser one
-BETWEEN_CLOUDS_TEXELS = {"preview": BETWEEN_CLOUDS_RESOLUTION // 2}
-
-
-def sun_through_others(clouds, shading: Shading, sun_direction, method: str = "exact") -> list[np.ndarray]:
+def sun_through_others(clouds, shading: Shading, sun_direction) -> list[np.ndarray]:
     """Per cloud (N_i,): the share of the sun's beam from `sun_direction` the other clouds let reach each
     particle (`cloudcore.light.cloud_shadows.between_clouds_transmittance`)."""
     clouds = list(clouds)
@@ -79,7 +74,6 @@ def sun_through_others(clouds, shading: Shading, sun_direction, method: str = "e
         opacity,
         np.concatenate([[0], np.cumsum(counts)]),
         sun_direction,
-        BETWEEN_CLOUDS_TEXELS.get(method, BETWEEN_CLOUDS_RESOLUTION),
     )
     return np.split(through, np.cumsum(counts)[:-1])
 
@@ -149,7 +143,7 @@ class IlluminationCache:
         #: (id of the cloud, shading, method) -> (the cloud, {light direction: incident (N,)})
         self._entries: dict[tuple, tuple[Cloud, dict[tuple, np.ndarray]]] = {}
         self.last_recomputed = 0  # (cloud, light direction) pairs shaded by the last call
-        #: ((the clouds, shading, method, sun direction), the sun through the others per cloud): the last asked
+        #: ((the clouds, shading, sun direction), the sun through the others per cloud): the last asked
         self._between: tuple[tuple, list[np.ndarray]] | None = None
         self.between_made = 0  # how many times the sun through the others was made
 
@@ -172,15 +166,16 @@ class IlluminationCache:
             for key, c in zip(keys, clouds)
         ]
         sun = shadowing_sun(lights) if between_clouds else None
-        return incident if sun is None else _dimmed(incident, self._sun_through_others(clouds, shading, sun, method))
+        return incident if sun is None else _dimmed(incident, self._sun_through_others(clouds, shading, sun))
 
-    def _sun_through_others(self, clouds, shading: Shading, sun, method: str) -> list[np.ndarray]:
-        """`sun_through_others`, kept while the clouds (by identity), their optics and the sun stay."""
-        source = (clouds, dataclasses.replace(shading, eye_pass=Shading().eye_pass), method, sun)
+    def _sun_through_others(self, clouds, shading: Shading, sun) -> list[np.ndarray]:
+        """`sun_through_others`, kept while the clouds (by identity), their optics and the sun stay (whichever
+        method lights them: a dragged slider's preview and the exact pass after it share it)."""
+        source = (clouds, dataclasses.replace(shading, eye_pass=Shading().eye_pass), sun)
         held = self._between
         if held is not None and held[0][1:] == source[1:] and _same_clouds(held[0][0], clouds):
             return held[1]
-        through = sun_through_others(clouds, shading, sun, method)
+        through = sun_through_others(clouds, shading, sun)
         self._between = (source, through)
         self.between_made += 1
         return through
