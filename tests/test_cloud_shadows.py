@@ -121,7 +121,11 @@ def test_the_light_pass_dims_the_sun_alone_and_the_cache_keeps_it_while_the_clou
     assert np.array_equal(shadowed[1][:, 1], alone[1][:, 1])  # the skylight is not the sun
     assert np.array_equal(cache.incident(clouds, shading, lights, "raster", between_clouds=True)[1], shadowed[1])
     assert cache.between_made == 1
-    cache.incident(clouds, shading, (Light(tuple(sun_direction(12.0))), lights[1]), "raster", between_clouds=True)
+    noon = (Light(tuple(sun_direction(12.0))), lights[1])
+    # a dragged slider's look keeps the clouds' shadows of the sun before; the look after the drag makes its own
+    cache.incident(clouds, shading, noon, "preview", between_clouds=True)
+    assert cache.between_made == 1
+    cache.incident(clouds, shading, noon, "raster", between_clouds=True)
     assert cache.between_made == 2
     # a sun that has set casts no shadow: the skylight, first of the lights that shine, is not dimmed
     night = (Light(tuple(SUN), intensity=0.0), lights[1])

@@ -48,7 +48,7 @@ MAP_RESOLUTION, PREVIEW_MAP_RESOLUTION = 512, 256
 #: scene's 90,000 particles in about 0.13 s (at 64 no faster: the particles' deposits, not the texels, cost it); the
 #: texel (about 45 m there) near the particles' median radius
 BETWEEN_CLOUDS_RESOLUTION = 128
-#: below this opacity-times-kernel a particle's optical depth is capped: float32's 1 - alpha K would round to 0
+#: a particle's opacity times its kernel is capped at this, so that float32's 1 - b K stays above 0
 _MOST_OPACITY = 1.0 - 1e-6
 
 

@@ -166,15 +166,18 @@ class IlluminationCache:
             for key, c in zip(keys, clouds)
         ]
         sun = shadowing_sun(lights) if between_clouds else None
-        return incident if sun is None else _dimmed(incident, self._sun_through_others(clouds, shading, sun))
+        return incident if sun is None else _dimmed(incident, self._sun_through_others(clouds, shading, sun, method))
 
-    def _sun_through_others(self, clouds, shading: Shading, sun) -> list[np.ndarray]:
-        """`sun_through_others`, kept while the clouds (by identity), their optics and the sun stay (whichever
-        method lights them: a dragged slider's preview and the exact pass after it share it)."""
+    def _sun_through_others(self, clouds, shading: Shading, sun, method: str) -> list[np.ndarray]:
+        """`sun_through_others`, kept while the clouds (by identity), their optics and the sun stay.  A dragged
+        slider's look (the preview method) takes the one held for these clouds and optics whatever its sun: made on
+        the thread that draws, 0.13 s a look would hold a time-of-day drag's frames over a second on this machine;
+        the look after the drag (the exact pass) makes it for its sun."""
         source = (clouds, dataclasses.replace(shading, eye_pass=Shading().eye_pass), sun)
         held = self._between
-        if held is not None and held[0][1:] == source[1:] and _same_clouds(held[0][0], clouds):
-            return held[1]
+        if held is not None and _same_clouds(held[0][0], clouds) and held[0][1] == source[1]:
+            if held[0][2] == sun or method == "preview":  # `cloudcore.light.shading`'s preview method
+                return held[1]
         through = sun_through_others(clouds, shading, sun)
         self._between = (source, through)
         self.between_made += 1
