@@ -399,7 +399,10 @@ class FrameRenderer:
         lights, ambient = scene_lights(lighting)
         # a dragged slider's look (the editor's preview) draws the coarse sky, as its clouds are a coarse raster
         preview = illumination_method == PREVIEW_METHOD
-        # the clouds shadow the sun's (the first light's) beam where there are clouds and it shines
+        # the clouds shadow the sun's (the first light's) beam where there are clouds and it shines; not a cloud
+        # field's: its clouds fade in and out by blend weights the map does not follow (their shadows would pop in
+        # whole: a step of 0.3 levels in the frame's mean as cells enter, tests/test_render_cloud_field.py)
+        cloud_shadows = cloud_shadows and scene.cloud_field is None
         sun = shadowing_sun(lights) if cloud_shadows and scene.clouds else None
         world_source = (scene.terrain, lighting, preview, sun is not None)
         if world_source != self._world_source:
