@@ -403,7 +403,9 @@ class FrameRenderer:
         # field's: its clouds fade in and out by blend weights the map does not follow (their shadows would pop in
         # whole: a step of 0.3 levels in the frame's mean as cells enter, tests/test_render_cloud_field.py)
         cloud_shadows = cloud_shadows and scene.cloud_field is None
-        sun = shadowing_sun(lights) if cloud_shadows and scene.clouds else None
+        sun = shadowing_sun(lights) if cloud_shadows else None
+        # the terrain's sun apart whether or not there are clouds: a scene's ground the same with clouds that shadow
+        # nothing as without them
         world_source = (scene.terrain, lighting, preview, sun is not None)
         if world_source != self._world_source:
             self.context.make_current()
@@ -427,8 +429,8 @@ class FrameRenderer:
         illumination_ms = 0.0
         if particles_source != self._particles_source:
             illumination_ms = self._prepare_particles(scene, lights, ambient, particles_source)
-        self._shadows = None if sun is None else self.shadow_map
-        if sun is not None:
+        self._shadows = None if sun is None or not scene.clouds else self.shadow_map
+        if self._shadows is not None:
             # made again only for another particle buffer, sun or size (`CloudShadowMap.update`)
             self.shadow_map.update(self._particles, sun, PREVIEW_MAP_RESOLUTION if preview else MAP_RESOLUTION)
             self.context.bind_target()
