@@ -227,6 +227,14 @@ class RenderSettings:
         help="under the physical sky, draw the terrain and the clouds through the air between them and the eye",
         label="Aerial perspective",
     )
+    #: the clouds' shadows in the sun's (the first light's) beam: on the terrain and the objects, and on each other
+    #: (`cloudcore.light.cloud_shadows`, docs/atmosphere.md); off, the sun reaches everything whole, as before
+    cloud_shadows: bool = _setting(
+        True,
+        flag="--no-cloud-shadows",
+        help="let the clouds shadow the terrain, the objects and one another in the sun's light",
+        label="Cloud shadows",
+    )
     #: "plain": premultiplied billboards (ONE, ONE_MINUS_SRC_ALPHA); "volume": Yusov's volume-aware
     #: blending (HPG 2014, 5.5), intersecting particles composited as volumes by a tiled compute pass
     #: where the GL has compute shaders (plain otherwise).  Plain by default: the goldens are its
@@ -318,6 +326,7 @@ class RenderSettings:
             "point_sprites",
             "world_antialiasing",
             "aerial_perspective",
+            "cloud_shadows",
         ):
             if not isinstance(getattr(self, name), bool):
                 problems.append(f"{name} must be true or false, got {getattr(self, name)!r}")

@@ -222,6 +222,9 @@ def test_the_example_scene_matches_its_committed_goldens(capsys):
     assert [line.split(": ")[:2] for line in output[:-1]] == [
         [f"aircraft_in_cloud/{view}", "pass"] for view in ("default", "sunset", "aircraft_inside", "orbit_quarter")
     ]
-    # the view at 10 s on the scene clock has the aircraft in the cloud's heart, where the default view at 0 s has not
+    # the view at 10 s on the scene clock has the aircraft in the cloud's heart, where the default view at 0 s has not:
+    # in the cloud's shadow it is dim, 10 levels from the cloud around it at most (the default tolerance's 12 would
+    # not tell them apart), so a tolerance of 5 is asked
     inside = iio.imread(EXAMPLE_GOLDENS / "aircraft_in_cloud" / "aircraft_inside.png")
-    assert not check_view("a", "v", inside, EXAMPLE_GOLDENS / "aircraft_in_cloud" / "default.png", Tolerance()).passed
+    default = EXAMPLE_GOLDENS / "aircraft_in_cloud" / "default.png"
+    assert not check_view("a", "v", inside, default, Tolerance(max_diff=5)).passed

@@ -1,6 +1,8 @@
 """Golden images of the full-3D renderer on the default scene at 160x120 (tolerance and the
 command that regenerates them: tests/goldens.py)."""
 
+import dataclasses
+
 import pytest
 from conftest import VALLEY
 from goldens import MAX_ABS, MIN_PSNR_DB, check_golden
@@ -38,13 +40,18 @@ VIEWS = {
     "sunset": lambda s: (s, 18.6, None),
     "midnight": lambda s: (s, 0.0, None),
     "empty_scene": lambda s: (Scene(camera=s.camera), 15.5, None),
+    # the pictures of before the clouds' shadows (their goldens those of then): the switch turns them off whole
+    "default_view_no_cloud_shadows": lambda s: (s, None, None),
+    "sunset_no_cloud_shadows": lambda s: (s, 18.6, None),
 }
+#: the views drawn with other settings than FULL_3D's
+SETTINGS = {name: dataclasses.replace(FULL_3D, cloud_shadows=False) for name in VIEWS if "no_cloud_shadows" in name}
 
 
 @pytest.mark.parametrize("name", VIEWS)
 def test_render_matches_golden(name, renderer, valley, request):
     scene, hours, camera = VIEWS[name](valley)
-    image, _ = renderer.render(scene, time_of_day=hours, camera=camera, settings=FULL_3D)
+    image, _ = renderer.render(scene, time_of_day=hours, camera=camera, settings=SETTINGS.get(name, FULL_3D))
     check_golden(image, name, request)
 
 

@@ -52,7 +52,9 @@ def test_split_impostors_match_split_full_3d_and_the_naive_impostor_cuts_the_air
     )
     print(f"t={time_s}: split impostor {whole} ({around_split} around the aircraft); naive {around_naive}")
     assert whole.psnr_db >= 45.0 and around_split.psnr_db >= 50.0
-    assert around_naive.psnr_db < 35.0 and around_naive.max_abs > 50
+    # the cut is a step of 42-64 levels: the aircraft in the cloud's shadow (cloud shadows) stands out less than it did
+    # lit by the whole sun (over 50)
+    assert around_naive.psnr_db < 35.0 and around_naive.max_abs > 35
 
 
 def test_an_object_outside_clouds_hides_the_cloud_behind_it(renderer, scene):

@@ -115,10 +115,13 @@ def test_pyrender_bounds_work_under_numpy_2(renderer):
     np.testing.assert_allclose(scene.bounds, [[0, 0, 0], [1, 1, 1]])
 
 
-def test_an_antialiased_world_differs_only_along_the_terrains_edges(renderer, valley, afternoon):
-    plain, _ = afternoon
+def test_an_antialiased_world_differs_only_along_the_terrains_edges(renderer, valley):
+    # without the clouds' shadows: multisampled, a pixel's depth is one sample's, off the pixel's centre, and the far
+    # ground's shadow edges move by it (6.5% of the pixels by over 8 levels at 160x120)
+    unshadowed = dataclasses.replace(FULL_3D, cloud_shadows=False)
+    plain, _ = renderer.render(valley, time_of_day=15.5, settings=unshadowed)
     smooth, stats = renderer.render(
-        valley, time_of_day=15.5, settings=dataclasses.replace(FULL_3D, world_antialiasing=True)
+        valley, time_of_day=15.5, settings=dataclasses.replace(unshadowed, world_antialiasing=True)
     )
     changed = np.abs(smooth.astype(int) - plain.astype(int)).max(axis=2) > 8
     assert 0.0 < changed.mean() < 0.01, changed.mean()  # the ridge line and nothing else

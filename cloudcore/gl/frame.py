@@ -48,13 +48,15 @@ from cloudcore.gl.objects import ObjectPass
 from cloudcore.gl.pass_clock import PassClock
 from cloudcore.gl.programs import build_program
 from cloudcore.gl.quads import SCREEN_CORNERS, QuadPass
+from cloudcore.gl.shadow_map import CloudShadowMap
 from cloudcore.gl.splats import SplatBatch, SplatPass, SplatSelection, splat_batch
 from cloudcore.gl.targets import TextureTarget, blit_depth, depth_renderbuffer
 from cloudcore.gl.volume_blending import GpuFeatures, VolumeBlendingPass
 from cloudcore.gl.world import WorldPass
 from cloudcore.light.air_between import air_between
+from cloudcore.light.cloud_shadows import MAP_RESOLUTION, PREVIEW_MAP_RESOLUTION
 from cloudcore.light.eye_scattering import ParticleBuffer
-from cloudcore.light.illumination import IlluminationCache
+from cloudcore.light.illumination import IlluminationCache, shadowing_sun
 from cloudcore.light.lighting import scene_lights
 from cloudcore.light.live_air import LiveAir
 from cloudcore.light.relighting import PREVIEW_METHOD
@@ -130,6 +132,9 @@ class FrameRenderer:
         self._quads = QuadPass()
         self._impostors = ImpostorStore(self._splats)
         self._world, self._world_source = None, None
+        #: the clouds' transmittance map, and this frame's: None where the clouds shadow nothing
+        self.shadow_map = CloudShadowMap()
+        self._shadows: CloudShadowMap | None = None
         self._objects, self._objects_source = None, None
         self._particles, self._particles_source = None, None
         self._facings: CloudFacings | None = None
@@ -232,7 +237,7 @@ class FrameRenderer:
         camera = scene.camera if camera is None else camera
         authored_clouds = len(scene.clouds)
         scene, fade_keys = self._with_field(scene, camera)
-        illumination_ms = self._prepare(scene, lighting, illumination_method)
+        illumination_ms = self._prepare(scene, lighting, illumination_method, settings.cloud_shadows)
         planning_started = time.perf_counter()
         particles = self._particles
         particles.weigh(self._field_weights)
@@ -286,6 +291,7 @@ class FrameRenderer:
                     projection @ view,
                     antialiased=antialiased,
                     through_air=settings.aerial_perspective,
+                    shadows=self._shadows,
                 )
                 if plan.objects_with_world:
                     self._objects.draw(
@@ -296,6 +302,7 @@ class FrameRenderer:
                         write_depth=True,
                         antialiased=antialiased,
                         air=self._world.air_volume if settings.aerial_perspective else None,
+                        shadows=self._shadows,
                     )
             with clock.timed("impostor updates"):
                 rendered = self._impostors.update(plan, particles, settings, time_s, way, self._unit_weights)
@@ -394,18 +401,27 @@ class FrameRenderer:
             (1.0,) * len(scene.clouds) + frame.fade_keys,
         )
 
-    def _prepare(self, scene: Scene, lighting: Lighting, illumination_method: str) -> float:
-        """Rebuild the world pass and the particle illumination where their inputs changed; ms spent shading."""
+    def _prepare(self, scene: Scene, lighting: Lighting, illumination_method: str, cloud_shadows: bool) -> float:
+        """Rebuild the world pass, the particle illumination and the clouds' transmittance map where their inputs
+        changed; ms spent shading."""
         lights, ambient = scene_lights(lighting)
         # a dragged slider's look (the editor's preview) draws the coarse sky, as its clouds are a coarse raster
         preview = illumination_method == PREVIEW_METHOD
+        # the clouds shadow the sun's (the first light's) beam where there are clouds and it shines; not a cloud
+        # field's: its clouds fade in and out by blend weights the map does not follow (their shadows would pop in
+        # whole: a step of 0.3 levels in the frame's mean as cells enter, tests/test_render_cloud_field.py)
+        cloud_shadows = cloud_shadows and scene.cloud_field is None
+        sun = shadowing_sun(lights) if cloud_shadows else None
         world_source = (scene.terrain, lighting, preview)
         if world_source != self._world_source:
             self.context.make_current()
             if self._world is not None:
                 self._world.close()
             self._world = WorldPass(
-                scene.terrain, terrain_light(lighting, lights, ambient), scene_sky(lighting, preview), self._air_for
+                scene.terrain,
+                terrain_light(lighting, lights, ambient),
+                scene_sky(lighting, preview),
+                self._air_for,
             )
             self._world_source = world_source
         objects_source = (scene.objects, lights, tuple(ambient), self.size)
@@ -415,10 +431,23 @@ class FrameRenderer:
                 self._objects.close()
             self._objects = ObjectPass(scene.objects, lights, ambient, self.size) if scene.objects else None
             self._objects_source = objects_source
-        particles_source = (scene.clouds, scene.shading, lighting, illumination_method)
-        if particles_source == self._particles_source:
-            return 0.0
+        particles_source = (scene.clouds, scene.shading, lighting, illumination_method, cloud_shadows)
+        illumination_ms = 0.0
+        if particles_source != self._particles_source:
+            illumination_ms = self._prepare_particles(scene, lights, ambient, particles_source)
+        self._shadows = None if sun is None or not scene.clouds else self.shadow_map
+        if self._shadows is not None:
+            # made again only for another particle buffer, sun or size (`CloudShadowMap.update`)
+            self.shadow_map.update(self._particles, sun, PREVIEW_MAP_RESOLUTION if preview else MAP_RESOLUTION)
+            self.context.bind_target()
+        return illumination_ms
+
+    def _prepare_particles(self, scene: Scene, lights, ambient, particles_source: tuple) -> float:
+        """Make the particle buffer (the clouds' light) again for `particles_source` (the clouds, shading,
+        lighting, light pass method, whether the clouds shadow one another); ms spent."""
+        _, _, lighting, illumination_method, cloud_shadows = particles_source
         start = time.perf_counter()
+        old_particles = self._particles
         self._particles = ParticleBuffer(
             scene.clouds,
             scene.shading,
@@ -427,15 +456,32 @@ class FrameRenderer:
             illumination_method,
             self._illumination,
             particle_styles(scene.clouds, lighting),
+            between_clouds=cloud_shadows,
         )
         self._facings = CloudFacings(self._particles)
         old_clouds, old_lighting = (
             ((), None) if self._particles_source is None else (self._particles_source[0], self._particles_source[1:])
         )
         same_lighting = old_lighting == particles_source[1:]
-        # by identity, not place: a cloud field's clouds that stay keep their keys when others come and go
-        held = dict(zip(map(id, old_clouds), self._lighting_keys)) if same_lighting else {}
-        self._lighting_keys = tuple(held.get(id(cloud)) or self._next_key() for cloud in scene.clouds)
+        # by identity, not place: a cloud field's clouds that stay keep their keys when others come and go, unless
+        # the light reaching them changed (the clouds shadow one another: one moved, another's shadow moves)
+        held = (
+            {
+                id(cloud): (key, old_particles.incident[start:stop])
+                for cloud, key, start, stop in zip(
+                    old_clouds, self._lighting_keys, old_particles.cloud_starts[:-1], old_particles.cloud_starts[1:]
+                )
+            }
+            if same_lighting
+            else {}
+        )
+        starts = self._particles.cloud_starts
+        self._lighting_keys = tuple(
+            key
+            if (key := _held_key(held.get(id(cloud)), self._particles.incident[start:stop])) is not None
+            else self._next_key()
+            for cloud, start, stop in zip(scene.clouds, starts[:-1], starts[1:])
+        )
         self._forming_clouds = tuple(index for index, cloud in enumerate(scene.clouds) if cloud.formation is not None)
         self._particles_source = particles_source
         return 1e3 * (time.perf_counter() - start)
@@ -547,6 +593,7 @@ class FrameRenderer:
                     write_depth=False,
                     antialiased=antialiased,
                     air=None if frame.air is None else frame.air[0],
+                    shadows=self._shadows,
                 )
             elif kind == "inside":
                 if item in screen_impostors:  # the rest of its run is in the same screen impostor
@@ -816,6 +863,7 @@ class FrameRenderer:
         self._splats.close()
         self._clock.close()
         self._volume.close()
+        self.shadow_map.close()
         if self._world is not None:
             self._world.close()
         if self._objects is not None:
@@ -827,6 +875,12 @@ class FrameRenderer:
 
     def __exit__(self, *exc):
         self.close()
+
+
+def _held_key(held, incident: np.ndarray):
+    """A cloud's lighting key from before (`held`: (key, the light that reached its particles then)) while the
+    light reaching it is the same, else None."""
+    return held[0] if held is not None and np.array_equal(held[1], incident) else None
 
 
 def render_full(

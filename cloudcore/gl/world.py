@@ -22,6 +22,7 @@ from cloudcore.camera import frustum_planes
 from cloudcore.gl.air_volume import AirVolume
 from cloudcore.gl.context import HeadlessContext
 from cloudcore.gl.programs import build_program, set_matrix, set_vec3
+from cloudcore.gl.shadow_map import CloudShadowMap
 from cloudcore.light.air_between import AirBetween, air_between
 from cloudcore.light.sky_background import SkyBackground
 from cloudcore.light.terrain_light import TerrainLight
@@ -37,9 +38,7 @@ def terrain_vertex_light(normals, base_colour, light: TerrainLight) -> tuple[np.
     """Linear RGB per vertex of unit `normals`: base * the sun's irradiance, and base * the rest (the sky's dome,
     the ground's bounce, the floor), which `light` gives each normal."""
     base = np.asarray(base_colour, dtype=np.float64)
-    unshadowed = light.irradiance(normals)
-    sky = light.irradiance(normals, sun_visibility=0.0)
-    return base * (unshadowed - sky), base * sky
+    return base * light.sun_irradiance(normals), base * light.irradiance(normals, sun_visibility=0.0)
 
 
 class TerrainMesh:
@@ -79,9 +78,11 @@ class TerrainMesh:
             self._programs[through_air] = build_program("terrain", {"THROUGH_AIR": int(through_air)})
         return self._programs[through_air]
 
-    def draw(self, camera: Camera, view_projection: np.ndarray, air: AirVolume | None) -> None:
+    def draw(
+        self, camera: Camera, view_projection: np.ndarray, air: AirVolume | None, shadows: CloudShadowMap | None
+    ) -> None:
         """Draw the tiles in view for `camera` into the bound target, depth tested and written, seen through
-        `air` (bound for `camera`'s eye) where there is one."""
+        `air` (bound for `camera`'s eye) where there is one, the sun's part in the clouds' `shadows` where given."""
         if self.tiles.update(camera.position):
             self._upload()
         in_view = np.flatnonzero(self.tiles.in_view(frustum_planes(view_projection)))
@@ -93,6 +94,10 @@ class TerrainMesh:
         if air is not None:
             air.bind(program)
             set_vec3(program, "eye_position", camera.position)
+        if shadows is None:
+            GL.glUniform1i(GL.glGetUniformLocation(program, "cloud_shadows"), 0)
+        else:
+            shadows.bind(program)
         GL.glEnable(GL.GL_DEPTH_TEST)
         GL.glDepthFunc(GL.GL_LESS)
         GL.glDepthMask(GL.GL_TRUE)
@@ -148,10 +153,11 @@ class WorldPass:
         *,
         antialiased: bool = False,
         through_air: bool = True,
+        shadows: CloudShadowMap | None = None,
     ) -> None:
         """Fill the render target: terrain colour and depth where there is terrain, sky elsewhere (both
         multisampled 4x when `antialiased`, the terrain seen through the air under the physical sky when
-        `through_air`)."""
+        `through_air`, its sun's part in the clouds' `shadows` where given)."""
         framebuffer = context.multisampled_target() if antialiased else context.framebuffer
         GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, framebuffer)
         GL.glViewport(0, 0, context.width, context.height)
@@ -165,7 +171,7 @@ class WorldPass:
             self._air_volume.upload(self._air_for(self._sky, camera.position))
             air = self._air_volume
         if self._terrain is not None:
-            self._terrain.draw(camera, view_projection, air)
+            self._terrain.draw(camera, view_projection, air, shadows)
         program = self._sky_program
         GL.glUseProgram(program)
         set_matrix(program, "inverse_view_projection", np.linalg.inv(view_projection))

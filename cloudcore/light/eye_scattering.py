@@ -32,6 +32,7 @@ import numpy as np
 from cloudcore.artist.formation import core_distances, opacity_factor
 from cloudcore.artist.particle_styles import ParticleStyles, particle_styles
 from cloudcore.artist.sprites import CELL_PIXELS
+from cloudcore.light.cloud_shadows import beam_opacity
 from cloudcore.light.illumination import IlluminationCache, cloud_optics, illuminate_clouds
 from cloudcore.light.lighting import active_lights
 from cloudcore.light.phase import phase_function
@@ -60,14 +61,17 @@ class ParticleBuffer:
         method: str = "exact",
         cache: IlluminationCache | None = None,
         styles: ParticleStyles | None = None,
+        between_clouds: bool = False,
     ):
         """`cache` keeps the illumination of unchanged clouds between instances (the editor);
         `styles` (`cloudcore.artist.particle_styles`, by default at the default hour) say which clouds
-        are sprites or artist-shaded."""
+        are sprites or artist-shaded; with `between_clouds` the sun reaches each cloud through the others
+        (`cloudcore.light.illumination.sun_through_others`)."""
         clouds = tuple(clouds)
         self.styles = styles if styles is not None else particle_styles(clouds, Lighting())
         self.phase, self.g = shading.phase, shading.g
-        lights = active_lights(lights)
+        # the clouds' shadows fall in the first light's beam (the sun), whether or not the others give light
+        scene_lights, lights = tuple(lights), active_lights(lights)
         self.light_directions = np.array([light.direction for light in lights], dtype=np.float64).reshape(-1, 3)
         radiance = [np.asarray(light.color) * light.intensity for light in lights]
         self.light_radiance = np.array(radiance, dtype=np.float64).reshape(-1, 3)
@@ -81,6 +85,8 @@ class ParticleBuffer:
         tau = _concatenated([o[0] for o in optics], (0,))
         albedo = _concatenated([o[1] for o in optics], (0,))
         self.alpha = -np.expm1(-tau)
+        #: what each particle takes out of the sun's beam: the clouds' transmittance map is made of it
+        self.beam_opacity = beam_opacity(tau, albedo, shading.phase, shading.g)
         artist = np.array([c.artist is not None for c in clouds], dtype=bool)
         self._opaque = (self.alpha > 0.0) | np.repeat(artist, counts)
         self._near_faded = self.styles.near_faded
@@ -95,9 +101,9 @@ class ParticleBuffer:
         )
         self.tint = np.repeat(np.array([c.color for c in clouds], dtype=np.float64).reshape(-1, 3), counts, axis=0)
         incident = (
-            cache.incident(clouds, shading, lights, method)
+            cache.incident(clouds, shading, scene_lights, method, between_clouds=between_clouds)
             if cache is not None
-            else illuminate_clouds(clouds, shading, lights, method)
+            else illuminate_clouds(clouds, shading, scene_lights, method, between_clouds=between_clouds)
         )
         #: (n, lights): light that reached each particle, per light (Harris's light pass)
         self.incident = _concatenated(incident, (0, len(lights)))

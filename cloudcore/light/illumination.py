@@ -1,8 +1,9 @@
 """Precomputed illumination of a scene's clouds: incident light per particle and light direction.
 
-Harris shades each cloud on its own (clouds do not shadow each other) once per
-light; this module maps a scene's clouds, shading defaults and lights onto
-`cloudcore.light.shading.incident_light`.
+Harris shades each cloud on its own once per light; this module maps a scene's clouds, shading defaults and
+lights onto `cloudcore.light.shading.incident_light`.  The sun (the first light) then reaches each cloud through
+the others too, where asked (`between_clouds`): the clouds' light-space map less each cloud's own part
+(`cloudcore.light.cloud_shadows`).
 """
 
 from __future__ import annotations
@@ -11,6 +12,7 @@ import dataclasses
 
 import numpy as np
 
+from cloudcore.light.cloud_shadows import beam_opacity, between_clouds_transmittance
 from cloudcore.light.lighting import active_lights
 from cloudcore.light.shading import DEFAULT_RASTER_RESOLUTION, incident_light
 from cloudcore.scene import Cloud, Shading
@@ -25,18 +27,60 @@ def cloud_optics(cloud: Cloud, shading: Shading) -> tuple[np.ndarray, np.ndarray
 
 
 def illuminate_clouds(
-    clouds, shading: Shading, lights, method: str = "exact", *, resolution: int = DEFAULT_RASTER_RESOLUTION
+    clouds,
+    shading: Shading,
+    lights,
+    method: str = "exact",
+    *,
+    resolution: int = DEFAULT_RASTER_RESOLUTION,
+    between_clouds: bool = False,
 ) -> list[np.ndarray]:
-    """Incident light (N_i, L) of each cloud for each light that contributes (`active_lights`)."""
+    """Incident light (N_i, L) of each cloud for each light that contributes (`active_lights`); with
+    `between_clouds`, the sun's (the first light's) through the other clouds too (`sun_through_others`)."""
     clouds = list(clouds)
     columns = [
         illuminate_direction(clouds, shading, light.direction, method, resolution=resolution)
         for light in active_lights(lights)
     ]
-    return [
+    incident = [
         np.column_stack([column[i] for column in columns]) if columns else np.zeros((len(cloud.particles), 0))
         for i, cloud in enumerate(clouds)
     ]
+    sun = shadowing_sun(lights) if between_clouds else None
+    return incident if sun is None else _dimmed(incident, sun_through_others(clouds, shading, sun))
+
+
+def shadowing_sun(lights) -> tuple[float, ...] | None:
+    """The direction of the light the clouds shadow (the sun, or the first of a scene's lights), None where it
+    gives no light: it is then not among the incident light's columns."""
+    lights = tuple(lights)
+    return light_directions(lights[:1])[0] if lights and active_lights(lights[:1]) else None
+
+
+def sun_through_others(clouds, shading: Shading, sun_direction) -> list[np.ndarray]:
+    """Per cloud (N_i,): the share of the sun's beam from `sun_direction` the other clouds let reach each
+    particle (`cloudcore.light.cloud_shadows.between_clouds_transmittance`)."""
+    clouds = list(clouds)
+    counts = [len(c.particles) for c in clouds]
+    if sum(counts) == 0:
+        return [np.ones(n) for n in counts]
+    optics = [cloud_optics(c, shading) for c in clouds]
+    opacity = beam_opacity(
+        np.concatenate([o[0] for o in optics]), np.concatenate([o[1] for o in optics]), shading.phase, shading.g
+    )
+    through = between_clouds_transmittance(
+        np.concatenate([c.centres for c in clouds]),
+        np.concatenate([c.radii for c in clouds]),
+        opacity,
+        np.concatenate([[0], np.cumsum(counts)]),
+        sun_direction,
+    )
+    return np.split(through, np.cumsum(counts)[:-1])
+
+
+def _dimmed(incident: list[np.ndarray], through: list[np.ndarray]) -> list[np.ndarray]:
+    """`incident` with its first column (the sun's) times `through`."""
+    return [np.column_stack([light[:, 0] * share, light[:, 1:]]) for light, share in zip(incident, through)]
 
 
 def illuminate_direction(
@@ -91,16 +135,23 @@ class IlluminationCache:
     does, so the entries are per light direction: a new time of day moves the sun
     and recolours the skylight, and only the sun is shaded again.  `incident`
     keeps only what it was last asked for; `store` adds work done elsewhere
-    (`cloudcore.light.relighting`) beside it.
+    (`cloudcore.light.relighting`) beside it.  The sun through the other clouds depends on every cloud: it is
+    held for the last set of clouds, shading and sun asked for, and made again when any of them changes.
     """
 
     def __init__(self):
         #: (id of the cloud, shading, method) -> (the cloud, {light direction: incident (N,)})
         self._entries: dict[tuple, tuple[Cloud, dict[tuple, np.ndarray]]] = {}
         self.last_recomputed = 0  # (cloud, light direction) pairs shaded by the last call
+        #: ((the clouds, shading, sun direction), the sun through the others per cloud): the last asked
+        self._between: tuple[tuple, list[np.ndarray]] | None = None
+        self.between_made = 0  # how many times the sun through the others was made
 
-    def incident(self, clouds, shading: Shading, lights, method: str = "exact") -> list[np.ndarray]:
-        """`illuminate_clouds(clouds, shading, lights, method)`, from what is held where it can be."""
+    def incident(
+        self, clouds, shading: Shading, lights, method: str = "exact", *, between_clouds: bool = False
+    ) -> list[np.ndarray]:
+        """`illuminate_clouds(clouds, shading, lights, method, between_clouds=...)`, from what is held where it
+        can be."""
         clouds = list(clouds)
         work = self.missing(clouds, shading, lights, method)
         for direction, stale in work:
@@ -110,10 +161,27 @@ class IlluminationCache:
         kept = {key: (cloud, {d: self._entries[key][1][d] for d in directions}) for key, cloud in zip(keys, clouds)}
         self._entries = kept
         self.last_recomputed = sum(len(stale) for _, stale in work)
-        return [
+        incident = [
             np.column_stack([kept[key][1][d] for d in directions]) if directions else np.zeros((len(c.particles), 0))
             for key, c in zip(keys, clouds)
         ]
+        sun = shadowing_sun(lights) if between_clouds else None
+        return incident if sun is None else _dimmed(incident, self._sun_through_others(clouds, shading, sun, method))
+
+    def _sun_through_others(self, clouds, shading: Shading, sun, method: str) -> list[np.ndarray]:
+        """`sun_through_others`, kept while the clouds (by identity), their optics and the sun stay.  A dragged
+        slider's look (the preview method) takes the one held for these clouds and optics whatever its sun: made on
+        the thread that draws, 0.13 s a look would hold a time-of-day drag's frames over a second on this machine;
+        the look after the drag (the exact pass) makes it for its sun."""
+        source = (clouds, dataclasses.replace(shading, eye_pass=Shading().eye_pass), sun)
+        held = self._between
+        if held is not None and _same_clouds(held[0][0], clouds) and held[0][1] == source[1]:
+            if held[0][2] == sun or method == "preview":  # `cloudcore.light.shading`'s preview method
+                return held[1]
+        through = sun_through_others(clouds, shading, sun)
+        self._between = (source, through)
+        self.between_made += 1
+        return through
 
     def missing(self, clouds, shading: Shading, lights, method: str = "exact") -> list[tuple[tuple, list[Cloud]]]:
         """(light direction, the clouds not held for it) for each direction some cloud lacks."""
@@ -144,3 +212,8 @@ class IlluminationCache:
         # the light pass does not depend on what the eye pass makes of its result
         light_pass = dataclasses.replace(shading, eye_pass=Shading().eye_pass)
         return [(id(cloud), light_pass, method) for cloud in clouds]
+
+
+def _same_clouds(these, those) -> bool:
+    """Whether two lists hold the same cloud objects in the same order."""
+    return len(these) == len(those) and all(a is b for a, b in zip(these, those))

@@ -4,8 +4,9 @@ sky's dome and the ground's bounce as hemisphere terms, at every time of day.
 An isotropic sky of irradiance E_sky on an upward surface gives a surface of normal n E_sky (1 + n_y) / 2; the
 ground below, a Lambertian reflector of the air's albedo under the sun and the sky, gives it
 albedo (E_sun cos + E_sky) (1 - n_y) / 2.  The gradient sky keeps the lights of before (its skylight a light
-from the zenith, n . l) and its ambient.  `sun_visibility` is the place of the clouds' shadows: the share of
-the sun's beam that reaches each vertex (1 until a shadow map gives it).
+from the zenith, n . l) and its ambient.  The clouds' shadows fall in the sun's beam alone: the world pass takes
+the sun's part (`sun_irradiance`) apart from the rest (`irradiance` with `sun_visibility` 0) and scales it per
+pixel by the clouds' transmittance map (`cloudcore.light.cloud_shadows`).
 """
 
 from __future__ import annotations
@@ -48,6 +49,10 @@ class TerrainLight:
             )
             irradiance = irradiance + (visibility * cosine)[:, None] * np.asarray(light.color) * light.intensity
         return irradiance
+
+    def sun_irradiance(self, normals) -> np.ndarray:
+        """(n, 3): the first light's (the sun's) part of `irradiance`, the part the clouds shadow."""
+        return self.irradiance(normals, 1.0) - self.irradiance(normals, 0.0)
 
 
 def terrain_light(lighting: Lighting, lights, ambient) -> TerrainLight:

@@ -1,13 +1,17 @@
 #version 420 core
-// The terrain's colour in linear RGB, seen through the air its vertices read (terrain.vert.glsl).
+// The terrain's colour in linear RGB, its sun's part in the clouds' shadow at the pixel (cloud_shadow.glsl), seen
+// through the air its vertices read (terrain.vert.glsl).
 
 in vec3 sun_lit;
 in vec3 sky_lit;
+in vec3 world_position;
 in vec3 air_let_through;
 in vec3 air_added;
 out vec4 frag_colour;
+#include "cloud_shadow.glsl"
 
 void main()
 {
-    frag_colour = vec4((sun_lit + sky_lit) * air_let_through + air_added, 1.0);
+    vec3 lit = sun_lit * cloud_shadow_transmittance(world_position) + sky_lit;
+    frag_colour = vec4(lit * air_let_through + air_added, 1.0);
 }

@@ -1,6 +1,6 @@
 #version 420 core
 // The terrain's tiles (cloudcore/terrain_tiles.py) lit as cloudcore/light/terrain_light.py lights them, per
-// vertex: the sun's part apart from the sky's (a shadow dims the sun's alone).  With THROUGH_AIR the air between
+// vertex: the sun's part apart from the sky's (the clouds' shadow dims the sun's alone, per pixel).  With THROUGH_AIR the air between
 // the eye and each vertex is read here, per vertex, not per pixel: a pixel's lookups cost llvmpipe more than
 // the vertices' (docs/performance.md, "The world pass: where its time goes").
 
@@ -12,6 +12,7 @@ uniform vec3 eye_position;
 
 out vec3 sun_lit;
 out vec3 sky_lit;
+out vec3 world_position;  // where the clouds' shadow map is read, per pixel (terrain.frag.glsl)
 out vec3 air_let_through;
 out vec3 air_added;
 
@@ -22,6 +23,7 @@ out vec3 air_added;
 void main()
 {
     gl_Position = view_projection * vec4(position, 1.0);
+    world_position = position;
     sun_lit = sun_light;
     sky_lit = sky_light;
 #if THROUGH_AIR

@@ -1,0 +1,32 @@
+#version 330 core
+// One particle of the clouds' transmittance map (cloudcore/light/cloud_shadows.py): a square over its disc,
+// widened to a texel where it is narrower, seen along the sun.  Triangle-strip corners from gl_VertexID.
+
+layout(location = 0) in vec3 centre;
+layout(location = 1) in float radius;
+layout(location = 2) in float beam_opacity;
+
+uniform mat4 world_to_map;  // world to (u, v, slice coordinate, 1): LightSpace.world_to_map
+uniform float texel_m;      // a texel's side
+uniform vec2 map_size;      // texels across, up
+uniform float slice_m;      // a slice's depth
+
+out vec2 offset;             // from the particle's centre, in (widened) radii
+flat out float opacity;      // beam opacity
+flat out float scale;        // what keeps the optical depth's integral where the particle is widened
+flat out float slice_centre;
+flat out float slice_half;   // the slab's half thickness, in slices
+
+void main()
+{
+    vec2 corner = vec2(gl_VertexID & 1, gl_VertexID >> 1) * 2.0 - 1.0;
+    vec3 mapped = (world_to_map * vec4(centre, 1.0)).xyz;
+    float wide = max(radius, texel_m);
+    offset = corner;
+    opacity = beam_opacity;
+    scale = (radius / wide) * (radius / wide);
+    slice_centre = mapped.z;
+    slice_half = radius / slice_m;
+    vec2 uv = mapped.xy + corner * wide / (texel_m * map_size);
+    gl_Position = vec4(2.0 * uv - 1.0, 0.0, 1.0);
+}
