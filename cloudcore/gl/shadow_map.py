@@ -20,7 +20,7 @@ from cloudcore.splat_kernel import SPLAT_SHARPNESS
 
 #: the texture units of the map's two targets (slices 1-4, 5-8), as shaders/cloud_shadow.glsl declares them
 SHADOW_UNITS = (5, 6)
-#: floats per particle: centre, radius, beam opacity (shadow_map.vert.glsl's attributes)
+#: floats per particle: centre, radius, opacity (shadow_map.vert.glsl's attributes)
 _PARTICLE_FLOATS = 5
 if SLICES != 8:
     raise ImportError("shaders/shadow_map.frag.glsl and cloud_shadow.glsl hold eight slices in two RGBA targets")
@@ -64,7 +64,9 @@ class CloudShadowMap:
         self.made += 1
 
     def _draw(self, particles, space: LightSpace) -> None:
-        instances = np.column_stack([particles.centres, particles.radii, particles.beam_opacity]).astype(np.float32)
+        # the ground's and the objects' shadow takes each particle's whole opacity out of the sun's beam: nearer the
+        # path-traced truth's shadows than the light pass's beam opacity (docs/atmosphere.md#cloud-shadows)
+        instances = np.column_stack([particles.centres, particles.radii, particles.alpha]).astype(np.float32)
         GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self._buffer)
         GL.glBufferData(GL.GL_ARRAY_BUFFER, instances.nbytes, np.ascontiguousarray(instances), GL.GL_STATIC_DRAW)
         self._bind_targets(space.size)

@@ -7,12 +7,15 @@ of it.  A particle of beam opacity b and radius r lets 1 - b K(rho / r) through 
 (`cloudcore.splat_kernel`), so it adds the optical depth -ln(1 - b K) there: the transmittance through many is
 exp(-sum), the product of theirs.
 
-The beam opacity is Harris's light pass's (`beam_opacity`): of the light a particle stops (its opacity alpha) it
-sends the share sigma_eff / alpha on forward (`cloudcore.light.shading`), so the beam loses alpha - sigma_eff, as
-Yusov's occlusion estimate takes it (`cloudcore.light.occlusion`'s xi).  A cloud then shadows another as it
-shadows its own particles, and the ground under it keeps the light its particles send on (the default scene's
-particles, optical depth 8 at albedo 0.9, pass on 86% at their centres: by their opacity alone a cloud's shadow
-would be e^-100 black and the evening's clouds each in another's).  In depth a particle
+What a particle takes out of the beam differs by who receives it.  Another cloud's particles: the beam opacity
+of Harris's light pass (`beam_opacity`): of the light a particle stops (its opacity alpha) it sends the share
+sigma_eff / alpha on forward (`cloudcore.light.shading`), so the beam loses alpha - sigma_eff, as Yusov's
+occlusion estimate takes it (`cloudcore.light.occlusion`'s xi); a cloud then shadows another as it shadows its own
+particles (the default scene's particles, optical depth 8 at albedo 0.9, pass on 86% at their centres: by their
+opacity alone the evening's clouds were each in another's).  The ground and the objects (the GL map,
+`cloudcore.gl.shadow_map`): the opacity alpha itself, the direct sun blocked and the sky's light left, which the
+path-traced truth's shadows on the ground bear out (`scripts/truth_shadows.py`, docs/atmosphere.md#cloud-shadows).
+In depth a particle
 is a slab of thickness 2 r: the share of it in front of a depth ramps from 0 to 1 across it.  Between the slices'
 depths the optical depth is interpolated linearly, so a point behind every cloud (the ground) reads the whole
 column and one in front of them reads 0.

@@ -32,7 +32,6 @@ import numpy as np
 from cloudcore.artist.formation import core_distances, opacity_factor
 from cloudcore.artist.particle_styles import ParticleStyles, particle_styles
 from cloudcore.artist.sprites import CELL_PIXELS
-from cloudcore.light.cloud_shadows import beam_opacity
 from cloudcore.light.illumination import IlluminationCache, cloud_optics, illuminate_clouds
 from cloudcore.light.lighting import active_lights
 from cloudcore.light.phase import phase_function
@@ -85,8 +84,6 @@ class ParticleBuffer:
         tau = _concatenated([o[0] for o in optics], (0,))
         albedo = _concatenated([o[1] for o in optics], (0,))
         self.alpha = -np.expm1(-tau)
-        #: what each particle takes out of the sun's beam: the clouds' transmittance map is made of it
-        self.beam_opacity = beam_opacity(tau, albedo, shading.phase, shading.g)
         artist = np.array([c.artist is not None for c in clouds], dtype=bool)
         self._opaque = (self.alpha > 0.0) | np.repeat(artist, counts)
         self._near_faded = self.styles.near_faded

@@ -4,7 +4,7 @@
 
 layout(location = 0) in vec3 centre;
 layout(location = 1) in float radius;
-layout(location = 2) in float beam_opacity;
+layout(location = 2) in float particle_opacity;
 
 uniform mat4 world_to_map;  // world to (u, v, slice coordinate, 1): LightSpace.world_to_map
 uniform float texel_m;      // a texel's side
@@ -12,7 +12,7 @@ uniform vec2 map_size;      // texels across, up
 uniform float slice_m;      // a slice's depth
 
 out vec2 offset;             // from the particle's centre, in (widened) radii
-flat out float opacity;      // beam opacity
+flat out float opacity;      // what the particle takes out of the sun's beam at its centre
 flat out float scale;        // what keeps the optical depth's integral where the particle is widened
 flat out float slice_centre;
 flat out float slice_half;   // the slab's half thickness, in slices
@@ -23,7 +23,7 @@ void main()
     vec3 mapped = (world_to_map * vec4(centre, 1.0)).xyz;
     float wide = max(radius, texel_m);
     offset = corner;
-    opacity = beam_opacity;
+    opacity = particle_opacity;
     scale = (radius / wide) * (radius / wide);
     slice_centre = mapped.z;
     slice_half = radius / slice_m;
