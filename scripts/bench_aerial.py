@@ -12,16 +12,13 @@ The camera stays still, so the aerial-perspective volume is built once (its buil
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import os
 from pathlib import Path
-
-import numpy as np
 
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 
 from cloudcore.gl.frame import FrameRenderer  # noqa: E402  (after the platform above)
-from cloudcore.measure.benchmark import machine, write_report  # noqa: E402
+from cloudcore.measure.benchmark import machine, setting_in_turns, write_report  # noqa: E402
 from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
 from cloudcore.scenefile import load_scene  # noqa: E402
 from cloudcore.settings import FULL_3D, RenderSettings  # noqa: E402
@@ -32,21 +29,13 @@ TIMINGS = ("world_ms", "cloud_ms", "impostor_update_ms", "frame_ms")
 
 
 def pass_costs(scene, width: int, height: int, repeat: int, warm_up: int) -> dict:
-    """Per representation, with the air and without, the median of each of `TIMINGS` over `repeat` frames, ms."""
-    row = {"size": f"{width}x{height}"}
+    """Per representation, with the air ("on") and without ("off"), the median of each of `TIMINGS` over `repeat`
+    frames, ms; one renderer (the volume is built once, the camera still)."""
     with FrameRenderer(width, height) as renderer:
-        for name, settings in REPRESENTATIONS.items():
-            # one representation at a time: auto's first frames after full 3D's remake impostors
-            turns = {air: dataclasses.replace(settings, aerial_perspective=air == "air") for air in ("air", "no_air")}
-            times = {air: {timing: [] for timing in TIMINGS} for air in turns}
-            for frame in range(warm_up + repeat):
-                for air, turn in turns.items():
-                    _, stats = renderer.render(scene, settings=turn, read_back=False)
-                    for timing in TIMINGS if frame >= warm_up else ():
-                        times[air][timing].append(getattr(stats, timing))
-            for air, named in times.items():
-                row.update({f"{name}_{air}_{timing}": float(np.median(values)) for timing, values in named.items()})
-    return row
+        costs = setting_in_turns(
+            {"on": renderer, "off": renderer}, scene, REPRESENTATIONS, "aerial_perspective", TIMINGS, repeat, warm_up
+        )
+    return {"size": f"{width}x{height}", **costs}
 
 
 def main() -> None:

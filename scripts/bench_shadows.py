@@ -32,7 +32,7 @@ from cloudcore.light.cloud_shadows import sample_map  # noqa: E402
 from cloudcore.light.eye_scattering import ParticleBuffer  # noqa: E402
 from cloudcore.light.illumination import shadowing_sun, sun_through_others  # noqa: E402
 from cloudcore.light.lighting import scene_lights  # noqa: E402
-from cloudcore.measure.benchmark import machine, write_report  # noqa: E402
+from cloudcore.measure.benchmark import machine, setting_in_turns, write_report  # noqa: E402
 from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
 from cloudcore.scenefile import load_scene  # noqa: E402
 from cloudcore.settings import FULL_3D, RenderSettings  # noqa: E402
@@ -93,24 +93,15 @@ def light_pass_costs(scene, repeat: int) -> dict:
 
 
 def frame_costs(scene, width: int, height: int, repeat: int, warm_up: int) -> dict:
-    """Per representation, with the shadows and without, the median of each of `TIMINGS` over `repeat` frames."""
-    row = {"size": f"{width}x{height}"}
-    renderers = {turn: FrameRenderer(width, height) for turn in ("shadows", "no_shadows")}
+    """Per representation, with the shadows ("on") and without ("off"), the median of each of `TIMINGS` over
+    `repeat` frames; a renderer each (each keeps its own map)."""
+    renderers = {turn: FrameRenderer(width, height) for turn in ("on", "off")}
     try:
-        for name, settings in REPRESENTATIONS.items():
-            turns = {turn: dataclasses.replace(settings, cloud_shadows=turn == "shadows") for turn in renderers}
-            times = {turn: {timing: [] for timing in TIMINGS} for turn in turns}
-            for frame in range(warm_up + repeat):
-                for turn, turn_settings in turns.items():
-                    _, stats = renderers[turn].render(scene, settings=turn_settings, read_back=False)
-                    for timing in TIMINGS if frame >= warm_up else ():
-                        times[turn][timing].append(getattr(stats, timing))
-            for turn, named in times.items():
-                row.update({f"{name}_{turn}_{timing}": float(np.median(values)) for timing, values in named.items()})
+        costs = setting_in_turns(renderers, scene, REPRESENTATIONS, "cloud_shadows", TIMINGS, repeat, warm_up)
     finally:
         for renderer in renderers.values():
             renderer.close()
-    return row
+    return {"size": f"{width}x{height}", **costs}
 
 
 def main() -> None:

@@ -9,6 +9,7 @@ from OpenGL import GL
 
 from cloudcore.atmosphere.aerial_perspective import MAX_DISTANCE_M
 from cloudcore.gl.programs import set_vec3
+from cloudcore.gl.targets import linear_filtering
 from cloudcore.light.air_between import AirBetween
 
 #: the texture units of the lookup's samplers, the light added and the transmittance, as
@@ -29,14 +30,7 @@ class AirVolume:
             return
         for texture, values in zip(self._textures, (air.in_scattered(), air.transmittance()), strict=True):
             GL.glBindTexture(GL.GL_TEXTURE_3D, texture)
-            for parameter, value in (
-                (GL.GL_TEXTURE_MIN_FILTER, GL.GL_LINEAR),
-                (GL.GL_TEXTURE_MAG_FILTER, GL.GL_LINEAR),
-                (GL.GL_TEXTURE_WRAP_S, GL.GL_CLAMP_TO_EDGE),
-                (GL.GL_TEXTURE_WRAP_T, GL.GL_CLAMP_TO_EDGE),
-                (GL.GL_TEXTURE_WRAP_R, GL.GL_CLAMP_TO_EDGE),
-            ):
-                GL.glTexParameteri(GL.GL_TEXTURE_3D, parameter, value)
+            linear_filtering(GL.GL_TEXTURE_3D)
             depth, height, width = values.shape[:3]
             pixels = np.ascontiguousarray(values, dtype=np.float32)
             GL.glTexImage3D(GL.GL_TEXTURE_3D, 0, GL.GL_RGB32F, width, height, depth, 0, GL.GL_RGB, GL.GL_FLOAT, pixels)

@@ -15,6 +15,7 @@ import numpy as np
 from OpenGL import GL
 
 from cloudcore.gl.programs import build_program, set_matrix
+from cloudcore.gl.targets import linear_filtering
 from cloudcore.light.cloud_shadows import SLICES, LightSpace, light_space
 from cloudcore.splat_kernel import SPLAT_SHARPNESS
 
@@ -99,13 +100,7 @@ class CloudShadowMap:
             for attachment, texture in enumerate(self._textures):
                 GL.glBindTexture(GL.GL_TEXTURE_2D, texture)
                 GL.glTexStorage2D(GL.GL_TEXTURE_2D, 1, GL.GL_RGBA32F, *size)
-                for parameter, value in (
-                    (GL.GL_TEXTURE_MIN_FILTER, GL.GL_LINEAR),
-                    (GL.GL_TEXTURE_MAG_FILTER, GL.GL_LINEAR),
-                    (GL.GL_TEXTURE_WRAP_S, GL.GL_CLAMP_TO_BORDER),
-                    (GL.GL_TEXTURE_WRAP_T, GL.GL_CLAMP_TO_BORDER),
-                ):
-                    GL.glTexParameteri(GL.GL_TEXTURE_2D, parameter, value)
+                linear_filtering(GL.GL_TEXTURE_2D, GL.GL_CLAMP_TO_BORDER)
                 # off the map no cloud is in front: no optical depth
                 GL.glTexParameterfv(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_BORDER_COLOR, np.zeros(4, dtype=np.float32))
                 GL.glFramebufferTexture2D(

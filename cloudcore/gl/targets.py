@@ -15,6 +15,17 @@ _TEXEL_BYTES = {GL.GL_RGBA16F: 8, GL.GL_R32F: 4, GL.GL_RGBA8: 4}
 _READ_FORMAT = {GL.GL_RGBA16F: (GL.GL_RGBA, 4), GL.GL_R32F: (GL.GL_RED, 1), GL.GL_RGBA8: (GL.GL_RGBA, 4)}
 
 
+def linear_filtering(target: int, wrap: int = GL.GL_CLAMP_TO_EDGE) -> None:
+    """The bound texture of `target` sampled linearly, wrapping by `wrap` on each of its axes."""
+    GL.glTexParameteri(target, GL.GL_TEXTURE_MIN_FILTER, GL.GL_LINEAR)
+    GL.glTexParameteri(target, GL.GL_TEXTURE_MAG_FILTER, GL.GL_LINEAR)
+    axes = (GL.GL_TEXTURE_WRAP_S, GL.GL_TEXTURE_WRAP_T) + (
+        (GL.GL_TEXTURE_WRAP_R,) if target == GL.GL_TEXTURE_3D else ()
+    )
+    for axis in axes:
+        GL.glTexParameteri(target, axis, wrap)
+
+
 class TextureTarget:
     """A framebuffer whose colour attachment is a linear-filtered texture of `internal_format`."""
 
@@ -23,10 +34,7 @@ class TextureTarget:
         self.texture = GL.glGenTextures(1)
         GL.glBindTexture(GL.GL_TEXTURE_2D, self.texture)
         GL.glTexStorage2D(GL.GL_TEXTURE_2D, 1, internal_format, self.width, self.height)
-        GL.glTexParameteri(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_MIN_FILTER, GL.GL_LINEAR)
-        GL.glTexParameteri(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_MAG_FILTER, GL.GL_LINEAR)
-        GL.glTexParameteri(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_WRAP_S, GL.GL_CLAMP_TO_EDGE)
-        GL.glTexParameteri(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_WRAP_T, GL.GL_CLAMP_TO_EDGE)
+        linear_filtering(GL.GL_TEXTURE_2D)
         self.framebuffer = GL.glGenFramebuffers(1)
         GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, self.framebuffer)
         GL.glFramebufferTexture2D(GL.GL_FRAMEBUFFER, GL.GL_COLOR_ATTACHMENT0, GL.GL_TEXTURE_2D, self.texture, 0)

@@ -23,6 +23,7 @@ from cloudcore.gl.air_volume import AirVolume
 from cloudcore.gl.context import HeadlessContext
 from cloudcore.gl.programs import build_program, set_matrix, set_vec3
 from cloudcore.gl.shadow_map import CloudShadowMap
+from cloudcore.gl.targets import linear_filtering
 from cloudcore.light.air_between import AirBetween, air_between
 from cloudcore.light.sky_background import SkyBackground
 from cloudcore.light.terrain_light import TerrainLight
@@ -235,13 +236,7 @@ def _sky_view_texture(sky: SkyBackground) -> int:
     texels as `cloudcore.atmosphere.table_sampling` reads it."""
     texture = GL.glGenTextures(1)
     GL.glBindTexture(GL.GL_TEXTURE_2D, texture)
-    for parameter, value in (
-        (GL.GL_TEXTURE_MIN_FILTER, GL.GL_LINEAR),
-        (GL.GL_TEXTURE_MAG_FILTER, GL.GL_LINEAR),
-        (GL.GL_TEXTURE_WRAP_S, GL.GL_CLAMP_TO_EDGE),
-        (GL.GL_TEXTURE_WRAP_T, GL.GL_CLAMP_TO_EDGE),
-    ):
-        GL.glTexParameteri(GL.GL_TEXTURE_2D, parameter, value)
+    linear_filtering(GL.GL_TEXTURE_2D)
     # row 0 of the table is v's first texel: GL's first row, so the shader reads it with the numpy side's (u, v)
     pixels = np.ascontiguousarray(sky.table(), dtype=np.float32)
     height, width = pixels.shape[:2]
