@@ -9,15 +9,18 @@ through the cloud's centre, below 35 dB over that box (measured 25-27 dB).
 """
 
 import dataclasses
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
-from cloudcore.camera import screen_box
+from cloudcore.camera import projection_matrix, screen_box
+from cloudcore.gl.objects import scissor_box
 from cloudcore.gl.pyrender_compat import pyrender
 from cloudcore.measure.imagecompare import compare
 from cloudcore.objects import object_poses
 from cloudcore.resources import DEFAULT_SCENE, resource_path
+from cloudcore.scene import Camera
 from cloudcore.scenefile import load_scene
 from cloudcore.settings import FULL_3D, RenderSettings
 
@@ -97,3 +100,36 @@ def test_the_terrain_and_the_aircraft_are_uploaded_once_not_every_frame(renderer
     for time_s in (9.0, 10.0):
         renderer.render(with_terrain, settings=SPLIT_IMPOSTOR, time_s=time_s)
     assert len(uploads) == 0, f"{len(uploads)} meshes uploaded again in two frames"
+
+
+def test_the_objects_composite_is_cut_to_a_box_holding_every_pixel_their_spheres_cover():
+    """`scissor_box` (the composite's scissor: llvmpipe pays its lookups over every pixel it covers) holds every
+    pixel of a sphere's image, for 400 spheres in front of the eye, off to its sides and nearly around it; the
+    whole target for one about the eye; nothing for one behind it."""
+    camera, size = Camera((0.0, 0.0, 0.0), (0.0, 0.0, -1.0), 60.0), (1280, 800)
+    projection = projection_matrix(camera.fov_y_deg, size[0] / size[1])
+    rng = np.random.default_rng(1)
+    checked = 0
+    for _ in range(400):
+        depth = rng.uniform(5.0, 200.0)
+        radius = rng.uniform(0.01, 0.95) * depth
+        angles = np.tan(rng.uniform(-1.2, 1.2, 2))
+        centre = np.array([angles[0] * depth, 0.6 * angles[1] * depth, -depth])
+        box = scissor_box([SimpleNamespace(centre=centre, radius=radius)], camera, size)
+        directions = rng.normal(size=(4000, 3))
+        points = centre + radius * directions / np.linalg.norm(directions, axis=1, keepdims=True)
+        points = points[points[:, 2] < -0.2]
+        ndc = (points[:, :2] * np.diag(projection)[:2]) / -points[:, 2:3]
+        pixels = (ndc + 1.0) * 0.5 * np.array(size)  # GL's, from the bottom left
+        seen = pixels[np.all((pixels >= 0.0) & (pixels < size), axis=1)]
+        if not len(seen):
+            continue
+        checked += 1
+        assert box is not None
+        x, y, width, height = box
+        assert np.all(seen >= (x, y)) and np.all(seen <= (x + width, y + height))
+    assert checked > 200
+    around = SimpleNamespace(centre=np.array([0.0, 0.0, -1.0]), radius=5.0)
+    behind = SimpleNamespace(centre=np.array([0.0, 0.0, 50.0]), radius=5.0)
+    assert scissor_box([around], camera, size) == (0, 0, *size)
+    assert scissor_box([behind], camera, size) is None

@@ -21,7 +21,13 @@ import math
 import numpy as np
 from OpenGL import GL
 
-from cloudcore.camera import FAR_PLANE_M, NEAR_PLANE_M, camera_pose, projection_matrix, view_matrix
+from cloudcore.camera import (
+    FAR_PLANE_M,
+    NEAR_PLANE_M,
+    camera_pose,
+    projection_matrix,
+    view_matrix,
+)
 from cloudcore.gl.air_volume import AirVolume
 from cloudcore.gl.programs import build_program, set_matrix, set_vec3
 from cloudcore.gl.pyrender_compat import pyrender
@@ -83,6 +89,10 @@ class ObjectPass:
         when `antialiased`), seen through `air` (uploaded for `camera`'s eye) where there is one, in the clouds'
         `shadows` where given."""
         which = set(which)
+        drawn = [poses[index] for index in sorted(which)]
+        box = scissor_box(drawn, camera, (context.width, context.height))
+        if box is None:  # none of them on the screen
+            return
         for index, (node, pose) in enumerate(zip(self._nodes, poses)):
             node.mesh.is_visible = index in which
             self._scene.set_pose(node, pose.model)
@@ -117,9 +127,14 @@ class ObjectPass:
         GL.glDepthMask(GL.GL_TRUE if write_depth else GL.GL_FALSE)
         GL.glEnable(GL.GL_BLEND)
         GL.glBlendFunc(GL.GL_ONE, GL.GL_ONE_MINUS_SRC_ALPHA)
+        # the full-screen composite within the objects' box alone: llvmpipe pays a pixel's lookups (the air, the
+        # shadows) whether or not an object covers it, and an aircraft covers a few percent of the screen
+        GL.glEnable(GL.GL_SCISSOR_TEST)
+        GL.glScissor(*box)
         GL.glBindVertexArray(self._vertex_array)
         GL.glDrawArrays(GL.GL_TRIANGLES, 0, 3)
         GL.glBindVertexArray(0)
+        GL.glDisable(GL.GL_SCISSOR_TEST)
         GL.glDepthMask(GL.GL_TRUE)
         GL.glDisable(GL.GL_BLEND)
 
@@ -195,3 +210,32 @@ def _sun_target(depth: int, width: int, height: int) -> tuple[int, int]:
     if status != GL.GL_FRAMEBUFFER_COMPLETE:
         raise RuntimeError(f"objects' sun framebuffer incomplete (status 0x{int(status):x})")
     return colour, framebuffer
+
+
+#: the corners of a cube of half side 1 about the origin
+_CUBE_CORNERS = np.array([[x, y, z] for x in (-1.0, 1.0) for y in (-1.0, 1.0) for z in (-1.0, 1.0)])
+
+
+def scissor_box(poses, camera: Camera, size: tuple[int, int]) -> tuple[int, int, int, int] | None:
+    """(x, y, width, height), GL's from the bottom left: pixels that hold every pixel the bounding spheres of
+    `poses` can cover, the image of the cubes around them (a sphere's image lies within its cube's, the cube wholly
+    in front of the eye); the whole target where a cube reaches the near plane; None where none is on the screen."""
+    width, height = size
+    centres = np.array([pose.centre for pose in poses], dtype=np.float64).reshape(-1, 3)
+    radii = np.array([pose.radius for pose in poses], dtype=np.float64)
+    eye = centres @ view_matrix(camera)[:3, :3].T + view_matrix(camera)[:3, 3]
+    ahead = -eye[:, 2] + radii > NEAR_PLANE_M  # the rest wholly behind the near plane
+    eye, radii = eye[ahead], radii[ahead]
+    if not len(radii):
+        return None
+    # a cube's nearest corner is sqrt(3) radii nearer than its centre at most
+    if np.any(-eye[:, 2] - np.sqrt(3.0) * radii <= NEAR_PLANE_M):
+        return (0, 0, width, height)
+    corners = (eye[:, None, :] + radii[:, None, None] * _CUBE_CORNERS).reshape(-1, 3)
+    projection = projection_matrix(camera.fov_y_deg, width / height)
+    ndc = (corners[:, :2] * np.diag(projection)[:2]) / -corners[:, 2:3]
+    low = np.floor((np.clip(ndc.min(axis=0), -1.0, 1.0) + 1.0) * 0.5 * np.array([width, height])).astype(int)
+    high = np.ceil((np.clip(ndc.max(axis=0), -1.0, 1.0) + 1.0) * 0.5 * np.array([width, height])).astype(int)
+    if np.any(high <= low):
+        return None
+    return (int(low[0]), int(low[1]), int(high[0] - low[0]), int(high[1] - low[1]))
