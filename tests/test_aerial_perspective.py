@@ -16,7 +16,7 @@ from cloudcore.atmosphere.sky import atmosphere_tables
 from cloudcore.atmosphere.sky_view import eye_radius
 from cloudcore.atmosphere.transmittance import optical_depth
 from cloudcore.camera import FAR_PLANE_M, NEAR_PLANE_M, camera_pose, pixel_rays
-from cloudcore.colour import srgb_decode, srgb_encode
+from cloudcore.colour import srgb_encode
 from cloudcore.light.air_between import AIR_CELL_ANGLE, AIR_MAX_CELLS, air_between, air_cells
 from cloudcore.light.lighting import PHYSICAL_EXPOSURE
 from cloudcore.light.live_air import LiveAir
@@ -105,6 +105,15 @@ def test_the_air_is_finite_at_the_extremes(eye_altitude, hours):
     assert np.isfinite(seen).all()
 
 
+def rays_and_distances(camera: Camera, depth: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(unit rays (h, w, 3), distances (h, w)): each pixel's ray and the distance along it to the window `depth`
+    (h, w) a frame of `camera` read back (its eye-space depth undone from the projection)."""
+    ndc = 2.0 * depth - 1.0
+    eye_depth = 2.0 * FAR_PLANE_M * NEAR_PLANE_M / (FAR_PLANE_M + NEAR_PLANE_M - ndc * (FAR_PLANE_M - NEAR_PLANE_M))
+    rays = pixel_rays(camera, RENDER_WIDTH, RENDER_HEIGHT)
+    return rays, eye_depth / (rays @ -camera_pose(camera)[:3, 2])
+
+
 @pytest.mark.gl
 def test_the_world_pass_draws_the_terrain_through_the_numpy_air(renderer):
     """A terrain of one known colour (lit by an ambient alone) seen from 600 m: each terrain pixel is
@@ -118,14 +127,8 @@ def test_the_world_pass_draws_the_terrain_through_the_numpy_air(renderer):
     depth = renderer.context.read_depth().astype(np.float64)
     on_terrain = depth < 1.0
     assert on_terrain.mean() > 0.3
-    # the eye-space depth from the window depth, then the distance along each pixel's ray
-    ndc = 2.0 * depth - 1.0
-    eye_depth = 2.0 * FAR_PLANE_M * NEAR_PLANE_M / (FAR_PLANE_M + NEAR_PLANE_M - ndc * (FAR_PLANE_M - NEAR_PLANE_M))
-    rays = pixel_rays(camera, RENDER_WIDTH, RENDER_HEIGHT)
-    forward = -camera_pose(camera)[:3, 2]
-    distances = eye_depth / (rays @ forward)
-    # the vertex colour as pyrender's 8-bit target holds it
-    colour = srgb_decode(np.round(srgb_encode(np.asarray(terrain.color) * ambient) * 255.0) / 255.0)
+    rays, distances = rays_and_distances(camera, depth)
+    colour = np.asarray(terrain.color) * ambient
     air = air_between(scene_sky(lighting), camera.position)
     expected = air.seen_through(np.broadcast_to(colour, rays.shape), rays, distances)
     close = np.abs(drawn - expected) <= 0.01 * expected + 2e-3
@@ -236,10 +239,7 @@ def test_an_object_far_away_is_seen_through_the_air(renderer):
     depth = renderer.context.read_depth().astype(np.float64)
     on_box = depth < 1.0
     assert on_box.mean() > 0.05
-    ndc = 2.0 * depth - 1.0
-    eye_depth = 2.0 * FAR_PLANE_M * NEAR_PLANE_M / (FAR_PLANE_M + NEAR_PLANE_M - ndc * (FAR_PLANE_M - NEAR_PLANE_M))
-    rays = pixel_rays(camera, RENDER_WIDTH, RENDER_HEIGHT)
-    distances = eye_depth / (rays @ -camera_pose(camera)[:3, 2])
+    rays, distances = rays_and_distances(camera, depth)
     expected = air_between(scene_sky(scene.lighting), camera.position).seen_through(drawn[False], rays, distances)
     close = np.abs(drawn[True] - expected) <= 0.01 * expected + 2e-3
     assert close.all(axis=-1)[on_box].mean() > 0.99

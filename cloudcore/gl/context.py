@@ -15,7 +15,7 @@ tools make the same picture:
 
 Multisampling the world is a choice per frame (`multisampled_target`, and
 `render_pyrender_scene`'s `antialiased`): on llvmpipe it doubles the world pass
-for 47.4-49.1 dB (docs/performance.md), so the frame's default is without.
+for a picture hardly different (docs/performance.md), so the frame's default is without.
 """
 
 from __future__ import annotations

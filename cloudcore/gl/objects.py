@@ -25,6 +25,7 @@ from cloudcore.camera import (
     FAR_PLANE_M,
     NEAR_PLANE_M,
     camera_pose,
+    points_in_eye_space,
     projection_matrix,
     view_matrix,
 )
@@ -223,7 +224,7 @@ def scissor_box(poses, camera: Camera, size: tuple[int, int]) -> tuple[int, int,
     width, height = size
     centres = np.array([pose.centre for pose in poses], dtype=np.float64).reshape(-1, 3)
     radii = np.array([pose.radius for pose in poses], dtype=np.float64)
-    eye = centres @ view_matrix(camera)[:3, :3].T + view_matrix(camera)[:3, 3]
+    eye = points_in_eye_space(centres, view_matrix(camera))
     ahead = -eye[:, 2] + radii > NEAR_PLANE_M  # the rest wholly behind the near plane
     eye, radii = eye[ahead], radii[ahead]
     if not len(radii):

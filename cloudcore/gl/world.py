@@ -39,7 +39,7 @@ def terrain_vertex_light(normals, base_colour, light: TerrainLight) -> tuple[np.
     """Linear RGB per vertex of unit `normals`: base * the sun's irradiance, and base * the rest (the sky's dome,
     the ground's bounce, the floor), which `light` gives each normal."""
     base = np.asarray(base_colour, dtype=np.float64)
-    return base * light.sun_irradiance(normals), base * light.irradiance(normals, sun_visibility=0.0)
+    return base * light.sun_irradiance(normals), base * light.unshadowed_irradiance(normals)
 
 
 class TerrainMesh:

@@ -42,14 +42,13 @@ from cloudcore.splat_kernel import splat_kernel
 
 #: the depths the map holds the optical depth at: the GL map's two RGBA targets
 SLICES = 8
-#: texels across the longer side of the map the terrain and the objects read, and while a slider is dragged: against
-#: a map of 2048 the ground's transmittance under the default scene's clouds is within 0.017-0.022 for 99% of the
-#: ground (mean 0.0014-0.0018; noon, 15:30, 18:15) at 512, made in 116 ms here; at 256, 0.06-0.075 in 69 ms; at
-#: 1024, 0.005 in 255 ms (scripts/bench_shadows.py, docs/atmosphere.md)
+#: texels across the longer side of the map the terrain and the objects read, and while a slider is dragged: chosen
+#: by the ground's transmittance against a map of 2048 and the making's time (scripts/bench_shadows.py,
+#: docs/atmosphere.md#cloud-shadows, "The resolution, by measurement")
 MAP_RESOLUTION, PREVIEW_MAP_RESOLUTION = 512, 256
-#: texels across the longer side of the map the light pass reads (clouds shadowing one another): the default
-#: scene's 90,000 particles in about 0.13 s (at 64 no faster: the particles' deposits, not the texels, cost it); the
-#: texel (about 45 m there) near the particles' median radius
+#: texels across the longer side of the map the light pass reads (clouds shadowing one another): the texel near
+#: the default scene's particles' median radius; a coarser map was no faster, the particles' deposits costing it,
+#: not the texels (docs/atmosphere.md#cloud-shadows)
 BETWEEN_CLOUDS_RESOLUTION = 128
 #: a particle's opacity times its kernel is capped at this, so that float32's 1 - b K stays above 0
 _MOST_OPACITY = 1.0 - 1e-6

@@ -5,7 +5,7 @@ An isotropic sky of irradiance E_sky on an upward surface gives a surface of nor
 ground below, a Lambertian reflector of the air's albedo under the sun and the sky, gives it
 albedo (E_sun cos + E_sky) (1 - n_y) / 2.  The gradient sky keeps the lights of before (its skylight a light
 from the zenith, n . l) and its ambient.  The clouds' shadows fall in the sun's beam alone: the world pass takes
-the sun's part (`sun_irradiance`) apart from the rest (`irradiance` with `sun_visibility` 0) and scales it per
+the sun's part (`sun_irradiance`) apart from the rest (`unshadowed_irradiance`) and scales it per
 pixel by the clouds' transmittance map (`cloudcore.light.cloud_shadows`).
 """
 
@@ -34,25 +34,34 @@ class TerrainLight:
         """(n, 3): the irradiance on surfaces of unit `normals` (n, 3), the sun's beam times `sun_visibility`
         (a scalar or (n,))."""
         normals = np.asarray(normals, dtype=np.float64)
+        visibility = np.broadcast_to(np.asarray(sun_visibility, dtype=np.float64), normals.shape[:1])[:, None]
+        return self.unshadowed_irradiance(normals) + visibility * self.sun_irradiance(normals)
+
+    def sun_irradiance(self, normals) -> np.ndarray:
+        """(n, 3): the first light's (the sun's) beam on surfaces of unit `normals`, the part the clouds shadow."""
+        normals = np.asarray(normals, dtype=np.float64)
+        return _beam(self.lights[:1], normals)
+
+    def unshadowed_irradiance(self, normals) -> np.ndarray:
+        """(n, 3): the rest of `irradiance`, which no shadow dims: the sky's dome, the ground's bounce, the floor
+        and the lights after the first."""
+        normals = np.asarray(normals, dtype=np.float64)
         up = normals[:, 1:2]
-        irradiance = (
+        return (
             np.asarray(self.floor)
             + 0.5 * (1.0 + up) * np.asarray(self.sky_dome)
             + 0.5 * (1.0 - up) * np.asarray(self.ground_bounce)
+            + _beam(self.lights[1:], normals)
         )
-        for index, light in enumerate(self.lights):
-            if not active_lights((light,)):
-                continue
-            cosine = np.maximum(normals @ np.asarray(light.direction, dtype=np.float64), 0.0)
-            visibility = (
-                np.broadcast_to(np.asarray(sun_visibility, dtype=np.float64), cosine.shape) if index == 0 else 1.0
-            )
-            irradiance = irradiance + (visibility * cosine)[:, None] * np.asarray(light.color) * light.intensity
-        return irradiance
 
-    def sun_irradiance(self, normals) -> np.ndarray:
-        """(n, 3): the first light's (the sun's) part of `irradiance`, the part the clouds shadow."""
-        return self.irradiance(normals, 1.0) - self.irradiance(normals, 0.0)
+
+def _beam(lights, normals: np.ndarray) -> np.ndarray:
+    """(n, 3): the directional `lights` that give light on surfaces of unit `normals`, by n . l."""
+    irradiance = np.zeros((len(normals), 3))
+    for light in active_lights(lights):
+        cosine = np.maximum(normals @ np.asarray(light.direction, dtype=np.float64), 0.0)
+        irradiance += cosine[:, None] * np.asarray(light.color) * light.intensity
+    return irradiance
 
 
 def terrain_light(lighting: Lighting, lights, ambient) -> TerrainLight:

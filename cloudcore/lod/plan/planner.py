@@ -269,9 +269,8 @@ def _plan_units(
             # the ring is kept within the tolerance (rebuilt once a cloud of it passes it: Wang's panels are
             # impostors too) while that costs at most its share of a frame, and adds at most `RING_CHASE_SHARE` of
             # the frames measured to what Wang's own rules rebuild; past it, only by his rules, as impostor mode
-            # does, and the error it then shows is the plan's accepted error (the 1.2M field orbiting 0.05 degrees
-            # a frame: 18 ms a frame of rebuilds to keep it so, 1.1 s every 60 frames, for 1.2 dB; Wang's scattered
-            # sky at 1024x768: 3 ms of 46, for 0.7 dB)
+            # does, and the error it then shows is the plan's accepted error (the 1.2M field and Wang's scattered
+            # sky paid for it in rebuilds for about a dB: docs/lod.md, `RING_CHASE_SHARE`)
             rebuild_ms = costs.ms(ring_rebuild)
             extra_ms = rebuild_ms / max(tolerance_lifetime, 1.0) - rebuild_ms / max(moved_lifetime, 1.0)
             measured = state.frame_times.get("units")
