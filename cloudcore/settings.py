@@ -235,6 +235,15 @@ class RenderSettings:
         help="let the clouds shadow the terrain, the objects and one another in the sun's light",
         label="Cloud shadows",
     )
+    #: under the physical sky with cloud shadows and aerial perspective, the air in the clouds' shadow scatters
+    #: no sunlight toward the eye (`cloudcore.light.light_shafts`, docs/atmosphere.md#light-shafts); off, the air
+    #: is lit whole, as before
+    light_shafts: bool = _setting(
+        True,
+        flag="--no-light-shafts",
+        help="darken the air in the clouds' shadows: shafts of sunlight between them",
+        label="Light shafts",
+    )
     #: "plain": premultiplied billboards (ONE, ONE_MINUS_SRC_ALPHA); "volume": Yusov's volume-aware
     #: blending (HPG 2014, 5.5), intersecting particles composited as volumes by a tiled compute pass
     #: where the GL has compute shaders (plain otherwise).  Plain by default: the goldens are its
@@ -327,6 +336,7 @@ class RenderSettings:
             "world_antialiasing",
             "aerial_perspective",
             "cloud_shadows",
+            "light_shafts",
         ):
             if not isinstance(getattr(self, name), bool):
                 problems.append(f"{name} must be true or false, got {getattr(self, name)!r}")

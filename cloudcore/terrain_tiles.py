@@ -106,16 +106,23 @@ _PERIMETER = _perimeter()
 TILE_VERTICES = _SIDE_VERTICES * _SIDE_VERTICES + len(_PERIMETER)
 
 
-def _tile_faces() -> np.ndarray:
-    """One tile's triangles: its grid's (counter-clockwise from above), then its skirt's."""
+def tile_faces(stride: int = 1) -> np.ndarray:
+    """One tile's triangles: its grid's (counter-clockwise from above), then its skirt's; with a `stride` (a
+    divisor of `TILE_CELLS`), those of the grid of every `stride`-th vertex, a coarser surface over the same
+    vertices."""
     n = _SIDE_VERTICES
-    i = np.arange(TILE_CELLS)
+    i = np.arange(0, TILE_CELLS, stride)
     corner = (i[:, None] * n + i[None, :]).ravel()
+    across, down = stride, stride * n
     grid = np.concatenate(
-        [np.stack([corner, corner + n, corner + 1], axis=1), np.stack([corner + 1, corner + n, corner + n + 1], 1)]
+        [
+            np.stack([corner, corner + down, corner + across], axis=1),
+            np.stack([corner + across, corner + down, corner + down + across], axis=1),
+        ]
     )
-    top, following = _PERIMETER, np.roll(_PERIMETER, -1)
-    bottom = n * n + np.arange(len(_PERIMETER))
+    kept = np.arange(0, len(_PERIMETER), stride)
+    top, following = _PERIMETER[kept], np.roll(_PERIMETER[kept], -1)
+    bottom = n * n + kept
     bottom_following = np.roll(bottom, -1)
     skirt = np.concatenate(
         [np.stack([top, bottom, following], axis=1), np.stack([following, bottom, bottom_following], axis=1)]
@@ -123,7 +130,7 @@ def _tile_faces() -> np.ndarray:
     return np.concatenate([grid, skirt])
 
 
-TILE_FACES = _tile_faces()
+TILE_FACES = tile_faces()
 
 
 def tile_meshes(terrain: Terrain, frame: TileFrame, tiles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

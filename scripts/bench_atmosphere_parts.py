@@ -6,7 +6,8 @@ physical sky, the valley's mountains and horizon, side by side in one run.
 
 Each way is its own renderer drawing the default view in auto mode (`RenderSettings()` but for what it turns
 off); the ways take turns frame by frame, so that all see the same machine load.  From everything to the plain
-world of before issue 52, one part off at a time: `all`; `no_shadows` (`cloud_shadows` off); `no_air` (and
+world of before issue 52, one part off at a time: `all`; `no_shafts` (`light_shafts` off); `no_shadows` (and
+`cloud_shadows` off); `no_air` (and
 `aerial_perspective` off); `patch` (and the terrain without `relief` and `reach`: the 6 km valley of before);
 `gradient` (and the gradient sky: the plain world, drawn by this tree's world pass).  The medians of
 `FrameStats.frame_ms`, `world_ms` and `cloud_ms` after the warm-up, ms.
@@ -35,7 +36,8 @@ TIMINGS = ("frame_ms", "world_ms", "cloud_ms")
 def ways(scene) -> dict:
     """name -> (scene, settings): everything, then one part off after another."""
     settings = RenderSettings()
-    no_shadows = dataclasses.replace(settings, cloud_shadows=False)
+    no_shafts = dataclasses.replace(settings, light_shafts=False)
+    no_shadows = dataclasses.replace(no_shafts, cloud_shadows=False)
     no_air = dataclasses.replace(no_shadows, aerial_perspective=False)
     patch = dataclasses.replace(scene, terrain=dataclasses.replace(scene.terrain, relief=0.0, reach=0.0))
     lighting = patch.lighting
@@ -44,6 +46,7 @@ def ways(scene) -> dict:
     )
     return {
         "all": (scene, settings),
+        "no_shafts": (scene, no_shafts),
         "no_shadows": (scene, no_shadows),
         "no_air": (scene, no_air),
         "patch": (patch, no_air),

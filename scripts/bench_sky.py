@@ -76,12 +76,12 @@ def table_costs(scene) -> dict:
 
 def world_pass_ms(context, world, camera, repeat: int) -> list[float]:
     """Each of `repeat` draws of `world` (terrain and sky, or sky alone), ended by a glFinish, in ms."""
-    view_projection = projection_matrix(camera.fov_y_deg, context.width / context.height) @ view_matrix(camera)
+    view, projection = view_matrix(camera), projection_matrix(camera.fov_y_deg, context.width / context.height)
     times = []
     for _ in range(repeat):
         context.bind_target()
         start = time.perf_counter()
-        world.draw(context, camera, view_projection)
+        world.draw(context, camera, view, projection)
         GL.glFinish()
         times.append((time.perf_counter() - start) * 1e3)
     return times

@@ -8,6 +8,7 @@ import pytest
 from conftest import RENDER_HEIGHT, RENDER_WIDTH
 
 from cloudcore.camera import projection_matrix, view_matrix
+from cloudcore.cloud_records import Formation
 from cloudcore.colour import srgb_decode
 from cloudcore.light.cloud_shadows import (
     SLICES,
@@ -204,3 +205,21 @@ def test_the_map_is_made_again_only_when_the_sun_or_the_clouds_change(renderer):
 def test_the_sun_of_explicit_lights_is_the_first():
     lighting = Lighting(time_of_day=None, lights=(Light((0.6, 0.8, 0.0)), Light((0.0, 1.0, 0.0))))
     assert shadowing_sun(scene_lights(lighting)[0]) == (0.6, 0.8, 0.0)
+
+
+@pytest.mark.gl
+def test_the_map_follows_a_forming_cloud_and_is_made_again_only_while_it_forms(renderer):
+    """Before its formation starts a cloud casts no shadow, while it forms its shadow deepens (the map made again
+    each frame), and once formed the map is held."""
+    scene, _, _ = shadow_scene()
+    forming = dataclasses.replace(scene.clouds[0], formation=Formation("form", 1.0, 2.0))
+    scene = dataclasses.replace(scene, clouds=(forming,))
+    depths, made = [], []
+    for time_s in (0.5, 1.5, 2.5, 4.0, 5.0):
+        renderer.render(scene, settings=FULL_3D, time_s=time_s, read_back=False)
+        renderer.context.make_current()
+        depths.append(renderer.shadow_map.read().max())
+        made.append(renderer.shadow_map.made)
+    assert depths[0] == 0.0
+    assert 0.0 < depths[1] < depths[2] < depths[3] == depths[4]
+    assert made[1] == made[0] + 1 and made[2] == made[1] + 1 and made[4] == made[3]

@@ -43,9 +43,12 @@ VIEWS = {
     # the pictures of before the clouds' shadows (their goldens those of then): the switch turns them off whole
     "default_view_no_cloud_shadows": lambda s: (s, None, None),
     "sunset_no_cloud_shadows": lambda s: (s, 18.6, None),
+    # the picture of before the light shafts (its golden that of then)
+    "default_view_no_light_shafts": lambda s: (s, None, None),
 }
 #: the views drawn with other settings than FULL_3D's
 SETTINGS = {name: dataclasses.replace(FULL_3D, cloud_shadows=False) for name in VIEWS if "no_cloud_shadows" in name}
+SETTINGS["default_view_no_light_shafts"] = dataclasses.replace(FULL_3D, light_shafts=False)
 
 
 @pytest.mark.parametrize("name", VIEWS)

@@ -44,6 +44,7 @@ from cloudcore.gl.air_volume import AirVolume
 from cloudcore.gl.context import HeadlessContext, WindowContext, check_frame_size
 from cloudcore.gl.impostor_atlas import atlas_instances
 from cloudcore.gl.impostor_store import ImpostorStore
+from cloudcore.gl.light_shafts import LightShaftPass
 from cloudcore.gl.objects import ObjectPass
 from cloudcore.gl.pass_clock import PassClock
 from cloudcore.gl.programs import build_program
@@ -180,6 +181,11 @@ class FrameRenderer:
         return self._units
 
     @property
+    def light_shafts(self) -> LightShaftPass | None:
+        """The world pass's light shafts, once a frame has drawn them (tests read their march)."""
+        return None if self._world is None else self._world.light_shafts
+
+    @property
     def volume_features(self) -> GpuFeatures:
         """What this GL offers volume-aware blending."""
         return self._volume.features
@@ -237,7 +243,7 @@ class FrameRenderer:
         camera = scene.camera if camera is None else camera
         authored_clouds = len(scene.clouds)
         scene, fade_keys = self._with_field(scene, camera)
-        illumination_ms = self._prepare(scene, lighting, illumination_method, settings.cloud_shadows)
+        illumination_ms = self._prepare(scene, lighting, illumination_method, settings.cloud_shadows, time_s)
         planning_started = time.perf_counter()
         particles = self._particles
         particles.weigh(self._field_weights)
@@ -288,10 +294,12 @@ class FrameRenderer:
                 self._world.draw(
                     self.context,
                     camera,
-                    projection @ view,
+                    view,
+                    projection,
                     antialiased=antialiased,
                     through_air=settings.aerial_perspective,
                     shadows=self._shadows,
+                    light_shafts=settings.light_shafts,
                 )
                 if plan.objects_with_world:
                     self._objects.draw(
@@ -401,9 +409,11 @@ class FrameRenderer:
             (1.0,) * len(scene.clouds) + frame.fade_keys,
         )
 
-    def _prepare(self, scene: Scene, lighting: Lighting, illumination_method: str, cloud_shadows: bool) -> float:
-        """Rebuild the world pass, the particle illumination and the clouds' transmittance map where their inputs
-        changed; ms spent shading."""
+    def _prepare(
+        self, scene: Scene, lighting: Lighting, illumination_method: str, cloud_shadows: bool, time_s: float
+    ) -> float:
+        """Rebuild the world pass, the particle illumination and the clouds' transmittance map (at the scene clock
+        `time_s`, forming clouds as opaque as they are then) where their inputs changed; ms spent shading."""
         lights, ambient = scene_lights(lighting)
         # a dragged slider's look (the editor's preview) draws the coarse sky, as its clouds are a coarse raster
         preview = illumination_method == PREVIEW_METHOD
@@ -417,6 +427,8 @@ class FrameRenderer:
             self.context.make_current()
             if self._world is not None:
                 self._world.close()
+                # closed: a new one that fails to build leaves none to close again, and none to draw
+                self._world, self._world_source = None, None
             self._world = WorldPass(
                 scene.terrain,
                 terrain_light(lighting, lights, ambient),
@@ -429,6 +441,7 @@ class FrameRenderer:
             self.context.make_current()
             if self._objects is not None:
                 self._objects.close()
+                self._objects, self._objects_source = None, None
             self._objects = ObjectPass(scene.objects, lights, ambient, self.size) if scene.objects else None
             self._objects_source = objects_source
         particles_source = (scene.clouds, scene.shading, lighting, illumination_method, cloud_shadows)
@@ -437,8 +450,16 @@ class FrameRenderer:
             illumination_ms = self._prepare_particles(scene, lights, ambient, particles_source)
         self._shadows = None if sun is None or not scene.clouds else self.shadow_map
         if self._shadows is not None:
-            # made again only for another particle buffer, sun or size (`CloudShadowMap.update`)
-            self.shadow_map.update(self._particles, sun, PREVIEW_MAP_RESOLUTION if preview else MAP_RESOLUTION)
+            # made again only for another particle buffer, sun, size or state of the clouds' formations
+            # (`CloudShadowMap.update`): every frame while a cloud forms or dissipates, never while none does
+            forming = tuple(formation_state(scene.clouds[index].formation, time_s) for index in self._forming_clouds)
+            self.shadow_map.update(
+                self._particles,
+                sun,
+                PREVIEW_MAP_RESOLUTION if preview else MAP_RESOLUTION,
+                self._particles.formation_factors(time_s),
+                forming,
+            )
             self.context.bind_target()
         return illumination_ms
 

@@ -50,24 +50,27 @@ class CloudShadowMap:
         self.space: LightSpace | None = None
         self.made = 0  # how many times a map was made
 
-    def update(self, particles, sun_direction, resolution: int) -> None:
-        """Make the map of `particles` (a `ParticleBuffer`) seen from `sun_direction` (toward the sun) at
-        `resolution` texels across, unless it is the one held (the same buffer, sun and resolution)."""
+    def update(self, particles, sun_direction, resolution: int, opacity_factors=None, factors_key=None) -> None:
+        """Make the map of `particles` (a `ParticleBuffer`, each particle's opacity times its `opacity_factors`
+        where given: the clouds' formations) seen from `sun_direction` (toward the sun) at `resolution` texels
+        across, unless it is the one held (the same buffer, sun, resolution and `factors_key`, which names the
+        factors)."""
         sun = tuple(float(v) for v in sun_direction)
-        source = (particles, sun, resolution)
+        source = (particles, sun, resolution, factors_key)
         if self._source is not None and self._source[0] is particles and self._source[1:] == source[1:]:
             return
         self._source = source
         self.space = light_space(particles.centres, particles.radii, sun, resolution)
         if self.space is None:
             return
-        self._draw(particles, self.space)
+        opacity = particles.alpha if opacity_factors is None else particles.alpha * opacity_factors
+        self._draw(particles, opacity, self.space)
         self.made += 1
 
-    def _draw(self, particles, space: LightSpace) -> None:
+    def _draw(self, particles, opacity, space: LightSpace) -> None:
         # the ground's and the objects' shadow takes each particle's whole opacity out of the sun's beam: nearer the
         # path-traced truth's shadows than the light pass's beam opacity (docs/atmosphere.md#cloud-shadows)
-        instances = np.column_stack([particles.centres, particles.radii, particles.alpha]).astype(np.float32)
+        instances = np.column_stack([particles.centres, particles.radii, opacity]).astype(np.float32)
         GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self._buffer)
         GL.glBufferData(GL.GL_ARRAY_BUFFER, instances.nbytes, np.ascontiguousarray(instances), GL.GL_STATIC_DRAW)
         self._bind_targets(space.size)

@@ -89,3 +89,52 @@ def blit_depth(source_framebuffer: int, source_size, target_framebuffer: int, ta
     GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, source_framebuffer)
     GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, target_framebuffer)
     GL.glBlitFramebuffer(0, 0, *source_size, 0, 0, *target_size, GL.GL_DEPTH_BUFFER_BIT, GL.GL_NEAREST)
+
+
+class DepthTexture:
+    """A depth texture and a framebuffer drawing into it alone, remade when the size asked for changes: a copy of
+    another framebuffer's depth (a renderbuffer, which a shader cannot read), or a depth drawn for a shader to
+    read."""
+
+    def __init__(self):
+        self.texture, self._framebuffer, self._size = None, None, None
+
+    def copy(self, framebuffer: int, size: tuple[int, int]) -> int:
+        """The texture, filled with the depth of `framebuffer` (of `size`); leaves it bound for drawing."""
+        self._make(size)
+        blit_depth(framebuffer, size, self._framebuffer, size)
+        return self.texture
+
+    def bind_cleared(self, size: tuple[int, int]) -> None:
+        """Draw into the texture of `size` from now on, depth tested and written, starting from the far plane."""
+        self._make(size)
+        GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, self._framebuffer)
+        GL.glViewport(0, 0, *size)
+        GL.glDisable(GL.GL_SCISSOR_TEST)
+        GL.glEnable(GL.GL_DEPTH_TEST)
+        GL.glDepthFunc(GL.GL_LESS)
+        GL.glDepthMask(GL.GL_TRUE)
+        GL.glClearDepth(1.0)
+        GL.glClear(GL.GL_DEPTH_BUFFER_BIT)
+
+    def _make(self, size: tuple[int, int]) -> None:
+        if self._size == size:
+            return
+        self.close()
+        self.texture = GL.glGenTextures(1)
+        GL.glBindTexture(GL.GL_TEXTURE_2D, self.texture)
+        GL.glTexStorage2D(GL.GL_TEXTURE_2D, 1, GL.GL_DEPTH_COMPONENT24, *size)
+        GL.glTexParameteri(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_MIN_FILTER, GL.GL_NEAREST)
+        GL.glTexParameteri(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_MAG_FILTER, GL.GL_NEAREST)
+        self._framebuffer = GL.glGenFramebuffers(1)
+        GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, self._framebuffer)
+        GL.glFramebufferTexture2D(GL.GL_FRAMEBUFFER, GL.GL_DEPTH_ATTACHMENT, GL.GL_TEXTURE_2D, self.texture, 0)
+        GL.glDrawBuffer(GL.GL_NONE)
+        GL.glReadBuffer(GL.GL_NONE)
+        self._size = size
+
+    def close(self) -> None:
+        if self.texture is not None:
+            GL.glDeleteTextures([self.texture])
+            GL.glDeleteFramebuffers(1, [self._framebuffer])
+        self.texture, self._framebuffer, self._size = None, None, None

@@ -21,7 +21,7 @@ from OpenGL import GL
 
 from cloudcore.gl.programs import build_compute_program, gl_renderer, set_vec3
 from cloudcore.gl.splats import SplatBatch
-from cloudcore.gl.targets import blit_depth
+from cloudcore.gl.targets import DepthTexture
 from cloudcore.gl.tile_binning import DISCS_BINDING, OCCUPIED_BINDING, BinnedTiles, GpuTileBinning
 from cloudcore.light.volume_blending import (
     FINISHED_TRANSMITTANCE,
@@ -65,7 +65,7 @@ class VolumeBlendingPass:
         self.features = GpuFeatures.query()
         self._programs: dict[bool, int] = {}  # per variant (plain?), built when first needed
         self._binning: GpuTileBinning | None = None
-        self._depth: tuple[int, int, tuple[int, int]] | None = None  # (texture, framebuffer, size)
+        self._depth = DepthTexture()  # the world's depth, which the compositing reads
 
     def draw(
         self,
@@ -106,7 +106,7 @@ class VolumeBlendingPass:
     def _composite(self, program, binned: BinnedTiles, view, projection, colour_texture, depth_framebuffer) -> None:
         """Run a compositing `program` over `binned`'s occupied tiles, by the indirect dispatch the binning made."""
         bound = GL.glGetIntegerv(GL.GL_DRAW_FRAMEBUFFER_BINDING)
-        depth_texture = self._world_depth(depth_framebuffer, binned.size)
+        depth_texture = self._depth.copy(depth_framebuffer, binned.size)
         GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, int(bound))
         for binding, buffer in (
             (_TILE_STARTS_BINDING, binned.starts),
@@ -138,32 +138,9 @@ class VolumeBlendingPass:
         )
         GL.glBindImageTexture(0, 0, 0, GL.GL_FALSE, 0, GL.GL_READ_WRITE, GL.GL_RGBA16F)
 
-    def _world_depth(self, framebuffer: int, size: tuple[int, int]) -> int:
-        """A texture holding the depth of `framebuffer` (a renderbuffer, which a shader cannot read)."""
-        if self._depth is None or self._depth[2] != size:
-            self._close_depth()
-            texture = GL.glGenTextures(1)
-            GL.glBindTexture(GL.GL_TEXTURE_2D, texture)
-            GL.glTexStorage2D(GL.GL_TEXTURE_2D, 1, GL.GL_DEPTH_COMPONENT24, *size)
-            GL.glTexParameteri(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_MIN_FILTER, GL.GL_NEAREST)
-            GL.glTexParameteri(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_MAG_FILTER, GL.GL_NEAREST)
-            target = GL.glGenFramebuffers(1)
-            GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, target)
-            GL.glFramebufferTexture2D(GL.GL_FRAMEBUFFER, GL.GL_DEPTH_ATTACHMENT, GL.GL_TEXTURE_2D, texture, 0)
-            self._depth = (texture, target, size)
-        texture, target, _ = self._depth
-        blit_depth(framebuffer, size, target, size)
-        return texture
-
-    def _close_depth(self) -> None:
-        if self._depth is not None:
-            GL.glDeleteTextures([self._depth[0]])
-            GL.glDeleteFramebuffers(1, [self._depth[1]])
-            self._depth = None
-
     def close(self) -> None:
         """Free the GL objects (the context must be current)."""
-        self._close_depth()
+        self._depth.close()
         for program in self._programs.values():
             GL.glDeleteProgram(program)
         if self._binning is not None:

@@ -21,16 +21,21 @@ from cloudcore.atmosphere.sky_view import eye_radius, horizon_angles
 from cloudcore.camera import frustum_planes
 from cloudcore.gl.air_volume import AirVolume
 from cloudcore.gl.context import HeadlessContext
+from cloudcore.gl.light_shafts import SHAFT_REDUCTION, LightShaftPass
 from cloudcore.gl.programs import build_program, set_matrix, set_vec3
 from cloudcore.gl.shadow_map import CloudShadowMap
 from cloudcore.gl.targets import linear_filtering
 from cloudcore.light.air_between import AirBetween, air_between
+from cloudcore.light.light_shafts import SHAFT_STEPS
 from cloudcore.light.sky_background import SkyBackground
 from cloudcore.light.terrain_light import TerrainLight
 from cloudcore.limits import DRAWN_TERRAIN_KINDS
 from cloudcore.scene import Camera, Terrain
-from cloudcore.terrain_tiles import TILE_FACES, TerrainTiles
+from cloudcore.terrain_tiles import TILE_FACES, TILE_VERTICES, TerrainTiles, tile_faces
 
+#: the light shafts' depth of the terrain takes every 4th vertex of a tile's grid: the frames with it and with the
+#: whole grid's agree to 58 dB or more (docs/atmosphere.md#light-shafts)
+_COARSE_TILE_FACES = tile_faces(4)
 #: floats a terrain vertex carries: its position, the sun's light and the sky's (terrain.vert.glsl)
 _VERTEX_FLOATS = 9
 
@@ -51,7 +56,9 @@ class TerrainMesh:
             raise ValueError(f"the GL prototype draws heightfield terrain only, not {terrain.kind!r}")
         self._terrain, self._light = terrain, light
         self.tiles = TerrainTiles(terrain)
-        self._programs: dict[bool, int] = {}
+        self._programs: dict[tuple[bool, bool], int] = {}  # per (through the air, light shafts)
+        self._depth_program: int | None = None
+        self._coarse_start = 0  # the first of the coarse surfaces' triangles in the index buffer
         self._vertex_array = GL.glGenVertexArrays(1)
         self._vertex_buffer, self._index_buffer = (int(b) for b in GL.glGenBuffers(2))
         GL.glBindVertexArray(self._vertex_array)
@@ -69,29 +76,34 @@ class TerrainMesh:
         vertices = np.ascontiguousarray(np.concatenate([tiles.positions, sun, sky], axis=1), dtype=np.float32)
         GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self._vertex_buffer)
         GL.glBufferData(GL.GL_ARRAY_BUFFER, vertices.nbytes, vertices, GL.GL_STATIC_DRAW)
-        indices = np.ascontiguousarray(tiles.faces, dtype=np.uint32)
+        # the tiles' triangles, then their coarse surfaces' (the light shafts' depth)
+        tile_starts = np.arange(len(tiles.faces) // len(TILE_FACES)) * TILE_VERTICES
+        coarse = (_COARSE_TILE_FACES[None, :, :] + tile_starts[:, None, None]).reshape(-1, 3)
+        indices = np.ascontiguousarray(np.concatenate([tiles.faces, coarse]), dtype=np.uint32)
+        self._coarse_start = len(tiles.faces)
         GL.glBindVertexArray(self._vertex_array)
         GL.glBufferData(GL.GL_ELEMENT_ARRAY_BUFFER, indices.nbytes, indices, GL.GL_STATIC_DRAW)
         GL.glBindVertexArray(0)
 
-    def _program(self, through_air: bool) -> int:
-        if through_air not in self._programs:
-            self._programs[through_air] = build_program("terrain", {"THROUGH_AIR": int(through_air)})
-        return self._programs[through_air]
+    def _program(self, through_air: bool, shafts: bool) -> int:
+        if (through_air, shafts) not in self._programs:
+            defines = {"THROUGH_AIR": int(through_air), "LIGHT_SHAFTS": int(shafts)}
+            self._programs[through_air, shafts] = build_program("terrain", defines)
+        return self._programs[through_air, shafts]
 
     def draw(
-        self, camera: Camera, view_projection: np.ndarray, air: AirVolume | None, shadows: CloudShadowMap | None
+        self,
+        camera: Camera,
+        view_projection: np.ndarray,
+        air: AirVolume | None,
+        shadows: CloudShadowMap | None,
+        shafts: LightShaftPass | None = None,
     ) -> None:
         """Draw the tiles in view for `camera` into the bound target, depth tested and written, seen through
-        `air` (bound for `camera`'s eye) where there is one, the sun's part in the clouds' `shadows` where given."""
-        if self.tiles.update(camera.position):
-            self._upload()
-        in_view = np.flatnonzero(self.tiles.in_view(frustum_planes(view_projection)))
-        if not len(in_view):
-            return
-        program = self._program(air is not None)
+        `air` (bound for `camera`'s eye) where there is one, the sun's part in the clouds' `shadows` where given,
+        less the light `shafts` (marched for this view) where given."""
+        program = self._program(air is not None, shafts is not None)
         GL.glUseProgram(program)
-        set_matrix(program, "view_projection", view_projection)
         if air is not None:
             air.bind(program)
             set_vec3(program, "eye_position", camera.position)
@@ -99,6 +111,28 @@ class TerrainMesh:
             GL.glUniform1i(GL.glGetUniformLocation(program, "cloud_shadows"), 0)
         else:
             shadows.bind(program)
+        if shafts is not None:
+            shafts.bind()
+        self._draw_tiles(program, camera, view_projection)
+
+    def draw_depth(self, camera: Camera, view_projection: np.ndarray) -> None:
+        """Draw the depth of the coarse surfaces of the tiles in view for `camera` alone into the bound target (the
+        light shafts' march reads it at a fraction of the screen's resolution, where the tiles' triangles are
+        mostly smaller than a pixel and cost llvmpipe their setup)."""
+        if self._depth_program is None:
+            self._depth_program = build_program("terrain_depth", {"THROUGH_AIR": 0}, vertex="terrain")
+        GL.glUseProgram(self._depth_program)
+        self._draw_tiles(self._depth_program, camera, view_projection, coarse=True)
+
+    def _draw_tiles(self, program: int, camera: Camera, view_projection: np.ndarray, coarse: bool = False) -> None:
+        """Draw the tiles in view with `program` (in use), depth tested and written; their coarse surfaces where
+        `coarse`."""
+        if self.tiles.update(camera.position):
+            self._upload()
+        in_view = np.flatnonzero(self.tiles.in_view(frustum_planes(view_projection)))
+        if not len(in_view):
+            return
+        set_matrix(program, "view_projection", view_projection)
         GL.glEnable(GL.GL_DEPTH_TEST)
         GL.glDepthFunc(GL.GL_LESS)
         GL.glDepthMask(GL.GL_TRUE)
@@ -106,9 +140,10 @@ class TerrainMesh:
         # a tile's triangles are contiguous: one draw of each run of tiles in view
         starts = np.concatenate([[0], np.flatnonzero(np.diff(in_view) != 1) + 1])
         ends = np.concatenate([starts[1:], [len(in_view)]])
-        per_tile = 3 * len(TILE_FACES)
+        per_tile = 3 * len(_COARSE_TILE_FACES if coarse else TILE_FACES)
+        first = 3 * self._coarse_start if coarse else 0
         counts = np.ascontiguousarray((ends - starts) * per_tile, dtype=np.int32)
-        offsets = np.ascontiguousarray(in_view[starts] * per_tile * 4, dtype=np.intp)
+        offsets = np.ascontiguousarray((first + in_view[starts] * per_tile) * 4, dtype=np.intp)
         GL.glMultiDrawElements(
             GL.GL_TRIANGLES,
             counts,
@@ -121,6 +156,8 @@ class TerrainMesh:
     def close(self) -> None:
         for program in self._programs.values():
             GL.glDeleteProgram(program)
+        if self._depth_program is not None:
+            GL.glDeleteProgram(self._depth_program)
         GL.glDeleteBuffers(2, [self._vertex_buffer, self._index_buffer])
         GL.glDeleteVertexArrays(1, [self._vertex_array])
 
@@ -134,31 +171,57 @@ class WorldPass:
         light: TerrainLight,
         sky: SkyBackground,
         air_for: Callable[[SkyBackground, np.ndarray], AirBetween | None] = air_between,
+        shaft_steps: int = SHAFT_STEPS,
+        shaft_reduction: int = SHAFT_REDUCTION,
     ):
-        """`air_for(sky, eye)`: the air an eye sees through (`air_between`, or the editor's `LiveAir`)."""
+        """`air_for(sky, eye)`: the air an eye sees through (`air_between`, or the editor's `LiveAir`); the light
+        shafts marched by `shaft_steps` at a pixel for each `shaft_reduction`-square block of the screen's."""
+        self._shaft_quality = shaft_steps, shaft_reduction
         self._sky, self._air_for = sky, air_for
-        # at the far plane (the window depth 1), drawn where the depth is still the clear's
-        self._sky_program = build_program("sky", {"PHYSICAL_SKY": int(sky.physical), "DEPTH": 1.0}, vertex="world")
+        self._sky_programs: dict[bool, int] = {}  # per light shafts
         self._sky_view_texture = _sky_view_texture(sky) if sky.physical else None
         # core profile draws nothing without a vertex array, even one with no attributes
         self._fullscreen_vertex_array = GL.glGenVertexArrays(1)
         self._terrain = TerrainMesh(terrain, light) if terrain is not None else None
         # the air's volume under the physical sky (the cloud pass reads it too: `air_volume`)
         self._air_volume = AirVolume() if sky.physical else None
+        self._shafts: LightShaftPass | None = None  # built when a frame first has them
 
     def draw(
         self,
         context: HeadlessContext,
         camera: Camera,
-        view_projection: np.ndarray,
+        view: np.ndarray,
+        projection: np.ndarray,
         *,
         antialiased: bool = False,
         through_air: bool = True,
         shadows: CloudShadowMap | None = None,
+        light_shafts: bool = False,
     ) -> None:
-        """Fill the render target: terrain colour and depth where there is terrain, sky elsewhere (both
-        multisampled 4x when `antialiased`, the terrain seen through the air under the physical sky when
-        `through_air`, its sun's part in the clouds' `shadows` where given)."""
+        """Fill the render target for `camera` seen through `view` and `projection`: terrain colour and depth where
+        there is terrain, sky elsewhere (both multisampled 4x when `antialiased`, the terrain seen through the air
+        under the physical sky when `through_air`, its sun's part in the clouds' `shadows` where given, and with
+        `light_shafts` the air in their shadow darkened where there are shadows and air)."""
+        view_projection = projection @ view
+        air = None
+        if self._air_volume is not None and through_air:
+            self._air_volume.upload(self._air_for(self._sky, camera.position))
+            air = self._air_volume
+        shafts = None
+        if light_shafts and air is not None and shadows is not None and shadows.space is not None:
+            shafts = self._light_shafts()
+            terrain = self._terrain
+            shafts.march(
+                (context.width, context.height),
+                None if terrain is None else lambda: terrain.draw_depth(camera, view_projection),
+                camera,
+                view,
+                projection,
+                air,
+                shadows,
+                self._sky.lowest_up(),
+            )
         framebuffer = context.multisampled_target() if antialiased else context.framebuffer
         GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, framebuffer)
         GL.glViewport(0, 0, context.width, context.height)
@@ -167,14 +230,12 @@ class WorldPass:
         GL.glClear(GL.GL_DEPTH_BUFFER_BIT)  # every colour is drawn: the terrain's, else the sky's
         GL.glDisable(GL.GL_BLEND)
         GL.glDisable(GL.GL_CULL_FACE)  # the skirts face either way
-        air = None
-        if self._air_volume is not None and through_air:
-            self._air_volume.upload(self._air_for(self._sky, camera.position))
-            air = self._air_volume
         if self._terrain is not None:
-            self._terrain.draw(camera, view_projection, air, shadows)
-        program = self._sky_program
+            self._terrain.draw(camera, view_projection, air, shadows, shafts)
+        program = self._sky_program(shafts is not None)
         GL.glUseProgram(program)
+        if shafts is not None:
+            shafts.bind()
         set_matrix(program, "inverse_view_projection", np.linalg.inv(view_projection))
         self._set_sky_uniforms(program, camera, context.height)
         GL.glEnable(GL.GL_DEPTH_TEST)
@@ -188,6 +249,23 @@ class WorldPass:
         if antialiased:
             context.resolve_multisampled_target()
         context.bind_target()
+
+    def _sky_program(self, shafts: bool) -> int:
+        if shafts not in self._sky_programs:
+            # at the far plane (the window depth 1), drawn where the depth is still the clear's
+            defines = {"PHYSICAL_SKY": int(self._sky.physical), "LIGHT_SHAFTS": int(shafts), "DEPTH": 1.0}
+            self._sky_programs[shafts] = build_program("sky", defines, vertex="world")
+        return self._sky_programs[shafts]
+
+    def _light_shafts(self) -> LightShaftPass:
+        if self._shafts is None:
+            self._shafts = LightShaftPass(*self._shaft_quality)
+        return self._shafts
+
+    @property
+    def light_shafts(self) -> LightShaftPass | None:
+        """The light shafts' pass, once a frame has drawn them (tests read its march)."""
+        return self._shafts
 
     def _set_sky_uniforms(self, program: int, camera: Camera, viewport_height: int) -> None:
         sky = self._sky
@@ -227,7 +305,10 @@ class WorldPass:
             self._air_volume.close()
         if self._terrain is not None:
             self._terrain.close()
-        GL.glDeleteProgram(self._sky_program)
+        if self._shafts is not None:
+            self._shafts.close()
+        for program in self._sky_programs.values():
+            GL.glDeleteProgram(program)
         GL.glDeleteVertexArrays(1, [self._fullscreen_vertex_array])
 
 

@@ -29,12 +29,17 @@ class AirBetween:
     def transmittance(self) -> np.ndarray:
         return self.volume.transmittance
 
+    def added(self, directions, distances) -> tuple[np.ndarray, np.ndarray]:
+        """(light added (..., 3), in the renderer's values as `in_scattered`'s, transmittance (..., 3)) along unit
+        `directions` (..., 3) over `distances` (...) from the eye."""
+        radiance, transmittance = self.volume.radiance_and_transmittance(directions, distances)
+        return np.pi * PHYSICAL_EXPOSURE * radiance + NIGHT_SKY * (1.0 - transmittance), transmittance
+
     def seen_through(self, colour, directions, distances, alpha=1.0) -> np.ndarray:
         """(..., 3): premultiplied linear `colour` (..., 3) of opacity `alpha` (...) seen along unit `directions`
         (..., 3) from `distances` (...) away: colour * transmittance + alpha * in-scattered (the air in front
         of a cloud is added where the cloud covers what is behind it)."""
-        radiance, transmittance = self.volume.radiance_and_transmittance(directions, distances)
-        added = np.pi * PHYSICAL_EXPOSURE * radiance + NIGHT_SKY * (1.0 - transmittance)
+        added, transmittance = self.added(directions, distances)
         return (
             np.asarray(colour, dtype=np.float64) * transmittance
             + np.asarray(alpha, dtype=np.float64)[..., None] * added

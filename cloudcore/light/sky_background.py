@@ -77,6 +77,12 @@ class SkyBackground:
         peak = float(scale.max()) * float(disc_radiance(0.0, 1.0))
         return scale * min(1.0, SUN_DISC_PEAK / peak) if peak > 0.0 else scale
 
+    def lowest_up(self) -> float:
+        """The cosine to the up of the lowest direction the physical sky is looked up along: one below it is drawn
+        as the one at it with its azimuth (`over_the_horizon`)."""
+        params = self.view.tables.params
+        return float(horizon_cosine(eye_radius(params, self.view.altitude_m), params.bottom_radius_m)) + HORIZON_MARGIN
+
     def radiance(self, directions, pixel_angle: float) -> np.ndarray:
         """(..., 3): the sky along unit `directions` (..., 3), the sun's disc with its rim spread over
         `pixel_angle` (radians, a pixel's side)."""

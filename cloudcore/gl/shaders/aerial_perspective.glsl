@@ -8,18 +8,28 @@ uniform vec3 air_sun_direction;
 uniform vec3 air_volume_size;         // (azimuth, cosine to the up, distance) texels
 uniform float air_max_distance;       // metres, the last slice's
 
-vec3 air_uvw(vec3 from_eye)
+// the texture coordinates (u, v) of the direction `direction` (unit), w of the distance `distance` (metres)
+vec2 air_direction_uv(vec3 direction)
 {
-    float distance = length(from_eye);
-    vec3 direction = from_eye / max(distance, 1e-6);
     float lengths = length(direction.xz) * length(air_sun_direction.xz);
     float light_view_cosine = lengths > 1e-12 ? clamp(dot(direction.xz, air_sun_direction.xz) / lengths, -1.0, 1.0) : 1.0;
     float azimuth = sqrt(clamp(0.5 - 0.5 * light_view_cosine, 0.0, 1.0));
     float mu = clamp(direction.y, -1.0, 1.0);
     float up = 0.5 + 0.5 * sign(mu) * sqrt(abs(mu));
-    float slice_position = sqrt(clamp(distance / air_max_distance, 0.0, 1.0));
     // table_sampling.py's unit_to_sub_uv: the unit range onto the first to the last texel's centre
-    return (vec3(azimuth, up, slice_position) + 0.5 / air_volume_size) * (air_volume_size / (air_volume_size + 1.0));
+    return (vec2(azimuth, up) + 0.5 / air_volume_size.xy) * (air_volume_size.xy / (air_volume_size.xy + 1.0));
+}
+
+float air_distance_w(float distance)
+{
+    float slice_position = sqrt(clamp(distance / air_max_distance, 0.0, 1.0));
+    return (slice_position + 0.5 / air_volume_size.z) * (air_volume_size.z / (air_volume_size.z + 1.0));
+}
+
+vec3 air_uvw(vec3 from_eye)
+{
+    float distance = length(from_eye);
+    return vec3(air_direction_uv(from_eye / max(distance, 1e-6)), air_distance_w(distance));
 }
 
 // the air's transmittance and the light it adds between the eye and `from_eye` (the point less the eye, metres);

@@ -1,8 +1,9 @@
 #version 420 core
 // The sky in linear RGB behind the terrain, drawn after it at the far plane: the depth test leaves out every
-// pixel the terrain covers.  PHYSICAL_SKY: the atmosphere's sky-view table and the sun's disc; else a vertical
-// gradient.  Compiled apart, as llvmpipe runs both sides of a branch (docs/performance.md, "The world pass:
-// where its time goes").  The sky reads its tables as cloudcore/light/sky_background.py does.
+// pixel the terrain covers.  PHYSICAL_SKY: the atmosphere's sky-view table and the sun's disc, the table's air
+// less the light the shafts take with LIGHT_SHAFTS; else a vertical gradient.  Compiled apart, as llvmpipe
+// runs both sides of a branch (docs/performance.md, "The world pass: where its time goes").  The sky reads its
+// tables as cloudcore/light/sky_background.py does.
 
 uniform mat4 inverse_view_projection;
 #if PHYSICAL_SKY
@@ -18,6 +19,9 @@ uniform float pixel_angle;           // radians a pixel spans: the disc's rim is
 const float SUN_ANGULAR_RADIUS = 0.004651302;  // radians(0.533 / 2), cloudcore/atmosphere/sun_disc.py
 const float LIMB_DARKENING = 0.6;
 const float PI = 3.14159265358979;
+#if LIGHT_SHAFTS
+#include "light_shafts_read.glsl"
+#endif
 #else
 uniform vec3 zenith_colour;
 uniform vec3 horizon_colour;
@@ -69,6 +73,9 @@ vec3 sky(vec3 ray)
     vec2 level = across > 1e-12 ? ray.xz * (sqrt(1.0 - up * up) / across) : vec2(sqrt(1.0 - up * up), 0.0);
     vec3 looked_up = ray.y < up ? vec3(level.x, up, level.y) : ray;
     vec3 air = texture(sky_view_table, sky_view_uv(looked_up)).rgb;
+#if LIGHT_SHAFTS
+    air = max(air - light_shafts_at(ndc).rgb, vec3(0.0));
+#endif
     return ray.y <= horizon_cosine ? air : air + sun_disc(ray);
 }
 #endif

@@ -1,8 +1,9 @@
 #version 420 core
 // The terrain's tiles (cloudcore/terrain_tiles.py) lit as cloudcore/light/terrain_light.py lights them, per
-// vertex: the sun's part apart from the sky's (the clouds' shadow dims the sun's alone, per pixel).  With THROUGH_AIR the air between
-// the eye and each vertex is read here, per vertex, not per pixel: a pixel's lookups cost llvmpipe more than
-// the vertices' (docs/performance.md, "The world pass: where its time goes").
+// vertex: the sun's part apart from the sky's (the clouds' shadow dims the sun's alone, per pixel).  With
+// THROUGH_AIR the air between the eye and each vertex is read here, per vertex, not per pixel, and with
+// LIGHT_SHAFTS the light shafts' share of its light taken off: a pixel's lookups cost llvmpipe more than the
+// vertices' (docs/performance.md, "The world pass: where its time goes").
 
 layout(location = 0) in vec3 position;
 layout(location = 1) in vec3 sun_light;  // albedo x the sun's irradiance, linear RGB
@@ -19,6 +20,9 @@ out vec3 air_added;
 #if THROUGH_AIR
 #include "aerial_perspective.glsl"
 #endif
+#if LIGHT_SHAFTS
+#include "light_shafts_read.glsl"
+#endif
 
 void main()
 {
@@ -28,6 +32,12 @@ void main()
     sky_lit = sky_light;
 #if THROUGH_AIR
     air_toward(position - eye_position, air_let_through, air_added);
+#if LIGHT_SHAFTS
+    // read where the vertex falls on the screen (the shafts change little across a triangle); none behind the
+    // eye, where the air is the eye's own
+    if (gl_Position.w > 0.0)
+        air_added *= 1.0 - light_shafts_at(clamp(gl_Position.xy / gl_Position.w, -1.0, 1.0)).a;
+#endif
 #else
     air_let_through = vec3(1.0);
     air_added = vec3(0.0);

@@ -1,0 +1,114 @@
+"""Light shafts on the GPU: the air's light the clouds' shadow keeps from the eye, marched at a fraction of the
+screen's resolution before the world is drawn (shaders/light_shafts.frag.glsl, `cloudcore.light.light_shafts`'
+twin, up to the terrain's depth drawn at that resolution), then taken off by the sky per pixel and, as a share of
+its air's light, by the terrain per vertex as they are drawn (shaders/light_shafts_read.glsl): a pass of its own
+over the screen's pixels, or the terrain's lookup per pixel, cost llvmpipe more than the march
+(docs/atmosphere.md#light-shafts)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+from OpenGL import GL
+
+from cloudcore.gl.air_volume import AirVolume
+from cloudcore.gl.programs import build_program, set_vec3
+from cloudcore.gl.shadow_map import CloudShadowMap
+from cloudcore.gl.targets import DepthTexture, TextureTarget
+from cloudcore.light.light_shafts import SHAFT_STEPS
+from cloudcore.scene import Camera
+
+#: screen pixels a shaft pixel spans, per axis: the shafts are as soft as the clouds' shadow map, whose texels
+#: cover many pixels (docs/atmosphere.md#light-shafts)
+SHAFT_REDUCTION = 8
+#: the texture unit of the march's target, as shaders/light_shafts_read.glsl declares it
+SHAFTS_UNIT = 7
+
+
+def shaft_size(width: int, height: int, reduction: int) -> tuple[int, int]:
+    """The march's (width, height) for a frame of `width` x `height`: a pixel for each `reduction`-square block,
+    each seeing the same view."""
+    return -(-width // reduction), -(-height // reduction)
+
+
+class LightShaftPass:
+    """The march's targets and program; `march` fills them, `bind` lets the terrain's and the sky's programs read
+    them."""
+
+    def __init__(self, steps: int = SHAFT_STEPS, reduction: int = SHAFT_REDUCTION):
+        """`steps` along each ray, a shaft pixel for each `reduction`-square block of the screen's (the benchmark
+        of the choice tries others: scripts/bench_light_shafts.py)."""
+        self._steps, self._reduction = steps, reduction
+        self._program = build_program("light_shafts", vertex="world")
+        self._depth = DepthTexture()
+        self._target: TextureTarget | None = None
+        # core profile draws nothing without a vertex array, even one with no attributes
+        self._fullscreen_vertex_array = GL.glGenVertexArrays(1)
+
+    def march(
+        self,
+        screen_size: tuple[int, int],
+        draw_terrain_depth: Callable[[], None] | None,
+        camera: Camera,
+        view: np.ndarray,
+        projection: np.ndarray,
+        air: AirVolume,
+        shadows: CloudShadowMap,
+        sky_lowest_up: float,
+    ) -> None:
+        """March the shafts of `shadows` in `air` (bound for `camera`'s eye) for a frame of `screen_size` seen
+        through `view` and `projection`, up to the depth `draw_terrain_depth` draws (nothing: the sky everywhere),
+        the sky's rays below `sky_lowest_up` (a cosine to the up) marched at it, as the sky draws them.  Leaves the
+        framebuffer of the march bound: the caller binds its own."""
+        size = shaft_size(*screen_size, self._reduction)
+        self._depth.bind_cleared(size)
+        if draw_terrain_depth is not None:
+            draw_terrain_depth()
+        target = self._target_of(size)
+        target.bind()
+        GL.glDisable(GL.GL_DEPTH_TEST)
+        GL.glDisable(GL.GL_BLEND)
+        program = self._program
+        GL.glUseProgram(program)
+        GL.glActiveTexture(GL.GL_TEXTURE0)
+        GL.glBindTexture(GL.GL_TEXTURE_2D, self._depth.texture)
+        set_vec3(program, "eye_position", camera.position)
+        set_vec3(program, "view_right", view[0, :3])
+        set_vec3(program, "view_up", view[1, :3])
+        set_vec3(program, "view_forward", -view[2, :3])
+        GL.glUniform2f(GL.glGetUniformLocation(program, "focal"), projection[0, 0], projection[1, 1])
+        GL.glUniform2f(GL.glGetUniformLocation(program, "depth_terms"), projection[2, 2], projection[2, 3])
+        GL.glUniform1i(GL.glGetUniformLocation(program, "steps"), self._steps)
+        GL.glUniform1f(GL.glGetUniformLocation(program, "sky_lowest_up"), sky_lowest_up)
+        air.bind(program)
+        shadows.bind(program)
+        GL.glBindVertexArray(self._fullscreen_vertex_array)
+        GL.glDrawArrays(GL.GL_TRIANGLES, 0, 3)
+        GL.glBindVertexArray(0)
+        GL.glEnable(GL.GL_DEPTH_TEST)
+
+    def bind(self) -> None:
+        """Bind the last march's target for shaders/light_shafts_read.glsl."""
+        GL.glActiveTexture(GL.GL_TEXTURE0 + SHAFTS_UNIT)
+        GL.glBindTexture(GL.GL_TEXTURE_2D, self._target.texture)
+        GL.glActiveTexture(GL.GL_TEXTURE0)
+
+    def read(self) -> np.ndarray:
+        """The last march's (height, width, 4) target, top row first: the air's light taken, its share (tests)."""
+        return self._target.read()
+
+    def _target_of(self, size: tuple[int, int]) -> TextureTarget:
+        if self._target is None or (self._target.width, self._target.height) != size:
+            if self._target is not None:
+                self._target.close()
+            self._target = TextureTarget(*size, GL.GL_RGBA16F)
+        return self._target
+
+    def close(self) -> None:
+        """Free the GL objects (the context must be current)."""
+        self._depth.close()
+        if self._target is not None:
+            self._target.close()
+        GL.glDeleteProgram(self._program)
+        GL.glDeleteVertexArrays(1, [self._fullscreen_vertex_array])

@@ -1,0 +1,98 @@
+"""Light shafts: the sunlight the air would scatter toward the eye, taken away where the clouds shadow the air.
+
+Yusov (HPG 2014, section 5.6) marches each view ray through a light-space cloud transparency buffer and integrates
+the airlight only where the sun reaches the air; the sun streaming through gaps between clouds, and the dark
+columns under them, are what is left.  Here the air's light between the eye and a surface is the
+aerial-perspective volume's (`cloudcore.light.air_between`): A(t), the light the air adds over the first t metres
+of a ray.  Its increase over a step, A(t_i+1) - A(t_i), is what that step's air adds as seen from the eye (its own
+in-scattering already dimmed by the air in front of it), so the share of it the clouds' shadow keeps from the
+step's air is taken away:
+
+    shadowed = sum_i (1 - V(x_i)) (A(t_i+1) - A(t_i)),
+
+V the clouds' transmittance map (`cloudcore.light.cloud_shadows`) at a point x_i within step i.  The steps span
+only the part of the ray the map covers (a prism along the sun over the clouds' footprint, behind its near
+plane): elsewhere nothing shadows the air.  A(t) holds the air's light scattered many times as well as once, which
+the shadow dims alike: the clouds also shade the sky that lights the air under them.
+
+The world pass's GL side (`cloudcore.gl.light_shafts`) marches the same steps at a fraction of the screen's
+resolution; the sky takes `shadowed` off its light, and the terrain scales its air's light by what `shadowed_share`
+leaves (a share, which changes little between neighbouring rays that end at different distances, where the light
+taken does).  This is its numpy twin.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from cloudcore.atmosphere.aerial_perspective import MAX_DISTANCE_M
+from cloudcore.light.air_between import AirBetween
+from cloudcore.light.cloud_shadows import LightSpace, sample_map
+
+#: Rec. 709's luminance of linear RGB: the share taken is the luminance's
+LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
+
+#: steps along each ray's part in the map's prism
+SHAFT_STEPS = 12
+
+
+def shaft_segments(space: LightSpace, eye, directions, distances) -> tuple[np.ndarray, np.ndarray]:
+    """(start, end) (n,) metres: the part of each ray from `eye` along unit `directions` (n, 3) over its
+    `distances` (n; at most `MAX_DISTANCE_M`, the air volume's reach) inside the map's prism: the map's texels
+    across the sun, at or behind its near plane (slice coordinate 0) along it.  end <= start where a ray misses it."""
+    directions = np.asarray(directions, dtype=np.float64).reshape(-1, 3)
+    to_map = space.world_to_map()
+    origin = to_map[:3, :3] @ np.asarray(eye, dtype=np.float64) + to_map[:3, 3]
+    rates = directions @ to_map[:3, :3].T  # (n, 3): d(u, v, s)/dt
+    start = np.zeros(len(directions))
+    end = np.minimum(np.asarray(distances, dtype=np.float64).reshape(-1), MAX_DISTANCE_M)
+    bounds = ((0, 0.0, 1.0), (1, 0.0, 1.0), (2, 0.0, np.inf))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        for axis, low, high in bounds:
+            rate, at = rates[:, axis], origin[axis]
+            moving = np.abs(rate) > 1e-15
+            enter = np.where(rate > 0, (low - at) / rate, (high - at) / rate)
+            leave = np.where(rate > 0, (high - at) / rate, (low - at) / rate)
+            still_inside = low <= at <= high
+            start = np.where(moving, np.maximum(start, np.nan_to_num(enter, nan=-np.inf)), start)
+            end = np.where(moving, np.minimum(end, np.nan_to_num(leave, nan=np.inf)), end if still_inside else -1.0)
+    return start, end
+
+
+def shadowed_in_scattering(
+    air: AirBetween,
+    space: LightSpace,
+    optical_depths: np.ndarray,
+    eye,
+    directions,
+    distances,
+    offsets=0.5,
+    steps: int = SHAFT_STEPS,
+) -> np.ndarray:
+    """(n, 3): the air's light, in the renderer's values, that the clouds' shadow (the map `optical_depths` of
+    `space`, `cloud_shadows.opacity_map`'s) keeps from the eye along each ray of `directions` (n, 3) from `eye` up
+    to `distances` (n).  Each step's transmittance is read at `offsets` (n, or one value in [0, 1)) of its length:
+    the GL side's dither across pixels."""
+    directions = np.asarray(directions, dtype=np.float64).reshape(-1, 3)
+    eye = np.asarray(eye, dtype=np.float64)
+    start, end = shaft_segments(space, eye, directions, distances)
+    length = np.maximum(end - start, 0.0)
+    offsets = np.broadcast_to(np.asarray(offsets, dtype=np.float64), (len(directions),))
+
+    shadowed = np.zeros((len(directions), 3))
+    before = air.added(directions, start)[0]
+    for step in range(steps):
+        after = air.added(directions, start + length * (step + 1) / steps)[0]
+        inside = start + length * (step + offsets) / steps
+        points = eye + directions * inside[:, None]
+        lit = np.exp(-sample_map(space, optical_depths, points))
+        shadowed += (1.0 - lit)[:, None] * np.maximum(after - before, 0.0)
+        before = after
+    return np.where(length[:, None] > 0.0, shadowed, 0.0)
+
+
+def shadowed_share(shadowed, whole) -> np.ndarray:
+    """(...): the share of the air's light `whole` (..., 3) that the light `shadowed` (..., 3) taken from it is,
+    by luminance, in [0, 1]."""
+    taken, all_of_it = np.asarray(shadowed) @ LUMINANCE, np.asarray(whole) @ LUMINANCE
+    return np.clip(taken / np.maximum(all_of_it, 1e-12), 0.0, 1.0)
