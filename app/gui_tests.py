@@ -718,6 +718,9 @@ def a_click_within_one_frame_is_not_lost(ctx, app: EditorUnderTest):
     io = imgui.get_io()
     CHECK(io.config_input_trickle_event_queue)
     use_window(ctx, "Camera")
+    ctx.scroll_to_top(
+        ""
+    )  # where an earlier test left it scrolled (to its path's keys, to recording) the button is hidden
     button = ctx.item_info("Orbit left").rect_full
     use_window(ctx, "Lighting")
     camera_window = imgui.internal.find_window_by_name("Camera")
