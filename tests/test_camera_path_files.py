@@ -218,6 +218,7 @@ BAD_FILES = {
         f"{MAX_CAMERA_KEYS + 1:,} keys, at most {MAX_CAMERA_KEYS:,}",
     ),
     "csv binary": (raw_file("bad.csv", b"\xff\xfe\x00garbage"), "not UTF-8 text"),
+    "csv field of a megabyte": (csv_file(CSV_HEADER + "0," + "1" * 2**20 + ",0,0,1,0,0\n"), "not a readable CSV"),
     "gltf truncated": (
         lambda d: raw_file("bad.gltf", (d / "tour.gltf").read_bytes()[:300] if (d / "tour.gltf").exists() else b"")(d),
         "not a readable glTF file (truncated or corrupt?)",

@@ -116,7 +116,10 @@ def _csv_keys(source: str, data: bytes) -> np.ndarray:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as error:
         raise SceneError(source, "(file)", f"not UTF-8 text: {error}") from None
-    rows = [row for row in csv.reader(io.StringIO(text)) if row and any(cell.strip() for cell in row)]
+    try:
+        rows = [row for row in csv.reader(io.StringIO(text)) if row and any(cell.strip() for cell in row)]
+    except csv.Error as error:  # a field past the csv module's 131,072 characters, a NUL
+        raise SceneError(source, "(file)", f"not a readable CSV: {error}") from None
     if not rows or tuple(cell.strip() for cell in rows[0]) != CSV_COLUMNS:
         found = ",".join(rows[0])[:80] if rows else "nothing"
         raise SceneError(source, "header", f"expected the columns {','.join(CSV_COLUMNS)}, got {found!r}")
