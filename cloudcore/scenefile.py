@@ -19,7 +19,7 @@ import tomlkit
 from cloudcore.artist.cloudgen import PRESETS
 from cloudcore.cloud_records import FACINGS, FORMATION_KINDS, MAX_SEED, ArtistShading, Formation, SpriteStyle
 from cloudcore.errors import SceneError
-from cloudcore.interop.heightmap import read_heightmap
+from cloudcore.interop.heightmap import read_heightmap, store_heightmap
 from cloudcore.light.lighting import SKIES
 from cloudcore.light.phase import PHASE_NAMES
 from cloudcore.light.shading import EYE_PASSES, LIGHT_PASSES
@@ -631,7 +631,8 @@ def save_scene(scene: Scene, path) -> Scene:
     that commits the save, the previous TOML and every file it names are intact: a
     crash at any moment leaves the old scene or the new one, never a mix.  After
     the commit, particle files in the scene's own folder the new TOML does not
-    name are deleted.
+    name are deleted.  A heightmap terrain's image is written beside the scene where
+    the folder lacks it (`cloudcore.interop.heightmap.store_heightmap`), on the same rule.
     """
     path = Path(path)
     saved_clouds = tuple(
@@ -640,7 +641,11 @@ def save_scene(scene: Scene, path) -> Scene:
         else cloud
         for cloud in scene.clouds
     )
-    saved = dataclasses.replace(scene, clouds=saved_clouds)
+    terrain = scene.terrain
+    if terrain is not None and terrain.heights is not None:
+        stored = store_heightmap(terrain.heights.values, terrain.heightmap or "", path)
+        terrain = dataclasses.replace(terrain, heightmap=stored)
+    saved = dataclasses.replace(scene, clouds=saved_clouds, terrain=terrain)
     document = tomlkit.dumps(scene_to_dict(saved)).encode("utf-8")
     atomic_write(path, lambda f: f.write(document))
     remove_unnamed_particle_files(path, {c.particles_file for c in saved_clouds if c.particles_file is not None})

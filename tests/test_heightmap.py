@@ -89,10 +89,21 @@ def test_the_example_scene_loads_and_saves_back_the_same(tmp_path):
     valley = dataclasses.replace(load_scene(DEFAULT_SCENE).terrain, relief=0.0)
     x, z = np.meshgrid(np.linspace(-3000, 3000, 257), np.linspace(-3000, 3000, 257))
     assert np.allclose(height_at(dataclasses.replace(terrain, relief=0.0), x, z), height_at(valley, x, z), atol=0.01)
-    (tmp_path / "heightmap_valley.png").write_bytes(resource_path("scenes", "heightmap_valley.png").read_bytes())
     scene = dataclasses.replace(scene, clouds=())
-    save_scene(scene, tmp_path / "again.toml")
+    save_scene(scene, tmp_path / "again.toml")  # another folder: the image goes along
+    assert (tmp_path / "heightmap_valley.png").exists()
     assert load_scene(tmp_path / "again.toml") == scene
+
+
+def test_saving_beside_another_image_of_that_name_keeps_it_and_writes_the_scenes_own(tmp_path):
+    scene = load_scene(EXAMPLE)
+    other = tmp_path / "heightmap_valley.png"
+    write_heightmap(other, np.zeros((4, 4)))
+    before = other.read_bytes()
+    saved = save_scene(scene, tmp_path / "mine.toml")
+    assert other.read_bytes() == before and saved.terrain.heightmap == "mine.heightmap.png"
+    assert load_scene(tmp_path / "mine.toml").terrain.heights == scene.terrain.heights
+    assert save_scene(scene, tmp_path / "mine.toml").terrain.heightmap == "mine.heightmap.png"  # found, not again
 
 
 def png_chunk(kind: bytes, data: bytes) -> bytes:

@@ -7,6 +7,7 @@ file; the heights come back whole or not at all.
 
 from __future__ import annotations
 
+import hashlib
 import io
 import struct
 import zlib
@@ -87,3 +88,33 @@ def write_heightmap(path, heights: np.ndarray) -> None:
     out = io.BytesIO()
     Image.fromarray(samples).save(out, format="PNG", optimize=True)
     atomic_write(Path(path), lambda f: f.write(out.getvalue()))
+
+
+def store_heightmap(heights: np.ndarray, wanted: str, scene_path: Path) -> str:
+    """The heightmap file, relative to the scene at `scene_path`, that holds `heights` (in [0, 1], 16-bit
+    levels), written if need be: `wanted` where it lies in the scene's folder and holds them or is free, else
+    `<scene>.heightmap.png`, else a name with their digest.  A file holding other heights is never overwritten
+    (the scene file on disk may still name it until the save's rename commits it), so a scene saved into
+    another folder takes its heightmap along."""
+    folder = Path(scene_path).parent.resolve()
+    digest = hashlib.sha256(np.ascontiguousarray(heights).tobytes()).hexdigest()[:16]
+    stem = Path(scene_path).stem
+    candidates = [f"{stem}.heightmap.png", f"{stem}.heightmap-{digest}.png"]
+    if wanted and not Path(wanted).is_absolute() and (folder / wanted).resolve().is_relative_to(folder):
+        candidates.insert(0, wanted)
+    for relative in candidates:
+        file = folder / relative
+        if not file.exists():
+            file.parent.mkdir(parents=True, exist_ok=True)
+            write_heightmap(file, heights)
+            return relative
+        if _holds(file, heights):
+            return relative
+    raise SceneError(str(folder / candidates[-1]), "heightmap", "holds other heights: move it away to save here")
+
+
+def _holds(file: Path, heights: np.ndarray) -> bool:
+    try:
+        return np.array_equal(read_heightmap(file), heights)
+    except SceneError:
+        return False
