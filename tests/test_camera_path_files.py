@@ -237,7 +237,7 @@ BAD_FILES = {
     ),
     "gltf 10^12 keys claimed": (
         mutated_gltf(lambda doc: doc["accessors"][0].update(count=10**12)),
-        "a count of 1000000000000, expected 1 to 400,000",
+        f"a count of 1000000000000, expected 1 to {4 * MAX_CAMERA_KEYS:,}",
     ),
     "gltf accessor past its buffer": (
         mutated_gltf(lambda doc: doc["bufferViews"][0].update(byteLength=10**6)),
@@ -253,7 +253,7 @@ BAD_FILES = {
     "gltf wrong types": (mutated_gltf(lambda doc: doc.update(nodes=5)), "not a readable glTF file"),
     "gltf negative count": (
         mutated_gltf(lambda doc: doc["accessors"][0].update(count=-5)),
-        "a count of -5, expected 1 to 400,000",
+        f"a count of -5, expected 1 to {4 * MAX_CAMERA_KEYS:,}",
     ),
     "not a path file": (raw_file("path.txt", b"t,px\n"), "cloudview imports .vdb, .csv, .gltf, .glb files"),
     "missing": (lambda d: "nowhere.gltf", "no such file"),

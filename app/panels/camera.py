@@ -98,12 +98,17 @@ class CameraPanel:
         self.selected_key = min(self.selected_key, len(keys) - 1)
         imgui.text(f"Keys ({len(keys)}): time (s), eye")
         if imgui.begin_list_box("##keys", imgui.ImVec2(-1.0, 5.5 * imgui.get_text_line_height_with_spacing())):
-            for index, key in enumerate(keys):
-                label = f"{index}: {key[0]:.2f}  {key[1]:.0f}, {key[2]:.0f}, {key[3]:.0f}###key{index}"
-                if imgui.selectable(label, index == self.selected_key)[0]:
-                    self.selected_key, self.key_time_s = index, float(key[0])
-                    editor.playing = False
-                    editor.show_path_time(float(key[0] - keys[0, 0]))
+            # the rows in sight alone: an imported path may hold a key a frame, 10,000 of them
+            clipper = imgui.ListClipper()
+            clipper.begin(len(keys))
+            while clipper.step():
+                for index in range(clipper.display_start, clipper.display_end):
+                    key = keys[index]
+                    label = f"{index}: {key[0]:.2f}  {key[1]:.0f}, {key[2]:.0f}, {key[3]:.0f}###key{index}"
+                    if imgui.selectable(label, index == self.selected_key)[0]:
+                        self.selected_key, self.key_time_s = index, float(key[0])
+                        editor.playing = False
+                        editor.show_path_time(float(key[0] - keys[0, 0]))
             imgui.end_list_box()
         self._key_time()
         self._add_key_at_the_view()
