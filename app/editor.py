@@ -19,9 +19,19 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from cloudcore.editing import History, delete_cloud, delete_particles
+from cloudcore.editing import (
+    History,
+    delete_cloud,
+    delete_particles,
+    new_camera_path,
+    with_camera_key,
+    with_camera_key_time,
+    with_camera_path,
+    without_camera_key,
+)
 from cloudcore.errors import SceneError
-from cloudcore.interop.vdb_clouds import DEFAULT_PARTICLES, export_vdb, import_vdb_clouds
+from cloudcore.interop.camera_paths import read_camera_path, write_camera_path
+from cloudcore.interop.vdb_clouds import DEFAULT_PARTICLES, export_vdb, free_name, import_vdb_clouds
 from cloudcore.limits import scene_limit_problems
 from cloudcore.measure.frame_stats import FrameStats
 from cloudcore.particle_files import particles_folder
@@ -320,6 +330,66 @@ class Editor:
             self.messages.append(f"could not export {path}: {error}")
             return False
         self.messages.append(f"exported {len(grids)} grid(s) to {path}")
+        return True
+
+    def _path_index(self) -> int | None:
+        """The index of the chosen camera path in the scene, or None where it has none of that name."""
+        names = [path.name for path in self.scene.camera_paths]
+        return names.index(self.camera_path_name) if self.camera_path_name in names else None
+
+    def add_camera_key(self, time_s: float) -> bool:
+        """Add a key at `time_s` looking as the view does now to the chosen camera path (undoable); with no
+        path, a new one from the scene's camera at time 0 to the view."""
+        index = self._path_index()
+        if index is None:
+            name = free_name("path", [path.name for path in self.scene.camera_paths])
+            if not self.change(lambda: new_camera_path(self.scene, name, time_s, self.camera)):
+                return False
+            self.camera_path_name, self.path_time_s, self.playing = name, 0.0, False
+            self.messages.append(f"new camera path {name}: the scene's camera, then the view at {time_s:g} s")
+            return True
+        if not self.change(lambda: with_camera_key(self.scene, index, time_s, self.camera)):
+            return False
+        self.messages.append(f"added a key at {time_s:g} s to {self.camera_path_name}")
+        return True
+
+    def move_camera_key(self, key_index: int, time_s: float) -> bool:
+        """Move key `key_index` of the chosen camera path to `time_s` (undoable; not past its neighbours)."""
+        index = self._path_index()
+        return index is not None and self.change(lambda: with_camera_key_time(self.scene, index, key_index, time_s))
+
+    def delete_camera_key(self, key_index: int) -> bool:
+        """Delete key `key_index` of the chosen camera path (undoable; a path keeps two keys at least)."""
+        index = self._path_index()
+        return index is not None and self.change(lambda: without_camera_key(self.scene, index, key_index))
+
+    def import_camera_path(self, path: Path) -> bool:
+        """Add the camera path of a glTF or CSV file as one undoable edit and choose it; a file that cannot be
+        imported leaves the scene as it was and says why."""
+        try:
+            imported = read_camera_path(path)
+        except SceneError as error:
+            self.messages.append(f"could not import: {error}")
+            return False
+        name = free_name(imported.name, [p.name for p in self.scene.camera_paths])
+        if not self.edit(with_camera_path(self.scene, dataclasses.replace(imported, name=name))):
+            return False
+        self.camera_path_name, self.path_time_s, self.playing = name, 0.0, False
+        self.messages.append(f"imported camera path {name} ({len(imported.keys)} keys) from {Path(path).name}")
+        return True
+
+    def export_camera_path(self, path: Path) -> bool:
+        """Write the chosen camera path to a glTF (.gltf, .glb) or CSV file."""
+        index = self._path_index()
+        if index is None:
+            self.messages.append("the scene has no camera path to export")
+            return False
+        try:
+            write_camera_path(path, self.scene.camera_paths[index], self.camera.fov_y_deg)
+        except (OSError, SceneError) as error:
+            self.messages.append(f"could not export {path}: {error}")
+            return False
+        self.messages.append(f"exported camera path {self.camera_path_name} to {path}")
         return True
 
     def _keep_unsaved_edits(self) -> bool:

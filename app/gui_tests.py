@@ -621,6 +621,59 @@ def playing_a_camera_path_moves_the_camera(ctx, app: EditorUnderTest):
     ctx.item_click("Reset to the scene's camera")
 
 
+def camera_keys_are_added_moved_deleted_and_undone(ctx, app: EditorUnderTest):
+    """The Camera panel adds a key at the view, moves its time, refuses a move past its neighbour and deletes
+    it, each one undoable edit; Export path... then Import path... brings the path back as a new one, and a
+    truncated file leaves the scene as it was, with a message naming it."""
+    use_window(ctx, "Camera")
+    before = app.editor.scene
+    keys = before.camera_path(app.editor.camera_path_name).keys
+    view = app.editor.camera
+    ctx.item_input_value("Key time (s)", float(keys[-1, 0] + 1.0))
+    ctx.item_click("Add key at the view")
+    added = app.editor.scene.camera_path(app.editor.camera_path_name).keys
+    CHECK(len(added) == len(keys) + 1)
+    CHECK(added[-1].tolist() == [keys[-1, 0] + 1.0, *view.position, *view.look_at])
+    ctx.item_click(f"**/###key{len(keys)}")
+    CHECK(app.panels.camera.selected_key == len(keys))
+    CHECK(bool(np.allclose(app.editor.camera.position, view.position)))  # the key's view is shown
+    ctx.item_input_value("Key time (s)", float(keys[-1, 0] + 2.5))
+    ctx.item_click("Move key")
+    CHECK(bool(app.editor.scene.camera_path(app.editor.camera_path_name).keys[-1, 0] == keys[-1, 0] + 2.5))
+    moved = app.editor.scene
+    ctx.item_input_value("Key time (s)", float(keys[0, 0] - 1.0))  # before the first key: refused
+    ctx.item_click("Move key")
+    CHECK(app.editor.scene is moved)
+    CHECK(any("key times must increase strictly" in m for m in app.editor.messages))
+    ctx.item_click("Delete key")
+    CHECK(bool(np.array_equal(app.editor.scene.camera_path(app.editor.camera_path_name).keys, keys)))
+    undo(ctx)
+    CHECK(app.editor.scene is moved)
+    undo(ctx)
+    undo(ctx)
+    CHECK(app.editor.scene is before)
+    use_window(ctx, "Camera")
+    exported = app.results_path.with_name("pan.gltf")
+    ctx.item_input_value("Path file", str(exported))
+    ctx.item_click("Export path...")
+    CHECK(exported.exists())
+    ctx.item_click("Import path...")
+    CHECK(app.editor.camera_path_name == "pan-2")
+    CHECK(bool(np.allclose(app.editor.scene.camera_path("pan-2").keys, keys, atol=1e-3)))
+    imported = app.editor.scene
+    bad = app.results_path.with_name("truncated.gltf")
+    bad.write_bytes(exported.read_bytes()[:100])
+    ctx.item_input_value("Path file", str(bad))
+    ctx.item_click("Import path...")
+    CHECK(app.editor.scene is imported)
+    CHECK(any("could not import" in m and "truncated.gltf" in m for m in app.editor.messages))
+    undo(ctx)
+    CHECK(app.editor.scene is before)
+    use_window(ctx, "Camera")
+    CHECK(app.editor.camera_path_name == "pan")  # the panel chooses a path the scene has again
+    ctx.item_click("Reset to the scene's camera")
+
+
 def an_untouched_editor_comes_to_rest(ctx, app: EditorUnderTest):
     """Left alone, the viewport shows its picture again and is at rest, when the window waits for input between
     frames (`app.main`; not while GUI tests drive it); while a path plays it is never at rest."""
@@ -665,6 +718,9 @@ def a_click_within_one_frame_is_not_lost(ctx, app: EditorUnderTest):
     io = imgui.get_io()
     CHECK(io.config_input_trickle_event_queue)
     use_window(ctx, "Camera")
+    ctx.scroll_to_top(
+        ""
+    )  # where an earlier test left it scrolled (to its path's keys, to recording) the button is hidden
     button = ctx.item_info("Orbit left").rect_full
     use_window(ctx, "Lighting")
     camera_window = imgui.internal.find_window_by_name("Camera")
@@ -800,6 +856,7 @@ GUI_TESTS = (
     the_gpu_sorts_the_splats_in_the_window,
     overlays_outline_impostors_and_the_ring,
     playing_a_camera_path_moves_the_camera,
+    camera_keys_are_added_moved_deleted_and_undone,
     an_untouched_editor_comes_to_rest,
     recording_runs_in_the_background,
     a_click_within_one_frame_is_not_lost,

@@ -18,7 +18,7 @@ import numpy as np
 
 from cloudcore.artist.cloudgen import box_fill, preset_cloud
 from cloudcore.camera import camera_pose
-from cloudcore.scene import Camera, Cloud, Scene
+from cloudcore.scene import Camera, CameraPath, Cloud, Scene
 
 DEFAULT_PARTICLE_RADIUS = 40.0
 _UP = np.array([0.0, 1.0, 0.0])
@@ -249,6 +249,55 @@ def replace_cloud(scene: Scene, cloud_index: int, cloud: Cloud) -> Scene:
     clouds = list(scene.clouds)
     clouds[cloud_index] = cloud
     return dataclasses.replace(scene, clouds=tuple(clouds))
+
+
+def with_camera_key(scene: Scene, path_index: int, time_s: float, camera: Camera) -> Scene:
+    """The scene with a key of camera path `path_index` at `time_s` looking as `camera` does, among the path's
+    keys in time order (a key at that very time is the caller's to refuse: `limits` does)."""
+    key = _camera_key(time_s, camera)
+    keys = scene.camera_paths[path_index].keys
+    at = int(np.searchsorted(keys[:, 0], key[0]))
+    return _with_keys(scene, path_index, np.insert(keys, at, key, axis=0))
+
+
+def with_camera_key_time(scene: Scene, path_index: int, key_index: int, time_s: float) -> Scene:
+    """The scene with key `key_index` of camera path `path_index` moved to `time_s`, kept in its place: moved
+    past a neighbour, the keys' times no longer increase and `limits` refuses the edit."""
+    if not math.isfinite(time_s):
+        raise ValueError(f"a key's time must be finite, got {time_s}")
+    keys = np.array(scene.camera_paths[path_index].keys)
+    keys[key_index, 0] = float(time_s)
+    return _with_keys(scene, path_index, keys)
+
+
+def without_camera_key(scene: Scene, path_index: int, key_index: int) -> Scene:
+    """The scene without key `key_index` of camera path `path_index` (a path left with one key `limits`
+    refuses)."""
+    return _with_keys(scene, path_index, np.delete(scene.camera_paths[path_index].keys, key_index, axis=0))
+
+
+def with_camera_path(scene: Scene, path: CameraPath) -> Scene:
+    """The scene with `path` added after its camera paths."""
+    return dataclasses.replace(scene, camera_paths=scene.camera_paths + (path,))
+
+
+def new_camera_path(scene: Scene, name: str, time_s: float, camera: Camera) -> Scene:
+    """The scene with a new camera path `name` from the scene's camera at time 0 to `camera` at `time_s`."""
+    start = _camera_key(0.0, scene.camera)
+    return with_camera_path(scene, CameraPath(name, np.stack([start, _camera_key(time_s, camera)])))
+
+
+def _camera_key(time_s: float, camera: Camera) -> np.ndarray:
+    key = np.array([time_s, *camera.position, *camera.look_at], dtype=np.float64)
+    if not np.all(np.isfinite(key)):
+        raise ValueError(f"a key's time and view must be finite, got {key.tolist()}")
+    return key
+
+
+def _with_keys(scene: Scene, path_index: int, keys: np.ndarray) -> Scene:
+    paths = list(scene.camera_paths)
+    paths[path_index] = dataclasses.replace(paths[path_index], keys=keys)
+    return dataclasses.replace(scene, camera_paths=tuple(paths))
 
 
 class History:

@@ -26,8 +26,8 @@ from cloudcore.scene import Air, Camera, Cloud, Light, Lighting, SceneObject, Sh
 #: lights that shine on clouds at once: the compute shader keeps one incident term per light
 #: per particle (`incident[MAX_LIGHTS]` in gl/shaders/splat_shade.comp.glsl)
 MAX_LIGHTS = 8
-#: the terrain kinds the world pass can draw (gl/world.py meshes heightfields only)
-DRAWN_TERRAIN_KINDS = ("heightfield",)
+#: the terrain kinds the world pass can draw (gl/world.py meshes heightfields, procedural or from a heightmap)
+DRAWN_TERRAIN_KINDS = ("heightfield", "heightmap")
 #: the largest side of a frame in pixels (llvmpipe's and most GPUs' largest renderbuffer)
 MAX_FRAME_SIDE = 16384
 #: the memory a frame of the headless commands takes, per pixel and whatever its size: the peak resident size
@@ -76,19 +76,22 @@ FIELD_RANGES = {
     # to the aerial-perspective volume's last slice (`MAX_DISTANCE_M`): the air past it is not looked up
     (Terrain, "reach"): (0.0, MAX_DISTANCE_M),
     (Terrain, "color"): (0.0, 1.0),
+    (Terrain, "steep_color"): (0.0, 1.0),
+    (Terrain, "steep_slope_deg"): (0.0, 90.0),
     (SceneObject, "color"): (0.0, 1.0),
     (View, "tolerance_psnr"): (0.0, math.inf),
 }
 _UNBOUNDED = (-math.inf, math.inf)
-#: where a record's field is not the scene file's key: an object's vertices come from its mesh file
-_FILE_KEYS = {"vertices": "mesh"}
+#: where a record's field is not the scene file's key: an object's vertices come from its mesh file, a
+#: terrain's heights from its heightmap
+_FILE_KEYS = {"vertices": "mesh", "heights": "heightmap"}
 
 
 def scene_limit_problems(scene, unchanged=None) -> list[tuple[str, str]]:
     """(field, problem) for each limit `scene` is past, fields as the scene file names them.
 
-    `unchanged`: a scene whose clouds, where they are the very same objects, need
-    no second look (the editor checks every edit; most leave most clouds alone).
+    `unchanged`: a scene whose clouds and terrain, where they are the very same objects, need
+    no second look (the editor checks every edit; most leave most clouds and the terrain alone).
     """
     problems = []
     if scene.lighting.lights:
@@ -110,7 +113,15 @@ def scene_limit_problems(scene, unchanged=None) -> list[tuple[str, str]]:
         )
     previous = {id(cloud) for cloud in unchanged.clouds} if unchanged is not None else set()
     for key in ("camera", "lighting", "shading", "terrain", "objects", "camera_paths", "views", "cloud_field"):
-        problems.extend(_out_of_bounds(key, getattr(scene, key)))
+        # a terrain left alone needs no second look: a 4097^2 heightmap's samples took 0.29 s every edit
+        if key != "terrain" or unchanged is None or scene.terrain is not unchanged.terrain:
+            problems.extend(_out_of_bounds(key, getattr(scene, key)))
+    if scene.terrain is not None:
+        problems.extend(_terrain_problems(scene.terrain))
+    for i, path in enumerate(scene.camera_paths):  # the editor moves and deletes keys
+        problem = camera_path_keys_problem(path.keys)
+        if problem is not None:
+            problems.append((f"camera_paths[{i}].keys", problem))
     for i, cloud in enumerate(scene.clouds):
         if id(cloud) in previous:
             continue
@@ -133,6 +144,38 @@ def scene_limit_problems(scene, unchanged=None) -> list[tuple[str, str]]:
                 )
             )
     return problems
+
+
+def camera_path_keys_problem(keys: np.ndarray) -> str | None:
+    """What is wrong with a camera path's keys (rows t, eye, look-at) for playing them, or None: at least two,
+    their times increasing, no key looking at its own eye."""
+    if len(keys) < 2:
+        return "a camera path needs at least 2 keys"
+    if np.any(np.diff(keys[:, 0]) <= 0):
+        return "key times must increase strictly"
+    if np.any(np.all(keys[:, 1:4] == keys[:, 4:7], axis=1)):
+        return "a key looks at its own position"
+    return None
+
+
+def _terrain_problems(terrain: Terrain) -> Iterator[tuple[str, str]]:
+    """What a terrain's fields must agree on: a heightmap terrain has heights (and only it), a colour ramp's
+    heights increase and its colours are within [0, 1], the steep colour turns in over a range of slopes."""
+    if (terrain.kind == "heightmap") != (terrain.heights is not None):
+        yield "terrain.heightmap", "heights come from a heightmap, for a terrain of kind 'heightmap' alone"
+    if terrain.color_ramp:
+        ramp = np.array(terrain.color_ramp, dtype=np.float64)
+        if ramp.ndim != 2 or ramp.shape[1] != 4:
+            yield "terrain.color_ramp", f"expected rows [height_m, r, g, b], got {terrain.color_ramp!r}"
+        elif not np.all(np.isfinite(ramp)):
+            return  # `_out_of_bounds` names the number
+        elif np.any(np.diff(ramp[:, 0]) <= 0.0):
+            yield "terrain.color_ramp", "the rows' heights must increase strictly"
+        elif not np.all((ramp[:, 1:] >= 0.0) & (ramp[:, 1:] <= 1.0)):
+            yield "terrain.color_ramp", "colours must be within [0, 1]"
+    low, high = terrain.steep_slope_deg
+    if not low < high:
+        yield "terrain.steep_slope_deg", f"expected [from, to] with from < to in degrees, got {[low, high]}"
 
 
 def _out_of_bounds(field: str, value, bounds=_UNBOUNDED, infinite_allowed=False) -> Iterator[tuple[str, str]]:

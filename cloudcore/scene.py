@@ -8,6 +8,7 @@ input enters (`cloudcore.scenefile`); these types only normalise.
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import math
 from dataclasses import dataclass, field
 
@@ -159,9 +160,37 @@ def splats_bounding_sphere(centres: np.ndarray, radii: np.ndarray) -> tuple[np.n
     return centre, float((np.linalg.norm(centres - centre, axis=1) + radii).max())
 
 
+@dataclass(frozen=True, eq=False)
+class HeightGrid(_Record):
+    """A heightmap's samples over its largest possible value, in [0, 1]: rows along z (the image's top row at
+    -z), columns along x.  Hashed by value, as a `Terrain` holding it keys the caches of its tiles."""
+
+    values: np.ndarray
+
+    def __post_init__(self):
+        values = np.array(self.values, dtype=np.float64)
+        if values.ndim != 2 or min(values.shape) < 2:
+            raise FieldError("heightmap", f"expected a grid of at least 2x2 samples, got shape {values.shape}")
+        values.flags.writeable = False
+        object.__setattr__(self, "values", values)
+
+    def __hash__(self):
+        digest = self.__dict__.get("_digest")
+        if digest is None:
+            digest = hashlib.blake2b(self.values.tobytes(), digest_size=16).digest()
+            object.__setattr__(self, "_digest", digest)
+        return hash((self.values.shape, digest))
+
+
 @dataclass(frozen=True)
 class Terrain:
-    """A procedural heightfield (`cloudcore.terrain`) or a mesh file."""
+    """A procedural heightfield (`cloudcore.terrain`), a heightmap image's heights, or a mesh file.
+
+    A "heightmap" terrain's `heights` come from the 16-bit greyscale PNG `heightmap` (relative to the scene
+    file's folder), stretched over `size` with white at `height` metres; its `resolution` and `seed` are
+    unused.  Any terrain may be coloured by height (`color_ramp`, rows (height_m, r, g, b)) and by slope:
+    from `steep_slope_deg[0]` to `[1]` the colour turns to `steep_color`.
+    """
 
     kind: str = "heightfield"
     size: tuple[float, float] = (6000.0, 6000.0)
@@ -174,6 +203,12 @@ class Terrain:
     relief: float = 0.0
     #: metres from the origin the ground is drawn to, at least the half of `size` (0: the patch of `size` alone)
     reach: float = 0.0
+    heightmap: str | None = None
+    #: the heightmap's samples, read by the loader (None for the procedural heightfield)
+    heights: HeightGrid | None = None
+    color_ramp: tuple[tuple[float, float, float, float], ...] = ()
+    steep_color: Vec3 | None = None
+    steep_slope_deg: tuple[float, float] = (30.0, 45.0)
 
 
 @dataclass(frozen=True, eq=False)

@@ -18,10 +18,12 @@ import tomlkit
 
 from cloudcore.artist.cloudgen import PRESETS
 from cloudcore.cloud_records import FACINGS, FORMATION_KINDS, MAX_SEED, ArtistShading, Formation, SpriteStyle
+from cloudcore.errors import SceneError
+from cloudcore.interop.heightmap import read_heightmap, store_heightmap
 from cloudcore.light.lighting import SKIES
 from cloudcore.light.phase import PHASE_NAMES
 from cloudcore.light.shading import EYE_PASSES, LIGHT_PASSES
-from cloudcore.limits import FIELD_RANGES, scene_limit_problems
+from cloudcore.limits import FIELD_RANGES, camera_path_keys_problem, scene_limit_problems
 from cloudcore.particle_files import (
     atomic_write,
     open_particle_array,
@@ -37,6 +39,7 @@ from cloudcore.scene import (
     CameraPath,
     Cloud,
     CloudField,
+    HeightGrid,
     Light,
     Lighting,
     Scene,
@@ -52,7 +55,7 @@ PRIMITIVES = ("box", "sphere", "aircraft")
 #: a terrain's side in metres, at least: its noise is scaled to the side, and a side of 5e-324 m halved to 0
 #: and put NaN in the heights
 MIN_TERRAIN_SIDE_M = 1.0
-TERRAIN_KINDS = ("heightfield", "mesh")
+TERRAIN_KINDS = ("heightfield", "heightmap", "mesh")
 #: TOML arrays are slow to parse; clouds larger than this are saved to .npy.
 INLINE_PARTICLE_LIMIT = 64
 
@@ -76,7 +79,8 @@ TABLE_KEYS = {
     "clouds.sprite": record_keys(SpriteStyle),
     "clouds.artist": record_keys(ArtistShading),
     "cloud_field": record_keys(CloudField),
-    "terrain": record_keys(Terrain),
+    # a heightmap's heights are read from `heightmap`, not written in the scene
+    "terrain": record_keys(Terrain, leave_out=("heights",)),
     # a mesh file's triangles are read from `mesh`, not written in the scene
     "objects": record_keys(SceneObject, leave_out=("vertices", "faces")),
     "camera_paths": record_keys(CameraPath),
@@ -121,7 +125,9 @@ def scene_from_dict(data: dict, source: str = "<scene>", base_dir=Path(".")) -> 
         lighting=_lighting(Table(source, "lighting", root.raw("lighting", {}))),
         shading=_shading(Table(source, "shading", root.raw("shading", {}))),
         clouds=clouds,
-        terrain=_terrain(Table(source, "terrain", root.raw("terrain"))) if root.has("terrain") else None,
+        terrain=_terrain(Table(source, "terrain", root.raw("terrain")), Path(base_dir))
+        if root.has("terrain")
+        else None,
         objects=objects,
         camera_paths=paths,
         description=root.string("description", ""),
@@ -392,14 +398,19 @@ def _read_particles(t: Table, file: Path) -> np.ndarray:
     return checked_matrix(array, 4, t.source, t.path("particles_file"), True)
 
 
-def _terrain(t: Table) -> Terrain:
+def _terrain(t: Table, base_dir: Path) -> Terrain:
     t.reject_unknown(TABLE_KEYS["terrain"])
     d = Terrain()
     kind = t.string("kind", d.kind, choices=TERRAIN_KINDS)
+    if kind != "heightmap" and t.has("heightmap"):
+        t.fail("heightmap", f"only a terrain of kind 'heightmap' reads it, this one is {kind!r}")
+    if kind == "heightmap" and t.has("resolution"):
+        t.fail("resolution", "a heightmap's pixels are its samples: leave resolution out")
     size = t.raw("size", list(d.size))
     if not (isinstance(size, list) and len(size) == 2):
         t.fail("size", f"expected [size_x, size_z] in metres, got {size!r}")
     sx = Table(t.source, t.path("size"), {"x": size[0], "z": size[1]})
+    heightmap = t.string("heightmap") if kind == "heightmap" else None
     return Terrain(
         kind=kind,
         size=(sx.number("x", low=MIN_TERRAIN_SIDE_M), sx.number("z", low=MIN_TERRAIN_SIDE_M)),
@@ -410,7 +421,27 @@ def _terrain(t: Table) -> Terrain:
         color=t.vector("color", d.color, **_range(Terrain, "color")),
         relief=t.number("relief", d.relief, **_range(Terrain, "relief")),
         reach=t.number("reach", d.reach, **_range(Terrain, "reach")),
+        heightmap=heightmap,
+        heights=_read_heights(t, base_dir, heightmap) if heightmap is not None else None,
+        color_ramp=tuple(map(tuple, t.matrix("color_ramp", 4).tolist())) if t.has("color_ramp") else (),
+        steep_color=t.vector("steep_color", None, **_range(Terrain, "steep_color")) if t.has("steep_color") else None,
+        steep_slope_deg=t.row("steep_slope_deg", 2, d.steep_slope_deg),
     )
+
+
+def _read_heights(t: Table, base_dir: Path, heightmap: str) -> HeightGrid:
+    """The heights of the PNG `heightmap` names, a path relative to the scene's folder that stays inside it (a
+    scene passed on may read no other file of its reader's)."""
+    if Path(heightmap).is_absolute():
+        t.fail("heightmap", f"{heightmap!r}: must be relative to the scene file's folder, not absolute")
+    folder = base_dir.resolve()
+    file = (folder / heightmap).resolve()
+    if not file.is_relative_to(folder):
+        t.fail("heightmap", f"{heightmap!r}: leads outside the scene file's folder ({folder})")
+    try:
+        return HeightGrid(read_heightmap(file))
+    except SceneError as error:
+        t.fail("heightmap", f"{error.source}: {error.problem}")
 
 
 def _object(t: Table, base_dir: Path) -> SceneObject:
@@ -456,11 +487,9 @@ def _read_mesh(t: Table, file: Path) -> tuple[np.ndarray, np.ndarray]:
 def _camera_path(t: Table) -> CameraPath:
     t.reject_unknown(TABLE_KEYS["camera_paths"])
     keys = t.matrix("keys", 7)
-    if len(keys) < 2:
-        t.fail("keys", "a camera path needs at least 2 keys")
-    _check_times(t, "keys", keys[:, 0])
-    if np.any(np.all(keys[:, 1:4] == keys[:, 4:7], axis=1)):
-        t.fail("keys", "a key looks at its own position")
+    problem = camera_path_keys_problem(keys)
+    if problem is not None:
+        t.fail("keys", problem)
     return CameraPath(t.string("name"), keys)
 
 
@@ -498,19 +527,20 @@ def scene_to_dict(scene: Scene) -> dict:
             data["shading"][key] = getattr(s, key)
     if scene.terrain is not None:
         t = scene.terrain
-        terrain = {
-            "kind": t.kind,
-            "size": list(t.size),
-            "resolution": t.resolution,
-            "height": t.height,
-            "seed": t.seed,
-            "color": list(t.color),
-        }
+        terrain = {"kind": t.kind, "size": list(t.size), "resolution": t.resolution, "height": t.height, "seed": t.seed}
+        if t.kind == "heightmap":  # its pixels are its samples; the seed stays, the mountains' of `relief`
+            del terrain["resolution"]
+            terrain["heightmap"] = t.heightmap
+        terrain["color"] = list(t.color)
         for key in ("relief", "reach"):  # files without them stay as they were
             if getattr(t, key) != getattr(Terrain(), key):
                 terrain[key] = getattr(t, key)
         if t.mesh is not None:
             terrain["mesh"] = t.mesh
+        if t.color_ramp:
+            terrain["color_ramp"] = _rows(np.array(t.color_ramp))
+        if t.steep_color is not None:
+            terrain.update(steep_color=list(t.steep_color), steep_slope_deg=list(t.steep_slope_deg))
         data["terrain"] = terrain
     data["clouds"] = [_cloud_dict(cloud) for cloud in scene.clouds]
     if scene.cloud_field is not None:
@@ -601,7 +631,8 @@ def save_scene(scene: Scene, path) -> Scene:
     that commits the save, the previous TOML and every file it names are intact: a
     crash at any moment leaves the old scene or the new one, never a mix.  After
     the commit, particle files in the scene's own folder the new TOML does not
-    name are deleted.
+    name are deleted.  A heightmap terrain's image is written beside the scene where
+    the folder lacks it (`cloudcore.interop.heightmap.store_heightmap`), on the same rule.
     """
     path = Path(path)
     saved_clouds = tuple(
@@ -610,7 +641,11 @@ def save_scene(scene: Scene, path) -> Scene:
         else cloud
         for cloud in scene.clouds
     )
-    saved = dataclasses.replace(scene, clouds=saved_clouds)
+    terrain = scene.terrain
+    if terrain is not None and terrain.heights is not None:
+        stored = store_heightmap(terrain.heights.values, terrain.heightmap or "", path)
+        terrain = dataclasses.replace(terrain, heightmap=stored)
+    saved = dataclasses.replace(scene, clouds=saved_clouds, terrain=terrain)
     document = tomlkit.dumps(scene_to_dict(saved)).encode("utf-8")
     atomic_write(path, lambda f: f.write(document))
     remove_unnamed_particle_files(path, {c.particles_file for c in saved_clouds if c.particles_file is not None})

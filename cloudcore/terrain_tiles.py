@@ -1,10 +1,10 @@
 """The heightfield drawn as tiles whose cells grow with their distance from the eye: a quadtree chosen per eye.
 
 A tile is a square of `TILE_CELLS` x `TILE_CELLS` cells.  The finest tiles' cells are the heightfield's own
-spacing (`Terrain.size` over `Terrain.resolution`: the ground near the eye at full resolution), each level's
-cells twice its children's.  The root, centred on the origin, covers the drawn square (its half side the larger
-of `Terrain.reach` and the patch's half sides; vertices past it are pulled onto its edge), and a tile is split
-while the eye is nearer to it than `SPLIT_DISTANCE` of its sides.  A cell then spans a near constant angle
+spacing (`Terrain.size` over its samples, `terrain.finest_cell_m`: the ground near the eye at full resolution),
+each level's cells twice its children's.  The root, centred on the origin, covers the drawn square (its half
+side the larger of `Terrain.reach` and the patch's half sides; vertices past it are pulled onto its edge), and a
+tile is split while the eye is nearer to it than `SPLIT_DISTANCE` of its sides.  A cell then spans a near constant angle
 from the eye, and the tiles' count grows with the log of the reach, not its square.
 
 Neighbouring tiles of different levels meet along an edge that the coarser samples half as often.  Each tile
@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from cloudcore.scene import Terrain
-from cloudcore.terrain import height_at
+from cloudcore.terrain import finest_cell_m, height_at, highest_ground_m
 
 #: cells along a tile's side
 TILE_CELLS = 16
@@ -57,11 +57,10 @@ class TileFrame:
 def tile_frame(terrain: Terrain) -> TileFrame:
     """The frame of `terrain`'s tiles: the finest cell the heightfield's spacing, the root just covering the
     drawn square."""
-    cell = min(terrain.size) / (terrain.resolution - 1)
+    cell = finest_cell_m(terrain)
     half = max(terrain.reach, 0.5 * max(terrain.size))
     root_level = max(0, math.ceil(math.log2(2.0 * half / (TILE_CELLS * cell))))
-    # the highest the heightfield reaches (`height_at`: the hills' 1.05 height, the mountains' relief)
-    return TileFrame(cell, root_level, half, 1.05 * terrain.height + terrain.relief)
+    return TileFrame(cell, root_level, half, highest_ground_m(terrain))
 
 
 def leaf_tiles(frame: TileFrame, eye) -> np.ndarray:

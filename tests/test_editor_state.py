@@ -11,7 +11,7 @@ import pytest
 from app.editor import Editor, recovery_path
 from app.tools import ViewportTools
 from cloudcore.editing import add_cloud
-from cloudcore.scene import Cloud, Scene
+from cloudcore.scene import Camera, Cloud, Scene
 from cloudcore.scenefile import load_scene, save_scene
 
 
@@ -89,3 +89,39 @@ def test_opening_a_pipe_is_refused_instead_of_waiting_for_ever(tmp_path):
     editor = Editor(one_cloud_scene(), None)
     assert not editor.open_file(pipe)
     assert "not a regular file" in editor.messages[-1]
+
+
+def test_camera_keys_are_added_moved_and_deleted_as_undoable_edits_within_the_paths_rules():
+    """With no path, a key at the view makes one from the scene's camera; a move past a neighbour, a NaN time
+    and a delete leaving one key are messages, the scene kept; undo walks back every edit."""
+    editor = Editor(one_cloud_scene(), None)
+    editor.camera = Camera((100.0, 500.0, 900.0), (0.0, 800.0, 0.0))
+    assert editor.add_camera_key(4.0)
+    path = editor.scene.camera_path(editor.camera_path_name)
+    assert path.keys.tolist() == [[0.0, 0.0, 500.0, 3000.0, 0.0, 700.0, 0.0], [4.0, 100, 500, 900, 0, 800, 0]]
+    editor.camera = Camera((0.0, 600.0, 500.0), (0.0, 800.0, 0.0))
+    assert editor.add_camera_key(2.0)  # between the two: kept in time order
+    assert editor.scene.camera_path("path").keys[:, 0].tolist() == [0.0, 2.0, 4.0]
+    three = editor.scene
+    for refused in (lambda: editor.move_camera_key(1, 5.0), lambda: editor.move_camera_key(1, math.nan)):
+        assert not refused() and editor.scene is three
+    assert "key times must increase strictly" in editor.messages[-2] and "finite" in editor.messages[-1]
+    assert editor.move_camera_key(1, 3.0) and editor.delete_camera_key(0)
+    assert editor.scene.camera_path("path").keys[:, 0].tolist() == [3.0, 4.0]
+    assert not editor.delete_camera_key(0)
+    assert "a camera path needs at least 2 keys" in editor.messages[-1]
+    for _ in range(4):
+        editor.undo()
+    assert editor.scene.camera_paths == ()
+
+
+def test_a_camera_path_file_the_editor_cannot_import_is_a_message_and_the_scene_kept(tmp_path):
+    editor = Editor(one_cloud_scene(), None)
+    (tmp_path / "bad.csv").write_text("t,px,py,pz,lx,ly,lz\n0,0,0,0,1,0,0\n0,1,0,0,2,0,0\n")
+    before = editor.scene
+    assert not editor.import_camera_path(tmp_path / "bad.csv")
+    assert (
+        editor.scene is before and f"could not import: {tmp_path / 'bad.csv'}: keys: key times" in editor.messages[-1]
+    )
+    assert not editor.export_camera_path(tmp_path / "out.csv")
+    assert editor.messages[-1] == "the scene has no camera path to export" and not (tmp_path / "out.csv").exists()

@@ -61,7 +61,7 @@ LIMITS = [
         "terrain kind",
         '[terrain]\nkind = "mesh"\nmesh = "ground.obj"\n' + CLOUD,
         "terrain.kind",
-        "heightfield terrain only",
+        "heightmap terrain only",
         '[terrain]\nkind = "heightfield"\n' + CLOUD,
     ),
     (
@@ -174,7 +174,7 @@ def past_limit(name: str) -> Scene:
 #: what the renderer says past each limit it refuses or fails at, had the scene got that far
 RENDERER_REFUSALS = {
     "lights": f"at most {MAX_LIGHTS} lights",
-    "terrain kind": "heightfield terrain only",
+    "terrain kind": "heightmap terrain only",
     "shading groups": "too small for a cloud this large",
     "camera far out": "Singular matrix",  # the world pass inverts the view-projection
     "particle far out": "overflow",  # the shading's distances between particles

@@ -1,4 +1,5 @@
-"""`cloudview import FILE.vdb --out SCENE.toml`: each float grid of an OpenVDB file as a cloud of particles.
+"""`cloudview import FILE --out SCENE.toml`: each float grid of an OpenVDB file (.vdb) as a cloud of particles,
+or a camera path from a glTF (.gltf, .glb) or CSV file (`cloudcore.cli.camera_path_files`).
 
 The clouds are added to SCENE.toml where it exists, else a new scene is made that looks at them; their
 particles go into .npy files beside it.  One line per cloud says its particles and the density error the fit
@@ -13,7 +14,9 @@ from pathlib import Path
 
 import numpy as np
 
+from cloudcore.cli import camera_path_files
 from cloudcore.errors import SceneError
+from cloudcore.interop.camera_paths import CAMERA_PATH_SUFFIXES
 from cloudcore.interop.vdb_clouds import DEFAULT_PARTICLES, import_vdb_clouds
 from cloudcore.limits import scene_limit_problems
 from cloudcore.scene import Camera, Scene, splats_bounding_sphere
@@ -21,10 +24,21 @@ from cloudcore.scenefile import load_scene, save_scene
 
 
 def add_parser(commands) -> None:
-    parser = commands.add_parser("import", help="OpenVDB density grids as clouds of particles, into a scene")
-    parser.add_argument("vdb", type=Path, metavar="FILE.vdb", help="OpenVDB file: each float grid becomes a cloud")
+    parser = commands.add_parser(
+        "import", help="OpenVDB density grids as clouds of particles, or a glTF or CSV camera path, into a scene"
+    )
     parser.add_argument(
-        "--out", required=True, type=Path, metavar="SCENE.toml", help="scene to add the clouds to (made if missing)"
+        "vdb",
+        type=Path,
+        metavar="FILE",
+        help="OpenVDB file (.vdb: each float grid becomes a cloud), or a camera path (.gltf, .glb, .csv)",
+    )
+    parser.add_argument(
+        "--out",
+        required=True,
+        type=Path,
+        metavar="SCENE.toml",
+        help="scene to add the clouds or the camera path to (made if missing)",
     )
     parser.add_argument(
         "--particles",
@@ -41,6 +55,7 @@ def add_parser(commands) -> None:
         help="extinction (1/m) per unit of the file's density (default 1: the file holds extinction, "
         "as `cloudview export` writes it)",
     )
+    camera_path_files.add_import_arguments(parser)
     parser.set_defaults(run=run)
 
 
@@ -53,6 +68,11 @@ def particle_budget(text: str) -> int:
 
 
 def run(args) -> int:
+    if args.vdb.suffix.lower() in CAMERA_PATH_SUFFIXES:
+        return camera_path_files.run_import(args.vdb, args.out, args.name, args.look_distance)
+    if args.vdb.suffix.lower() != ".vdb":
+        known = ", ".join((".vdb", *CAMERA_PATH_SUFFIXES))
+        raise SceneError(str(args.vdb), "(file)", f"cloudview imports {known} files, told apart by their suffix")
     scene = load_scene(args.out) if args.out.exists() else None
     imported = import_vdb_clouds(
         args.vdb, args.particles, args.extinction, [cloud.name for cloud in scene.clouds] if scene else ()

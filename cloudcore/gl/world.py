@@ -31,6 +31,7 @@ from cloudcore.light.sky_background import SkyBackground
 from cloudcore.light.terrain_light import TerrainLight
 from cloudcore.limits import DRAWN_TERRAIN_KINDS
 from cloudcore.scene import Camera, Terrain
+from cloudcore.terrain import ground_colours
 from cloudcore.terrain_tiles import TILE_FACES, TILE_VERTICES, TerrainTiles, tile_faces
 
 #: the light shafts' depth of the terrain takes every 4th vertex of a tile's grid: the frames with it and with the
@@ -41,8 +42,9 @@ _VERTEX_FLOATS = 9
 
 
 def terrain_vertex_light(normals, base_colour, light: TerrainLight) -> tuple[np.ndarray, np.ndarray]:
-    """Linear RGB per vertex of unit `normals`: base * the sun's irradiance, and base * the rest (the sky's dome,
-    the ground's bounce, the floor), which `light` gives each normal."""
+    """Linear RGB per vertex of unit `normals` and `base_colour` (one, or one a vertex): base * the sun's
+    irradiance, and base * the rest (the sky's dome, the ground's bounce, the floor), which `light` gives each
+    normal."""
     base = np.asarray(base_colour, dtype=np.float64)
     return base * light.sun_irradiance(normals), base * light.unshadowed_irradiance(normals)
 
@@ -53,7 +55,7 @@ class TerrainMesh:
 
     def __init__(self, terrain: Terrain, light: TerrainLight):
         if terrain.kind not in DRAWN_TERRAIN_KINDS:  # the scene loader refuses these first (cloudcore.limits)
-            raise ValueError(f"the GL prototype draws heightfield terrain only, not {terrain.kind!r}")
+            raise ValueError(f"the GL prototype draws heightfield and heightmap terrain only, not {terrain.kind!r}")
         self._terrain, self._light = terrain, light
         self.tiles = TerrainTiles(terrain)
         self._programs: dict[tuple[bool, bool], int] = {}  # per (through the air, light shafts)
@@ -72,7 +74,8 @@ class TerrainMesh:
 
     def _upload(self) -> None:
         tiles = self.tiles
-        sun, sky = terrain_vertex_light(tiles.normals, self._terrain.color, self._light)
+        colours = ground_colours(self._terrain, tiles.positions, tiles.normals)
+        sun, sky = terrain_vertex_light(tiles.normals, colours, self._light)
         vertices = np.ascontiguousarray(np.concatenate([tiles.positions, sun, sky], axis=1), dtype=np.float32)
         GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self._vertex_buffer)
         GL.glBufferData(GL.GL_ARRAY_BUFFER, vertices.nbytes, vertices, GL.GL_STATIC_DRAW)

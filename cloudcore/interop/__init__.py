@@ -1,1 +1,1 @@
-"""Clouds in and out of the files other tools keep volumes in: OpenVDB density grids."""
+"""What comes in from and goes out to other tools' files: OpenVDB density grids, heightmaps, camera paths."""

@@ -49,15 +49,16 @@ def import_vdb_clouds(
     imported = []
     for grid, budget in zip(grids, budgets):
         fit = fit_particles(grid, int(budget), extinction_scale)
-        name = _free_name(grid.name or "vdb", taken)
+        name = free_name(grid.name or "vdb", taken)
         taken.add(name)
         cloud = Cloud(name=name, particles=fit.particles, optical_depth=fit.optical_depth)
         imported.append(ImportedCloud(cloud, fit, grid))
     return imported
 
 
-def _free_name(wanted: str, taken: set) -> str:
-    """`wanted` cut to a name's length, with a number after it where a cloud has that name already."""
+def free_name(wanted: str, taken) -> str:
+    """`wanted` cut to a name's length, with a number after it where something has that name already (a cloud,
+    a camera path: the names in `taken`)."""
     name = wanted[:MAX_NAME_LENGTH]
     number = 2
     while name in taken:
