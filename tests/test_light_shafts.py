@@ -119,7 +119,7 @@ def test_the_gl_march_is_numpys(renderer):
     scene = shaft_scene()
     renderer.render(scene, settings=FULL_3D, read_back=False)
     renderer.context.make_current()
-    march = renderer.light_shafts.read()
+    march = renderer.light_shafts.read(blurred=False)
     width, height = shaft_size(RENDER_WIDTH, RENDER_HEIGHT, SHAFT_REDUCTION)
     assert march.shape == (height, width, 4)
     centres, radii, _, _ = particles_of(scene.clouds)
@@ -142,6 +142,14 @@ def test_the_gl_march_is_numpys(renderer):
     assert np.abs(march[..., 3] - share).max() < 0.02
     taken = taken.reshape(height, width, 3)
     assert np.abs(march[..., :3] - taken).max() < 0.02 * taken.max()
+    # what the world reads: the march blurred by a 3x3 tent, its edges clamped
+    padded = np.pad(march, ((1, 1), (1, 1), (0, 0)), mode="edge")
+    tent = np.array([1.0, 2.0, 1.0])
+    blurred = (
+        sum(tent[dy] * tent[dx] * padded[dy : dy + height, dx : dx + width] for dy in range(3) for dx in range(3))
+        / 16.0
+    )
+    assert np.abs(renderer.light_shafts.read() - blurred).max() < 2e-3 * max(blurred.max(), 1.0)
 
 
 def frames_with_and_without_shafts(renderer, scene: Scene) -> dict[bool, np.ndarray]:

@@ -19,6 +19,7 @@ from cloudcore.scene import (
     CloudField,
     Lighting,
     Scene,
+    Terrain,
 )
 from cloudcore.settings import FULL_3D, RenderSettings
 
@@ -89,6 +90,33 @@ def test_flying_across_ring_boundaries_changes_the_picture_smoothly(own_renderer
     # auto mode draws the same field within a level of full 3D on the way
     auto = _flight_means(own_renderer[0], RenderSettings())
     assert np.abs(auto - full).max() < 1.0
+
+
+def test_a_field_s_shadows_on_the_ground_fade_in_and_out_with_its_clouds(own_renderer):
+    """Over a plain under the physical sky at 15:30 the field's shadows fall on the ground, and flying across the
+    rings' edges they fade with their clouds: the frame's mean steps at most 0.02 levels more than without them
+    (0.137 against 0.122 in steps of 40 m).  Shadows of whole clouds, blind to the blend weights, stepped it 0.47
+    levels as cells entered (`cloudcore.gl.shadow_map`)."""
+    renderer = own_renderer[0]
+    scene = Scene(
+        camera=ABOVE,
+        cloud_field=FIELD,
+        lighting=Lighting(time_of_day=15.5),
+        terrain=Terrain(size=(60000.0, 60000.0), resolution=129, height=1.0),
+    )
+    steps, frames = {}, {}
+    for shadows in (False, True):
+        settings = dataclasses.replace(FULL_3D, cloud_shadows=shadows)
+        means = []
+        for step in np.arange(0.0, 3.0, 0.1):
+            x = step * FIELD.cell_size
+            camera = dataclasses.replace(ABOVE, position=(x, 5000.0, 0.0), look_at=(x, 1200.0, -3000.0))
+            image = renderer.render(scene, camera=camera, settings=settings)[0].astype(float)
+            means.append(image.mean())
+            frames.setdefault(shadows, image)
+        steps[shadows] = np.abs(np.diff(means)).max()
+    assert frames[True].mean() < frames[False].mean() - 1.0  # shadows on the ground
+    assert steps[True] < steps[False] + 0.02
 
 
 EXTREMES = {

@@ -243,10 +243,9 @@ class FrameRenderer:
         camera = scene.camera if camera is None else camera
         authored_clouds = len(scene.clouds)
         scene, fade_keys = self._with_field(scene, camera)
-        illumination_ms = self._prepare(scene, lighting, illumination_method, settings.cloud_shadows, time_s)
+        illumination_ms = self._prepare(scene, lighting, illumination_method, settings.cloud_shadows, time_s, fade_keys)
         planning_started = time.perf_counter()
         particles = self._particles
-        particles.weigh(self._field_weights)
         poses = self._objects.poses(time_s) if self._objects is not None else ()
         starts = particles.cloud_starts
         cloud_keys, ring_keys = self._cloud_keys(scene, fade_keys, time_s)
@@ -410,18 +409,25 @@ class FrameRenderer:
         )
 
     def _prepare(
-        self, scene: Scene, lighting: Lighting, illumination_method: str, cloud_shadows: bool, time_s: float
+        self,
+        scene: Scene,
+        lighting: Lighting,
+        illumination_method: str,
+        cloud_shadows: bool,
+        time_s: float,
+        fade_keys: tuple,
     ) -> float:
         """Rebuild the world pass, the particle illumination and the clouds' transmittance map (at the scene clock
-        `time_s`, forming clouds as opaque as they are then) where their inputs changed; ms spent shading."""
+        `time_s`, forming clouds as opaque as they are then, a field's by their blend weights, whose steps
+        `fade_keys` are) where their inputs changed; ms spent shading."""
         lights, ambient = scene_lights(lighting)
         # a dragged slider's look (the editor's preview) draws the coarse sky, as its clouds are a coarse raster
         preview = illumination_method == PREVIEW_METHOD
-        # the clouds shadow the sun's (the first light's) beam where there are clouds and it shines; not a cloud
-        # field's: its clouds fade in and out by blend weights the map does not follow (their shadows would pop in
-        # whole: a step of 0.3 levels in the frame's mean as cells enter, tests/test_render_cloud_field.py)
-        cloud_shadows = cloud_shadows and scene.cloud_field is None
+        # the clouds shadow the sun's (the first light's) beam where there are clouds and it shines
         sun = shadowing_sun(lights) if cloud_shadows else None
+        # on one another too, but not a cloud field's: the light pass's part is made again for every new set of
+        # clouds, and a flight through a field brings one every few frames (`sun_through_others`, 100 ms)
+        cloud_shadows = cloud_shadows and scene.cloud_field is None
         world_source = (scene.terrain, lighting, preview)
         if world_source != self._world_source:
             self.context.make_current()
@@ -448,17 +454,19 @@ class FrameRenderer:
         illumination_ms = 0.0
         if particles_source != self._particles_source:
             illumination_ms = self._prepare_particles(scene, lights, ambient, particles_source)
+        self._particles.weigh(self._field_weights)
         self._shadows = None if sun is None or not scene.clouds else self.shadow_map
         if self._shadows is not None:
-            # made again only for another particle buffer, sun, size or state of the clouds' formations
-            # (`CloudShadowMap.update`): every frame while a cloud forms or dissipates, never while none does
+            # made again only for another particle buffer, sun or size, or when the clouds' opacities change: every
+            # frame while a cloud forms or dissipates, when a field's clouds' blend weights leave their steps (they
+            # fade in and out, their shadows with them), never while none does (`CloudShadowMap.update`)
             forming = tuple(formation_state(scene.clouds[index].formation, time_s) for index in self._forming_clouds)
             self.shadow_map.update(
                 self._particles,
                 sun,
                 PREVIEW_MAP_RESOLUTION if preview else MAP_RESOLUTION,
-                self._particles.formation_factors(time_s),
-                forming,
+                self._particles.opacity_factors(time_s),
+                (forming, fade_keys),
             )
             self.context.bind_target()
         return illumination_ms

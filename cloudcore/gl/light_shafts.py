@@ -41,8 +41,9 @@ class LightShaftPass:
         of the choice tries others: scripts/bench_light_shafts.py)."""
         self._steps, self._reduction = steps, reduction
         self._program = build_program("light_shafts", vertex="world")
+        self._blur_program = build_program("light_shafts_blur", vertex="world")
         self._depth = DepthTexture()
-        self._target: TextureTarget | None = None
+        self._targets: tuple[TextureTarget, TextureTarget] | None = None  # the march's, and its blurred
         # core profile draws nothing without a vertex array, even one with no attributes
         self._fullscreen_vertex_array = GL.glGenVertexArrays(1)
 
@@ -65,8 +66,8 @@ class LightShaftPass:
         self._depth.bind_cleared(size)
         if draw_terrain_depth is not None:
             draw_terrain_depth()
-        target = self._target_of(size)
-        target.bind()
+        march, blurred = self._targets_of(size)
+        march.bind()
         GL.glDisable(GL.GL_DEPTH_TEST)
         GL.glDisable(GL.GL_BLEND)
         program = self._program
@@ -85,30 +86,40 @@ class LightShaftPass:
         shadows.bind(program)
         GL.glBindVertexArray(self._fullscreen_vertex_array)
         GL.glDrawArrays(GL.GL_TRIANGLES, 0, 3)
+        blurred.bind()
+        GL.glUseProgram(self._blur_program)
+        GL.glBindTexture(GL.GL_TEXTURE_2D, march.texture)
+        GL.glDrawArrays(GL.GL_TRIANGLES, 0, 3)
         GL.glBindVertexArray(0)
         GL.glEnable(GL.GL_DEPTH_TEST)
 
     def bind(self) -> None:
         """Bind the last march's target for shaders/light_shafts_read.glsl."""
         GL.glActiveTexture(GL.GL_TEXTURE0 + SHAFTS_UNIT)
-        GL.glBindTexture(GL.GL_TEXTURE_2D, self._target.texture)
+        GL.glBindTexture(GL.GL_TEXTURE_2D, self._targets[1].texture)
         GL.glActiveTexture(GL.GL_TEXTURE0)
 
-    def read(self) -> np.ndarray:
-        """The last march's (height, width, 4) target, top row first: the air's light taken, its share (tests)."""
-        return self._target.read()
+    def read(self, blurred: bool = True) -> np.ndarray:
+        """The last march's (height, width, 4) target, top row first, blurred as the world reads it or not: the
+        air's light taken, its share (tests)."""
+        return self._targets[int(blurred)].read()
 
-    def _target_of(self, size: tuple[int, int]) -> TextureTarget:
-        if self._target is None or (self._target.width, self._target.height) != size:
-            if self._target is not None:
-                self._target.close()
-            self._target = TextureTarget(*size, GL.GL_RGBA16F)
-        return self._target
+    def _targets_of(self, size: tuple[int, int]) -> tuple[TextureTarget, TextureTarget]:
+        if self._targets is None or (self._targets[0].width, self._targets[0].height) != size:
+            self._close_targets()
+            self._targets = (TextureTarget(*size, GL.GL_RGBA16F), TextureTarget(*size, GL.GL_RGBA16F))
+        return self._targets
+
+    def _close_targets(self) -> None:
+        if self._targets is not None:
+            for target in self._targets:
+                target.close()
+        self._targets = None
 
     def close(self) -> None:
         """Free the GL objects (the context must be current)."""
         self._depth.close()
-        if self._target is not None:
-            self._target.close()
+        self._close_targets()
         GL.glDeleteProgram(self._program)
+        GL.glDeleteProgram(self._blur_program)
         GL.glDeleteVertexArrays(1, [self._fullscreen_vertex_array])
