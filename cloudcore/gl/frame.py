@@ -55,7 +55,7 @@ from cloudcore.gl.targets import TextureTarget, blit_depth, depth_renderbuffer
 from cloudcore.gl.volume_blending import GpuFeatures, VolumeBlendingPass
 from cloudcore.gl.world import WorldPass
 from cloudcore.light.air_between import air_between
-from cloudcore.light.cloud_shadows import MAP_RESOLUTION, PREVIEW_MAP_RESOLUTION
+from cloudcore.light.cloud_shadows import FIELD_MAP_RESOLUTION, MAP_RESOLUTION, PREVIEW_MAP_RESOLUTION
 from cloudcore.light.eye_scattering import ParticleBuffer
 from cloudcore.light.illumination import IlluminationCache, shadowing_sun
 from cloudcore.light.lighting import scene_lights
@@ -464,7 +464,7 @@ class FrameRenderer:
             self.shadow_map.update(
                 self._particles,
                 sun,
-                PREVIEW_MAP_RESOLUTION if preview else MAP_RESOLUTION,
+                PREVIEW_MAP_RESOLUTION if preview else FIELD_MAP_RESOLUTION if scene.cloud_field else MAP_RESOLUTION,
                 self._particles.opacity_factors(time_s),
                 (forming, fade_keys),
             )
