@@ -109,7 +109,7 @@ def scene_limit_problems(scene, unchanged=None) -> list[tuple[str, str]]:
             )
         )
     previous = {id(cloud) for cloud in unchanged.clouds} if unchanged is not None else set()
-    for key in ("camera", "lighting", "shading", "terrain", "objects", "camera_paths", "views", "cloud_field"):
+    for key in ("camera", "lighting", "shading", "terrain", "objects", "camera_paths", "views", "cloud_field", "wind"):
         problems.extend(_out_of_bounds(key, getattr(scene, key)))
     for i, cloud in enumerate(scene.clouds):
         if id(cloud) in previous:

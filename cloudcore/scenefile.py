@@ -44,6 +44,7 @@ from cloudcore.scene import (
     Shading,
     Terrain,
     View,
+    Wind,
 )
 from cloudcore.settings import MODES, RenderSettings, setting_options
 from cloudcore.toml_table import Table, checked_matrix, field_error
@@ -76,6 +77,7 @@ TABLE_KEYS = {
     "clouds.sprite": record_keys(SpriteStyle),
     "clouds.artist": record_keys(ArtistShading),
     "cloud_field": record_keys(CloudField),
+    "wind": record_keys(Wind),
     "terrain": record_keys(Terrain),
     # a mesh file's triangles are read from `mesh`, not written in the scene
     "objects": record_keys(SceneObject, leave_out=("vertices", "faces")),
@@ -127,6 +129,7 @@ def scene_from_dict(data: dict, source: str = "<scene>", base_dir=Path(".")) -> 
         description=root.string("description", ""),
         views=views,
         cloud_field=root.table("cloud_field", _cloud_field),
+        wind=root.table("wind", _wind),
     )
     # what every field allows, the renderer may still not draw: refuse that here, not in the GL code
     problems = scene_limit_problems(scene)
@@ -329,6 +332,17 @@ def _cloud_field(t: Table) -> CloudField:
     )
 
 
+def _wind(t: Table) -> Wind:
+    """`[wind]`: types here, ranges by the record itself (the editor's panel edits it too)."""
+    t.reject_unknown(TABLE_KEYS["wind"])
+    d = Wind()
+    return t.record(
+        Wind,
+        bands=tuple(map(tuple, t.matrix("bands", 3))) if t.has("bands") else d.bands,
+        **{name: t.number(name, getattr(d, name)) for name in record_keys(Wind, leave_out=("bands",))},
+    )
+
+
 def _formation(t: Table) -> Formation:
     t.reject_unknown(TABLE_KEYS["clouds.formation"])
     return Formation(
@@ -515,6 +529,8 @@ def scene_to_dict(scene: Scene) -> dict:
     data["clouds"] = [_cloud_dict(cloud) for cloud in scene.clouds]
     if scene.cloud_field is not None:
         data["cloud_field"] = _record_dict(scene.cloud_field)
+    if scene.wind is not None:
+        data["wind"] = _record_dict(scene.wind)
     data["objects"] = [_object_dict(o) for o in scene.objects]
     data["camera_paths"] = [{"name": p.name, "keys": _rows(p.keys)} for p in scene.camera_paths]
     data["views"] = [_view_dict(view) for view in scene.views]

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
+import math
 import os
 import platform
 import time
@@ -74,6 +75,7 @@ from cloudcore.measured_way import COMPOSITING_WAYS, MeasuredWay
 from cloudcore.scene import Camera, Lighting, Scene
 from cloudcore.settings import FULL_3D, RenderSettings
 from cloudcore.splat_coverage import analytic_overdraw
+from cloudcore.wind import AirMotion, CloudMotion, field_drift, light_time, shape_change_bound_m
 
 
 @dataclass(frozen=True)
@@ -164,6 +166,11 @@ class FrameRenderer:
         self._cloud_weights: np.ndarray | None = None
         self._units: LodUnits | None = None
         self._units_source = None
+        self._air: AirMotion | None = None  # the wind applied to the authored clouds (None: still air)
+        #: this frame's carried particles and units and the clouds' motion, and what they were made from
+        self._carry_source, self._carry_made = None, None
+        self._ring_drift = None  # (ring keys, clouds' drift steps, the keys with them) under wind
+        self._shadow_source = (None, MAP_RESOLUTION)  # the sun and the size of the clouds' transmittance map
         self._layer = None  # screen-sized, sharing the frame's depth: crossfading clouds' full-3D image
         self._inside = []  # (target, its depth renderbuffer) per screen impostor of a frame, all of one size
         self._overdraw_target = None
@@ -175,9 +182,9 @@ class FrameRenderer:
 
     @property
     def units(self) -> LodUnits:
-        """The units (clouds, or groups of interpenetrating clouds) of the scene last rendered; a frame may plan
-        some groups apart (`FramePlan.units`)."""
-        return self._units
+        """The units (clouds, or groups of interpenetrating clouds) of the scene last rendered, where the wind
+        had carried them; a frame may plan some groups apart (`FramePlan.units`)."""
+        return self._units if self._carry_made is None else self._carry_made[1]
 
     @property
     def volume_features(self) -> GpuFeatures:
@@ -236,20 +243,26 @@ class FrameRenderer:
         )
         camera = scene.camera if camera is None else camera
         authored_clouds = len(scene.clouds)
-        scene, fade_keys = self._with_field(scene, camera)
+        air = self._air_motion(scene)
+        if air is not None:  # the clouds as their light is made now: at rest, while the wind only carries them
+            scene = dataclasses.replace(scene, clouds=air.lit_clouds(time_s))
+        field_carried = field_drift(scene.wind, scene.cloud_field, time_s)
+        scene, fade_keys = self._with_field(scene, camera, field_carried)
         illumination_ms = self._prepare(scene, lighting, illumination_method, settings.cloud_shadows)
+        # the units follow the particles' places and sizes, not their light: a relit scene keeps them
+        if (scene.clouds, settings.group_clouds) != self._units_source:
+            self._units = lod_units(self._particles, settings.group_clouds, authored_clouds)
+            self._units_source = (scene.clouds, settings.group_clouds)
+        particles, units, motion = self._carried(air, field_carried, time_s)
+        illumination_ms += self._update_shadows(particles)
         planning_started = time.perf_counter()
-        particles = self._particles
         particles.weigh(self._field_weights)
         poses = self._objects.poses(time_s) if self._objects is not None else ()
         starts = particles.cloud_starts
         cloud_keys, ring_keys = self._cloud_keys(scene, fade_keys, time_s)
-        # the units follow the particles' places and sizes, not their light: a relit scene keeps them
-        if (scene.clouds, settings.group_clouds) != self._units_source:
-            self._units = lod_units(particles, settings.group_clouds, authored_clouds)
-            self._units_source = (scene.clouds, settings.group_clouds)
+        ring_keys = self._ring_keys_under_wind(ring_keys, motion, settings)
         plan = plan_frame(
-            self._units,
+            units,
             camera,
             self.size,
             settings,
@@ -263,6 +276,7 @@ class FrameRenderer:
                 particles.radii[starts[cloud] : starts[cloud + 1]],
             ),
             ring_keys,
+            motion,
         )
         self.last_plan = plan
 
@@ -386,13 +400,16 @@ class FrameRenderer:
             held += target.nbytes if target is not None else 0
         return held
 
-    def _with_field(self, scene: Scene, camera: Camera) -> tuple[Scene, tuple]:
+    def _with_field(self, scene: Scene, camera: Camera, carried: np.ndarray) -> tuple[Scene, tuple]:
         """The scene with its cloud field's clouds for this eye after its own (`cloudcore.field.state`), and
-        per cloud the key of its blend weights; the field's weights are held for the particle buffer."""
+        per cloud the key of its blend weights; the field's weights are held for the particle buffer.  The field's
+        grid has drifted `carried` (3,) metres with the wind: its cells are made and weighed for the eye's place
+        relative to the air, where the particle buffer's carry (`_carried`) then moves them."""
         if scene.cloud_field is None:
             self.field_state, self._field_weights, self._cloud_weights = FieldState(), None, None
             return scene, (1.0,) * len(scene.clouds)
-        frame, self.field_state = update_field(scene.cloud_field, camera.position, self.field_state)
+        eye_in_air = np.asarray(camera.position, dtype=np.float64) - carried
+        frame, self.field_state = update_field(scene.cloud_field, eye_in_air, self.field_state)
         authored = scene.particle_count
         self._field_weights = np.concatenate([np.ones(authored), frame.weights])
         self._cloud_weights = np.concatenate([np.ones(len(scene.clouds)), frame.mean_weights])
@@ -436,11 +453,72 @@ class FrameRenderer:
         if particles_source != self._particles_source:
             illumination_ms = self._prepare_particles(scene, lights, ambient, particles_source)
         self._shadows = None if sun is None or not scene.clouds else self.shadow_map
-        if self._shadows is not None:
-            # made again only for another particle buffer, sun or size (`CloudShadowMap.update`)
-            self.shadow_map.update(self._particles, sun, PREVIEW_MAP_RESOLUTION if preview else MAP_RESOLUTION)
-            self.context.bind_target()
+        self._shadow_source = (sun, PREVIEW_MAP_RESOLUTION if preview else MAP_RESOLUTION)
         return illumination_ms
+
+    def _update_shadows(self, particles: ParticleBuffer) -> float:
+        """Make the clouds' transmittance map again for another particle buffer, sun or size (`CloudShadowMap.update`):
+        each frame the wind moves the clouds; ms spent."""
+        if self._shadows is None:
+            return 0.0
+        start = time.perf_counter()
+        self.shadow_map.update(particles, *self._shadow_source)
+        self.context.bind_target()
+        return 1e3 * (time.perf_counter() - start)
+
+    def _air_motion(self, scene: Scene) -> AirMotion | None:
+        """The wind applied to the scene's authored clouds (`cloudcore.wind.AirMotion`), made again for other
+        clouds or another wind; None in still air."""
+        if scene.wind is None:
+            self._air = None
+        elif self._air is None or self._air.wind != scene.wind or self._air.clouds is not scene.clouds:
+            self._air = AirMotion(scene.wind, scene.clouds)
+        return self._air
+
+    def _carried(
+        self, air: AirMotion | None, field_carried: np.ndarray, time_s: float
+    ) -> tuple[ParticleBuffer, LodUnits, CloudMotion | None]:
+        """(the particle buffer, the units, what the wind did to each cloud) at `time_s`: the buffer whose light was
+        made for the clouds' shapes now (`AirMotion.lit_clouds`) with every particle carried on to its place now,
+        and the units with it (the same arrays moved: no loop over clouds), the authored clouds by `air`, a field's
+        by its grid's drift `field_carried` (`air` is None only in still air: the buffer and units themselves)."""
+        lit, units = self._particles, self._units
+        if air is None:
+            self._carry_source = self._carry_made = None
+            return lit, units, None
+        source = (lit, units, time_s, tuple(field_carried))
+        held = self._carry_source
+        if held is not None and held[0] is lit and held[1] is units and held[2:] == source[2:]:
+            return self._carry_made
+        authored = len(air.clouds)
+        field_drifts = np.tile(field_carried, (len(lit.cloud_starts) - 1 - authored, 1))
+        field_particles = len(lit.radii) - int(lit.cloud_starts[authored])
+        offsets = np.concatenate([air.carry(time_s), np.tile(field_carried, (field_particles, 1))])
+        drifts = np.concatenate([air.drifts(time_s), field_drifts])
+        # the authored clouds' light was made where they were at `light_time`: their buffer carries them on from there
+        shifts = np.concatenate([air.drifts(time_s) - air.drifts(light_time(air.wind, time_s)), field_drifts])
+        grown = shape_change_bound_m(air.wind, math.inf)
+        self._carry_source = source
+        self._carry_made = (
+            lit.carried(offsets, shifts, grown),
+            units.moved(shifts, grown),
+            CloudMotion(drifts, time_s, air.wind),
+        )
+        return self._carry_made
+
+    def _ring_keys_under_wind(self, ring_keys: tuple, motion: CloudMotion | None, settings: RenderSettings) -> tuple:
+        """Wang's ring's panels stand where their clouds were when they were built: under wind a cloud's ring key
+        changes each time it has drifted another rebuild distance (`ring_rebuild_horizontal` of `ring_radius`), the
+        bound the ring keeps on the eye's own steps, and the ring is built again.  The same tuple while no cloud
+        crossed a step."""
+        if motion is None or not math.isfinite(settings.ring_radius):
+            return ring_keys
+        steps = np.floor(motion.drifts / (settings.ring_rebuild_horizontal * settings.ring_radius)).astype(np.int64)
+        held = self._ring_drift
+        if held is None or held[0] is not ring_keys or not np.array_equal(held[1], steps):
+            keys = tuple((*key, tuple(step)) for key, step in zip(ring_keys, steps.tolist()))
+            self._ring_drift = (ring_keys, steps, keys)
+        return self._ring_drift[2]
 
     def _prepare_particles(self, scene: Scene, lights, ambient, particles_source: tuple) -> float:
         """Make the particle buffer (the clouds' light) again for `particles_source` (the clouds, shading,
@@ -729,6 +807,7 @@ class FrameRenderer:
         images, corners, extents, made_at = self._impostors.cloud_impostors(
             [(cloud.members, item.layer) for cloud, item in zip(clouds, items)]
         )
+        corners = corners + frame.plan.impostor_shifts([item.index for item in items])[:, None, :]
         faded = self._faded([cloud.members for cloud in clouds], made_at)
         weights = np.array([cloud.impostor_weight for cloud in clouds]) * faded
         for _, run in itertools.groupby(range(len(images)), key=lambda i: id(images[i].atlas)):  # one atlas a run
@@ -752,6 +831,7 @@ class FrameRenderer:
         """A unit between its impostor and full 3D: its splats (`batch`) into a screen layer, mixed with the
         impostor."""
         image, corners, extent, made_at = self._impostors.cloud_impostor(cloud.members, item.layer)
+        corners = corners + frame.plan.impostor_shifts([item.index])[0]
         faded = self._faded([cloud.members], np.array([made_at]))
         layer = self._screen_layer()
         layer.bind_cleared()

@@ -87,6 +87,7 @@ from cloudcore.lod.units import LodUnits
 from cloudcore.scene import Camera
 from cloudcore.settings import RenderSettings
 from cloudcore.splat_coverage import splats_in_view
+from cloudcore.wind import CloudMotion
 
 
 def plan_frame(
@@ -101,6 +102,7 @@ def plan_frame(
     costs: CostModel | None = None,
     cloud_splats=None,
     ring_keys: tuple | None = None,
+    motion: CloudMotion | None = None,
 ) -> FramePlan:
     """Plan one frame of `units` (`cloudcore.lod.units.LodUnits`) seen by `camera`.
 
@@ -114,7 +116,9 @@ def plan_frame(
     `ring_keys`, per cloud, is what Wang's ring goes stale by where that is less than `lighting_key`: a cloud
     field's blend weights follow the eye's place, as parallax does, so the ring's rebuild distance bounds their
     change in its panels, while a key that changed with them rebuilt a field's ring every frame (None: the
-    lighting keys).
+    lighting keys).  `motion` (`cloudcore.wind.CloudMotion`) is what the wind has done to the clouds: an
+    impostor follows its unit's drift, and its error counts the unit's motion and change since it was made
+    (`held_impostor_errors`); None: still air.
     """
     scene_particles = float(np.sum(units.particle_counts))
     if state.frame_times and not comparable(state.particles, scene_particles):
@@ -133,6 +137,7 @@ def plan_frame(
             costs,
             cloud_splats,
             ring_keys,
+            motion,
         )
         drawn = {full_plan.clouds.members[i]: Representation("full", 1.0) for i in full_plan.clouds.indices_of("full")}
         return dataclasses.replace(
@@ -164,6 +169,7 @@ def plan_frame(
         "costs": costs,
         "cloud_splats": cloud_splats,
         "ring_keys": ring_keys,
+        "motion": motion,
     }
     if not groups_may_open:
         return _plan_units(units, frozenset(), **arguments)
@@ -194,6 +200,7 @@ def _plan_units(
     costs: CostModel,
     cloud_splats,
     ring_keys: tuple | None,
+    motion: CloudMotion | None,
 ) -> FramePlan:
     """`plan_frame` with the groups `opened` planned apart, their clouds each a unit of its own; `pricing` is
     `pricing_of`'s, `seen` the `seen_from` of the units (of `LodUnits.and_clouds` when groups may be opened)."""
@@ -226,6 +233,7 @@ def _plan_units(
         seen.lifetimes,
     )
     cloud_keys = lighting_key if isinstance(lighting_key, tuple) else (lighting_key,) * sum(map(len, units.members))
+    unit_drifts = None if motion is None else units.member_means(motion.drifts)
 
     def unit_key(index: int) -> tuple:
         """What the colours of unit `index` were computed from: its clouds' keys."""
@@ -421,7 +429,9 @@ def _plan_units(
         if members in units.row_of and individuals[units.row_of[members]] > 0.0
     }
     held_errors = (
-        held_impostor_errors(units, drawable, records, translation_error, eye) if settings.mode != "full" else None
+        held_impostor_errors(units, drawable, records, translation_error, eye, motion, unit_drifts)
+        if settings.mode != "full"
+        else None
     )
     eye_in = distances[drawable] < INSIDE_RADII * radii[drawable]
     holders, outside = drawable[eye_in], drawable[~eye_in]  # the units the eye is in; those that may be impostors
@@ -575,6 +585,8 @@ def _plan_units(
                 split_distances.get(index, ()),
                 split_objects.get(index, ()),
                 content_depth(centres[index], radii[index], eye, *splats_of(index)) if cloud_splats else None,
+                (0.0, 0.0, 0.0) if unit_drifts is None else tuple(float(v) for v in unit_drifts[index]),
+                0.0 if motion is None else motion.time_s,
             )
         reason = reasons.get(index)
         if reason is not None:
@@ -672,4 +684,5 @@ def _plan_units(
         tolerance_deg=tolerance,
         accepted_error=accepted,
         units=units,
+        unit_drifts=unit_drifts,
     )

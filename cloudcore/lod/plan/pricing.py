@@ -276,21 +276,36 @@ def impostor_ms_of(units: LodUnits, seen: Seen, chosen, focal_px, settings, cost
     return costs.quad_pixels * seen.quad_pixels[chosen] + costs.quads + remake / np.maximum(seen.lifetimes[chosen], 1.0)
 
 
-def held_impostor_errors(units: LodUnits, drawable, records: Mapping, translation_error, eye) -> np.ndarray:
+def held_impostor_errors(
+    units: LodUnits, drawable, records: Mapping, translation_error, eye, motion=None, unit_drifts=None
+) -> np.ndarray:
     """Per unit, the translation error of the impostor held (inf: none), measured for the units `drawable` (the
     rest are not drawn on their own: out of view, or in the ring); the parallax between the near and far points
-    of what it holds (`ImpostorRecord.content`) where the record has them."""
+    of what it holds (`ImpostorRecord.content`) where the record has them.
+
+    Under wind (`motion`, a `cloudcore.wind.CloudMotion`, and `unit_drifts` (units, 3) now) a unit's drift since
+    its impostor was made is an eye's step the other way, measured as one; the most turbulence may have moved a
+    particle within it since then, seen from the eye at the sphere's near side, is added in degrees."""
     rows = [row for row in drawable.tolist() if units.members[row] in records]
     errors = np.full(len(units.members), math.inf)
     if not rows:
         return errors
     held = [records[units.members[index]] for index in rows]
     centres, radii = units.centres[rows], units.radii[rows]
+    eyes_now = np.asarray(eye, dtype=np.float64)
+    if unit_drifts is not None:
+        shifts = unit_drifts[rows] - np.array([record.drift for record in held], dtype=np.float64)
+        eyes_now = eyes_now - shifts
+        centres = centres - shifts
     if translation_error is parallax_errors_deg:
         centres = np.array([c if h.content is None else h.content[0] for c, h in zip(centres, held)], dtype=np.float64)
         radii = np.array([r if h.content is None else h.content[1] for r, h in zip(radii, held)], dtype=np.float64)
     eyes = np.array([record.eye for record in held], dtype=np.float64)
-    errors[rows] = np.nan_to_num(translation_error(centres, radii, eyes, eye), nan=math.inf)
+    errors[rows] = np.nan_to_num(translation_error(centres, radii, eyes, eyes_now), nan=math.inf)
+    if motion is not None:
+        changed = motion.shape_change_m([record.made_at_s for record in held])
+        gaps = np.linalg.norm(units.centres[rows] - np.asarray(eye, dtype=np.float64), axis=1) - units.radii[rows]
+        errors[rows] += np.degrees(np.arctan2(changed, np.maximum(gaps, 0.0)))
     return errors
 
 
