@@ -285,7 +285,7 @@ class FrameRenderer:
         self._last_matrices = view, projection
         # in the editor's context the GUI leaves its scissor rectangle on, which would clip our targets
         GL.glDisable(GL.GL_SCISSOR_TEST)
-        for start, facing in self._facings.update(camera.position):
+        for start, facing in self._facings.update(camera.position, particles):
             self._splats.update_facing(particles, start, facing)
         before_passes_ms = 1e3 * (time.perf_counter() - planning_started)
         self._splats.particles_as_points = 0
