@@ -11,6 +11,7 @@ import pytest
 
 from cloudcore.errors import FieldError, SceneError
 from cloudcore.field.state import update_field
+from cloudcore.light.cloud_shadows import light_space
 from cloudcore.lod.impostors import ImpostorRecord, parallax_errors_deg
 from cloudcore.lod.plan.pricing import held_impostor_errors
 from cloudcore.lod.units import LodUnits
@@ -268,3 +269,15 @@ def test_the_record_refuses_what_the_file_would_so_the_editor_s_edits_are_checke
 
 def test_a_scene_dict_without_wind_has_still_air():
     assert scene_from_dict({}).wind is None
+
+
+def test_the_ground_s_shadow_map_moves_with_clouds_all_drifting_alike():
+    rng = np.random.default_rng(8)
+    centres, radii = rng.normal(size=(300, 3)) * 400.0 + [0.0, 1500.0, 0.0], rng.uniform(40.0, 90.0, 300)
+    sun = (0.3, 0.8, -0.52)
+    shift = np.array([640.0, 0.0, -210.0])
+    space = light_space(centres, radii, sun, 256)
+    ground = rng.uniform(-3000.0, 3000.0, size=(50, 3)) * [1.0, 0.0, 1.0]
+    # a point under the moved clouds reads the texel and slice its place less the shift read under them at rest
+    for moved, at_rest in zip(space.moved(shift).texel_coordinates(ground + shift), space.texel_coordinates(ground)):
+        np.testing.assert_allclose(moved, at_rest, atol=1e-9)

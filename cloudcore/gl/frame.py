@@ -75,7 +75,7 @@ from cloudcore.measured_way import COMPOSITING_WAYS, MeasuredWay
 from cloudcore.scene import Camera, Lighting, Scene
 from cloudcore.settings import FULL_3D, RenderSettings
 from cloudcore.splat_coverage import analytic_overdraw
-from cloudcore.wind import AirMotion, CloudMotion, field_drift, light_time, shape_change_bound_m
+from cloudcore.wind import AirMotion, CloudMotion, field_drift, light_time, reshapes, shape_change_bound_m
 
 
 @dataclass(frozen=True)
@@ -254,7 +254,7 @@ class FrameRenderer:
             self._units = lod_units(self._particles, settings.group_clouds, authored_clouds)
             self._units_source = (scene.clouds, settings.group_clouds)
         particles, units, motion = self._carried(air, field_carried, time_s)
-        illumination_ms += self._update_shadows(particles)
+        illumination_ms += self._update_shadows(particles, motion)
         planning_started = time.perf_counter()
         particles.weigh(self._field_weights)
         poses = self._objects.poses(time_s) if self._objects is not None else ()
@@ -456,13 +456,17 @@ class FrameRenderer:
         self._shadow_source = (sun, PREVIEW_MAP_RESOLUTION if preview else MAP_RESOLUTION)
         return illumination_ms
 
-    def _update_shadows(self, particles: ParticleBuffer) -> float:
-        """Make the clouds' transmittance map again for another particle buffer, sun or size (`CloudShadowMap.update`):
-        each frame the wind moves the clouds; ms spent."""
+    def _update_shadows(self, particles: ParticleBuffer, motion: CloudMotion | None) -> float:
+        """Make the clouds' transmittance map again for another particle buffer, sun or size (`CloudShadowMap.update`);
+        ms spent.  A wind that moves every cloud alike moves the map made of their buffer at rest with them; one that
+        changes them otherwise makes it again each frame, of the particles where they are (`particles`)."""
         if self._shadows is None:
             return 0.0
         start = time.perf_counter()
-        self.shadow_map.update(particles, *self._shadow_source)
+        if motion is not None and not reshapes(motion.wind):
+            self.shadow_map.update(self._particles, *self._shadow_source, motion.drifts[0])
+        else:
+            self.shadow_map.update(particles, *self._shadow_source)
         self.context.bind_target()
         return 1e3 * (time.perf_counter() - start)
 
