@@ -27,7 +27,7 @@ from cloudcore.measure.imagecompare import compare
 from cloudcore.measure.overlays import to_pixels
 from cloudcore.navigation import orbited
 from cloudcore.paths import camera_on_path
-from cloudcore.scene import CloudField, Wind
+from cloudcore.scene import CloudField, Weather, Wind
 from cloudcore.scenefile import load_scene, save_scene
 from cloudcore.settings import RenderSettings
 
@@ -751,6 +751,13 @@ def the_cloud_field_panel_edits_the_field(ctx, app: EditorUnderTest):
     target = app.results_path.with_name("field_saved_by_gui.toml")
     CHECK(app.editor.save(target))
     CHECK(load_scene(target).cloud_field == field and "[cloud_field]" in target.read_text())
+    use_window(ctx, "Cloud field")
+    ctx.combo_click("Weather/broken")  # a named weather sets the field's coverage, type and altitudes
+    CHECK(app.editor.scene.weather == Weather("broken"))
+    ctx.yield_(SETTLE)
+    CHECK(abs(app.viewport.renderer.field_state.field.coverage - 0.7) < 1e-9)
+    undo(ctx)
+    CHECK(app.editor.scene.weather is None)
     for _ in range(4):  # the rings, the time of day, the rings again, the cloud type
         undo(ctx)
     CHECK(app.editor.scene.cloud_field.cloud_type == "cumulus_humilis")

@@ -108,8 +108,21 @@ def scene_limit_problems(scene, unchanged=None) -> list[tuple[str, str]]:
                 f"the renderer draws {' or '.join(DRAWN_TERRAIN_KINDS)} terrain only, not {scene.terrain.kind!r}",
             )
         )
+    if scene.weather is not None and scene.cloud_field is None:
+        problems.append(("weather", "a weather sets a cloud field's coverage: the scene has no [cloud_field]"))
     previous = {id(cloud) for cloud in unchanged.clouds} if unchanged is not None else set()
-    for key in ("camera", "lighting", "shading", "terrain", "objects", "camera_paths", "views", "cloud_field", "wind"):
+    for key in (
+        "camera",
+        "lighting",
+        "shading",
+        "terrain",
+        "objects",
+        "camera_paths",
+        "views",
+        "cloud_field",
+        "wind",
+        "weather",
+    ):
         problems.extend(_out_of_bounds(key, getattr(scene, key)))
     for i, cloud in enumerate(scene.clouds):
         if id(cloud) in previous:

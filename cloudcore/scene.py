@@ -374,6 +374,36 @@ class Wind:
             object.__setattr__(self, name, value)
 
 
+#: the named weathers of `[weather]` (`cloudcore.weather.WEATHER_PRESETS` holds what each sets)
+WEATHER_NAMES = ("fair_weather_cumulus", "scattered", "broken", "overcast")
+
+
+@dataclass(frozen=True)
+class Weather:
+    """A named weather over a scene's cloud field (`cloudcore.weather`): `preset` sets its coverage, cloud type and
+    altitudes; with `to`, the weather changes to that one over `duration_s` seconds of the scene clock from
+    `start_s`, the coverage following a smoothstep between the two."""
+
+    preset: str = "scattered"
+    to: str | None = None
+    start_s: float = 0.0
+    duration_s: float = 600.0
+
+    def __post_init__(self):
+        for name in ("preset", "to"):
+            value = getattr(self, name)
+            if (value is not None or name == "preset") and value not in WEATHER_NAMES:
+                raise FieldError(name, f"{value!r} is not one of: {', '.join(WEATHER_NAMES)}")
+        for name, low, high in (("start_s", -1.0e9, 1.0e9), ("duration_s", 1.0, 86400.0)):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+                raise FieldError(name, f"expected a number, got {value!r}")
+            value = float(value)
+            if not low <= value <= high:  # NaN fails too
+                raise FieldError(name, f"must be within [{low:g}, {high:g}], got {value}")
+            object.__setattr__(self, name, value)
+
+
 @dataclass(frozen=True)
 class Scene:
     camera: Camera = Camera()
@@ -390,6 +420,8 @@ class Scene:
     cloud_field: CloudField | None = None
     #: the air's motion (`[wind]`): the clouds drift and churn with the scene clock; None: still air
     wind: Wind | None = None
+    #: named weather over the cloud field (`[weather]`), changing with the scene clock; None: the field's own keys
+    weather: Weather | None = None
 
     @property
     def particle_count(self) -> int:

@@ -44,6 +44,7 @@ from cloudcore.scene import (
     Shading,
     Terrain,
     View,
+    Weather,
     Wind,
 )
 from cloudcore.settings import MODES, RenderSettings, setting_options
@@ -78,6 +79,7 @@ TABLE_KEYS = {
     "clouds.artist": record_keys(ArtistShading),
     "cloud_field": record_keys(CloudField),
     "wind": record_keys(Wind),
+    "weather": record_keys(Weather),
     "terrain": record_keys(Terrain),
     # a mesh file's triangles are read from `mesh`, not written in the scene
     "objects": record_keys(SceneObject, leave_out=("vertices", "faces")),
@@ -130,6 +132,7 @@ def scene_from_dict(data: dict, source: str = "<scene>", base_dir=Path(".")) -> 
         views=views,
         cloud_field=root.table("cloud_field", _cloud_field),
         wind=root.table("wind", _wind),
+        weather=root.table("weather", _weather),
     )
     # what every field allows, the renderer may still not draw: refuse that here, not in the GL code
     problems = scene_limit_problems(scene)
@@ -343,6 +346,19 @@ def _wind(t: Table) -> Wind:
     )
 
 
+def _weather(t: Table) -> Weather:
+    """`[weather]`: types here, names and ranges by the record itself (the editor's combo sets it too)."""
+    t.reject_unknown(TABLE_KEYS["weather"])
+    d = Weather()
+    return t.record(
+        Weather,
+        preset=t.string("preset", d.preset),
+        to=t.string("to") if t.has("to") else None,
+        start_s=t.number("start_s", d.start_s),
+        duration_s=t.number("duration_s", d.duration_s),
+    )
+
+
 def _formation(t: Table) -> Formation:
     t.reject_unknown(TABLE_KEYS["clouds.formation"])
     return Formation(
@@ -531,6 +547,8 @@ def scene_to_dict(scene: Scene) -> dict:
         data["cloud_field"] = _record_dict(scene.cloud_field)
     if scene.wind is not None:
         data["wind"] = _record_dict(scene.wind)
+    if scene.weather is not None:
+        data["weather"] = {k: v for k, v in _record_dict(scene.weather).items() if v is not None}
     data["objects"] = [_object_dict(o) for o in scene.objects]
     data["camera_paths"] = [{"name": p.name, "keys": _rows(p.keys)} for p in scene.camera_paths]
     data["views"] = [_view_dict(view) for view in scene.views]

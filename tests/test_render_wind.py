@@ -9,7 +9,7 @@ import pytest
 from cloudcore.artist.cloudgen import preset_cloud
 from cloudcore.gl.frame import FrameRenderer
 from cloudcore.light.illumination import IlluminationCache
-from cloudcore.scene import Camera, Scene, Wind
+from cloudcore.scene import Camera, CloudField, Scene, Weather, Wind
 from cloudcore.settings import FULL_3D, RenderSettings
 from cloudcore.wind import drift
 
@@ -112,3 +112,29 @@ def test_a_drift_keeps_the_light_and_turbulence_relights_at_its_period(still):
             shaded.append(cache.shaded - every)
         # the first period's light is the clouds' at rest (held from above); then once a period, both clouds
         assert shaded == [0, 0, 0, every, every, 2 * every]
+
+
+def test_a_field_drifts_with_the_air_its_cells_kept_and_a_change_of_weather_remakes_it_in_steps():
+    field = CloudField(seed=2, coverage=0.5, cell_size=600.0, rings=1)
+    scene = Scene(camera=Camera((0.0, 1500.0, 0.0), (0.0, 1800.0, -3000.0), 60.0), cloud_field=field, wind=WIND)
+    with FrameRenderer(96, 72) as renderer:
+        renderer.render(scene, settings=FULL_3D)
+        slots, cells = renderer.field_state.slots, dict(renderer.field_state.cells)
+        rest = renderer.units.centres.copy()
+        # 200 m east: the eye's place relative to the air moved 200 m west, as if it had flown there; the cells that
+        # stay are the very clouds (their light kept) in their places, carried 200 m
+        renderer.render(scene, settings=FULL_3D, time_s=20.0)
+        kept = [i for i, key in enumerate(renderer.field_state.slots) if i < len(slots) and key == slots[i] and key]
+        assert len(kept) > 10
+        assert all(renderer.field_state.cells[slots[i]] is cells[slots[i]] for i in kept)
+        np.testing.assert_allclose(
+            renderer.units.centres[kept] - rest[kept], np.tile([200.0, 0.0, 0.0], (len(kept), 1)), atol=1e-6
+        )
+        changing = dataclasses.replace(
+            scene, wind=None, weather=Weather("scattered", to="overcast", start_s=0.0, duration_s=100.0)
+        )
+        coverages = []
+        for time_s in (0.0, 25.0, 50.0, 75.0, 100.0):
+            renderer.render(changing, settings=FULL_3D, time_s=time_s)
+            coverages.append(renderer.field_state.field.coverage)
+        np.testing.assert_allclose(coverages, [0.4, 0.5, 0.7, 0.85, 0.95], atol=1e-9)

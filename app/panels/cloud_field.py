@@ -17,7 +17,16 @@ from app.editor import Editor
 from app.panels.widgets import ReleasedSliders
 from app.viewport import Viewport
 from cloudcore.artist.cloudgen import PRESETS
-from cloudcore.scene import MAX_LAYERS, MAX_RINGS, MAX_TURBULENCE_M, MAX_WIND_SPEED, CloudField, Wind
+from cloudcore.scene import (
+    MAX_LAYERS,
+    MAX_RINGS,
+    MAX_TURBULENCE_M,
+    MAX_WIND_SPEED,
+    WEATHER_NAMES,
+    CloudField,
+    Weather,
+    Wind,
+)
 
 #: the float sliders: label -> (field, index in a pair or None, low, high, format)
 _SLIDERS = {
@@ -109,6 +118,15 @@ class CloudFieldPanel:
             value = self._sliders.slider_int(label, getattr(field, name), 1, high)
             if value is not None:
                 changes[name] = value
+        weather = editor.scene.weather
+        choice = 0 if weather is None else 1 + WEATHER_NAMES.index(weather.preset)
+        changed, choice = imgui.combo("Weather", choice, ["the field's own", *WEATHER_NAMES])
+        if changed:
+            editor.edit(
+                dataclasses.replace(editor.scene, weather=None if choice == 0 else Weather(WEATHER_NAMES[choice - 1]))
+            )
+        if weather is not None:
+            imgui.text_wrapped("The weather sets the coverage, cloud type and altitudes.")
         changed, type_index = imgui.combo("Cloud type", _CLOUD_TYPES.index(field.cloud_type), list(_CLOUD_TYPES))
         if changed:
             changes["cloud_type"] = _CLOUD_TYPES[type_index]
@@ -121,5 +139,5 @@ class CloudFieldPanel:
             imgui.text(
                 f"{len(cells)} cells made, {len(clouds)} cloudy, {sum(len(c.particles) for c in clouds)} particles"
             )
-        if imgui.button("Remove cloud field"):
-            editor.edit(dataclasses.replace(editor.scene, cloud_field=None))
+        if imgui.button("Remove cloud field"):  # its weather with it: a weather without a field is refused
+            editor.edit(dataclasses.replace(editor.scene, cloud_field=None, weather=None))

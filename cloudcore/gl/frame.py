@@ -75,6 +75,7 @@ from cloudcore.measured_way import COMPOSITING_WAYS, MeasuredWay
 from cloudcore.scene import Camera, Lighting, Scene
 from cloudcore.settings import FULL_3D, RenderSettings
 from cloudcore.splat_coverage import analytic_overdraw
+from cloudcore.weather import field_under_weather
 from cloudcore.wind import AirMotion, CloudMotion, field_drift, light_time, reshapes, shape_change_bound_m
 
 
@@ -243,6 +244,10 @@ class FrameRenderer:
         )
         camera = scene.camera if camera is None else camera
         authored_clouds = len(scene.clouds)
+        if scene.weather is not None and scene.cloud_field is not None:  # the field as the weather has it now
+            scene = dataclasses.replace(
+                scene, cloud_field=field_under_weather(scene.cloud_field, scene.weather, time_s)
+            )
         air = self._air_motion(scene)
         if air is not None:  # the clouds as their light is made now: at rest, while the wind only carries them
             scene = dataclasses.replace(scene, clouds=air.lit_clouds(time_s))
