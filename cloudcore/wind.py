@@ -150,6 +150,7 @@ class CloudMotion:
     drifts: np.ndarray  # (clouds, 3) metres
     time_s: float
     wind: Wind | None
+    velocities: np.ndarray  # (clouds, 3) m/s now, gusts included: what predicts how long an impostor lasts
 
     def shape_change_m(self, made_at_s) -> np.ndarray:
         """(n,) metres: the most a particle's place in its cloud has changed since `made_at_s` (n,)."""
@@ -179,6 +180,10 @@ class AirMotion:
     def drifts(self, time_s: float) -> np.ndarray:
         """(clouds, 3) metres each cloud has drifted by `time_s`."""
         return self.velocities * carried_seconds(self.wind, time_s)
+
+    def speeds(self, time_s: float) -> np.ndarray:
+        """(clouds, 3) m/s each cloud moves at `time_s`, gusts included."""
+        return self.velocities * gust_factor(self.wind, time_s)
 
     def offsets(self, time_s: float) -> np.ndarray:
         """(particles, 3) metres each particle is from its rest place at `time_s`: its cloud's drift and turbulence."""
@@ -212,3 +217,10 @@ def field_drift(wind: Wind | None, field, time_s: float) -> np.ndarray:
     if wind is None or field is None:
         return np.zeros(3)
     return drift(wind, [0.5 * (field.altitude[0] + field.altitude[1])], time_s)[0]
+
+
+def field_speed(wind: Wind, field, time_s: float) -> np.ndarray:
+    """(3,) m/s the cloud field's grid moves at `time_s`, gusts included (zeros without a field)."""
+    if field is None:
+        return np.zeros(3)
+    return velocity_at(wind, [0.5 * (field.altitude[0] + field.altitude[1])])[0] * gust_factor(wind, time_s)

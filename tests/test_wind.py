@@ -13,11 +13,13 @@ from cloudcore.errors import FieldError, SceneError
 from cloudcore.field.state import update_field
 from cloudcore.light.cloud_shadows import light_space
 from cloudcore.lod.impostors import ImpostorRecord, parallax_errors_deg
-from cloudcore.lod.plan.pricing import held_impostor_errors
+from cloudcore.lod.plan.pricing import held_impostor_errors, pricing_of, seen_from
+from cloudcore.lod.plan.state import LodState
 from cloudcore.lod.units import LodUnits
 from cloudcore.resources import DEFAULT_SCENE
-from cloudcore.scene import CloudField, Scene, Wind, splats_bounding_sphere
+from cloudcore.scene import Camera, CloudField, Scene, Wind, splats_bounding_sphere
 from cloudcore.scenefile import TABLE_KEYS, load_scene, save_scene, scene_from_dict
+from cloudcore.settings import RenderSettings
 from cloudcore.wind import (
     AirMotion,
     CloudMotion,
@@ -94,7 +96,7 @@ def test_a_pure_drift_keeps_the_clouds_and_their_light_at_rest_and_turbulence_re
         np.concatenate([c.centres for c in lit]) + churning.carry(23.0), churning.rest + churning.offsets(23.0)
     )
     # bands that carry clouds apart change their light on one another: relit too
-    assert light_time(Wind(bands=((0.0, 5.0, 270.0), (3000.0, 15.0, 270.0))), 23.0) == 20.0
+    assert light_time(Wind(bands=((0.0, 5.0, 270.0), (3000.0, 15.0, 270.0))), 83.0) == 60.0
 
 
 def test_the_turbulent_field_is_divergence_free_and_bounded():
@@ -123,7 +125,7 @@ def test_over_ten_minutes_turbulence_keeps_every_cloud_s_particles_and_extent_wi
     starts = np.concatenate([[0], np.cumsum(air.counts)])
     rest_radii = np.array([c.bounding_sphere()[1] for c in clouds])
     for time_s in TEN_MINUTES[::10]:
-        offsets = air.carry(time_s)
+        offsets = air.offsets(time_s)  # from each particle's place at rest
         assert offsets.shape == air.rest.shape  # every particle kept
         assert np.linalg.norm(offsets, axis=1).max() <= amplitude  # each at most the amplitude from its place
         moved = air.rest + offsets
@@ -170,7 +172,7 @@ def test_a_drift_of_the_cloud_is_measured_as_the_eye_s_step_the_other_way():
     eye = np.array(made_from)
     # the cloud has drifted 250 m east since (260 now against 10 then), its sphere with it
     moved = LodUnits.of_spheres([[250.0, 1000.0, 0.0]], [300.0])
-    motion = CloudMotion(np.array([[260.0, 0.0, 0.0]]), 25.0, None)
+    motion = CloudMotion(np.array([[260.0, 0.0, 0.0]]), 25.0, None, np.array([[10.0, 0.0, 0.0]]))
     error = held_impostor_errors(moved, drawable, records, parallax_errors_deg, eye, motion, np.array([[260.0, 0, 0]]))
     stepped = held_impostor_errors(units, drawable, records, parallax_errors_deg, eye - [250.0, 0.0, 0.0])
     np.testing.assert_allclose(error, stepped, rtol=1e-12)
@@ -184,7 +186,7 @@ def test_turbulence_since_an_impostor_was_made_adds_its_angle():
     eye = np.array([0.0, 1000.0, 3300.0])
     records = {(0,): ImpostorRecord(tuple(eye), 64, 0, made_at_s=0.0)}
     wind = Wind(bands=((0.0, 0.0, 0.0),), turbulence_m=30.0, turbulence_period_s=60.0)
-    motion = CloudMotion(np.zeros((1, 3)), 120.0, wind)
+    motion = CloudMotion(np.zeros((1, 3)), 120.0, wind, np.zeros((1, 3)))
     error = held_impostor_errors(units, np.array([0]), records, parallax_errors_deg, eye, motion, np.zeros((1, 3)))
     np.testing.assert_allclose(error, [math.degrees(math.atan2(60.0, 3000.0))])
 
@@ -227,7 +229,7 @@ def test_the_table_reads_saves_and_reads_again(tmp_path):
         ("turbulence_m = 501.0", "wind.turbulence_m", "must be within [0, 500], got 501.0"),
         ("turbulence_scale_m = 1.0", "wind.turbulence_scale_m", "must be within [10, 10000], got 1.0"),
         ("turbulence_period_s = inf", "wind.turbulence_period_s", "must be finite, got inf"),
-        ("relight_period_s = 0.1", "wind.relight_period_s", "must be within [0.5, 600], got 0.1"),
+        ("relight_period_s = 0.1", "wind.relight_period_s", "must be within [0.5, 3600], got 0.1"),
         ("gusts = 1.0", "wind.gusts", "unknown key; valid keys: " + ", ".join(TABLE_KEYS["wind"])),
         ('turbulence_m = "a lot"', "wind.turbulence_m", "expected a number, got 'a lot'"),
     ],
@@ -281,3 +283,20 @@ def test_the_ground_s_shadow_map_moves_with_clouds_all_drifting_alike():
     # a point under the moved clouds reads the texel and slice its place less the shift read under them at rest
     for moved, at_rest in zip(space.moved(shift).texel_coordinates(ground + shift), space.texel_coordinates(ground)):
         np.testing.assert_allclose(moved, at_rest, atol=1e-9)
+
+
+def test_an_impostor_of_a_drifting_cloud_is_priced_to_last_as_long_as_the_eye_s_step_relative_to_it():
+    units = LodUnits.of_spheres([[0.0, 1000.0, -4000.0]], [400.0])
+    camera = Camera((0.0, 1000.0, 0.0), (0.0, 1000.0, -4000.0), 60.0)
+    settings = RenderSettings(ring_radius=math.inf)
+    still_eye = LodState(eye=camera.position)
+    # a still eye and a cloud carried 20 m east in the frame ...
+    drifting = seen_from(
+        units, pricing_of(camera, (640, 480), settings, still_eye, ()), air_steps=np.array([[20.0, 0, 0]])
+    )
+    # ... is the cloud at rest and an eye that stepped 20 m west
+    stepped = LodState(eye=(20.0, 1000.0, 0.0))
+    moving = seen_from(units, pricing_of(camera, (640, 480), settings, stepped, ()))
+    assert np.isfinite(drifting.lifetimes[0]) and drifting.lifetimes[0] == pytest.approx(moving.lifetimes[0], rel=1e-12)
+    still_air = seen_from(units, pricing_of(camera, (640, 480), settings, still_eye, ()))
+    assert still_air.lifetimes[0] > 2.0 * drifting.lifetimes[0]

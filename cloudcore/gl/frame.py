@@ -76,7 +76,15 @@ from cloudcore.scene import Camera, Lighting, Scene
 from cloudcore.settings import FULL_3D, RenderSettings
 from cloudcore.splat_coverage import analytic_overdraw
 from cloudcore.weather import field_under_weather
-from cloudcore.wind import AirMotion, CloudMotion, field_drift, light_time, reshapes, shape_change_bound_m
+from cloudcore.wind import (
+    AirMotion,
+    CloudMotion,
+    field_drift,
+    field_speed,
+    light_time,
+    reshapes,
+    shape_change_bound_m,
+)
 
 
 @dataclass(frozen=True)
@@ -500,7 +508,9 @@ class FrameRenderer:
         if held is not None and held[0] is lit and held[1] is units and held[2:] == source[2:]:
             return self._carry_made
         authored = len(air.clouds)
-        field_drifts = np.tile(field_carried, (len(lit.cloud_starts) - 1 - authored, 1))
+        field_clouds = len(lit.cloud_starts) - 1 - authored
+        field_drifts = np.tile(field_carried, (field_clouds, 1))
+        field_speeds = np.tile(field_speed(air.wind, self.field_state.field, time_s), (field_clouds, 1))
         field_particles = len(lit.radii) - int(lit.cloud_starts[authored])
         offsets = np.concatenate([air.carry(time_s), np.tile(field_carried, (field_particles, 1))])
         drifts = np.concatenate([air.drifts(time_s), field_drifts])
@@ -511,7 +521,7 @@ class FrameRenderer:
         self._carry_made = (
             lit.carried(offsets, shifts, grown),
             units.moved(shifts, grown),
-            CloudMotion(drifts, time_s, air.wind),
+            CloudMotion(drifts, time_s, air.wind, np.concatenate([air.speeds(time_s), field_speeds])),
         )
         return self._carry_made
 

@@ -155,7 +155,13 @@ def plan_frame(
     groups_may_open = settings.mode == "auto" and settings.groups_apart_in_motion and units.clouds is not None
     # the units and, where groups may be planned apart, their clouds, priced in one pass: a pass costs about
     # 0.2 ms whatever its size (the field's groups priced apart 0.72 -> 0.15 ms a frame)
-    seen = seen_from(units.and_clouds if groups_may_open else units, pricing, priced=prices_units(settings))
+    priced_units = units.and_clouds if groups_may_open else units
+    air_steps = (
+        priced_units.member_means(motion.velocities) * (motion.time_s - state.time_s)
+        if motion is not None and state.time_s is not None
+        else None
+    )
+    seen = seen_from(priced_units, pricing, priced=prices_units(settings), air_steps=air_steps)
     arguments = {
         "pricing": pricing,
         "seen": seen,
@@ -668,6 +674,7 @@ def _plan_units(
         ring_prices=ring_prices,
         object_centres=tuple(tuple(float(v) for v in centre) for centre in object_centres),
         near_work=(units, camera, tuple(viewport), near_work) if near_work else None,
+        time_s=None if motion is None else motion.time_s,
     )
     return FramePlan(
         clouds=plans,

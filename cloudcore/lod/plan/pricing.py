@@ -65,9 +65,11 @@ class Seen:
         return Seen(*(getattr(self, field.name)[rows] for field in dataclasses.fields(self)))
 
 
-def seen_from(units: LodUnits, pricing: Pricing, priced: bool = True) -> Seen:
+def seen_from(units: LodUnits, pricing: Pricing, priced: bool = True, air_steps=None) -> Seen:
     """What is seen of `units` from this frame's eye (`pricing`).  Not `priced` (full 3D), only the distances:
-    every price zero."""
+    every price zero.  `air_steps` (units, 3): how far the wind carried each unit since last frame (None: still
+    air); relative to a unit, last frame's eye was that much further along, and its impostor lives as long as the
+    eye's step relative to it allows."""
     eye, last_eye, focal_px, screen_pixels = pricing.eye, pricing.last_eye, pricing.focal_px, pricing.screen_pixels
     centres, radii = units.centres, units.radii
     distances = row_lengths(centres - eye)
@@ -75,7 +77,11 @@ def seen_from(units: LodUnits, pricing: Pricing, priced: bool = True) -> Seen:
         nothing = np.zeros(len(radii))
         return Seen(distances, nothing, nothing, nothing, nothing, nothing + 1.0)
     # the translation error of one frame at the eye's current speed
-    rates = pricing.translation_error(centres, radii, last_eye, eye) if last_eye is not None else np.zeros(len(radii))
+    if last_eye is None:
+        rates = np.zeros(len(radii))
+    else:
+        then = last_eye if air_steps is None else last_eye + air_steps
+        rates = pricing.translation_error(centres, radii, then, eye)
     object_centres, object_radii, depth_steps = pricing.splitting
     if len(object_radii):
         reach = np.linalg.norm(centres[:, None] - object_centres[None], axis=2) < radii[:, None] + object_radii[None]
