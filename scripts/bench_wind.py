@@ -12,7 +12,11 @@ step each frame:
 - timelapse: the same wind, 2 s a frame (60 times real time: 20 m a frame);
 - churn: bands from 6 m/s at the ground to 18 m/s at 3 km veering 250 -> 290 degrees, gusts of 0.4 over 45 s,
   turbulence of 30 m, 2 s a frame (the clouds relit every 10 s of the clock: every 5th frame);
-- field: the cumulus field demo at its flight's first view, still camera, with the breeze at 2 s a frame.
+- field_still, field: the cumulus field demo at its flight's first view, still camera, without wind and with the
+  breeze at 2 s a frame;
+- relight (not among the default cases): what leaving the light of turbulent shapes unrelit costs the picture: the
+  default view at 55 s in full 3D, 320x240, its light made at rest against made at 50 s, for turbulence of 30 and
+  100 m with one band and with the churn's two, and what a relight of the default scene takes.
 
 Prints one line a case: auto's mean and 95th-percentile frame, its regenerations a frame, the largest error it
 accepted (in tolerances), its PSNR against full 3D of the same frame, and the light's ms a frame (relighting and the
@@ -33,11 +37,12 @@ os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 
 from cloudcore.gl import FrameRenderer  # noqa: E402
 from cloudcore.measure.benchmark import bench_path, machine, write_report  # noqa: E402
+from cloudcore.measure.imagecompare import compare  # noqa: E402
 from cloudcore.paths import camera_on_path  # noqa: E402
 from cloudcore.resources import CUMULUS_FIELD, DEFAULT_SCENE  # noqa: E402
 from cloudcore.scene import Wind  # noqa: E402
 from cloudcore.scenefile import load_scene  # noqa: E402
-from cloudcore.settings import RenderSettings  # noqa: E402
+from cloudcore.settings import FULL_3D, RenderSettings  # noqa: E402
 
 SETTLE_FRAMES = 20
 BREEZE = Wind(bands=((0.0, 10.0, 270.0),))
@@ -50,6 +55,7 @@ CASES = {
     "breeze": (DEFAULT_SCENE, BREEZE, 1.0 / 30.0),
     "timelapse": (DEFAULT_SCENE, BREEZE, 2.0),
     "churn": (DEFAULT_SCENE, CHURN, 2.0),
+    "field_still": (CUMULUS_FIELD, None, 2.0),
     "field": (CUMULUS_FIELD, BREEZE, 2.0),
 }
 
@@ -58,7 +64,7 @@ def run_case(name: str, frames: int, size: tuple[int, int]) -> dict:
     path, wind, step = CASES[name]
     scene = dataclasses.replace(load_scene(path), wind=wind)
     camera = scene.camera
-    if name == "field":  # the flight's first view: at 2 km among the clouds
+    if name.startswith("field"):  # the flight's first view: at 2 km among the clouds
         flight = scene.camera_path("flight")
         camera = camera_on_path(flight, 0.0, scene.camera.fov_y_deg)
     views = [(step * frame, camera) for frame in range(SETTLE_FRAMES + frames)]
@@ -88,16 +94,53 @@ def run_case(name: str, frames: int, size: tuple[int, int]) -> dict:
     return {"summary": summary, "report": report}
 
 
+def relight_error() -> list[dict]:
+    """The `relight` case: PSNR of the picture lit from the shapes at rest against relit 5 s before, and the ms a
+    relight takes (the frame that makes the light again)."""
+    scene = load_scene(DEFAULT_SCENE)
+    rows = []
+    for amplitude in (30.0, 100.0):
+        for bands in (BREEZE.bands, CHURN.bands):
+            images, relight_ms = {}, 0.0
+            for period in (10.0, 600.0):  # relit at 50 s, or the light of the clouds at rest
+                wind = Wind(bands=bands, turbulence_m=amplitude, relight_period_s=period)
+                with FrameRenderer(320, 240) as renderer:
+                    renderer.render(dataclasses.replace(scene, wind=wind), settings=FULL_3D)
+                    images[period], stats = renderer.render(
+                        dataclasses.replace(scene, wind=wind), settings=FULL_3D, time_s=55.0
+                    )
+                    relight_ms = stats.illumination_ms if period == 10.0 else relight_ms
+            difference = compare(images[600.0], images[10.0])
+            rows.append(
+                {
+                    "turbulence_m": amplitude,
+                    "bands": len(bands),
+                    "psnr_db": difference.psnr_db,
+                    "mean_abs": difference.mean_abs,
+                    "relight_ms": relight_ms,
+                }
+            )
+            print(
+                f"relight    turbulence {amplitude:.0f} m, {len(bands)} band(s): unrelit against relit "
+                f"{difference.psnr_db:.1f} dB (mean {difference.mean_abs:.2f} levels); a relight {relight_ms:.0f} ms",
+                flush=True,
+            )
+    return rows
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--frames", type=int, default=60)
     parser.add_argument("--size", default="640x480")
-    parser.add_argument("--cases", default=",".join(CASES))
+    parser.add_argument("--cases", default=",".join(CASES), help=f"of {', '.join(CASES)}, relight")
     parser.add_argument("--json", type=Path)
     args = parser.parse_args(argv)
     size = tuple(int(v) for v in args.size.split("x"))
     results = []
     for name in args.cases.split(","):
+        if name == "relight":
+            results.append({"summary": {"case": "relight", "rows": relight_error()}})
+            continue
         result = run_case(name, args.frames, size)
         s = result["summary"]
         print(

@@ -138,3 +138,28 @@ def test_a_field_drifts_with_the_air_its_cells_kept_and_a_change_of_weather_rema
             renderer.render(changing, settings=FULL_3D, time_s=time_s)
             coverages.append(renderer.field_state.field.coverage)
         np.testing.assert_allclose(coverages, [0.4, 0.5, 0.7, 0.85, 0.95], atol=1e-9)
+
+
+def test_another_wind_at_the_same_time_carries_the_clouds_by_its_own_drift(renderer, still):
+    renderer.render(still, settings=FULL_3D)
+    rest = renderer.units.centres.copy()
+    for speed in (10.0, 20.0, 0.0):  # the editor's slider: a new wind, the clock where it was
+        renderer.render(
+            dataclasses.replace(still, wind=Wind(bands=((0.0, speed, 270.0),))), settings=FULL_3D, time_s=30.0
+        )
+        np.testing.assert_allclose(
+            renderer.units.centres - rest, np.tile([30.0 * speed, 0.0, 0.0], (len(rest), 1)), atol=1e-6
+        )
+
+
+def test_wang_s_ring_follows_its_clouds_drifting_alike_without_being_made_again(still):
+    far = dataclasses.replace(still, camera=Camera((0.0, 1100.0, 6500.0), (0.0, 1050.0, 0.0), 50.0), wind=WIND)
+    ring = RenderSettings(mode="impostor", ring_radius=4000.0)
+    with FrameRenderer(96, 72) as renderer:
+        for _ in range(20):  # its segments built, one a frame, and faded in
+            renderer.render(far, settings=ring)
+        built = renderer.last_plan.ring_state.current
+        assert built is not None and renderer.last_plan.ring_shifts
+        _, stats = renderer.render(far, settings=ring, time_s=30.0)
+        assert renderer.last_plan.ring_state.current is built and stats.plan.ring_segments_built == 0
+        np.testing.assert_allclose(renderer.last_plan.ring_shifts[0], [300.0, 0.0, 0.0], atol=1e-6)

@@ -471,17 +471,18 @@ class FrameRenderer:
 
     def _update_shadows(self, particles: ParticleBuffer, motion: CloudMotion | None) -> float:
         """Make the clouds' transmittance map again for another particle buffer, sun or size (`CloudShadowMap.update`);
-        ms spent.  A wind that moves every cloud alike moves the map made of their buffer at rest with them; one that
-        changes them otherwise makes it again each frame, of the particles where they are (`particles`)."""
+        ms spent making it (0 when it was held).  A wind that moves every cloud alike moves the map made of their
+        buffer at rest with them; one that changes them otherwise makes it again each frame, of the particles where
+        they are (`particles`)."""
         if self._shadows is None:
             return 0.0
-        start = time.perf_counter()
+        start, made = time.perf_counter(), self.shadow_map.made
         if motion is not None and not reshapes(motion.wind):
             self.shadow_map.update(self._particles, *self._shadow_source, motion.drifts[0])
         else:
             self.shadow_map.update(particles, *self._shadow_source)
         self.context.bind_target()
-        return 1e3 * (time.perf_counter() - start)
+        return 1e3 * (time.perf_counter() - start) if self.shadow_map.made != made else 0.0
 
     def _air_motion(self, scene: Scene) -> AirMotion | None:
         """The wind applied to the scene's authored clouds (`cloudcore.wind.AirMotion`), made again for other
@@ -503,9 +504,9 @@ class FrameRenderer:
         if air is None:
             self._carry_source = self._carry_made = None
             return lit, units, None
-        source = (lit, units, time_s, tuple(field_carried))
+        source = (lit, units, air, time_s, tuple(field_carried))
         held = self._carry_source
-        if held is not None and held[0] is lit and held[1] is units and held[2:] == source[2:]:
+        if held is not None and all(a is b for a, b in zip(held[:3], source[:3])) and held[3:] == source[3:]:
             return self._carry_made
         authored = len(air.clouds)
         field_clouds = len(lit.cloud_starts) - 1 - authored
@@ -526,13 +527,14 @@ class FrameRenderer:
         return self._carry_made
 
     def _ring_keys_under_wind(self, ring_keys: tuple, motion: CloudMotion | None, settings: RenderSettings) -> tuple:
-        """Wang's ring's panels stand where their clouds were when they were built: under wind a cloud's ring key
-        changes each time it has drifted another rebuild distance (`ring_rebuild_horizontal` of `ring_radius`), the
-        bound the ring keeps on the eye's own steps, and the ring is built again.  The same tuple while no cloud
-        crossed a step."""
-        if motion is None or not math.isfinite(settings.ring_radius):
+        """Wang's ring's panels follow their clouds' mean drift (`FramePlan.ring_shifts`); under bands that carry
+        clouds apart a cloud's ring key changes each time it has drifted another rebuild distance
+        (`ring_rebuild_horizontal` of `ring_radius`) from the clouds' mean, the bound the ring keeps on the eye's own
+        steps, and the ring is built again.  The same tuple while no cloud crossed a step."""
+        if motion is None or not math.isfinite(settings.ring_radius) or not len(motion.drifts):
             return ring_keys
-        steps = np.floor(motion.drifts / (settings.ring_rebuild_horizontal * settings.ring_radius)).astype(np.int64)
+        apart = motion.drifts - motion.drifts.mean(axis=0)
+        steps = np.rint(apart / (settings.ring_rebuild_horizontal * settings.ring_radius)).astype(np.int64)
         held = self._ring_drift
         if held is None or held[0] is not ring_keys or not np.array_equal(held[1], steps):
             keys = tuple((*key, tuple(step)) for key, step in zip(ring_keys, steps.tolist()))
@@ -813,10 +815,11 @@ class FrameRenderer:
     def _draw_ring(self, frame: _CloudPassFrame, elevation_deg: float) -> None:
         """Wang's ring: the panels of the generations drawn (two while a rebuilt one fades in)."""
         quads = []
-        for generation, weight in frame.plan.ring.draws:
+        shifts = frame.plan.ring_shifts or [np.zeros(3)] * len(frame.plan.ring.draws)
+        for (generation, weight), shift in zip(frame.plan.ring.draws, shifts):
             for segment in generation.occupied_segments:
                 target, corners, extent = self._impostors.ring_panel(generation, segment, elevation_deg)
-                quads.append((np.asarray(corners, dtype=np.float32), target.texture, float(weight), extent))
+                quads.append((np.asarray(corners + shift, dtype=np.float32), target.texture, float(weight), extent))
         self._draw_quad_run(frame, quads)
 
     def _draw_impostors(self, frame: _CloudPassFrame, items) -> None:

@@ -45,6 +45,9 @@ class FramePlan:
     units: LodUnits | None = None  # the frame's units, which `clouds` index: the groups planned apart opened
     #: (units, 3) metres the wind has carried each unit (`cloudcore.wind`); None: still air
     unit_drifts: np.ndarray | None = None
+    #: per generation of `ring.draws`, (3,) metres the wind has carried its clouds since it was planned: its panels
+    #: follow them
+    ring_shifts: tuple = ()
 
     @property
     def records(self) -> Mapping:

@@ -313,7 +313,14 @@ def _plan_units(
             )
         ring_ms, alone_ms = ring_prices.ring_ms, ring_prices.alone_ms
         chases_tolerance = ring_prices.chases_tolerance
-        ring_error = ring_translation_error(state.ring.current, translation_error, eye)
+        # under wind, the eye relative to the ring's clouds, as its panels follow them (`_ring_shift`)
+        current = state.ring.current
+        ring_eye = (
+            eye - _ring_shift(current, current.rows_in(units.members, units.row_of), centres)
+            if unit_drifts is not None and current is not None
+            else eye
+        )
+        ring_error = ring_translation_error(current, translation_error, ring_eye)
         # a candidate drawn on its own until a ring being built takes it: an impostor made for it now lasts only
         # that long (Harris's circle at 800 clouds made 136 impostors in its first frame for a ring in 16 frames)
         lifetimes = np.where(candidates, np.minimum(lifetimes, frames_to_show(state.ring, step, settings)), lifetimes)
@@ -598,9 +605,11 @@ def _plan_units(
         if reason is not None:
             (regenerate if index in served else postponed)[index] = reason
         texture_sizes[index] = record.size
+    ring_shifts = []  # per generation drawn, how far the wind has carried its clouds since it was planned
     if ring is not None:
         for generation, _ in ring.draws:
             rows = generation.rows_in(units.members, units.row_of)
+            ring_shifts.append(_ring_shift(generation, rows, centres) if unit_drifts is not None else np.zeros(3))
             shown = rows[visible[rows]]
             shown_segments = segments_of(centres[shown], generation.eye)
             pixels = panel_pixels(centres[shown], shown_segments, quad_pixels_of[shown], view_projection, viewport)
@@ -692,4 +701,15 @@ def _plan_units(
         accepted_error=accepted,
         units=units,
         unit_drifts=unit_drifts,
+        ring_shifts=tuple(ring_shifts),
     )
+
+
+def _ring_shift(generation, rows: np.ndarray, centres: np.ndarray) -> np.ndarray:
+    """(3,) metres the clouds of ring `generation` (its members' rows among the units now) have moved, on average,
+    since it was planned: its panels move by it (the wind carries them all alike but for its bands); zeros where a
+    member is gone (the ring is then made again)."""
+    then = generation.spheres[0]
+    if len(rows) != len(then) or not len(rows):
+        return np.zeros(3)
+    return centres[rows].mean(axis=0) - then.mean(axis=0)
