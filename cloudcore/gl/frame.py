@@ -527,14 +527,14 @@ class FrameRenderer:
         return self._carry_made
 
     def _ring_keys_under_wind(self, ring_keys: tuple, motion: CloudMotion | None, settings: RenderSettings) -> tuple:
-        """Wang's ring's panels follow their clouds' mean drift (`FramePlan.ring_shifts`); under bands that carry
-        clouds apart a cloud's ring key changes each time it has drifted another rebuild distance
-        (`ring_rebuild_horizontal` of `ring_radius`) from the clouds' mean, the bound the ring keeps on the eye's own
-        steps, and the ring is built again.  The same tuple while no cloud crossed a step."""
-        if motion is None or not math.isfinite(settings.ring_radius) or not len(motion.drifts):
+        """Wang's ring's panels follow their clouds' mean drift (`FramePlan.ring_shifts`), but the eye's place relative
+        to the clouds moves the other way: a cloud's ring key changes each time the wind has carried it another
+        rebuild distance (`ring_rebuild_horizontal` of `ring_radius`; the first at half of one), the bound Wang's
+        ring keeps on the eye's own steps, and the ring is built again.  The same tuple while no cloud crossed a step."""
+        if motion is None or not math.isfinite(settings.ring_radius):
             return ring_keys
-        apart = motion.drifts - motion.drifts.mean(axis=0)
-        steps = np.rint(apart / (settings.ring_rebuild_horizontal * settings.ring_radius)).astype(np.int64)
+        # rounded, not floored: a drift across the wind of -1e-14 m is no step
+        steps = np.rint(motion.drifts / (settings.ring_rebuild_horizontal * settings.ring_radius)).astype(np.int64)
         held = self._ring_drift
         if held is None or held[0] is not ring_keys or not np.array_equal(held[1], steps):
             keys = tuple((*key, tuple(step)) for key, step in zip(ring_keys, steps.tolist()))

@@ -3,6 +3,7 @@ state to carry into the next frame; its statistics (`plan_stats`)."""
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Mapping
 from dataclasses import dataclass
 
@@ -48,6 +49,9 @@ class FramePlan:
     #: per generation of `ring.draws`, (3,) metres the wind has carried its clouds since it was planned: its panels
     #: follow them
     ring_shifts: tuple = ()
+    #: the same for the generation whose segments this frame builds: they are rendered as its clouds were when it was
+    #: planned, so that all its segments agree and `ring_shifts` moves them alike
+    ring_build_shift: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(3))
 
     @property
     def records(self) -> Mapping:

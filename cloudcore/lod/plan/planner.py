@@ -702,6 +702,11 @@ def _plan_units(
         units=units,
         unit_drifts=unit_drifts,
         ring_shifts=tuple(ring_shifts),
+        ring_build_shift=(
+            _ring_shift(ring.building, ring.building.rows_in(units.members, units.row_of), centres)
+            if unit_drifts is not None and ring is not None and ring.building is not None
+            else np.zeros(3)
+        ),
     )
 
 
