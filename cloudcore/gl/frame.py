@@ -530,7 +530,7 @@ class FrameRenderer:
         """Wang's ring's panels follow their clouds' mean drift (`FramePlan.ring_shifts`), but the eye's place relative
         to the clouds moves the other way: a cloud's ring key changes each time the wind has carried it another
         rebuild distance (`ring_rebuild_horizontal` of `ring_radius`; the first at half of one), the bound Wang's
-        ring keeps on the eye's own steps, and the ring is built again.  The same tuple while no cloud crossed a step."""
+        ring keeps on the eye's own steps, and the ring is built again.  The same tuple while no cloud crossed one."""
         if motion is None or not math.isfinite(settings.ring_radius):
             return ring_keys
         # rounded, not floored: a drift across the wind of -1e-14 m is no step
