@@ -336,8 +336,8 @@ class Wind:
     turbulence_m: float = 0.0
     turbulence_scale_m: float = 400.0
     turbulence_period_s: float = 120.0
-    #: 60 s: the default scene relit costs 3.6 s on llvmpipe (a hitch); its light left at rest for 55 s of 30 m
-    #: turbulence was within 45 dB of relit (docs/lod.md, "Clouds that move with the wind")
+    #: 60 s: relighting the default scene took 2.1 to 2.4 s of this machine's CPU (a hitch); its light left at rest
+    #: for 55 s of 30 m turbulence was within 45 dB of relit (docs/lod.md, "Clouds that move with the wind")
     relight_period_s: float = 60.0
 
     def __post_init__(self):
