@@ -784,23 +784,25 @@ def every_panel_shows_its_lines_whole(ctx, app: EditorUnderTest):
 
 def the_wind_carries_the_clouds_as_the_clock_runs(ctx, app: EditorUnderTest):
     """Add a wind in the Cloud field panel, set its speed and direction, run the scene clock: the clouds are drawn
-    where the wind has carried them, and at time 0 where they were; removing the wind is one undo step."""
+    where the wind has carried them, and at time 0 where they were; each change is one undo step."""
     use_window(ctx, "Cloud field")
     start = app.editor.scene
     CHECK(start.wind is None)
     ctx.item_click("Add wind")
     ctx.item_input_value("Wind speed", 20.0)  # m/s: a "/" in a label would split its test-engine path
-    ctx.item_input_value("Wind from (deg)", 270.0)  # a westerly: toward +x, across the view
-    CHECK(app.editor.scene.wind == Wind(bands=((0.0, 20.0, 270.0),)))
+    ctx.item_input_value("Wind from (deg)", 90.0)  # an easterly: toward -x, across the view
+    CHECK(app.editor.scene.wind == Wind(bands=((0.0, 20.0, 90.0),)))
+    app.editor.playing = False  # the clock where the tests before left it: stopped, and set to 0 below
+    use_window(ctx, "Camera")
+    ctx.item_input_value("Scene time (s)", 0.0)
     ctx.yield_(SETTLE)
     still = app.capture(ctx)
     rest = app.viewport.renderer.units.centres.copy()
-    use_window(ctx, "Camera")
-    ctx.item_input_value("Scene time (s)", 60.0)  # 1.2 km east
+    ctx.item_input_value("Scene time (s)", 60.0)  # 1.2 km west
     ctx.yield_(SETTLE)
     carried = app.capture(ctx)
     moved = app.viewport.renderer.units.centres - rest
-    CHECK(np.allclose(moved, [1200.0, 0.0, 0.0], atol=1e-3))
+    CHECK(np.allclose(moved, [-1200.0, 0.0, 0.0], atol=1e-3))
     changed = float((np.abs(carried.astype(int) - still.astype(int)).max(axis=2) > 10).mean())
     app.outcome["wind_changed_fraction"] = changed
     CHECK(changed > 0.02)
