@@ -48,6 +48,8 @@ AUTOSAVE_SECONDS = 60.0
 #: no window frame over 150 ms; docs/performance.md)
 EDITOR_FRAME_BUDGET_MS = 30.0
 RECENT_LIMIT = 8
+#: the Camera panel's scene clock runs to at least this many seconds under wind: ten minutes of drifting clouds
+WIND_CLOCK_S = 600.0
 #: what a left press in the viewport does, by name: (key, label)
 TOOLS = (("place", "Place"), ("brush", "Brush"), ("move_cloud", "Move cloud"), ("move_particle", "Move particle"))
 
@@ -122,8 +124,10 @@ class Editor:
 
     @property
     def scene_duration_s(self) -> float:
-        """The last key time of any object path (0 for a scene with static objects only)."""
-        return max((float(o.path[-1, 0]) for o in self.scene.objects if o.path is not None), default=0.0)
+        """The last key time of any object path (0 for a scene with static objects only), and under wind at least
+        `WIND_CLOCK_S`: the clouds move as long as the clock runs."""
+        paths = max((float(o.path[-1, 0]) for o in self.scene.objects if o.path is not None), default=0.0)
+        return paths if self.scene.wind is None else max(paths, WIND_CLOCK_S)
 
     @classmethod
     def open(cls, path: Path) -> Editor:

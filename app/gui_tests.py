@@ -27,7 +27,7 @@ from cloudcore.measure.imagecompare import compare
 from cloudcore.measure.overlays import to_pixels
 from cloudcore.navigation import orbited
 from cloudcore.paths import camera_on_path
-from cloudcore.scene import CloudField
+from cloudcore.scene import CloudField, Weather, Wind
 from cloudcore.scenefile import load_scene, save_scene
 from cloudcore.settings import RenderSettings
 
@@ -807,6 +807,13 @@ def the_cloud_field_panel_edits_the_field(ctx, app: EditorUnderTest):
     target = app.results_path.with_name("field_saved_by_gui.toml")
     CHECK(app.editor.save(target))
     CHECK(load_scene(target).cloud_field == field and "[cloud_field]" in target.read_text())
+    use_window(ctx, "Cloud field")
+    ctx.combo_click("Weather/broken")  # a named weather sets the field's coverage, type and altitudes
+    CHECK(app.editor.scene.weather == Weather("broken"))
+    ctx.yield_(SETTLE)
+    CHECK(abs(app.viewport.renderer.field_state.field.coverage - 0.7) < 1e-9)
+    undo(ctx)
+    CHECK(app.editor.scene.weather is None)
     for _ in range(4):  # the rings, the time of day, the rings again, the cloud type
         undo(ctx)
     CHECK(app.editor.scene.cloud_field.cloud_type == "cumulus_humilis")
@@ -829,6 +836,39 @@ def every_panel_shows_its_lines_whole(ctx, app: EditorUnderTest):
     app.outcome["panel_widths"] = widths
     for width in widths.values():
         CHECK(width["widest line"] <= width["panel"])
+
+
+def the_wind_carries_the_clouds_as_the_clock_runs(ctx, app: EditorUnderTest):
+    """Add a wind in the Cloud field panel, set its speed and direction, run the scene clock: the clouds are drawn
+    where the wind has carried them, and at time 0 where they were; each change is one undo step."""
+    use_window(ctx, "Cloud field")
+    start = app.editor.scene
+    CHECK(start.wind is None)
+    ctx.item_click("Add wind")
+    ctx.item_input_value("Wind speed", 20.0)  # m/s: a "/" in a label would split its test-engine path
+    ctx.item_input_value("Wind from (deg)", 90.0)  # an easterly: toward -x, across the view
+    CHECK(app.editor.scene.wind == Wind(bands=((0.0, 20.0, 90.0),)))
+    app.editor.playing = False  # the clock where the tests before left it: stopped, and set to 0 below
+    use_window(ctx, "Camera")
+    ctx.item_input_value("Scene time (s)", 0.0)
+    ctx.yield_(SETTLE)
+    still = app.capture(ctx)
+    rest = app.viewport.renderer.units.centres.copy()
+    ctx.item_input_value("Scene time (s)", 60.0)  # 1.2 km west
+    ctx.yield_(SETTLE)
+    carried = app.capture(ctx)
+    moved = app.viewport.renderer.units.centres - rest
+    CHECK(np.allclose(moved, [-1200.0, 0.0, 0.0], atol=1e-3))
+    changed = float((np.abs(carried.astype(int) - still.astype(int)).max(axis=2) > 10).mean())
+    app.outcome["wind_changed_fraction"] = changed
+    CHECK(changed > 0.02)
+    ctx.item_input_value("Scene time (s)", 0.0)
+    ctx.yield_(SETTLE)
+    CHECK(np.array_equal(app.capture(ctx), still))
+    for _ in range(3):  # the direction, the speed, the wind added
+        undo(ctx)
+    CHECK(app.editor.scene.wind is None)
+    app.editor.edit(start)
 
 
 #: the GUI tests, in the order they run; `tests/test_gui.py` reads their names here
@@ -861,6 +901,7 @@ GUI_TESTS = (
     recording_runs_in_the_background,
     a_click_within_one_frame_is_not_lost,
     the_cloud_field_panel_edits_the_field,
+    the_wind_carries_the_clouds_as_the_clock_runs,
     every_panel_shows_its_lines_whole,
 )
 

@@ -111,8 +111,21 @@ def scene_limit_problems(scene, unchanged=None) -> list[tuple[str, str]]:
                 f"the renderer draws {' or '.join(DRAWN_TERRAIN_KINDS)} terrain only, not {scene.terrain.kind!r}",
             )
         )
+    if scene.weather is not None and scene.cloud_field is None:
+        problems.append(("weather", "a weather sets a cloud field's coverage: the scene has no [cloud_field]"))
     previous = {id(cloud) for cloud in unchanged.clouds} if unchanged is not None else set()
-    for key in ("camera", "lighting", "shading", "terrain", "objects", "camera_paths", "views", "cloud_field"):
+    for key in (
+        "camera",
+        "lighting",
+        "shading",
+        "terrain",
+        "objects",
+        "camera_paths",
+        "views",
+        "cloud_field",
+        "wind",
+        "weather",
+    ):
         # a terrain left alone needs no second look: a 4097^2 heightmap's samples took 0.29 s every edit
         if key != "terrain" or unchanged is None or scene.terrain is not unchanged.terrain:
             problems.extend(_out_of_bounds(key, getattr(scene, key)))

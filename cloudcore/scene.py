@@ -347,6 +347,100 @@ class CloudField:
             )
 
 
+#: the most altitude bands a wind may have
+MAX_WIND_BANDS = 16
+#: the fastest wind in m/s: past the jet stream's
+MAX_WIND_SPEED = 100.0
+#: the most a particle strays from its place in its cloud by turbulence, in metres
+MAX_TURBULENCE_M = 500.0
+
+
+@dataclass(frozen=True)
+class Wind:
+    """The air's motion (`cloudcore.wind`): rows (altitude m, speed m/s, direction deg) interpolated by altitude
+    (one row: the same wind at every altitude), the direction the meteorological one, the bearing the wind
+    blows *from*, clockwise from north (-z): 270 is a westerly, carrying clouds toward +x.  Gusts scale every
+    band's speed by 1 + `gust_amplitude` sin(2 pi t / `gust_period_s`).  Turbulence moves each particle about
+    its place in its cloud by a divergence-free field at most `turbulence_m` metres, of wavelength
+    `turbulence_scale_m` and period `turbulence_period_s`; clouds whose shapes or relative places change are
+    relit every `relight_period_s` of the scene clock."""
+
+    bands: tuple[tuple[float, float, float], ...] = ((0.0, 10.0, 270.0),)
+    gust_amplitude: float = 0.0
+    gust_period_s: float = 60.0
+    turbulence_m: float = 0.0
+    turbulence_scale_m: float = 400.0
+    turbulence_period_s: float = 120.0
+    #: 60 s: relighting the default scene took 2.1 to 2.4 s of this machine's CPU (a hitch); its light left at rest
+    #: for 55 s of 30 m turbulence was within 45 dB of relit (docs/lod.md, "Clouds that move with the wind")
+    relight_period_s: float = 60.0
+
+    def __post_init__(self):
+        try:
+            bands = tuple(tuple(float(v) for v in row) for row in self.bands)
+        except (TypeError, ValueError):
+            raise FieldError("bands", f"expected rows of [altitude, speed, direction], got {self.bands!r}") from None
+        if not 1 <= len(bands) <= MAX_WIND_BANDS or any(len(row) != 3 for row in bands):
+            raise FieldError(
+                "bands", f"expected 1 to {MAX_WIND_BANDS} rows of [altitude, speed, direction], got {len(bands)} rows"
+            )
+        for index, (altitude, speed, direction) in enumerate(bands):
+            if not math.isfinite(altitude):
+                raise FieldError("bands", f"row {index}: altitude must be finite, got {altitude}")
+            if not 0.0 <= speed <= MAX_WIND_SPEED:
+                raise FieldError("bands", f"row {index}: speed must be within [0, {MAX_WIND_SPEED:g}] m/s, got {speed}")
+            if not 0.0 <= direction <= 360.0:
+                raise FieldError("bands", f"row {index}: direction must be within [0, 360] degrees, got {direction}")
+        if any(not below[0] < above[0] for below, above in zip(bands, bands[1:])):
+            raise FieldError("bands", "altitudes must increase from row to row")
+        object.__setattr__(self, "bands", bands)
+        for name, low, high in (
+            ("gust_amplitude", 0.0, 1.0),
+            ("gust_period_s", 1.0, 3600.0),
+            ("turbulence_m", 0.0, MAX_TURBULENCE_M),
+            ("turbulence_scale_m", 10.0, 10000.0),
+            ("turbulence_period_s", 1.0, 3600.0),
+            ("relight_period_s", 0.5, 3600.0),
+        ):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+                raise FieldError(name, f"expected a number, got {value!r}")
+            value = float(value)
+            if not low <= value <= high:  # NaN fails too
+                raise FieldError(name, f"must be within [{low:g}, {high:g}], got {value}")
+            object.__setattr__(self, name, value)
+
+
+#: the named weathers of `[weather]` (`cloudcore.weather.WEATHER_PRESETS` holds what each sets)
+WEATHER_NAMES = ("fair_weather_cumulus", "scattered", "broken", "overcast")
+
+
+@dataclass(frozen=True)
+class Weather:
+    """A named weather over a scene's cloud field (`cloudcore.weather`): `preset` sets its coverage, cloud type and
+    altitudes; with `to`, the weather changes to that one over `duration_s` seconds of the scene clock from
+    `start_s`, the coverage following a smoothstep between the two."""
+
+    preset: str = "scattered"
+    to: str | None = None
+    start_s: float = 0.0
+    duration_s: float = 600.0
+
+    def __post_init__(self):
+        for name in ("preset", "to"):
+            value = getattr(self, name)
+            if (value is not None or name == "preset") and value not in WEATHER_NAMES:
+                raise FieldError(name, f"{value!r} is not one of: {', '.join(WEATHER_NAMES)}")
+        for name, low, high in (("start_s", -1.0e9, 1.0e9), ("duration_s", 1.0, 86400.0)):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+                raise FieldError(name, f"expected a number, got {value!r}")
+            value = float(value)
+            if not low <= value <= high:  # NaN fails too
+                raise FieldError(name, f"must be within [{low:g}, {high:g}], got {value}")
+            object.__setattr__(self, name, value)
+
+
 @dataclass(frozen=True)
 class Scene:
     camera: Camera = Camera()
@@ -361,6 +455,10 @@ class Scene:
     views: tuple[View, ...] = ()
     #: clouds generated around the eye to the horizon (`[cloud_field]`), besides the authored `clouds`
     cloud_field: CloudField | None = None
+    #: the air's motion (`[wind]`): the clouds drift and churn with the scene clock; None: still air
+    wind: Wind | None = None
+    #: named weather over the cloud field (`[weather]`), changing with the scene clock; None: the field's own keys
+    weather: Weather | None = None
 
     @property
     def particle_count(self) -> int:

@@ -47,6 +47,8 @@ from cloudcore.scene import (
     Shading,
     Terrain,
     View,
+    Weather,
+    Wind,
 )
 from cloudcore.settings import MODES, RenderSettings, setting_options
 from cloudcore.toml_table import Table, checked_matrix, field_error
@@ -79,6 +81,8 @@ TABLE_KEYS = {
     "clouds.sprite": record_keys(SpriteStyle),
     "clouds.artist": record_keys(ArtistShading),
     "cloud_field": record_keys(CloudField),
+    "wind": record_keys(Wind),
+    "weather": record_keys(Weather),
     # a heightmap's heights are read from `heightmap`, not written in the scene
     "terrain": record_keys(Terrain, leave_out=("heights",)),
     # a mesh file's triangles are read from `mesh`, not written in the scene
@@ -133,6 +137,8 @@ def scene_from_dict(data: dict, source: str = "<scene>", base_dir=Path(".")) -> 
         description=root.string("description", ""),
         views=views,
         cloud_field=root.table("cloud_field", _cloud_field),
+        wind=root.table("wind", _wind),
+        weather=root.table("weather", _weather),
     )
     # what every field allows, the renderer may still not draw: refuse that here, not in the GL code
     problems = scene_limit_problems(scene)
@@ -332,6 +338,30 @@ def _cloud_field(t: Table) -> CloudField:
         cloud_type=t.string("cloud_type", d.cloud_type, choices=tuple(PRESETS)),
         extent=t.row("extent", 2, d.extent),
         centre=t.row("centre", 2, d.centre),
+    )
+
+
+def _wind(t: Table) -> Wind:
+    """`[wind]`: types here, ranges by the record itself (the editor's panel edits it too)."""
+    t.reject_unknown(TABLE_KEYS["wind"])
+    d = Wind()
+    return t.record(
+        Wind,
+        bands=tuple(map(tuple, t.matrix("bands", 3))) if t.has("bands") else d.bands,
+        **{name: t.number(name, getattr(d, name)) for name in record_keys(Wind, leave_out=("bands",))},
+    )
+
+
+def _weather(t: Table) -> Weather:
+    """`[weather]`: types here, names and ranges by the record itself (the editor's combo sets it too)."""
+    t.reject_unknown(TABLE_KEYS["weather"])
+    d = Weather()
+    return t.record(
+        Weather,
+        preset=t.string("preset", d.preset),
+        to=t.string("to") if t.has("to") else None,
+        start_s=t.number("start_s", d.start_s),
+        duration_s=t.number("duration_s", d.duration_s),
     )
 
 
@@ -545,6 +575,10 @@ def scene_to_dict(scene: Scene) -> dict:
     data["clouds"] = [_cloud_dict(cloud) for cloud in scene.clouds]
     if scene.cloud_field is not None:
         data["cloud_field"] = _record_dict(scene.cloud_field)
+    if scene.wind is not None:
+        data["wind"] = _record_dict(scene.wind)
+    if scene.weather is not None:
+        data["weather"] = {k: v for k, v in _record_dict(scene.weather).items() if v is not None}
     data["objects"] = [_object_dict(o) for o in scene.objects]
     data["camera_paths"] = [{"name": p.name, "keys": _rows(p.keys)} for p in scene.camera_paths]
     data["views"] = [_view_dict(view) for view in scene.views]

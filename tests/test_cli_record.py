@@ -158,6 +158,8 @@ def test_ctrl_c_keeps_a_playable_video_of_the_frames_so_far(tmp_path):
         (["--camera-path", "flythrough", "--out", "{tmp}/x.mp4", "--fps", "nan"], "--fps"),
         (["--camera-path", "flythrough", "--out", "{tmp}/x.mp4", "--fps", "inf"], "--fps"),
         (["--camera-path", "flythrough", "--out", "{tmp}/x.mp4", "--frames", "0"], "--frames"),
+        (["--camera-path", "flythrough", "--out", "{tmp}/x.mp4", "--clock-rate", "0"], "--clock-rate"),
+        (["--camera-path", "flythrough", "--out", "{tmp}/x.mp4", "--clock-rate", "inf"], "--clock-rate"),
         (["--camera-path", "flythrough", "--out", "{tmp}/file/x.mp4"], "{tmp}/file/x.mp4: output:"),
         (["--camera-path", "flythrough", "--frames-dir", "{tmp}/file"], "{tmp}/file: output:"),
         (

@@ -45,8 +45,9 @@ LAYERS = (
         "toml_table",
         "vectors",
     ),
-    # the particles and how they look besides the light: Wang's artist tools, Yusov's cloud fields
-    ("artist", "field"),
+    # the particles and how they look besides the light: Wang's artist tools, Yusov's cloud fields, the wind that
+    # moves them and the weather over a field
+    ("artist", "field", "weather", "wind"),
     # what is done with the particles: the light, the level of detail, how splats are drawn
     ("light", "lod", "point_sprites"),
     # measurement

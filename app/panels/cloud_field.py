@@ -1,4 +1,5 @@
-"""The Cloud field panel: the scene's `[cloud_field]` (Yusov's nested grid to the horizon) as widgets.
+"""The Cloud field panel: the scene's `[cloud_field]` (Yusov's nested grid to the horizon) and its `[wind]` as
+widgets.
 
 Each widget edits the scene through the editor's history, on release (a
 slider dragged does not remake the field every frame); the record refuses
@@ -16,7 +17,16 @@ from app.editor import Editor
 from app.panels.widgets import ReleasedSliders
 from app.viewport import Viewport
 from cloudcore.artist.cloudgen import PRESETS
-from cloudcore.scene import MAX_LAYERS, MAX_RINGS, CloudField
+from cloudcore.scene import (
+    MAX_LAYERS,
+    MAX_RINGS,
+    MAX_TURBULENCE_M,
+    MAX_WIND_SPEED,
+    WEATHER_NAMES,
+    CloudField,
+    Weather,
+    Wind,
+)
 
 #: the float sliders: label -> (field, index in a pair or None, low, high, format)
 _SLIDERS = {
@@ -39,6 +49,47 @@ class CloudFieldPanel:
         self.editor, self.viewport, self._sliders = editor, viewport, sliders
 
     def draw(self) -> None:
+        self._field()
+        self._wind()
+
+    def _wind(self) -> None:
+        """`[wind]`: the lowest band's speed and direction (the one band of a wind the panel adds), turbulence and
+        gusts; the clouds move as the scene clock runs (the Camera panel's "Scene time")."""
+        editor = self.editor
+        imgui.separator_text("Wind")
+        wind = editor.scene.wind
+        if wind is None:
+            imgui.text_wrapped("Still air: the clouds stay where they are.")
+            if imgui.button("Add wind"):
+                editor.edit(dataclasses.replace(editor.scene, wind=Wind()))
+            return
+        changes: dict = {}
+        altitude = wind.bands[0][0]
+        if len(wind.bands) > 1:
+            imgui.text(f"{len(wind.bands)} bands: the lowest, at {altitude:.0f} m")
+        speed = self._sliders.slider("Wind speed", wind.bands[0][1], 0.0, MAX_WIND_SPEED, "%.1f m/s")
+        direction = self._sliders.slider("Wind from (deg)", wind.bands[0][2], 0.0, 360.0, "%.0f")
+        if speed is not None or direction is not None:
+            band = (
+                altitude,
+                wind.bands[0][1] if speed is None else speed,
+                wind.bands[0][2] if direction is None else direction,
+            )
+            changes["bands"] = (band, *wind.bands[1:])
+        for label, name, high in (
+            ("Gusts", "gust_amplitude", 1.0),
+            ("Turbulence (m)", "turbulence_m", MAX_TURBULENCE_M),
+        ):
+            value = self._sliders.slider(label, getattr(wind, name), 0.0, high, "%.2f" if high == 1.0 else "%.0f")
+            if value is not None:
+                changes[name] = value
+        if changes:
+            scene = editor.scene
+            editor.change(lambda: dataclasses.replace(scene, wind=dataclasses.replace(wind, **changes)))
+        if imgui.button("Remove wind"):
+            editor.edit(dataclasses.replace(editor.scene, wind=None))
+
+    def _field(self) -> None:
         editor = self.editor
         field = editor.scene.cloud_field
         if field is None:
@@ -67,6 +118,15 @@ class CloudFieldPanel:
             value = self._sliders.slider_int(label, getattr(field, name), 1, high)
             if value is not None:
                 changes[name] = value
+        weather = editor.scene.weather
+        choice = 0 if weather is None else 1 + WEATHER_NAMES.index(weather.preset)
+        changed, choice = imgui.combo("Weather", choice, ["the field's own", *WEATHER_NAMES])
+        if changed:
+            editor.edit(
+                dataclasses.replace(editor.scene, weather=None if choice == 0 else Weather(WEATHER_NAMES[choice - 1]))
+            )
+        if weather is not None:
+            imgui.text_wrapped("The weather sets the coverage, cloud type and altitudes.")
         changed, type_index = imgui.combo("Cloud type", _CLOUD_TYPES.index(field.cloud_type), list(_CLOUD_TYPES))
         if changed:
             changes["cloud_type"] = _CLOUD_TYPES[type_index]
@@ -79,5 +139,5 @@ class CloudFieldPanel:
             imgui.text(
                 f"{len(cells)} cells made, {len(clouds)} cloudy, {sum(len(c.particles) for c in clouds)} particles"
             )
-        if imgui.button("Remove cloud field"):
-            editor.edit(dataclasses.replace(editor.scene, cloud_field=None))
+        if imgui.button("Remove cloud field"):  # its weather with it: a weather without a field is refused
+            editor.edit(dataclasses.replace(editor.scene, cloud_field=None, weather=None))

@@ -177,9 +177,11 @@ class CloudFacings:
         self._particles = particles
         self._locks: dict[int, FacingLocks] = {}
 
-    def update(self, eye) -> list[tuple[int, FacingState]]:
-        """(first particle, state) of each cloud whose locks were updated for `eye` this frame."""
-        particles, eye = self._particles, np.asarray(eye, dtype=np.float64)
+    def update(self, eye, particles=None) -> list[tuple[int, FacingState]]:
+        """(first particle, state) of each cloud whose locks were updated for `eye` this frame; `particles`: where
+        the frame has the particles, when the wind has carried them on (`ParticleBuffer.carried`, the same clouds)."""
+        particles = self._particles if particles is None else particles
+        eye = np.asarray(eye, dtype=np.float64)
         updated = []
         for cloud in particles.styles.sprite_clouds:
             locks = self._locks.get(cloud)

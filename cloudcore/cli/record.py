@@ -1,6 +1,8 @@
 """`cloudview record SCENE --camera-path NAME --out F.mp4`: each frame of a camera path, headless, to H.264 and/or PNGs.
 
-Frame i shows the path at i / fps seconds; --stats writes one CSV row per
+Frame i shows the path at i / fps seconds, the scene clock (the wind, forming clouds, objects on their paths)
+at --clock-rate times that from the path's first key (a time-lapse: the clouds move faster than the camera);
+--stats writes one CSV row per
 frame (`cloudcore.measure.recording.COLUMNS`).  Ctrl-C stops after the frame being
 drawn: the video is finished properly, so it plays with the frames so far,
 and the exit status is 130.  The same arguments give the same frames.
@@ -38,6 +40,12 @@ def add_parser(commands) -> None:
     parser.add_argument("--stats", type=Path, help="one row of frame statistics per frame (CSV)")
     parser.add_argument("--fps", type=frame_rate, default=30.0, help="frames per second (default 30)")
     parser.add_argument("--frames", type=frame_count, help="record only the first N frames")
+    parser.add_argument(
+        "--clock-rate",
+        type=clock_rate,
+        default=1.0,
+        help="scene seconds a second of the path: > 1 a time-lapse of the wind and the clouds (default 1)",
+    )
     parser.add_argument("--width", type=pixel_count, default=640)
     parser.add_argument("--height", type=pixel_count, default=480)
     parser.add_argument(
@@ -69,6 +77,11 @@ def frame_rate(text: str) -> float:
     if not (math.isfinite(value) and value > 0):
         raise ValueError(text)
     return value
+
+
+def clock_rate(text: str) -> float:
+    """Scene seconds a second of the camera path, finite and > 0; argparse names this function in its refusal."""
+    return frame_rate(text)
 
 
 def frame_count(text: str) -> int:
@@ -122,7 +135,9 @@ def run(args) -> int:
         bar = outputs.enter_context(tqdm(total=len(times), unit="frame", desc="record"))
         for index, t in enumerate(times):
             camera = camera_on_path(path, t, scene.camera.fov_y_deg)
-            image, stats = renderer.render(scene, camera=camera, settings=settings, time_s=path.keys[0, 0] + t)
+            image, stats = renderer.render(
+                scene, camera=camera, settings=settings, time_s=path.keys[0, 0] + args.clock_rate * t
+            )
             if not args.no_overdraw:
                 stats = stats.with_overdraw(renderer.measure_overdraw()[1])
             if video is not None:

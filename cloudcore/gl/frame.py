@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
+import math
 import os
 import platform
 import time
@@ -75,6 +76,16 @@ from cloudcore.measured_way import COMPOSITING_WAYS, MeasuredWay
 from cloudcore.scene import Camera, Lighting, Scene
 from cloudcore.settings import FULL_3D, RenderSettings
 from cloudcore.splat_coverage import analytic_overdraw
+from cloudcore.weather import field_under_weather
+from cloudcore.wind import (
+    AirMotion,
+    CloudMotion,
+    field_drift,
+    field_speed,
+    light_time,
+    reshapes,
+    shape_change_bound_m,
+)
 
 
 @dataclass(frozen=True)
@@ -165,6 +176,11 @@ class FrameRenderer:
         self._cloud_weights: np.ndarray | None = None
         self._units: LodUnits | None = None
         self._units_source = None
+        self._air: AirMotion | None = None  # the wind applied to the authored clouds (None: still air)
+        #: this frame's carried particles and units and the clouds' motion, and what they were made from
+        self._carry_source, self._carry_made = None, None
+        self._ring_drift = None  # (ring keys, clouds' drift steps, the keys with them) under wind
+        self._shadow_source = (None, MAP_RESOLUTION)  # the sun and the size of the clouds' transmittance map
         self._layer = None  # screen-sized, sharing the frame's depth: crossfading clouds' full-3D image
         self._inside = []  # (target, its depth renderbuffer) per screen impostor of a frame, all of one size
         self._overdraw_target = None
@@ -176,9 +192,9 @@ class FrameRenderer:
 
     @property
     def units(self) -> LodUnits:
-        """The units (clouds, or groups of interpenetrating clouds) of the scene last rendered; a frame may plan
-        some groups apart (`FramePlan.units`)."""
-        return self._units
+        """The units (clouds, or groups of interpenetrating clouds) of the scene last rendered, where the wind
+        had carried them; a frame may plan some groups apart (`FramePlan.units`)."""
+        return self._units if self._carry_made is None else self._carry_made[1]
 
     @property
     def light_shafts(self) -> LightShaftPass | None:
@@ -242,19 +258,30 @@ class FrameRenderer:
         )
         camera = scene.camera if camera is None else camera
         authored_clouds = len(scene.clouds)
-        scene, fade_keys = self._with_field(scene, camera)
-        illumination_ms = self._prepare(scene, lighting, illumination_method, settings.cloud_shadows, time_s, fade_keys)
+        if scene.weather is not None and scene.cloud_field is not None:  # the field as the weather has it now
+            scene = dataclasses.replace(
+                scene, cloud_field=field_under_weather(scene.cloud_field, scene.weather, time_s)
+            )
+        air = self._air_motion(scene)
+        if air is not None:  # the clouds as their light is made now: at rest, while the wind only carries them
+            scene = dataclasses.replace(scene, clouds=air.lit_clouds(time_s))
+        field_carried = field_drift(scene.wind, scene.cloud_field, time_s)
+        scene, fade_keys = self._with_field(scene, camera, field_carried)
+        illumination_ms = self._prepare(scene, lighting, illumination_method, settings.cloud_shadows)
+        # the units follow the particles' places and sizes, not their light: a relit scene keeps them
+        if (scene.clouds, settings.group_clouds) != self._units_source:
+            self._units = lod_units(self._particles, settings.group_clouds, authored_clouds)
+            self._units_source = (scene.clouds, settings.group_clouds)
+        particles, units, motion = self._carried(air, field_carried, time_s)
+        particles.weigh(self._field_weights)
+        illumination_ms += self._update_shadows(scene, particles, motion, time_s, fade_keys)
         planning_started = time.perf_counter()
-        particles = self._particles
         poses = self._objects.poses(time_s) if self._objects is not None else ()
         starts = particles.cloud_starts
         cloud_keys, ring_keys = self._cloud_keys(scene, fade_keys, time_s)
-        # the units follow the particles' places and sizes, not their light: a relit scene keeps them
-        if (scene.clouds, settings.group_clouds) != self._units_source:
-            self._units = lod_units(particles, settings.group_clouds, authored_clouds)
-            self._units_source = (scene.clouds, settings.group_clouds)
+        ring_keys = self._ring_keys_under_wind(ring_keys, motion, settings)
         plan = plan_frame(
-            self._units,
+            units,
             camera,
             self.size,
             settings,
@@ -268,6 +295,7 @@ class FrameRenderer:
                 particles.radii[starts[cloud] : starts[cloud + 1]],
             ),
             ring_keys,
+            motion,
         )
         self.last_plan = plan
 
@@ -276,7 +304,7 @@ class FrameRenderer:
         self._last_matrices = view, projection
         # in the editor's context the GUI leaves its scissor rectangle on, which would clip our targets
         GL.glDisable(GL.GL_SCISSOR_TEST)
-        for start, facing in self._facings.update(camera.position):
+        for start, facing in self._facings.update(camera.position, particles):
             self._splats.update_facing(particles, start, facing)
         before_passes_ms = 1e3 * (time.perf_counter() - planning_started)
         self._splats.particles_as_points = 0
@@ -393,13 +421,16 @@ class FrameRenderer:
             held += target.nbytes if target is not None else 0
         return held
 
-    def _with_field(self, scene: Scene, camera: Camera) -> tuple[Scene, tuple]:
+    def _with_field(self, scene: Scene, camera: Camera, carried: np.ndarray) -> tuple[Scene, tuple]:
         """The scene with its cloud field's clouds for this eye after its own (`cloudcore.field.state`), and
-        per cloud the key of its blend weights; the field's weights are held for the particle buffer."""
+        per cloud the key of its blend weights; the field's weights are held for the particle buffer.  The field's
+        grid has drifted `carried` (3,) metres with the wind: its cells are made and weighed for the eye's place
+        relative to the air, where the particle buffer's carry (`_carried`) then moves them."""
         if scene.cloud_field is None:
             self.field_state, self._field_weights, self._cloud_weights = FieldState(), None, None
             return scene, (1.0,) * len(scene.clouds)
-        frame, self.field_state = update_field(scene.cloud_field, camera.position, self.field_state)
+        eye_in_air = np.asarray(camera.position, dtype=np.float64) - carried
+        frame, self.field_state = update_field(scene.cloud_field, eye_in_air, self.field_state)
         authored = scene.particle_count
         self._field_weights = np.concatenate([np.ones(authored), frame.weights])
         self._cloud_weights = np.concatenate([np.ones(len(scene.clouds)), frame.mean_weights])
@@ -408,18 +439,9 @@ class FrameRenderer:
             (1.0,) * len(scene.clouds) + frame.fade_keys,
         )
 
-    def _prepare(
-        self,
-        scene: Scene,
-        lighting: Lighting,
-        illumination_method: str,
-        cloud_shadows: bool,
-        time_s: float,
-        fade_keys: tuple,
-    ) -> float:
-        """Rebuild the world pass, the particle illumination and the clouds' transmittance map (at the scene clock
-        `time_s`, forming clouds as opaque as they are then, a field's by their blend weights, whose steps
-        `fade_keys` are) where their inputs changed; ms spent shading."""
+    def _prepare(self, scene: Scene, lighting: Lighting, illumination_method: str, cloud_shadows: bool) -> float:
+        """Rebuild the world pass and the particle illumination where their inputs changed, and say which map of
+        the clouds' shadows the frame takes (`_update_shadows` makes it); ms spent shading."""
         lights, ambient = scene_lights(lighting)
         # a dragged slider's look (the editor's preview) draws the coarse sky, as its clouds are a coarse raster
         preview = illumination_method == PREVIEW_METHOD
@@ -454,22 +476,90 @@ class FrameRenderer:
         illumination_ms = 0.0
         if particles_source != self._particles_source:
             illumination_ms = self._prepare_particles(scene, lights, ambient, particles_source)
-        self._particles.weigh(self._field_weights)
         self._shadows = None if sun is None or not scene.clouds else self.shadow_map
-        if self._shadows is not None:
-            # made again only for another particle buffer, sun or size, or when the clouds' opacities change: every
-            # frame while a cloud forms or dissipates, when a field's clouds' blend weights leave their steps (they
-            # fade in and out, their shadows with them), never while none does (`CloudShadowMap.update`)
-            forming = tuple(formation_state(scene.clouds[index].formation, time_s) for index in self._forming_clouds)
-            self.shadow_map.update(
-                self._particles,
-                sun,
-                PREVIEW_MAP_RESOLUTION if preview else FIELD_MAP_RESOLUTION if scene.cloud_field else MAP_RESOLUTION,
-                self._particles.opacity_factors(time_s),
-                (forming, fade_keys),
-            )
-            self.context.bind_target()
+        self._shadow_source = (
+            sun,
+            PREVIEW_MAP_RESOLUTION if preview else FIELD_MAP_RESOLUTION if scene.cloud_field else MAP_RESOLUTION,
+        )
         return illumination_ms
+
+    def _update_shadows(
+        self, scene: Scene, particles: ParticleBuffer, motion: CloudMotion | None, time_s: float, fade_keys: tuple
+    ) -> float:
+        """Make the clouds' transmittance map again for another particle buffer, sun or size, or when the clouds'
+        opacities change (`CloudShadowMap.update`): every frame while a cloud forms or dissipates, when a field's
+        clouds' blend weights leave their steps (`fade_keys`: they fade in and out, their shadows with them), never
+        while none does; ms spent making it (0 when it was held).  A wind that moves every cloud alike moves the map
+        made of their buffer at rest with them; one that changes them otherwise makes it again each frame, of the
+        particles where they are (`particles`, weighed)."""
+        if self._shadows is None:
+            return 0.0
+        start, made = time.perf_counter(), self.shadow_map.made
+        forming = tuple(formation_state(scene.clouds[index].formation, time_s) for index in self._forming_clouds)
+        opacity = (particles.opacity_factors(time_s), (forming, fade_keys))
+        if motion is not None and not reshapes(motion.wind):
+            self.shadow_map.update(self._particles, *self._shadow_source, *opacity, motion.drifts[0])
+        else:
+            self.shadow_map.update(particles, *self._shadow_source, *opacity)
+        self.context.bind_target()
+        return 1e3 * (time.perf_counter() - start) if self.shadow_map.made != made else 0.0
+
+    def _air_motion(self, scene: Scene) -> AirMotion | None:
+        """The wind applied to the scene's authored clouds (`cloudcore.wind.AirMotion`), made again for other
+        clouds or another wind; None in still air."""
+        if scene.wind is None:
+            self._air = None
+        elif self._air is None or self._air.wind != scene.wind or self._air.clouds is not scene.clouds:
+            self._air = AirMotion(scene.wind, scene.clouds)
+        return self._air
+
+    def _carried(
+        self, air: AirMotion | None, field_carried: np.ndarray, time_s: float
+    ) -> tuple[ParticleBuffer, LodUnits, CloudMotion | None]:
+        """(the particle buffer, the units, what the wind did to each cloud) at `time_s`: the buffer whose light was
+        made for the clouds' shapes now (`AirMotion.lit_clouds`) with every particle carried on to its place now,
+        and the units with it (the same arrays moved: no loop over clouds), the authored clouds by `air`, a field's
+        by its grid's drift `field_carried` (`air` is None only in still air: the buffer and units themselves)."""
+        lit, units = self._particles, self._units
+        if air is None:
+            self._carry_source = self._carry_made = None
+            return lit, units, None
+        source = (lit, units, air, time_s, tuple(field_carried))
+        held = self._carry_source
+        if held is not None and all(a is b for a, b in zip(held[:3], source[:3])) and held[3:] == source[3:]:
+            return self._carry_made
+        authored = len(air.clouds)
+        field_clouds = len(lit.cloud_starts) - 1 - authored
+        field_drifts = np.tile(field_carried, (field_clouds, 1))
+        field_speeds = np.tile(field_speed(air.wind, self.field_state.field, time_s), (field_clouds, 1))
+        field_particles = len(lit.radii) - int(lit.cloud_starts[authored])
+        offsets = np.concatenate([air.carry(time_s), np.tile(field_carried, (field_particles, 1))])
+        drifts = np.concatenate([air.drifts(time_s), field_drifts])
+        # the authored clouds' light was made where they were at `light_time`: their buffer carries them on from there
+        shifts = np.concatenate([air.drifts(time_s) - air.drifts(light_time(air.wind, time_s)), field_drifts])
+        grown = shape_change_bound_m(air.wind, math.inf)
+        self._carry_source = source
+        self._carry_made = (
+            lit.carried(offsets, shifts, grown),
+            units.moved(shifts, grown),
+            CloudMotion(drifts, time_s, air.wind, np.concatenate([air.speeds(time_s), field_speeds])),
+        )
+        return self._carry_made
+
+    def _ring_keys_under_wind(self, ring_keys: tuple, motion: CloudMotion | None, settings: RenderSettings) -> tuple:
+        """Wang's ring's panels follow their clouds' mean drift (`FramePlan.ring_shifts`), but the eye's place relative
+        to the clouds moves the other way: a cloud's ring key changes each time the wind has carried it another
+        rebuild distance (`ring_rebuild_horizontal` of `ring_radius`; the first at half of one), the bound Wang's
+        ring keeps on the eye's own steps, and the ring is built again.  The same tuple while no cloud crossed one."""
+        if motion is None or not math.isfinite(settings.ring_radius):
+            return ring_keys
+        # rounded, not floored: a drift across the wind of -1e-14 m is no step
+        steps = np.rint(motion.drifts / (settings.ring_rebuild_horizontal * settings.ring_radius)).astype(np.int64)
+        held = self._ring_drift
+        if held is None or held[0] is not ring_keys or not np.array_equal(held[1], steps):
+            keys = tuple((*key, tuple(step)) for key, step in zip(ring_keys, steps.tolist()))
+            self._ring_drift = (ring_keys, steps, keys)
+        return self._ring_drift[2]
 
     def _prepare_particles(self, scene: Scene, lights, ambient, particles_source: tuple) -> float:
         """Make the particle buffer (the clouds' light) again for `particles_source` (the clouds, shading,
@@ -745,10 +835,11 @@ class FrameRenderer:
     def _draw_ring(self, frame: _CloudPassFrame, elevation_deg: float) -> None:
         """Wang's ring: the panels of the generations drawn (two while a rebuilt one fades in)."""
         quads = []
-        for generation, weight in frame.plan.ring.draws:
+        shifts = frame.plan.ring_shifts or [np.zeros(3)] * len(frame.plan.ring.draws)
+        for (generation, weight), shift in zip(frame.plan.ring.draws, shifts):
             for segment in generation.occupied_segments:
                 target, corners, extent = self._impostors.ring_panel(generation, segment, elevation_deg)
-                quads.append((np.asarray(corners, dtype=np.float32), target.texture, float(weight), extent))
+                quads.append((np.asarray(corners + shift, dtype=np.float32), target.texture, float(weight), extent))
         self._draw_quad_run(frame, quads)
 
     def _draw_impostors(self, frame: _CloudPassFrame, items) -> None:
@@ -758,6 +849,7 @@ class FrameRenderer:
         images, corners, extents, made_at = self._impostors.cloud_impostors(
             [(cloud.members, item.layer) for cloud, item in zip(clouds, items)]
         )
+        corners = corners + frame.plan.impostor_shifts([item.index for item in items])[:, None, :]
         faded = self._faded([cloud.members for cloud in clouds], made_at)
         weights = np.array([cloud.impostor_weight for cloud in clouds]) * faded
         for _, run in itertools.groupby(range(len(images)), key=lambda i: id(images[i].atlas)):  # one atlas a run
@@ -781,6 +873,7 @@ class FrameRenderer:
         """A unit between its impostor and full 3D: its splats (`batch`) into a screen layer, mixed with the
         impostor."""
         image, corners, extent, made_at = self._impostors.cloud_impostor(cloud.members, item.layer)
+        corners = corners + frame.plan.impostor_shifts([item.index])[0]
         faded = self._faded([cloud.members], np.array([made_at]))
         layer = self._screen_layer()
         layer.bind_cleared()

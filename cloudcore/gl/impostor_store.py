@@ -98,6 +98,10 @@ class ImpostorStore:
             generation, first = ring.building, piece[0] == 0
             size = generation.texture_size
             view, projection = segment_camera(generation, segment, settings.ring_elevation_deg)
+            # the clouds as they were when the ring was planned: moved back by the wind's drift since
+            back = np.eye(4)
+            back[:3, 3] = -plan.ring_build_shift
+            view = view @ back
             clouds = [cloud for unit in members for cloud in unit]
             extent = _extent(particles, clouds, view, projection, size)
             if first:
@@ -106,7 +110,7 @@ class ImpostorStore:
                 target, held = self._ring[generation, segment]
                 extent = _union(held, extent)
             self._ring[generation, segment] = (target, extent)
-            batch = splat_batch(particles, clouds, generation.eye, None, time_s)
+            batch = splat_batch(particles, clouds, np.add(generation.eye, plan.ring_build_shift), None, time_s)
             renders.append((target, batch, view, projection, first))
         selections = _cell_selections(particles, time_s, on_gpu)
         self._splats.shade_ahead(

@@ -46,26 +46,35 @@ class CloudShadowMap:
         self._textures: list[int] = []
         self._texture_size: tuple[int, int] | None = None
         self._source = None
-        #: the view the map was made in, None while there is no map
+        self._made_space: LightSpace | None = None  # the view the map was drawn in
+        #: the view the map is read in (the one it was drawn in, moved with the clouds), None while there is no map
         self.space: LightSpace | None = None
         self.made = 0  # how many times a map was made
 
-    def update(self, particles, sun_direction, resolution: int, opacity_factors=None, factors_key=None) -> None:
+    def update(
+        self,
+        particles,
+        sun_direction,
+        resolution: int,
+        opacity_factors=None,
+        factors_key=None,
+        shift=(0.0, 0.0, 0.0),
+    ) -> None:
         """Make the map of `particles` (a `ParticleBuffer`, each particle's opacity times its `opacity_factors`
-        where given: the clouds' formations) seen from `sun_direction` (toward the sun) at `resolution` texels
-        across, unless it is the one held (the same buffer, sun, resolution and `factors_key`, which names the
-        factors)."""
+        where given: the clouds' formations, a field's blend weights) seen from `sun_direction` (toward the sun) at
+        `resolution` texels across, unless it is the one held (the same buffer, sun, resolution and `factors_key`,
+        which names the factors), and read it as the map of those particles all moved by `shift` (3,) metres: the
+        wind drifting every cloud alike moves their shadows without making the map again (`LightSpace.moved`)."""
         sun = tuple(float(v) for v in sun_direction)
         source = (particles, sun, resolution, factors_key)
-        if self._source is not None and self._source[0] is particles and self._source[1:] == source[1:]:
-            return
-        self._source = source
-        self.space = light_space(particles.centres, particles.radii, sun, resolution)
-        if self.space is None:
-            return
-        opacity = particles.alpha if opacity_factors is None else particles.alpha * opacity_factors
-        self._draw(particles, opacity, self.space)
-        self.made += 1
+        if self._source is None or self._source[0] is not particles or self._source[1:] != source[1:]:
+            self._source = source
+            self._made_space = light_space(particles.centres, particles.radii, sun, resolution)
+            if self._made_space is not None:
+                opacity = particles.alpha if opacity_factors is None else particles.alpha * opacity_factors
+                self._draw(particles, opacity, self._made_space)
+                self.made += 1
+        self.space = None if self._made_space is None else self._made_space.moved(shift)
 
     def _draw(self, particles, opacity, space: LightSpace) -> None:
         # the ground's and the objects' shadow takes each particle's whole opacity out of the sun's beam: nearer the

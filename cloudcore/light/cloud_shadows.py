@@ -31,6 +31,7 @@ own particles are Harris's light pass's: `cloudcore.light.illumination`).
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -92,6 +93,16 @@ class LightSpace:
         y = (points @ np.asarray(self.up) - self.origin[1]) / self.texel_m
         s = (points @ np.asarray(self.forward) - self.near_m) / self.slice_m
         return x, y, s
+
+    def moved(self, shift) -> LightSpace:
+        """This view carried `shift` (3,) metres with what it was made over: the map of particles all moved by one
+        translation (the wind's drift) is the same map, read at points less the shift."""
+        shift = np.asarray(shift, dtype=np.float64)
+        return dataclasses.replace(
+            self,
+            origin=(self.origin[0] + float(shift @ self.right), self.origin[1] + float(shift @ self.up)),
+            near_m=self.near_m + float(shift @ self.forward),
+        )
 
     def world_to_map(self) -> np.ndarray:
         """4x4: world (x, y, z, 1) to (u, v, s, 1), u and v texture coordinates in [0, 1] over the map, s the

@@ -27,6 +27,8 @@ shaded by Wang's artist model instead (`styles`) have their reference in
 
 from __future__ import annotations
 
+import copy
+
 import numpy as np
 
 from cloudcore.artist.formation import core_distances, opacity_factor
@@ -122,6 +124,17 @@ class ParticleBuffer:
         self._weights: np.ndarray | None = None
         #: changes whenever the weights do, so the GL side uploads them only then
         self.weights_serial = 0
+
+    def carried(self, offsets: np.ndarray, cloud_shifts: np.ndarray, grown: float) -> ParticleBuffer:
+        """These particles, each moved by `offsets` (n, 3) metres, with the light, styles and formation they have:
+        the wind's drift and turbulence since their light was made (`cloudcore.wind.AirMotion.carry`).  Each
+        cloud's bounding sphere moves by its `cloud_shifts` (clouds, 3) and grows by `grown` metres, the most a
+        particle strays from its cloud's shift."""
+        moved = copy.copy(self)
+        moved.centres = self.centres + offsets
+        moved.bounding_centres = self.bounding_centres + cloud_shifts
+        moved.bounding_radii = np.where(self.bounding_radii > 0.0, self.bounding_radii + grown, 0.0)
+        return moved
 
     def seen_from(self, eye, indices: np.ndarray, *, time_s: float | None = None) -> tuple[np.ndarray, np.ndarray]:
         """(linear RGB (n, 3), opacity (n,)) of particles `indices` seen from `eye`, near fade applied.

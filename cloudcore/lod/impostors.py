@@ -52,6 +52,11 @@ class ImpostorRecord:
     #: the middle and half the depth, along the view axis from `eye`, of what the texture holds (its particles'
     #: discs; `content_depth`): the near and far points of Harris's parallax (None: the bounding sphere's)
     content: tuple[tuple[float, float, float], float] | None = None
+    #: metres the wind had carried the unit when it was made, and the scene time then (`cloudcore.wind`): the
+    #: quad follows the unit's drift since, and the error counts the eye's place relative to the moved unit and
+    #: how far turbulence may have changed it
+    drift: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    made_at_s: float = 0.0
 
 
 @dataclass(frozen=True)

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -169,6 +170,40 @@ class LodUnits:
             self.finest_radii[rows],
             self.fragment_costs[rows],
             sample=self.sample,
+        )
+
+    def member_means(self, per_cloud: np.ndarray) -> np.ndarray:
+        """(units, 3): the mean over each unit's clouds of `per_cloud` (clouds, 3), without a loop over units."""
+        per_cloud = np.asarray(per_cloud, dtype=np.float64).reshape(-1, 3)
+        if not self.members:
+            return np.zeros((0, 3))
+        flat = np.fromiter(itertools.chain.from_iterable(self.members), dtype=np.int64)
+        return np.add.reduceat(per_cloud[flat], self._member_firsts, axis=0) / self.member_counts[:, None]
+
+    @functools.cached_property
+    def _member_firsts(self) -> np.ndarray:
+        return np.concatenate([[0], np.cumsum(self.member_counts)[:-1]]).astype(np.int64)
+
+    def moved(self, cloud_shifts: np.ndarray, grown: float) -> LodUnits:
+        """These units with their clouds moved by `cloud_shifts` (clouds, 3) metres and each cloud's particles
+        strayed at most `grown` metres besides (the wind: `cloudcore.wind`): a unit moves by its members' mean
+        shift, and its sphere grows by `grown` and by the farthest a member moved from that mean."""
+        cloud_shifts = np.asarray(cloud_shifts, dtype=np.float64).reshape(-1, 3)
+        shifts, spread = self.member_means(cloud_shifts), np.zeros(len(self.members))
+        if self.members:
+            flat = np.fromiter(itertools.chain.from_iterable(self.members), dtype=np.int64)
+            apart = np.linalg.norm(cloud_shifts[flat] - np.repeat(shifts, self.member_counts, axis=0), axis=1)
+            spread = np.maximum.reduceat(apart, self._member_firsts)
+        sample = self.sample
+        if sample is not None:
+            per_sample = np.repeat(cloud_shifts, np.diff(sample.cloud_starts), axis=0)
+            sample = dataclasses.replace(sample, centres=sample.centres + per_sample)
+        return dataclasses.replace(
+            self,
+            centres=self.centres + shifts,
+            radii=np.where(self.radii > 0.0, self.radii + grown + spread, 0.0),
+            clouds=None if self.clouds is None else self.clouds.moved(cloud_shifts, grown),
+            sample=sample,
         )
 
     @staticmethod

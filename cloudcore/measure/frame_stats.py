@@ -24,7 +24,8 @@ class FrameStats:
     frame, on the CPU, on the GPU: `cloudcore.gl.pass_clock`); the defaults are an empty frame's."""
 
     plan: PlanStats = field(default_factory=PlanStats)
-    illumination_ms: float = 0.0  # shading the particles' light, when the scene or its light changed
+    #: shading the particles' light, and making the clouds' shadow map, when the scene, its light or the wind changed
+    illumination_ms: float = 0.0
     frame_ms: float = 0.0  # planning, then world, impostor updates and cloud pass, to the frame's glFinish
     #: on the CPU before the passes: the plan, the splats' facings; auto mode prices its choices there, and on a
     #: 1.2M-particle field that once took longer than its passes

@@ -3,6 +3,7 @@ state to carry into the next frame; its statistics (`plan_stats`)."""
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Mapping
 from dataclasses import dataclass
 
@@ -43,10 +44,26 @@ class FramePlan:
     #: Wang's rules, its upkeep within the tolerance past `RING_FRAME_MS`)
     accepted_error: float = 0.0
     units: LodUnits | None = None  # the frame's units, which `clouds` index: the groups planned apart opened
+    #: (units, 3) metres the wind has carried each unit (`cloudcore.wind`); None: still air
+    unit_drifts: np.ndarray | None = None
+    #: per generation of `ring.draws`, (3,) metres the wind has carried its clouds since it was planned: its panels
+    #: follow them
+    ring_shifts: tuple = ()
+    #: the same for the generation whose segments this frame builds: they are rendered as its clouds were when it was
+    #: planned, so that all its segments agree and `ring_shifts` moves them alike
+    ring_build_shift: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(3))
 
     @property
     def records(self) -> Mapping:
         return self.state.records
+
+    def impostor_shifts(self, indices) -> np.ndarray:
+        """(n, 3) metres the units at `indices` have drifted since their impostors were made: their quads move
+        by it."""
+        if self.unit_drifts is None:
+            return np.zeros((len(indices), 3))
+        held = np.array([self.records[self.clouds.members[i]].drift for i in indices], dtype=np.float64)
+        return self.unit_drifts[list(indices)] - held.reshape(-1, 3)
 
     @property
     def ring_state(self) -> RingState:

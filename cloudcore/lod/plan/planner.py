@@ -87,6 +87,7 @@ from cloudcore.lod.units import LodUnits
 from cloudcore.scene import Camera
 from cloudcore.settings import RenderSettings
 from cloudcore.splat_coverage import splats_in_view
+from cloudcore.wind import CloudMotion
 
 
 def plan_frame(
@@ -101,6 +102,7 @@ def plan_frame(
     costs: CostModel | None = None,
     cloud_splats=None,
     ring_keys: tuple | None = None,
+    motion: CloudMotion | None = None,
 ) -> FramePlan:
     """Plan one frame of `units` (`cloudcore.lod.units.LodUnits`) seen by `camera`.
 
@@ -114,7 +116,9 @@ def plan_frame(
     `ring_keys`, per cloud, is what Wang's ring goes stale by where that is less than `lighting_key`: a cloud
     field's blend weights follow the eye's place, as parallax does, so the ring's rebuild distance bounds their
     change in its panels, while a key that changed with them rebuilt a field's ring every frame (None: the
-    lighting keys).
+    lighting keys).  `motion` (`cloudcore.wind.CloudMotion`) is what the wind has done to the clouds: an
+    impostor follows its unit's drift, and its error counts the unit's motion and change since it was made
+    (`held_impostor_errors`); None: still air.
     """
     scene_particles = float(np.sum(units.particle_counts))
     if state.frame_times and not comparable(state.particles, scene_particles):
@@ -133,6 +137,7 @@ def plan_frame(
             costs,
             cloud_splats,
             ring_keys,
+            motion,
         )
         drawn = {full_plan.clouds.members[i]: Representation("full", 1.0) for i in full_plan.clouds.indices_of("full")}
         return dataclasses.replace(
@@ -150,7 +155,13 @@ def plan_frame(
     groups_may_open = settings.mode == "auto" and settings.groups_apart_in_motion and units.clouds is not None
     # the units and, where groups may be planned apart, their clouds, priced in one pass: a pass costs about
     # 0.2 ms whatever its size (the field's groups priced apart 0.72 -> 0.15 ms a frame)
-    seen = seen_from(units.and_clouds if groups_may_open else units, pricing, priced=prices_units(settings))
+    priced_units = units.and_clouds if groups_may_open else units
+    air_steps = (
+        priced_units.member_means(motion.velocities) * (motion.time_s - state.time_s)
+        if motion is not None and state.time_s is not None
+        else None
+    )
+    seen = seen_from(priced_units, pricing, priced=prices_units(settings), air_steps=air_steps)
     arguments = {
         "pricing": pricing,
         "seen": seen,
@@ -164,6 +175,7 @@ def plan_frame(
         "costs": costs,
         "cloud_splats": cloud_splats,
         "ring_keys": ring_keys,
+        "motion": motion,
     }
     if not groups_may_open:
         return _plan_units(units, frozenset(), **arguments)
@@ -194,6 +206,7 @@ def _plan_units(
     costs: CostModel,
     cloud_splats,
     ring_keys: tuple | None,
+    motion: CloudMotion | None,
 ) -> FramePlan:
     """`plan_frame` with the groups `opened` planned apart, their clouds each a unit of its own; `pricing` is
     `pricing_of`'s, `seen` the `seen_from` of the units (of `LodUnits.and_clouds` when groups may be opened)."""
@@ -226,6 +239,7 @@ def _plan_units(
         seen.lifetimes,
     )
     cloud_keys = lighting_key if isinstance(lighting_key, tuple) else (lighting_key,) * sum(map(len, units.members))
+    unit_drifts = None if motion is None else units.member_means(motion.drifts)
 
     def unit_key(index: int) -> tuple:
         """What the colours of unit `index` were computed from: its clouds' keys."""
@@ -299,7 +313,14 @@ def _plan_units(
             )
         ring_ms, alone_ms = ring_prices.ring_ms, ring_prices.alone_ms
         chases_tolerance = ring_prices.chases_tolerance
-        ring_error = ring_translation_error(state.ring.current, translation_error, eye)
+        # under wind, the eye relative to the ring's clouds, as its panels follow them (`_ring_shift`)
+        current = state.ring.current
+        ring_eye = (
+            eye - _ring_shift(current, current.rows_in(units.members, units.row_of), centres)
+            if unit_drifts is not None and current is not None
+            else eye
+        )
+        ring_error = ring_translation_error(current, translation_error, ring_eye)
         # a candidate drawn on its own until a ring being built takes it: an impostor made for it now lasts only
         # that long (Harris's circle at 800 clouds made 136 impostors in its first frame for a ring in 16 frames)
         lifetimes = np.where(candidates, np.minimum(lifetimes, frames_to_show(state.ring, step, settings)), lifetimes)
@@ -421,7 +442,9 @@ def _plan_units(
         if members in units.row_of and individuals[units.row_of[members]] > 0.0
     }
     held_errors = (
-        held_impostor_errors(units, drawable, records, translation_error, eye) if settings.mode != "full" else None
+        held_impostor_errors(units, drawable, records, translation_error, eye, motion, unit_drifts)
+        if settings.mode != "full"
+        else None
     )
     eye_in = distances[drawable] < INSIDE_RADII * radii[drawable]
     holders, outside = drawable[eye_in], drawable[~eye_in]  # the units the eye is in; those that may be impostors
@@ -575,14 +598,18 @@ def _plan_units(
                 split_distances.get(index, ()),
                 split_objects.get(index, ()),
                 content_depth(centres[index], radii[index], eye, *splats_of(index)) if cloud_splats else None,
+                (0.0, 0.0, 0.0) if unit_drifts is None else tuple(float(v) for v in unit_drifts[index]),
+                0.0 if motion is None else motion.time_s,
             )
         reason = reasons.get(index)
         if reason is not None:
             (regenerate if index in served else postponed)[index] = reason
         texture_sizes[index] = record.size
+    ring_shifts = []  # per generation drawn, how far the wind has carried its clouds since it was planned
     if ring is not None:
         for generation, _ in ring.draws:
             rows = generation.rows_in(units.members, units.row_of)
+            ring_shifts.append(_ring_shift(generation, rows, centres) if unit_drifts is not None else np.zeros(3))
             shown = rows[visible[rows]]
             shown_segments = segments_of(centres[shown], generation.eye)
             pixels = panel_pixels(centres[shown], shown_segments, quad_pixels_of[shown], view_projection, viewport)
@@ -656,6 +683,7 @@ def _plan_units(
         ring_prices=ring_prices,
         object_centres=tuple(tuple(float(v) for v in centre) for centre in object_centres),
         near_work=(units, camera, tuple(viewport), near_work) if near_work else None,
+        time_s=None if motion is None else motion.time_s,
     )
     return FramePlan(
         clouds=plans,
@@ -672,4 +700,21 @@ def _plan_units(
         tolerance_deg=tolerance,
         accepted_error=accepted,
         units=units,
+        unit_drifts=unit_drifts,
+        ring_shifts=tuple(ring_shifts),
+        ring_build_shift=(
+            _ring_shift(ring.building, ring.building.rows_in(units.members, units.row_of), centres)
+            if unit_drifts is not None and ring is not None and ring.building is not None
+            else np.zeros(3)
+        ),
     )
+
+
+def _ring_shift(generation, rows: np.ndarray, centres: np.ndarray) -> np.ndarray:
+    """(3,) metres the clouds of ring `generation` (its members' rows among the units now) have moved, on average,
+    since it was planned: its panels move by it (the wind carries them all alike but for its bands); zeros where a
+    member is gone (the ring is then made again)."""
+    then = generation.spheres[0]
+    if len(rows) != len(then) or not len(rows):
+        return np.zeros(3)
+    return centres[rows].mean(axis=0) - then.mean(axis=0)

@@ -65,9 +65,11 @@ class Seen:
         return Seen(*(getattr(self, field.name)[rows] for field in dataclasses.fields(self)))
 
 
-def seen_from(units: LodUnits, pricing: Pricing, priced: bool = True) -> Seen:
+def seen_from(units: LodUnits, pricing: Pricing, priced: bool = True, air_steps=None) -> Seen:
     """What is seen of `units` from this frame's eye (`pricing`).  Not `priced` (full 3D), only the distances:
-    every price zero."""
+    every price zero.  `air_steps` (units, 3): how far the wind carried each unit since last frame (None: still
+    air); relative to a unit, last frame's eye was that much further along, and its impostor lives as long as the
+    eye's step relative to it allows."""
     eye, last_eye, focal_px, screen_pixels = pricing.eye, pricing.last_eye, pricing.focal_px, pricing.screen_pixels
     centres, radii = units.centres, units.radii
     distances = row_lengths(centres - eye)
@@ -75,7 +77,11 @@ def seen_from(units: LodUnits, pricing: Pricing, priced: bool = True) -> Seen:
         nothing = np.zeros(len(radii))
         return Seen(distances, nothing, nothing, nothing, nothing, nothing + 1.0)
     # the translation error of one frame at the eye's current speed
-    rates = pricing.translation_error(centres, radii, last_eye, eye) if last_eye is not None else np.zeros(len(radii))
+    if last_eye is None:
+        rates = np.zeros(len(radii))
+    else:
+        then = last_eye if air_steps is None else last_eye + air_steps
+        rates = pricing.translation_error(centres, radii, then, eye)
     object_centres, object_radii, depth_steps = pricing.splitting
     if len(object_radii):
         reach = np.linalg.norm(centres[:, None] - object_centres[None], axis=2) < radii[:, None] + object_radii[None]
@@ -276,21 +282,36 @@ def impostor_ms_of(units: LodUnits, seen: Seen, chosen, focal_px, settings, cost
     return costs.quad_pixels * seen.quad_pixels[chosen] + costs.quads + remake / np.maximum(seen.lifetimes[chosen], 1.0)
 
 
-def held_impostor_errors(units: LodUnits, drawable, records: Mapping, translation_error, eye) -> np.ndarray:
+def held_impostor_errors(
+    units: LodUnits, drawable, records: Mapping, translation_error, eye, motion=None, unit_drifts=None
+) -> np.ndarray:
     """Per unit, the translation error of the impostor held (inf: none), measured for the units `drawable` (the
     rest are not drawn on their own: out of view, or in the ring); the parallax between the near and far points
-    of what it holds (`ImpostorRecord.content`) where the record has them."""
+    of what it holds (`ImpostorRecord.content`) where the record has them.
+
+    Under wind (`motion`, a `cloudcore.wind.CloudMotion`, and `unit_drifts` (units, 3) now) a unit's drift since
+    its impostor was made is an eye's step the other way, measured as one; the most turbulence may have moved a
+    particle within it since then, seen from the eye at the sphere's near side, is added in degrees."""
     rows = [row for row in drawable.tolist() if units.members[row] in records]
     errors = np.full(len(units.members), math.inf)
     if not rows:
         return errors
     held = [records[units.members[index]] for index in rows]
     centres, radii = units.centres[rows], units.radii[rows]
+    eyes_now = np.asarray(eye, dtype=np.float64)
+    if unit_drifts is not None:
+        shifts = unit_drifts[rows] - np.array([record.drift for record in held], dtype=np.float64)
+        eyes_now = eyes_now - shifts
+        centres = centres - shifts
     if translation_error is parallax_errors_deg:
         centres = np.array([c if h.content is None else h.content[0] for c, h in zip(centres, held)], dtype=np.float64)
         radii = np.array([r if h.content is None else h.content[1] for r, h in zip(radii, held)], dtype=np.float64)
     eyes = np.array([record.eye for record in held], dtype=np.float64)
-    errors[rows] = np.nan_to_num(translation_error(centres, radii, eyes, eye), nan=math.inf)
+    errors[rows] = np.nan_to_num(translation_error(centres, radii, eyes, eyes_now), nan=math.inf)
+    if motion is not None:
+        changed = motion.shape_change_m([record.made_at_s for record in held])
+        gaps = np.linalg.norm(units.centres[rows] - np.asarray(eye, dtype=np.float64), axis=1) - units.radii[rows]
+        errors[rows] += np.degrees(np.arctan2(changed, np.maximum(gaps, 0.0)))
     return errors
 
 

@@ -94,6 +94,8 @@ class LodState:
     #: the units near the eye priced splat by splat last frame, for the same view to ask again (a still eye):
     #: (units, camera, viewport, {members: (their clouds' keys, Work)}), or None
     near_work: tuple | None = None
+    #: last frame's scene clock under wind (None: still air): the wind's step since carries the units
+    time_s: float | None = None
 
     def measured(self, measurements, fit: bool = True) -> LodState:
         """The state with this frame's (predicted work, measured ms) pairs folded into the cost fit (unless not

@@ -1,0 +1,167 @@
+"""Clouds in the wind, rendered: drawn where the wind took them, in full 3D and as impostors that follow them,
+remade when their cloud has moved past the tolerance, and lit once while they only drift."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from cloudcore.artist.cloudgen import preset_cloud
+from cloudcore.gl.frame import FrameRenderer
+from cloudcore.light.illumination import IlluminationCache
+from cloudcore.scene import Camera, CloudField, Scene, Weather, Wind
+from cloudcore.settings import FULL_3D, RenderSettings
+from cloudcore.wind import drift
+
+pytestmark = pytest.mark.gl
+
+IMPOSTOR = RenderSettings(mode="impostor", ring_radius=float("inf"))
+MODES = {"full": FULL_3D, "impostor": IMPOSTOR}
+#: a westerly: the clouds drift toward +x, across the view
+WIND = Wind(bands=((0.0, 10.0, 270.0),))
+
+
+@pytest.fixture(scope="module")
+def still() -> Scene:
+    # Harris's splats: Wang's artist model shades groups on a grid that stays with the cloud as it drifts (made at
+    # rest), where a cloud put at the drifted place has groups of its own
+    clouds = tuple(
+        dataclasses.replace(preset_cloud("cumulus_humilis", name, centre, seed=seed), sprite=None, artist=None)
+        for name, centre, seed in (("left", (-300.0, 1000.0, 0.0), 3), ("right", (500.0, 1100.0, -400.0), 5))
+    )
+    return Scene(camera=Camera((0.0, 1100.0, 2600.0), (0.0, 1050.0, 0.0), 50.0), clouds=clouds)
+
+
+def carried(scene: Scene, wind: Wind, time_s: float) -> Scene:
+    """`scene` in still air with its clouds where `wind` has carried them by `time_s`."""
+    clouds = tuple(
+        dataclasses.replace(
+            cloud,
+            particles=np.column_stack(
+                [cloud.centres + drift(wind, [cloud.bounding_sphere()[0][1]], time_s)[0], cloud.radii]
+            ),
+        )
+        for cloud in scene.clouds
+    )
+    return dataclasses.replace(scene, clouds=clouds)
+
+
+@pytest.mark.parametrize("mode", MODES)
+def test_at_time_zero_a_windy_scene_is_the_still_one(renderer, still, mode):
+    settings = MODES[mode]
+    image = renderer.render(still, settings=settings)[0]
+    windy = renderer.render(dataclasses.replace(still, wind=WIND), settings=settings)[0]
+    np.testing.assert_array_equal(windy, image)
+
+
+def test_a_drifting_cloud_is_drawn_where_the_wind_took_it(renderer, still):
+    windy = dataclasses.replace(still, wind=WIND)
+    image, _ = renderer.render(windy, settings=FULL_3D, time_s=30.0)
+    centres = renderer.units.centres.copy()
+    expected, _ = renderer.render(carried(still, WIND, 30.0), settings=FULL_3D)
+    # the same splats 300 m east; their light made at rest (a translation leaves Harris's self-shading)
+    assert np.abs(image.astype(int) - expected.astype(int)).max() <= 2
+    np.testing.assert_allclose(centres, renderer.units.centres, atol=1e-6)
+    rest, _ = renderer.render(still, settings=FULL_3D)
+    assert np.abs(image.astype(int) - rest.astype(int)).mean() > 1.0  # and it did move
+
+
+def test_impostors_follow_their_clouds_and_are_remade_once_the_drift_passes_the_tolerance(still):
+    windy = dataclasses.replace(still, wind=WIND)
+    with FrameRenderer(160, 120) as renderer:
+        _, first = renderer.render(windy, settings=IMPOSTOR)
+        made = first.plan.impostors_regenerated
+        assert made >= 1 and first.plan.regeneration_reasons == {"new": made}
+        # 5 m of drift: within the tolerance, the impostors are kept and drawn 5 m on
+        image, kept = renderer.render(windy, settings=IMPOSTOR, time_s=0.5)
+        assert kept.plan.impostors_regenerated == 0
+    with FrameRenderer(160, 120) as fresh:
+        made_there, _ = fresh.render(carried(still, WIND, 0.5), settings=IMPOSTOR)
+    # the kept impostors moved with their clouds: as close to ones made there as their parallax allows
+    assert np.abs(image.astype(int) - made_there.astype(int)).max() <= 6
+    with FrameRenderer(160, 120) as renderer:
+        _, first = renderer.render(windy, settings=IMPOSTOR)
+        _, later = renderer.render(windy, settings=IMPOSTOR, time_s=60.0)  # 600 m across the view, the eye still
+        assert later.plan.regeneration_reasons == {"translation": first.plan.impostors_regenerated}
+
+
+class CountingCache(IlluminationCache):
+    """Counts every (cloud, light direction) pair it shades: `last_recomputed` holds only its last call's."""
+
+    shaded = 0
+
+    def incident(self, *args, **kwargs):
+        incident = super().incident(*args, **kwargs)
+        self.shaded += self.last_recomputed
+        return incident
+
+
+def test_a_drift_keeps_the_light_and_turbulence_relights_at_its_period(still):
+    cache = CountingCache()
+    churning = Wind(bands=((0.0, 10.0, 270.0),), turbulence_m=20.0, relight_period_s=10.0)
+    with FrameRenderer(96, 72, illumination=cache) as renderer:
+        renderer.render(dataclasses.replace(still, wind=WIND), settings=FULL_3D)
+        every = cache.shaded  # (cloud, light direction) pairs: both clouds, each light
+        assert every >= 2
+        for time_s in (20.0, 45.0):
+            renderer.render(dataclasses.replace(still, wind=WIND), settings=FULL_3D, time_s=time_s)
+        assert cache.shaded == every
+        shaded = []
+        for time_s in (1.0, 4.0, 9.5, 10.5, 12.0, 21.0):
+            renderer.render(dataclasses.replace(still, wind=churning), settings=FULL_3D, time_s=time_s)
+            shaded.append(cache.shaded - every)
+        # the first period's light is the clouds' at rest (held from above); then once a period, both clouds
+        assert shaded == [0, 0, 0, every, every, 2 * every]
+
+
+def test_a_field_drifts_with_the_air_its_cells_kept_and_a_change_of_weather_remakes_it_in_steps():
+    field = CloudField(seed=2, coverage=0.5, cell_size=600.0, rings=1)
+    scene = Scene(camera=Camera((0.0, 1500.0, 0.0), (0.0, 1800.0, -3000.0), 60.0), cloud_field=field, wind=WIND)
+    with FrameRenderer(96, 72) as renderer:
+        renderer.render(scene, settings=FULL_3D)
+        slots, cells = renderer.field_state.slots, dict(renderer.field_state.cells)
+        rest = renderer.units.centres.copy()
+        # 200 m east: the eye's place relative to the air moved 200 m west, as if it had flown there; the cells that
+        # stay are the very clouds (their light kept) in their places, carried 200 m
+        renderer.render(scene, settings=FULL_3D, time_s=20.0)
+        kept = [i for i, key in enumerate(renderer.field_state.slots) if i < len(slots) and key == slots[i] and key]
+        assert len(kept) > 10
+        assert all(renderer.field_state.cells[slots[i]] is cells[slots[i]] for i in kept)
+        np.testing.assert_allclose(
+            renderer.units.centres[kept] - rest[kept], np.tile([200.0, 0.0, 0.0], (len(kept), 1)), atol=1e-6
+        )
+        changing = dataclasses.replace(
+            scene, wind=None, weather=Weather("scattered", to="overcast", start_s=0.0, duration_s=100.0)
+        )
+        coverages = []
+        for time_s in (0.0, 25.0, 50.0, 75.0, 100.0):
+            renderer.render(changing, settings=FULL_3D, time_s=time_s)
+            coverages.append(renderer.field_state.field.coverage)
+        np.testing.assert_allclose(coverages, [0.4, 0.5, 0.7, 0.85, 0.95], atol=1e-9)
+
+
+def test_another_wind_at_the_same_time_carries_the_clouds_by_its_own_drift(renderer, still):
+    renderer.render(still, settings=FULL_3D)
+    rest = renderer.units.centres.copy()
+    for speed in (10.0, 20.0, 0.0):  # the editor's slider: a new wind, the clock where it was
+        renderer.render(
+            dataclasses.replace(still, wind=Wind(bands=((0.0, speed, 270.0),))), settings=FULL_3D, time_s=30.0
+        )
+        np.testing.assert_allclose(
+            renderer.units.centres - rest, np.tile([30.0 * speed, 0.0, 0.0], (len(rest), 1)), atol=1e-6
+        )
+
+
+def test_wang_s_ring_follows_its_clouds_drifting_alike_without_being_made_again(still):
+    far = dataclasses.replace(still, camera=Camera((0.0, 1100.0, 6500.0), (0.0, 1050.0, 0.0), 50.0), wind=WIND)
+    ring = RenderSettings(mode="impostor", ring_radius=4000.0)
+    with FrameRenderer(96, 72) as renderer:
+        for _ in range(20):  # its segments built, one a frame, and faded in
+            renderer.render(far, settings=ring)
+        built = renderer.last_plan.ring_state.current
+        assert built is not None and renderer.last_plan.ring_shifts
+        _, stats = renderer.render(far, settings=ring, time_s=25.0)  # 250 m: within half a rebuild distance (600 m)
+        assert renderer.last_plan.ring_state.current is built and stats.plan.ring_segments_built == 0
+        np.testing.assert_allclose(renderer.last_plan.ring_shifts[0], [250.0, 0.0, 0.0], atol=1e-6)
+        _, stats = renderer.render(far, settings=ring, time_s=31.0)  # 310 m: the eye relative to the clouds stepped
+        assert stats.plan.ring_segments_built > 0
