@@ -28,10 +28,18 @@ from cloudcore.cli.render import (
     pixel_count,
     write_output,
 )
+from cloudcore.cli.workers import Job, add_workers_argument, run_job
 from cloudcore.colour import linear_to_srgb8
 from cloudcore.errors import SceneError
 from cloudcore.light.shading import EYE_PASSES, METHODS
-from cloudcore.light.truth import DEFAULT_VOXELS_PER_RADIUS, VARIANTS, mitsuba_variant, render_truth
+from cloudcore.light.truth import (
+    DEFAULT_VOXELS_PER_RADIUS,
+    SAMPLES_PER_PASS,
+    VARIANTS,
+    PathTracer,
+    mitsuba_variant,
+    render_truth,
+)
 from cloudcore.measure.benchmark import PSNR_CAP_DB
 from cloudcore.measure.imagecompare import compare, diff_image
 from cloudcore.measure.truth_comparison import BODY_ALPHA, CLOUD_ALPHA, region_errors, truth_regions
@@ -89,6 +97,7 @@ def add_parser(commands) -> None:
         help=f"with --json: the models compared, comma-separated (default {','.join(DEFAULT_MODELS)}; "
         "any eye pass-illumination method: yusov-occlusion is Yusov's whole model)",
     )
+    add_workers_argument(parser, f"passes of {SAMPLES_PER_PASS} samples")
     parser.set_defaults(run=run)
 
 
@@ -186,9 +195,60 @@ def _render(scene, camera, args, seed: int):
                 variant=args.variant,
                 progress=lambda done, total: bar.update(done - bar.n),
                 terrain=args.terrain,
+                run_passes=None
+                if args.workers is None
+                else lambda samples: _passes_on_workers(args, camera, seed, samples),
             )
+        except SceneError:  # already says where (a piece that failed on the workers)
+            raise
         except ValueError as error:
             raise SceneError(args.scene, "truth", str(error)) from None
+
+
+def _passes_on_workers(args, camera, seed: int, samples: list[int]):
+    """The truth's passes on `args.workers` processes (`render_truth`'s run_passes); its bar is the spp one."""
+    job = Job(
+        "truth",
+        TruthPasses,
+        (
+            args.scene,
+            args.width,
+            args.height,
+            camera,
+            args.time_of_day,
+            args.voxels_per_radius,
+            args.variant,
+            args.terrain,
+            seed,
+        ),
+        pieces=list(enumerate(samples)),
+        unit="pass",
+        label=lambda index: f"pass {index} (seed {seed})",
+        bar={"disable": True},
+    )
+    return run_job(job, args.workers)
+
+
+class TruthPasses:
+    """One Mitsuba scene of a truth render: a worker of `cloudcore.cli.workers`, called with (pass number,
+    samples), giving `PathTracer.pass_radiance`."""
+
+    def __init__(self, scene_file, width, height, camera, time_of_day, voxels_per_radius, variant, terrain, seed):
+        self.tracer = PathTracer(
+            load_scene(scene_file),
+            width,
+            height,
+            camera=camera,
+            time_of_day=time_of_day,
+            voxels_per_radius=voxels_per_radius,
+            variant=variant,
+            terrain=terrain,
+        )
+        self.seed = seed
+
+    def __call__(self, piece: tuple[int, int]) -> np.ndarray:
+        number, samples = piece
+        return self.tracer.pass_radiance(number, samples, self.seed)
 
 
 #: the models that can be compared with the truth: name -> (eye pass, illumination method)
