@@ -153,3 +153,25 @@ def test_a_piece_whose_worker_dies_on_every_try_fails_the_job_in_one_line(truth_
         "the job is given up"
     )
     assert "Traceback" not in result.stderr and not (tmp_path / "t.png").exists()
+
+
+def test_without_ray_a_cluster_is_refused_with_the_extra_to_install(monkeypatch, capsys):
+    monkeypatch.setattr("importlib.util.find_spec", lambda name: None if name == "ray" else True)
+    with pytest.raises(SystemExit) as stopped:
+        main(["check", str(EXAMPLE), "--goldens", "g", "--cluster", "auto"])
+    assert stopped.value.code == 2
+    assert capsys.readouterr().err == (
+        "cloudview check: error: argument --cluster: needs Ray, which is not installed: "
+        "pip install 'cloudview[cluster]' (see --help)\n"
+    )
+
+
+def test_a_truth_on_a_local_ray_is_the_picture_of_one_process_even_when_a_task_s_worker_dies(truth_scene, tmp_path):
+    """`--cluster local` starts a Ray on this machine (as many CPUs as it has: 2 here)."""
+    pytest.importorskip("ray")
+    size = ["--width", "32", "--height", "24", "--spp", "40"]
+    alone = cloudview("truth", truth_scene, "--out", tmp_path / "alone.png", *size)
+    on_ray = cloudview("truth", truth_scene, "--out", tmp_path / "ray.png", *size, "--cluster", "local", kill="2")
+    assert alone.returncode == on_ray.returncode == 0, on_ray.stderr
+    assert "cloudview truth: pass 2 (seed 0): its worker died; running it again (try 2 of 3)" in on_ray.stderr
+    assert (tmp_path / "ray.png").read_bytes() == (tmp_path / "alone.png").read_bytes()

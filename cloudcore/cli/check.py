@@ -18,7 +18,7 @@ from pathlib import Path
 
 from cloudcore.cli.compare import decibels
 from cloudcore.cli.render import pixel_count
-from cloudcore.cli.workers import Job, add_workers_argument, run_job
+from cloudcore.cli.workers import Job, add_workers_arguments, run_job
 from cloudcore.errors import SceneError
 from cloudcore.measure.screenshot_check import (
     DEFAULT_MAX_DIFF,
@@ -72,7 +72,7 @@ def add_parser(commands) -> None:
         metavar="WxH",
         help=f"frame size of every view (default {size_text(DEFAULT_SIZE)})",
     )
-    add_workers_argument(parser, "views")
+    add_workers_arguments(parser, "views")
     parser.set_defaults(run=run)
 
 
@@ -143,7 +143,7 @@ def run(args) -> int:
     from tqdm import tqdm
 
     checks, entries, written = [], [], 0
-    with closing(run_job(job, args.workers)) as renders:
+    with closing(run_job(job, args.workers, args.cluster)) as renders:
         for (name, _, view), actual in zip(cases, renders):
             golden = golden_path(args.goldens, name, view.name)
             check = check_view(name, view.name, actual, golden, default_tolerance.for_view(view))

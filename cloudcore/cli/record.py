@@ -21,7 +21,7 @@ from types import SimpleNamespace
 
 from cloudcore.cli.render import add_scene_argument, pixel_count, write_output
 from cloudcore.cli.settings_args import add_settings_arguments, settings_from
-from cloudcore.cli.workers import Job, add_workers_argument, run_job
+from cloudcore.cli.workers import Job, add_workers_arguments, run_job, spread
 from cloudcore.collector import freeze_what_is_set_up
 from cloudcore.errors import SceneError
 from cloudcore.measure.recording import COLUMNS, frame_row, frame_times
@@ -47,7 +47,7 @@ def add_parser(commands) -> None:
         action="store_true",
         help="leave the overdraw columns empty (measuring replays each frame's cloud draws)",
     )
-    add_workers_argument(parser, "frames")
+    add_workers_arguments(parser, "frames")
     # many frames: impostors pay off
     add_settings_arguments(parser, default_mode="auto")
     parser.set_defaults(run=run)
@@ -123,7 +123,7 @@ def run(args) -> int:
         video = outputs.enter_context(_video(args.out, (args.width, args.height), args.fps)) if args.out else None
         # here one frame a piece keeps Ctrl-C and the bar to a frame; a worker draws runs of consecutive frames, so
         # that auto mode's impostors and crossfades carry from frame to frame as they do here, but at a run's start
-        run = 1 if args.workers is None else FRAMES_PER_PIECE
+        run = FRAMES_PER_PIECE if spread(args) else 1
         frames = list(enumerate(times))
         job = Job(
             "record",
@@ -135,7 +135,7 @@ def run(args) -> int:
             size=len,
         )
         # closed first (exits run last in, first out): a stop kills the workers still drawing, then the video ends
-        runs = outputs.enter_context(closing(run_job(job, args.workers)))
+        runs = outputs.enter_context(closing(run_job(job, args.workers, args.cluster)))
         for (index, t), (image, stats) in zip(frames, itertools.chain.from_iterable(runs)):
             if video is not None:
                 video.send(image)

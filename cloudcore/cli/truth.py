@@ -28,7 +28,7 @@ from cloudcore.cli.render import (
     pixel_count,
     write_output,
 )
-from cloudcore.cli.workers import Job, add_workers_argument, run_job
+from cloudcore.cli.workers import Job, add_workers_arguments, run_job, spread
 from cloudcore.colour import linear_to_srgb8
 from cloudcore.errors import SceneError
 from cloudcore.light.shading import EYE_PASSES, METHODS
@@ -97,7 +97,7 @@ def add_parser(commands) -> None:
         help=f"with --json: the models compared, comma-separated (default {','.join(DEFAULT_MODELS)}; "
         "any eye pass-illumination method: yusov-occlusion is Yusov's whole model)",
     )
-    add_workers_argument(parser, f"passes of {SAMPLES_PER_PASS} samples")
+    add_workers_arguments(parser, f"passes of {SAMPLES_PER_PASS} samples")
     parser.set_defaults(run=run)
 
 
@@ -195,9 +195,7 @@ def _render(scene, camera, args, seed: int):
                 variant=args.variant,
                 progress=lambda done, total: bar.update(done - bar.n),
                 terrain=args.terrain,
-                run_passes=None
-                if args.workers is None
-                else lambda samples: _passes_on_workers(args, camera, seed, samples),
+                run_passes=(lambda samples: _passes_on_workers(args, camera, seed, samples)) if spread(args) else None,
             )
         except SceneError:  # already says where (a piece that failed on the workers)
             raise
@@ -206,7 +204,7 @@ def _render(scene, camera, args, seed: int):
 
 
 def _passes_on_workers(args, camera, seed: int, samples: list[int]):
-    """The truth's passes on `args.workers` processes (`render_truth`'s run_passes); its bar is the spp one."""
+    """The truth's passes on workers (`render_truth`'s run_passes); its bar is the spp one."""
     job = Job(
         "truth",
         TruthPasses,
@@ -226,7 +224,7 @@ def _passes_on_workers(args, camera, seed: int, samples: list[int]):
         label=lambda index: f"pass {index} (seed {seed})",
         bar={"disable": True},
     )
-    return run_job(job, args.workers)
+    return run_job(job, args.workers, args.cluster)
 
 
 class TruthPasses:

@@ -14,6 +14,8 @@ what stops, and kills the workers still holding a piece when it stops early.
 
 from __future__ import annotations
 
+import argparse
+import importlib.util
 import multiprocessing
 import os
 import signal
@@ -22,7 +24,6 @@ from collections import deque
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
-from contextlib import ExitStack
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -44,13 +45,33 @@ def worker_count(text: str) -> int:
     return value
 
 
-def add_workers_argument(parser, piece: str) -> None:
+def cluster_address(text: str) -> str:
+    """--cluster: a Ray address, refused here where Ray is not installed (argparse prints the reason)."""
+    if importlib.util.find_spec("ray") is None:
+        raise argparse.ArgumentTypeError("needs Ray, which is not installed: pip install 'cloudview[cluster]'")
+    return text
+
+
+def add_workers_arguments(parser, pieces: str) -> None:
     parser.add_argument(
         "--workers",
         type=worker_count,
         metavar="N",
-        help=f"spread the {piece} over N worker processes (docs/workers.md); the output is the same for any N",
+        help=f"spread the {pieces} over N worker processes, or N tasks at a time with --cluster (docs/workers.md); "
+        "the output is the same for any N",
     )
+    parser.add_argument(
+        "--cluster",
+        type=cluster_address,
+        metavar="ADDRESS",
+        help="run the pieces as tasks on the Ray cluster at ADDRESS ('auto': the one this machine is part of; "
+        "'local': start one here), as many at a time as it has CPUs unless --workers says",
+    )
+
+
+def spread(args) -> bool:
+    """Whether the command's arguments spread its job (--workers or --cluster)."""
+    return args.workers is not None or args.cluster is not None
 
 
 @dataclass(frozen=True)
@@ -68,20 +89,24 @@ class Job:
     bar: dict = field(default_factory=dict)  # tqdm's options for the job's one progress bar
 
 
-def run_job(job: Job, workers: int | None) -> Iterator:
-    """The results of the job's pieces, in the pieces' order: made in this process when `workers` is None, on
-    `workers` processes otherwise."""
+def run_job(job: Job, workers: int | None, cluster: str | None = None) -> Iterator:
+    """The results of the job's pieces, in the pieces' order: made in this process when neither `workers` nor
+    `cluster` is given, on `workers` processes, or as Ray tasks on `cluster`."""
     from tqdm import tqdm
 
     with tqdm(total=sum(map(job.size, job.pieces)), desc=job.name, unit=job.unit, **job.bar) as bar:
-        if workers is None:
+        if workers is None and cluster is None:
             with job.make_worker(*job.arguments) as worker:
                 for piece in job.pieces:
                     result = worker(piece)
                     bar.update(job.size(piece))
                     yield result
         else:
-            yield from _on_processes(job, workers, bar)
+            places = _RayTasks(cluster, workers) if cluster else _LocalProcesses(min(workers, len(job.pieces)))
+            try:
+                yield from _spread(job, places, bar)
+            finally:
+                places.close()
 
 
 # ---------------------------------------------------------------- in a worker process
@@ -98,11 +123,12 @@ def _start_worker() -> None:
 def _run_piece(make_worker, arguments: tuple, index: int, piece, attempt: int):
     global _worker
     _die_if_asked(index, attempt)
-    if _worker is None:
+    # a Ray worker process may serve pieces of several jobs in turn
+    if _worker is None or _worker[0] != (make_worker, arguments):
         # never closed: it goes with the process (closing a FrameRenderer stores its cost fit for the next run,
         # which N workers would write over one another)
-        _worker = make_worker(*arguments)
-    return _worker(piece)
+        _worker = (make_worker, arguments), make_worker(*arguments)
+    return _worker[1](piece)
 
 
 def _die_if_asked(index: int, attempt: int) -> None:
@@ -113,6 +139,48 @@ def _die_if_asked(index: int, attempt: int) -> None:
 
 
 # ---------------------------------------------------------------- in this process
+
+
+class _WorkerDied(Exception):
+    """The process running a piece ended before the piece did."""
+
+
+def _spread(job: Job, places, bar) -> Iterator:
+    """The pieces' results in order, each piece handed to `places` (`_LocalProcesses` or `_RayTasks`) as it
+    has room, a piece whose worker died handed out again."""
+    waiting = deque(range(len(job.pieces)))
+    attempts = [0] * len(job.pieces)
+    finished: dict[int, Any] = {}
+    running: dict[Any, int] = {}  # a place's handle of a piece -> the piece
+    next_out = 0  # the piece the output waits for
+    while next_out < len(job.pieces):
+        while places.has_room() and waiting and waiting[0] < next_out + RUN_AHEAD * places.capacity:
+            index = waiting.popleft()
+            attempts[index] += 1
+            call = (job.make_worker, job.arguments, index, job.pieces[index], attempts[index])
+            running[places.submit(call)] = index
+        for handle in places.finished(list(running)):
+            index = running.pop(handle)
+            try:
+                finished[index] = places.result(handle)
+            except _WorkerDied:
+                if attempts[index] > RETRIES:
+                    raise SceneError(
+                        f"cloudview {job.name}",
+                        job.label(index),
+                        f"its worker died on each of {attempts[index]} tries: the job is given up",
+                    ) from None
+                bar.write(
+                    f"cloudview {job.name}: {job.label(index)}: its worker died; running it again "
+                    f"(try {attempts[index] + 1} of {RETRIES + 1})",
+                    file=sys.stderr,
+                )
+                waiting.appendleft(index)
+            else:
+                bar.update(job.size(job.pieces[index]))
+        while next_out in finished:
+            yield finished.pop(next_out)
+            next_out += 1
 
 
 class _Process:
@@ -129,55 +197,86 @@ class _Process:
         self.pool.shutdown(wait=True, cancel_futures=True)
 
 
-def _on_processes(job: Job, workers: int, bar) -> Iterator:
-    context = multiprocessing.get_context("spawn")
-    waiting = deque(range(len(job.pieces)))
-    attempts = [0] * len(job.pieces)
-    finished: dict[int, Any] = {}
-    running: dict[Future, tuple[_Process, int]] = {}
-    next_out = 0  # the piece the output waits for
-    with ExitStack() as processes:
-        idle = []
-        for _ in range(min(workers, len(job.pieces))):
-            idle.append(_Process(context))
-            processes.callback(idle[-1].stop)
-        while next_out < len(job.pieces):
-            while idle and waiting and waiting[0] < next_out + RUN_AHEAD * workers:
-                process, index = idle.pop(), waiting.popleft()
-                attempts[index] += 1
-                process.busy = process.pool.submit(
-                    _run_piece, job.make_worker, job.arguments, index, job.pieces[index], attempts[index]
-                )
-                running[process.busy] = process, index
-            done, _ = wait(running, return_when=FIRST_COMPLETED)
-            for future in done:
-                process, index = running.pop(future)
-                process.busy = None
-                try:
-                    finished[index] = future.result()
-                except BrokenProcessPool:
-                    _check_attempts(job, index, attempts[index])
-                    bar.write(
-                        f"cloudview {job.name}: {job.label(index)}: its worker died; running it again "
-                        f"(try {attempts[index] + 1} of {RETRIES + 1})",
-                        file=sys.stderr,
-                    )
-                    waiting.appendleft(index)
-                    process.stop()
-                    process = _Process(context)
-                    processes.callback(process.stop)
-                else:
-                    bar.update(job.size(job.pieces[index]))
-                idle.append(process)
-            while next_out in finished:
-                yield finished.pop(next_out)
-                next_out += 1
+class _LocalProcesses:
+    """`capacity` spawned processes, a piece at a time each: the process a piece died in is known, and replaced."""
+
+    def __init__(self, capacity: int):
+        self.capacity = capacity
+        self._context = multiprocessing.get_context("spawn")
+        self._idle = [_Process(self._context) for _ in range(capacity)]
+        self._holding: dict[Future, _Process] = {}
+
+    def has_room(self) -> bool:
+        return bool(self._idle)
+
+    def submit(self, call: tuple) -> Future:
+        process = self._idle.pop()
+        process.busy = process.pool.submit(_run_piece, *call)
+        self._holding[process.busy] = process
+        return process.busy
+
+    def finished(self, futures: list[Future]) -> set[Future]:
+        return wait(futures, return_when=FIRST_COMPLETED).done
+
+    def result(self, future: Future):
+        process = self._holding.pop(future)
+        process.busy = None
+        try:
+            return future.result()
+        except BrokenProcessPool:
+            process.stop()
+            process = _Process(self._context)  # in the dead one's place
+            raise _WorkerDied from None
+        finally:
+            self._idle.append(process)
+
+    def close(self) -> None:
+        for process in self._idle + list(self._holding.values()):
+            process.stop()
 
 
-def _check_attempts(job: Job, index: int, attempts: int) -> None:
-    if attempts > RETRIES:
-        raise SceneError(
-            f"cloudview {job.name}",
-            job.label(index),
-            f"its worker died on each of {attempts} tries: the job is given up",
-        )
+class _RayTasks:
+    """Pieces as Ray tasks on the cluster at `address`, at most `capacity` at a time (None: its CPUs).  Ray's own
+    retries are off: a task whose worker died comes back to `_spread`, which says so and hands it out again."""
+
+    def __init__(self, address: str, capacity: int | None):
+        import ray
+
+        self._ray = ray
+        try:
+            ray.init(
+                address=address,
+                runtime_env={"env_vars": {"PYOPENGL_PLATFORM": "egl"}},  # headless GL in every worker
+                log_to_driver=False,
+                logging_level="error",
+            )
+        except (ConnectionError, RuntimeError, ValueError) as error:
+            raise SceneError("--cluster", address, str(error).strip().splitlines()[0]) from None
+        self.capacity = capacity or max(1, int(ray.cluster_resources().get("CPU", 1)))
+        self._run = ray.remote(max_retries=0)(_run_piece)
+        self._pending = set()
+
+    def has_room(self) -> bool:
+        return len(self._pending) < self.capacity
+
+    def submit(self, call: tuple):
+        task = self._run.remote(*call)
+        self._pending.add(task)
+        return task
+
+    def finished(self, tasks: list) -> list:
+        return self._ray.wait(tasks, num_returns=1)[0]
+
+    def result(self, task):
+        self._pending.discard(task)
+        try:
+            return self._ray.get(task)
+        except self._ray.exceptions.WorkerCrashedError:
+            raise _WorkerDied from None
+        except self._ray.exceptions.RayTaskError as error:
+            raise error.cause from None  # the piece's own exception, a SceneError one line as here
+
+    def close(self) -> None:
+        for task in self._pending:
+            self._ray.cancel(task, force=True)
+        self._ray.shutdown()
