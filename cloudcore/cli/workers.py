@@ -1,4 +1,5 @@
-"""`--workers N`: a long job's independent pieces spread over N local processes, the results in the pieces' order.
+"""`--workers N` and `--cluster ADDRESS`: a long job's independent pieces spread over N local processes or Ray
+tasks, the results in the pieces' order (docs/workers.md).
 
 A job is a worker class, the arguments to make one, and the pieces.  A worker is made once per process, on the
 process's first piece (its own scene read from the file, its own headless GL context), and is called with each
@@ -6,6 +7,7 @@ piece handed to it; without --workers one worker is made in this process and cal
 both ways run the same code.  Each process is a pool of one (`ProcessPoolExecutor(1)`) that holds one piece at a
 time: a pool whose process dies names the piece that was in it, which runs again in a fresh process, at most
 `RETRIES` more times, each rerun said on stderr; one more death fails the job (a SceneError: one line, exit 2).
+On Ray (`_RayTasks`) the same loop hands the pieces out as tasks, Ray's own retries off so that it says so too.
 
 Processes are started with `spawn`, never forked: a fork of a process holding a GL context shares the driver's
 state with it.  Workers ignore Ctrl-C (the terminal sends it to the whole process group): this process decides
