@@ -60,7 +60,7 @@ def add_workers_arguments(parser, pieces: str) -> None:
         type=worker_count,
         metavar="N",
         help=f"spread the {pieces} over N worker processes, or N tasks at a time with --cluster (docs/workers.md); "
-        "the output is the same for any N",
+        "the output is one process's wherever that is deterministic",
     )
     parser.add_argument(
         "--cluster",
