@@ -1,6 +1,7 @@
 """`--workers N` of `cloudview record`, `truth` and `check`: the same output as the command run in one process,
 a worker killed on purpose has its piece run again, one killed on every try fails the job in one line."""
 
+import importlib.util
 import os
 import subprocess
 import sys
@@ -156,13 +157,24 @@ def test_a_piece_whose_worker_dies_on_every_try_fails_the_job_in_one_line(truth_
 
 
 def test_without_ray_a_cluster_is_refused_with_the_extra_to_install(monkeypatch, capsys):
-    monkeypatch.setattr("importlib.util.find_spec", lambda name: None if name == "ray" else True)
+    found = importlib.util.find_spec
+    monkeypatch.setattr("importlib.util.find_spec", lambda name, *rest: None if name == "ray" else found(name, *rest))
     with pytest.raises(SystemExit) as stopped:
         main(["check", str(EXAMPLE), "--goldens", "g", "--cluster", "auto"])
     assert stopped.value.code == 2
     assert capsys.readouterr().err == (
         "cloudview check: error: argument --cluster: needs Ray, which is not installed: "
         "pip install 'cloudview[cluster]' (see --help)\n"
+    )
+
+
+def test_a_cluster_that_does_not_answer_is_refused_at_once_in_one_line(monkeypatch, capsys, tmp_path):
+    """Ray itself waits minutes for a head that is not there; nothing listens on port 1 here."""
+    found = importlib.util.find_spec
+    monkeypatch.setattr("importlib.util.find_spec", lambda name, *rest: name == "ray" or found(name, *rest))
+    assert main(["check", str(EXAMPLE), "--goldens", str(tmp_path), "--cluster", "127.0.0.1:1"]) == 2
+    assert (
+        capsys.readouterr().err == "cloudview: error: --cluster: 127.0.0.1:1: cannot be reached: Connection refused\n"
     )
 
 

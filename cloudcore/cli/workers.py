@@ -21,6 +21,7 @@ import importlib.util
 import multiprocessing
 import os
 import signal
+import socket
 import sys
 from collections import deque
 from collections.abc import Callable, Iterator, Sequence
@@ -237,11 +238,27 @@ class _LocalProcesses:
             process.stop()
 
 
+#: seconds to wait for a cluster's head to answer before the job is refused (Ray's own wait is minutes)
+CONNECT_TIMEOUT_S = 5.0
+
+
+def _check_reachable(address: str) -> None:
+    """A cluster named by HOST:PORT (or ray://HOST:PORT) answers on that port, else a SceneError at once."""
+    host, separator, port = address.removeprefix("ray://").rpartition(":")
+    if not (separator and host and port.isdigit()):
+        return  # "auto", "local": Ray finds or starts the cluster itself
+    try:
+        socket.create_connection((host, int(port)), timeout=CONNECT_TIMEOUT_S).close()
+    except OSError as error:
+        raise SceneError("--cluster", address, f"cannot be reached: {error.strerror or error}") from None
+
+
 class _RayTasks:
     """Pieces as Ray tasks on the cluster at `address`, at most `capacity` at a time (None: its CPUs).  Ray's own
     retries are off: a task whose worker died comes back to `_spread`, which says so and hands it out again."""
 
     def __init__(self, address: str, capacity: int | None):
+        _check_reachable(address)
         import ray
 
         self._ray = ray
