@@ -195,7 +195,9 @@ def _render(scene, camera, args, seed: int):
                 variant=args.variant,
                 progress=lambda done, total: bar.update(done - bar.n),
                 terrain=args.terrain,
-                run_passes=(lambda samples: _passes_on_workers(args, camera, seed, samples)) if spread(args) else None,
+                run_passes=(lambda samples, grids: _passes_on_workers(args, camera, seed, samples, grids))
+                if spread(args)
+                else None,
             )
         except SceneError:  # already says where (a piece that failed on the workers)
             raise
@@ -203,22 +205,13 @@ def _render(scene, camera, args, seed: int):
             raise SceneError(args.scene, "truth", str(error)) from None
 
 
-def _passes_on_workers(args, camera, seed: int, samples: list[int]):
-    """The truth's passes on workers (`render_truth`'s run_passes); its bar is the spp one."""
+def _passes_on_workers(args, camera, seed: int, samples: list[int], grids):
+    """The truth's passes on workers (`render_truth`'s run_passes), the medium sent to each rather than built
+    again there; its bar is the spp one."""
     job = Job(
         "truth",
         TruthPasses,
-        (
-            args.scene,
-            args.width,
-            args.height,
-            camera,
-            args.time_of_day,
-            args.voxels_per_radius,
-            args.variant,
-            args.terrain,
-            seed,
-        ),
+        (args.scene, grids, args.width, args.height, camera, args.time_of_day, args.variant, args.terrain, seed),
         pieces=list(enumerate(samples)),
         unit="pass",
         label=lambda index: f"pass {index} (seed {seed})",
@@ -231,16 +224,16 @@ class TruthPasses:
     """One Mitsuba scene of a truth render: a worker of `cloudcore.cli.workers`, called with (pass number,
     samples), giving `PathTracer.pass_radiance`."""
 
-    def __init__(self, scene_file, width, height, camera, time_of_day, voxels_per_radius, variant, terrain, seed):
+    def __init__(self, scene_file, grids, width, height, camera, time_of_day, variant, terrain, seed):
         self.tracer = PathTracer(
             load_scene(scene_file),
             width,
             height,
             camera=camera,
             time_of_day=time_of_day,
-            voxels_per_radius=voxels_per_radius,
             variant=variant,
             terrain=terrain,
+            grids=grids,
         )
         self.seed = seed
 

@@ -23,6 +23,7 @@ import os
 import signal
 import socket
 import sys
+import uuid
 from collections import deque
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
@@ -80,7 +81,8 @@ def spread(args) -> bool:
 @dataclass(frozen=True)
 class Job:
     """`make_worker(*arguments)` is called with a piece (and is a context manager, to run in this process); both
-    must pickle (a module's class, plain arguments: a scene goes as its file, which each worker reads)."""
+    must pickle (a module's class, and arguments sent once to each worker: a scene goes as its file, which each
+    worker reads)."""
 
     name: str  # the command, for the progress bar and the messages
     make_worker: Callable[..., Any]
@@ -105,7 +107,9 @@ def run_job(job: Job, workers: int | None, cluster: str | None = None) -> Iterat
                     bar.update(job.size(piece))
                     yield result
         else:
-            places = _RayTasks(cluster, workers) if cluster else _LocalProcesses(min(workers, len(job.pieces)))
+            places = (
+                _RayTasks(job, cluster, workers) if cluster else _LocalProcesses(job, min(workers, len(job.pieces)))
+            )
             try:
                 yield from _spread(job, places, bar)
             finally:
@@ -114,23 +118,29 @@ def run_job(job: Job, workers: int | None, cluster: str | None = None) -> Iterat
 
 # ---------------------------------------------------------------- in a worker process
 
-#: this process's worker, made on its first piece
+#: a local worker process's job, (token, worker class, its arguments), given once when the process starts
+_job = None
+#: this process's worker, (its job's token, the worker), made on its first piece
 _worker = None
 
 
-def _start_worker() -> None:
+def _start_worker(job: tuple) -> None:
+    global _job
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     os.environ.setdefault("PYOPENGL_PLATFORM", "egl")  # headless: before OpenGL is first imported
+    _job = job
 
 
-def _run_piece(make_worker, arguments: tuple, index: int, piece, attempt: int):
+def _run_piece(index: int, piece, attempt: int, job: tuple | None = None):
+    """Piece `index` of `job` (a Ray task's: a Ray worker process may serve several jobs in turn), or of the job
+    this local process was started for."""
     global _worker
+    token, make_worker, arguments = job or _job
     _die_if_asked(index, attempt)
-    # a Ray worker process may serve pieces of several jobs in turn
-    if _worker is None or _worker[0] != (make_worker, arguments):
+    if _worker is None or _worker[0] != token:
         # never closed: it goes with the process (closing a FrameRenderer stores its cost fit for the next run,
         # which N workers would write over one another)
-        _worker = (make_worker, arguments), make_worker(*arguments)
+        _worker = token, make_worker(*arguments)
     return _worker[1](piece)
 
 
@@ -160,8 +170,7 @@ def _spread(job: Job, places, bar) -> Iterator:
         while places.has_room() and waiting and waiting[0] < next_out + RUN_AHEAD * places.capacity:
             index = waiting.popleft()
             attempts[index] += 1
-            call = (job.make_worker, job.arguments, index, job.pieces[index], attempts[index])
-            running[places.submit(call)] = index
+            running[places.submit(index, job.pieces[index], attempts[index])] = index
         for handle in places.finished(list(running)):
             index = running.pop(handle)
             try:
@@ -189,8 +198,8 @@ def _spread(job: Job, places, bar) -> Iterator:
 class _Process:
     """One worker process: a pool of one, which holds at most one piece."""
 
-    def __init__(self, context):
-        self.pool = ProcessPoolExecutor(1, mp_context=context, initializer=_start_worker)
+    def __init__(self, context, job: tuple):
+        self.pool = ProcessPoolExecutor(1, mp_context=context, initializer=_start_worker, initargs=(job,))
         self.pid = self.pool.submit(os.getpid)  # to kill it by, should the job stop while it holds a piece
         self.busy: Future | None = None
 
@@ -203,18 +212,19 @@ class _Process:
 class _LocalProcesses:
     """`capacity` spawned processes, a piece at a time each: the process a piece died in is known, and replaced."""
 
-    def __init__(self, capacity: int):
+    def __init__(self, job: Job, capacity: int):
         self.capacity = capacity
         self._context = multiprocessing.get_context("spawn")
-        self._idle = [_Process(self._context) for _ in range(capacity)]
+        self._job = (None, job.make_worker, job.arguments)  # sent once to each process as it starts
+        self._idle = [_Process(self._context, self._job) for _ in range(capacity)]
         self._holding: dict[Future, _Process] = {}
 
     def has_room(self) -> bool:
         return bool(self._idle)
 
-    def submit(self, call: tuple) -> Future:
+    def submit(self, index: int, piece, attempt: int) -> Future:
         process = self._idle.pop()
-        process.busy = process.pool.submit(_run_piece, *call)
+        process.busy = process.pool.submit(_run_piece, index, piece, attempt)
         self._holding[process.busy] = process
         return process.busy
 
@@ -228,7 +238,7 @@ class _LocalProcesses:
             return future.result()
         except BrokenProcessPool:
             process.stop()
-            process = _Process(self._context)  # in the dead one's place
+            process = _Process(self._context, self._job)  # in the dead one's place
             raise _WorkerDied from None
         finally:
             self._idle.append(process)
@@ -257,7 +267,7 @@ class _RayTasks:
     """Pieces as Ray tasks on the cluster at `address`, at most `capacity` at a time (None: its CPUs).  Ray's own
     retries are off: a task whose worker died comes back to `_spread`, which says so and hands it out again."""
 
-    def __init__(self, address: str, capacity: int | None):
+    def __init__(self, job: Job, address: str, capacity: int | None):
         _check_reachable(address)
         import ray
 
@@ -273,13 +283,15 @@ class _RayTasks:
             raise SceneError("--cluster", address, str(error).strip().splitlines()[0]) from None
         self.capacity = capacity or max(1, int(ray.cluster_resources().get("CPU", 1)))
         self._run = ray.remote(max_retries=0)(_run_piece)
+        # put in Ray's object store once, fetched once a node, whatever the pieces; the token tells the jobs apart
+        self._job = ray.put((uuid.uuid4().hex, job.make_worker, job.arguments))
         self._pending = set()
 
     def has_room(self) -> bool:
         return len(self._pending) < self.capacity
 
-    def submit(self, call: tuple):
-        task = self._run.remote(*call)
+    def submit(self, index: int, piece, attempt: int):
+        task = self._run.remote(index, piece, attempt, self._job)
         self._pending.add(task)
         return task
 

@@ -518,10 +518,12 @@ class PathTracer:
         variant: str | None = None,
         max_depth: int = -1,
         terrain: bool = False,
+        grids: list[MediumGrid] | None = None,
     ):
+        """`grids`: the medium, where it is built already (`medium_grids`'s); otherwise built here."""
         self.camera = scene.camera if camera is None else camera
         self.variant = mitsuba_variant(variant)
-        self.grids = medium_grids(scene, voxels_per_radius)
+        self.grids = medium_grids(scene, voxels_per_radius) if grids is None else grids
         self.ground = terrain_shape(scene.terrain) if terrain and scene.terrain is not None else None
         self._describe = lambda: mitsuba_scene_description(
             self.grids,
@@ -565,8 +567,8 @@ def render_truth(
     `camera` (the scene's).
 
     `spp` samples per pixel in the passes of `pass_samples`, seeded as `PathTracer` says, so a seed gives the
-    same picture every time.  `run_passes(samples)`, given the samples of each pass, gives each pass's
-    `PathTracer.pass_radiance` in order, run elsewhere (by default here); they are added in that order.
+    same picture every time.  `run_passes(samples, grids)`, given the samples of each pass and the medium, gives
+    each pass's `PathTracer.pass_radiance` in order, run elsewhere (by default here); they are added in that order.
     `progress(done, total)` is called after each pass.
     """
     samples = pass_samples(spp)
@@ -586,7 +588,7 @@ def render_truth(
     if run_passes is None:
         passes = (tracer.pass_radiance(number, count, seed) for number, count in enumerate(samples))
     else:
-        passes = run_passes(samples)
+        passes = run_passes(samples, tracer.grids)
     radiance = np.zeros((height, width, 3))
     done = 0
     for count, weighted in zip(samples, passes, strict=True):
