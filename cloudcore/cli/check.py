@@ -5,7 +5,8 @@ rendered headless and compared with `DIR/<scene>/<view>.png`; one line per
 view.  Exit status: 0 when every view passes, 1 when any fails (a missing,
 unreadable or wrong-sized golden fails too), 2 on bad input (a scene that
 does not load, two scenes of one name, an unwritable folder).  `--update`
-writes the goldens whose pixels changed instead, and exits 0.
+writes the goldens whose pixels changed instead, and exits 0.  --workers N (or --cluster) renders the views on
+N processes (`cloudcore.cli.workers`), with the same lines and images.
 """
 
 from __future__ import annotations

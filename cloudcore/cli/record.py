@@ -3,7 +3,9 @@
 Frame i shows the path at i / fps seconds; --stats writes one CSV row per
 frame (`cloudcore.measure.recording.COLUMNS`).  Ctrl-C stops after the frame being
 drawn: the video is finished properly, so it plays with the frames so far,
-and the exit status is 130.  The same arguments give the same frames.
+and the exit status is 130.  The same arguments give the same frames.  --workers N (or --cluster) draws runs
+of frames on N processes (`cloudcore.cli.workers`): the same frames in full 3D, auto mode's within its own
+run-to-run differences (docs/workers.md).
 """
 
 from __future__ import annotations

@@ -5,7 +5,8 @@ eye pass with the exact one, or those --models names (any eye pass with any illu
 truth and the models both show the clouds over the sky, the terrain and objects left out
 (`cloudcore.light.truth` says what the medium and the lights are); --terrain path traces the terrain too, the
 clouds' shadows on it, for a picture alone.  The report renders the truth again
-with the next seed, for its own noise, and each model through the GL renderer in full 3D.
+with the next seed, for its own noise, and each model through the GL renderer in full 3D.  --workers N (or
+--cluster) path traces the passes of 16 samples on N processes (`cloudcore.cli.workers`): the same picture.
 """
 
 from __future__ import annotations
