@@ -15,6 +15,10 @@ class SceneError(ValueError):
         self.problem = problem
         super().__init__(f"{self.source}: {field}: {problem}")
 
+    def __reduce__(self):
+        # raised in a worker process (`cloudcore.cli.workers`), it is pickled back to the command
+        return SceneError, (self.source, self.field, self.problem)
+
 
 class FieldError(ValueError):
     """A value that breaks a record's own rule, naming the field (`levels`, `rotation_deg`...).

@@ -5,7 +5,8 @@ rendered headless and compared with `DIR/<scene>/<view>.png`; one line per
 view.  Exit status: 0 when every view passes, 1 when any fails (a missing,
 unreadable or wrong-sized golden fails too), 2 on bad input (a scene that
 does not load, two scenes of one name, an unwritable folder).  `--update`
-writes the goldens whose pixels changed instead, and exits 0.
+writes the goldens whose pixels changed instead, and exits 0.  --workers N (or --cluster) renders the views on
+N processes (`cloudcore.cli.workers`), with the same lines and images.
 """
 
 from __future__ import annotations
@@ -13,10 +14,12 @@ from __future__ import annotations
 import os
 import shlex
 import sys
+from contextlib import closing
 from pathlib import Path
 
 from cloudcore.cli.compare import decibels
 from cloudcore.cli.render import pixel_count
+from cloudcore.cli.workers import Job, add_workers_arguments, run_job
 from cloudcore.errors import SceneError
 from cloudcore.measure.screenshot_check import (
     DEFAULT_MAX_DIFF,
@@ -70,6 +73,7 @@ def add_parser(commands) -> None:
         metavar="WxH",
         help=f"frame size of every view (default {size_text(DEFAULT_SIZE)})",
     )
+    add_workers_arguments(parser, "views")
     parser.set_defaults(run=run)
 
 
@@ -116,7 +120,8 @@ def scene_files(arguments: list[str]) -> list[tuple[str, Path]]:
 
 def run(args) -> int:
     # every scene is loaded before anything renders: bad input stops the check at once (exit 2)
-    scenes = [(name, load_scene(file)) for name, file in scene_files(args.scenes)]
+    files = scene_files(args.scenes)
+    scenes = [(name, load_scene(file)) for name, file in files]
     if args.goldens.exists() and not args.goldens.is_dir():
         raise SceneError(args.goldens, "--goldens", "is not a folder")
     default_tolerance = Tolerance(args.tolerance_psnr, args.max_diff)
@@ -124,19 +129,23 @@ def run(args) -> int:
         ["cloudview", "check", *args.scenes, "--goldens", str(args.goldens), "--size", size_text(args.size), "--update"]
     )
     cases = [(name, scene, view) for name, scene in scenes for view in scene.all_views]
+    job = Job(
+        "check",
+        CheckViews,
+        (tuple(file for _, file in files), args.size),
+        # (scene, view) by number: a worker reads the scenes from their files
+        pieces=[(number, view) for number, (_, scene) in enumerate(scenes) for view in range(len(scene.all_views))],
+        unit="view",
+        label=lambda index: f"view {cases[index][0]}/{cases[index][2].name}",
+        bar={"delay": 1.0, "leave": False, "disable": None, "file": sys.stderr},
+    )
 
     os.environ.setdefault("PYOPENGL_PLATFORM", "egl")  # headless: before OpenGL is first imported
     from tqdm import tqdm
 
-    from cloudcore.gl.views import ViewRenderer
-
     checks, entries, written = [], [], 0
-    with (
-        ViewRenderer() as renderer,
-        tqdm(cases, desc="check", unit="view", delay=1.0, leave=False, disable=None, file=sys.stderr) as progress,
-    ):
-        for name, scene, view in progress:
-            actual = renderer.render(scene, view, args.size)
+    with closing(run_job(job, args.workers, args.cluster)) as renders:
+        for (name, _, view), actual in zip(cases, renders):
             golden = golden_path(args.goldens, name, view.name)
             check = check_view(name, view.name, actual, golden, default_tolerance.for_view(view))
             note = ""
@@ -148,7 +157,7 @@ def run(args) -> int:
                 line = f"{check.label}: {note}" + (f" (was {check.status}: {check.detail})" if changed else "")
             else:
                 line = check.line(update_command)
-            progress.write(line, file=sys.stdout)
+            tqdm.write(line, file=sys.stdout)
             checks.append(check)
             if args.report:
                 entries.append(keep_images(args.report, check, actual, note))
@@ -160,3 +169,26 @@ def run(args) -> int:
     if args.report:
         print(f"report: {write_report(args.report, entries, 'cloudview check ' + shlex.join(args.scenes))}")
     return 0 if args.update or failed == 0 else 1
+
+
+class CheckViews:
+    """One GL context drawing the views of scenes: a worker of `cloudcore.cli.workers`, called with (scene
+    number, view number), giving the view's image."""
+
+    def __init__(self, scene_files: tuple[Path, ...], size: tuple[int, int]):
+        from cloudcore.gl.views import ViewRenderer
+
+        self.scenes = [load_scene(file) for file in scene_files]
+        self.size = size
+        self.renderer = ViewRenderer()
+
+    def __call__(self, piece: tuple[int, int]):
+        scene_number, view_number = piece
+        scene = self.scenes[scene_number]
+        return self.renderer.render(scene, scene.all_views[view_number], self.size)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.renderer.close()

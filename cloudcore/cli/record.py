@@ -5,23 +5,27 @@ at --clock-rate times that from the path's first key (a time-lapse: the clouds m
 --stats writes one CSV row per
 frame (`cloudcore.measure.recording.COLUMNS`).  Ctrl-C stops after the frame being
 drawn: the video is finished properly, so it plays with the frames so far,
-and the exit status is 130.  The same arguments give the same frames.
+and the exit status is 130.  The same arguments give the same frames.  --workers N (or --cluster) draws runs
+of frames on N processes (`cloudcore.cli.workers`): the same frames in full 3D, auto mode's within its own
+run-to-run differences (docs/workers.md).
 """
 
 from __future__ import annotations
 
 import argparse
 import csv
+import itertools
 import math
 import os
 import signal
 import sys
-from contextlib import ExitStack, contextmanager
+from contextlib import ExitStack, closing, contextmanager
 from pathlib import Path
 from types import SimpleNamespace
 
 from cloudcore.cli.render import add_scene_argument, pixel_count, write_output
 from cloudcore.cli.settings_args import add_settings_arguments, settings_from
+from cloudcore.cli.workers import Job, add_workers_arguments, run_job, spread
 from cloudcore.collector import freeze_what_is_set_up
 from cloudcore.errors import SceneError
 from cloudcore.measure.recording import COLUMNS, frame_row, frame_times
@@ -53,10 +57,14 @@ def add_parser(commands) -> None:
         action="store_true",
         help="leave the overdraw columns empty (measuring replays each frame's cloud draws)",
     )
+    add_workers_arguments(parser, "frames")
     # many frames: impostors pay off
     add_settings_arguments(parser, default_mode="auto")
     parser.set_defaults(run=run)
 
+
+#: frames of a piece of a recording on workers (`cloudview record --workers`)
+FRAMES_PER_PIECE = 8
 
 #: the containers ffmpeg picks by a file's suffix that hold H.264
 VIDEO_SUFFIXES = (".mp4", ".m4v", ".mkv", ".mov")
@@ -113,9 +121,6 @@ def run(args) -> int:
     # headless: EGL must be chosen before OpenGL is first imported
     os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
     import imageio.v3 as iio
-    from tqdm import tqdm
-
-    from cloudcore.gl import FrameRenderer
 
     frame_ms = []
     with _stop_on_interrupt() as stop, ExitStack() as outputs:
@@ -130,16 +135,23 @@ def run(args) -> int:
         rows = csv.DictWriter(table, COLUMNS) if table is not None else None
         if rows is not None:
             rows.writeheader()
-        renderer = outputs.enter_context(FrameRenderer(args.width, args.height, remember_costs=True))
         video = outputs.enter_context(_video(args.out, (args.width, args.height), args.fps)) if args.out else None
-        bar = outputs.enter_context(tqdm(total=len(times), unit="frame", desc="record"))
-        for index, t in enumerate(times):
-            camera = camera_on_path(path, t, scene.camera.fov_y_deg)
-            image, stats = renderer.render(
-                scene, camera=camera, settings=settings, time_s=path.keys[0, 0] + args.clock_rate * t
-            )
-            if not args.no_overdraw:
-                stats = stats.with_overdraw(renderer.measure_overdraw()[1])
+        # here one frame a piece keeps Ctrl-C and the bar to a frame; a worker draws runs of consecutive frames, so
+        # that auto mode's impostors and crossfades carry from frame to frame as they do here, but at a run's start
+        run = FRAMES_PER_PIECE if spread(args) else 1
+        frames = list(enumerate(times))
+        job = Job(
+            "record",
+            RecordFrames,
+            (args.scene, args.camera_path, settings, args.width, args.height, not args.no_overdraw, args.clock_rate),
+            pieces=[frames[start : start + run] for start in range(0, len(frames), run)],
+            unit="frame",
+            label=lambda index: f"frames {index * run}-{min((index + 1) * run, len(frames)) - 1}",
+            size=len,
+        )
+        # closed first (exits run last in, first out): a stop kills the workers still drawing, then the video ends
+        runs = outputs.enter_context(closing(run_job(job, args.workers, args.cluster)))
+        for (index, t), (image, stats) in zip(frames, itertools.chain.from_iterable(runs)):
             if video is not None:
                 video.send(image)
             if args.frames_dir:
@@ -148,9 +160,6 @@ def run(args) -> int:
                 rows.writerow(frame_row(index, t, stats))
                 table.flush()  # a run cut short, even by a kill, keeps its rows
             frame_ms.append(stats.frame_ms)
-            if index == 0:  # the renderer set up: out of the collector's full passes (`cloudcore.collector`)
-                freeze_what_is_set_up()
-            bar.update()
             if stop.requested:
                 break
     written = ", ".join(str(p) for p in (args.out, args.frames_dir, args.stats) if p)
@@ -163,6 +172,43 @@ def run(args) -> int:
         return 130
     print(f"wrote {summary}")
     return 0
+
+
+class RecordFrames:
+    """One GL context drawing frames of a camera path: a worker of `cloudcore.cli.workers`, called with a run of
+    (frame number, seconds along the path), giving (image, frame statistics) of each."""
+
+    def __init__(
+        self, scene_file: str, path_name: str, settings, width: int, height: int, overdraw: bool, clock_rate: float
+    ):
+        from cloudcore.gl import FrameRenderer
+
+        self.scene = load_scene(scene_file)
+        self.path = self.scene.camera_path(path_name)
+        self.settings, self.overdraw, self.clock_rate = settings, overdraw, clock_rate
+        self.renderer = FrameRenderer(width, height, remember_costs=True)
+        self.drawn = 0
+
+    def __call__(self, frames: list[tuple[int, float]]) -> list:
+        return [self.frame(t) for _, t in frames]
+
+    def frame(self, t: float):
+        camera = camera_on_path(self.path, t, self.scene.camera.fov_y_deg)
+        image, stats = self.renderer.render(
+            self.scene, camera=camera, settings=self.settings, time_s=self.path.keys[0, 0] + self.clock_rate * t
+        )
+        if self.overdraw:
+            stats = stats.with_overdraw(self.renderer.measure_overdraw()[1])
+        if self.drawn == 0:  # the renderer set up: out of the collector's full passes (`cloudcore.collector`)
+            freeze_what_is_set_up()
+        self.drawn += 1
+        return image, stats
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.renderer.close()
 
 
 @contextmanager

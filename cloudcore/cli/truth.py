@@ -5,7 +5,8 @@ eye pass with the exact one, or those --models names (any eye pass with any illu
 truth and the models both show the clouds over the sky, the terrain and objects left out
 (`cloudcore.light.truth` says what the medium and the lights are); --terrain path traces the terrain too, the
 clouds' shadows on it, for a picture alone.  The report renders the truth again
-with the next seed, for its own noise, and each model through the GL renderer in full 3D.
+with the next seed, for its own noise, and each model through the GL renderer in full 3D.  --workers N (or
+--cluster) path traces the passes of 16 samples on N processes (`cloudcore.cli.workers`): the same picture.
 """
 
 from __future__ import annotations
@@ -28,10 +29,18 @@ from cloudcore.cli.render import (
     pixel_count,
     write_output,
 )
+from cloudcore.cli.workers import Job, add_workers_arguments, run_job, spread
 from cloudcore.colour import linear_to_srgb8
 from cloudcore.errors import SceneError
 from cloudcore.light.shading import EYE_PASSES, METHODS
-from cloudcore.light.truth import DEFAULT_VOXELS_PER_RADIUS, VARIANTS, mitsuba_variant, render_truth
+from cloudcore.light.truth import (
+    DEFAULT_VOXELS_PER_RADIUS,
+    SAMPLES_PER_PASS,
+    VARIANTS,
+    PathTracer,
+    mitsuba_variant,
+    render_truth,
+)
 from cloudcore.measure.benchmark import PSNR_CAP_DB
 from cloudcore.measure.imagecompare import compare, diff_image
 from cloudcore.measure.truth_comparison import BODY_ALPHA, CLOUD_ALPHA, region_errors, truth_regions
@@ -89,6 +98,7 @@ def add_parser(commands) -> None:
         help=f"with --json: the models compared, comma-separated (default {','.join(DEFAULT_MODELS)}; "
         "any eye pass-illumination method: yusov-occlusion is Yusov's whole model)",
     )
+    add_workers_arguments(parser, f"passes of {SAMPLES_PER_PASS} samples")
     parser.set_defaults(run=run)
 
 
@@ -186,9 +196,51 @@ def _render(scene, camera, args, seed: int):
                 variant=args.variant,
                 progress=lambda done, total: bar.update(done - bar.n),
                 terrain=args.terrain,
+                run_passes=(lambda samples, grids: _passes_on_workers(args, camera, seed, samples, grids))
+                if spread(args)
+                else None,
             )
+        except SceneError:  # already says where (a piece that failed on the workers)
+            raise
         except ValueError as error:
             raise SceneError(args.scene, "truth", str(error)) from None
+
+
+def _passes_on_workers(args, camera, seed: int, samples: list[int], grids):
+    """The truth's passes on workers (`render_truth`'s run_passes), the medium sent to each rather than built
+    again there; its bar is the spp one."""
+    job = Job(
+        "truth",
+        TruthPasses,
+        (args.scene, grids, args.width, args.height, camera, args.time_of_day, args.variant, args.terrain, seed),
+        pieces=list(enumerate(samples)),
+        unit="pass",
+        label=lambda index: f"pass {index} (seed {seed})",
+        bar={"disable": True},
+    )
+    return run_job(job, args.workers, args.cluster)
+
+
+class TruthPasses:
+    """One Mitsuba scene of a truth render: a worker of `cloudcore.cli.workers`, called with (pass number,
+    samples), giving `PathTracer.pass_radiance`."""
+
+    def __init__(self, scene_file, grids, width, height, camera, time_of_day, variant, terrain, seed):
+        self.tracer = PathTracer(
+            load_scene(scene_file),
+            width,
+            height,
+            camera=camera,
+            time_of_day=time_of_day,
+            variant=variant,
+            terrain=terrain,
+            grids=grids,
+        )
+        self.seed = seed
+
+    def __call__(self, piece: tuple[int, int]) -> np.ndarray:
+        number, samples = piece
+        return self.tracer.pass_radiance(number, samples, self.seed)
 
 
 #: the models that can be compared with the truth: name -> (eye pass, illumination method)

@@ -490,6 +490,63 @@ class Truth:
     seed: int
 
 
+def pass_samples(spp: int) -> list[int]:
+    """Samples per pixel of each Mitsuba render call of a truth of `spp`: `SAMPLES_PER_PASS` each, the last
+    the rest."""
+    if spp < 1:
+        raise ValueError(f"samples per pixel must be >= 1, got {spp}")
+    return [min(SAMPLES_PER_PASS, spp - done) for done in range(0, spp, SAMPLES_PER_PASS)]
+
+
+class PathTracer:
+    """The Mitsuba scene of a truth render, and its passes.
+
+    Pass k of a render of `seed` is seeded with (seed << 16) + k, so a pass gives the same samples wherever it
+    runs (`cloudview truth --workers` spreads them over processes) and two seeds share none.  The Mitsuba
+    scene is loaded on the first pass: the compositing needs only the grids and the ground.
+    """
+
+    def __init__(
+        self,
+        scene: Scene,
+        width: int,
+        height: int,
+        *,
+        camera: Camera | None = None,
+        time_of_day: float | None = None,
+        voxels_per_radius: float = DEFAULT_VOXELS_PER_RADIUS,
+        variant: str | None = None,
+        max_depth: int = -1,
+        terrain: bool = False,
+        grids: list[MediumGrid] | None = None,
+    ):
+        """`grids`: the medium, where it is built already (`medium_grids`'s); otherwise built here."""
+        self.camera = scene.camera if camera is None else camera
+        self.variant = mitsuba_variant(variant)
+        self.grids = medium_grids(scene, voxels_per_radius) if grids is None else grids
+        self.ground = terrain_shape(scene.terrain) if terrain and scene.terrain is not None else None
+        self._describe = lambda: mitsuba_scene_description(
+            self.grids,
+            scene,
+            self.camera,
+            width,
+            height,
+            time_of_day=time_of_day,
+            max_depth=max_depth,
+            ground=self.ground,
+        )
+        self._loaded = None
+
+    def pass_radiance(self, number: int, samples: int, seed: int) -> np.ndarray:
+        """(height, width, 3) float64: pass `number`'s mean radiance times its `samples`, so passes add up."""
+        import mitsuba as mi
+
+        if self._loaded is None:
+            self._loaded = mi.load_dict(self._describe())
+        image = mi.render(self._loaded, spp=samples, seed=(seed << 16) + number)
+        return np.asarray(image, dtype=np.float64) * samples
+
+
 def render_truth(
     scene: Scene,
     width: int,
@@ -504,39 +561,44 @@ def render_truth(
     max_depth: int = -1,
     progress=None,
     terrain: bool = False,
+    run_passes=None,
 ) -> Truth:
     """Path trace `scene` (its clouds, sky and, with `terrain`, its heightfield terrain; no objects) from
     `camera` (the scene's).
 
-    `spp` samples per pixel in passes of `SAMPLES_PER_PASS`, pass k seeded with (seed << 16) + k, so a
-    seed gives the same picture every time and two seeds share no samples.  `progress(done, total)`
-    is called after each pass.
+    `spp` samples per pixel in the passes of `pass_samples`, seeded as `PathTracer` says, so a seed gives the
+    same picture every time.  `run_passes(samples, grids)`, given the samples of each pass and the medium, gives
+    each pass's `PathTracer.pass_radiance` in order, run elsewhere (by default here); they are added in that order.
+    `progress(done, total)` is called after each pass.
     """
-    if spp < 1:
-        raise ValueError(f"samples per pixel must be >= 1, got {spp}")
-    import mitsuba as mi
-
+    samples = pass_samples(spp)
     camera = scene.camera if camera is None else camera
     start = time.perf_counter()
-    used_variant = mitsuba_variant(variant)
-    grids = medium_grids(scene, voxels_per_radius)
-    ground = terrain_shape(scene.terrain) if terrain and scene.terrain is not None else None
-    description = mitsuba_scene_description(
-        grids, scene, camera, width, height, time_of_day=time_of_day, max_depth=max_depth, ground=ground
+    tracer = PathTracer(
+        scene,
+        width,
+        height,
+        camera=camera,
+        time_of_day=time_of_day,
+        voxels_per_radius=voxels_per_radius,
+        variant=variant,
+        max_depth=max_depth,
+        terrain=terrain,
     )
-    mitsuba_scene = mi.load_dict(description)
-    passes = -(-spp // SAMPLES_PER_PASS)
+    if run_passes is None:
+        passes = (tracer.pass_radiance(number, count, seed) for number, count in enumerate(samples))
+    else:
+        passes = run_passes(samples, tracer.grids)
     radiance = np.zeros((height, width, 3))
     done = 0
-    for number in range(passes):
-        samples = min(SAMPLES_PER_PASS, spp - done)
-        image = mi.render(mitsuba_scene, spp=samples, seed=(seed << 16) + number)
-        radiance += np.asarray(image, dtype=np.float64) * samples
-        done += samples
+    for count, weighted in zip(samples, passes, strict=True):
+        radiance += weighted
+        done += count
         if progress is not None:
             progress(done, spp)
     radiance /= spp
 
+    grids, ground = tracer.grids, tracer.ground
     lighting = scene.lighting if time_of_day is None else dataclasses.replace(scene.lighting, time_of_day=time_of_day)
     rays = pixel_rays(camera, width, height).reshape(-1, 3)
     eye = np.broadcast_to(np.asarray(camera.position, dtype=np.float64), rays.shape)
@@ -553,7 +615,7 @@ def render_truth(
         sun_depth=_sun_depths(grids, eye, rays, unit_distance, lighting).reshape(height, width),
         ground_distance=ground_distance.reshape(height, width),
         seconds=time.perf_counter() - start,
-        variant=used_variant,
+        variant=tracer.variant,
         voxels=sum(grid.extinction.size for grid in grids),
         spp=spp,
         seed=seed,
