@@ -864,7 +864,13 @@ def the_wind_carries_the_clouds_as_the_clock_runs(ctx, app: EditorUnderTest):
     CHECK(changed > 0.02)
     ctx.item_input_value("Scene time (s)", 0.0)
     ctx.yield_(SETTLE)
-    CHECK(np.array_equal(app.capture(ctx), still))
+    # where they were: the units exactly; the picture within what auto mode changes by drawing a cloud otherwise
+    # than the first time (it chooses by costs measured frame by frame: after the suite's earlier tests, 1.3% of the
+    # pixels by over 10 levels, against 12% carried), never as far as carried
+    CHECK(bool(np.allclose(app.viewport.renderer.units.centres, rest, atol=1e-6)))
+    back = float((np.abs(app.capture(ctx).astype(int) - still.astype(int)).max(axis=2) > 10).mean())
+    app.outcome["wind_back_changed_fraction"] = back
+    CHECK(back < 0.25 * changed)
     for _ in range(3):  # the direction, the speed, the wind added
         undo(ctx)
     CHECK(app.editor.scene.wind is None)
