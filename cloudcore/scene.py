@@ -394,21 +394,30 @@ class Wind:
         if any(not below[0] < above[0] for below, above in zip(bands, bands[1:])):
             raise FieldError("bands", "altitudes must increase from row to row")
         object.__setattr__(self, "bands", bands)
-        for name, low, high in (
-            ("gust_amplitude", 0.0, 1.0),
-            ("gust_period_s", 1.0, 3600.0),
-            ("turbulence_m", 0.0, MAX_TURBULENCE_M),
-            ("turbulence_scale_m", 10.0, 10000.0),
-            ("turbulence_period_s", 1.0, 3600.0),
-            ("relight_period_s", 0.5, 3600.0),
-        ):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-                raise FieldError(name, f"expected a number, got {value!r}")
-            value = float(value)
-            if not low <= value <= high:  # NaN fails too
-                raise FieldError(name, f"must be within [{low:g}, {high:g}], got {value}")
-            object.__setattr__(self, name, value)
+        _set_bounded_numbers(
+            self,
+            (
+                ("gust_amplitude", 0.0, 1.0),
+                ("gust_period_s", 1.0, 3600.0),
+                ("turbulence_m", 0.0, MAX_TURBULENCE_M),
+                ("turbulence_scale_m", 10.0, 10000.0),
+                ("turbulence_period_s", 1.0, 3600.0),
+                ("relight_period_s", 0.5, 3600.0),
+            ),
+        )
+
+
+def _set_bounded_numbers(record, bounds) -> None:
+    """Set each field `name` of the frozen `record` to its value as a float, for each (name, low, high) of `bounds`;
+    a value that is no number, or outside [low, high] (NaN among them), is refused naming the field."""
+    for name, low, high in bounds:
+        value = getattr(record, name)
+        if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+            raise FieldError(name, f"expected a number, got {value!r}")
+        value = float(value)
+        if not low <= value <= high:  # NaN fails too
+            raise FieldError(name, f"must be within [{low:g}, {high:g}], got {value}")
+        object.__setattr__(record, name, value)
 
 
 #: the named weathers of `[weather]` (`cloudcore.weather.WEATHER_PRESETS` holds what each sets)
@@ -431,14 +440,7 @@ class Weather:
             value = getattr(self, name)
             if (value is not None or name == "preset") and value not in WEATHER_NAMES:
                 raise FieldError(name, f"{value!r} is not one of: {', '.join(WEATHER_NAMES)}")
-        for name, low, high in (("start_s", -1.0e9, 1.0e9), ("duration_s", 1.0, 86400.0)):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-                raise FieldError(name, f"expected a number, got {value!r}")
-            value = float(value)
-            if not low <= value <= high:  # NaN fails too
-                raise FieldError(name, f"must be within [{low:g}, {high:g}], got {value}")
-            object.__setattr__(self, name, value)
+        _set_bounded_numbers(self, (("start_s", -1.0e9, 1.0e9), ("duration_s", 1.0, 86400.0)))
 
 
 @dataclass(frozen=True)
