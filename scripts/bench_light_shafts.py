@@ -3,7 +3,7 @@ fraction of the screen's resolution, against a reference marched finely at the s
 the world pass without them.
 
     python scripts/bench_light_shafts.py [SCENE] [--sizes 640x480,1280x800] [--qualities 12x8,16x4,...]
-                                         [--repeat 12] [--json out/bench_light_shafts.json]
+                                         [--repeat 12] [--json out/bench_light_shafts.json] [--pictures DIR]
 
 Four views of the scene: its camera at its time of day, and three it was not tuned on (toward the low sun at 17:30
 from the valley's sunward side's opposite, from 1.5 km up at 16:00, toward the morning sun at 9:00).  Per size and
@@ -11,7 +11,8 @@ view, each quality's world pass (`cloudcore.gl.world.WorldPass`, terrain and sky
 renderer for that view) is drawn in turns with the others and with no shafts, each draw waited for (glFinish), the
 median of --repeat after one of warm-up; its picture (8-bit sRGB) against the reference's (`REFERENCE`) in dB, and
 the shafts' own size: the picture without them against the reference.  What `SHAFT_STEPS` and `SHAFT_REDUCTION`
-were chosen by (docs/atmosphere.md#light-shafts).
+were chosen by (docs/atmosphere.md#light-shafts).  --pictures DIR writes each view's frame (full 3D, the default
+settings) with and without the shafts, side by side, per size: DIR/VIEW_WIDTHxHEIGHT.png.
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ import os
 import time
 from pathlib import Path
 
+import imageio.v3 as imageio
 import numpy as np
 
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
@@ -80,6 +82,20 @@ def timed_draw(world, shafts: bool, context, camera, view, projection, shadows) 
     return 1e3 * (time.perf_counter() - start)
 
 
+def write_pictures(scene, width: int, height: int, folder: Path) -> None:
+    """Each view's frame with the shafts and without, side by side, into `folder`."""
+    folder.mkdir(parents=True, exist_ok=True)
+    with FrameRenderer(width, height) as renderer:
+        for name, (hours, camera) in views(scene).items():
+            frames = [
+                renderer.render(
+                    scene, time_of_day=hours, camera=camera, settings=dataclasses.replace(FULL_3D, light_shafts=on)
+                )[0]
+                for on in (True, False)
+            ]
+            imageio.imwrite(folder / f"{name}_{width}x{height}.png", np.concatenate(frames, axis=1))
+
+
 def measure(scene, width: int, height: int, qualities, repeat: int) -> dict:
     row = {"size": f"{width}x{height}"}
     with FrameRenderer(width, height) as renderer:
@@ -124,10 +140,15 @@ def main() -> None:
     parser.add_argument("--qualities", default="8x8,12x8,16x8,12x4,16x4,24x4,12x16")
     parser.add_argument("--repeat", type=int, default=12)
     parser.add_argument("--json", type=Path)
+    parser.add_argument("--pictures", type=Path, help="write each view with and without shafts here, and stop")
     args = parser.parse_args()
     scene = load_scene(args.scene)
     qualities = [tuple(int(v) for v in quality.split("x")) for quality in args.qualities.split(",")]
     sizes = [tuple(int(v) for v in size.split("x")) for size in args.sizes.split(",")]
+    if args.pictures is not None:
+        for width, height in sizes:
+            write_pictures(scene, width, height, args.pictures)
+        return
     report = {
         "machine": machine(),
         "scene": str(args.scene),
