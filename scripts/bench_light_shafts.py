@@ -10,7 +10,7 @@ from the valley's sunward side's opposite, from 1.5 km up at 16:00, toward the m
 view, each quality's world pass (`cloudcore.gl.world.WorldPass`, terrain and sky, the clouds' shadow map made by a
 renderer for that view) is drawn in turns with the others and with no shafts, each draw waited for (glFinish), the
 median of --repeat after one of warm-up; its picture (8-bit sRGB) against the reference's (`REFERENCE`) in dB, and
-the shafts' own size: the picture without them against the reference.  What `SHAFT_STEPS` and `SHAFT_REDUCTION`
+the shafts' own size: the picture without them against the reference.  What `SHAFT_STEPS` and `SHAFT_COLUMNS`
 were chosen by (docs/atmosphere.md#light-shafts).  --pictures DIR writes each view's frame (full 3D, the default
 settings) with and without the shafts, side by side, per size: DIR/VIEW_WIDTHxHEIGHT.png.
 """

@@ -12,7 +12,7 @@ from test_cloud_shadows import ball, particles_of
 from cloudcore.atmosphere.aerial_perspective import MAX_DISTANCE_M
 from cloudcore.camera import pixel_rays
 from cloudcore.colour import srgb_decode
-from cloudcore.gl.light_shafts import SHAFT_REDUCTION, shaft_size
+from cloudcore.gl.light_shafts import shaft_reduction, shaft_size
 from cloudcore.light.air_between import air_between
 from cloudcore.light.cloud_shadows import SLICES, light_space, opacity_map
 from cloudcore.light.light_shafts import shadowed_in_scattering, shadowed_share, shaft_segments
@@ -120,7 +120,7 @@ def test_the_gl_march_is_numpys(renderer):
     renderer.render(scene, settings=FULL_3D, read_back=False)
     renderer.context.make_current()
     march = renderer.light_shafts.read(blurred=False)
-    width, height = shaft_size(RENDER_WIDTH, RENDER_HEIGHT, SHAFT_REDUCTION)
+    width, height = shaft_size(RENDER_WIDTH, RENDER_HEIGHT, shaft_reduction(RENDER_WIDTH))
     assert march.shape == (height, width, 4)
     centres, radii, _, _ = particles_of(scene.clouds)
     opacity = -np.expm1(-np.full(len(radii), scene.shading.optical_depth))
@@ -167,7 +167,8 @@ def test_shafts_only_darken_and_most_where_most_of_the_air_is_shadowed(renderer)
     assert darker.min() > -2.0 / 255.0  # never brighter (the 8-bit dither aside)
     assert darker.max() > 0.02
     renderer.context.make_current()
-    shares = np.kron(renderer.light_shafts.read()[..., 3], np.ones((SHAFT_REDUCTION, SHAFT_REDUCTION)))
+    block = shaft_reduction(RENDER_WIDTH)
+    shares = np.kron(renderer.light_shafts.read()[..., 3], np.ones((block, block)))
     shares = shares[:RENDER_HEIGHT, :RENDER_WIDTH]
     most, least = shares > np.percentile(shares, 80), shares < np.percentile(shares, 20)
     assert darker[most].mean() > 2.0 * darker[least].mean()

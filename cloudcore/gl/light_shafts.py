@@ -19,11 +19,17 @@ from cloudcore.gl.targets import DepthTexture, TextureTarget
 from cloudcore.light.light_shafts import SHAFT_STEPS
 from cloudcore.scene import Camera
 
-#: screen pixels a shaft pixel spans, per axis: the shafts are as soft as the clouds' shadow map, whose texels
-#: cover many pixels (docs/atmosphere.md#light-shafts)
-SHAFT_REDUCTION = 8
+#: the march's columns, about: its error against a fine march is set by how many rays it has, not by the screen's
+#: pixels, and its cost with them (docs/atmosphere.md#light-shafts)
+SHAFT_COLUMNS = 80
 #: the texture unit of the march's target, as shaders/light_shafts_read.glsl declares it
 SHAFTS_UNIT = 7
+
+
+def shaft_reduction(width: int) -> int:
+    """Screen pixels a shaft pixel spans, per axis, for a frame `width` pixels wide: about `SHAFT_COLUMNS`
+    columns."""
+    return max(1, round(width / SHAFT_COLUMNS))
 
 
 def shaft_size(width: int, height: int, reduction: int) -> tuple[int, int]:
@@ -36,9 +42,9 @@ class LightShaftPass:
     """The march's targets and program; `march` fills them, `bind` lets the terrain's and the sky's programs read
     them."""
 
-    def __init__(self, steps: int = SHAFT_STEPS, reduction: int = SHAFT_REDUCTION):
-        """`steps` along each ray, a shaft pixel for each `reduction`-square block of the screen's (the benchmark
-        of the choice tries others: scripts/bench_light_shafts.py)."""
+    def __init__(self, steps: int = SHAFT_STEPS, reduction: int | None = None):
+        """`steps` along each ray, a shaft pixel for each `reduction`-square block of the screen's, by default
+        `shaft_reduction`'s (the benchmark of the choice tries others: scripts/bench_light_shafts.py)."""
         self._steps, self._reduction = steps, reduction
         self._program = build_program("light_shafts", vertex="world")
         self._blur_program = build_program("light_shafts_blur", vertex="world")
@@ -62,7 +68,8 @@ class LightShaftPass:
         through `view` and `projection`, up to the depth `draw_terrain_depth` draws (nothing: the sky everywhere),
         the sky's rays below `sky_lowest_up` (a cosine to the up) marched at it, as the sky draws them.  Leaves the
         framebuffer of the march bound: the caller binds its own."""
-        size = shaft_size(*screen_size, self._reduction)
+        reduction = shaft_reduction(screen_size[0]) if self._reduction is None else self._reduction
+        size = shaft_size(*screen_size, reduction)
         self._depth.bind_cleared(size)
         if draw_terrain_depth is not None:
             draw_terrain_depth()

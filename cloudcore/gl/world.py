@@ -21,7 +21,7 @@ from cloudcore.atmosphere.sky_view import eye_radius, horizon_angles
 from cloudcore.camera import frustum_planes
 from cloudcore.gl.air_volume import AirVolume
 from cloudcore.gl.context import HeadlessContext
-from cloudcore.gl.light_shafts import SHAFT_REDUCTION, LightShaftPass
+from cloudcore.gl.light_shafts import LightShaftPass
 from cloudcore.gl.programs import build_program, set_matrix, set_vec3
 from cloudcore.gl.shadow_map import CloudShadowMap
 from cloudcore.gl.targets import linear_filtering
@@ -34,8 +34,8 @@ from cloudcore.scene import Camera, Terrain
 from cloudcore.terrain import ground_colours
 from cloudcore.terrain_tiles import TILE_FACES, TILE_VERTICES, TerrainTiles, tile_faces
 
-#: the light shafts' depth of the terrain takes every 4th vertex of a tile's grid: the frames with it and with the
-#: whole grid's agree to 58 dB or more (docs/atmosphere.md#light-shafts)
+#: the light shafts' depth of the terrain takes every 4th vertex of a tile's grid: the frames agree closely with the
+#: whole grid's, whose triangles cost llvmpipe their setup (docs/atmosphere.md#light-shafts)
 _COARSE_TILE_FACES = tile_faces(4)
 #: floats a terrain vertex carries: its position, the sun's light and the sky's (terrain.vert.glsl)
 _VERTEX_FLOATS = 9
@@ -175,10 +175,11 @@ class WorldPass:
         sky: SkyBackground,
         air_for: Callable[[SkyBackground, np.ndarray], AirBetween | None] = air_between,
         shaft_steps: int = SHAFT_STEPS,
-        shaft_reduction: int = SHAFT_REDUCTION,
+        shaft_reduction: int | None = None,
     ):
         """`air_for(sky, eye)`: the air an eye sees through (`air_between`, or the editor's `LiveAir`); the light
-        shafts marched by `shaft_steps` at a pixel for each `shaft_reduction`-square block of the screen's."""
+        shafts marched by `shaft_steps` at a pixel for each `shaft_reduction`-square block of the screen's (None:
+        `light_shafts.shaft_reduction`'s)."""
         self._shaft_quality = shaft_steps, shaft_reduction
         self._sky, self._air_for = sky, air_for
         self._sky_programs: dict[bool, int] = {}  # per light shafts

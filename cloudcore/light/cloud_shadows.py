@@ -48,8 +48,7 @@ SLICES = 8
 #: docs/atmosphere.md#cloud-shadows, "The resolution, by measurement")
 MAP_RESOLUTION, PREVIEW_MAP_RESOLUTION = 512, 256
 #: texels across the map of a scene with a cloud field: made again nearly every frame of a flight (its clouds' blend
-#: weights change), of particles hundreds of metres across; a flight through the demo field's frames cost 19 ms more
-#: with the shadows at 512, 11 at 256 (docs/atmosphere.md#cloud-shadows)
+#: weights change), of particles hundreds of metres across (docs/atmosphere.md#cloud-shadows)
 FIELD_MAP_RESOLUTION = 256
 #: texels across the longer side of the map the light pass reads (clouds shadowing one another): the texel near
 #: the default scene's particles' median radius; a coarser map was no faster, the particles' deposits costing it,
