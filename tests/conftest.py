@@ -96,6 +96,17 @@ def small_scene() -> Scene:
     )
 
 
+def assert_file_refused_in_one_line(path, field: str, problem: str) -> None:
+    """Loading the scene file `path` raises one `SceneError` naming `field` and `problem`, in one line."""
+    from cloudcore.errors import SceneError
+    from cloudcore.scenefile import load_scene
+
+    with pytest.raises(SceneError) as caught:
+        load_scene(path)
+    assert (caught.value.field, caught.value.problem) == (field, problem)
+    assert str(caught.value) == f"{path}: {field}: {problem}" and "\n" not in str(caught.value)
+
+
 def pytest_collection_modifyitems(items):
     """Every test that asks for the shared renderer renders: marked `gl` (modules that render otherwise
     say so themselves with `pytestmark`)."""

@@ -5,6 +5,7 @@ import dataclasses
 
 import numpy as np
 import pytest
+from conftest import assert_file_refused_in_one_line
 
 from cloudcore.errors import FieldError, SceneError
 from cloudcore.ramps import smoothstep
@@ -71,10 +72,7 @@ def test_the_table_reads_saves_and_reads_again(tmp_path):
 def test_every_key_is_refused_in_one_line_naming_file_and_field(tmp_path, table, field, problem):
     path = tmp_path / "bad.toml"
     path.write_text(f"[cloud_field]\n\n[weather]\n{table}\n")
-    with pytest.raises(SceneError) as caught:
-        load_scene(path)
-    assert (caught.value.field, caught.value.problem) == (field, problem)
-    assert str(caught.value) == f"{path}: {field}: {problem}" and "\n" not in str(caught.value)
+    assert_file_refused_in_one_line(path, field, problem)
 
 
 def test_a_weather_without_a_field_is_refused(tmp_path):

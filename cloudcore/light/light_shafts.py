@@ -47,15 +47,13 @@ def shaft_segments(space: LightSpace, eye, directions, distances) -> tuple[np.nd
     start = np.zeros(len(directions))
     end = np.minimum(np.asarray(distances, dtype=np.float64).reshape(-1), MAX_DISTANCE_M)
     bounds = ((0, 0.0, 1.0), (1, 0.0, 1.0), (2, 0.0, np.inf))
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore"):  # a ray still along an axis takes neither face's
         for axis, low, high in bounds:
             rate, at = rates[:, axis], origin[axis]
             moving = np.abs(rate) > 1e-15
-            enter = np.where(rate > 0, (low - at) / rate, (high - at) / rate)
-            leave = np.where(rate > 0, (high - at) / rate, (low - at) / rate)
-            still_inside = low <= at <= high
-            start = np.where(moving, np.maximum(start, np.nan_to_num(enter, nan=-np.inf)), start)
-            end = np.where(moving, np.minimum(end, np.nan_to_num(leave, nan=np.inf)), end if still_inside else -1.0)
+            to_low, to_high = (low - at) / rate, (high - at) / rate
+            start = np.where(moving, np.maximum(start, np.fmin(to_low, to_high)), start)
+            end = np.where(moving, np.minimum(end, np.fmax(to_low, to_high)), end if low <= at <= high else -1.0)
     return start, end
 
 
