@@ -141,6 +141,34 @@ def time_of_day_changes_the_picture(ctx, app: EditorUnderTest):
     CHECK(bool(changed > 0.3))  # the sky and the clouds both change
 
 
+def the_air_panel_changes_the_sky_and_the_light(ctx, app: EditorUnderTest):
+    """Thicker haze pales the sky and the distance; the gradient sky of before; the ground's albedo kept within
+    its range when typed past it; each change one undo step."""
+    use_window(ctx, "Lighting")
+    start = app.editor.scene
+    app.relit(ctx)
+    clear = app.capture(ctx).astype(float)
+    ctx.item_input_value("Haze (x Earth's aerosols)", 20.0)
+    CHECK(abs(app.editor.scene.lighting.air.mie_density_scale - 20.0) < 1e-4)  # through a float32 slider
+    app.relit(ctx)
+    hazy = app.capture(ctx).astype(float)
+    # saturation (the spread of a pixel's channels) falls as the aerosols whiten the sky and the air
+    saturation = {name: float((p.max(axis=2) - p.min(axis=2)).mean()) for name, p in (("clear", clear), ("hazy", hazy))}
+    app.outcome["air_panel_saturation"] = saturation
+    CHECK(saturation["hazy"] < 0.9 * saturation["clear"])  # 0.74 measured
+    ctx.item_input_value("Ground albedo", 2.0)  # past its range: its end
+    CHECK(app.editor.scene.lighting.air.ground_albedo == 1.0)
+    ctx.combo_click("Sky/gradient")
+    CHECK(app.editor.scene.lighting.air.sky == "gradient")
+    app.relit(ctx)
+    gradient = app.capture(ctx).astype(float)
+    CHECK(float((np.abs(gradient - hazy).max(axis=2) > 10).mean()) > 0.1)
+    for _ in range(3):  # the sky, the albedo, the haze
+        undo(ctx)
+    CHECK(app.editor.scene.lighting.air == start.lighting.air)
+    app.editor.edit(start)
+
+
 def shading_pictures(ctx, app: EditorUnderTest, field: str, choice: str) -> tuple[np.ndarray, np.ndarray]:
     """The viewport relit with Harris's shading, then with `choice` picked in the Lighting panel's combo of
     the `Shading` field `field` (the edit undone afterwards), in the afternoon: the light passes shade the sun's
@@ -881,6 +909,7 @@ def the_wind_carries_the_clouds_as_the_clock_runs(ctx, app: EditorUnderTest):
 GUI_TESTS = (
     place_particles_by_clicking,
     time_of_day_changes_the_picture,
+    the_air_panel_changes_the_sky_and_the_light,
     the_saturated_eye_pass_darkens_the_clouds,
     the_occlusion_light_pass_relights_the_clouds,
     dragging_the_time_of_day_relights_live,

@@ -8,14 +8,26 @@ from imgui_bundle import imgui
 
 from app.editor import Editor
 from app.panels.widgets import ReleasedSliders
+from cloudcore.light.lighting import SKIES
 from cloudcore.light.phase import PHASE_NAMES
 from cloudcore.light.shading import EYE_PASSES, LIGHT_PASSES
+from cloudcore.limits import FIELD_RANGES
+from cloudcore.scene import Air
 
 #: the shading sliders: label -> (`Shading` field, low, high)
 _SHADING_SLIDERS = {
     "Albedo": ("albedo", 0.0, 1.0),
     "Optical depth": ("optical_depth", 0.0, 50.0),
     "g": ("g", -0.99, 0.99),
+}
+
+#: the air's sliders: label -> (`Air` field, format, logarithmic); their ranges are the scene file's
+#: (`cloudcore.limits.FIELD_RANGES`).  The haze spans clear air to a hundred times its aerosols, and the altitude
+#: sea level to 50 km: decades a linear slider would crowd into its first pixels
+_AIR_SLIDERS = {
+    "Haze (x Earth's aerosols)": ("mie_density_scale", "%.2f", True),
+    "Ground albedo": ("ground_albedo", "%.2f", False),
+    "Origin altitude (m)": ("origin_altitude_m", "%.0f", True),
 }
 
 
@@ -76,3 +88,25 @@ class LightingPanel:
             changes["eye_pass"] = EYE_PASSES[eye_pass_index]
         if changes:
             editor.edit(dataclasses.replace(scene, shading=dataclasses.replace(shading, **changes)))
+        self._draw_air()
+
+    def _draw_air(self) -> None:
+        """The air the sky and the sun's light come through (docs/atmosphere.md): each change one edit, made on
+        release (a new air builds its tables: a fraction of a second, once per air)."""
+        imgui.separator_text("Air")
+        scene = self.editor.scene
+        air = scene.lighting.air
+        changed_sky, sky_index = imgui.combo("Sky", SKIES.index(air.sky), list(SKIES))
+        imgui.set_item_tooltip(
+            "physical: Hillaire's atmosphere gives the sky, the sun's and the sky's light and the air between the "
+            "eye and what it sees; gradient: the two-colour sky and heuristic light of before (older pictures)."
+        )
+        changes = {"sky": SKIES[sky_index]} if changed_sky else {}
+        for label, (field, fmt, logarithmic) in _AIR_SLIDERS.items():
+            low, high = FIELD_RANGES[Air, field]
+            released = self._sliders.slider(label, getattr(air, field), low, high, fmt, logarithmic)
+            if released is not None:
+                changes[field] = float(released)
+        if changes:
+            lighting = dataclasses.replace(scene.lighting, air=dataclasses.replace(air, **changes))
+            self.editor.edit(dataclasses.replace(scene, lighting=lighting))

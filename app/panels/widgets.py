@@ -26,11 +26,15 @@ def labels_in_full() -> Iterator[None]:
         imgui.pop_item_width()
 
 
-def bounded_slider(label: str, value: float, low: float, high: float, fmt: str = "%.3f") -> tuple[bool, float]:
+def bounded_slider(
+    label: str, value: float, low: float, high: float, fmt: str = "%.3f", logarithmic: bool = False
+) -> tuple[bool, float]:
     """imgui.slider_float whose value stays within [low, high] when a number is typed (ctrl+click): ImGui takes
     any by default, and a typed brush rate of 0, a fly speed of 1e38 or an orbit step of 1e39 raised every frame
-    or flung the camera out of the world.  A number the clamp cannot place (NaN) leaves the value as it was."""
-    changed, typed = imgui.slider_float(label, value, low, high, fmt, imgui.SliderFlags_.always_clamp)
+    or flung the camera out of the world.  A number the clamp cannot place (NaN) leaves the value as it was.
+    `logarithmic` spreads a range of several decades along the slider."""
+    flags = imgui.SliderFlags_.always_clamp | (imgui.SliderFlags_.logarithmic if logarithmic else 0)
+    changed, typed = imgui.slider_float(label, value, low, high, fmt, flags)
     if not low <= typed <= high:
         return False, value
     return changed, typed
@@ -43,9 +47,11 @@ class ReleasedSliders:
     def __init__(self):
         self._dragging: dict[str, float] = {}
 
-    def slider(self, label: str, value: float, low: float, high: float, fmt: str = "%.3f") -> float | None:
-        """The slider `label`; returns the released value, or None."""
-        changed, shown = bounded_slider(label, self._dragging.get(label, value), low, high, fmt)
+    def slider(
+        self, label: str, value: float, low: float, high: float, fmt: str = "%.3f", logarithmic: bool = False
+    ) -> float | None:
+        """The slider `label` (`bounded_slider`'s); returns the released value, or None."""
+        changed, shown = bounded_slider(label, self._dragging.get(label, value), low, high, fmt, logarithmic)
         return self._released(label, changed, shown)
 
     def slider_int(self, label: str, value: int, low: int, high: int) -> int | None:
