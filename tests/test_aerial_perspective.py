@@ -201,22 +201,35 @@ def test_a_quad_is_cut_into_cells_by_the_angle_it_spans():
 
 
 def test_a_new_altitude_s_air_is_coarse_until_its_exact_volume_is_built():
-    """The editor's air (`LiveAir`): a frame at a new altitude gets the coarse volume at once while the exact one
-    is built in the background, then the exact one, the very volume a headless frame waits for."""
+    """The editor's air (`LiveAir`): a frame at a new altitude gets the coarse volume and the scene's sky at once
+    while the exact ones are built in the background, then the exact ones, the very volume and sky a headless
+    frame waits for; a frame at the next altitude meanwhile draws the nearest sky built."""
     sky = scene_sky(Lighting(time_of_day=11.75))
     eye = (0.0, 3456.0, 0.0)  # an altitude no other test draws from, so no volume of it is cached
     live = LiveAir()
+
+    def built(count: int) -> None:
+        for _ in range(400):
+            if live.built >= count:
+                break
+            time.sleep(0.05)
+        assert live.built == count
+
     try:
         first = live(sky, eye)
         assert first.volume.in_scattered.shape == (16, 16, 16, 3)
-        for _ in range(400):
-            if live.built:
-                break
-            time.sleep(0.05)
-        assert live.built == 1
+        assert live.sky_seen_from(sky, eye) is sky
+        built(1)
         exact = live(sky, eye)
         assert exact.volume is air_between(sky, eye).volume and exact.volume.in_scattered.shape == (32, 32, 32, 3)
         assert live(sky, (0.0, 3460.0, 0.0)) is exact, "an eye within the same altitude step draws the same volume"
+        seen = live.sky_seen_from(sky, eye).view
+        assert seen.altitude_m == 3500.0 and np.array_equal(seen.table, sky.seen_from(eye).view.table)
+        climbed = (0.0, 3620.0, 0.0)
+        assert live.sky_seen_from(sky, climbed).view is seen  # until the 3,600 m sky is built
+        live(sky, climbed)
+        built(2)
+        assert live.sky_seen_from(sky, climbed).view.altitude_m == 3600.0
     finally:
         live.close()
 

@@ -19,28 +19,29 @@ def sky_frame(renderer, lighting: Lighting, camera: Camera, method: str = "exact
     return renderer.context.read_linear_rgb()
 
 
-def looking_at_the_sun(hours: float, fov_y_deg: float = 60.0) -> Camera:
-    eye = np.array([0.0, 200.0, 0.0])
+def looking_at_the_sun(hours: float, fov_y_deg: float = 60.0, altitude_m: float = 200.0) -> Camera:
+    eye = np.array([0.0, altitude_m, 0.0])
     return Camera(tuple(eye), tuple(eye + 1000.0 * sun_direction(hours)), fov_y_deg)
 
 
 @pytest.mark.parametrize(
-    ("hours", "sky", "method"),
+    ("hours", "sky", "method", "altitude_m"),
     [
-        (12.0, "physical", "exact"),
-        (18.6, "physical", "exact"),
-        (18.6, "physical", "preview"),
-        (18.6, "gradient", "exact"),
+        (12.0, "physical", "exact", 200.0),
+        (18.6, "physical", "exact", 200.0),
+        (18.6, "physical", "exact", 6000.0),
+        (18.6, "physical", "preview", 200.0),
+        (18.6, "gradient", "exact", 200.0),
     ],
 )
-def test_the_world_pass_draws_the_numpy_sky(renderer, hours, sky, method):
-    """Toward the sun at noon (the disc in the middle), at sunset (the disc on the horizon, the ground below it);
-    a dragged slider's look (the preview method) draws the coarse table."""
+def test_the_world_pass_draws_the_numpy_sky(renderer, hours, sky, method, altitude_m):
+    """Toward the sun at noon (the disc in the middle), at sunset (the disc on the horizon, the ground below it),
+    from 6 km up (the sky seen from there); a dragged slider's look (the preview method) draws the coarse table."""
     lighting = Lighting(time_of_day=hours, air=Air(sky=sky))
-    camera = looking_at_the_sun(hours)
+    camera = looking_at_the_sun(hours, altitude_m=altitude_m)
     drawn = sky_frame(renderer, lighting, camera, method)
     rays = pixel_rays(camera, RENDER_WIDTH, RENDER_HEIGHT)
-    background = scene_sky(lighting, preview=method == PREVIEW_METHOD)
+    background = scene_sky(lighting, preview=method == PREVIEW_METHOD).seen_from(camera.position)
     expected = background.radiance(rays, np.radians(camera.fov_y_deg) / RENDER_HEIGHT)
     # float32 directions and a 16-bit float target (2^-11 relative); the disc's rim turns on within a pixel, so a
     # few pixels on it differ by much: all but those within 1% + 1e-3
@@ -57,3 +58,31 @@ def test_the_sun_s_disc_is_as_wide_as_the_sun_and_darker_at_its_limb(renderer):
     on_disc = np.flatnonzero(row > 0.5 * row.max())
     assert 30 <= len(on_disc) <= 34
     assert row[on_disc[2]] < 0.8 * row[RENDER_WIDTH // 2]
+
+
+def test_a_climbing_eye_sees_the_sky_from_its_altitude(renderer):
+    """From 8 km up the zenith is darker and the horizon has sunk (the air at it drawn lower): the sky is the one
+    seen from the eye, not from the scene's origin."""
+    lighting = Lighting(time_of_day=15.5)
+    level = np.array([0.0, 0.0, -1000.0])
+    pictures = {
+        altitude: sky_frame(renderer, lighting, Camera((0.0, altitude, 0.0), tuple(level + [0.0, altitude, 0.0]), 60.0))
+        for altitude in (100.0, 8000.0)
+    }
+    top = {altitude: float(picture[0].mean()) for altitude, picture in pictures.items()}
+    assert top[8000.0] < 0.9 * top[100.0]
+    # the brightest row (the air at the horizon) lies at the middle from near the ground, lower from 8 km
+    brightest = {altitude: int(np.argmax(picture.mean(axis=(1, 2)))) for altitude, picture in pictures.items()}
+    assert brightest[8000.0] > brightest[100.0] + 2
+
+
+def test_the_sky_seen_from_an_eye_steps_with_the_air_s_volume():
+    """An eye within a step of the sky's altitude sees the sky itself; the scene's origin's altitude counts; the
+    gradient is the same from everywhere."""
+    sky = scene_sky(Lighting(time_of_day=10.0, air=Air(origin_altitude_m=1000.0)))
+    assert sky.seen_from((5.0, 40.0, 0.0)) is sky
+    high = sky.seen_from((0.0, 1480.0, 0.0))
+    assert high.view.altitude_m == 2500.0 and high.origin_altitude_m == 1000.0
+    assert high.eye_altitude_m((0.0, 0.0, 0.0)) == 1000.0  # the air between stays measured from the origin
+    gradient = scene_sky(Lighting(air=Air(sky="gradient")))
+    assert gradient.seen_from((0.0, 9000.0, 0.0)) is gradient

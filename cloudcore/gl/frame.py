@@ -62,7 +62,7 @@ from cloudcore.light.illumination import IlluminationCache, shadowing_sun
 from cloudcore.light.lighting import scene_lights
 from cloudcore.light.live_air import LiveAir
 from cloudcore.light.relighting import PREVIEW_METHOD
-from cloudcore.light.sky_background import scene_sky
+from cloudcore.light.sky_background import SkyBackground, scene_sky
 from cloudcore.light.terrain_light import terrain_light
 from cloudcore.light.volume_blending import blending_path
 from cloudcore.lod.costs import CostEstimator, CostModel, remember_fit, remembered_prior
@@ -133,9 +133,9 @@ class FrameRenderer:
         one fitted here is kept for the next when it closes (`cloudcore.lod.costs.remembered_prior`): the
         editor and the command line; the tests and benchmarks start from the same prior every time.
 
-        `air`: the editor's, which gives a coarse aerial-perspective volume while the exact one for a new
-        altitude is built in the background (`cloudcore.light.live_air`); without it a frame waits for the
-        exact one."""
+        `air`: the editor's, which gives a coarse aerial-perspective volume and the nearest altitude's sky while
+        the exact ones for a new altitude are built in the background (`cloudcore.light.live_air`); without it a
+        frame waits for the exact ones."""
         self.context = context if context is not None else HeadlessContext(width, height)
         self.context.make_current()
         self._splats = SplatPass()
@@ -152,6 +152,7 @@ class FrameRenderer:
         self._facings: CloudFacings | None = None
         self._illumination = illumination if illumination is not None else IlluminationCache()
         self._air_for = air if air is not None else air_between
+        self._sky_for = air.sky_seen_from if air is not None else SkyBackground.seen_from
         #: per cloud, changes whenever that cloud's particle colours may have: its impostor is stale
         self._lighting_keys: tuple = ()
         self._forming_clouds: tuple = ()  # the clouds that form or dissipate, whose colours follow the clock
@@ -462,6 +463,7 @@ class FrameRenderer:
                 terrain_light(lighting, lights, ambient),
                 scene_sky(lighting, preview),
                 self._air_for,
+                self._sky_for,
             )
             self._world_source = world_source
         objects_source = (scene.objects, lights, tuple(ambient), self.size)

@@ -174,16 +174,19 @@ class WorldPass:
         light: TerrainLight,
         sky: SkyBackground,
         air_for: Callable[[SkyBackground, np.ndarray], AirBetween | None] = air_between,
+        sky_for: Callable[[SkyBackground, np.ndarray], SkyBackground] = SkyBackground.seen_from,
         shaft_steps: int = SHAFT_STEPS,
         shaft_reduction: int | None = None,
     ):
-        """`air_for(sky, eye)`: the air an eye sees through (`air_between`, or the editor's `LiveAir`); the light
+        """`air_for(sky, eye)`: the air an eye sees through (`air_between`, or the editor's `LiveAir`), and
+        `sky_for(sky, eye)` the sky it sees (`SkyBackground.seen_from`, or `LiveAir.sky_seen_from`); the light
         shafts marched by `shaft_steps` at a pixel for each `shaft_reduction`-square block of the screen's (None:
         `light_shafts.shaft_reduction`'s)."""
         self._shaft_quality = shaft_steps, shaft_reduction
-        self._sky, self._air_for = sky, air_for
+        self._sky, self._air_for, self._sky_for = sky, air_for, sky_for
         self._sky_programs: dict[bool, int] = {}  # per light shafts
-        self._sky_view_texture = _sky_view_texture(sky) if sky.physical else None
+        self._sky_view_texture = GL.glGenTextures(1) if sky.physical else None
+        self._uploaded_view = None  # the sky-view table the texture holds
         # core profile draws nothing without a vertex array, even one with no attributes
         self._fullscreen_vertex_array = GL.glGenVertexArrays(1)
         self._terrain = TerrainMesh(terrain, light) if terrain is not None else None
@@ -208,6 +211,10 @@ class WorldPass:
         under the physical sky when `through_air`, its sun's part in the clouds' `shadows` where given, and with
         `light_shafts` the air in their shadow darkened where there are shadows and air)."""
         view_projection = projection @ view
+        sky = self._sky_for(self._sky, camera.position)
+        if sky.physical and sky.view is not self._uploaded_view:
+            _upload_sky_view(self._sky_view_texture, sky)
+            self._uploaded_view = sky.view
         air = None
         if self._air_volume is not None and through_air:
             self._air_volume.upload(self._air_for(self._sky, camera.position))
@@ -224,7 +231,7 @@ class WorldPass:
                 projection,
                 air,
                 shadows,
-                self._sky.lowest_up(),
+                sky.lowest_up(),
             )
         framebuffer = context.multisampled_target() if antialiased else context.framebuffer
         GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, framebuffer)
@@ -241,7 +248,7 @@ class WorldPass:
         if shafts is not None:
             shafts.bind()
         set_matrix(program, "inverse_view_projection", np.linalg.inv(view_projection))
-        self._set_sky_uniforms(program, camera, context.height)
+        self._set_sky_uniforms(program, sky, camera, context.height)
         GL.glEnable(GL.GL_DEPTH_TEST)
         GL.glDepthFunc(GL.GL_LEQUAL)
         GL.glDepthMask(GL.GL_FALSE)
@@ -271,8 +278,7 @@ class WorldPass:
         """The light shafts' pass, once a frame has drawn them (tests read its march)."""
         return self._shafts
 
-    def _set_sky_uniforms(self, program: int, camera: Camera, viewport_height: int) -> None:
-        sky = self._sky
+    def _set_sky_uniforms(self, program: int, sky: SkyBackground, camera: Camera, viewport_height: int) -> None:
         if not sky.physical:
             set_vec3(program, "zenith_colour", sky.zenith)
             set_vec3(program, "horizon_colour", sky.horizon)
@@ -316,10 +322,9 @@ class WorldPass:
         GL.glDeleteVertexArrays(1, [self._fullscreen_vertex_array])
 
 
-def _sky_view_texture(sky: SkyBackground) -> int:
-    """The sky-view table in the renderer's values as a float texture, sampled linearly and clamped to its edge
-    texels as `cloudcore.atmosphere.table_sampling` reads it."""
-    texture = GL.glGenTextures(1)
+def _upload_sky_view(texture: int, sky: SkyBackground) -> None:
+    """Fill `texture` with the sky-view table of `sky` in the renderer's values, as floats, sampled linearly and
+    clamped to its edge texels as `cloudcore.atmosphere.table_sampling` reads it."""
     GL.glBindTexture(GL.GL_TEXTURE_2D, texture)
     linear_filtering(GL.GL_TEXTURE_2D)
     # row 0 of the table is v's first texel: GL's first row, so the shader reads it with the numpy side's (u, v)
@@ -327,4 +332,3 @@ def _sky_view_texture(sky: SkyBackground) -> int:
     height, width = pixels.shape[:2]
     GL.glTexImage2D(GL.GL_TEXTURE_2D, 0, GL.GL_RGB32F, width, height, 0, GL.GL_RGB, GL.GL_FLOAT, pixels)
     GL.glBindTexture(GL.GL_TEXTURE_2D, 0)
-    return texture

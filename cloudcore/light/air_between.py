@@ -54,13 +54,8 @@ def air_between(sky: SkyBackground, eye_position, coarse: bool = False) -> AirBe
     view = sky.view
     preview = coarse or view.preview
     return AirBetween(
-        aerial_perspective_from(view.tables, eye_altitude_m(sky, eye_position), view.sun_direction, preview)
+        aerial_perspective_from(view.tables, sky.eye_altitude_m(eye_position), view.sun_direction, preview)
     )
-
-
-def eye_altitude_m(sky: SkyBackground, eye_position) -> float:
-    """The altitude over the sea of an eye at `eye_position` in a scene under the physical `sky`."""
-    return sky.view.altitude_m + float(np.asarray(eye_position, dtype=np.float64)[1])
 
 
 #: the widest angle (radians) one cell of a quad seen through the air spans from the eye: the air is read at the

@@ -6,12 +6,14 @@ composites this one behind its clouds.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
 
+from cloudcore.atmosphere.aerial_perspective import volume_altitude
 from cloudcore.atmosphere.geometry import horizon_cosine, ray_hits_ground
-from cloudcore.atmosphere.sky import SkyView
+from cloudcore.atmosphere.sky import SkyView, sky_seen_from
 from cloudcore.atmosphere.sky_view import eye_radius
 from cloudcore.atmosphere.sun_disc import disc_radiance
 from cloudcore.light.lighting import (
@@ -61,10 +63,31 @@ class SkyBackground:
     view: SkyView | None = None
     #: (3,) the sun's irradiance reaching the scene, renderer values (`lighting.physical_sun`)
     sun_irradiance: np.ndarray | None = None
+    #: the altitude over the sea of the scene's origin, where its y is 0 (`Air.origin_altitude_m`); `view` is the
+    #: sky seen from there, or from an eye (`seen_from`)
+    origin_altitude_m: float = 0.0
 
     @property
     def physical(self) -> bool:
         return self.view is not None
+
+    def eye_altitude_m(self, eye_position) -> float:
+        """The altitude over the sea of an eye at `eye_position` (scene metres, y up)."""
+        return self.origin_altitude_m + float(np.asarray(eye_position, dtype=np.float64)[1])
+
+    def seen_from(self, eye_position) -> SkyBackground:
+        """This sky as an eye at `eye_position` sees it: the table from its altitude, rounded as the air's volume
+        is (`volume_altitude`, 100 m: neighbouring steps' skies differ by less than 8 bits show), so a climbing
+        eye sees the horizon sink and the zenith darken (2 km up the sky is 31 dB from the one at the ground).
+        The gradient sky is the same from everywhere."""
+        if not self.physical:
+            return self
+        view = self.view
+        altitude = volume_altitude(self.eye_altitude_m(eye_position))
+        if altitude == view.altitude_m:
+            return self
+        seen = sky_seen_from(view.tables.params, altitude, view.sun_direction, view.preview)
+        return dataclasses.replace(self, view=seen)
 
     def table(self) -> np.ndarray:
         """(height, width, 3): the sky-view table in the renderer's values, the night's sky under it."""
@@ -108,6 +131,8 @@ def scene_sky(lighting: Lighting, preview: bool = False) -> SkyBackground:
     hours = scene_hour(lighting)
     if lighting.air.sky == "physical":
         return SkyBackground(
-            view=physical_sky(hours, lighting.air, preview), sun_irradiance=physical_sun(hours, lighting.air)
+            view=physical_sky(hours, lighting.air, preview),
+            sun_irradiance=physical_sun(hours, lighting.air),
+            origin_altitude_m=lighting.air.origin_altitude_m,
         )
     return SkyBackground(*sky_colors(hours))

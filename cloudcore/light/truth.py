@@ -605,7 +605,8 @@ def render_truth(
     ground_distance = _ground_distances(ground, eye, rays)
     view_depth, unit_distance = optical_depths(grids, eye, rays, stops=ground_distance)
     transmittance = np.exp(-view_depth).reshape(height, width)
-    sky = scene_sky(lighting).radiance(rays, np.radians(camera.fov_y_deg) / height).reshape(height, width, 3)
+    sky = scene_sky(lighting).seen_from(camera.position).radiance(rays, np.radians(camera.fov_y_deg) / height)
+    sky = sky.reshape(height, width, 3)
     sky[np.isfinite(ground_distance).reshape(height, width)] = 0.0  # the terrain's light is path traced
     radiance = np.nan_to_num(radiance, nan=0.0, posinf=0.0, neginf=0.0)
     return Truth(
