@@ -132,6 +132,11 @@ def tile_faces(stride: int = 1) -> np.ndarray:
 TILE_FACES = tile_faces()
 
 
+def grid_face_count(stride: int = 1) -> int:
+    """How many of `tile_faces(stride)`'s triangles are its grid's (the first), the rest its skirt's."""
+    return 2 * (TILE_CELLS // stride) ** 2
+
+
 def tile_meshes(terrain: Terrain, frame: TileFrame, tiles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Positions and unit normals (T, TILE_VERTICES, 3) of `tiles`: each tile's grid, then its skirt's lower
     edge (the normals of the edge above it).  Normals by central differences over the tile's own cells, so a

@@ -32,11 +32,12 @@ from cloudcore.light.terrain_light import TerrainLight
 from cloudcore.limits import DRAWN_TERRAIN_KINDS
 from cloudcore.scene import Camera, Terrain
 from cloudcore.terrain import ground_colours
-from cloudcore.terrain_tiles import TILE_FACES, TILE_VERTICES, TerrainTiles, tile_faces
+from cloudcore.terrain_tiles import TILE_FACES, TILE_VERTICES, TerrainTiles, grid_face_count, tile_faces
 
 #: the light shafts' depth of the terrain takes every 4th vertex of a tile's grid: the frames agree closely with the
 #: whole grid's, whose triangles cost llvmpipe their setup (docs/atmosphere.md#light-shafts)
-_COARSE_TILE_FACES = tile_faces(4)
+_COARSE_STRIDE = 4
+_COARSE_TILE_FACES = tile_faces(_COARSE_STRIDE)
 #: floats a terrain vertex carries: its position, the sun's light and the sky's (terrain.vert.glsl)
 _VERTEX_FLOATS = 9
 
@@ -140,20 +141,17 @@ class TerrainMesh:
         GL.glDepthFunc(GL.GL_LESS)
         GL.glDepthMask(GL.GL_TRUE)
         GL.glBindVertexArray(self._vertex_array)
-        # a tile's triangles are contiguous: one draw of each run of tiles in view
-        starts = np.concatenate([[0], np.flatnonzero(np.diff(in_view) != 1) + 1])
-        ends = np.concatenate([starts[1:], [len(in_view)]])
-        per_tile = 3 * len(_COARSE_TILE_FACES if coarse else TILE_FACES)
-        first = 3 * self._coarse_start if coarse else 0
-        counts = np.ascontiguousarray((ends - starts) * per_tile, dtype=np.int32)
-        offsets = np.ascontiguousarray((first + in_view[starts] * per_tile) * 4, dtype=np.intp)
-        GL.glMultiDrawElements(
-            GL.GL_TRIANGLES,
-            counts,
-            GL.GL_UNSIGNED_INT,
-            (ctypes.c_void_p * len(offsets))(*offsets.tolist()),
-            len(counts),
-        )
+        faces, stride = (_COARSE_TILE_FACES, _COARSE_STRIDE) if coarse else (TILE_FACES, 1)
+        grid = grid_face_count(stride)
+        first = (self._coarse_start if coarse else 0) + in_view * len(faces)  # each tile's first triangle
+        # the grids with their back faces culled: the far sides of hills, hidden behind their near sides, which
+        # llvmpipe then does not set up; the skirts not, as either of two neighbours' may be the one that hangs
+        # past the other's edge, seen from either side
+        GL.glEnable(GL.GL_CULL_FACE)
+        GL.glCullFace(GL.GL_BACK)
+        _draw_ranges(first, grid)
+        GL.glDisable(GL.GL_CULL_FACE)
+        _draw_ranges(first + grid, len(faces) - grid)
         GL.glBindVertexArray(0)
 
     def close(self) -> None:
@@ -163,6 +161,15 @@ class TerrainMesh:
             GL.glDeleteProgram(self._depth_program)
         GL.glDeleteBuffers(2, [self._vertex_buffer, self._index_buffer])
         GL.glDeleteVertexArrays(1, [self._vertex_array])
+
+
+def _draw_ranges(first_triangles: np.ndarray, triangles: int) -> None:
+    """Draw `triangles` triangles of the bound element buffer from each of `first_triangles`, in one call."""
+    counts = np.full(len(first_triangles), 3 * triangles, dtype=np.int32)
+    offsets = (3 * 4 * np.asarray(first_triangles, dtype=np.intp)).tolist()  # bytes of uint32 indices
+    GL.glMultiDrawElements(
+        GL.GL_TRIANGLES, counts, GL.GL_UNSIGNED_INT, (ctypes.c_void_p * len(offsets))(*offsets), len(counts)
+    )
 
 
 class WorldPass:
@@ -240,7 +247,7 @@ class WorldPass:
         GL.glClearDepth(1.0)
         GL.glClear(GL.GL_DEPTH_BUFFER_BIT)  # every colour is drawn: the terrain's, else the sky's
         GL.glDisable(GL.GL_BLEND)
-        GL.glDisable(GL.GL_CULL_FACE)  # the skirts face either way
+        GL.glDisable(GL.GL_CULL_FACE)  # the sky's triangle is not culled (the terrain's tiles cull their own)
         if self._terrain is not None:
             self._terrain.draw(camera, view_projection, air, shadows, shafts)
         program = self._sky_program(shafts is not None)
