@@ -20,6 +20,7 @@ from imgui_bundle.imgui import test_engine as te
 from imgui_bundle.imgui.test_engine_checks import CHECK
 
 from app.editor import discard_recovery, recovery_path
+from cloudcore.artist.cloudgen import cumulus
 from cloudcore.editing import add_cloud
 from cloudcore.interop.example_grids import sphere_grid
 from cloudcore.interop.vdb import write_density_grids
@@ -27,7 +28,7 @@ from cloudcore.measure.imagecompare import compare
 from cloudcore.measure.overlays import to_pixels
 from cloudcore.navigation import orbited
 from cloudcore.paths import camera_on_path
-from cloudcore.scene import CloudField, Weather, Wind
+from cloudcore.scene import Cloud, CloudField, Weather, Wind
 from cloudcore.scenefile import load_scene, save_scene
 from cloudcore.settings import RenderSettings
 
@@ -905,6 +906,39 @@ def the_wind_carries_the_clouds_as_the_clock_runs(ctx, app: EditorUnderTest):
     app.editor.edit(start)
 
 
+def turbulence_is_relit_in_the_worker(ctx, app: EditorUnderTest):
+    """Under a turbulent wind the clouds' shapes are lit anew each `relight_period_s`: past a period the window
+    keeps drawing the shapes lit before, carried on, while the relighting worker lights the new ones, then
+    switches to them with nothing shaded where the GUI runs (shading them there held the window 2 seconds)."""
+    start = app.editor.scene
+    app.editor.playing = False
+    # more particles than are shaded in the frame that needs them (`relighting.SYNCHRONOUS_PARTICLES`)
+    tower = Cloud("tower", cumulus((300.0, 1100.0, -2400.0), (900.0, 600.0, 700.0), 7000, 45.0, seed=11))
+    app.editor.edit(dataclasses.replace(start, clouds=start.clouds + (tower,), wind=Wind(turbulence_m=30.0)))
+    use_window(ctx, "Camera")
+    ctx.item_input_value("Scene time (s)", 0.0)
+    app.relit(ctx)
+    CHECK(app.viewport.lit_at == 0.0)
+    period = app.editor.scene.wind.relight_period_s
+    ctx.item_input_value("Scene time (s)", period + 5.0)  # into the next period: new shapes to light
+    ctx.yield_(2)
+    CHECK(app.viewport.lit_at == 0.0)  # the shapes lit before, carried on to now
+    asked = time.perf_counter()
+    for _ in range(1200):
+        if app.viewport.lit_at == period:
+            break
+        ctx.yield_()
+    CHECK(app.viewport.lit_at == period)
+    ctx.yield_(SETTLE)
+    CHECK(app.viewport.relighting.cache.last_recomputed == 0)  # the switch shaded nothing here
+    app.outcome["turbulence_relight_s"] = time.perf_counter() - asked
+    app.outcome["turbulence_relight_shading_ms_on_the_gui_thread_max"] = max(
+        frame.frame.illumination_ms for frame in list(app.editor.frame_times) if frame.frame_start_s >= asked
+    )
+    ctx.item_input_value("Scene time (s)", 0.0)
+    app.editor.edit(start)
+
+
 #: the GUI tests, in the order they run; `tests/test_gui.py` reads their names here
 GUI_TESTS = (
     place_particles_by_clicking,
@@ -937,6 +971,7 @@ GUI_TESTS = (
     a_click_within_one_frame_is_not_lost,
     the_cloud_field_panel_edits_the_field,
     the_wind_carries_the_clouds_as_the_clock_runs,
+    turbulence_is_relit_in_the_worker,
     every_panel_shows_its_lines_whole,
 )
 

@@ -32,6 +32,7 @@ from cloudcore.light.relighting import EXACT_METHOD, PREVIEW_METHOD, LiveIllumin
 from cloudcore.measure.heatmap import heat_image, ramp_colours
 from cloudcore.measure.overlays import impostor_outlines, ring_outlines, to_pixels
 from cloudcore.navigation import moved, turned
+from cloudcore.wind import light_time, reshapes
 
 TURN_DEG_PER_PIXEL = 0.2
 #: a frame that shows the picture again while the relighting worker runs waits this long first: the
@@ -64,6 +65,9 @@ class Viewport:
         self.relighting = LiveIllumination(IlluminationCache())
         self.relighting.start()
         self.air = LiveAir()
+        #: the scene time whose shapes of the clouds a wind reshapes are drawn lit (`FrameRenderer.render`'s
+        #: `lit_at`): the clock's period once the worker has its light (`_choose_lit_at`)
+        self.lit_at: float | None = None
         self._last_inputs, self._last_stats = None, None  # what the picture shown was drawn from, and its stats
         #: the last frame showed the picture before it again and no path is playing: nothing moves on its own
         self.at_rest = False
@@ -93,7 +97,16 @@ class Viewport:
         scene, method = self._scene_as_shown()
         # an exact aerial-perspective volume built since (`LiveAir`) draws the picture again
         air_built = self.air.built
-        inputs = (scene, method, editor.camera, editor.settings, editor.scene_time_s, (width, height), air_built)
+        inputs = (
+            scene,
+            method,
+            editor.camera,
+            editor.settings,
+            editor.scene_time_s,
+            self.lit_at,
+            (width, height),
+            air_built,
+        )
         plan = self.renderer.last_plan
         if (
             inputs == self._last_inputs
@@ -115,6 +128,7 @@ class Viewport:
                 time_s=editor.scene_time_s,
                 read_back=False,
                 illumination_method=method,
+                lit_at=self.lit_at,
             )
             self._last_inputs, self._last_stats, reused = inputs, stats, False
         heat = None
@@ -172,13 +186,25 @@ class Viewport:
         editor = self.editor
         shading, lighting = editor.look
         wanted = Look(shading, lighting, PREVIEW_METHOD if editor.dragged_look is not None else EXACT_METHOD)
-        look = self.relighting.look_for(self._with_field_clouds(editor.scene), wanted)
+        scene = editor.scene
+        lit = dataclasses.replace(scene, clouds=self.renderer.drawn_clouds(scene, self._choose_lit_at(scene, wanted)))
+        look = self.relighting.look_for(self._with_field_clouds(lit), wanted)
         if self.relighting.failure is not None and self.relighting.failure not in editor.messages:
             editor.messages.append(self.relighting.failure)
-        scene = editor.scene
         if (look.shading, look.lighting) != (scene.shading, scene.lighting):
             scene = dataclasses.replace(scene, shading=look.shading, lighting=look.lighting)
         return scene, look.method
+
+    def _choose_lit_at(self, scene, look: Look) -> float:
+        """The scene time whose shapes the wind gives the clouds are drawn lit: the clock's relight period
+        (`cloudcore.wind.light_time`) once its light is at hand, else the one drawn before while the relighting
+        worker lights the new shapes: the window keeps drawing, where shading them here held it 2 seconds."""
+        now = light_time(scene.wind, self.editor.scene_time_s)
+        if self.lit_at is None or self.lit_at == now or not reshapes(scene.wind):
+            self.lit_at = now
+        elif self.relighting.lit(self.renderer.drawn_clouds(scene, now), look):
+            self.lit_at = now
+        return self.lit_at
 
     def _with_field_clouds(self, scene):
         """`scene` with the clouds its cloud field has made around the eye (the renderer holds them), so that

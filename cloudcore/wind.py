@@ -175,7 +175,7 @@ class AirMotion:
         self.rest = np.concatenate([c.centres for c in self.clouds]) if self.clouds else np.zeros((0, 3))
         altitudes = np.array([c.bounding_sphere()[0][1] for c in self.clouds], dtype=np.float64)
         self.velocities = velocity_at(wind, altitudes)  # (clouds, 3) m/s, steady
-        self._lit: tuple[float, tuple] | None = None
+        self._lit: dict[float, tuple] = {}  # lit_at -> the clouds then, oldest first
 
     def drifts(self, time_s: float) -> np.ndarray:
         """(clouds, 3) metres each cloud has drifted by `time_s`."""
@@ -189,26 +189,26 @@ class AirMotion:
         """(particles, 3) metres each particle is from its rest place at `time_s`: its cloud's drift and turbulence."""
         return np.repeat(self.drifts(time_s), self.counts, axis=0) + turbulent_offsets(self.wind, self.rest, time_s)
 
-    def lit_clouds(self, time_s: float) -> tuple:
-        """The clouds as the wind has made them at `light_time(time_s)`, the shapes their light is made from: the
-        very clouds at rest while the wind only translates them (a cache by identity keeps their light)."""
-        when = light_time(self.wind, time_s)
-        if when == 0.0:
+    def lit_clouds(self, lit_at: float) -> tuple:
+        """The clouds as the wind has made them at scene time `lit_at` (`light_time`'s, or an older one whose light
+        is at hand), the shapes their light is made from: the very clouds at rest for 0.  The last two asked for
+        are kept (the editor asks for the next period's while it draws the last one's)."""
+        if lit_at == 0.0:
             return self.clouds
-        if self._lit is None or self._lit[0] != when:
-            moved = self.rest + self.offsets(when)
+        if lit_at not in self._lit:
+            moved = self.rest + self.offsets(lit_at)
             starts = np.concatenate([[0], np.cumsum(self.counts)])
-            clouds = tuple(
+            self._lit[lit_at] = tuple(
                 dataclasses.replace(cloud, particles=np.column_stack([moved[start:stop], cloud.radii]))
                 for cloud, start, stop in zip(self.clouds, starts[:-1], starts[1:])
             )
-            self._lit = (when, clouds)
-        return self._lit[1]
+            while len(self._lit) > 2:
+                del self._lit[next(iter(self._lit))]
+        return self._lit[lit_at]
 
-    def carry(self, time_s: float) -> np.ndarray:
-        """(particles, 3) metres from where `lit_clouds(time_s)` has each particle to where it is at `time_s`."""
-        when = light_time(self.wind, time_s)
-        return self.offsets(time_s) - (self.offsets(when) if when != 0.0 else 0.0)
+    def carry(self, time_s: float, lit_at: float) -> np.ndarray:
+        """(particles, 3) metres from where `lit_clouds(lit_at)` has each particle to where it is at `time_s`."""
+        return self.offsets(time_s) - (self.offsets(lit_at) if lit_at != 0.0 else 0.0)
 
 
 def field_drift(wind: Wind | None, field, time_s: float) -> np.ndarray:

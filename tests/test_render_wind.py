@@ -114,6 +114,25 @@ def test_a_drift_keeps_the_light_and_turbulence_relights_at_its_period(still):
         assert shaded == [0, 0, 0, every, every, 2 * every]
 
 
+def test_a_frame_lit_at_an_earlier_period_draws_those_shapes_carried_to_now(still):
+    """`render(lit_at=...)` (the editor's while its worker lights the next period): the light of the shapes at
+    `lit_at`, nothing shaded anew, every particle carried to where the wind has it now, as the frame lit for now
+    places them."""
+    cache = CountingCache()
+    churning = Wind(bands=((0.0, 10.0, 270.0),), turbulence_m=20.0, relight_period_s=10.0)
+    scene = dataclasses.replace(still, wind=churning)
+    with FrameRenderer(96, 72, illumination=cache) as renderer:
+        renderer.render(scene, settings=FULL_3D, time_s=4.0)
+        shaded = cache.shaded
+        renderer.render(scene, settings=FULL_3D, time_s=14.0, lit_at=0.0)
+        assert cache.shaded == shaded  # the shapes at rest, whose light is held
+        assert renderer.drawn_clouds(scene, 0.0) is scene.clouds
+        earlier = renderer.particles.centres.copy()
+        renderer.render(scene, settings=FULL_3D, time_s=14.0)  # lit for its own period, 10 s
+        assert cache.shaded > shaded
+        np.testing.assert_allclose(renderer.particles.centres, earlier, atol=1e-6)
+
+
 def test_a_field_drifts_with_the_air_its_cells_kept_and_a_change_of_weather_remakes_it_in_steps():
     field = CloudField(seed=2, coverage=0.5, cell_size=600.0, rings=1)
     scene = Scene(camera=Camera((0.0, 1500.0, 0.0), (0.0, 1800.0, -3000.0), 60.0), cloud_field=field, wind=WIND)

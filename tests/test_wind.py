@@ -75,7 +75,8 @@ def test_a_cloud_s_centre_moves_by_the_wind_s_displacement():
     air = AirMotion(wind, clouds)
     for time_s in (0.0, 37.5, 600.0):
         # the clouds as their light was made (bands apart: every `relight_period_s`), carried on to `time_s`
-        moved = np.concatenate([c.centres for c in air.lit_clouds(time_s)]) + air.carry(time_s)
+        lit_at = light_time(wind, time_s)
+        moved = np.concatenate([c.centres for c in air.lit_clouds(lit_at)]) + air.carry(time_s, lit_at)
         for index in (0, 7, len(clouds) - 1):
             cloud = clouds[index]
             start = int(np.sum(air.counts[:index]))
@@ -87,15 +88,19 @@ def test_a_cloud_s_centre_moves_by_the_wind_s_displacement():
 def test_a_pure_drift_keeps_the_clouds_and_their_light_at_rest_and_turbulence_relights_at_its_period():
     clouds = clouds_of_the_default_scene()
     drifting = AirMotion(Wind(bands=((0.0, 20.0, 10.0),)), clouds)
-    assert drifting.lit_clouds(250.0) is clouds and light_time(drifting.wind, 250.0) == 0.0
+    assert light_time(drifting.wind, 250.0) == 0.0 and drifting.lit_clouds(0.0) is clouds
     churning = AirMotion(Wind(turbulence_m=30.0, relight_period_s=10.0), clouds)
-    assert churning.lit_clouds(5.0) is clouds  # the first period's light is the clouds' at rest
-    lit = churning.lit_clouds(23.0)
-    assert lit is churning.lit_clouds(29.9) and lit is not churning.lit_clouds(30.0)
-    # the lit clouds are where the wind had them at 20 s; the carry takes them on to 23 s
-    np.testing.assert_allclose(
-        np.concatenate([c.centres for c in lit]) + churning.carry(23.0), churning.rest + churning.offsets(23.0)
-    )
+    assert light_time(churning.wind, 5.0) == 0.0  # the first period's light is the clouds' at rest
+    assert [light_time(churning.wind, t) for t in (23.0, 29.9, 30.0)] == [20.0, 20.0, 30.0]
+    lit = churning.lit_clouds(20.0)
+    assert lit is churning.lit_clouds(20.0) and lit is not churning.lit_clouds(30.0)
+    assert churning.lit_clouds(20.0) is lit  # the last two kept: the editor draws one while the next is lit
+    # the lit clouds are where the wind had them at 20 s; the carry takes them on to 23 s, or from an older light
+    for lit_at in (20.0, 10.0):
+        np.testing.assert_allclose(
+            np.concatenate([c.centres for c in churning.lit_clouds(lit_at)]) + churning.carry(23.0, lit_at),
+            churning.rest + churning.offsets(23.0),
+        )
     # bands that carry clouds apart change their light on one another: relit too
     assert light_time(Wind(bands=((0.0, 5.0, 270.0), (3000.0, 15.0, 270.0))), 83.0) == 60.0
 

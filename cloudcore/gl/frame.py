@@ -198,6 +198,11 @@ class FrameRenderer:
         return self._units if self._carry_made is None else self._carry_made[1]
 
     @property
+    def particles(self) -> ParticleBuffer:
+        """The particle buffer of the scene last rendered, where the wind had carried it."""
+        return self._particles if self._carry_made is None else self._carry_made[0]
+
+    @property
     def light_shafts(self) -> LightShaftPass | None:
         """The world pass's light shafts, once a frame has drawn them (tests read their march)."""
         return None if self._world is None else self._world.light_shafts
@@ -222,6 +227,7 @@ class FrameRenderer:
         time_s: float = 0.0,
         read_back: bool = True,
         costs: CostModel | None = None,
+        lit_at: float | None = None,
     ) -> tuple[np.ndarray | None, FrameStats]:
         """(sRGB uint8 (height, width, 3), stats); `time_of_day` and `camera` override the scene's.
 
@@ -235,8 +241,12 @@ class FrameRenderer:
 
         A frame one of whose draws composited by compute had more tile pairs than the GPU had room for is
         drawn twice (`FrameStats.drawn_again`; `cloudcore.gl.tile_binning`).
+
+        `lit_at`: the scene time whose shapes of the clouds a wind reshapes their light is made for, carried on
+        to `time_s` (`drawn_clouds`); by default `wind.light_time`'s, the frame waiting for it.  The editor
+        passes the last period's while its relighting worker lights the new one.
         """
-        drawing = (scene, time_of_day, camera, illumination_method, settings, time_s, costs)
+        drawing = (scene, time_of_day, camera, illumination_method, settings, time_s, costs, lit_at)
         stats = self._draw_frame(*drawing)
         if self._volume.settle():
             # a draw composited by compute had more tile pairs than the room the GPU had for them, and lost its
@@ -249,8 +259,22 @@ class FrameRenderer:
             )
         return (linear_to_srgb8(self.context.read_linear_rgb()) if read_back else None), stats
 
+    def drawn_clouds(self, scene: Scene, lit_at: float) -> tuple:
+        """The authored clouds of `scene` as a frame lit at `lit_at` draws them under its wind: their shapes then
+        (`AirMotion.lit_clouds`), whose light the frame needs; the scene's own in still air."""
+        air = self._air_motion(scene)
+        return scene.clouds if air is None else air.lit_clouds(lit_at)
+
     def _draw_frame(
-        self, scene: Scene, time_of_day, camera, illumination_method: str, settings: RenderSettings, time_s, costs
+        self,
+        scene: Scene,
+        time_of_day,
+        camera,
+        illumination_method: str,
+        settings: RenderSettings,
+        time_s,
+        costs,
+        lit_at: float | None,
     ) -> FrameStats:
         """`render`'s frame, left in the render target."""
         self.context.make_current()  # several renderers may share a thread (the benchmarks take turns)
@@ -265,7 +289,8 @@ class FrameRenderer:
             )
         air = self._air_motion(scene)
         if air is not None:  # the clouds as their light is made now: at rest, while the wind only carries them
-            scene = dataclasses.replace(scene, clouds=air.lit_clouds(time_s))
+            lit_at = light_time(air.wind, time_s) if lit_at is None else lit_at
+            scene = dataclasses.replace(scene, clouds=air.lit_clouds(lit_at))
         field_carried = field_drift(scene.wind, scene.cloud_field, time_s)
         scene, fade_keys = self._with_field(scene, camera, field_carried)
         illumination_ms = self._prepare(scene, lighting, illumination_method, settings.cloud_shadows)
@@ -273,7 +298,7 @@ class FrameRenderer:
         if (scene.clouds, settings.group_clouds) != self._units_source:
             self._units = lod_units(self._particles, settings.group_clouds, authored_clouds)
             self._units_source = (scene.clouds, settings.group_clouds)
-        particles, units, motion = self._carried(air, field_carried, time_s)
+        particles, units, motion = self._carried(air, field_carried, time_s, lit_at)
         particles.weigh(self._field_weights)
         illumination_ms += self._update_shadows(scene, particles, motion, time_s, fade_keys)
         planning_started = time.perf_counter()
@@ -516,17 +541,18 @@ class FrameRenderer:
         return self._air
 
     def _carried(
-        self, air: AirMotion | None, field_carried: np.ndarray, time_s: float
+        self, air: AirMotion | None, field_carried: np.ndarray, time_s: float, lit_at: float | None
     ) -> tuple[ParticleBuffer, LodUnits, CloudMotion | None]:
         """(the particle buffer, the units, what the wind did to each cloud) at `time_s`: the buffer whose light was
-        made for the clouds' shapes now (`AirMotion.lit_clouds`) with every particle carried on to its place now,
-        and the units with it (the same arrays moved: no loop over clouds), the authored clouds by `air`, a field's
-        by its grid's drift `field_carried` (`air` is None only in still air: the buffer and units themselves)."""
+        made for the clouds' shapes at `lit_at` (`AirMotion.lit_clouds`) with every particle carried on to its place
+        now, and the units with it (the same arrays moved: no loop over clouds), the authored clouds by `air`, a
+        field's by its grid's drift `field_carried` (`air` is None only in still air: the buffer and units
+        themselves)."""
         lit, units = self._particles, self._units
         if air is None:
             self._carry_source = self._carry_made = None
             return lit, units, None
-        source = (lit, units, air, time_s, tuple(field_carried))
+        source = (lit, units, air, time_s, lit_at, tuple(field_carried))
         held = self._carry_source
         if held is not None and all(a is b for a, b in zip(held[:3], source[:3])) and held[3:] == source[3:]:
             return self._carry_made
@@ -535,10 +561,10 @@ class FrameRenderer:
         field_drifts = np.tile(field_carried, (field_clouds, 1))
         field_speeds = np.tile(field_speed(air.wind, self.field_state.field, time_s), (field_clouds, 1))
         field_particles = len(lit.radii) - int(lit.cloud_starts[authored])
-        offsets = np.concatenate([air.carry(time_s), np.tile(field_carried, (field_particles, 1))])
+        offsets = np.concatenate([air.carry(time_s, lit_at), np.tile(field_carried, (field_particles, 1))])
         drifts = np.concatenate([air.drifts(time_s), field_drifts])
-        # the authored clouds' light was made where they were at `light_time`: their buffer carries them on from there
-        shifts = np.concatenate([air.drifts(time_s) - air.drifts(light_time(air.wind, time_s)), field_drifts])
+        # the authored clouds' light was made where they were at `lit_at`: their buffer carries them on from there
+        shifts = np.concatenate([air.drifts(time_s) - air.drifts(lit_at), field_drifts])
         grown = shape_change_bound_m(air.wind, math.inf)
         self._carry_source = source
         self._carry_made = (

@@ -68,19 +68,31 @@ class LiveIllumination:
 
     def look_for(self, scene: Scene, wanted: Look) -> Look:
         """The look to draw `scene` with this frame: `wanted` when it can be shown now, else the last shown."""
-        self._collect(scene)
-        if self._shown is None or self.failure is not None or self._cheap(scene, wanted):
+        self._collect()
+        if self._shown is None or self.failure is not None or self._cheap(scene.clouds, wanted):
             self._waiting = None  # shaded on the spot: what waited is no longer wanted
             self._shown = wanted
             return wanted
         self._request(tuple(scene.clouds), wanted)
-        if not self._cheap(scene, self._shown):
+        if not self._cheap(scene.clouds, self._shown):
             self._shown = wanted  # nothing shown before fits these clouds (another scene): shade it here
         return self._shown
 
-    def _cheap(self, scene: Scene, look: Look) -> bool:
-        """Whether drawing `scene` with `look` leaves few enough particles to shade in the frame."""
-        work = self.cache.missing(scene.clouds, look.shading, look.lights(), look.method)
+    def lit(self, clouds: tuple, look: Look) -> bool:
+        """Whether `clouds`, shapes the wind will give the scene's clouds (`FrameRenderer.drawn_clouds`), can be
+        drawn in `look` now: their light held, or few enough particles to shade in the frame.  Else the worker
+        is asked for it when it is free (a look asked for meanwhile goes first: it is what the artist moves),
+        and the frames draw the shapes lit before, carried on."""
+        self._collect()
+        if self.failure is not None or self._cheap(clouds, look):
+            return True
+        if not self.busy:
+            self._submit(tuple(clouds), look)
+        return False
+
+    def _cheap(self, clouds, look: Look) -> bool:
+        """Whether drawing `clouds` with `look` leaves few enough particles to shade in the frame."""
+        work = self.cache.missing(clouds, look.shading, look.lights(), look.method)
         return sum(len(cloud.particles) for _, stale in work for cloud in stale) <= SYNCHRONOUS_PARTICLES
 
     def start(self) -> None:
@@ -116,8 +128,9 @@ class LiveIllumination:
             return
         self._running = (future, clouds, look, work)
 
-    def _collect(self, scene: Scene) -> None:
-        """Store a finished result for the clouds still in the scene, show its look, start what waits."""
+    def _collect(self) -> None:
+        """Store a finished result, show its look, start what waits.  Clouds an edit has removed since are stored
+        too: the renderer's next use of the cache keeps only the clouds it draws."""
         if self._running is None or not self._running[0].done():
             return
         future, _, look, work = self._running
@@ -127,12 +140,8 @@ class LiveIllumination:
         except Exception as error:  # the worker died, or the light pass refused its input: shade here from now
             self._stop(error)
             return
-        current = {id(cloud) for cloud in scene.clouds}
         for (direction, clouds), incident in zip(work, results):
-            kept = [(cloud, light) for cloud, light in zip(clouds, incident) if id(cloud) in current]
-            self.cache.store(
-                [cloud for cloud, _ in kept], look.shading, look.method, direction, [light for _, light in kept]
-            )
+            self.cache.store(clouds, look.shading, look.method, direction, incident)
         self._shown = look
         if self._waiting is not None:
             waiting, self._waiting = self._waiting, None
