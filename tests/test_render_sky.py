@@ -84,5 +84,8 @@ def test_the_sky_seen_from_an_eye_steps_with_the_air_s_volume():
     high = sky.seen_from((0.0, 1480.0, 0.0))
     assert high.view.altitude_m == 2500.0 and high.origin_altitude_m == 1000.0
     assert high.eye_altitude_m((0.0, 0.0, 0.0)) == 1000.0  # the air between stays measured from the origin
+    top = sky.seen_from((0.0, 99_000.0, 0.0)).view
+    assert top.altitude_m == 100_000.0  # the air's top: above it, the same table for every eye
+    assert sky.seen_from((0.0, 2e5, 0.0)).view is top and sky.seen_from((0.0, 1e12, 0.0)).view is top
     gradient = scene_sky(Lighting(air=Air(sky="gradient")))
     assert gradient.seen_from((0.0, 9000.0, 0.0)) is gradient

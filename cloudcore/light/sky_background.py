@@ -83,10 +83,12 @@ class SkyBackground:
         if not self.physical:
             return self
         view = self.view
-        altitude = volume_altitude(self.eye_altitude_m(eye_position))
+        params = view.tables.params
+        # over the top of the air every eye sees the sky from its top (`eye_radius`): one table, not one a step
+        altitude = min(volume_altitude(self.eye_altitude_m(eye_position)), params.top_radius_m - params.bottom_radius_m)
         if altitude == view.altitude_m:
             return self
-        seen = sky_seen_from(view.tables.params, altitude, view.sun_direction, view.preview)
+        seen = sky_seen_from(params, altitude, view.sun_direction, view.preview)
         return dataclasses.replace(self, view=seen)
 
     def table(self) -> np.ndarray:
