@@ -186,10 +186,11 @@ class HeightGrid(_Record):
 class Terrain:
     """A procedural heightfield (`cloudcore.terrain`), a heightmap image's heights, or a mesh file.
 
-    A "heightmap" terrain's `heights` come from the 16-bit greyscale PNG `heightmap` (relative to the scene
-    file's folder), stretched over `size` with white at `height` metres; its `resolution` and `seed` are
-    unused.  Any terrain may be coloured by height (`color_ramp`, rows (height_m, r, g, b)) and by slope:
-    from `steep_slope_deg[0]` to `[1]` the colour turns to `steep_color`.
+    A "heightmap" terrain's `heights` come from the 16-bit greyscale PNG or the GeoTIFF of elevations `heightmap`
+    (relative to the scene file's folder), stretched over `size` with white (the GeoTIFF's highest sample) at
+    `height` metres; its `resolution` and `seed` are unused.  Any terrain may be coloured by height
+    (`color_ramp`, rows (height_m, r, g, b)) and by slope: from `steep_slope_deg[0]` to `[1]` the colour turns to
+    `steep_color`.
     """
 
     kind: str = "heightfield"

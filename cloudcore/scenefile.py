@@ -19,7 +19,7 @@ import tomlkit
 from cloudcore.artist.cloudgen import PRESETS
 from cloudcore.cloud_records import FACINGS, FORMATION_KINDS, MAX_SEED, ArtistShading, Formation, SpriteStyle
 from cloudcore.errors import SceneError
-from cloudcore.interop.heightmap import read_heightmap, store_heightmap
+from cloudcore.interop.heightmap import Heightmap, read_heightmap_file, store_heightmap
 from cloudcore.light.lighting import SKIES
 from cloudcore.light.phase import PHASE_NAMES
 from cloudcore.light.shading import EYE_PASSES, LIGHT_PASSES
@@ -436,32 +436,35 @@ def _terrain(t: Table, base_dir: Path) -> Terrain:
         t.fail("heightmap", f"only a terrain of kind 'heightmap' reads it, this one is {kind!r}")
     if kind == "heightmap" and t.has("resolution"):
         t.fail("resolution", "a heightmap's pixels are its samples: leave resolution out")
-    size = t.raw("size", list(d.size))
+    heightmap = t.string("heightmap") if kind == "heightmap" else None
+    read = _read_heightmap(t, base_dir, heightmap) if heightmap is not None else None
+    # a georeferenced elevation model gives the extent and the height it spans where the scene leaves them out
+    size = t.raw("size", list(read.extent_m if read is not None and read.extent_m is not None else d.size))
     if not (isinstance(size, list) and len(size) == 2):
         t.fail("size", f"expected [size_x, size_z] in metres, got {size!r}")
     sx = Table(t.source, t.path("size"), {"x": size[0], "z": size[1]})
-    heightmap = t.string("heightmap") if kind == "heightmap" else None
+    height = read.rise_m if read is not None and read.rise_m is not None else d.height
     return Terrain(
         kind=kind,
         size=(sx.number("x", low=MIN_TERRAIN_SIDE_M), sx.number("z", low=MIN_TERRAIN_SIDE_M)),
         resolution=t.integer("resolution", d.resolution, low=2, high=4096),
-        height=t.number("height", d.height, **_range(Terrain, "height")),
+        height=t.number("height", height, **_range(Terrain, "height")),
         seed=t.integer("seed", d.seed, low=0, high=2**31 - 1),
         mesh=t.string("mesh") if kind == "mesh" else None,
         color=t.vector("color", d.color, **_range(Terrain, "color")),
         relief=t.number("relief", d.relief, **_range(Terrain, "relief")),
         reach=t.number("reach", d.reach, **_range(Terrain, "reach")),
         heightmap=heightmap,
-        heights=_read_heights(t, base_dir, heightmap) if heightmap is not None else None,
+        heights=HeightGrid(read.heights) if read is not None else None,
         color_ramp=tuple(map(tuple, t.matrix("color_ramp", 4).tolist())) if t.has("color_ramp") else (),
         steep_color=t.vector("steep_color", None, **_range(Terrain, "steep_color")) if t.has("steep_color") else None,
         steep_slope_deg=t.row("steep_slope_deg", 2, d.steep_slope_deg),
     )
 
 
-def _read_heights(t: Table, base_dir: Path, heightmap: str) -> HeightGrid:
-    """The heights of the PNG `heightmap` names, a path relative to the scene's folder that stays inside it (a
-    scene passed on may read no other file of its reader's)."""
+def _read_heightmap(t: Table, base_dir: Path, heightmap: str) -> Heightmap:
+    """The PNG or GeoTIFF `heightmap` names, a path relative to the scene's folder that stays inside it (a scene
+    passed on may read no other file of its reader's)."""
     if Path(heightmap).is_absolute():
         t.fail("heightmap", f"{heightmap!r}: must be relative to the scene file's folder, not absolute")
     folder = base_dir.resolve()
@@ -469,7 +472,7 @@ def _read_heights(t: Table, base_dir: Path, heightmap: str) -> HeightGrid:
     if not file.is_relative_to(folder):
         t.fail("heightmap", f"{heightmap!r}: leads outside the scene file's folder ({folder})")
     try:
-        return HeightGrid(read_heightmap(file))
+        return read_heightmap_file(file)
     except SceneError as error:
         t.fail("heightmap", f"{error.source}: {error.problem}")
 

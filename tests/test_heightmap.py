@@ -1,7 +1,9 @@
-"""Terrain from a heightmap: a 16-bit greyscale PNG read whole, sampled bilinearly, meshed into the same tiles and
-coloured by height and slope; every bad file or key refused with one line naming the file and the problem."""
+"""Terrain from a heightmap: a 16-bit greyscale PNG or a GeoTIFF of elevations read whole, sampled bilinearly,
+meshed into the same tiles and coloured by height and slope; every bad file or key refused with one line naming
+the file and the problem."""
 
 import dataclasses
+import io
 import struct
 import zlib
 
@@ -116,13 +118,62 @@ def png_claiming(width: int, height: int, depth: int = 16, colour_type: int = 0)
     return b"\x89PNG\r\n\x1a\n" + header + png_chunk(b"IEND", b"")
 
 
+#: GeoKey directories: a projected model in metres, a geographic one (degrees)
+PROJECTED_IN_METRES = (1, 1, 0, 2, 1024, 0, 1, 1, 3076, 0, 1, 9001)
+GEOGRAPHIC = (1, 1, 0, 1, 1024, 0, 1, 2)
+
+
+def geotiff_bytes(elevations, scale=None, keys=None, tie=None, no_data=None) -> bytes:
+    """A one-band float32 GeoTIFF of `elevations`, with the pixel `scale` (x, y), GeoKey directory `keys`, tie
+    point (x, y) of its top left pixel and GDAL's no-data value where given."""
+    from PIL import Image, TiffImagePlugin
+
+    tags = TiffImagePlugin.ImageFileDirectory_v2()
+    for tag, value, kind in (
+        (33550, None if scale is None else (*scale, 0.0), 12),
+        (33922, None if tie is None else (0.0, 0.0, 0.0, *tie, 0.0), 12),
+        (34735, keys, 3),
+        (42113, no_data, 2),
+    ):
+        if value is not None:
+            tags[tag], tags.tagtype[tag] = value, kind
+    out = io.BytesIO()
+    Image.fromarray(np.asarray(elevations, dtype=np.float32), mode="F").save(
+        out, format="TIFF", tiffinfo=tags, compression="tiff_deflate"
+    )
+    return out.getvalue()
+
+
+def tiff_claiming(width: int, height: int) -> bytes:
+    """A little-endian TIFF header and first directory claiming a 16-bit grey image, and no pixels."""
+    entries = [(256, 4, width), (257, 4, height), (258, 3, 16), (259, 3, 1), (262, 3, 1), (273, 4, 0), (277, 3, 1)]
+    directory = struct.pack("<H", len(entries)) + b"".join(
+        struct.pack("<HHII", tag, kind, 1, value) for tag, kind, value in entries
+    )
+    return b"II*\x00" + struct.pack("<I", 8) + directory + struct.pack("<I", 0)
+
+
+def rgb_tiff_bytes() -> bytes:
+    from PIL import Image
+
+    out = io.BytesIO()
+    Image.new("RGB", (16, 16), (90, 120, 60)).save(out, format="TIFF")
+    return out.getvalue()
+
+
+def with_holes(value: float) -> np.ndarray:
+    elevations = np.linspace(200.0, 900.0, 4096).reshape(64, 64)
+    elevations[[3, 10, 40], [5, 60, 2]] = value
+    return elevations
+
+
 def bad_file(folder, name: str, content: bytes) -> str:
     (folder / name).write_bytes(content)
     return name
 
 
 BAD_HEIGHTMAPS = {
-    "not a PNG": (lambda d: bad_file(d, "ground.png", b"GIF89a" + bytes(64)), "not a PNG file"),
+    "not a PNG": (lambda d: bad_file(d, "ground.png", b"GIF89a" + bytes(64)), "neither a PNG nor a TIFF file"),
     "truncated": (
         lambda d: bad_file(d, "ground.png", (d.parent / "good.png").read_bytes()[:-400]),
         "not a readable PNG (truncated or corrupt?)",
@@ -138,6 +189,26 @@ BAD_HEIGHTMAPS = {
     "corrupt header": (
         lambda d: bad_file(d, "ground.png", png_claiming(64, 64)[:29] + b"\0\0\0\0"),
         "its header chunk is corrupt (CRC mismatch)",
+    ),
+    "TIFF truncated": (
+        lambda d: bad_file(d, "dem.tif", geotiff_bytes(np.arange(4096.0).reshape(64, 64))[:-3000]),
+        "not a readable TIFF (truncated or corrupt?)",
+    ),
+    "TIFF of 10^12 pixels claimed": (
+        lambda d: bad_file(d, "dem.tif", tiff_claiming(1_000_000, 1_000_000)),
+        f"each side must be within [2, {MAX_HEIGHTMAP_SIDE}]",
+    ),
+    "TIFF in colour": (
+        lambda d: bad_file(d, "dem.tif", rgb_tiff_bytes()),
+        "expected one band of elevations, got Pillow's mode 'RGB'",
+    ),
+    "TIFF with no-data samples": (
+        lambda d: bad_file(d, "dem.tif", geotiff_bytes(with_holes(-9999.0), no_data="-9999")),
+        "3 of its 4,096 samples hold no elevation (no-data or not finite): fill them first",
+    ),
+    "TIFF with NaN": (
+        lambda d: bad_file(d, "dem.tif", geotiff_bytes(with_holes(np.nan))),
+        "3 of its 4,096 samples hold no elevation",
     ),
     "missing": (lambda d: "nowhere.png", "no such file"),
     "outside the folder": (lambda d: "../good.png", "leads outside the scene file's folder"),
@@ -228,3 +299,42 @@ def test_an_edit_that_leaves_the_terrain_alone_does_not_check_its_heights_again(
     broken = dataclasses.replace(scene.terrain, heights=HeightGrid(np.full((3, 3), np.nan)))
     problems = limits.scene_limit_problems(dataclasses.replace(scene, terrain=broken), unchanged=scene)
     assert problems == [("terrain.heightmap.values", "numbers must be finite, got nan")]
+
+
+def test_a_geotiff_s_elevations_are_read_whole_with_the_extent_and_rise_it_gives(tmp_path):
+    """Float32 elevations in metres over a projected model's 30 m pixels: the lowest becomes the ground's 0, the
+    terrain rises by the file's span, over the extent its pixel scale gives, unless the scene says otherwise."""
+    elevations = 1200.0 + 800.0 * np.random.default_rng(4).random((40, 60))
+    (tmp_path / "dem.tif").write_bytes(geotiff_bytes(elevations, (30.0, 30.0), PROJECTED_IN_METRES, (5e5, 4.1e6)))
+    terrain = scene_from_dict({"terrain": {"kind": "heightmap", "heightmap": "dem.tif"}}, base_dir=tmp_path).terrain
+    assert terrain.size == (60 * 30.0, 40 * 30.0)
+    rise = float(np.ptp(elevations.astype(np.float32)))
+    assert terrain.height == pytest.approx(rise)
+    np.testing.assert_allclose(
+        terrain.heights.values * terrain.height,
+        elevations.astype(np.float32) - elevations.astype(np.float32).min(),
+        atol=1e-9 * rise,
+    )
+    given = {"kind": "heightmap", "heightmap": "dem.tif", "size": [900.0, 400.0], "height": 50.0}
+    assert scene_from_dict({"terrain": given}, base_dir=tmp_path).terrain.size == (900.0, 400.0)
+    saved = tmp_path / "scene.toml"
+    save_scene(scene_from_dict({"terrain": given}, base_dir=tmp_path), saved)
+    again = load_scene(saved).terrain
+    assert again.heightmap == "dem.tif" and again.heights == HeightGrid(terrain.heights.values)
+
+
+def test_a_geographic_geotiff_s_degrees_become_metres_at_its_middle_latitude(tmp_path):
+    """One arc-second pixels (SRTM's) at 46 degrees north: a degree of longitude spans cos(46) of the equator's."""
+    elevations = np.linspace(300.0, 2900.0, 3600).reshape(60, 60)
+    second = 1.0 / 3600.0
+    (tmp_path / "srtm.tif").write_bytes(
+        geotiff_bytes(elevations, (second, second), GEOGRAPHIC, (7.0, 46.0 + 30 * second))
+    )
+    terrain = scene_from_dict({"terrain": {"kind": "heightmap", "heightmap": "srtm.tif"}}, base_dir=tmp_path).terrain
+    across, down = terrain.size
+    assert across == pytest.approx(60 * second * 111_320.0 * np.cos(np.radians(46.0)), rel=1e-9)
+    assert down == pytest.approx(60 * second * 110_574.0, rel=1e-9)
+    ungeoreferenced = tmp_path / "plain.tif"
+    ungeoreferenced.write_bytes(geotiff_bytes(elevations))
+    plain = scene_from_dict({"terrain": {"kind": "heightmap", "heightmap": "plain.tif"}}, base_dir=tmp_path).terrain
+    assert plain.size == Terrain().size and plain.height == pytest.approx(2600.0)  # the default extent, its rise

@@ -1,21 +1,32 @@
-"""Heightmaps: greyscale PNG images read as terrain heights, 16 bits kept, and written for the examples.
+"""Heightmaps: greyscale PNG images and GeoTIFF elevation models read as terrain heights, 16 bits kept, and
+written for the examples.
 
-The image's header is read and checked before Pillow decodes a pixel: a file that claims 10^12 pixels is
-refused from its first 33 bytes, not after the memory is gone.  Any problem is one `SceneError` naming the
-file; the heights come back whole or not at all.
+The image's header is read and checked before a pixel is decoded: a file that claims 10^12 pixels is refused
+from its first bytes, not after the memory is gone.  Any problem is one `SceneError` naming the file; the heights
+come back whole or not at all.
+
+A PNG's samples are heights over its white, which the scene's `height` places.  A GeoTIFF (one band of
+elevations, integer or float, as DEMs are published) holds metres: its lowest sample becomes the ground's 0, its
+highest the height its rise gives, and where it is georeferenced (its pixel scale, in metres or, for longitude
+and latitude, converted at its middle latitude) the extent it covers.  Pillow, which the project has for PNG,
+reads the TIFF and its tags: no GDAL.
 """
 
 from __future__ import annotations
 
 import hashlib
 import io
+import math
 import struct
+import warnings
 import zlib
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from cloudcore.errors import SceneError
+from cloudcore.limits import MAX_MAGNITUDE
 from cloudcore.particle_files import atomic_write
 
 #: samples along a heightmap's side, at most: 4097^2 float64 heights are 134 MB, and the finest tiles' cells
@@ -29,11 +40,42 @@ _GREYSCALE = 0
 _BIT_DEPTHS = (8, 16)
 
 
-def read_heightmap(path) -> np.ndarray:
-    """The heights (rows, columns) in [0, 1] of the 8- or 16-bit greyscale PNG at `path`: each sample over the
-    largest its bit depth holds (65535 for 16 bits).  SceneError (naming the file) for anything else."""
-    from PIL import Image
+#: a TIFF file's first bytes, little- and big-endian
+TIFF_SIGNATURES = (b"II*\x00", b"MM\x00*")
+#: GeoTIFF's tags: the pixel's size in model units, the tie of a pixel to a model point, the GeoKey directory,
+#: and GDAL's no-data value (ASCII)
+_PIXEL_SCALE, _TIEPOINT, _GEO_KEYS, _NO_DATA = 33550, 33922, 34735, 42113
+#: GeoKeys: the model's type (1 projected, 2 geographic) and a projected model's linear unit
+_MODEL_TYPE, _LINEAR_UNITS = 1024, 3076
+_PROJECTED, _GEOGRAPHIC = 1, 2
+#: metres of EPSG's linear units: the metre, the foot and the US survey foot
+_METRES_PER_UNIT = {9001: 1.0, 9002: 0.3048, 9003: 1200.0 / 3937.0}
+#: metres of a degree of latitude, and of longitude at the equator (WGS 84, near enough for a terrain's extent)
+_METRES_PER_DEGREE_LATITUDE, _METRES_PER_DEGREE_LONGITUDE = 110_574.0, 111_320.0
+#: the sample types read from a TIFF (Pillow's modes): 8, 16 and 32-bit integers, 32-bit floats
+_TIFF_MODES = ("L", "I;16", "I;16B", "I;16S", "I", "F")
 
+
+@dataclass(frozen=True)
+class Heightmap:
+    """A heightmap file's heights and what it says of its place."""
+
+    heights: np.ndarray  # (rows, columns) in [0, 1]
+    #: metres from the lowest sample to the highest, where the file holds elevations (a GeoTIFF); None for a PNG,
+    #: whose white the scene's `height` places
+    rise_m: float | None = None
+    #: metres (along x, along z) the file's georeferencing spans; None where it has none
+    extent_m: tuple[float, float] | None = None
+
+
+def read_heightmap(path) -> np.ndarray:
+    """The heights (rows, columns) in [0, 1] of the heightmap at `path` (`read_heightmap_file`'s)."""
+    return read_heightmap_file(path).heights
+
+
+def read_heightmap_file(path) -> Heightmap:
+    """The heightmap at `path`: an 8- or 16-bit greyscale PNG (each sample over the largest its bit depth holds,
+    65535 for 16 bits) or a GeoTIFF of elevations (`Heightmap`).  SceneError (naming the file) for anything else."""
     path = Path(path)
     source = str(path)
     if not path.is_file():
@@ -41,6 +83,14 @@ def read_heightmap(path) -> np.ndarray:
     if path.stat().st_size > MAX_HEIGHTMAP_BYTES:
         raise SceneError(source, "heightmap", f"{path.stat().st_size:,} bytes, at most {MAX_HEIGHTMAP_BYTES:,}")
     data = path.read_bytes()
+    if data[:4] in TIFF_SIGNATURES:
+        return _read_geotiff(source, data)
+    return Heightmap(_read_png(source, data))
+
+
+def _read_png(source: str, data: bytes) -> np.ndarray:
+    from PIL import Image
+
     width, height, depth = _checked_header(source, data)
     try:
         with Image.open(io.BytesIO(data), formats=["PNG"]) as image:
@@ -53,21 +103,107 @@ def read_heightmap(path) -> np.ndarray:
     return samples.astype(np.float64) / (2**depth - 1)
 
 
-def _checked_header(source: str, data: bytes) -> tuple[int, int, int]:
-    """(width, height, bit depth) from the PNG's IHDR chunk, checked against what can be read."""
-    if data[:8] != PNG_SIGNATURE:
-        raise SceneError(source, "heightmap", "not a PNG file (its first bytes are not PNG's signature)")
-    if len(data) < 33 or data[12:16] != b"IHDR":
-        raise SceneError(source, "heightmap", "a PNG without its header chunk (truncated?)")
-    width, height, depth, colour_type = struct.unpack(">IIBB", data[16:26])
-    if zlib.crc32(data[12:29]) != struct.unpack(">I", data[29:33])[0]:
-        raise SceneError(source, "heightmap", "its header chunk is corrupt (CRC mismatch)")
+def _read_geotiff(source: str, data: bytes) -> Heightmap:
+    """A GeoTIFF's one band of elevations, its size checked from its header before a sample is decoded."""
+    from PIL import Image, UnidentifiedImageError
+
+    unreadable = "not a readable TIFF (truncated or corrupt?)"
+    with warnings.catch_warnings():  # Pillow warns of what it cannot read, then fails: the failure is the message
+        warnings.simplefilter("ignore")
+        try:
+            image = Image.open(io.BytesIO(data), formats=["TIFF"])
+        except Image.DecompressionBombError:  # Pillow's own bound, past ours, checked as it reads the header
+            raise SceneError(
+                source,
+                "heightmap",
+                f"its header claims over {Image.MAX_IMAGE_PIXELS:.3g} pixels, each side must be within"
+                f" [2, {MAX_HEIGHTMAP_SIDE}]",
+            ) from None
+        except UnidentifiedImageError:  # its message names Pillow's buffer, not the file
+            raise SceneError(source, "heightmap", unreadable) from None
+        except Exception as error:  # a forged header raises anything from OSError to struct.error
+            raise SceneError(source, "heightmap", f"{unreadable}: {error}") from None
+        with image:
+            width, height = image.size
+            _check_side(source, width, height)
+            if image.mode not in _TIFF_MODES or getattr(image, "n_frames", 1) != 1:
+                raise SceneError(
+                    source,
+                    "heightmap",
+                    f"expected one band of elevations, got Pillow's mode {image.mode!r} (one band: grey)",
+                )
+            tags = dict(image.tag_v2)
+            try:
+                image.load()
+                samples = np.asarray(image, dtype=np.float64)
+            except Exception as error:
+                raise SceneError(source, "heightmap", f"{unreadable}: {error}") from None
+    if samples.shape != (height, width):
+        raise SceneError(source, "heightmap", f"decoded as {samples.shape}, its header says {height}x{width}")
+    missing = ~np.isfinite(samples)
+    no_data = tags.get(_NO_DATA)
+    if no_data is not None:
+        try:
+            missing |= samples == float(str(no_data).strip("\x00 "))
+        except ValueError:
+            raise SceneError(source, "heightmap", f"its no-data value {no_data!r} is not a number") from None
+    if missing.any():
+        raise SceneError(
+            source,
+            "heightmap",
+            f"{np.count_nonzero(missing):,} of its {samples.size:,} samples hold no elevation (no-data or not finite):"
+            " fill them first",
+        )
+    if np.abs(samples).max() > MAX_MAGNITUDE:
+        raise SceneError(source, "heightmap", f"an elevation of {np.abs(samples).max():.3g}, at most {MAX_MAGNITUDE:g}")
+    low, rise = float(samples.min()), float(np.ptp(samples))
+    heights = (samples - low) / rise if rise > 0.0 else np.zeros_like(samples)
+    return Heightmap(np.clip(heights, 0.0, 1.0), rise, _georeferenced_extent(tags, width, height))
+
+
+def _georeferenced_extent(tags: dict, width: int, height: int) -> tuple[float, float] | None:
+    """Metres (along x, along z) a GeoTIFF's `width` x `height` pixels span, from its pixel scale: in a projected
+    model's linear unit, or in degrees of a geographic model at its middle latitude; None where it says neither."""
+    scale, keys = tags.get(_PIXEL_SCALE), tags.get(_GEO_KEYS)
+    if scale is None or keys is None or len(scale) < 2 or len(keys) < 4:
+        return None
+    geo_keys = {keys[i]: keys[i + 3] for i in range(4, min(len(keys), 4 + 4 * keys[3]) - 3, 4) if keys[i + 1] == 0}
+    across, down = abs(float(scale[0])) * width, abs(float(scale[1])) * height
+    model = geo_keys.get(_MODEL_TYPE)
+    if model == _PROJECTED:
+        metres = _METRES_PER_UNIT.get(geo_keys.get(_LINEAR_UNITS, 9001))
+        extent = None if metres is None else (across * metres, down * metres)
+    elif model == _GEOGRAPHIC:
+        tie = tags.get(_TIEPOINT)
+        latitude = float(tie[4]) - 0.5 * down if tie is not None and len(tie) >= 6 else 0.0
+        extent = (
+            across * _METRES_PER_DEGREE_LONGITUDE * math.cos(math.radians(min(abs(latitude), 90.0))),
+            down * _METRES_PER_DEGREE_LATITUDE,
+        )
+    else:
+        return None
+    return extent if extent is not None and all(math.isfinite(v) and v > 0.0 for v in extent) else None
+
+
+def _check_side(source: str, width: int, height: int) -> None:
     if not (2 <= width <= MAX_HEIGHTMAP_SIDE and 2 <= height <= MAX_HEIGHTMAP_SIDE):
         raise SceneError(
             source,
             "heightmap",
             f"{width}x{height} pixels ({width * height:.3g}), each side must be within [2, {MAX_HEIGHTMAP_SIDE}]",
         )
+
+
+def _checked_header(source: str, data: bytes) -> tuple[int, int, int]:
+    """(width, height, bit depth) from the PNG's IHDR chunk, checked against what can be read."""
+    if data[:8] != PNG_SIGNATURE:
+        raise SceneError(source, "heightmap", "neither a PNG nor a TIFF file (its first bytes are neither's signature)")
+    if len(data) < 33 or data[12:16] != b"IHDR":
+        raise SceneError(source, "heightmap", "a PNG without its header chunk (truncated?)")
+    width, height, depth, colour_type = struct.unpack(">IIBB", data[16:26])
+    if zlib.crc32(data[12:29]) != struct.unpack(">I", data[29:33])[0]:
+        raise SceneError(source, "heightmap", "its header chunk is corrupt (CRC mismatch)")
+    _check_side(source, width, height)
     if colour_type != _GREYSCALE or depth not in _BIT_DEPTHS:
         raise SceneError(
             source,
