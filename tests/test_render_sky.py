@@ -51,6 +51,30 @@ def test_the_world_pass_draws_the_numpy_sky(renderer, hours, sky, method, altitu
         assert drawn.max() > 1.0 and drawn.max() <= SUN_DISC_PEAK * 1.001  # the disc is in view, capped
 
 
+@pytest.mark.parametrize(("yaw_deg", "pitch_deg"), [(6.5, 0.0), (-6.5, 4.2)])
+def test_the_sun_s_disc_near_the_screen_s_corner_is_drawn_whole(renderer, yaw_deg, pitch_deg):
+    """The disc is drawn in a box around it (`world.sun_box`): near the corner of a wide view, where a pixel spans
+    the least angle, every pixel of it is the numpy sky's (a 12 degree view: the disc 4 pixels across)."""
+    hours = 9.0
+    sun = sun_direction(hours)
+    yaw, pitch = np.radians(yaw_deg), np.radians(pitch_deg)
+    turned = np.array([sun[0] * np.cos(yaw) - sun[2] * np.sin(yaw), 0.0, sun[0] * np.sin(yaw) + sun[2] * np.cos(yaw)])
+    turned = turned / np.linalg.norm(turned) * np.cos(np.arcsin(sun[1]) + pitch)
+    turned[1] = np.sin(np.arcsin(sun[1]) + pitch)
+    eye = np.array([0.0, 200.0, 0.0])
+    camera = Camera(tuple(eye), tuple(eye + 1000.0 * turned), 12.0)
+    lighting = Lighting(time_of_day=hours)
+    drawn = sky_frame(renderer, lighting, camera)
+    expected = (
+        scene_sky(lighting)
+        .seen_from(camera.position)
+        .radiance(pixel_rays(camera, RENDER_WIDTH, RENDER_HEIGHT), np.radians(camera.fov_y_deg) / RENDER_HEIGHT)
+    )
+    on_disc = expected.max(axis=-1) > 1.0
+    assert 20 <= np.count_nonzero(on_disc) < 200  # the disc, in view
+    np.testing.assert_allclose(drawn[on_disc], expected[on_disc], rtol=0.02, atol=1e-3)
+
+
 def test_the_sun_s_disc_is_as_wide_as_the_sun_and_darker_at_its_limb(renderer):
     camera = looking_at_the_sun(12.0, fov_y_deg=2.0)  # 120 pixels across 2 degrees: the disc 32 wide
     drawn = sky_frame(renderer, Lighting(time_of_day=12.0), camera).mean(axis=-1)

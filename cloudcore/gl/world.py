@@ -18,6 +18,7 @@ from OpenGL import GL
 
 from cloudcore.atmosphere.geometry import horizon_cosine
 from cloudcore.atmosphere.sky_view import eye_radius, horizon_angles
+from cloudcore.atmosphere.sun_disc import SUN_ANGULAR_RADIUS
 from cloudcore.camera import frustum_planes
 from cloudcore.gl.air_volume import AirVolume
 from cloudcore.gl.context import HeadlessContext
@@ -191,7 +192,7 @@ class WorldPass:
         `light_shafts.shaft_reduction`'s)."""
         self._shaft_quality = shaft_steps, shaft_reduction
         self._sky, self._air_for, self._sky_for = sky, air_for, sky_for
-        self._sky_programs: dict[bool, int] = {}  # per light shafts
+        self._sky_programs: dict[tuple[bool, bool], int] = {}  # per (light shafts, the sun's disc alone)
         self._sky_view_texture = GL.glGenTextures(1) if sky.physical else None
         self._uploaded_view = None  # the sky-view table the texture holds
         # core profile draws nothing without a vertex array, even one with no attributes
@@ -250,17 +251,31 @@ class WorldPass:
         GL.glDisable(GL.GL_CULL_FACE)  # the sky's triangle is not culled (the terrain's tiles cull their own)
         if self._terrain is not None:
             self._terrain.draw(camera, view_projection, air, shadows, shafts)
+        inverse_view_projection = np.linalg.inv(view_projection)
         program = self._sky_program(shafts is not None)
         GL.glUseProgram(program)
         if shafts is not None:
             shafts.bind()
-        set_matrix(program, "inverse_view_projection", np.linalg.inv(view_projection))
+        set_matrix(program, "inverse_view_projection", inverse_view_projection)
         self._set_sky_uniforms(program, sky, camera, context.height)
         GL.glEnable(GL.GL_DEPTH_TEST)
         GL.glDepthFunc(GL.GL_LEQUAL)
         GL.glDepthMask(GL.GL_FALSE)
         GL.glBindVertexArray(self._fullscreen_vertex_array)
         GL.glDrawArrays(GL.GL_TRIANGLES, 0, 3)
+        box = sun_box(sky, camera, view_projection, (context.width, context.height)) if sky.physical else None
+        if box is not None:  # the sun's disc added where it can be
+            disc = self._sky_program(False, sun_disc=True)
+            GL.glUseProgram(disc)
+            set_matrix(disc, "inverse_view_projection", inverse_view_projection)
+            self._set_sky_uniforms(disc, sky, camera, context.height)
+            GL.glEnable(GL.GL_BLEND)
+            GL.glBlendFunc(GL.GL_ONE, GL.GL_ONE)
+            GL.glEnable(GL.GL_SCISSOR_TEST)
+            GL.glScissor(*box)
+            GL.glDrawArrays(GL.GL_TRIANGLES, 0, 3)
+            GL.glDisable(GL.GL_SCISSOR_TEST)
+            GL.glDisable(GL.GL_BLEND)
         GL.glBindVertexArray(0)
         GL.glDepthMask(GL.GL_TRUE)
         GL.glDepthFunc(GL.GL_LESS)
@@ -268,12 +283,19 @@ class WorldPass:
             context.resolve_multisampled_target()
         context.bind_target()
 
-    def _sky_program(self, shafts: bool) -> int:
-        if shafts not in self._sky_programs:
+    def _sky_program(self, shafts: bool, sun_disc: bool = False) -> int:
+        """The sky's program, less the light `shafts` take where asked; the sun's disc alone for `sun_disc`."""
+        if (shafts, sun_disc) not in self._sky_programs:
             # at the far plane (the window depth 1), drawn where the depth is still the clear's
-            defines = {"PHYSICAL_SKY": int(self._sky.physical), "LIGHT_SHAFTS": int(shafts), "DEPTH": 1.0}
-            self._sky_programs[shafts] = build_program("sky", defines, vertex="world")
-        return self._sky_programs[shafts]
+            defines = {
+                "PHYSICAL_SKY": int(self._sky.physical),
+                "LIGHT_SHAFTS": int(shafts),
+                "SUN_DISC": int(sun_disc),
+                "VIEW_RAY": 1,
+                "DEPTH": 1.0,
+            }
+            self._sky_programs[shafts, sun_disc] = build_program("sky", defines, vertex="world")
+        return self._sky_programs[shafts, sun_disc]
 
     def _light_shafts(self) -> LightShaftPass:
         if self._shafts is None:
@@ -327,6 +349,31 @@ class WorldPass:
         for program in self._sky_programs.values():
             GL.glDeleteProgram(program)
         GL.glDeleteVertexArrays(1, [self._fullscreen_vertex_array])
+
+
+def sun_box(
+    sky: SkyBackground, camera: Camera, view_projection: np.ndarray, size: tuple[int, int]
+) -> tuple[int, int, int, int] | None:
+    """The window's box (x, y from the bottom left, width, height) holding every pixel the sun's disc may touch
+    for `camera` seen through `view_projection` on a target of `size`: the disc and two pixels of rim around it,
+    its edge projected at 16 points; None where none of it is on the screen or it is behind the eye."""
+    sun = sky.view.sun_direction
+    reach = SUN_ANGULAR_RADIUS + 2.0 * np.radians(camera.fov_y_deg) / max(size[1], 1)
+    # two unit vectors across the sun's direction, and the rim's points at `reach` from it
+    side = np.cross(sun, [0.0, 1.0, 0.0] if abs(sun[1]) < 0.9 else [1.0, 0.0, 0.0])
+    side /= np.linalg.norm(side)
+    other = np.cross(sun, side)
+    turns = np.linspace(0.0, 2.0 * np.pi, 16, endpoint=False)[:, None]
+    rim = np.cos(reach) * sun + np.sin(reach) * (np.cos(turns) * side + np.sin(turns) * other)
+    clip = np.column_stack([rim + np.asarray(camera.position, dtype=np.float64), np.ones(len(rim))]) @ view_projection.T
+    if np.any(clip[:, 3] <= 0.0):
+        return None
+    pixels = (0.5 * (clip[:, :2] / clip[:, 3:4]) + 0.5) * np.asarray(size, dtype=np.float64)
+    low = np.maximum(np.floor(pixels.min(axis=0)) - 1.0, 0.0)
+    high = np.minimum(np.ceil(pixels.max(axis=0)) + 1.0, size)
+    if np.any(high <= low):
+        return None
+    return int(low[0]), int(low[1]), int(high[0] - low[0]), int(high[1] - low[1])
 
 
 def _upload_sky_view(texture: int, sky: SkyBackground) -> None:

@@ -1,11 +1,11 @@
 #version 420 core
 // The sky in linear RGB behind the terrain, drawn after it at the far plane: the depth test leaves out every
-// pixel the terrain covers.  PHYSICAL_SKY: the atmosphere's sky-view table and the sun's disc, the table's air
-// less the light the shafts take with LIGHT_SHAFTS; else a vertical gradient.  Compiled apart, as llvmpipe
-// runs both sides of a branch (docs/performance.md, "The world pass: where its time goes").  The sky reads its
-// tables as cloudcore/light/sky_background.py does.
+// pixel the terrain covers.  PHYSICAL_SKY: the atmosphere's sky-view table, the table's air less the light the
+// shafts take with LIGHT_SHAFTS, or with SUN_DISC the sun's disc alone (added in a box around it: its arithmetic
+// over every pixel of the sky cost llvmpipe more than the table's lookup); else a vertical gradient.  Compiled apart,
+// as llvmpipe runs both sides of a branch (docs/performance.md, "The world pass: where its time goes").  The sky
+// reads its tables as cloudcore/light/sky_background.py does.
 
-uniform mat4 inverse_view_projection;
 #if PHYSICAL_SKY
 // the atmosphere: its sky-view table (cloudcore/atmosphere/sky_view.py) seen from the scene's origin
 layout(binding = 1) uniform sampler2D sky_view_table;
@@ -28,13 +28,8 @@ uniform vec3 horizon_colour;
 #endif
 
 in vec2 ndc;
+in vec3 view_ray;  // world.vert.glsl's VIEW_RAY
 out vec4 frag_colour;
-
-vec3 unproject(float depth)
-{
-    vec4 world = inverse_view_projection * vec4(ndc, depth, 1.0);
-    return world.xyz / world.w;
-}
 
 #if PHYSICAL_SKY
 vec2 sky_view_uv(vec3 ray)
@@ -76,14 +71,17 @@ vec3 sky(vec3 ray)
 #if LIGHT_SHAFTS
     air = max(air - light_shafts_at(ndc).rgb, vec3(0.0));
 #endif
-    return ray.y <= horizon_cosine ? air : air + sun_disc(ray);
+    return air;
 }
 #endif
 
 void main()
 {
-    vec3 ray = normalize(unproject(1.0) - unproject(-1.0));
-#if PHYSICAL_SKY
+    vec3 ray = normalize(view_ray);
+#if PHYSICAL_SKY && SUN_DISC
+    // added to the sky (blended one to one); none below the horizon, where the ground hides the sun
+    frag_colour = vec4(ray.y <= horizon_cosine ? vec3(0.0) : sun_disc(ray), 0.0);
+#elif PHYSICAL_SKY
     frag_colour = vec4(sky(ray), 1.0);
 #else
     // horizon colour at and below the horizon line; the square root keeps the pale band near the horizon
