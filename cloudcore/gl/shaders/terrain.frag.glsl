@@ -4,7 +4,7 @@
 
 in vec3 sun_lit;
 in vec3 sky_lit;
-in vec3 world_position;
+in vec3 shadow_mapped;  // the pixel's place in the clouds' transmittance map (terrain.vert.glsl)
 in vec3 air_let_through;
 in vec3 air_added;
 out vec4 frag_colour;
@@ -12,6 +12,6 @@ out vec4 frag_colour;
 
 void main()
 {
-    vec3 lit = sun_lit * cloud_shadow_transmittance(world_position) + sky_lit;
+    vec3 lit = sun_lit * (cloud_shadows ? cloud_shadow_transmittance_mapped(shadow_mapped) : 1.0) + sky_lit;
     frag_colour = vec4(lit * air_let_through + air_added, 1.0);
 }

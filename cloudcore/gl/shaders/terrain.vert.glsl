@@ -13,7 +13,10 @@ uniform vec3 eye_position;
 
 out vec3 sun_lit;
 out vec3 sky_lit;
-out vec3 world_position;  // where the clouds' shadow map is read, per pixel (terrain.frag.glsl)
+// where the clouds' shadow map is read, per pixel (terrain.frag.glsl): the map's coordinates are affine in the
+// world's, so the vertices' interpolate to each pixel's exactly, without the matrix a pixel
+out vec3 shadow_mapped;
+uniform mat4 world_to_cloud_shadow;  // cloud_shadow.glsl's
 out vec3 air_let_through;
 out vec3 air_added;
 
@@ -27,7 +30,7 @@ out vec3 air_added;
 void main()
 {
     gl_Position = view_projection * vec4(position, 1.0);
-    world_position = position;
+    shadow_mapped = (world_to_cloud_shadow * vec4(position, 1.0)).xyz;
     sun_lit = sun_light;
     sky_lit = sky_light;
 #if THROUGH_AIR
