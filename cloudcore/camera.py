@@ -23,7 +23,7 @@ def camera_pose(camera: Camera) -> np.ndarray:
     """Camera-to-world 4x4: columns are the camera's right, up and back axes and its position.
 
     Written out in scalars: every impostor regeneration makes a pose, and numpy's `cross` and `norm` on
-    3-vectors cost 0.25 ms of each (40 regenerations a frame, docs/performance.md).
+    3-vectors cost 0.25 ms of each (40 regenerations a frame, docs/journal.md, "A frame's regenerations together").
     """
     ex, ey, ez = (float(value) for value in camera.position)
     fx, fy, fz = (float(target) - origin for target, origin in zip(camera.look_at, (ex, ey, ez)))

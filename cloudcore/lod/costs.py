@@ -105,7 +105,7 @@ class CostModel:
 
 #: a fragment of an atlas sprite (`cloudcore.artist.sprites`) costs this many of a Gaussian kernel splat's: its
 #: texture fetch, before the sprite's transparent texels are discarded (`scripts/bench_sprite_fragments.py`;
-#: docs/performance.md, "The ring priced when it may have changed, and a sprite's fragment at its cost"); the plan
+#: docs/performance.md, "The cost model"); the plan
 #: counts a unit's fragments so weighted (`LodUnits.fragment_costs`): one coefficient fitted to both priced neither
 SPRITE_FRAGMENT_COST = 3.1
 

@@ -5,7 +5,8 @@
 // premultiplied images is itself a correct premultiplied image, so the
 // crossfade neither brightens nor darkens.  Only the CROSSFADE variant reads the
 // layer: behind a branch on a uniform, llvmpipe paid for the fetch on every
-// quad that never took it (7% of the flythrough's clouds, docs/performance.md).
+// quad that never took it (7% of the flythrough's clouds, docs/journal.md, "The level of detail by error
+// and cost", eighth session).
 // ATLAS samples a layer of the impostor atlas within the instance's cell, its
 // weight per instance.  COUNT_FRAGMENTS writes 1 instead.  AIR adds the air between the eye
 // and the quad now (quad.vert.glsl's, interpolated) to the impostor's part (aerial perspective: never in an impostor's texture, which is

@@ -18,7 +18,8 @@
 // built: its image in pixels, colour, centre and radius (a third of the instance's bytes).  A splat faces the
 // image plane, so its quad's image is a rectangle over which the raster interpolates the kernel's coordinates
 // linearly: d is the pixel's offset from the image's centre over its half sizes, with no ray to intersect
-// with the splat's plane (the plain walk took 108 against 200 ms on llvmpipe, docs/performance.md).
+// with the splat's plane (the plain walk took 108 against 200 ms on llvmpipe, docs/journal.md, "The compute
+// passes cut to a quarter again").
 
 layout(local_size_x = TILE_PIXELS, local_size_y = TILE_PIXELS) in;
 
