@@ -6,8 +6,12 @@ import pytest
 from conftest import RENDER_HEIGHT, RENDER_WIDTH
 
 from cloudcore.camera import pixel_rays
+from cloudcore.colour import linear_to_srgb8
+from cloudcore.gl.frame import FrameRenderer
+from cloudcore.gl.world import sky_reduction
 from cloudcore.light.relighting import PREVIEW_METHOD
 from cloudcore.light.sky_background import SUN_DISC_PEAK, scene_sky
+from cloudcore.measure.imagecompare import compare
 from cloudcore.scene import Air, Camera, Lighting, Scene
 from cloudcore.sun import sun_direction
 
@@ -113,3 +117,22 @@ def test_the_sky_seen_from_an_eye_steps_with_the_air_s_volume():
     assert sky.seen_from((0.0, 2e5, 0.0)).view is top and sky.seen_from((0.0, 1e12, 0.0)).view is top
     gradient = scene_sky(Lighting(air=Air(sky="gradient")))
     assert gradient.seen_from((0.0, 9000.0, 0.0)) is gradient
+
+
+@pytest.mark.parametrize("hours", [17.6, 11.0])
+def test_the_sky_read_from_its_picture_is_the_sky_a_pixel_within_what_8_bits_show(hours):
+    """At 640x480 the physical sky is drawn at a fifth of the resolution a side (`world.sky_reduction`) and read
+    bilinearly: toward the low sun (its aureole changes fastest) and at noon, within 57 dB of the numpy sky
+    (8-bit sRGB), the disc drawn at the screen's own."""
+    width, height = 640, 480
+    assert sky_reduction(width) == 5
+    lighting = Lighting(time_of_day=hours)
+    camera = looking_at_the_sun(hours, fov_y_deg=50.0)
+    with FrameRenderer(width, height) as renderer:
+        drawn = sky_frame(renderer, lighting, camera)
+    expected = (
+        scene_sky(lighting)
+        .seen_from(camera.position)
+        .radiance(pixel_rays(camera, width, height), np.radians(camera.fov_y_deg) / height)
+    )
+    assert compare(linear_to_srgb8(drawn), linear_to_srgb8(expected)).psnr_db > 57.0  # 60-63 dB measured

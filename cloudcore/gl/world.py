@@ -25,7 +25,7 @@ from cloudcore.gl.context import HeadlessContext
 from cloudcore.gl.light_shafts import LightShaftPass
 from cloudcore.gl.programs import build_program, set_matrix, set_vec3
 from cloudcore.gl.shadow_map import CloudShadowMap
-from cloudcore.gl.targets import linear_filtering
+from cloudcore.gl.targets import TextureTarget, linear_filtering
 from cloudcore.light.air_between import AirBetween, air_between
 from cloudcore.light.light_shafts import SHAFT_STEPS
 from cloudcore.light.sky_background import SkyBackground
@@ -39,6 +39,19 @@ from cloudcore.terrain_tiles import TILE_FACES, TILE_VERTICES, TerrainTiles, gri
 #: whole grid's, whose triangles cost llvmpipe their setup (docs/atmosphere.md#light-shafts)
 _COARSE_STRIDE = 4
 _COARSE_TILE_FACES = tile_faces(_COARSE_STRIDE)
+#: the physical sky's picture's columns, about: read bilinearly from it, the sky is 65 to 86 dB from the sky a pixel
+#: (8-bit sRGB, the sun's disc apart: it is drawn at the screen's), where each pixel's lookup cost llvmpipe more
+#: than the fetch; its error follows the angle its pixels span, not the screen's (docs/atmosphere.md, "The sky at
+#: a fraction of the resolution")
+SKY_COLUMNS = 128
+
+
+def sky_reduction(width: int) -> int:
+    """Screen pixels a side of the sky's picture's pixel, for a frame `width` pixels wide: about `SKY_COLUMNS`
+    columns, and the screen's own pixels on a screen narrower than that."""
+    return max(1, round(width / SKY_COLUMNS))
+
+
 #: floats a terrain vertex carries: its position, the sun's light and the sky's (terrain.vert.glsl)
 _VERTEX_FLOATS = 9
 
@@ -201,6 +214,9 @@ class WorldPass:
         # the air's volume under the physical sky (the cloud pass reads it too: `air_volume`)
         self._air_volume = AirVolume() if sky.physical else None
         self._shafts: LightShaftPass | None = None  # built when a frame first has them
+        # the physical sky at a fraction of the screen's resolution, and the program that reads it at its own
+        self._sky_target: TextureTarget | None = None
+        self._sky_read: int | None = None
 
     def draw(
         self,
@@ -241,6 +257,8 @@ class WorldPass:
                 shadows,
                 sky.lowest_up(),
             )
+        if sky.physical:
+            self._draw_sky_picture(sky, camera, view_projection, (context.width, context.height), shafts)
         framebuffer = context.multisampled_target() if antialiased else context.framebuffer
         GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, framebuffer)
         GL.glViewport(0, 0, context.width, context.height)
@@ -251,24 +269,63 @@ class WorldPass:
         GL.glDisable(GL.GL_CULL_FACE)  # the sky's triangle is not culled (the terrain's tiles cull their own)
         if self._terrain is not None:
             self._terrain.draw(camera, view_projection, air, shadows, shafts)
-        inverse_view_projection = np.linalg.inv(view_projection)
+        self._draw_sky(sky, camera, view_projection, (context.width, context.height), shafts)
+        if antialiased:
+            context.resolve_multisampled_target()
+        context.bind_target()
+
+    def _draw_sky_picture(
+        self, sky: SkyBackground, camera: Camera, view_projection: np.ndarray, size: tuple[int, int], shafts
+    ) -> None:
+        """The physical sky, less the light `shafts` take, into the sky's target at `sky_reduction`'s fraction of
+        the screen's resolution, over every pixel whatever is drawn in front (the full-size pass reads it)."""
+        reduction = sky_reduction(size[0])
+        wanted = (-(-size[0] // reduction), -(-size[1] // reduction))
+        if self._sky_target is None or (self._sky_target.width, self._sky_target.height) != wanted:
+            if self._sky_target is not None:
+                self._sky_target.close()
+            self._sky_target = TextureTarget(*wanted, GL.GL_RGBA16F)
+        self._sky_target.bind()
         program = self._sky_program(shafts is not None)
         GL.glUseProgram(program)
         if shafts is not None:
             shafts.bind()
-        set_matrix(program, "inverse_view_projection", inverse_view_projection)
-        self._set_sky_uniforms(program, sky, camera, context.height)
+        set_matrix(program, "inverse_view_projection", np.linalg.inv(view_projection))
+        self._set_sky_uniforms(program, sky, camera, size[1])
+        GL.glDisable(GL.GL_DEPTH_TEST)
+        GL.glDisable(GL.GL_BLEND)
+        GL.glBindVertexArray(self._fullscreen_vertex_array)
+        GL.glDrawArrays(GL.GL_TRIANGLES, 0, 3)
+        GL.glBindVertexArray(0)
+
+    def _draw_sky(
+        self, sky: SkyBackground, camera: Camera, view_projection: np.ndarray, size: tuple[int, int], shafts
+    ) -> None:
+        """The sky behind the terrain drawn into the bound target: the physical sky's picture read (with the sun's
+        disc added in its box), or the gradient."""
+        inverse_view_projection = np.linalg.inv(view_projection)
+        if sky.physical:
+            program = self._sky_read_program()
+            GL.glUseProgram(program)
+            GL.glActiveTexture(GL.GL_TEXTURE2)
+            GL.glBindTexture(GL.GL_TEXTURE_2D, self._sky_target.texture)
+            GL.glActiveTexture(GL.GL_TEXTURE0)
+        else:
+            program = self._sky_program(False)
+            GL.glUseProgram(program)
+            set_matrix(program, "inverse_view_projection", inverse_view_projection)
+            self._set_sky_uniforms(program, sky, camera, size[1])
         GL.glEnable(GL.GL_DEPTH_TEST)
         GL.glDepthFunc(GL.GL_LEQUAL)
         GL.glDepthMask(GL.GL_FALSE)
         GL.glBindVertexArray(self._fullscreen_vertex_array)
         GL.glDrawArrays(GL.GL_TRIANGLES, 0, 3)
-        box = sun_box(sky, camera, view_projection, (context.width, context.height)) if sky.physical else None
+        box = sun_box(sky, camera, view_projection, size) if sky.physical else None
         if box is not None:  # the sun's disc added where it can be
             disc = self._sky_program(False, sun_disc=True)
             GL.glUseProgram(disc)
             set_matrix(disc, "inverse_view_projection", inverse_view_projection)
-            self._set_sky_uniforms(disc, sky, camera, context.height)
+            self._set_sky_uniforms(disc, sky, camera, size[1])
             GL.glEnable(GL.GL_BLEND)
             GL.glBlendFunc(GL.GL_ONE, GL.GL_ONE)
             GL.glEnable(GL.GL_SCISSOR_TEST)
@@ -279,9 +336,11 @@ class WorldPass:
         GL.glBindVertexArray(0)
         GL.glDepthMask(GL.GL_TRUE)
         GL.glDepthFunc(GL.GL_LESS)
-        if antialiased:
-            context.resolve_multisampled_target()
-        context.bind_target()
+
+    def _sky_read_program(self) -> int:
+        if self._sky_read is None:
+            self._sky_read = build_program("sky_read", {"DEPTH": 1.0}, vertex="world")
+        return self._sky_read
 
     def _sky_program(self, shafts: bool, sun_disc: bool = False) -> int:
         """The sky's program, less the light `shafts` take where asked; the sun's disc alone for `sun_disc`."""
@@ -348,6 +407,10 @@ class WorldPass:
             self._shafts.close()
         for program in self._sky_programs.values():
             GL.glDeleteProgram(program)
+        if self._sky_read is not None:
+            GL.glDeleteProgram(self._sky_read)
+        if self._sky_target is not None:
+            self._sky_target.close()
         GL.glDeleteVertexArrays(1, [self._fullscreen_vertex_array])
 
 
