@@ -1,7 +1,9 @@
-"""`--workers N` of `cloudview record`, `truth` and `check`: the same output as the command run in one process,
-a worker killed on purpose has its piece run again, one killed on every try fails the job in one line."""
+"""`--workers N` of `cloudview record`, `truth`, `check` and `bench`: the same output as the command run in one
+process (a bench's settings each measured beside its own worker's reference), a worker killed on purpose has its
+piece run again, one killed on every try fails the job in one line."""
 
 import importlib.util
+import json
 import os
 import subprocess
 import sys
@@ -32,7 +34,7 @@ def files_of(folder):
     return {path.relative_to(folder): path.read_bytes() for path in sorted(folder.rglob("*")) if path.is_file()}
 
 
-@pytest.mark.parametrize("command", ["record", "truth", "check"])
+@pytest.mark.parametrize("command", ["record", "truth", "check", "bench"])
 @pytest.mark.parametrize("count", ["0", "-2"])
 def test_no_workers_is_refused_in_one_line(command, count, capsys):
     with pytest.raises(SystemExit) as stopped:
@@ -80,6 +82,31 @@ def test_a_check_on_two_workers_gives_the_verdicts_and_images_of_one_process_eve
     )
     assert "view aircraft_in_cloud/aircraft_inside: its worker died; running it again" in spread.stderr
     assert files_of(tmp_path / "two") == files_of(tmp_path / "one")
+
+
+@pytest.mark.gl
+def test_a_sweep_on_two_workers_measures_each_setting_beside_its_own_reference_even_when_a_worker_dies(tmp_path):
+    """Three settings dealt to two workers (the first and third to one): the runs in the sweep's order, each
+    with its group's reference, its speed-up against that reference; the second group's worker killed once."""
+    common = ["bench", VALLEY, "--still", "--frames", "2", "--width", "32", "--height", "24", "--no-shading"]
+    common += ["--mode", "impostor", "--sweep", "tolerance=0.15,1,2"]
+    spread = cloudview(*common, "--json", tmp_path / "two.json", "--workers", "2", kill="1")
+    if spread.returncode != 0 and "EGL" in spread.stderr:
+        pytest.skip("no headless OpenGL (EGL) context")
+    assert spread.returncode == 0, spread.stderr
+    assert "cloudview bench: settings group 1: its worker died; running it again" in spread.stderr
+    report = json.loads((tmp_path / "two.json").read_text())
+    assert [run["settings"]["tolerance_deg"] for run in report["runs"]] == [0.15, 1.0, 2.0]
+    assert [run["reference_group"] for run in report["runs"]] == [0, 1, 0]
+    assert (
+        len(report["references"]) == 2
+        and report["reference"]["frame_ms_mean"] == report["references"][0]["frame_ms_mean"]
+    )
+    for run in report["runs"]:
+        reference = report["references"][run["reference_group"]]
+        assert run["speedup_vs_full"] == pytest.approx(reference["frame_ms_mean"] / run["frame_ms_mean"])
+        assert len(run["per_frame"]) == 2
+    assert {"scene", "path", "width", "height", "frames", "shading"} <= set(report)
 
 
 @pytest.fixture

@@ -4,6 +4,13 @@ Each setting of the sweeps is rendered along the path beside the full-3D
 reference in the same run; the report is `cloudcore.measure.benchmark.bench_path`'s,
 plus the shading precompute (exact against raster).  With no --sweep, the
 default settings are run.
+
+With --workers N (or --cluster) the sweep's settings are split into N groups, each run on a worker beside its
+own full-3D reference, frames taking turns there as in one process: a setting's speed-up and error are measured
+against the reference drawn beside it, on the same machine at the same time, never against another worker's
+(`references` lists each group's, `reference_group` says a run's).  Alone on one machine the workers share its
+cores, so their times are slower than one process's; spread over a cluster's machines, each group's times are its
+machine's.
 """
 
 from __future__ import annotations
@@ -13,10 +20,12 @@ import dataclasses
 import itertools
 import json
 import os
+from contextlib import closing
 from pathlib import Path
 
 from cloudcore.cli.render import check_outputs, pixel_count, write_output
 from cloudcore.cli.settings_args import SWEEPABLE, add_settings_arguments, parse_sweep, settings_from
+from cloudcore.cli.workers import Job, add_workers_arguments, run_job, spread
 from cloudcore.errors import SceneError
 from cloudcore.measure.benchmark import (
     bench_path,
@@ -66,6 +75,7 @@ def add_parser(commands) -> None:
         help="fly the scene without its terrain: the whole frame is then the sky and the clouds",
     )
     add_settings_arguments(parser)
+    add_workers_arguments(parser, "sweep's settings, in groups each beside its own full-3D reference,")
     parser.set_defaults(run=run)
 
 
@@ -85,13 +95,6 @@ def run(args) -> int:
         raise SceneError("--warmup", "warmup", f"must be >= 0, got {args.warmup}")
     if args.orbit is not None and not abs(args.orbit) < 360.0:
         raise SceneError("--orbit", "orbit", f"must be within (-360, 360) degrees a frame, got {args.orbit}")
-    views = (
-        still_views(scene, args.frames)
-        if args.still
-        else orbit_views(scene, args.frames, args.orbit)
-        if args.orbit is not None
-        else None
-    )
     motion = (
         "still" if args.still else f"orbit {args.orbit:g} deg/frame" if args.orbit is not None else args.camera_path
     )
@@ -101,33 +104,28 @@ def run(args) -> int:
         settings_from(args, **dict(zip(fields, values)))
         for values in itertools.product(*(values for _, values in args.sweep))
     ] or [base]
+    groups = min(args.workers or 1, len(settings_list)) if spread(args) else 1
+    job = Job(
+        "bench",
+        BenchSettings,
+        (str(args.scene), args.without_terrain, args.camera_path, args.still, args.orbit, args.frames, args.warmup)
+        + ((args.width, args.height),),
+        pieces=[settings_list[group::groups] for group in range(groups)],
+        unit="frame",
+        label=lambda index: f"settings group {index}",
+        size=lambda group: (args.frames + args.warmup) * (1 + len(group)),
+    )
+    if spread(args):
+        with closing(run_job(job, args.workers, args.cluster)) as reports:
+            report = _merged(list(reports), groups)
+    else:  # one group, here, its bar counting each frame
+        from tqdm import tqdm
 
-    os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
-    from tqdm import tqdm
-
-    from cloudcore.gl import FrameRenderer
-    from cloudcore.light.illumination import IlluminationCache
-
-    with (
-        contextlib.ExitStack() as renderers,
-        tqdm(total=(args.frames + args.warmup) * (1 + len(settings_list)), unit="frame", desc="bench") as bar,
-    ):
-        illumination = IlluminationCache()  # the clouds' light, computed once for every run
-        report = bench_path(
-            [
-                renderers.enter_context(FrameRenderer(args.width, args.height, illumination=illumination))
-                for _ in range(1 + len(settings_list))
-            ],
-            scene,
-            args.camera_path,
-            args.frames,
-            settings_list,
-            (args.width, args.height),
-            progress=bar.update,
-            views=views,
-            warmup=args.warmup,
-            freeze=True,
-        )
+        with (
+            tqdm(total=job.size(settings_list), unit="frame", desc="bench") as bar,
+            job.make_worker(*job.arguments, progress=bar.update) as worker,
+        ):
+            report = worker(settings_list)
     report["path"] = motion
     report["scene"] = str(args.scene)
     report["without_terrain"] = args.without_terrain
@@ -150,6 +148,85 @@ def run(args) -> int:
         plot_error_against_time(report, args.plot)
     print(f"wrote {args.json}" + (f" and {args.plot}" if args.plot else ""))
     return 0
+
+
+class BenchSettings:
+    """A worker of `cloudcore.cli.workers`: called with a group of settings, the bench report of them beside one
+    full-3D reference, frames taking turns, in this process's own GL context."""
+
+    def __init__(
+        self,
+        scene_file: str,
+        without_terrain: bool,
+        camera_path,
+        still: bool,
+        orbit,
+        frames,
+        warmup,
+        size,
+        progress=None,
+    ):
+        """`progress(frames)` is told of each frame drawn, where one is given (in this process)."""
+        self.progress = progress
+        self.scene = load_scene(scene_file)
+        if without_terrain:
+            self.scene = dataclasses.replace(self.scene, terrain=None)
+        self.path, self.frames, self.warmup, self.size = camera_path, frames, warmup, size
+        self.views = (
+            still_views(self.scene, frames)
+            if still
+            else orbit_views(self.scene, frames, orbit)
+            if orbit is not None
+            else None
+        )
+
+    def __call__(self, settings_list: list) -> dict:
+        os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
+        from cloudcore.gl import FrameRenderer
+        from cloudcore.light.illumination import IlluminationCache
+
+        illumination = IlluminationCache()  # the clouds' light, computed once for every run
+        with contextlib.ExitStack() as renderers:
+            return bench_path(
+                [
+                    renderers.enter_context(FrameRenderer(*self.size, illumination=illumination))
+                    for _ in range(1 + len(settings_list))
+                ],
+                self.scene,
+                self.path,
+                self.frames,
+                settings_list,
+                self.size,
+                progress=self.progress,
+                views=self.views,
+                warmup=self.warmup,
+                freeze=True,
+            )
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        pass
+
+
+def _merged(reports: list[dict], groups: int) -> dict:
+    """One report of the groups' (the settings dealt to them in turn): their runs in the sweep's order, each
+    measured against its own group's reference, which `references` holds where there are several."""
+    if groups == 1:
+        return reports[0]
+    order = sorted(
+        (
+            (group + groups * position, group, run)
+            for group, report in enumerate(reports)
+            for position, run in enumerate(report["runs"])
+        ),
+        key=lambda item: item[0],
+    )
+    return reports[0] | {
+        "references": [{k: v for k, v in report["reference"].items() if k != "per_frame"} for report in reports],
+        "runs": [run | {"reference_group": group} for _, group, run in order],
+    }
 
 
 def sweep_label(settings: dict, runs: list[dict]) -> str:
