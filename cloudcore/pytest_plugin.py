@@ -16,17 +16,25 @@ keeps the expected, actual and diff images.  Options:
   images go to pytest's temporary folder (the message names it).
 
 Rendering is headless (EGL; PYOPENGL_PLATFORM is set to egl unless already
-set), one context per frame size for the whole session.
+set), one context per frame size for the whole session.  Under pytest-xdist
+(`pytest -n auto`) each worker process makes its own context; the workers
+hand their views to the controller, which writes the one report.
 """
 
 from __future__ import annotations
 
 import os
+import pickle
 from pathlib import Path
 
 import pytest
 
 GOLDENS_FOLDER = "cloudview_goldens"
+#: the key of a pytest-xdist worker's output that carries its report entries to the controller (pickled: they are
+#: records of paths and numbers, and xdist's channel carries bytes)
+_WORKER_ENTRIES = "cloudview_report_entries"
+#: the controller's gathering of its workers' entries
+_GATHERED = pytest.StashKey[list]()
 
 
 def pytest_addoption(parser):
@@ -48,6 +56,7 @@ class _Session:
     """What the session's screenshot tests share: the renderer (made on first use) and the report's entries."""
 
     def __init__(self, config, scratch: Path):
+        self.config = config
         self.update = config.getoption("--cloudview-update-goldens")
         self.report = config.getoption("--cloudview-report")
         self.scratch = scratch
@@ -65,10 +74,35 @@ class _Session:
     def close(self) -> None:
         if self._renderer is not None:
             self._renderer.close()
-        if self.report is not None and self.entries:
-            from cloudcore.measure.screenshot_check import write_report
+        if self.report is None or not self.entries:
+            return
+        worker_output = getattr(self.config, "workeroutput", None)
+        if worker_output is not None:  # a pytest-xdist worker: the controller writes the report of them all
+            worker_output[_WORKER_ENTRIES] = pickle.dumps(self.entries)
+        else:
+            _write_report(self.report, self.entries)
 
-            write_report(self.report, self.entries, "cloudview screenshot tests")
+
+def _write_report(folder: Path, entries: list) -> None:
+    from cloudcore.measure.screenshot_check import write_report
+
+    write_report(folder, entries, "cloudview screenshot tests")
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_testnodedown(node, error):
+    """pytest-xdist's controller: keep a finished worker's report entries."""
+    entries = getattr(node, "workeroutput", {}).get(_WORKER_ENTRIES)
+    if entries is not None:
+        node.config.stash.setdefault(_GATHERED, []).extend(pickle.loads(entries))
+
+
+def pytest_sessionfinish(session):
+    """pytest-xdist's controller: the one report of every worker's views."""
+    gathered = session.config.stash.get(_GATHERED, [])
+    folder = session.config.getoption("--cloudview-report")
+    if gathered and folder is not None:
+        _write_report(folder, gathered)
 
 
 @pytest.fixture(scope="session")

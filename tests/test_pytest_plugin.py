@@ -87,3 +87,18 @@ def test_no_such_scene(cloudview_check):
             "*cloudview: *none.toml: (file): no such file",
         ],
     )
+
+
+def test_under_xdist_each_worker_renders_and_the_controller_writes_one_report(user_project):
+    """`pytest -n 2`: the two views on two workers, each with its own GL context; the report lists both."""
+    pytest.importorskip("xdist")
+    user_project.runpytest_subprocess("-n", "2", "--cloudview-update-goldens").assert_outcomes(skipped=2)
+    report = user_project.path / "report"
+    run = user_project.runpytest_subprocess("-n", "2", "--cloudview-report", str(report))
+    run.assert_outcomes(passed=2)
+    run.stdout.fnmatch_lines(["*2 workers*"])
+    page = (report / "index.html").read_text()
+    assert "2 views: 2 passed, 0 failed" in page
+    assert {"sky/default-actual.png", "sky/dusk-actual.png"} <= {
+        str(path.relative_to(report)) for path in report.rglob("*.png")
+    }
