@@ -3,9 +3,9 @@ composites full 3D's splats (`compositing`).
 
 A setting's "auto" resolves here, per renderer.  On a software rasterizer the
 GPU is the same cores: there the first way is taken untried (the CPU's sort:
-the radix sort on llvmpipe is 5-9 times slower than numpy's from 100,000 keys,
-the flythrough's full-3D frame 1.32 times; the raster: the compute compositor
-takes 1.1-2.3 times as long there, docs/performance.md).  On a GPU, the first frames that do the work alternate
+the radix sort on llvmpipe is several times slower than numpy's; the raster:
+the compute compositor takes longer there; docs/performance.md, "The GPU's
+order" and "Compositing by compute").  On a GPU, the first frames that do the work alternate
 the two ways, `TRIAL_FRAMES` each, and the way whose passes took less time
 (median) is kept.  Neighbouring frames of a moving camera draw nearly the
 same particles, so the alternation compares like with like; a frame that does

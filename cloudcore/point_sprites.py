@@ -5,9 +5,9 @@ scales both image axes of a plane parallel to the image plane by the same
 1/depth, so the square projects to a square: a point sprite of that side in
 pixels, centred on the projected centre, covers the same pixels with the same
 kernel coordinates (`gl_PointCoord`), and the picture does not change
-(`tests/test_point_sprites.py`).  On llvmpipe a particle then costs 0.29 us
-of vertex set-up instead of 0.50 (10,000 splats into 32-128 texel targets,
-docs/performance.md), which is most of an impostor regeneration's cost.
+(`tests/test_point_sprites.py`).  On llvmpipe a particle then costs less vertex
+set-up (a quad's four vertices against a point's one), which is most of an
+impostor regeneration's cost (docs/journal.md#point-sprites-third-session).
 
 Three things keep a particle on quads:
 - a look that varies across its square: an atlas sprite, a sprite facing
@@ -31,8 +31,8 @@ import numpy as np
 from cloudcore.artist.particle_styles import FACING_SPLAT, ParticleStyles
 
 #: a run of points costs two more draws (one each side) than drawing it with its neighbours as quads: on
-#: llvmpipe 3.4 us a draw against about 1 us saved a particle, even at 6-7 particles; twice that for
-#: margin (scripts/bench_point_sprites.py, docs/performance.md)
+#: llvmpipe a draw costs what a few particles save, even at 6-7 particles; twice that for margin
+#: (scripts/bench_point_sprites.py, docs/performance.md, "Full 3D: the splats, their order and their compositing")
 SHORTEST_POINT_RUN = 16
 
 

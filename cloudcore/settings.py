@@ -75,9 +75,9 @@ class RenderSettings:
         label="Mode",
     )
     #: degrees of translation error past which an impostor is regenerated; see `translation_metric`.
-    #: SkyWorks' default is 0.125 (0.9 of a pixel at 480 lines and 60 degrees).  1 saved an eighth of the
-    #: default flythrough's cloud pass for 0.5 dB (side by side), but on a cumulus field the project was not
-    #: tuned on it saved a tenth and cost 5 dB on the worst frame, 40.4 to 35.2 (docs/performance.md)
+    #: SkyWorks' default is 0.125 (0.9 of a pixel at 480 lines and 60 degrees).  1 saved little of the default
+    #: flythrough's cloud pass for its error there, but on a cumulus field the project was not tuned on it cost
+    #: its worst frame 5 dB (docs/journal.md#point-sprites-third-session)
     tolerance_deg: float = _setting(
         0.5,
         flag="--tolerance",
@@ -168,10 +168,9 @@ class RenderSettings:
     )
     #: auto mode plans a group apart, its clouds each a unit of its own, while the eye moves and their impostors
     #: cost less than the group's (`cloudcore.lod.plan.choice.groups_cheaper_apart`); still, or with the eye in its
-    #: sphere, a group is whole.  Side by side along the default flythrough: 21.4 against 25.4 ms of clouds for
-    #: 2.1 dB of mean PSNR (51.6 against 53.7; the worst frame 34.0 both); orbiting the default view 23.0
-    #: against 54.4 ms for 9.3 dB (36.9 against 46.2): the blobs of clouds sorted whole, while the eye moves
-    #: (docs/performance.md)
+    #: sphere, a group is whole.  Side by side, along the default flythrough it saved a sixth of the clouds' time
+    #: for 2 dB of mean PSNR; orbiting the default view, more than half for 9 dB: the blobs of clouds sorted
+    #: whole, while the eye moves (docs/journal.md#the-level-of-detail-by-error-and-cost)
     groups_apart_in_motion: bool = _setting(
         True,
         flag="--no-groups-apart-in-motion",
@@ -180,9 +179,9 @@ class RenderSettings:
         label="Groups apart in motion",
     )
     #: per axis: the screen impostor of a cloud the eye is inside has this fraction of the screen's pixels
-    #: (Harris's quarter).  An eighth saved 9% of the default flythrough's cloud pass for 0.45 dB, but under
-    #: a stratocumulus deck, whose one unit's sphere holds the eye, it blurred its underside (4.2 dB on
-    #: the worst frame; docs/performance.md)
+    #: (Harris's quarter).  An eighth saved a little of the default flythrough's cloud pass, but under a
+    #: stratocumulus deck, whose one unit's sphere holds the eye, it blurred its underside
+    #: (docs/journal.md#point-sprites-third-session)
     inside_resolution_scale: float = _setting(
         0.25,
         flag="--inside-resolution",
@@ -203,7 +202,8 @@ class RenderSettings:
     #: with the world and clouds are depth-tested against them (the naive picture, for comparison)
     split_objects: bool = True
     #: draw batches of plain splats as point sprites (one vertex per particle) where the picture is the
-    #: same (`cloudcore.point_sprites`); off, always as quads (for comparison; docs/performance.md)
+    #: same (`cloudcore.point_sprites`); off, always as quads (for comparison:
+    #: docs/journal.md#point-sprites-third-session)
     point_sprites: bool = _setting(
         True,
         flag="--no-point-sprites",
@@ -211,7 +211,7 @@ class RenderSettings:
         label="Point sprites",
     )
     #: multisample the world (terrain, objects) 4x: smooth ridge lines against the sky, for twice the world
-    #: pass on llvmpipe (640x480 and 1280x800; without it 47.4 and 49.1 dB: docs/performance.md)
+    #: pass on llvmpipe (docs/performance.md, "The world pass: where its time goes")
     world_antialiasing: bool = _setting(
         False,
         flag="--world-antialiasing",

@@ -15,7 +15,8 @@ tools make the same picture:
 
 Multisampling the world is a choice per frame (`multisampled_target`, and
 `render_pyrender_scene`'s `antialiased`): on llvmpipe it doubles the world pass
-for a picture hardly different (docs/performance.md), so the frame's default is without.
+for a picture hardly different (docs/performance.md, "The world pass: where its time goes"), so the frame's
+default is without.
 """
 
 from __future__ import annotations

@@ -135,8 +135,9 @@ class ImpostorStore:
 
     def _draw_cells(self, renders, settings: RenderSettings) -> None:
         """Render (atlas image, batch, view, projection) into their cells, cleared first: per atlas, those all of
-        point sprites in one multi-draw (`SplatPass.draw_point_cells`: with the one shading dispatch, the fixed
-        cost of a regeneration on llvmpipe fell from 0.63 to 0.40 ms, docs/performance.md), the others one by one."""
+        point sprites in one multi-draw (`SplatPass.draw_point_cells`: with the one shading dispatch, a third of a
+        regeneration's fixed cost on llvmpipe: docs/performance.md, "A frame's regenerations together"), the others
+        one by one."""
         by_atlas: dict[int, list] = {}
         for render in renders:
             by_atlas.setdefault(id(render[0].atlas), []).append(render)

@@ -14,8 +14,8 @@ pair a tile is written there, in the draw's far-to-near order, and one stable ra
 
 How many pairs a draw makes is known only once the GPU has counted them, and a draw's buffers and the sort's
 work must be sized before.  Reading the count back made the CPU wait, mid-frame, for everything the GPU had
-queued before it: on the H200 that cost the compute pass 2.4 ms of CPU a frame at 640x480 (docs/performance.md),
-more than auto mode's small full-3D draws gain by it.  So the count stays on the GPU: the buffers get `room`
+queued before it: on the H200 that cost the compute pass more CPU a frame than auto mode's small full-3D draws
+gain by it (docs/performance.md, "Compositing by compute").  So the count stays on the GPU: the buffers get `room`
 for `ROOM_FACTOR` times the most pairs a draw had in the frame before (at least `MIN_ROOM`), the shaders take
 the lesser of the count and the room, and the counts are read once the frame has been waited for
 (`GpuTileBinning.settle`).  A draw with more pairs than its room has lost its nearest splats: `settle` says so,

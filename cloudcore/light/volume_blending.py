@@ -46,7 +46,7 @@ MAX_OPTICAL_DEPTH = 50.0
 #: what a pixel lets through of what lies behind it when the compute pass of plain splats stops walking its
 #: splats near to far: what it leaves out is at most this much of the brightest radiance behind (the frame is
 #: clamped to 1 before sRGB), under a fifth of an 8-bit level where sRGB's curve is steepest (12.92 x 255 /
-#: 16384).  1/4096 and 1/16384 took the same time on llvmpipe (docs/performance.md)
+#: 16384).  1/4096 took no less time on llvmpipe (docs/performance.md, "Compositing by compute")
 FINISHED_TRANSMITTANCE = 1.0 / 16384
 _TINY = np.finfo(np.float64).tiny
 

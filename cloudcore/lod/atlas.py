@@ -1,8 +1,8 @@
 """Where impostors live in one array texture: square power-of-two cells in layers, by quadtree buddy allocation.
 
-llvmpipe pays for every texture a draw binds (docs/performance.md: a run of
-impostor quads each from its own texture cost up to twice as much per quad as
-the same run from regions of one texture), so the impostors of the units share
+llvmpipe pays for every texture a draw binds (a run of impostor quads each from
+its own texture cost more per quad than the same run from regions of one
+texture: docs/journal.md#the-level-of-detail-by-error-and-cost), so the impostors of the units share
 one array texture and a run of them is one instanced draw.  A request of side
 s gets a cell of the smallest power of two >= s (at least `smallest`): a
 layer of side `layer_side` splits into four quadrants, those into four, and
