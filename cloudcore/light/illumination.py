@@ -172,7 +172,8 @@ class IlluminationCache:
         """`sun_through_others`, kept while the clouds (by identity), their optics and the sun stay.  A dragged
         slider's look (the preview method) takes the one held for these clouds and optics whatever its sun: made on
         the thread that draws every look, it held a time-of-day drag's frames over a second (docs/atmosphere.md,
-        "Clouds on one another"); the look after the drag (the exact pass) makes it for its sun."""
+        "Cloud shadows": the clouds on one another); the look after the drag (the exact pass) makes it for its
+        sun."""
         source = (clouds, dataclasses.replace(shading, eye_pass=Shading().eye_pass), sun)
         held = self._between
         if held is not None and _same_clouds(held[0][0], clouds) and held[0][1] == source[1]:
