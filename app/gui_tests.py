@@ -147,6 +147,7 @@ def the_air_panel_changes_the_sky_and_the_light(ctx, app: EditorUnderTest):
     its range when typed past it; each change one undo step."""
     use_window(ctx, "Lighting")
     start = app.editor.scene
+    ctx.item_input_value("Time of day", 12.0)  # the tests before leave the sun where they set it
     app.relit(ctx)
     clear = app.capture(ctx).astype(float)
     ctx.item_input_value("Haze (x Earth's aerosols)", 20.0)

@@ -3,6 +3,7 @@ frame's one glFinish, and the passes' wall times add up to the frame's."""
 
 import time
 
+import numpy as np
 import pytest
 
 
@@ -62,10 +63,10 @@ def test_a_pass_gpu_time_covers_its_raster_work(renderer, clock):
     binned with the pass's draws, came back as late as the last tile's start: 0.04 of a 5 ms cloud pass."""
     from OpenGL import GL
 
-    from cloudcore.gl.programs import build_program
+    from cloudcore.gl.programs import build_program, set_matrix
 
     # one triangle over the screen, from gl_VertexID alone, coloured by the gradient sky
-    program = build_program("sky", {"PHYSICAL_SKY": 0}, vertex="world")
+    program = build_program("sky", {"PHYSICAL_SKY": 0, "VIEW_RAY": 1}, vertex="world")
     vertex_array = GL.glGenVertexArrays(1)
     try:
         with clock.frame():
@@ -73,6 +74,7 @@ def test_a_pass_gpu_time_covers_its_raster_work(renderer, clock):
                 clear_screen(renderer)
             with clock.timed("fill"):
                 GL.glUseProgram(program)
+                set_matrix(program, "inverse_view_projection", np.eye(4))  # any view: its rays' colours
                 GL.glDisable(GL.GL_DEPTH_TEST)
                 GL.glBindVertexArray(vertex_array)
                 GL.glDrawArraysInstanced(GL.GL_TRIANGLES, 0, 3, 400)
