@@ -4,7 +4,7 @@
                                         [--rings 2,3,4,5,6] [--modes full,impostor] [--cells-from REV]
                                         [--json out/bench_cloud_field.json]
 
-The demo scene (`cloudcore/resources/scenes/cumulus_field.toml`: 100 km of cumulus, 5 rings) is flown over
+The demo scene (`cloudcore/resources/scenes/cumulus_field.toml`: 100 km of cumulus, 6 rings) is flown over
 the first 20 km of its `flight` path (at 2 km through the clouds, then climbing above them) in auto mode
 with the default settings.  A CPU cannot draw the 3,000 frames of 20 km at 200 m/s and 30 fps, and frames
 kilometres apart would defeat what auto mode keeps between frames (Wang's ring lags its eye by its 16
@@ -21,9 +21,9 @@ cells and rebuilding the particle buffer, the passes), the renderer's own frame 
 only), the cloud pass and impostor updates, the field's particles, the cells made per frame, what preparing
 the particles costs where cells entered (`illumination_ms`), and the pure field update on its own
 (`update_field`, timed beside the renderer).  `--cells-from REV` flies the demo a second time in auto mode and in
-each of `--modes` with git revision REV's cells (`cloudcore/field/cells.py` as it was there: what a cell's
-particles are), interleaved with this tree's, so a change to the clouds' structure is measured before and after in
-one run (each frame of REV's compared with REV's full 3D).
+each of `--modes` with git revision REV's cells and demo (`cloudcore/field/cells.py`, what a cell's particles
+are, and the demo scene as they were there), interleaved with this tree's, so a change to the clouds'
+structure is measured before and after in one run (each frame of REV's compared with REV's full 3D).
 """
 
 from __future__ import annotations
@@ -33,6 +33,7 @@ import contextlib
 import dataclasses
 import os
 import subprocess
+import tempfile
 import time
 import types
 from pathlib import Path
@@ -51,6 +52,8 @@ from cloudcore.resources import CUMULUS_FIELD  # noqa: E402
 from cloudcore.scenefile import load_scene  # noqa: E402
 from cloudcore.settings import RenderSettings  # noqa: E402
 
+#: the cells' module and the demo scene, as paths in the repository (`--cells-from`)
+CELLS, DEMO = "cloudcore/field/cells.py", "cloudcore/resources/scenes/cumulus_field.toml"
 #: how much of the flight is flown, metres (the issue's 20 km)
 FLOWN_M = 20000.0
 #: metres a frame at 200 m/s and 30 frames a second
@@ -68,15 +71,27 @@ def views_along(scene, path_name: str, distances_m) -> list:
     return [camera_on_path(path, t, scene.camera.fov_y_deg) for t in np.interp(distances_m, travelled, times)]
 
 
+def _at_revision(revision: str, path: str) -> str:
+    """The text of `path` at git `revision`."""
+    root = Path(__file__).resolve().parent.parent
+    return subprocess.run(
+        ["git", "show", f"{revision}:{path}"], cwd=root, capture_output=True, text=True, check=True
+    ).stdout
+
+
 def cells_of_revision(revision: str) -> types.ModuleType:
     """`cloudcore/field/cells.py` as it was at git `revision`, as a module of its own."""
-    root = Path(__file__).resolve().parent.parent
-    source = subprocess.run(
-        ["git", "show", f"{revision}:cloudcore/field/cells.py"], cwd=root, capture_output=True, text=True, check=True
-    ).stdout
     module = types.ModuleType(f"cells_at_{revision}")
-    exec(compile(source, f"{revision}:cloudcore/field/cells.py", "exec"), module.__dict__)
+    exec(compile(_at_revision(revision, CELLS), f"{revision}:{CELLS}", "exec"), module.__dict__)
     return module
+
+
+def demo_of_revision(revision: str):
+    """The demo scene as it was at git `revision`."""
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "cumulus_field.toml"
+        path.write_text(_at_revision(revision, DEMO))
+        return load_scene(path)
 
 
 @contextlib.contextmanager
@@ -122,10 +137,10 @@ def main() -> None:
     compared = dict.fromkeys([demo_name, *(f"mode={mode}" for mode in modes)], "mode=full") if "full" in modes else {}
     revision_cells = {}
     if args.cells_from:
-        module = cells_of_revision(args.cells_from)
+        module, revision_demo = cells_of_revision(args.cells_from), demo_of_revision(args.cells_from)
         for mode in ["auto", *modes]:
             name = f"{args.cells_from}:mode={mode}"
-            scenes[name], settings[name], revision_cells[name] = demo, RenderSettings(mode=mode), module
+            scenes[name], settings[name], revision_cells[name] = revision_demo, RenderSettings(mode=mode), module
             if "full" in modes:
                 compared[name] = f"{args.cells_from}:mode=full"
     renderers = {name: FrameRenderer(args.width, args.height) for name in scenes}

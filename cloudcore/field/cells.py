@@ -46,9 +46,9 @@ from cloudcore.noise import hash01, value_noise
 from cloudcore.scene import Cloud, CloudField
 
 #: candidate columns along a cell's side
-CANDIDATES_PER_SIDE = 8
+CANDIDATES_PER_SIDE = 7
 #: a particle's radius over the column spacing in a cloud's core: neighbours overlap, no gaps between splats
-RADIUS_SPACINGS = 1.5
+RADIUS_SPACINGS = 1.7
 #: how much smaller a particle at the band's top is than one on the base (Yusov's narrower tops)
 TOP_SHRINK = 0.35
 #: how much smaller a particle at a cloud's rim is than one in its core: the thin wisps of its edge
@@ -56,7 +56,7 @@ RIM_SHRINK = 0.25
 #: the share of the columns at a cloud's rim that are kept, rising to all of them in the core: ragged, thinner edges
 RIM_KEEP = 0.5
 #: the cloud sites' lattice spacing, in inner cells: clouds about a cell across (docs/scene-format.md)
-SITE_SPACING_CELLS = 1.0
+SITE_SPACING_CELLS = 3.0
 #: a site's reach, in site spacings (its footprint at coverage 1): reaches this long overlap everywhere
 SITE_REACH = (0.8, 1.3)
 #: the regional noise that gathers sites into clusters, its wavelength in site spacings
@@ -152,7 +152,7 @@ def cumulus_columns(field: CloudField, x, z) -> tuple[np.ndarray, np.ndarray, np
     cloud's rim (0 at its site, 1 at the rim and beyond).
 
     A site of strength w > T (T the coverage's threshold) is cloudy out to rho_e = sqrt(1 - T / w) of its
-    reach, its column there the ellipse H sqrt(1 - (rho / rho_e)^2), H = aspect * rho_e * reach, at most the
+    reach, its column there the ellipse H sqrt(1 - (rho / rho_e)^2), H = aspect * rho_e * reach eased into the
     band; turrets cut up to `TURRET_DEPTH` of it.  An anvil (`type_structure`) spreads to anvil_spread rho_e,
     from anvil_low H at the tower to the tower's top, thinning toward its rim.
     """
@@ -169,7 +169,9 @@ def cumulus_columns(field: CloudField, x, z) -> tuple[np.ndarray, np.ndarray, np
         ratio = np.where(cloudy, (strength - shares) / np.where(cloudy, strength - threshold, 1.0), np.inf)
     else:  # coverage 1: every point cloudy, every site at its full reach
         footprint, ratio = np.ones_like(shares), np.zeros_like(shares)
-    towers = np.minimum(aspect * np.sqrt(footprint) * reach * spacing, band)
+    # the tower the type's aspect makes, eased into the band (band (1 - e^(-H / band))): a tower taller than the
+    # band is squeezed, its top still a dome, not cut flat
+    towers = band * -np.expm1(-aspect * np.sqrt(footprint) * reach * spacing / band)
     heights = towers * np.sqrt(np.clip(1.0 - ratio, 0.0, 1.0))
     anvils = np.full_like(heights, np.inf)
     if anvil_spread > 0.0:
