@@ -46,7 +46,7 @@ from cloudcore.noise import hash01, value_noise
 from cloudcore.scene import Cloud, CloudField
 
 #: candidate columns along a cell's side
-CANDIDATES_PER_SIDE = 7
+CANDIDATES_PER_SIDE = 8
 #: a particle's radius over the column spacing in a cloud's core: neighbours overlap, no gaps between splats
 RADIUS_SPACINGS = 1.7
 #: how much smaller a particle at the band's top is than one on the base (Yusov's narrower tops)
