@@ -17,8 +17,8 @@ cloud is a dome on a flat base: its column's height falls from the tower's
 top at the site to nothing at the rim like an ellipse, and the tower rises
 by the cloud's size, its height over its footprint's radius that of the
 field's cloud type (`cloudcore.artist.cloudgen.PRESETS`: humilis about as
-tall as half its width, congestus three times), at most the band of
-`field.altitude`, its top broken by turrets (`cumulus_columns`).  A type whose
+tall as half its width, congestus three and a half times), eased into the
+band of `field.altitude`, its top broken by turrets (`cumulus_columns`).  A type whose
 top box is wider than the one below (the cumulonimbus) spreads an anvil there.
 
 A cell samples that structure: `CANDIDATES_PER_SIDE`^2 jittered columns, and
@@ -29,7 +29,7 @@ cloud's rim smaller and sparser still: the thin wisps of its edge.  The
 column spacing, and the particle radius with it, follows the cell's side, so a
 coarser ring has a quarter as many particles per area, each twice as large:
 the same share of the sky covered, the same clouds.  Every random choice is an
-integer hash of (seed, level, layer, candidate) or of a site, never a
+integer hash of (seed, level, layer, column) or of a site, never a
 generator stream (`cloudcore.noise`), so a cell is the same on every machine
 and numpy.
 """
@@ -81,10 +81,10 @@ def _sites_about(u: np.ndarray, v: np.ndarray, seed: int):
     from the point (du, dv), reaches and strengths, each (points, 25).  Every site that reaches a point is among
     them (a reach and a jitter are at most 1.3 + 0.35 spacings).  The regional noise scales the strengths where
     the point is (once a point, not once a site: a cloud thins toward a gap)."""
-    offsets = np.arange(-2, 3)
-    a = (np.floor(u)[:, None, None] + offsets[None, :, None] + 0 * offsets[None, None, :]).reshape(len(u), 25)
-    b = (np.floor(v)[:, None, None] + offsets[None, None, :] + 0 * offsets[None, :, None]).reshape(len(u), 25)
-    site = functools.partial(_hash, a.astype(np.int64), b.astype(np.int64), seed, -1, 0)
+    offset_a, offset_b = (offset.ravel() for offset in np.meshgrid(np.arange(-2, 3), np.arange(-2, 3), indexing="ij"))
+    a = (np.floor(u)[:, None] + offset_a).astype(np.int64)
+    b = (np.floor(v)[:, None] + offset_b).astype(np.int64)
+    site = functools.partial(_hash, a, b, seed, -1, 0)
     du = a + 0.5 + 0.7 * (site(_SITE_X) - 0.5) - u[:, None]
     dv = b + 0.5 + 0.7 * (site(_SITE_Z) - 0.5) - v[:, None]
     reach = SITE_REACH[0] + (SITE_REACH[1] - SITE_REACH[0]) * site(_SITE_REACH)
