@@ -303,8 +303,8 @@ class CloudField:
     `cell_size` (m) the side of the inner ring's cells, each ring's cells twice
     the size of the ring inside it; `rings` the nested levels; `layers` the
     particle layers of a cell between `altitude` = (bottom, top) in metres;
-    `cloud_type` a preset of `cloudcore.artist.cloudgen.PRESETS` (its optics and
-    colour); the field covers `extent` = (x, z) metres about `centre` = (x, z).
+    `cloud_type` a preset of `cloudcore.artist.cloudgen.PRESETS` (its optics,
+    colour and the shape of its towers); the field covers `extent` = (x, z) metres about `centre` = (x, z).
     """
 
     seed: int = 0

@@ -1,9 +1,10 @@
 """Frame time of a cloud field against its rings and against its extent: 20 km of the demo's flight in auto mode (JSON).
 
     python scripts/bench_cloud_field.py [--stations 8] [--burst 16] [--warmup 6] [--width 320] [--height 240]
-                                        [--rings 2,3,4,5,6] [--modes full,impostor] [--json out/bench_cloud_field.json]
+                                        [--rings 2,3,4,5,6] [--modes full,impostor] [--cells-from REV]
+                                        [--json out/bench_cloud_field.json]
 
-The demo scene (`cloudcore/resources/scenes/cumulus_field.toml`: 100 km of cumulus, 5 rings) is flown over
+The demo scene (`cloudcore/resources/scenes/cumulus_field.toml`: 100 km of cumulus, 6 rings) is flown over
 the first 20 km of its `flight` path (at 2 km through the clouds, then climbing above them) in auto mode
 with the default settings.  A CPU cannot draw the 3,000 frames of 20 km at 200 m/s and 30 fps, and frames
 kilometres apart would defeat what auto mode keeps between frames (Wang's ring lags its eye by its 16
@@ -19,21 +20,29 @@ ratios hold.  Per configuration: the whole `render` call (`render_ms`: the field
 cells and rebuilding the particle buffer, the passes), the renderer's own frame time (`frame_ms`: the passes
 only), the cloud pass and impostor updates, the field's particles, the cells made per frame, what preparing
 the particles costs where cells entered (`illumination_ms`), and the pure field update on its own
-(`update_field`, timed beside the renderer).
+(`update_field`, timed beside the renderer).  `--cells-from REV` flies the demo a second time in auto mode and in
+each of `--modes` with git revision REV's cells and demo (`cloudcore/field/cells.py`, what a cell's particles
+are, and the demo scene as they were there), interleaved with this tree's, so a change to the clouds'
+structure is measured before and after in one run (each frame of REV's compared with REV's full 3D).
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import os
+import subprocess
+import tempfile
 import time
+import types
 from pathlib import Path
 
 import numpy as np
 
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 
+import cloudcore.field.state  # noqa: E402
 from cloudcore.field.state import FieldState, update_field  # noqa: E402
 from cloudcore.gl import FrameRenderer  # noqa: E402
 from cloudcore.measure.benchmark import machine, write_report  # noqa: E402
@@ -43,6 +52,8 @@ from cloudcore.resources import CUMULUS_FIELD  # noqa: E402
 from cloudcore.scenefile import load_scene  # noqa: E402
 from cloudcore.settings import RenderSettings  # noqa: E402
 
+#: the cells' module and the demo scene, as paths in the repository (`--cells-from`)
+CELLS, DEMO = "cloudcore/field/cells.py", "cloudcore/resources/scenes/cumulus_field.toml"
 #: how much of the flight is flown, metres (the issue's 20 km)
 FLOWN_M = 20000.0
 #: metres a frame at 200 m/s and 30 frames a second
@@ -60,6 +71,40 @@ def views_along(scene, path_name: str, distances_m) -> list:
     return [camera_on_path(path, t, scene.camera.fov_y_deg) for t in np.interp(distances_m, travelled, times)]
 
 
+def _at_revision(revision: str, path: str) -> str:
+    """The text of `path` at git `revision`."""
+    root = Path(__file__).resolve().parent.parent
+    return subprocess.run(
+        ["git", "show", f"{revision}:{path}"], cwd=root, capture_output=True, text=True, check=True
+    ).stdout
+
+
+def cells_of_revision(revision: str) -> types.ModuleType:
+    """`cloudcore/field/cells.py` as it was at git `revision`, as a module of its own."""
+    module = types.ModuleType(f"cells_at_{revision}")
+    exec(compile(_at_revision(revision, CELLS), f"{revision}:{CELLS}", "exec"), module.__dict__)
+    return module
+
+
+def demo_of_revision(revision: str):
+    """The demo scene as it was at git `revision`."""
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "cumulus_field.toml"
+        path.write_text(_at_revision(revision, DEMO))
+        return load_scene(path)
+
+
+@contextlib.contextmanager
+def cells_from(module: types.ModuleType | None):
+    """The field's step makes cells with `module`'s `cell_clouds` meanwhile (this tree's with None)."""
+    own = cloudcore.field.state.cell_clouds
+    cloudcore.field.state.cell_clouds = own if module is None else module.cell_clouds
+    try:
+        yield
+    finally:
+        cloudcore.field.state.cell_clouds = own
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--stations", type=int, default=8)
@@ -71,6 +116,7 @@ def main() -> None:
         "--rings", default="2,3,4,5,6", help="ring counts to fly at the demo's extent (its own is always flown)"
     )
     parser.add_argument("--modes", default="full,impostor", help="modes to fly the demo in beside auto ('' none)")
+    parser.add_argument("--cells-from", help="a git revision whose cells fly the demo beside this tree's")
     parser.add_argument("--json", type=Path)
     args = parser.parse_args()
 
@@ -87,7 +133,16 @@ def main() -> None:
     modes = [mode for mode in args.modes.split(",") if mode]
     for mode in modes:
         scenes[f"mode={mode}"], settings[f"mode={mode}"] = demo, RenderSettings(mode=mode)
-    compared = {demo_name, *(f"mode={mode}" for mode in modes)} if "full" in modes else set()
+    # configuration -> the full 3D configuration its frames are compared with
+    compared = dict.fromkeys([demo_name, *(f"mode={mode}" for mode in modes)], "mode=full") if "full" in modes else {}
+    revision_cells = {}
+    if args.cells_from:
+        module, revision_demo = cells_of_revision(args.cells_from), demo_of_revision(args.cells_from)
+        for mode in ["auto", *modes]:
+            name = f"{args.cells_from}:mode={mode}"
+            scenes[name], settings[name], revision_cells[name] = revision_demo, RenderSettings(mode=mode), module
+            if "full" in modes:
+                compared[name] = f"{args.cells_from}:mode=full"
     renderers = {name: FrameRenderer(args.width, args.height) for name in scenes}
     states = dict.fromkeys(scenes, FieldState())
     rows = {name: [] for name in scenes}
@@ -96,14 +151,16 @@ def main() -> None:
     for frame, camera in enumerate(views_along(demo, "flight", distances)):
         images = {}
         for name, scene in scenes.items():
-            start = time.perf_counter()
-            field_frame, states[name] = update_field(scene.cloud_field, camera.position, states[name])
-            update_ms = 1e3 * (time.perf_counter() - start)
-            start = time.perf_counter()
-            images[name], stats = renderers[name].render(
-                scene, camera=camera, settings=settings[name], read_back=name in compared
-            )
-            render_ms = 1e3 * (time.perf_counter() - start)
+            with cells_from(revision_cells.get(name)):
+                start = time.perf_counter()
+                field_frame, states[name] = update_field(scene.cloud_field, camera.position, states[name])
+                update_ms = 1e3 * (time.perf_counter() - start)
+                start = time.perf_counter()
+                images[name], stats = renderers[name].render(
+                    scene, camera=camera, settings=settings[name], read_back=name in compared
+                )
+                render_ms = 1e3 * (time.perf_counter() - start)
+            radii = np.concatenate([cloud.radii for cloud in field_frame.clouds])
             rows[name].append(
                 {
                     "frame": frame,
@@ -117,6 +174,8 @@ def main() -> None:
                     "illumination_ms": stats.illumination_ms,
                     "field_update_ms": update_ms,
                     "field_particles": field_frame.particle_count,
+                    "field_clouds": sum(len(cloud.particles) > 0 for cloud in field_frame.clouds),
+                    "median_particle_radius_m": float(np.median(radii)) if len(radii) else 0.0,
                     "cells_held": len(states[name].cells),
                     "cells_made": len(states[name].made),
                     "particles_drawn": stats.particles_drawn,
@@ -125,8 +184,8 @@ def main() -> None:
                     "clouds_inside": stats.plan.clouds_by_kind.get("inside", 0),
                 }
             )
-        for name in compared:
-            rows[name][-1]["psnr_db"] = min(compare(images[name], images["mode=full"]).psnr_db, 99.0)
+        for name, reference in compared.items():
+            rows[name][-1]["psnr_db"] = min(compare(images[name], images[reference]).psnr_db, 99.0)
     for renderer in renderers.values():
         renderer.close()
 
@@ -153,6 +212,8 @@ def main() -> None:
                 else {}
             ),
             "mean_field_particles": float(column["field_particles"].mean()),
+            "mean_field_clouds": float(column["field_clouds"].mean()),
+            "median_particle_radius_m": float(np.median(column["median_particle_radius_m"])),
             "max_cells_held": int(column["cells_held"].max()),
             "flying_frames_with_cells_made": int(np.count_nonzero(column["cells_made"])),
             "mean_field_update_ms": float(column["field_update_ms"].mean()),
@@ -174,7 +235,8 @@ def main() -> None:
     report = {
         "command": "python scripts/bench_cloud_field.py "
         f"--stations {args.stations} --burst {args.burst} --warmup {args.warmup} "
-        f"--width {args.width} --height {args.height} --rings {args.rings} --modes {args.modes}",
+        f"--width {args.width} --height {args.height} --rings {args.rings} --modes {args.modes}"
+        + (f" --cells-from {args.cells_from}" if args.cells_from else ""),
         "machine": machine(),
         "date": time.strftime("%Y-%m-%d"),
         "flown_m": FLOWN_M,

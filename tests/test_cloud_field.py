@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from cloudcore.errors import FieldError
-from cloudcore.field.cells import cell_cloud, cell_clouds, cloud_density, coverage_threshold
+from cloudcore.field.cells import CANDIDATES_PER_SIDE, cell_cloud, cell_clouds, cloud_density, coverage_threshold
 from cloudcore.field.grid import (
     RING_HALF_CELLS,
     cell_side,
@@ -78,13 +78,15 @@ def test_particles_stay_in_their_cell_and_altitude_band_and_coarser_cells_have_l
 
 
 def test_higher_layers_are_smaller_and_fewer():
-    cloud_rows = [cell_cloud(FIELD, 0, i, j) for i in range(-6, 6) for j in range(-6, 6)]
+    # towers (congestus) that reach the band's top: a humilis of these 500 m cells is a few hundred metres tall
+    field = dataclasses.replace(FIELD, cloud_type="cumulus_congestus")
+    cloud_rows = [cell_cloud(field, 0, i, j) for i in range(-6, 6) for j in range(-6, 6)]
     particles = np.concatenate([c.particles for c in cloud_rows if c is not None])
-    bottom, top = FIELD.altitude
-    layer = np.minimum(((particles[:, 1] - bottom) / (top - bottom) * FIELD.layers).astype(int), FIELD.layers - 1)
-    counts = np.bincount(layer, minlength=FIELD.layers)
+    bottom, top = field.altitude
+    layer = np.minimum(((particles[:, 1] - bottom) / (top - bottom) * field.layers).astype(int), field.layers - 1)
+    counts = np.bincount(layer, minlength=field.layers)
     assert np.all(np.diff(counts) < 0)  # narrower tops
-    sizes = [particles[layer == k, 3].mean() for k in range(FIELD.layers)]
+    sizes = [particles[layer == k, 3].mean() for k in range(field.layers)]
     assert np.all(np.diff(sizes) < 0)
 
 
@@ -99,7 +101,7 @@ def test_no_coverage_no_clouds_and_full_coverage_clouds_everywhere():
     assert update_field(dataclasses.replace(FIELD, coverage=0.0), EYE)[0].particle_count == 0
     overcast = dataclasses.replace(FIELD, coverage=1.0, layers=1)
     cloud = cell_cloud(overcast, 0, 0, 0)
-    assert len(cloud.particles) == 36  # every candidate of the one layer
+    assert len(cloud.particles) == CANDIDATES_PER_SIDE**2  # every candidate of the one layer
 
 
 def test_moving_one_inner_cell_makes_only_the_cells_entering_a_ring():
@@ -200,7 +202,8 @@ def test_no_popping_a_cell_s_region_changes_smoothly_as_it_changes_level():
     field = dataclasses.replace(FIELD, coverage=0.6)
     side = cell_side(field, 2)
     low, high = np.array([0.0, 0.0]), np.array([side, side])
-    steps = np.arange(0.0, level_reach(field, 3), 0.02 * field.cell_size)
+    # on until the region's nearest point (half its side from its centre) is past the last ring's reach
+    steps = np.arange(0.0, level_reach(field, 3) + 0.5 * side + 0.02 * field.cell_size, 0.02 * field.cell_size)
     state, values = FieldState(), []
     for step in steps:
         value, state = _region_opacity(field, np.array([0.5 * side - step, 2000.0, 0.5 * side]), state, low, high)

@@ -83,10 +83,10 @@ def _flight_means(renderer, settings) -> np.ndarray:
 
 def test_flying_across_ring_boundaries_changes_the_picture_smoothly(own_renderer):
     """The frame's mean brightness never steps.  The view itself slides by 20 m a frame; with the rings switched
-    hard instead of blended (weights rounded to 0 or 1) the largest change between frames was 0.054 levels here,
-    blended 0.009."""
+    hard instead of blended (weights rounded to 0 or 1) the largest change between frames is 0.059 levels here,
+    blended 0.026, all of it the view's motion over the cumulus (the soft balls before: 0.054 and 0.009)."""
     full = _flight_means(own_renderer[0], FULL_3D)
-    assert np.abs(np.diff(full)).max() < 0.025
+    assert np.abs(np.diff(full)).max() < 0.04
     # auto mode draws the same field within a level of full 3D on the way
     auto = _flight_means(own_renderer[0], RenderSettings())
     assert np.abs(auto - full).max() < 1.0
@@ -94,9 +94,10 @@ def test_flying_across_ring_boundaries_changes_the_picture_smoothly(own_renderer
 
 def test_a_field_s_shadows_on_the_ground_fade_in_and_out_with_its_clouds(own_renderer):
     """Over a plain under the physical sky at 15:30 the field's shadows fall on the ground, and flying across the
-    rings' edges they fade with their clouds: the frame's mean steps at most 0.02 levels more than without them
-    (0.137 against 0.122 in steps of 40 m).  Shadows of whole clouds, blind to the blend weights, stepped it 0.47
-    levels as cells entered (`cloudcore.gl.shadow_map`)."""
+    rings' edges they fade with their clouds: the frame's mean steps at most 0.1 levels more than without them
+    (0.169 against 0.108 in steps of 40 m: the cumulus' crisper shadows move with the view; the soft balls before
+    stepped it 0.137 against 0.122).  Shadows of whole clouds, blind to the blend weights, stepped it 0.47 levels as
+    cells entered (`cloudcore.gl.shadow_map`)."""
     renderer = own_renderer[0]
     scene = Scene(
         camera=ABOVE,
@@ -116,7 +117,7 @@ def test_a_field_s_shadows_on_the_ground_fade_in_and_out_with_its_clouds(own_ren
             frames.setdefault(shadows, image)
         steps[shadows] = np.abs(np.diff(means)).max()
     assert frames[True].mean() < frames[False].mean() - 1.0  # shadows on the ground
-    assert steps[True] < steps[False] + 0.02
+    assert steps[True] < steps[False] + 0.1
 
 
 EXTREMES = {
