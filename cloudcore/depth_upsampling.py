@@ -11,10 +11,13 @@ is never covered by a cloud that is behind it there (the farthest would spread a
 the wing: a halo of cloud on the object).  What a block straddling a depth edge loses is the clouds between its
 near and its far surface, which its far pixels should see: they take them from a neighbouring texel whose block
 lies at their own depth.  So the upsampling weighs the four reduced texels around a pixel by their bilinear share
-and by how close the depth each was tested against is to the pixel's own (`DEPTH_TOLERANCE`, relative): on a
-smooth surface it is bilinear, across a depth step it takes only the texels on the pixel's side.  Where none of the
-four is near the pixel's depth (a far pixel squeezed between near ones, thinner than a texel), it takes the one
-whose depth is nearest to its own.
+and by how close the depth each was tested against is to the pixel's own, relative: on a smooth surface it is
+bilinear, across a depth step it takes only the texels on the pixel's side.  A texel tested against a depth behind
+the pixel's may hold clouds behind the pixel's surface (a cloud lying on a ridge), and weighs within a tenth of the
+tolerance of one tested in front (`BEHIND_TOLERANCE`, `DEPTH_TOLERANCE`); the pixel's own block is never behind it.
+Where none of the four is near the pixel's depth (a far pixel in a block straddling the edge whose three other
+texels lie on the near side too, or one squeezed between near surfaces), it takes whole the texel whose depth is
+nearest its own among the nine around its own texel.
 """
 
 from __future__ import annotations
@@ -27,6 +30,9 @@ import numpy as np
 #: against the sky, or of an object against the terrain behind it, is a difference of 1 or more; a slope of terrain
 #: across a quarter-resolution block near the horizon (4 rows of 0.125 degrees at 6 degrees below it) one of 0.09
 DEPTH_TOLERANCE = 0.1
+#: the same for a texel tested against a depth behind the pixel's: only the depth buffer's own steps (6 m at 10 km)
+#: and a little more; the clouds it holds between the two surfaces would cover the pixel's
+BEHIND_TOLERANCE = 0.01
 #: below this sum of weights no texel is at the pixel's depth (the nearest of them, 3 tolerances away, weighs
 #: e^-9 of its bilinear share): the one whose depth is nearest is taken whole
 NO_MATCH_WEIGHT = 1e-6
@@ -67,6 +73,7 @@ def upsample(
     near_m: float,
     far_m: float,
     tolerance: float = DEPTH_TOLERANCE,
+    behind_tolerance: float = BEHIND_TOLERANCE,
 ) -> np.ndarray:
     """The reduced pass's premultiplied `clouds` (h, w, 4), tested against `cloud_depth` (h, w), at every pixel of the
     screen's `world_depth` (H, W) (window depths): cloud_upsample.frag.glsl's weights, in float64."""
@@ -80,21 +87,27 @@ def upsample(
     fx, fy = at_x - base_x, at_y - base_y
     total = np.zeros((height, width))
     summed = np.zeros((height, width, 4))
-    best = np.full((height, width), np.inf)
-    nearest = np.zeros((height, width, 4))
     for ox, oy in ((0, 0), (1, 0), (0, 1), (1, 1)):
         tx = np.clip(base_x.astype(np.int64) + ox, 0, w - 1)
         ty = np.clip(base_y.astype(np.int64) + oy, 0, h - 1)
         bilinear = (fy if oy else 1.0 - fy)[:, None] * (fx if ox else 1.0 - fx)[None, :]
         zt = texel_z[ty[:, None], tx[None, :]]
         apart = np.abs(zt - z) / np.minimum(zt, z)
-        weight = bilinear * np.exp(-((apart / tolerance) ** 2))
-        colour = clouds[ty[:, None], tx[None, :]]
-        summed += weight[..., None] * colour
+        weight = bilinear * np.exp(-((apart / np.where(zt > z, behind_tolerance, tolerance)) ** 2))
+        summed += weight[..., None] * clouds[ty[:, None], tx[None, :]]
         total += weight
-        closer = apart < best
-        best = np.where(closer, apart, best)
-        nearest = np.where(closer[..., None], colour, nearest)
+    # the pixel's own texel and the eight around it, for the one nearest in depth
+    own_x, own_y = np.floor(at_x + 0.5).astype(np.int64), np.floor(at_y + 0.5).astype(np.int64)
+    best = np.full((height, width), np.inf)
+    nearest = np.zeros((height, width, 4))
+    for oy in (-1, 0, 1):
+        for ox in (-1, 0, 1):
+            tx, ty = np.clip(own_x + ox, 0, w - 1), np.clip(own_y + oy, 0, h - 1)
+            zt = texel_z[ty[:, None], tx[None, :]]
+            apart = np.abs(zt - z) / np.minimum(zt, z)
+            closer = apart < best
+            best = np.where(closer, apart, best)
+            nearest = np.where(closer[..., None], clouds[ty[:, None], tx[None, :]], nearest)
     matched = total > NO_MATCH_WEIGHT
     mean = summed / np.where(matched, total, 1.0)[..., None]
     return np.where(matched[..., None], mean, nearest)

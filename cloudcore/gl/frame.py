@@ -206,6 +206,11 @@ class FrameRenderer:
         return None if self._world is None else self._world.light_shafts
 
     @property
+    def reduced_clouds(self) -> ReducedClouds | None:
+        """The reduced cloud pass, once a frame has drawn one (tests read what it laid over the screen)."""
+        return self._reduced
+
+    @property
     def volume_features(self) -> GpuFeatures:
         """What this GL offers volume-aware blending."""
         return self._volume.features

@@ -10,10 +10,11 @@ full resolution.  Objects between cloud layers (Harris 3.1.1) are drawn at full 
 
 from __future__ import annotations
 
+import numpy as np
 from OpenGL import GL
 
 from cloudcore.camera import FAR_PLANE_M, NEAR_PLANE_M
-from cloudcore.depth_upsampling import DEPTH_TOLERANCE, NO_MATCH_WEIGHT
+from cloudcore.depth_upsampling import BEHIND_TOLERANCE, DEPTH_TOLERANCE, NO_MATCH_WEIGHT
 from cloudcore.gl.programs import build_program, uniform_locations
 from cloudcore.gl.targets import DepthTexture, TextureTarget
 
@@ -33,6 +34,7 @@ class ReducedClouds:
         GL.glUniform1f(GL.glGetUniformLocation(self._upsample, "near_m"), NEAR_PLANE_M)
         GL.glUniform1f(GL.glGetUniformLocation(self._upsample, "far_m"), FAR_PLANE_M)
         GL.glUniform1f(GL.glGetUniformLocation(self._upsample, "tolerance"), DEPTH_TOLERANCE)
+        GL.glUniform1f(GL.glGetUniformLocation(self._upsample, "behind_tolerance"), BEHIND_TOLERANCE)
         GL.glUniform1f(GL.glGetUniformLocation(self._upsample, "no_match_weight"), NO_MATCH_WEIGHT)
         self._sizes = {
             program: uniform_locations(program, _SCREEN_SIZES) for program in (self._block_depth, self._upsample)
@@ -110,6 +112,16 @@ class ReducedClouds:
         GL.glDrawArrays(GL.GL_TRIANGLES, 0, 3)
         GL.glBindVertexArray(0)
         GL.glDepthFunc(GL.GL_LESS)
+
+    def read(self) -> tuple[np.ndarray, np.ndarray]:
+        """(its colour (h, w, 4), the depth it was tested against (h, w)) as float32, bottom row first (GL's order,
+        `cloudcore.depth_upsampling`'s): what the last composite laid over the screen, for tests."""
+        GL.glBindTexture(GL.GL_TEXTURE_2D, self._depth.texture)
+        GL.glPixelStorei(GL.GL_PACK_ALIGNMENT, 1)
+        depth = GL.glGetTexImage(GL.GL_TEXTURE_2D, 0, GL.GL_DEPTH_COMPONENT, GL.GL_FLOAT)
+        width, height = self.size
+        depth = np.frombuffer(depth, dtype=np.float32).reshape(height, width)
+        return self.target.read()[::-1].copy(), depth.copy()
 
     @property
     def nbytes(self) -> int:
