@@ -2,8 +2,9 @@
 
 Used for the overdraw counter (R32F, sharing the frame's depth so hidden
 fragments are not counted), impostor textures, screen layers and the reduced
-cloud pass (RGBA16F, premultiplied linear colour; the last over a depth texture:
-`cloudcore.gl.reduced_clouds`) and the editor's display image (RGBA8, sRGB).
+cloud pass (RGBA16F, premultiplied linear colour; the last over a depth texture,
+with an R8 map of the screen's tiles it covers: `cloudcore.gl.reduced_clouds`)
+and the editor's display image (RGBA8, sRGB).
 """
 
 from __future__ import annotations
@@ -12,8 +13,13 @@ import numpy as np
 from OpenGL import GL
 
 #: bytes per texel of the formats used here, for texture-memory statistics
-_TEXEL_BYTES = {GL.GL_RGBA16F: 8, GL.GL_R32F: 4, GL.GL_RGBA8: 4}
-_READ_FORMAT = {GL.GL_RGBA16F: (GL.GL_RGBA, 4), GL.GL_R32F: (GL.GL_RED, 1), GL.GL_RGBA8: (GL.GL_RGBA, 4)}
+_TEXEL_BYTES = {GL.GL_RGBA16F: 8, GL.GL_R32F: 4, GL.GL_RGBA8: 4, GL.GL_R8: 1}
+_READ_FORMAT = {
+    GL.GL_RGBA16F: (GL.GL_RGBA, 4),
+    GL.GL_R32F: (GL.GL_RED, 1),
+    GL.GL_RGBA8: (GL.GL_RGBA, 4),
+    GL.GL_R8: (GL.GL_RED, 1),
+}
 
 
 def linear_filtering(target: int, wrap: int = GL.GL_CLAMP_TO_EDGE) -> None:
