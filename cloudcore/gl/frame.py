@@ -692,7 +692,7 @@ class FrameRenderer:
             splat_order,
             compositing,
             None if air is None else (air, np.asarray(camera.position, float)),
-            self._reduced_pass(plan.cloud_size),
+            None,  # begun below, once the CPU's part of the pass is done
         )
         # the world pass uploaded the air for this eye: the cloud pass's splats take it per particle
         self._splats.air = air
@@ -704,6 +704,9 @@ class FrameRenderer:
             [(batch, view) for batch in inside_batches]
             + [(step[-1], view) for step in steps if step[0] in ("splats", "crossfade")]
         )
+        # the reduced pass reads the world's depth, and on llvmpipe the CPU then waits for the world to be drawn:
+        # begun after the batches are sorted and shaded, which the world's drawing overlapped
+        frame = dataclasses.replace(frame, reduced=self._reduced_pass(plan.cloud_size))
         # units the eye is in, one after the other: one screen impostor each run, laid where the run starts
         screen_impostors = self._screen_impostors(frame, runs, inside_batches)
         if plan.ring is not None:
