@@ -195,8 +195,10 @@ class RenderSettings:
     )
     #: per axis: the whole cloud pass (splats, impostors, ring panels, crossfades, screen impostors' composites) is
     #: drawn at this fraction of the screen's resolution and upsampled against the world's depth (Yusov 2014, 5.4;
-    #: `cloudcore.depth_upsampling`); 1 draws it at the screen's, as before.  Its cost and error side by side:
-    #: docs/performance.md, "The cloud pass at a reduced resolution"
+    #: `cloudcore.depth_upsampling`); 1 draws it at the screen's, as before.  1 by default: in full 3D a quarter
+    #: cut the frame to 0.17-0.77 within the tolerance, but auto mode already draws what costs fill at a reduced cost
+    #: and on llvmpipe lost 14-22% of its frame to the pass's wait for the world's depth and its composite
+    #: (docs/performance.md, "The cloud pass at a reduced resolution")
     cloud_resolution_scale: float = _setting(
         1.0,
         flag="--cloud-resolution",
