@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import math
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -544,6 +545,26 @@ def delete_key_and_statistics_toggle(ctx, app: EditorUnderTest):
     ctx.item_click("Place")
 
 
+def the_cloud_pass_at_a_quarter_resolution_in_the_window(ctx, app: EditorUnderTest):
+    """The LOD panel's "Cloud pass scale" draws the clouds into a reduced pass in the window's own context and lays it
+    over the world (`cloudcore.gl.reduced_clouds`): the same picture, its clouds' rims softer."""
+    use_window(ctx, "LOD")
+    ctx.combo_click("Mode/full")
+    ctx.yield_(SETTLE)
+    full = app.capture(ctx)
+    ctx.item_input_value("Cloud pass scale", 0.25)
+    CHECK(app.editor.settings.cloud_resolution_scale == 0.25)
+    ctx.yield_(SETTLE)
+    reduced = app.capture(ctx)
+    width, height = app.viewport.renderer.size
+    CHECK(app.viewport.renderer.last_plan.cloud_size == (math.ceil(width / 4), math.ceil(height / 4)))
+    ctx.item_input_value("Cloud pass scale", 1.0)
+    ctx.combo_click("Mode/auto")
+    difference = compare(full, reduced)
+    app.outcome["cloud_pass_at_a_quarter"] = {"psnr_db": difference.psnr_db, "max_abs": difference.max_abs}
+    CHECK(bool(30.0 < difference.psnr_db < math.inf))  # drawn otherwise, and close
+
+
 def heat_map_changes_the_picture(ctx, app: EditorUnderTest):
     # in full 3D, where every splat counts: auto draws this still view from impostors, one a pixel
     use_window(ctx, "LOD")
@@ -963,6 +984,7 @@ GUI_TESTS = (
     delete_key_and_statistics_toggle,
     heat_map_changes_the_picture,
     volume_blending_composites_in_the_window,
+    the_cloud_pass_at_a_quarter_resolution_in_the_window,
     the_gpu_sorts_the_splats_in_the_window,
     overlays_outline_impostors_and_the_ring,
     playing_a_camera_path_moves_the_camera,

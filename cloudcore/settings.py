@@ -18,6 +18,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, fields
 
+from cloudcore.depth_upsampling import LOWEST_SCALE
 from cloudcore.measured_way import COMPOSITING_WAYS, SPLAT_ORDER_WAYS
 
 MODES = ("auto", "full", "impostor")
@@ -191,6 +192,22 @@ class RenderSettings:
         high=1.0,
         display="%.3f",
     )
+    #: per axis: the whole cloud pass (splats, impostors, ring panels, crossfades, screen impostors' composites) is
+    #: drawn at this fraction of the screen's resolution and upsampled against the world's depth (Yusov 2014, 5.4;
+    #: `cloudcore.depth_upsampling`); 1 draws it at the screen's, as before.  1 by default: in full 3D a quarter
+    #: cut the frame to 0.17-0.77 within the tolerance, but auto mode already draws what costs fill at a reduced cost
+    #: and on llvmpipe lost 14-22% of its frame to the pass's wait for the world's depth and its composite
+    #: (docs/performance.md, "The cloud pass at a reduced resolution")
+    cloud_resolution_scale: float = _setting(
+        1.0,
+        flag="--cloud-resolution",
+        help="per axis, the fraction of the screen's resolution the cloud pass is drawn at, then upsampled against "
+        "the world's depth; 1: the screen's",
+        label="Cloud pass scale",
+        low=LOWEST_SCALE,
+        high=1.0,
+        display="%.3f",
+    )
     #: the ring is rebuilt when the eye has moved this fraction of ring_radius horizontally / vertically
     ring_rebuild_horizontal: float = 0.15
     ring_rebuild_vertical: float = 0.02
@@ -322,6 +339,10 @@ class RenderSettings:
             problems.append(f"transition_frames must be an integer >= 1, got {self.transition_frames!r}")
         if not 0.0 < self.inside_resolution_scale <= 1.0:
             problems.append(f"inside_resolution_scale must be within (0, 1], got {self.inside_resolution_scale}")
+        if not LOWEST_SCALE <= self.cloud_resolution_scale <= 1.0:
+            problems.append(
+                f"cloud_resolution_scale must be within [{LOWEST_SCALE}, 1], got {self.cloud_resolution_scale}"
+            )
         if not (self.ring_rebuild_horizontal > 0.0 and self.ring_rebuild_vertical > 0.0):
             problems.append("ring rebuild fractions must be > 0")
         if not 0.0 < self.ring_elevation_deg < 90.0:

@@ -435,6 +435,16 @@ def test_the_eye_inside_a_cloud_gets_the_screen_impostor(position):
     assert cloud_plan.clouds[0].regenerate is None  # a screen impostor is redrawn every frame, not cached
 
 
+def test_a_reduced_cloud_pass_is_planned_at_its_size_and_its_composite_priced_as_the_screen():
+    """`cloud_resolution_scale`: the pass's size rounds up; laying it over the screen is one screen of quad pixels."""
+    eye = orbit(2000.0, 0.0)
+    full = plan(eye)
+    reduced = plan(eye, dataclasses.replace(NO_RING, cloud_resolution_scale=0.25))
+    assert full.cloud_size == VIEWPORT and reduced.cloud_size == (160, 120)
+    extra = reduced.cloud_work.quad_pixels - full.cloud_work.quad_pixels
+    assert extra == VIEWPORT[0] * VIEWPORT[1] and reduced.cloud_work.quads == full.cloud_work.quads + 1
+
+
 def test_an_impostor_quad_past_the_screen_is_priced_as_the_screen():
     """Just outside its sphere's inside band the eye sees a cloud's quad wider than the screen: it fills the screen."""
     near = camera_at((0.0, 0.0, 1.1 * RADIUS), look_at=(0.0, 0.0, 0.0))

@@ -26,6 +26,7 @@ LAYERS = (
         "camera",
         "collector",
         "colour",
+        "depth_upsampling",
         "disk_cache",
         "measured_way",
         "navigation",

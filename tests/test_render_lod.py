@@ -74,11 +74,13 @@ def test_the_default_view_still_is_drawn_from_impostors(renderer, valley):
     assert again.plan.impostors_regenerated == 0 and again.plan.ring_segments_built == 0  # nothing moved
 
 
-def test_the_crossfade_mixes_full_3d_and_impostor_linearly(renderer, valley):
+@pytest.mark.parametrize("scale", [1.0, 0.5])
+def test_the_crossfade_mixes_full_3d_and_impostor_linearly(renderer, valley, scale):
     """When the measured costs turn, the unit crossfades from its impostor to full 3D; at every step the
     frame's mean is the plan's weighted mean of the two ends.
 
-    A blend that brightened or darkened mid-fade (the seam) would leave this line.
+    A blend that brightened or darkened mid-fade (the seam) would leave this line; so would a reduced cloud pass
+    (`scale`) whose crossfade layer were not its own size and depth.
     """
     cloud = valley.clouds[5]
     centre, radius = cloud.bounding_sphere()
@@ -86,14 +88,19 @@ def test_the_crossfade_mixes_full_3d_and_impostor_linearly(renderer, valley):
     # the impostor is made from one eye and seen from another, three quarters of the tolerance round:
     # kept, but far enough from full 3D that switching to it calls for the crossfade
     auto = dataclasses.replace(
-        RenderSettings(), ring_radius=np.inf, transition_frames=5, translation_metric="centre", tolerance_deg=1.0
+        RenderSettings(),
+        ring_radius=np.inf,
+        transition_frames=5,
+        translation_metric="centre",
+        tolerance_deg=1.0,
+        cloud_resolution_scale=scale,
     )
     made_from = Camera(tuple(centre + [0.0, 0.0, 3.0 * radius]), tuple(centre), 60.0)
     camera = orbited(made_from, 0.75)
     renderer.render(scene, camera=made_from, settings=dataclasses.replace(auto, mode="impostor"))
     ends = [
         renderer.render(scene, camera=camera, settings=s)[0].astype(float).mean()
-        for s in (FULL_3D, dataclasses.replace(auto, mode="impostor"))
+        for s in (dataclasses.replace(auto, mode="full"), dataclasses.replace(auto, mode="impostor"))
     ]
     assert renderer.last_plan.clouds[0].regenerate is None
     means, weights = [], []

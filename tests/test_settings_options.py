@@ -27,7 +27,7 @@ def other_value(name: str):
         return not default
     if isinstance(default, int):
         return {"impostor_min_size": 32, "impostor_max_size": 256}.get(name, default + 1)
-    return {"inside_resolution_scale": 0.5}.get(name, default + 0.25)
+    return {"inside_resolution_scale": 0.5, "cloud_resolution_scale": 0.5}.get(name, default + 0.25)
 
 
 def test_no_options_give_the_default_settings():

@@ -50,6 +50,7 @@ from cloudcore.gl.objects import ObjectPass
 from cloudcore.gl.pass_clock import PassClock
 from cloudcore.gl.programs import build_program
 from cloudcore.gl.quads import SCREEN_CORNERS, QuadPass
+from cloudcore.gl.reduced_clouds import ReducedClouds
 from cloudcore.gl.shadow_map import CloudShadowMap
 from cloudcore.gl.splats import SplatBatch, SplatPass, SplatSelection, splat_batch
 from cloudcore.gl.targets import TextureTarget, blit_depth, depth_renderbuffer
@@ -107,6 +108,8 @@ class _CloudPassFrame:
     compositing: str  # the GPU's plain full-3D splats blended by the "raster" or by "compute" ("auto" resolved)
     #: the air's volume uploaded for this eye, and the eye, that world-space quads are seen through; None: no air
     air: tuple[AirVolume, np.ndarray] | None
+    #: where the cloud draws go: None, the frame's target; else the reduced pass (`plan.cloud_size`)
+    reduced: ReducedClouds | None
 
     @property
     def eye(self) -> np.ndarray:
@@ -183,6 +186,7 @@ class FrameRenderer:
         self._ring_drift = None  # (ring keys, clouds' drift steps, the keys with them) under wind
         self._shadow_source = (None, MAP_RESOLUTION)  # the sun and the size of the clouds' transmittance map
         self._layer = None  # screen-sized, sharing the frame's depth: crossfading clouds' full-3D image
+        self._reduced: ReducedClouds | None = None  # the cloud pass at a fraction of the screen's resolution
         self._inside = []  # (target, its depth renderbuffer) per screen impostor of a frame, all of one size
         self._overdraw_target = None
         self._display = None  # (RGBA8 target, program): the frame in sRGB for the editor
@@ -206,6 +210,11 @@ class FrameRenderer:
     def light_shafts(self) -> LightShaftPass | None:
         """The world pass's light shafts, once a frame has drawn them (tests read their march)."""
         return None if self._world is None else self._world.light_shafts
+
+    @property
+    def reduced_clouds(self) -> ReducedClouds | None:
+        """The reduced cloud pass, once a frame has drawn one (tests read what it laid over the screen)."""
+        return self._reduced
 
     @property
     def volume_features(self) -> GpuFeatures:
@@ -445,7 +454,7 @@ class FrameRenderer:
         held = self._impostors.texture_bytes
         for target in (self._layer, *(target for target, _ in self._inside)):
             held += target.nbytes if target is not None else 0
-        return held
+        return held + (self._reduced.nbytes if self._reduced is not None else 0)
 
     def _with_field(self, scene: Scene, camera: Camera, carried: np.ndarray) -> tuple[Scene, tuple]:
         """The scene with its cloud field's clouds for this eye after its own (`cloudcore.field.state`), and
@@ -711,6 +720,7 @@ class FrameRenderer:
             splat_order,
             compositing,
             None if air is None else (air, np.asarray(camera.position, float)),
+            None,  # begun below, once the CPU's part of the pass is done
         )
         # the world pass uploaded the air for this eye: the cloud pass's splats take it per particle
         self._splats.air = air
@@ -722,6 +732,9 @@ class FrameRenderer:
             [(batch, view) for batch in inside_batches]
             + [(step[-1], view) for step in steps if step[0] in ("splats", "crossfade")]
         )
+        # the reduced pass reads the world's depth, and on llvmpipe the CPU then waits for the world to be drawn:
+        # begun after the batches are sorted and shaded, which the world's drawing overlapped
+        frame = dataclasses.replace(frame, reduced=self._reduced_pass(plan.cloud_size))
         # units the eye is in, one after the other: one screen impostor each run, laid where the run starts
         screen_impostors = self._screen_impostors(frame, runs, inside_batches)
         if plan.ring is not None:
@@ -732,6 +745,8 @@ class FrameRenderer:
                 drawn += self._draw_splats(frame, batch)
             elif kind == "object":
                 antialiased = settings.world_antialiasing
+                if frame.reduced is not None:  # the clouds behind it laid over the screen first, at its resolution
+                    frame.reduced.composite(self.context)
                 self._objects.draw(
                     self.context,
                     camera,
@@ -742,6 +757,8 @@ class FrameRenderer:
                     air=None if frame.air is None else frame.air[0],
                     shadows=self._shadows,
                 )
+                if frame.reduced is not None:
+                    frame.reduced.resume()
             elif kind == "inside":
                 if item in screen_impostors:  # the rest of its run is in the same screen impostor
                     target, particles_drawn, extent = screen_impostors[item]
@@ -751,7 +768,19 @@ class FrameRenderer:
                 self._draw_impostors(frame, item)
             else:
                 drawn += self._draw_crossfade(frame, item, plan.clouds[item.index], batch)
+        if frame.reduced is not None:
+            frame.reduced.composite(self.context)
         return drawn
+
+    def _reduced_pass(self, size: tuple) -> ReducedClouds | None:
+        """The reduced cloud pass begun for this frame at `size`, bound; None at the screen's size (the frame's
+        target, as before)."""
+        if tuple(size) == self.size:
+            return None
+        if self._reduced is None:
+            self._reduced = ReducedClouds()
+        self._reduced.begin(self.context, size)
+        return self._reduced
 
     def _cloud_pass_steps(self, frame: _CloudPassFrame) -> list[tuple]:
         """The cloud pass's draws in order, (kind, draw item, splat batch or None), kind one of "splats" (a run
@@ -814,16 +843,9 @@ class FrameRenderer:
             self._compositable += batch.slots if compositable else 0
             if frame.compositing == "compute" and compositable:
                 instances, count_at = self._splats.selected_instances(batch, view)
-                target = self.context.colour_texture if colour_texture is None else colour_texture
+                target, framebuffer, size = self._drawn_into(frame, colour_texture)
                 composited = self._volume.draw(
-                    instances,
-                    view,
-                    projection,
-                    target,
-                    self.context.framebuffer,
-                    self.size,
-                    plain=True,
-                    count_at=count_at,
+                    instances, view, projection, target, framebuffer, size, plain=True, count_at=count_at
                 )
             if composited:
                 self._splats.count_drawn(batch)
@@ -840,16 +862,31 @@ class FrameRenderer:
         composited = False
         if path == "volume" and len(batch):
             buffer, first = self._splats.shade(batch, view)
-            target = self.context.colour_texture if colour_texture is None else colour_texture
-            composited = self._volume.draw(
-                (buffer, first, len(batch)), view, projection, target, self.context.framebuffer, self.size
-            )
+            target, framebuffer, size = self._drawn_into(frame, colour_texture)
+            composited = self._volume.draw((buffer, first, len(batch)), view, projection, target, framebuffer, size)
             self._particles_as_volumes += len(batch) if composited else 0
         if not composited:  # plain billboards, asked for or past the binning's pairs
             self._splats.draw(batch, view, projection, point_sprites=points)
         self._replay.append(lambda: self._splats.draw(batch, view, projection, counting=True, point_sprites=points))
         self._screen_batches.append(batch)
         return len(batch)
+
+    def _drawn_into(self, frame: _CloudPassFrame, colour_texture: int | None) -> tuple[int, int, tuple[int, int]]:
+        """(the colour texture, the framebuffer whose depth cuts it, their size) a compositing pass draws into: the
+        frame's target or the reduced pass's, or `colour_texture` (a screen layer of the same size and depth)."""
+        if frame.reduced is None:
+            framebuffer, size, texture = self.context.framebuffer, self.size, self.context.colour_texture
+        else:
+            target = frame.reduced.target
+            framebuffer, size, texture = target.framebuffer, frame.reduced.size, target.texture
+        return (texture if colour_texture is None else colour_texture), framebuffer, size
+
+    def _bind_cloud_target(self, frame: _CloudPassFrame) -> None:
+        """Draw into the frame's target, or the reduced pass's, from now on."""
+        if frame.reduced is None:
+            self.context.bind_target()
+        else:
+            frame.reduced.bind()
 
     def _draw_screen_quad(self, texture, weight, extent) -> None:
         """A screen impostor: the part `extent` (u0, v0, u1, v1) of `texture` that its particles can cover,
@@ -903,10 +940,10 @@ class FrameRenderer:
         image, corners, extent, made_at = self._impostors.cloud_impostor(cloud.members, item.layer)
         corners = corners + frame.plan.impostor_shifts([item.index])[0]
         faded = self._faded([cloud.members], np.array([made_at]))
-        layer = self._screen_layer()
+        layer = self._screen_layer() if frame.reduced is None else frame.reduced.layer()
         layer.bind_cleared()
         drawn = self._draw_splats(frame, batch, layer.texture)
-        self.context.bind_target()
+        self._bind_cloud_target(frame)
         instance = atlas_instances([image], corners[None], cloud.impostor_weight * faded, extent[None])
         self._draw_instanced(
             frame, image.atlas.texture, instance, layer_texture=layer.texture, layer_weight=cloud.full_weight
@@ -931,7 +968,7 @@ class FrameRenderer:
             self._splats.draw(batch, frame.view, frame.projection, point_sprites=frame.point_sprites)
             extent = particle_extent(frame.view, frame.projection, batch.centres, batch.radii, frame.plan.inside_size)
             made[run[0]] = (target, len(batch), extent)
-        self.context.bind_target()
+        self._bind_cloud_target(frame)
         return made
 
     def _screen_layer(self) -> TextureTarget:
@@ -990,6 +1027,9 @@ class FrameRenderer:
             GL.glDeleteProgram(self._display[1])
         self._overdraw_target = self._layer = self._display = None
         self._close_inside()
+        if self._reduced is not None:
+            self._reduced.close()
+            self._reduced = None
 
     @property
     def _machine(self) -> dict:

@@ -1,8 +1,10 @@
 """Offscreen render targets: a colour texture, optionally sharing a depth renderbuffer.
 
 Used for the overdraw counter (R32F, sharing the frame's depth so hidden
-fragments are not counted), impostor textures and screen layers (RGBA16F,
-premultiplied linear colour) and the editor's display image (RGBA8, sRGB).
+fragments are not counted), impostor textures, screen layers and the reduced
+cloud pass (RGBA16F, premultiplied linear colour; the last over a depth texture,
+with an R8 map of the screen's tiles it covers: `cloudcore.gl.reduced_clouds`)
+and the editor's display image (RGBA8, sRGB).
 """
 
 from __future__ import annotations
@@ -11,8 +13,13 @@ import numpy as np
 from OpenGL import GL
 
 #: bytes per texel of the formats used here, for texture-memory statistics
-_TEXEL_BYTES = {GL.GL_RGBA16F: 8, GL.GL_R32F: 4, GL.GL_RGBA8: 4}
-_READ_FORMAT = {GL.GL_RGBA16F: (GL.GL_RGBA, 4), GL.GL_R32F: (GL.GL_RED, 1), GL.GL_RGBA8: (GL.GL_RGBA, 4)}
+_TEXEL_BYTES = {GL.GL_RGBA16F: 8, GL.GL_R32F: 4, GL.GL_RGBA8: 4, GL.GL_R8: 1}
+_READ_FORMAT = {
+    GL.GL_RGBA16F: (GL.GL_RGBA, 4),
+    GL.GL_R32F: (GL.GL_RED, 1),
+    GL.GL_RGBA8: (GL.GL_RGBA, 4),
+    GL.GL_R8: (GL.GL_RED, 1),
+}
 
 
 def linear_filtering(target: int, wrap: int = GL.GL_CLAMP_TO_EDGE) -> None:
@@ -29,7 +36,15 @@ def linear_filtering(target: int, wrap: int = GL.GL_CLAMP_TO_EDGE) -> None:
 class TextureTarget:
     """A framebuffer whose colour attachment is a linear-filtered texture of `internal_format`."""
 
-    def __init__(self, width: int, height: int, internal_format=GL.GL_RGBA16F, depth_renderbuffer: int | None = None):
+    def __init__(
+        self,
+        width: int,
+        height: int,
+        internal_format=GL.GL_RGBA16F,
+        depth_renderbuffer: int | None = None,
+        depth_texture: int | None = None,
+    ):
+        """With `depth_renderbuffer` or `depth_texture` (one of the two), drawn depth-tested against it."""
         self.width, self.height, self.internal_format = int(width), int(height), internal_format
         self.texture = GL.glGenTextures(1)
         GL.glBindTexture(GL.GL_TEXTURE_2D, self.texture)
@@ -42,6 +57,8 @@ class TextureTarget:
             GL.glFramebufferRenderbuffer(
                 GL.GL_FRAMEBUFFER, GL.GL_DEPTH_ATTACHMENT, GL.GL_RENDERBUFFER, depth_renderbuffer
             )
+        elif depth_texture is not None:
+            GL.glFramebufferTexture2D(GL.GL_FRAMEBUFFER, GL.GL_DEPTH_ATTACHMENT, GL.GL_TEXTURE_2D, depth_texture, 0)
         status = GL.glCheckFramebufferStatus(GL.GL_FRAMEBUFFER)
         if status != GL.GL_FRAMEBUFFER_COMPLETE:
             raise RuntimeError(f"framebuffer incomplete (status 0x{int(status):x})")

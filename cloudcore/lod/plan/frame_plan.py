@@ -31,6 +31,8 @@ class FramePlan:
     ring: RingPlan | None
     state: LodState = LodState()  # to carry into the next frame
     inside_size: tuple = (0, 0)  # the screen impostor's texture size (width, height)
+    #: the cloud pass's size (width, height): the screen's, or less (`settings.cloud_resolution_scale`), upsampled
+    cloud_size: tuple = (0, 0)
     draw_items: DrawItems | None = None  # the cloud pass, far to near
     objects_with_world: tuple = ()  # visible objects outside split clouds: drawn before the cloud pass
     update_work: Work = Work()  # predicted work of the impostor updates (regenerations, ring segment)

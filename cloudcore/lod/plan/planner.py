@@ -4,7 +4,6 @@
 from __future__ import annotations
 
 import dataclasses
-import math
 from collections.abc import Hashable
 
 import numpy as np
@@ -15,6 +14,7 @@ from cloudcore.camera import (
     spheres_in_frustum,
     view_matrix,
 )
+from cloudcore.depth_upsampling import reduced_size
 from cloudcore.lod.costs import CostModel, Work
 from cloudcore.lod.impostors import (
     INSIDE_RADII,
@@ -636,13 +636,16 @@ def _plan_units(
     )
     drawn = np.flatnonzero(of_kinds(kinds, *DRAWN))
     draw_order = tuple(drawn[np.argsort(-distances[drawn], kind="stable")].tolist())
-    inside_size = tuple(max(1, math.ceil(side * settings.inside_resolution_scale)) for side in viewport)
+    inside_size = reduced_size(viewport, settings.inside_resolution_scale)
+    cloud_size = reduced_size(viewport, settings.cloud_resolution_scale)
     items = draw_items(plans, draw_order, radii, object_centres, objects_visible, eye)
     screen_impostors = len(inside_runs(items, plans))
+    # a reduced cloud pass is laid over the screen once, and once more after each object between cloud layers
+    upsamplings = 0 if cloud_size == tuple(viewport) else 1 + len(items.objects)
     cloud_work += Work(
         batches=float(full_runs(kinds[list(draw_order)]) + screen_impostors),
-        quad_pixels=screen_impostors * screen_pixels,
-        quads=float(screen_impostors),
+        quad_pixels=(screen_impostors + upsamplings) * screen_pixels,
+        quads=float(screen_impostors + upsamplings),
     )
     between = set(items.objects)
     with_world = tuple(i for i in range(len(object_radii)) if objects_visible[i] and i not in between)
@@ -691,6 +694,7 @@ def _plan_units(
         ring=ring,
         state=next_state,
         inside_size=inside_size,
+        cloud_size=cloud_size,
         draw_items=items,
         objects_with_world=with_world,
         update_work=update_work if priced else Work(),
