@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 import shutil
 import time
 from collections import deque
@@ -36,6 +37,7 @@ from cloudcore.limits import scene_limit_problems
 from cloudcore.measure.frame_stats import FrameStats
 from cloudcore.particle_files import particles_folder
 from cloudcore.paths import camera_on_path
+from cloudcore.resources import DEFAULT_SCENE
 from cloudcore.scene import Camera, Lighting, Scene, Shading
 from cloudcore.scenefile import load_scene, save_scene
 from cloudcore.settings import RenderSettings
@@ -54,7 +56,18 @@ WIND_CLOCK_S = 600.0
 TOOLS = (("place", "Place"), ("brush", "Brush"), ("move_cloud", "Move cloud"), ("move_particle", "Move particle"))
 
 
+#: the folder of the built-in scenes, package data: an artist's unsaved edits to one are kept elsewhere
+BUILT_IN_SCENES = DEFAULT_SCENE.parent
+
+
 def recovery_path(path: Path) -> Path:
+    """Where the unsaved edits to the scene at `path` are kept: beside it, but for the built-in scenes, which are
+    the package's own files (in site-packages where installed): under the user's state directory,
+    `$XDG_STATE_HOME/cloudview/recovery` (`~/.local/state` where that is unset)."""
+    path = Path(path)
+    if path.resolve().is_relative_to(BUILT_IN_SCENES.resolve()):
+        state = os.environ.get("XDG_STATE_HOME") or str(Path.home() / ".local" / "state")
+        return Path(state) / "cloudview" / "recovery" / f"{path.stem}.recovery.toml"
     return path.with_name(f"{path.stem}.recovery.toml")
 
 
@@ -448,7 +461,9 @@ class Editor:
 
     def _write_recovery(self) -> bool:
         try:
-            save_scene(dataclasses.replace(self.scene, camera=self.camera), recovery_path(self.path))
+            recovery = recovery_path(self.path)
+            recovery.parent.mkdir(parents=True, exist_ok=True)
+            save_scene(dataclasses.replace(self.scene, camera=self.camera), recovery)
         except (OSError, SceneError, ValueError) as error:
             self.messages.append(f"could not write the recovery file: {error}")
             return False

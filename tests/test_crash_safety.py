@@ -23,6 +23,7 @@ from conftest import ROOT
 
 from app.editor import AUTOSAVE_SECONDS, Editor, recovery_path
 from cloudcore.particle_files import particles_folder
+from cloudcore.resources import DEFAULT_SCENE
 from cloudcore.scene import Camera, Cloud, Scene
 from cloudcore.scenefile import INLINE_PARTICLE_LIMIT, load_scene, save_scene
 
@@ -272,3 +273,18 @@ def test_recover_without_a_recovery_file_says_so(scene_file):
     assert not any("recovery" in message for message in editor.messages)
     assert not editor.recover() and editor.messages[-1] == "there is no recovery file to load"
     assert not editor.dirty
+
+
+def test_unsaved_edits_to_a_built_in_scene_are_kept_in_the_user_s_state_folder(tmp_path, monkeypatch):
+    """The built-in scenes are the package's files (in site-packages where installed): an artist's edits to the
+    default scene go to $XDG_STATE_HOME/cloudview/recovery, not beside it, and are offered again from there."""
+    monkeypatch.setenv("XDG_STATE_HOME", str(tmp_path / "state"))
+    packaged = set(DEFAULT_SCENE.parent.iterdir())
+    editor = Editor.open(DEFAULT_SCENE)
+    editor.set_time_of_day(9.0)
+    assert editor.autosave(now=time.monotonic() + AUTOSAVE_SECONDS)
+    kept = recovery_path(DEFAULT_SCENE)
+    assert kept == tmp_path / "state" / "cloudview" / "recovery" / "valley.recovery.toml"
+    assert load_scene(kept).lighting.time_of_day == 9.0 and len(load_scene(kept).clouds) == len(editor.scene.clouds)
+    assert set(DEFAULT_SCENE.parent.iterdir()) == packaged
+    assert any(str(kept) in message for message in Editor.open(DEFAULT_SCENE).messages)
