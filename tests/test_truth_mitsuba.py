@@ -133,7 +133,13 @@ def test_the_report_compares_every_shading_method_region_by_region(tmp_path):
     )
     assert result.returncode == 0, result.stderr
     report = json.loads(report_path.read_text())
-    assert set(report["models"]) == {"harris-exact", "harris-raster", "harris-preview", "saturated-exact"}
+    assert set(report["models"]) == {
+        "harris-exact",
+        "harris-raster",
+        "harris-preview",
+        "saturated-exact",
+        "saturated-octaves",
+    }
     assert 10 < report["truth"]["noise_psnr_db"] < 100
     exact = report["models"]["harris-exact"]
     assert set(exact["errors"]) == {"image", "sky", "silhouette", "lit", "shadowed"}
