@@ -4,7 +4,8 @@
 
 For each light that contributes at the scene's hour, the two methods take turns (`illuminate_direction` over every
 cloud, after one warm-up each), so what the shared machine does falls on both; the ratio octaves / exact is
-reported with its 95% interval (`ratio_interval`).  Results for this machine are in docs/shading.md ("Octaves").
+reported with its 95% interval (`ratio_interval`) and the range of the turns' own ratios.  Results for this machine
+are in docs/shading.md ("Octaves").
 """
 
 from __future__ import annotations
@@ -41,11 +42,14 @@ def main() -> None:
                 if turn > 0:  # the first turn warms up
                     seconds[method].append(time.perf_counter() - start)
         ratio, low, high = ratio_interval(seconds["octaves"], [seconds["exact"]])
+        # with fewer turns than the bootstrap's block the interval is one point: the turns' own ratios beside it
+        per_turn = [octave / exact for octave, exact in zip(seconds["octaves"], seconds["exact"])]
         rows.append(
             {
                 "direction": direction,
                 "seconds": {method: sorted(times)[len(times) // 2] for method, times in seconds.items()},
                 "octaves_over_exact": {"ratio": ratio, "low": low, "high": high},
+                "per_turn_ratio": {"min": min(per_turn), "max": max(per_turn)},
                 "runs": seconds,
             }
         )
