@@ -90,8 +90,9 @@ class Shading:
     """Harris's defaults for every cloud; `eye_pass` chooses what a particle sends to the eye
     (`cloudcore.light.shading.EYE_PASSES`: Harris's eq. 5, its saturated form, closer to the path-traced
     truth, or Yusov's precomputed reference particle: docs/shading.md) and `light_pass` how the light
-    reaching it is found (`LIGHT_PASSES`: Harris's multiple forward scattering or Yusov's occlusion
-    estimate; "yusov" and "occlusion" together are Yusov's model)."""
+    reaching it is found (`LIGHT_PASSES`: Harris's multiple forward scattering, Yusov's occlusion
+    estimate, or Wrenninge's multiple-scattering octaves; "yusov" and "occlusion" together are Yusov's model,
+    "saturated" and "octaves" the octave model: docs/shading.md, "Octaves")."""
 
     albedo: float = 0.9
     optical_depth: float = 8.0

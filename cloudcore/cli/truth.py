@@ -245,8 +245,9 @@ class TruthPasses:
 
 #: the models that can be compared with the truth: name -> (eye pass, illumination method)
 MODELS = {f"{eye_pass}-{method}": (eye_pass, method) for eye_pass in EYE_PASSES for method in METHODS}
-#: those compared unless --models names others: Harris's light pass methods, the saturated eye pass
-DEFAULT_MODELS = ("harris-exact", "harris-raster", "harris-preview", "saturated-exact")
+#: those compared unless --models names others: Harris's light pass methods, the saturated eye pass, and it over
+#: the multiple-scattering octaves (docs/shading.md, "Octaves")
+DEFAULT_MODELS = ("harris-exact", "harris-raster", "harris-preview", "saturated-exact", "saturated-octaves")
 
 
 def model_names(text: str) -> tuple[str, ...]:

@@ -115,9 +115,12 @@ def illuminate_direction(
 
 def light_pass_method(shading: Shading, method: str) -> str:
     """The incident-light method that runs when `method` is asked under `shading`: Yusov's occlusion
-    estimate in place of Harris's exact and raster passes where `shading.light_pass` says so; the
-    editor's preview (Harris's, fast while a slider moves) and an explicit method stay as asked."""
-    return "occlusion" if shading.light_pass == "occlusion" and method in ("exact", "raster") else method
+    estimate or Harris's pass with multiple-scattering octaves in place of Harris's exact and raster passes
+    where `shading.light_pass` says so; the editor's preview (Harris's, fast while a slider moves) and an
+    explicit method stay as asked."""
+    if shading.light_pass in ("occlusion", "octaves") and method in ("exact", "raster"):
+        return shading.light_pass
+    return method
 
 
 def light_directions(lights) -> tuple[tuple[float, ...], ...]:

@@ -36,6 +36,10 @@ Two methods:
 * "occlusion": not Harris's: Yusov's light-space occlusion estimate (`cloudcore.light.occlusion`), the
   sunlight through the other particles with no light order, each particle losing the share
   1 - sigma_eff / alpha of what it stops; the light pass of Yusov's model (eye pass "yusov").
+* "octaves": not Harris's either: the exact method's overlaps, but each particle's light is the direct
+  light plus Wrenninge's multiple-scattering octaves, transmittances toward the light through the particles
+  ahead with their optical depths scaled, each counting only the light the direct beam has lost
+  (`cloudcore.light.octaves`); no light order is needed.
 """
 
 from __future__ import annotations
@@ -44,20 +48,22 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from cloudcore.light.occlusion import occlusion_estimate
+from cloudcore.light.octaves import most_light, octave_light, octave_optical_depths
 from cloudcore.light.phase import check_phase, phase_function
 from cloudcore.light.precomputed import eye_pass_profiles
 from cloudcore.segments import concatenated_ranges
 from cloudcore.splat_kernel import splat_kernel
 
-METHODS = ("exact", "raster", "preview", "occlusion")
+METHODS = ("exact", "raster", "preview", "occlusion", "octaves")
 #: what a particle sends toward the eye (`cloudcore.light.eye_scattering`): Harris's eq. 5 as printed,
 #: "saturated", its scattering coefficient and ambient term made those of a thick medium, or "yusov", the
 #: light leaving Yusov's precomputed reference particle (`cloudcore.light.precomputed`)
 EYE_PASSES = ("harris", "saturated", "yusov")
 #: how the light reaching each particle is found (`[shading] light_pass`): Harris's multiple forward
 #: scattering (computed by the method asked: exact, raster or the editor's preview) or Yusov's
-#: light-space occlusion estimate (the method "occlusion" in place of exact and raster)
-LIGHT_PASSES = ("harris", "occlusion")
+#: light-space occlusion estimate (the method "occlusion" in place of exact and raster), or Wrenninge's
+#: multiple-scattering octaves over Harris's light-plane overlaps (the method "octaves": `cloudcore.light.octaves`)
+LIGHT_PASSES = ("harris", "occlusion", "octaves")
 FOUR_PI = 4.0 * np.pi
 
 #: raster grid cells across the widest axis of a cloud's light-plane footprint.
@@ -154,6 +160,10 @@ def incident_light(
     toward_light = positions @ light
     alpha = -np.expm1(-tau)
     sigma = scattering_coefficient(tau, albedo, phase, g) * float(phase_function(1.0, phase, g))
+    if method == "octaves":
+        octave_tau = octave_optical_depths(tau)
+        through = _transmittance_exact(plane, toward_light, radii, -np.expm1(-octave_tau), groups)
+        return np.clip(octave_light(np.clip(through, 0.0, 1.0)), 0.0, most_light())
     if method == "exact":
         result = _incident_exact(plane, toward_light, radii, alpha, sigma, groups)
     elif method == "occlusion":
@@ -250,10 +260,32 @@ def _overlaps_in_light_order(plane: np.ndarray, radii: np.ndarray):
 
 def _incident_exact(plane, toward_light, radii, alpha, sigma, groups):
     """Exact incident light: overlaps found per group, all groups' levels walked together."""
+    order, source, target, weight = _overlaps_by_group(plane, toward_light, radii, groups)
+    incident = np.empty(len(plane))
+    incident[order] = _incident_in_light_order(source, target, weight, alpha[order], sigma[order])
+    return incident
+
+
+def _transmittance_exact(plane, toward_light, radii, alpha, groups):
+    """(N, K): the product of 1 - alpha_j K_j over the particles j ahead of each (toward the light) whose splat
+    covers its centre, for each of the K columns of `alpha` (N, K): the frame buffer of Harris's pass with no
+    light scattered on, which needs no light order."""
+    order, source, target, weight = _overlaps_by_group(plane, toward_light, radii, groups)
+    blocked = alpha[order][source] * weight[:, None]
+    log_through = np.log(np.maximum(1.0 - blocked, np.finfo(np.float64).tiny))
+    through = np.empty(alpha.shape)
+    through[order] = np.exp(
+        np.stack([np.bincount(target, column, minlength=len(plane)) for column in log_through.T], axis=1)
+    )
+    return through
+
+
+def _overlaps_by_group(plane, toward_light, radii, groups):
+    """(light order, source, target, K_source(x_target)): the overlaps of `_overlaps_in_light_order` found group
+    by group, indices into the light order (group-major; ties, coincident particles, keep their index order)."""
     n = len(plane)
-    # group-major light order; ties (coincident particles) keep their index order
     order = np.lexsort((np.arange(n), -toward_light, groups))
-    plane, radii, alpha, sigma = plane[order], radii[order], alpha[order], sigma[order]
+    plane, radii = plane[order], radii[order]
     sources, targets, weights = [], [], []
     bounds = np.flatnonzero(np.diff(groups[order])) + 1
     for start, stop in zip(np.concatenate([[0], bounds]), np.concatenate([bounds, [n]])):
@@ -261,11 +293,7 @@ def _incident_exact(plane, toward_light, radii, alpha, sigma, groups):
         sources.append(source + start)
         targets.append(target + start)
         weights.append(weight)
-    incident = np.empty(n)
-    incident[order] = _incident_in_light_order(
-        np.concatenate(sources), np.concatenate(targets), np.concatenate(weights), alpha, sigma
-    )
-    return incident
+    return order, np.concatenate(sources), np.concatenate(targets), np.concatenate(weights)
 
 
 def _incident_in_light_order(source, target, weight, alpha, sigma):

@@ -66,6 +66,26 @@ SAMPLES_PER_PASS = 16
 PHASE_TABLE_POINTS = 4097
 #: ray-marching step of the transmittance, in voxels (midpoint rule on the trilinear field)
 MARCH_STEP_VOXELS = 0.5
+#: where Mitsuba's Russian roulette starts: never.  From its default depth (5) it keeps a path with probability
+#: its weight, capped at 0.95, and divides by that, so in a thick medium of albedo near 1 a path's weight grows
+#: 1/0.95 a bounce while it survives: the light is carried by a few long walks that a few dozen samples a pixel
+#: miss, and the picture comes out too dark (a thick slab at albedo 0.999 by 12%, docs/shading.md, "The truth's
+#: estimator").  Paths end by leaving the medium, or at `path_depth`.
+NO_ROULETTE_DEPTH = 2**31 - 1
+#: a path is followed until its weight, albedo^depth, falls below this: what it could still carry
+PATH_WEIGHT_CUTOFF = 1e-4
+
+
+def path_depth(albedo: float) -> int:
+    """Mitsuba's max_depth where no bounce keeps more than `albedo` of the light (the media's single-scattering
+    albedo, the ground's reflectance): one past the depth at which a path's weight albedo^depth falls below
+    PATH_WEIGHT_CUTOFF, and at least 2 (the light gathered at the first bounce); -1 (no limit) at albedo 1, where
+    paths end only by leaving the medium."""
+    if albedo >= 1.0:
+        return -1
+    if albedo <= PATH_WEIGHT_CUTOFF:
+        return 2
+    return max(2, int(np.ceil(np.log(PATH_WEIGHT_CUTOFF) / np.log(albedo))) + 1)
 
 
 def peak_extinction(optical_depth, radii) -> np.ndarray:
@@ -341,11 +361,12 @@ def mitsuba_scene_description(
     height: int,
     *,
     time_of_day: float | None = None,
-    max_depth: int = -1,
+    max_depth: int | None = None,
     ground=None,
 ) -> dict:
     """The `mi.load_dict` description: the grids in null-bounded cubes, the model's lights, the camera, and
-    `ground` (`terrain_shape`'s) when given.
+    `ground` (`terrain_shape`'s) when given.  `max_depth` (-1: no limit) bounds the paths; by default
+    `path_depth` of the grids' largest albedo.
 
     Call `mitsuba_variant` first (the dictionary holds Mitsuba objects of that variant).
     """
@@ -356,8 +377,7 @@ def mitsuba_scene_description(
     phase = phase_description(scene.shading.phase, scene.shading.g)
     description = {
         "type": "scene",
-        # emitters hidden from camera rays: the sky is composited behind the clouds with their transmittance
-        "integrator": {"type": "volpath", "max_depth": int(max_depth), "hide_emitters": True},
+        "integrator": integrator_description(_largest_albedo(grids, scene, ground is not None), max_depth),
         "sensor": _sensor(mi, camera, width, height, grids),
         "ambient": {"type": "constant", "radiance": {"type": "rgb", "value": [float(v) for v in ambient]}},
     }
@@ -378,6 +398,25 @@ def mitsuba_scene_description(
     if ground is not None:
         description["terrain"] = ground
     return description
+
+
+def _largest_albedo(grids: list[MediumGrid], scene: Scene, with_ground: bool) -> float:
+    """The largest share of light any bounce keeps: the media's single-scattering albedo, the ground's colour."""
+    ground = max(scene.terrain.color) if with_ground and scene.terrain is not None else 0.0
+    return max([float(ground), *(float(grid.albedo.max()) for grid in grids)])
+
+
+def integrator_description(albedo: float, max_depth: int | None = None) -> dict:
+    """The truth's path tracer for a medium whose largest single-scattering albedo is `albedo`: Mitsuba's volpath
+    without Russian roulette (`NO_ROULETTE_DEPTH`), paths bounded by `max_depth` (-1: no limit; by default
+    `path_depth(albedo)`), the emitters hidden from camera rays (the sky is composited behind the clouds with their
+    transmittance)."""
+    return {
+        "type": "volpath",
+        "max_depth": path_depth(albedo) if max_depth is None else int(max_depth),
+        "rr_depth": NO_ROULETTE_DEPTH,
+        "hide_emitters": True,
+    }
 
 
 def terrain_shape(terrain: Terrain):
@@ -516,7 +555,7 @@ class PathTracer:
         time_of_day: float | None = None,
         voxels_per_radius: float = DEFAULT_VOXELS_PER_RADIUS,
         variant: str | None = None,
-        max_depth: int = -1,
+        max_depth: int | None = None,
         terrain: bool = False,
         grids: list[MediumGrid] | None = None,
     ):
@@ -558,7 +597,7 @@ def render_truth(
     seed: int = 0,
     voxels_per_radius: float = DEFAULT_VOXELS_PER_RADIUS,
     variant: str | None = None,
-    max_depth: int = -1,
+    max_depth: int | None = None,
     progress=None,
     terrain: bool = False,
     run_passes=None,
