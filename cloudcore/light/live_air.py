@@ -22,7 +22,7 @@ from concurrent.futures import Future, ThreadPoolExecutor
 from cloudcore.atmosphere.aerial_perspective import aerial_perspective_from, volume_altitude
 from cloudcore.atmosphere.sky import SkyView, sky_seen_from
 from cloudcore.light.air_between import AirBetween, air_between
-from cloudcore.light.sky_background import SkyBackground
+from cloudcore.light.sky_background import SkyBackground, sky_view_altitude
 
 #: the exact volumes and skies kept, most recently drawn last
 KEPT_VOLUMES = 8
@@ -54,8 +54,7 @@ class LiveAir:
         ready = self._built_for(sky, eye_position)
         if ready is not None:
             return dataclasses.replace(sky, view=ready[1])
-        tables, _, sun = self._key(sky, eye_position)
-        altitude = volume_altitude(sky.eye_altitude_m(eye_position))
+        tables, altitude, sun = self._key(sky, eye_position)
         built = [(abs(key[1] - altitude), key) for key in self._ready if key[0] is tables and key[2] == sun]
         nearest = min(built, key=lambda distance_and_key: distance_and_key[0], default=None)
         return sky if nearest is None else dataclasses.replace(sky, view=self._ready[nearest[1]][1])
@@ -106,6 +105,7 @@ class LiveAir:
 
 def _air_and_sky(tables, altitude_m: float, sun_direction: tuple):
     """The exact aerial-perspective volume and sky-view table for an eye at `altitude_m` (the worker's task)."""
+    params = tables.params
     return aerial_perspective_from(tables, altitude_m, sun_direction), sky_seen_from(
-        tables.params, altitude_m, sun_direction
+        params, sky_view_altitude(params, altitude_m), sun_direction
     )

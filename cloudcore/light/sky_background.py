@@ -49,6 +49,13 @@ def over_the_horizon(directions, horizon: float) -> np.ndarray:
     return np.stack([level[..., 0], np.full(directions.shape[:-1], up), level[..., 1]], axis=-1)
 
 
+def sky_view_altitude(params, eye_altitude_m: float) -> float:
+    """The altitude whose sky-view table an eye at `eye_altitude_m` sees: rounded as the air's volume is
+    (`volume_altitude`), and over the top of the air the top's (the table clamps its eye there, `eye_radius`: one
+    table, not one a step)."""
+    return min(volume_altitude(eye_altitude_m), params.top_radius_m - params.bottom_radius_m)
+
+
 #: the night's sky under the moon and the stars, which the atmosphere (the sun's light alone) leaves black: the
 #: gradient's night zenith, as the ambient keeps its night floor (`lighting.NIGHT_AMBIENT`)
 NIGHT_SKY = 0.8 * NIGHT_AMBIENT
@@ -84,8 +91,7 @@ class SkyBackground:
             return self
         view = self.view
         params = view.tables.params
-        # over the top of the air every eye sees the sky from its top (`eye_radius`): one table, not one a step
-        altitude = min(volume_altitude(self.eye_altitude_m(eye_position)), params.top_radius_m - params.bottom_radius_m)
+        altitude = sky_view_altitude(params, self.eye_altitude_m(eye_position))
         if altitude == view.altitude_m:
             return self
         seen = sky_seen_from(params, altitude, view.sun_direction, view.preview)
