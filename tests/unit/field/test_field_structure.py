@@ -120,18 +120,35 @@ def test_only_a_type_with_an_anvil_spreads_one_over_clear_ground():
             assert not anvil_only.any()
 
 
+def test_the_towering_cumulus_spreads_anvils_wider_than_its_towers():
+    """Its particles high up cover more of the plane than those at mid-height (the anvil over the tower's narrowing
+    dome), and are larger there: a sheet, not turrets."""
+    field = field_under_weather(FIELD, Weather("towering_cumulus"), 0.0)
+    clouds = cell_clouds(field, [(0, i, j) for i in range(-24, 24) for j in range(-24, 24)])
+    particles = np.concatenate([cloud.particles for cloud in clouds if cloud is not None])
+    bottom, top = field.altitude
+    share = (particles[:, 1] - bottom) / (top - bottom)
+    middle, high = (share > 0.35) & (share < 0.55), share > 0.65
+
+    def area_km2(chosen):  # the square kilometres holding a particle
+        return len(np.unique(np.floor(particles[chosen][:, [0, 2]] / 1000.0), axis=0))
+
+    assert area_km2(high) > 1.2 * area_km2(middle)
+    assert np.median(particles[high, 3]) > 1.3 * np.median(particles[middle, 3])
+
+
 def test_the_weather_presets_keep_their_meaning():
     """Each preset's share of cloudy sky is its coverage, and its clouds are its type's: overcast a flat sheet of
-    stratocumulus, broken the towers of congestus, the fair-weather and scattered humilis between."""
-    x, z = _plane(200000.0, 600.0)
+    stratocumulus, broken the towers of congestus, the fair-weather and scattered humilis between, the towering
+    cumulus taller than all."""
     median_height = {}
     for name, preset in WEATHER_PRESETS.items():
         field = field_under_weather(FIELD, Weather(name), 0.0)
-        heights = cumulus_columns(field, x, z)[0]
+        heights = cumulus_columns(field, *_plane(400.0 * field.cell_size, 1.2 * field.cell_size))[0]  # 267 sites a side
         assert np.mean(heights > 0.0) == pytest.approx(preset["coverage"], abs=0.03)
         median_height[name] = np.median(heights[heights > 0.0])
     assert median_height["overcast"] < median_height["fair_weather_cumulus"] < median_height["scattered"]
-    assert median_height["scattered"] < 0.5 * median_height["broken"]
+    assert median_height["scattered"] < 0.5 * median_height["broken"] < median_height["towering_cumulus"]
 
 
 def test_the_demo_s_particles_around_the_eye_stay_within_the_budget_along_its_flight():

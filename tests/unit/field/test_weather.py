@@ -18,14 +18,18 @@ FIELD = CloudField(seed=4, coverage=0.1, rings=2, cloud_type="cirrus", altitude=
 
 def test_every_named_weather_sets_the_field_s_coverage_type_and_altitudes():
     assert tuple(WEATHER_PRESETS) == WEATHER_NAMES
-    coverages = [WEATHER_PRESETS[name]["coverage"] for name in WEATHER_NAMES]
-    assert coverages == sorted(coverages)  # from fair weather to overcast
+    cumulus_to_overcast = [WEATHER_PRESETS[name]["coverage"] for name in WEATHER_NAMES[:4]]
+    assert cumulus_to_overcast == sorted(cumulus_to_overcast)
     for name in WEATHER_NAMES:
         field = field_under_weather(FIELD, Weather(name), 123.0)
         preset = WEATHER_PRESETS[name]
         assert field.coverage == pytest.approx(preset["coverage"], abs=1e-12)
         assert (field.cloud_type, field.altitude) == (preset["cloud_type"], preset["altitude"])
-        assert (field.seed, field.rings, field.cell_size) == (FIELD.seed, FIELD.rings, FIELD.cell_size)
+        scale = (preset.get("cell_size", FIELD.cell_size), preset.get("layers", FIELD.layers))
+        assert (field.seed, field.rings, field.cell_size, field.layers) == (FIELD.seed, FIELD.rings, *scale)
+    # thunderstorms' clouds are of another scale than the field's cumulus: larger cells, every layer
+    towering = field_under_weather(FIELD, Weather("towering_cumulus"), 0.0)
+    assert towering.cell_size > FIELD.cell_size and towering.layers == 8
     assert field_under_weather(FIELD, None, 50.0) is FIELD
 
 
