@@ -1106,3 +1106,19 @@ def test_auto_mode_rebuilds_a_ring_whose_clouds_passed_the_tolerance_where_it_ca
     if mode == "auto" and not rebuilds:
         # the ring shown is past the tolerance (500 m) or within it (300 m): the plan says which, and by how much
         assert (frame.accepted_error > 1.0) is (across_m == 500.0), frame.accepted_error
+
+
+def test_a_ring_being_built_when_the_eye_jumps_is_started_again_at_the_new_eye():
+    """A rebuild under way (here a relight's) when the eye jumps past the rebuild distance: finished at the jump's
+    pace it would be shown at once from the eye it was begun at, holding what now fills its members' places (a
+    cloud field's entering cells take the leaving ones'), for the frames its successor then takes (issue 51: 16 dB
+    against 34 without the ring, nine frames).  It is started again at the new eye, shown in the jump's frame."""
+    settled = run_ring_flight(SETTLED)[-1].state
+    (relit,) = run_ring_flight([(0.0, 0.0, 0.0)], settled, lighting=2)
+    begun = relit.state.ring.pending
+    assert begun is not None and relit.ring.build_segment == 0
+    jump = (2.0 * RING.ring_rebuild_horizontal * RING.ring_radius, 0.0, 0.0)
+    (jumped,) = run_ring_flight([jump], relit.state, lighting=2)
+    shown, weight = jumped.ring.draws[0]
+    assert shown is not begun and shown.eye == (jump[0], 100.0, 0.0) and weight == 1.0
+    assert jumped.ring.building is shown and len(jumped.ring.builds) == SEGMENTS

@@ -273,13 +273,20 @@ def _needs_rebuild(
         return True
     if not holds_clouds:
         return False  # holding nothing, nothing goes stale
-    moved = np.asarray(eye, dtype=np.float64) - np.asarray(generation.eye)
     return (
         past_tolerance
         or _relit(generation, cloud_keys, present)
         or _wrong_size(generation, texture_size)
         or generation.radius != settings.ring_radius
-        or math.hypot(moved[0], moved[2]) > settings.ring_rebuild_horizontal * settings.ring_radius
+        or _moved_past(generation, eye, settings)
+    )
+
+
+def _moved_past(generation: RingGeneration, eye, settings: RenderSettings) -> bool:
+    """The eye has moved past Wang's rebuild distance from the generation's eye, horizontally or vertically."""
+    moved = np.asarray(eye, dtype=np.float64) - np.asarray(generation.eye)
+    return (
+        math.hypot(moved[0], moved[2]) > settings.ring_rebuild_horizontal * settings.ring_radius
         or abs(moved[1]) > settings.ring_rebuild_vertical * settings.ring_radius
     )
 
@@ -319,7 +326,8 @@ def plan_ring(
 
     A ring being built when its members' keys change is finished first and rebuilt after: a cloud
     forming in the ring, whose key changes every frame, would otherwise keep the ring from ever
-    completing; one whose members are no longer all units (removed, regrouped) starts again.
+    completing; one whose members are no longer all units (removed, regrouped), or whose eye the eye has
+    moved past the rebuild distance from, starts again (at the eye's pace it is finished within half of it).
     """
     if not settings.uses_ring:
         return None
@@ -330,6 +338,9 @@ def plan_ring(
         or _wrong_size(pending, texture_size)
         or not pending.members <= present  # a member gone (a cloud field's cell left): nothing to render it from
         or pending.holds_clouds != holds_clouds
+        # the eye outran it (a jump): finished at the jump's pace it would show at once, from where the eye was,
+        # the clouds that now fill its members' places (a cloud field's entering cells take the leaving ones')
+        or (pending.holds_clouds and _moved_past(pending, eye, settings))
     ):
         pending = None  # the ring it was being built for is gone: start again
     if pending is None and (
