@@ -19,7 +19,7 @@ from cloudcore.lod.impostors import (
 from cloudcore.lod.plan import FRAME_SETTLE_FRAMES, PROBE_FRAMES, SWITCH_MARGIN, LodState, inside_runs, plan_frame
 from cloudcore.lod.plan.pricing import in_view_work, pricing_of, seen_from
 from cloudcore.lod.plan.state import RING_PRICE_FRAMES, RING_PRICE_TURN_DEG, FrameTime
-from cloudcore.lod.ring import SEGMENTS, RingState
+from cloudcore.lod.ring import SEGMENTS, RingState, ring_members
 from cloudcore.lod.units import LodUnits, SplatSample
 from cloudcore.scene import Camera
 from cloudcore.settings import RenderSettings
@@ -1122,3 +1122,22 @@ def test_a_ring_being_built_when_the_eye_jumps_is_started_again_at_the_new_eye()
     shown, weight = jumped.ring.draws[0]
     assert shown is not begun and shown.eye == (jump[0], 100.0, 0.0) and weight == 1.0
     assert jumped.ring.building is shown and len(jumped.ring.builds) == SEGMENTS
+
+
+def test_a_flat_cloud_whose_sphere_grazes_the_ring_s_band_joins_the_ring_by_its_splats_heights():
+    """A cloud field's coarse cell, 8 km off and kilometres wide, its clouds a band a kilometre thick: its sphere
+    reaches 30.6 degrees from the horizon, past the band's 30, while its splats reach 5.  Left out of the ring it was
+    drawn on its own in front of the panels, over the nearer clouds they hold (issue 51: 36.7 dB against 40.4)."""
+    settings = RenderSettings(mode="impostor", ring_radius=4000.0)
+    eye = (0.0, 2000.0, 0.0)
+    centres, radii = np.array([[7889.0, 1220.0, -996.0]]), np.array([3380.0])
+    horizontal = math.hypot(7889.0, 996.0)
+    assert not ring_members(centres, radii, eye, settings)[0]
+    assert ring_members(centres, radii, eye, settings, heights=[[1150.0, 2450.0]])[0]
+    # splats that do reach past the band keep it out, above or below the eye
+    steepest = math.tan(math.radians(settings.ring_elevation_deg)) * (horizontal - radii[0])
+    assert not ring_members(centres, radii, eye, settings, heights=[[1150.0, 2000.0 + 1.01 * steepest]])[0]
+    assert not ring_members(centres, radii, eye, settings, heights=[[2000.0 - 1.01 * steepest, 2450.0]])[0]
+    # and within the ring radius it stays out, however flat
+    near = np.array([[4500.0, 1800.0, 0.0]])
+    assert not ring_members(near, np.array([600.0]), eye, settings, heights=[[1700.0, 1900.0]])[0]
