@@ -374,6 +374,8 @@ class FrameRenderer:
                         air=self._world.air_volume if settings.aerial_perspective else None,
                         shadows=self._shadows,
                     )
+            # the world pass uploaded the air for this eye: the ring's segments are drawn through it
+            self._splats.air = self._world.air_volume if settings.aerial_perspective else None
             with clock.timed("impostor updates"):
                 rendered = self._impostors.update(plan, particles, settings, time_s, way, self._unit_weights)
             with clock.timed("clouds"):
@@ -907,7 +909,7 @@ class FrameRenderer:
             for segment in generation.occupied_segments:
                 target, corners, extent = self._impostors.ring_panel(generation, segment, elevation_deg)
                 quads.append((np.asarray(corners + shift, dtype=np.float32), target.texture, float(weight), extent))
-        self._draw_quad_run(frame, quads)
+        self._draw_quad_run(frame, quads, through_air=False)  # their segments hold their clouds through the air
 
     def _draw_impostors(self, frame: _CloudPassFrame, items) -> None:
         """Units' impostors (a layer each, when split around objects), consecutive in the pass: one instanced
@@ -931,9 +933,9 @@ class FrameRenderer:
             lambda: self._quads.draw_instanced(instances, frame.view_projection, atlas_texture, counting=True)
         )
 
-    def _draw_quad_run(self, frame: _CloudPassFrame, quads) -> None:
+    def _draw_quad_run(self, frame: _CloudPassFrame, quads, through_air: bool = True) -> None:
         """World-space quads (corners, texture, weight, uv_rect), depth-tested, one after the other."""
-        self._quads.draw_run(quads, frame.view_projection, air=frame.air)
+        self._quads.draw_run(quads, frame.view_projection, air=frame.air if through_air else None)
         self._replay.append(lambda: self._quads.draw_run(quads, frame.view_projection, counting=True))
 
     def _draw_crossfade(self, frame: _CloudPassFrame, item, cloud, batch: SplatBatch) -> int:
