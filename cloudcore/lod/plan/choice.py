@@ -180,8 +180,7 @@ def groups_cheaper_apart(units: LodUnits, seen: Seen, settings, state: LodState,
     `plan_frame` opens a group only where its own impostor is due anyway.  `seen`: the `seen_from` of
     `units.and_clouds`.
     """
-    rows = units.group_rows
-    groups, group_seen = units.take(rows), seen.take(rows)
+    groups, group_seen = units.groups, seen.take(units.group_rows)
     # a group whose sphere holds the eye is whole: its screen impostor draws its particles sorted together, as
     # full 3D does, and apart its clouds would cost as much (the particles near the eye are the screen
     # impostor's cost, whatever holds them; under a stratocumulus deck apart was 1.7 times dearer)
