@@ -94,7 +94,7 @@ def represent_units(
     """
     weights = np.zeros(len(rows))
     at = np.flatnonzero(priced)
-    units = [members[int(rows[row])] for row in at.tolist()]
+    units = [members[row] for row in rows[at].tolist()]
     held = [previous.get(unit) for unit in units]
     # the eye has left a unit it was inside: its particles were on screen, as full 3D's
     was = np.array(
@@ -124,8 +124,13 @@ def represent_units(
     stepped = np.where(target == _FULL, np.minimum(1.0, was_weight + step), np.maximum(0.0, was_weight - step))
     weight = np.where(at_once, np.where(target == _FULL, 1.0, 0.0), stepped)
     weights[at] = weight
-    names = np.where(target == _FULL, "full", "impostor").tolist()
-    chosen = {unit: Representation(name, w) for unit, name, w in zip(units, names, weight.tolist())}
+    # a unit's representation as it was is kept, not made anew: most units keep theirs from frame to frame
+    chosen = {
+        unit: h if h is not None and h.target == name and h.full_weight == w else Representation(name, w)
+        for unit, h, name, w in zip(
+            units, held, ["full" if t == _FULL else "impostor" for t in target.tolist()], weight.tolist()
+        )
+    }
     prices_of = list(zip(rows[at].tolist(), distances[at].tolist(), full_ms.tolist(), prices.impostor_ms[at].tolist()))
     return weights, chosen, prices_of
 
