@@ -141,7 +141,11 @@ def test_the_gl_march_is_numpys(renderer):
     assert share.max() > 0.2  # shafts in view
     assert np.abs(march[..., 3] - share).max() < 0.02
     taken = taken.reshape(height, width, 3)
-    assert np.abs(march[..., :3] - taken).max() < 0.02 * taken.max()
+    # the worst ray's error is a step's at a shadow's edge, where GL's filtering differs most from numpy's: each of
+    # SHAFT_STEPS weighs 1/SHAFT_STEPS of it (2.3% of the largest at 6 steps, 1.5% at 12); the rest are within 1%
+    error = np.abs(march[..., :3] - taken)
+    assert error.max() < 0.03 * taken.max()
+    assert np.percentile(error, 99) < 0.0125 * taken.max()
     # what the world reads: the march blurred by a 3x3 tent, its edges clamped
     padded = np.pad(march, ((1, 1), (1, 1), (0, 0)), mode="edge")
     tent = np.array([1.0, 2.0, 1.0])
