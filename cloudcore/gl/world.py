@@ -39,8 +39,9 @@ from cloudcore.terrain_tiles import TILE_FACES, TILE_VERTICES, TerrainTiles, gri
 #: whole grid's, whose triangles cost llvmpipe their setup (docs/atmosphere.md#light-shafts)
 _COARSE_STRIDE = 4
 #: a tile's vertices its coarse surface uses (into its grid's), and the surface's triangles (into these): the coarse
-#: surfaces have a buffer of their own, as llvmpipe shades every vertex of the range a draw's indices span (drawn
-#: from the whole grids' buffer it shaded all of a tile's vertices for the few the surface uses)
+#: surfaces have a buffer of their own, as llvmpipe drew the same triangles slower from the whole grids' buffer,
+#: whose index range spans all of a tile's vertices for the few the surface uses
+#: (docs/atmosphere.md#the-shafts-cheaper-issue-52s-budget)
 _COARSE_TILE_VERTICES, _COARSE_TILE_FACES = np.unique(tile_faces(_COARSE_STRIDE), return_inverse=True)
 _COARSE_TILE_FACES = _COARSE_TILE_FACES.reshape(-1, 3)
 #: the physical sky's picture's columns, about: read bilinearly from it, the sky is 65 to 86 dB from the sky a pixel
