@@ -33,7 +33,7 @@ from cloudcore.light.cloud_shadows import LightSpace, sample_map
 LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
 
 #: steps along each ray's part in the map's prism: dithered across pixels and blurred over 3x3 (the GL march), 6
-#: came within 0.2-1 dB of 12 on four views, at about half the march's cost (docs/atmosphere.md#light-shafts)
+#: came within 0.2-1.4 dB of 12 on four views (docs/atmosphere.md#the-shafts-cheaper-issue-52s-budget)
 SHAFT_STEPS = 6
 
 

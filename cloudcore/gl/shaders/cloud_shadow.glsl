@@ -18,7 +18,8 @@ float cloud_shadow_transmittance_mapped(vec3 mapped)
         return exp(-far.w);
     vec4 near = textureLod(cloud_shadow_slices_1_to_4, mapped.xy, 0.0);
     // linear between the slices' depths (0 at s = 0, slice k's at s = k) as a sum of each span's rise times how much
-    // of it lies below s: no array indexed per pixel, which llvmpipe spills to memory
+    // of it lies below s: an array indexed per pixel cost the light shafts' march more
+    // (docs/atmosphere.md#the-shafts-cheaper-issue-52s-budget)
     vec4 near_rise = near - vec4(0.0, near.xyz);
     vec4 far_rise = far - vec4(near.w, far.xyz);
     vec4 covered_near = clamp(vec4(s) - vec4(0.0, 1.0, 2.0, 3.0), 0.0, 1.0);
