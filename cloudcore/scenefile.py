@@ -189,7 +189,7 @@ def _view(t: Table, camera: Camera, paths: tuple[CameraPath, ...]) -> View:
             t.fail("look_at", "must differ from position")
         t.fail("position", "must differ from look_at (the scene camera's)")
     mode = t.string("mode", "full", choices=MODES)
-    settings = t.table("settings", _view_settings) or ()
+    settings = t.table("settings", settings_overrides) or ()
     try:
         RenderSettings(mode=mode, **dict(settings))
     except ValueError as error:
@@ -216,7 +216,7 @@ def _view(t: Table, camera: Camera, paths: tuple[CameraPath, ...]) -> View:
 VIEW_SETTINGS = tuple(f.name for f in dataclasses.fields(RenderSettings) if f.name != "mode")
 
 
-def _view_settings(t: Table) -> tuple[tuple[str, object], ...]:
+def settings_overrides(t: Table) -> tuple[tuple[str, object], ...]:
     """RenderSettings overrides, each of its field's type; their ranges are RenderSettings' own (checked by the
     caller, with the view's mode)."""
     t.reject_unknown(VIEW_SETTINGS)
