@@ -11,6 +11,9 @@ against the reference drawn beside it, on the same machine at the same time, nev
 (`references` lists each group's, `reference_group` says a run's).  Alone on one machine the workers share its
 cores, so their times are slower than one process's; spread over a cluster's machines, each group's times are its
 machine's.
+
+`cloudview bench --suite NAME [--cases A,B]` runs a benchmark suite's cases instead (`cloudcore.cli.bench_suite`),
+each by the same runner (`bench_views`).
 """
 
 from __future__ import annotations

@@ -4,11 +4,11 @@ A suite is a TOML file, `cloudcore/resources/bench/NAME.toml` (or any file named
 and its `[[cases]]`, each case a scene (a scene file, and a sky made from a seed over it:
 `cloudcore.measure.bench_skies`), its views (still, orbiting, a camera path, or a sky's own flight), a size, the
 settings variants drawn beside the full-3D reference, the unmeasured warm-up frames and the frames measured.
-Every key is checked when the suite is read, before any frame (docs/architecture.md, "How to add a benchmark
-case").  Each case is one run of `cloudcore.measure.benchmark.bench_path` (`cloudcore.cli.bench.bench_views`):
-the reference and the variants take turns frame by frame, each variant's frame compared with the reference's
-(PSNR); the report gives each variant's time over the reference's with its 95% interval (`ratio_interval`), and
-auto's over the faster of the others where the case asks.
+Every key is checked when the suite is read, before any frame (how to add a case:
+docs/architecture.md#how-to-add-).  Each case is one run of `cloudcore.measure.benchmark.bench_path`
+(`cloudcore.cli.bench.bench_views`): the reference and the variants take turns frame by frame, each variant's
+frame compared with the reference's (PSNR); the report gives each variant's time over the reference's with its
+95% interval (`ratio_interval`), and auto's over the faster of the others where the case asks.
 """
 
 from __future__ import annotations
@@ -435,10 +435,19 @@ def plot_suite(result: dict, path: Path) -> None:
             [r["cloud_speedup"] for r in points], [r["psnr_mean"] for r in points], marker=marker, label=mode, zorder=3
         )
         for r in points:
+            changed = r["variant"].partition(" ")[2]  # what besides its mode sets the variant apart
             axes.annotate(
-                r["case"], (r["cloud_speedup"], r["psnr_mean"]), fontsize=6, xytext=(5, 4), textcoords="offset points"
+                f"{r['case']} {changed}".strip(),
+                (r["cloud_speedup"], r["psnr_mean"]),
+                fontsize=6,
+                xytext=(5, 4),
+                textcoords="offset points",
             )
     axes.set_xscale("log")
+    speedups = [r["cloud_speedup"] for r in variants]
+    ticks = [t for t in (0.5, 1, 2, 3, 5, 10, 20, 50, 100, 200) if min(speedups) / 1.5 <= t <= max(speedups) * 1.5]
+    axes.set_xticks(ticks, [f"x{tick:g}" for tick in ticks])
+    axes.minorticks_off()  # the log axis' own minor labels overprint each other
     axes.set_xlabel("cloud pass + impostor updates, speed-up over full 3D (same run)")
     axes.set_ylabel("mean PSNR against full 3D (dB)")
     axes.set_title(f"suite {result['suite']} on {result['machine']}: error against time")
