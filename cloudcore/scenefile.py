@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -51,7 +50,7 @@ from cloudcore.scene import (
     Wind,
 )
 from cloudcore.settings import MODES, RenderSettings, setting_options
-from cloudcore.toml_table import Table, checked_matrix, field_error
+from cloudcore.toml_table import Table, checked_matrix, field_error, read_toml
 
 PRIMITIVES = ("box", "sphere", "aircraft")
 #: a terrain's side in metres, at least: its noise is scaled to the side, and a side of 5e-324 m halved to 0
@@ -95,21 +94,7 @@ TABLE_KEYS = {
 def load_scene(path) -> Scene:
     """Read and validate a scene file; raise SceneError on any problem."""
     path = Path(path)
-    source = str(path)
-    if path.exists() and not (path.is_file() or path.is_dir()):  # a folder is refused by the read below
-        raise field_error(source, "(file)", "not a regular file (a pipe or a device): reading it would wait forever")
-    try:
-        # utf-8-sig: a byte-order mark (Windows editors write one) is not part of the TOML
-        data = tomllib.loads(path.read_text(encoding="utf-8-sig"))
-    except FileNotFoundError:
-        raise field_error(source, "(file)", "no such file") from None
-    except (OSError, UnicodeDecodeError) as error:
-        raise field_error(source, "(file)", f"cannot read: {error}") from None
-    except RecursionError:
-        raise field_error(source, "(toml)", "arrays or tables nested too deeply") from None
-    except ValueError as error:  # TOMLDecodeError, or tomllib's ValueError for an integer of over 4300 digits
-        raise field_error(source, "(toml)", str(error)) from None
-    return scene_from_dict(data, source, path.parent)
+    return scene_from_dict(read_toml(path), str(path), path.parent)
 
 
 def scene_from_dict(data: dict, source: str = "<scene>", base_dir=Path(".")) -> Scene:

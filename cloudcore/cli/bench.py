@@ -42,7 +42,7 @@ from cloudcore.measure.benchmark import (
     still_views,
 )
 from cloudcore.scenefile import load_scene
-from cloudcore.settings import setting_options
+from cloudcore.settings import FULL_3D, setting_options
 
 
 def add_parser(commands) -> None:
@@ -259,11 +259,13 @@ class BenchSettings:
         pass
 
 
-def bench_views(scene, views, settings_list: list, size, warmup: int, path=None, frames=None, progress=None) -> dict:
-    """The bench's runner: `bench_path`'s report of full 3D and each of `settings_list` drawing `views` (or
-    `frames` along the camera path `path`) at `size`, frames taking turns, each in a renderer of its own in this
-    process's GL context, after `warmup` unmeasured frames; what this process set up is then kept out of the
-    garbage collector's full passes (a benchmark's own process)."""
+def bench_views(
+    scene, views, settings_list: list, size, warmup: int, path=None, frames=None, progress=None, reference=FULL_3D
+) -> dict:
+    """The bench's runner: `bench_path`'s report of full 3D (drawn with `reference`) and each of `settings_list`
+    drawing `views` (or `frames` along the camera path `path`) at `size`, frames taking turns, each in a renderer
+    of its own in this process's GL context, after `warmup` unmeasured frames; what this process set up is then
+    kept out of the garbage collector's full passes (a benchmark's own process)."""
     os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
     from cloudcore.gl import FrameRenderer
     from cloudcore.light.illumination import IlluminationCache
@@ -284,6 +286,7 @@ def bench_views(scene, views, settings_list: list, size, warmup: int, path=None,
             views=views,
             warmup=warmup,
             freeze=True,
+            reference=reference,
         )
 
 

@@ -14,9 +14,9 @@ frame compared with the reference's (PSNR); the report gives each variant's time
 from __future__ import annotations
 
 import dataclasses
+import math
 import sys
 import time
-import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -35,8 +35,8 @@ from cloudcore.measure.benchmark import (
 from cloudcore.resources import resource_path
 from cloudcore.scene import Scene
 from cloudcore.scenefile import load_scene, settings_overrides
-from cloudcore.settings import RenderSettings
-from cloudcore.toml_table import Table, field_error
+from cloudcore.settings import FULL_3D, RenderSettings
+from cloudcore.toml_table import Table, read_toml
 
 #: the suites shipped, one TOML file each
 SUITES_FOLDER = resource_path("bench")
@@ -60,11 +60,13 @@ CASE_KEYS = (
     "views",
     "orbit_deg",
     "camera_path",
+    "times_s",
     "frames",
     "fps",
     "width",
     "height",
     "warmup",
+    "reference",
     "variants",
     "auto_vs_faster",
     "first_counted_frame",
@@ -86,10 +88,12 @@ class Case:
     views: str
     orbit_deg: float
     camera_path: str
+    times_s: tuple[float, ...]  # seconds along the camera path its frames are drawn at, in turn; () for all of it
     frames: int  # 0: `fps` frames a second of the camera path
     fps: float
     size: tuple[int, int]
     warmup: int
+    reference: RenderSettings  # full 3D, as shipped unless the case compares ways of drawing every particle
     variants: tuple[RenderSettings, ...]
     auto_vs_faster: bool
     first_counted_frame: int
@@ -126,14 +130,7 @@ def load_suite(name: str) -> Suite:
     if not name.endswith(".toml") and name not in suite_names():
         raise SceneError("--suite", "suite", f"no suite {name!r}; the suites: {', '.join(suite_names())}")
     source = str(path)
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise field_error(source, "(file)", "no such file") from None
-    except (OSError, UnicodeDecodeError) as error:
-        raise field_error(source, "(file)", f"cannot read: {error}") from None
-    except ValueError as error:
-        raise field_error(source, "(toml)", str(error)) from None
+    data = read_toml(path)
     return suite_from_dict(data, path.stem, source)
 
 
@@ -181,12 +178,20 @@ def _case(t: Table, defaults: Table) -> Case:
         merged.fail("frames", "give either frames or fps (frames along the whole camera path, so many a second)")
     if merged.has("fps") and views != "path":
         merged.fail("fps", "only a camera path's views are counted a second")
+    if merged.has("times_s") and (views != "path" or merged.has("fps")):
+        merged.fail("times_s", "instants of a camera path (views = 'path'), drawn in turn for `frames` frames")
+    times = merged.raw("times_s", [])
+    if not (isinstance(times, list) and all(_is_time(t) for t in times)):
+        merged.fail("times_s", f"expected a list of seconds >= 0, got {times!r}")
     variants = merged.raw("variants", [])
     if not isinstance(variants, list) or not variants:
         merged.fail("variants", "expected a non-empty list of settings tables ({ mode = 'auto' }, ...)")
     settings = tuple(
         _variant(Table(t.source, f"{merged.path('variants')}[{i}]", item)) for i, item in enumerate(variants)
     )
+    reference = merged.table("reference", _variant) or FULL_3D
+    if reference.mode != "full":
+        merged.fail("reference", f"the reference draws every particle: mode must be 'full', got {reference.mode!r}")
     auto_vs_faster = merged.raw("auto_vs_faster", False)
     if not isinstance(auto_vs_faster, bool):
         merged.fail("auto_vs_faster", f"expected true or false, got {auto_vs_faster!r}")
@@ -205,14 +210,20 @@ def _case(t: Table, defaults: Table) -> Case:
         views=views,
         orbit_deg=merged.number("orbit_deg", 0.0, low=-360.0, high=360.0, low_open=True),
         camera_path=merged.string("camera_path", ""),
+        times_s=tuple(float(t) for t in times),
         frames=merged.integer("frames", 0, low=1 if merged.has("frames") else 0, high=MAX_FRAMES),
         fps=merged.number("fps", 0.0, low=0.0, high=1000.0, low_open=merged.has("fps")),
         size=(merged.integer("width", 640, low=1, high=MAX_SIDE), merged.integer("height", 480, low=1, high=MAX_SIDE)),
         warmup=merged.integer("warmup", 0, low=0, high=MAX_FRAMES),
+        reference=reference,
         variants=settings,
         auto_vs_faster=auto_vs_faster,
         first_counted_frame=merged.integer("first_counted_frame", 0, low=0, high=MAX_FRAMES),
     )
+
+
+def _is_time(value) -> bool:
+    return not isinstance(value, bool) and isinstance(value, (int, float)) and 0.0 <= value < math.inf
 
 
 def _sky(t: Table) -> tuple:
@@ -285,7 +296,7 @@ def case_views(case: Case, scene: Scene, quick: bool = False) -> list:
     if case.views == "orbit":
         return orbit_views(scene, frames, case.orbit_deg)
     if case.views == "path":
-        return path_views(scene, case.camera_path, frames)
+        return path_views(scene, case.camera_path, frames, case.times_s)
     if case.views == "harris_circle":
         return bench_skies.circle_views(frames)
     if case.views == "harris_through":
@@ -306,9 +317,9 @@ def built_cases(suite_name: str, names: list[str] | None, quick: bool = False) -
 
 
 def run_suite(suite: Suite, names: list[str] | None, quick: bool, bench_views) -> dict:
-    """Every case asked, one after the other, each by `bench_views(scene, views, variants, size, warmup)` (the
-    bench's runner: full 3D and the variants taking turns frame by frame); the report: each case's and the
-    summary's rows."""
+    """Every case asked, one after the other, each by `bench_views(scene, views, variants, size, warmup,
+    reference=)` (the bench's runner: full 3D and the variants taking turns frame by frame); the report: each
+    case's and the summary's rows."""
     cases = suite.chosen(names)
     result = {
         "suite": suite.name,
@@ -323,7 +334,7 @@ def run_suite(suite: Suite, names: list[str] | None, quick: bool, bench_views) -
         start = time.perf_counter()
         scene = case_scene(case)
         views = case_views(case, scene, quick)
-        report = bench_views(scene, views, list(case.variants), case.size, case.warmup)
+        report = bench_views(scene, views, list(case.variants), case.size, case.warmup, reference=case.reference)
         report["seconds"] = time.perf_counter() - start
         report["warmup"] = case.warmup
         result["cases"][case.name] = report
@@ -385,14 +396,15 @@ def summary_rows(case: Case, report: dict) -> list[dict]:
             "world_ms": run["world_ms_mean"],
             "cloud_ms": run["cloud_ms_mean"],
             "plan_ms": run["plan_ms_mean"],
+            "cloud_gpu_ms": run["gpu_ms_by_pass"]["clouds"],
             "fps": 1e3 / run["frame_ms_mean"],
         }
 
-    rows = [row(reference, "reference (full 3D)")]
+    rows = [row(reference, "reference (" + variant_label(reference["settings"]).replace("full", "full 3D", 1) + ")")]
     labels = [variant_label(run["settings"]) for run in runs]
     for run, label in zip(runs, labels):
         ratios = {}
-        for key in ("frame_ms", "world_ms", "cloud_ms"):
+        for key in ("frame_ms", "world_ms", "cloud_ms", "cloud_gpu_ms"):
             ratio, low, high = ratio_interval(per_frame(run, key), [per_frame(reference, key)])
             ratios |= {f"{key}_vs_reference": ratio, f"{key}_vs_reference_low": low, f"{key}_vs_reference_high": high}
         rows.append(

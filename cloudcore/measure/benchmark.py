@@ -44,10 +44,12 @@ def resident_memory_bytes() -> int:
     raise RuntimeError("no VmRSS line in /proc/self/status")
 
 
-def path_views(scene: Scene, path_name: str, frames: int) -> list:
-    """(scene clock in seconds, camera) of `frames` frames spread along the path."""
+def path_views(scene: Scene, path_name: str, frames: int, times_s=()) -> list:
+    """(scene clock in seconds, camera) of `frames` frames spread along the path, or at the seconds along it
+    `times_s` in turn where given (a few views drawn again and again)."""
     path = scene.camera_path(path_name)
-    return [(path.keys[0, 0] + t, camera_on_path(path, t, scene.camera.fov_y_deg)) for t in frame_times(path, frames)]
+    times = [times_s[frame % len(times_s)] for frame in range(frames)] if times_s else frame_times(path, frames)
+    return [(path.keys[0, 0] + t, camera_on_path(path, t, scene.camera.fov_y_deg)) for t in times]
 
 
 def still_views(scene: Scene, frames: int) -> list:
@@ -90,11 +92,18 @@ def turns(runs: int, frames: int) -> list[list[int]]:
 
 
 def _interleaved_rows(
-    renderers, scene: Scene, views, settings_list, progress=None, warmup: int = 0, freeze: bool = False
+    renderers,
+    scene: Scene,
+    views,
+    settings_list,
+    progress=None,
+    warmup: int = 0,
+    freeze: bool = False,
+    reference=FULL_3D,
 ) -> list:
     """Per renderer (the reference's first, in full 3D), one row a frame: its statistics and, but for the
     reference's, its error against the reference's image of that frame."""
-    runs = list(zip(renderers, [FULL_3D, *settings_list]))
+    runs = list(zip(renderers, [reference, *settings_list]))
     for renderer, settings in runs:
         for _ in range(warmup):  # unmeasured frames at the first view: caches built, the ring faded in
             renderer.render(scene, camera=views[0][1], settings=settings, time_s=views[0][0])
@@ -157,6 +166,7 @@ def bench_path(
     views=None,
     warmup: int = 0,
     freeze: bool = False,
+    reference=FULL_3D,
 ) -> dict:
     """The report: reference (full 3D) and one run per settings object, errors per frame and overall.
 
@@ -164,15 +174,25 @@ def bench_path(
     render frame by frame in turn.  The frames are `views` ((scene clock, camera) pairs) when given,
     else `frames` along the path; each run first renders `warmup` unmeasured frames of the first view.
     `freeze`: after those, leave what is set up out of the garbage collector's full passes, for the rest of the
-    process (`cloudcore.collector`; a benchmark's own process, not a test's).
+    process (`cloudcore.collector`; a benchmark's own process, not a test's).  `reference`: the full-3D settings
+    the reference is drawn with (a way of drawing every particle measured against another: `compositing`...).
     """
+    if reference.mode != "full":
+        raise ValueError(f"the reference draws every particle (mode 'full'), not {reference.mode!r}")
     if len(renderers) != 1 + len(settings_list):
         raise ValueError(f"{len(renderers)} renderers for the reference and {len(settings_list)} settings")
     views = path_views(scene, path_name, frames) if views is None else views
     for renderer in renderers:  # shading precompute, shader compiles; in full 3D, no impostor made ahead
         renderer.render(scene, camera=views[0][1], settings=FULL_3D)
-    reference_rows, *rows_of_runs = _interleaved_rows(renderers, scene, views, settings_list, progress, warmup, freeze)
-    reference = {"mode": "full", **_summary(reference_rows), "per_frame": reference_rows}
+    reference_rows, *rows_of_runs = _interleaved_rows(
+        renderers, scene, views, settings_list, progress, warmup, freeze, reference
+    )
+    reference = {
+        "mode": "full",
+        "settings": dataclasses.asdict(reference),
+        **_summary(reference_rows),
+        "per_frame": reference_rows,
+    }
     runs = []
     for settings, rows in zip(settings_list, rows_of_runs):
         psnr = np.array([r["psnr_db"] for r in rows])

@@ -34,7 +34,7 @@ frames = 3
 
 
 def test_every_shipped_suite_loads_and_its_default_cases_are_some_of_its_cases():
-    assert {"lod", "world"} <= set(suite_names())
+    assert {"lod", "world", "compositing"} <= set(suite_names())
     for name in suite_names():
         suite = load_suite(name)
         chosen = suite.chosen(None)
@@ -63,6 +63,16 @@ def test_a_case_s_frames_follow_its_camera_path_at_its_rate_and_quick_takes_a_th
     frames = int(scene.camera_path("flythrough").duration * 30) + 1
     assert len(case_views(case, scene)) == frames
     assert len(case_views(case, scene, quick=True)) == max(3, frames // 30)
+
+
+def test_a_case_at_instants_of_its_path_draws_them_in_turn_and_compares_ways_of_drawing_every_particle():
+    suite = load_suite("compositing")
+    case = suite.chosen(["flythrough_640"])[0]
+    scene = case_scene(case)
+    path = scene.camera_path("flythrough")
+    assert [round(t - path.keys[0, 0], 9) for t, _ in case_views(case, scene)] == [9.0, 20.0] * 10
+    assert (case.reference.mode, case.reference.splat_order, case.reference.compositing) == ("full", "gpu", "raster")
+    assert [(v.mode, v.compositing) for v in case.variants] == [("full", "compute")]
 
 
 def test_a_harris_case_flies_harris_s_field():
@@ -100,6 +110,12 @@ def _suite(text: str) -> dict:
         (('kind = "harris"', 'kind = "wang"'), "cases[1].sky.count", "unknown key; valid keys: kind, scenario"),
         (('name = "tiny_harris"', 'name = "tiny_still"'), "cases[1].name", "'tiny_still' names two cases"),
         (("[defaults]", 'default_cases = ["nowhere"]\n[defaults]'), "default_cases", "no case or group 'nowhere'"),
+        (
+            ("[defaults]", '[defaults]\nreference = { mode = "impostor" }'),
+            "cases[0].reference",
+            "the reference draws every particle: mode must be 'full', got 'impostor'",
+        ),
+        (("frames = 4", "frames = 4\ntimes_s = [1.0]"), "cases[0].times_s", "instants of a camera path"),
     ],
 )
 def test_a_bad_suite_is_refused_in_one_line_naming_its_field(change, field, problem):
@@ -157,6 +173,7 @@ def test_a_tiny_suite_runs_end_to_end_and_writes_the_report_it_promises(tmp_path
     assert list(report["cases"]) == ["tiny_still", "tiny_harris"]
     still = report["cases"]["tiny_still"]
     assert (still["width"], still["height"], still["warmup"]) == (64, 48, 1)
+    assert still["reference"]["settings"]["mode"] == "full"
     assert [len(run["per_frame"]) for run in (still["reference"], *still["runs"])] == [4, 4, 4]
     assert [run["settings"]["tolerance_deg"] for run in still["runs"]] == [0.5, 2.0]
     rows = [row for row in report["summary"] if row["case"] == "tiny_still"]
