@@ -122,7 +122,7 @@ def scene_from_dict(data: dict, source: str = "<scene>", base_dir=Path(".")) -> 
         description=root.string("description", ""),
         views=views,
         cloud_field=root.table("cloud_field", _cloud_field),
-        wind=root.table("wind", _wind),
+        wind=root.table("wind", read_wind),
         weather=root.table("weather", _weather),
     )
     # what every field allows, the renderer may still not draw: refuse that here, not in the GL code
@@ -326,7 +326,7 @@ def _cloud_field(t: Table) -> CloudField:
     )
 
 
-def _wind(t: Table) -> Wind:
+def read_wind(t: Table) -> Wind:
     """`[wind]`: types here, ranges by the record itself (the editor's panel edits it too)."""
     t.reject_unknown(TABLE_KEYS["wind"])
     d = Wind()

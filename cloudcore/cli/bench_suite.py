@@ -33,8 +33,8 @@ from cloudcore.measure.benchmark import (
     still_views,
 )
 from cloudcore.resources import resource_path
-from cloudcore.scene import Scene
-from cloudcore.scenefile import load_scene, settings_overrides
+from cloudcore.scene import Scene, Wind
+from cloudcore.scenefile import load_scene, read_wind, settings_overrides
 from cloudcore.settings import FULL_3D, RenderSettings
 from cloudcore.toml_table import Table, read_toml
 
@@ -56,6 +56,7 @@ CASE_KEYS = (
     "group",
     "scene",
     "sky",
+    "wind",
     "without_terrain",
     "views",
     "orbit_deg",
@@ -63,6 +64,7 @@ CASE_KEYS = (
     "times_s",
     "frames",
     "fps",
+    "seconds_a_frame",
     "width",
     "height",
     "warmup",
@@ -84,6 +86,7 @@ class Case:
     group: str
     scene: Path
     sky: tuple  # (kind, *its values) or () for the scene file's own clouds
+    wind: Wind | None  # the scene's wind instead of its file's, where the case gives one
     without_terrain: bool
     views: str
     orbit_deg: float
@@ -91,6 +94,7 @@ class Case:
     times_s: tuple[float, ...]  # seconds along the camera path its frames are drawn at, in turn; () for all of it
     frames: int  # 0: `fps` frames a second of the camera path
     fps: float
+    seconds_a_frame: float  # the scene clock's step a frame, whatever the views; 0: the views' own clock
     size: tuple[int, int]
     warmup: int
     reference: RenderSettings  # full 3D, as shipped unless the case compares ways of drawing every particle
@@ -206,6 +210,7 @@ def _case(t: Table, defaults: Table) -> Case:
         group=merged.string("group", ""),
         scene=Path(scene) if "/" in scene else resource_path("scenes", scene),
         sky=sky,
+        wind=merged.table("wind", read_wind),
         without_terrain=without_terrain,
         views=views,
         orbit_deg=merged.number("orbit_deg", 0.0, low=-360.0, high=360.0, low_open=True),
@@ -213,6 +218,7 @@ def _case(t: Table, defaults: Table) -> Case:
         times_s=tuple(float(t) for t in times),
         frames=merged.integer("frames", 0, low=1 if merged.has("frames") else 0, high=MAX_FRAMES),
         fps=merged.number("fps", 0.0, low=0.0, high=1000.0, low_open=merged.has("fps")),
+        seconds_a_frame=merged.number("seconds_a_frame", 0.0, low=0.0, high=86_400.0),
         size=(merged.integer("width", 640, low=1, high=MAX_SIDE), merged.integer("height", 480, low=1, high=MAX_SIDE)),
         warmup=merged.integer("warmup", 0, low=0, high=MAX_FRAMES),
         reference=reference,
@@ -259,6 +265,8 @@ def case_scene(case: Case) -> Scene:
     scene = load_scene(case.scene)
     if case.without_terrain:
         scene = dataclasses.replace(scene, terrain=None)
+    if case.wind is not None:
+        scene = dataclasses.replace(scene, wind=case.wind)
     kind, *values = case.sky or ("",)
     if kind == "harris":
         return bench_skies.harris_scene(scene, *values)
@@ -281,8 +289,15 @@ def case_frames(case: Case, scene: Scene) -> int:
 
 
 def case_views(case: Case, scene: Scene, quick: bool = False) -> list:
-    """(scene clock, camera) of each frame the case measures; `quick`: a thirtieth of them, at least 3 (a smoke
-    run, not numbers to quote)."""
+    """(scene clock, camera) of each frame the case measures, the clock `seconds_a_frame` a frame where the case
+    gives it; `quick`: a thirtieth of them, at least 3 (a smoke run, not numbers to quote)."""
+    views = _views(case, scene, quick)
+    if case.seconds_a_frame:
+        return [(frame * case.seconds_a_frame, camera) for frame, (_, camera) in enumerate(views)]
+    return views
+
+
+def _views(case: Case, scene: Scene, quick: bool) -> list:
     if case.views == "path":
         try:
             scene.camera_path(case.camera_path)
@@ -397,6 +412,7 @@ def summary_rows(case: Case, report: dict) -> list[dict]:
             "cloud_ms": run["cloud_ms_mean"],
             "plan_ms": run["plan_ms_mean"],
             "cloud_gpu_ms": run["gpu_ms_by_pass"]["clouds"],
+            "light_ms": float(np.mean([f.get("illumination_ms", 0.0) for f in run["per_frame"]])),
             "fps": 1e3 / run["frame_ms_mean"],
         }
 
@@ -415,6 +431,8 @@ def summary_rows(case: Case, report: dict) -> list[dict]:
                 "psnr_mean": run["psnr_mean"],
                 "psnr_min": run["psnr_min"],
                 "regenerations_per_frame": run["regenerations_per_frame"],
+                # the largest error an impostor or the ring was drawn with, in tolerances
+                "accepted_error_max": max(f.get("accepted_error_tolerances", 0.0) for f in run["per_frame"]),
                 "predicted_ms": run["predicted_ms_mean"],
             }
             | ratios

@@ -34,7 +34,7 @@ frames = 3
 
 
 def test_every_shipped_suite_loads_and_its_default_cases_are_some_of_its_cases():
-    assert {"lod", "world", "compositing"} <= set(suite_names())
+    assert {"lod", "world", "compositing", "wind"} <= set(suite_names())
     for name in suite_names():
         suite = load_suite(name)
         chosen = suite.chosen(None)
@@ -73,6 +73,20 @@ def test_a_case_at_instants_of_its_path_draws_them_in_turn_and_compares_ways_of_
     assert [round(t - path.keys[0, 0], 9) for t, _ in case_views(case, scene)] == [9.0, 20.0] * 10
     assert (case.reference.mode, case.reference.splat_order, case.reference.compositing) == ("full", "gpu", "raster")
     assert [(v.mode, v.compositing) for v in case.variants] == [("full", "compute")]
+
+
+def test_a_wind_case_replaces_the_scene_s_wind_and_runs_its_clock_with_the_camera_still():
+    suite = load_suite("wind")
+    churn = suite.chosen(["churn"])[0]
+    scene = case_scene(churn)
+    assert [band[1] for band in scene.wind.bands] == [6.0, 18.0] and scene.wind.turbulence_m == 30.0
+    views = case_views(churn, scene)
+    assert [t for t, _ in views] == [2.0 * frame for frame in range(60)]
+    assert {camera for _, camera in views} == {scene.camera}
+    field = suite.chosen(["field_still"])[0]
+    scene = case_scene(field)
+    assert scene.wind is None and scene.cloud_field is not None
+    assert [t for t, _ in case_views(field, scene, quick=True)] == [0.0, 2.0, 4.0]
 
 
 def test_a_harris_case_flies_harris_s_field():
@@ -116,6 +130,8 @@ def _suite(text: str) -> dict:
             "the reference draws every particle: mode must be 'full', got 'impostor'",
         ),
         (("frames = 4", "frames = 4\ntimes_s = [1.0]"), "cases[0].times_s", "instants of a camera path"),
+        (("frames = 4", "frames = 4\nwind = { bands = [[0, 10]] }"), "cases[0].wind.bands", "3"),
+        (("frames = 4", "frames = 4\nseconds_a_frame = -1"), "cases[0].seconds_a_frame", "must be within"),
     ],
 )
 def test_a_bad_suite_is_refused_in_one_line_naming_its_field(change, field, problem):
