@@ -42,7 +42,10 @@ from cloudcore.measure.benchmark import (
     still_views,
 )
 from cloudcore.scenefile import load_scene
-from cloudcore.settings import FULL_3D, setting_options
+from cloudcore.settings import FULL_3D, RenderSettings, setting_options
+
+DEFAULT_FRAMES = 60
+DEFAULT_SIZE = (640, 480)
 
 
 def add_parser(commands) -> None:
@@ -74,7 +77,9 @@ def add_parser(commands) -> None:
         default=[],
         help=f"NAME=V1,V2,... with NAME one of {', '.join(SWEEPABLE)}; several --sweep options combine",
     )
-    parser.add_argument("--frames", type=int, default=60, help="frames spread along the path (default 60)")
+    parser.add_argument(
+        "--frames", type=int, default=DEFAULT_FRAMES, help=f"frames spread along the path (default {DEFAULT_FRAMES})"
+    )
     parser.add_argument(
         "--warmup",
         type=int,
@@ -82,8 +87,8 @@ def add_parser(commands) -> None:
         help="unmeasured frames of the first view before each run: 20 build a still view's "
         "impostors and ring (default %(default)s)",
     )
-    parser.add_argument("--width", type=pixel_count, default=640)
-    parser.add_argument("--height", type=pixel_count, default=480)
+    parser.add_argument("--width", type=pixel_count, default=DEFAULT_SIZE[0])
+    parser.add_argument("--height", type=pixel_count, default=DEFAULT_SIZE[1])
     parser.add_argument("--plot", type=Path, help="write the error-against-time plot here (PNG)")
     parser.add_argument("--no-shading", action="store_true", help="skip the shading precompute comparison")
     parser.add_argument(
@@ -188,12 +193,18 @@ def run_suite_command(args) -> int:
             ("--sweep", args.sweep or None),
             ("--workers", args.workers),
             ("--cluster", args.cluster),
+            ("--frames", args.frames if args.frames != DEFAULT_FRAMES else None),
+            ("--warmup", args.warmup or None),
+            ("--width/--height", (args.width, args.height) if (args.width, args.height) != DEFAULT_SIZE else None),
+            ("--without-terrain", args.without_terrain or None),
+            ("--no-shading", args.no_shading or None),
+            ("the settings options", True if settings_from(args) != RenderSettings() else None),
         )
         if value is not None
     ]
     if given:
         raise SceneError(
-            "--suite", "suite", f"a suite's cases name their own scenes, views and settings: drop {given[0]}"
+            "--suite", "suite", f"a suite's cases name their own scenes, views, sizes and settings: drop {given[0]}"
         )
     suite = load_suite(args.suite)
     names = None if args.cases is None else [name for name in args.cases.split(",") if name]

@@ -155,7 +155,12 @@ def _bench(*args, cwd=None):
     [
         (["--suite", "nowhere"], "--suite: suite: no suite 'nowhere'; the suites: "),
         (["--suite", "lod", "--cases", "still,nowhere"], "--cases: cases: no case or group 'nowhere' in suite 'lod'"),
-        (["--suite", "lod", "--still"], "a suite's cases name their own scenes, views and settings: drop --still"),
+        (
+            ["--suite", "lod", "--still"],
+            "a suite's cases name their own scenes, views, sizes and settings: drop --still",
+        ),
+        (["--suite", "lod", "--width", "320"], "drop --width/--height"),
+        (["--suite", "lod", "--tolerance", "2"], "drop the settings options"),
         (["--cases", "still"], "--cases: cases: only with --suite NAME"),
         ([], "bench: scene: name a scene file, or a suite with --suite NAME"),
     ],
