@@ -36,7 +36,7 @@ from cloudcore.resources import resource_path
 from cloudcore.scene import Scene, Wind
 from cloudcore.scenefile import load_scene, read_wind, settings_overrides
 from cloudcore.settings import FULL_3D, RenderSettings
-from cloudcore.toml_table import Table, read_toml
+from cloudcore.toml_table import Table, field_error, read_toml
 
 #: the suites shipped, one TOML file each
 SUITES_FOLDER = resource_path("bench")
@@ -256,8 +256,8 @@ def _variant(t: Table) -> RenderSettings:
     overrides = dict(settings_overrides(Table(t.source, t.field, {k: v for k, v in t.data.items() if k != "mode"})))
     try:
         return RenderSettings(mode=mode, **overrides)
-    except ValueError as error:
-        t.fail("mode" if not overrides else next(iter(overrides)), str(error))
+    except ValueError as error:  # a rule between fields, or a range: RenderSettings names the field in its words
+        raise field_error(t.source, t.field, str(error)) from None
 
 
 def case_scene(case: Case) -> Scene:
@@ -281,6 +281,26 @@ def case_scene(case: Case) -> Scene:
     return scene
 
 
+def check_camera_paths(suite: Suite, cases: list[Case]) -> None:
+    """Before any frame: every case flying a camera path names one its scene has (each scene file read once)."""
+    files: dict = {}
+    for case in cases:
+        if case.views != "path":
+            continue
+        if case.sky[:1] == ("untuned",):
+            names = {bench_skies.UNTUNED_SCENES[case.sky[1]]}
+        else:
+            if case.scene not in files:
+                files[case.scene] = {path.name for path in load_scene(case.scene).camera_paths}
+            names = files[case.scene]
+        if case.camera_path not in names:
+            raise field_error(
+                suite.source,
+                f"cases.{case.name}.camera_path",
+                f"no camera path {case.camera_path!r} in its scene; it has: {', '.join(sorted(names)) or 'none'}",
+            )
+
+
 def case_frames(case: Case, scene: Scene) -> int:
     """How many frames the case measures: its own count, or `fps` a second of its camera path."""
     if case.frames:
@@ -298,11 +318,6 @@ def case_views(case: Case, scene: Scene, quick: bool = False) -> list:
 
 
 def _views(case: Case, scene: Scene, quick: bool) -> list:
-    if case.views == "path":
-        try:
-            scene.camera_path(case.camera_path)
-        except KeyError as error:
-            raise SceneError(str(case.scene), "camera_paths", error.args[0]) from None
     frames = case_frames(case, scene)
     frames = max(3, frames // 30) if quick else frames
     kind, *values = case.sky or ("",)
@@ -324,8 +339,11 @@ def _views(case: Case, scene: Scene, quick: bool) -> list:
 def built_cases(suite_name: str, names: list[str] | None, quick: bool = False) -> list:
     """(name, scene, views, (width, height), warmup) of each case asked of the suite: what the scripts that
     replay or time a case's frames their own way take (`scripts/bench_plan.py`...)."""
+    suite = load_suite(suite_name)
+    cases = suite.chosen(names)
+    check_camera_paths(suite, cases)
     built = []
-    for case in load_suite(suite_name).chosen(names):
+    for case in cases:
         scene = case_scene(case)
         built.append((case.name, scene, case_views(case, scene, quick), case.size, case.warmup))
     return built
@@ -336,6 +354,7 @@ def run_suite(suite: Suite, names: list[str] | None, quick: bool, bench_views) -
     reference=)` (the bench's runner: full 3D and the variants taking turns frame by frame); the report: each
     case's and the summary's rows."""
     cases = suite.chosen(names)
+    check_camera_paths(suite, cases)
     result = {
         "suite": suite.name,
         "source": suite.source,

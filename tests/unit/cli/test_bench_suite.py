@@ -117,7 +117,11 @@ def _suite(text: str) -> dict:
             "'harris_circle' flies Harris's field: needs sky.kind = 'harris'",
         ),
         (('views = "still"', 'views = "path"'), "cases[0].camera_path", "views = 'path' needs the name of a camera"),
-        (("tolerance_deg = 2.0 }", "tolerance_deg = -1.0 }"), "cases[0].variants[1].tolerance_deg", "within [0, 180]"),
+        (
+            ("tolerance_deg = 2.0 }", "tolerance_deg = -1.0 }"),
+            "cases[0].variants[1]",
+            "tolerance_deg must be within [0, 180]",
+        ),
         (('mode = "impostor" }', 'mode = "impostor", colour = 1 }'), "cases[0].variants[0].colour", "unknown key"),
         (('mode = "impostor" }', 'mode = "auto" }'), "cases[0].auto_vs_faster", "exactly one variant in mode 'auto'"),
         (("count = 4 }", "count = 0 }"), "cases[1].sky.count", "must be within [1, 100000], got 0"),
@@ -179,6 +183,17 @@ def test_a_bad_suite_file_exits_2_in_one_line(tmp_path):
     result = _bench("--suite", str(suite), "--json", str(tmp_path / "b.json"))
     assert result.returncode == 2
     assert result.stderr.strip() == f"cloudview: error: {suite}: cases[0].frames: must be within [1, 100000], got -4"
+
+
+def test_a_case_flying_a_camera_path_its_scene_lacks_is_refused_before_any_frame(tmp_path):
+    suite = tmp_path / "paths.toml"
+    suite.write_text(TINY_SUITE.replace('views = "still"', 'views = "path"\ncamera_path = "nowhere"'))
+    result = _bench("--suite", str(suite), "--json", str(tmp_path / "b.json"))
+    assert result.returncode == 2
+    assert result.stderr.strip() == (
+        f"cloudview: error: {suite}: cases.tiny_still.camera_path: no camera path 'nowhere' in its scene; it has: "
+        "flythrough"
+    )
 
 
 @pytest.mark.gl
