@@ -306,27 +306,6 @@ def ratio_interval(numerator, denominators, resamples: int = 4000, seed: int = 0
     return float(ratios(runs.sum(axis=1))), float(low), float(high)
 
 
-def setting_in_turns(renderers, scene, representations: dict, setting: str, timings, repeat: int, warm_up: int):
-    """A boolean `setting` on and off, side by side: per representation (name -> `RenderSettings`), the frames of
-    `scene` drawn with it (turn "on", by `renderers["on"]`) and without ("off", `renderers["off"]`, which may be the
-    same renderer) one after the other frame by frame, so that both see the same machine load; returns
-    {f"{representation}_{turn}_{timing}": the median of `FrameStats.<timing>` over `repeat` frames after `warm_up`}
-    for each of `timings` (ms)."""
-    row = {}
-    for name, settings in representations.items():
-        # one representation at a time: auto's first frames after full 3D's remake impostors
-        turns = {turn: dataclasses.replace(settings, **{setting: turn == "on"}) for turn in ("on", "off")}
-        times = {turn: {timing: [] for timing in timings} for turn in turns}
-        for frame in range(warm_up + repeat):
-            for turn, turn_settings in turns.items():
-                _, stats = renderers[turn].render(scene, settings=turn_settings, read_back=False)
-                for timing in timings if frame >= warm_up else ():
-                    times[turn][timing].append(getattr(stats, timing))
-        for turn, named in times.items():
-            row.update({f"{name}_{turn}_{timing}": float(np.median(values)) for timing, values in named.items()})
-    return row
-
-
 def machine() -> str:
     """The processor the numbers were measured on, for a report."""
     return platform.processor() or platform.machine()
