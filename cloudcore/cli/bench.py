@@ -193,6 +193,7 @@ def run_suite_command(args) -> int:
             ("--sweep", args.sweep or None),
             ("--workers", args.workers),
             ("--cluster", args.cluster),
+            ("--gpus-per-task", args.gpus_per_task),
             ("--frames", args.frames if args.frames != DEFAULT_FRAMES else None),
             ("--warmup", args.warmup or None),
             ("--width/--height", (args.width, args.height) if (args.width, args.height) != DEFAULT_SIZE else None),
