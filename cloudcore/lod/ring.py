@@ -303,7 +303,7 @@ def ring_candidates(held: RingCandidates | None, units, eye, settings: RenderSet
     """`ring_members` of `units` (`LodUnits`) from `eye`, the same answer, asking again only of the units whose
     answer may have changed since `held` (`_RingTests.slack`): auto mode asks of every unit each frame, and at
     Harris's scale (12,800 clouds) that was most of the time its plan spent on the ring while the ring's prices
-    held (docs/lod.md, "Auto mode at Harris's scale")."""
+    held (docs/lod.md, "Auto mode: the cheaper representation within the tolerance")."""
     eye = np.asarray(eye, dtype=np.float64)
     if (
         held is not None
