@@ -41,8 +41,8 @@ Two methods:
   ahead with their optical depths scaled, each counting only the light the direct beam has lost
   (`cloudcore.light.octaves`); no light order is needed.
 * "octaves-lit-face": the octaves, each particle's light then increased by what the medium behind it (away
-  from the light) reflects back to it (`cloudcore.light.lit_face`): one more product over the overlaps, found
-  from the other side.
+  from the light) reflects back to it (`cloudcore.light.lit_face`): one more product, over the overlaps behind each
+  particle, which the same search finds.
 """
 
 from __future__ import annotations
