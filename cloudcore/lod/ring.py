@@ -191,26 +191,143 @@ def ring_members(centres: np.ndarray, radii: np.ndarray, eye, settings: RenderSe
     those at the sphere's nearest horizontal distance: a cloud field's coarse cells are flat, their spheres
     kilometres high, and those that grazed the band's edge stayed out, drawn on their own over the panels that
     hold nearer clouds (docs/lod.md, "Wang's ring")."""
-    x, y, z = (np.asarray(centres, dtype=np.float64) - np.asarray(eye, dtype=np.float64)).T
-    horizontal_squared = x * x + z * z
-    horizontal = np.sqrt(horizontal_squared)
-    # the elevation of the centre plus the sphere's angular radius within the band, by their cosines (the planner
-    # asks of every cloud each frame): cos(elevation + angular radius) = (h sqrt(d^2 - r^2) - |y| r) / d^2,
-    # the sum at most 180 degrees, where the cosine falls
-    distance_squared = horizontal_squared + y * y
-    with np.errstate(invalid="ignore", divide="ignore"):
-        cosine = (horizontal * np.sqrt(distance_squared - radii * radii) - np.abs(y) * radii) / distance_squared
-    beyond = (radii > 0) & (horizontal - radii > settings.ring_radius)  # so wholly outside the eye's sphere too
-    in_band = cosine >= math.cos(math.radians(settings.ring_elevation_deg))
-    if heights is not None:
-        eye_y = float(np.asarray(eye, dtype=np.float64)[1])
-        bottoms, tops = np.asarray(heights, dtype=np.float64).reshape(-1, 2).T
-        # the steepest a splat can be seen at: its reach above or below the eye over the nearest horizontal
-        # distance of the sphere (positive for a cloud beyond the radius)
-        rise = np.maximum(tops - eye_y, eye_y - bottoms)
+    tests = _RingTests.of(centres, radii, eye, settings, heights)
+    return tests.beyond & tests.in_band
+
+
+class _RingTests(NamedTuple):
+    """`ring_members`' tests of each cloud from one eye, with the margins they pass or fail by."""
+
+    beyond: np.ndarray  # wholly beyond the ring radius, horizontally
+    beyond_margin: np.ndarray  # metres: its horizontal distance less its radius, less the ring radius
+    horizontal: np.ndarray  # metres from the eye's vertical
+    distance: np.ndarray  # metres from the eye
+    cosine: np.ndarray  # of the elevation of the centre plus the sphere's angular radius
+    sphere_in_band: np.ndarray
+    #: per cloud, how far its splats' steepest reach (`heights`) lies within the band at the sphere's nearest
+    #: horizontal distance, in metres of rise (None: no heights)
+    heights_margin: np.ndarray | None
+
+    @property
+    def in_band(self) -> np.ndarray:
+        if self.heights_margin is None:
+            return self.sphere_in_band
+        return self.sphere_in_band | (self.heights_margin >= 0.0)
+
+    @staticmethod
+    def of(centres, radii, eye, settings: RenderSettings, heights) -> _RingTests:
+        x, y, z = (np.asarray(centres, dtype=np.float64) - np.asarray(eye, dtype=np.float64)).T
+        horizontal_squared = x * x + z * z
+        horizontal = np.sqrt(horizontal_squared)
+        # the elevation of the centre plus the sphere's angular radius within the band, by their cosines (the
+        # planner asks of every cloud each frame): cos(elevation + angular radius) = (h sqrt(d^2 - r^2) - |y| r) / d^2,
+        # the sum at most 180 degrees, where the cosine falls
+        distance_squared = horizontal_squared + y * y
         with np.errstate(invalid="ignore", divide="ignore"):
-            in_band |= rise <= math.tan(math.radians(settings.ring_elevation_deg)) * (horizontal - radii)
-    return beyond & in_band
+            cosine = (horizontal * np.sqrt(distance_squared - radii * radii) - np.abs(y) * radii) / distance_squared
+        beyond_margin = horizontal - radii - settings.ring_radius
+        beyond = (radii > 0) & (beyond_margin > 0.0)  # so wholly outside the eye's sphere too
+        heights_margin = None
+        if heights is not None:
+            eye_y = float(np.asarray(eye, dtype=np.float64)[1])
+            bottoms, tops = np.asarray(heights, dtype=np.float64).reshape(-1, 2).T
+            # the steepest a splat can be seen at: its reach above or below the eye over the nearest horizontal
+            # distance of the sphere (positive for a cloud beyond the radius)
+            rise = np.maximum(tops - eye_y, eye_y - bottoms)
+            with np.errstate(invalid="ignore"):
+                heights_margin = math.tan(math.radians(settings.ring_elevation_deg)) * (horizontal - radii) - rise
+        return _RingTests(
+            beyond,
+            beyond_margin,
+            horizontal,
+            np.sqrt(distance_squared),
+            cosine,
+            cosine >= math.cos(math.radians(settings.ring_elevation_deg)),
+            heights_margin,
+        )
+
+    def slack(self, radii, settings: RenderSettings) -> np.ndarray:
+        """Per cloud, metres the eye may move, any way, before its answer (`beyond & in_band`) may change.
+
+        Beyond: the horizontal distance moves by at most the eye's step.  In the band by the sphere: the angle
+        e + asin(r / d) (elevation e of the centre, d its distance) moves by at most pi s / (2 d) + s r / (a
+        sqrt(a^2 - r^2)) after a step s at most (d - r) / 2, a = (d + r) / 2 (the ray to the centre turns by at
+        most asin(s / d), and the angular radius grows fastest at the nearest distance); by the heights, the rise
+        and the horizontal distance each by at most s.  An answer held by two tests holds while one of those
+        that make it does."""
+        band = math.radians(settings.ring_elevation_deg)
+        radii = np.asarray(radii, dtype=np.float64)
+        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+            beyond_slack = np.where(radii > 0.0, np.abs(self.beyond_margin), math.inf)
+            angle_margin = np.abs(band - np.arccos(np.clip(self.cosine, -1.0, 1.0)))
+            nearest = 0.5 * (self.distance + radii)
+            rate = 0.5 * math.pi / self.distance + radii / (nearest * np.sqrt(nearest * nearest - radii * radii))
+            sphere_slack = np.minimum(angle_margin / rate, 0.5 * (self.distance - radii))
+            if self.heights_margin is None:
+                band_slack = sphere_slack
+            else:
+                heights_slack = np.abs(self.heights_margin) / (1.0 + math.tan(band))
+                heights_in = self.heights_margin >= 0.0
+                held_by = np.maximum(
+                    np.where(self.sphere_in_band, sphere_slack, 0.0), np.where(heights_in, heights_slack, 0.0)
+                )
+                either = np.minimum(sphere_slack, heights_slack)
+                band_slack = np.where(self.sphere_in_band | heights_in, held_by, either)
+        in_band = self.in_band
+        slack = np.where(
+            self.beyond & in_band,
+            np.minimum(beyond_slack, band_slack),
+            np.maximum(np.where(self.beyond, 0.0, beyond_slack), np.where(in_band, 0.0, band_slack)),
+        )
+        return np.nan_to_num(slack, nan=0.0, posinf=math.inf)
+
+
+#: `ring_candidates` asks `ring_members` again of every unit once more than this share of them may have changed
+#: (their slack passed); fewer are asked alone
+RING_CANDIDATES_REFRESH_SHARE = 0.125
+
+
+@dataclass(frozen=True, eq=False)
+class RingCandidates:
+    """`ring_members` of a frame's units from an eye, held while the eye moves less than each answer's slack."""
+
+    units: object  # the units asked of (by identity)
+    radius: float
+    elevation_deg: float
+    eye: np.ndarray  # where every unit was last asked from
+    slack: np.ndarray  # per unit, metres the eye may move from `eye` before its answer may change
+    members: np.ndarray  # bool per unit: in the ring from this frame's eye
+
+
+def ring_candidates(held: RingCandidates | None, units, eye, settings: RenderSettings) -> RingCandidates:
+    """`ring_members` of `units` (`LodUnits`) from `eye`, the same answer, asking again only of the units whose
+    answer may have changed since `held` (`_RingTests.slack`): auto mode asks of every unit each frame, and at
+    Harris's scale (12,800 clouds) that was most of the time its plan spent on the ring while the ring's prices
+    held (docs/lod.md, "Auto mode: the cheaper representation within the tolerance")."""
+    eye = np.asarray(eye, dtype=np.float64)
+    if (
+        held is not None
+        and held.units is units
+        and held.radius == settings.ring_radius
+        and held.elevation_deg == settings.ring_elevation_deg
+    ):
+        step = float(np.linalg.norm(eye - held.eye))
+        # a margin for the rounding of the slacks themselves
+        unsure = np.flatnonzero(held.slack <= 1.001 * step + 1e-9)
+        if len(unsure) <= RING_CANDIDATES_REFRESH_SHARE * len(held.slack):
+            members = held.members.copy()
+            heights = None if units.heights is None else units.heights[unsure]
+            members[unsure] = ring_members(units.centres[unsure], units.radii[unsure], eye, settings, heights)
+            return replace(held, members=members)
+    tests = _RingTests.of(units.centres, units.radii, eye, settings, units.heights)
+    return RingCandidates(
+        units,
+        float(settings.ring_radius),
+        float(settings.ring_elevation_deg),
+        eye,
+        tests.slack(units.radii, settings),
+        tests.beyond & tests.in_band,
+    )
 
 
 def segment_texture_size(viewport_height: int, fov_y_deg: float, settings: RenderSettings) -> tuple[int, int]:

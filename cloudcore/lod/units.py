@@ -151,6 +151,12 @@ class LodUnits:
         """The rows of the units of more than one cloud."""
         return np.array([row for row, members in enumerate(self.members) if len(members) > 1], dtype=np.int64)
 
+    @functools.cached_property
+    def groups(self) -> LodUnits:
+        """The units of more than one cloud (`group_rows`), on their own: auto mode prices them every frame its
+        eye moves (`cloudcore.lod.plan.choice.groups_cheaper_apart`)."""
+        return self.take(self.group_rows)
+
     def apart_rows(self, groups: frozenset) -> np.ndarray:
         """The rows of `and_clouds` of these units with each group of `groups` (their members) replaced, in
         place, by its clouds' own units."""

@@ -94,7 +94,7 @@ def represent_units(
     """
     weights = np.zeros(len(rows))
     at = np.flatnonzero(priced)
-    units = [members[int(rows[row])] for row in at.tolist()]
+    units = [members[row] for row in rows[at].tolist()]
     held = [previous.get(unit) for unit in units]
     # the eye has left a unit it was inside: its particles were on screen, as full 3D's
     was = np.array(
@@ -124,8 +124,13 @@ def represent_units(
     stepped = np.where(target == _FULL, np.minimum(1.0, was_weight + step), np.maximum(0.0, was_weight - step))
     weight = np.where(at_once, np.where(target == _FULL, 1.0, 0.0), stepped)
     weights[at] = weight
-    names = np.where(target == _FULL, "full", "impostor").tolist()
-    chosen = {unit: Representation(name, w) for unit, name, w in zip(units, names, weight.tolist())}
+    # a unit's representation as it was is kept, not made anew: most units keep theirs from frame to frame
+    chosen = {
+        unit: h if h is not None and h.target == name and h.full_weight == w else Representation(name, w)
+        for unit, h, name, w in zip(
+            units, held, ["full" if t == _FULL else "impostor" for t in target.tolist()], weight.tolist()
+        )
+    }
     prices_of = list(zip(rows[at].tolist(), distances[at].tolist(), full_ms.tolist(), prices.impostor_ms[at].tolist()))
     return weights, chosen, prices_of
 
@@ -180,8 +185,7 @@ def groups_cheaper_apart(units: LodUnits, seen: Seen, settings, state: LodState,
     `plan_frame` opens a group only where its own impostor is due anyway.  `seen`: the `seen_from` of
     `units.and_clouds`.
     """
-    rows = units.group_rows
-    groups, group_seen = units.take(rows), seen.take(rows)
+    groups, group_seen = units.groups, seen.take(units.group_rows)
     # a group whose sphere holds the eye is whole: its screen impostor draws its particles sorted together, as
     # full 3D does, and apart its clouds would cost as much (the particles near the eye are the screen
     # impostor's cost, whatever holds them; under a stratocumulus deck apart was 1.7 times dearer)

@@ -76,17 +76,18 @@ from cloudcore.lod.plan.unit_plans import (
 )
 from cloudcore.lod.ring import (
     RING_FRAME_MS,
+    RingCandidates,
     RingState,
     frames_to_show,
     plan_ring,
-    ring_members,
+    ring_candidates,
     segment_texture_size,
 )
 from cloudcore.lod.splitting import layers_hold, objects_reaching
 from cloudcore.lod.units import LodUnits
 from cloudcore.scene import Camera
 from cloudcore.settings import RenderSettings
-from cloudcore.splat_coverage import splats_in_view
+from cloudcore.splat_coverage import splats_in_view_by_owner
 from cloudcore.wind import CloudMotion
 
 
@@ -258,8 +259,10 @@ def _plan_units(
     in_view_particles, in_view_fragments = units.particle_counts.astype(np.float64), ball_fragments.copy()
     step = eye - last_eye if last_eye is not None else np.zeros(3)
     ring_prices, counted_in_view = None, False
+    held_candidates: RingCandidates | None = None
     if settings.mode == "auto" and settings.uses_ring:
-        candidates = ring_members(centres, radii, eye, settings, units.heights)
+        held_candidates = ring_candidates(state.ring_candidates, units, eye, settings)
+        candidates = held_candidates.members
         alone = candidates & visible
         ring_prices = state.ring_prices
         in_view_count = int(np.count_nonzero(alone))
@@ -398,23 +401,41 @@ def _plan_units(
     )
     near_work = {}  # members -> (keys, Work) of the units priced splat by splat this frame
 
-    def full_3d(index: int, radius: float, distance: float) -> Work:
-        """The unit drawn in full 3D: a ball of discs far off; near, splat by splat, only the splats in the
-        frustum (the renderer leaves out the rest), their discs clipped to the screen; a still eye's again
-        from last frame (auto mode's plan of the default view 4.65 -> 3.2 ms, best of 40)."""
+    def full_3d_of(indices: list) -> list:
+        """Each unit of `indices` drawn in full 3D (`Work`): a ball of discs far off; near, splat by splat, only the
+        splats in the frustum (the renderer leaves out the rest), their discs clipped to the screen, every near
+        unit in one pass (`splats_in_view_by_owner`); a still eye's again from last frame (auto mode's plan of the
+        default view 4.65 -> 3.2 ms, best of 40)."""
         if not priced:
-            return Work()
-        if cloud_splats is None or distance >= NEAR_EXACT_RADII * radius:
-            return Work(particles=float(units.particle_counts[index]), fragments=float(ball_fragments[index]))
-        members = units.members[index]
-        held = known_near.get(members)
-        if held is not None and held[0] == unit_key(index):
-            near_work[members] = held
-            return held[1]
-        kept, overdraw = splats_in_view(*splats_of(index), view, projection)
-        work = Work(particles=float(kept), fragments=float(screen_pixels * overdraw * units.fragment_costs[index]))
-        near_work[members] = (unit_key(index), work)
-        return work
+            return [Work() for _ in indices]
+        works, counted = {}, []
+        for index in indices:
+            if cloud_splats is None or distances[index] >= NEAR_EXACT_RADII * radii[index]:
+                particles, fragments = float(units.particle_counts[index]), float(ball_fragments[index])
+                works[index] = Work(particles=particles, fragments=fragments)
+                continue
+            members = units.members[index]
+            held = known_near.get(members)
+            if held is not None and held[0] == unit_key(index):
+                near_work[members], works[index] = held, held[1]
+            else:
+                counted.append(index)
+        if counted:
+            splats = [splats_of(index) for index in counted]
+            owners = np.repeat(np.arange(len(counted)), [len(splat_radii) for _, splat_radii in splats])
+            kept, overdraws = splats_in_view_by_owner(
+                np.concatenate([splat_centres for splat_centres, _ in splats]),
+                np.concatenate([splat_radii for _, splat_radii in splats]),
+                owners,
+                len(counted),
+                view,
+                projection,
+            )
+            for index, count, overdraw in zip(counted, kept.tolist(), overdraws.tolist()):
+                fragments = float(screen_pixels * overdraw * units.fragment_costs[index])
+                works[index] = Work(particles=float(count), fragments=fragments)
+                near_work[units.members[index]] = (unit_key(index), works[index])
+        return [works[index] for index in indices]
 
     representations = {}
     update_work, cloud_work = Work(), Work()
@@ -470,11 +491,10 @@ def _plan_units(
     ordered = eye_in[np.argsort(-distances[drawable], kind="stable")]
     composites = np.count_nonzero(ordered & ~np.concatenate([[False], ordered[:-1]]))
     composite = Work(quad_pixels=screen_pixels, quads=1, batches=1).scaled(composites / max(len(holders), 1))
-    for index in holders.tolist():
-        radius, distance, members = radii[index], float(distances[index]), units.members[index]
+    for index, full in zip(holders.tolist(), full_3d_of(holders.tolist())):
+        distance, members = float(distances[index]), units.members[index]
         individual = float(individuals[index])
         inside, splits = split_at(index, eye)
-        full = full_3d(index, radius, distance)
         everything_full += full
         screen_impostor = dataclasses.replace(full, fragments=full.fragments * settings.inside_resolution_scale**2)
         full_ms, inside_ms = (
@@ -512,7 +532,7 @@ def _plan_units(
             seen,
             lifetimes,
             layers,
-            {int(k): full_3d(int(outside[k]), radii[outside[k]], float(distances[outside[k]])) for k in near.tolist()},
+            dict(zip(near.tolist(), full_3d_of(outside[near].tolist()))),
             priced_each,
             pricing,
             settings,
@@ -685,6 +705,7 @@ def _plan_units(
         particles=scene_particles,
         opened=opened,
         ring_prices=ring_prices,
+        ring_candidates=held_candidates,
         object_centres=tuple(tuple(float(v) for v in centre) for centre in object_centres),
         near_work=(units, camera, tuple(viewport), near_work) if near_work else None,
         time_s=None if motion is None else motion.time_s,

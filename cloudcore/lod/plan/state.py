@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 
 from cloudcore.lod.costs import CostEstimator, CostModel
 from cloudcore.lod.ring import (
+    RingCandidates,
     RingState,
 )
 
@@ -90,6 +91,7 @@ class LodState:
     particles: float = 0.0
     opened: frozenset = frozenset()  # the groups of clouds planned apart (`groups_cheaper_apart`)
     ring_prices: RingPrices | None = None  # auto mode's last pricing of the ring (`choice.ring_prices_hold`)
+    ring_candidates: RingCandidates | None = None  # auto mode's units in the ring, held by their slack
     object_centres: tuple = ()  # the objects' bounding-sphere centres: which of them move
     #: the units near the eye priced splat by splat last frame, for the same view to ask again (a still eye):
     #: (units, camera, viewport, {members: (their clouds' keys, Work)}), or None

@@ -13,7 +13,15 @@ from cloudcore.lod.plan import LodState, plan_frame
 from cloudcore.lod.plan.draw_items import DrawItem, draw_items
 from cloudcore.lod.plan.pricing import panel_pixels, ring_translation_error, segments_of
 from cloudcore.lod.plan.unit_plans import FULL, KINDS, UnitPlans
-from cloudcore.lod.ring import SEGMENTS, RingGeneration, RingState, frames_to_show, plan_ring, ring_members
+from cloudcore.lod.ring import (
+    SEGMENTS,
+    RingGeneration,
+    RingState,
+    frames_to_show,
+    plan_ring,
+    ring_candidates,
+    ring_members,
+)
 from cloudcore.lod.splitting import layer_bounds, layer_sort_key
 from cloudcore.lod.units import LodUnits
 from cloudcore.scene import Camera
@@ -230,3 +238,39 @@ def test_the_ring_s_largest_parallax_error_is_its_whole_ring_s_whatever_the_step
                 now = np.asarray(eye) + step * np.asarray(direction) / np.linalg.norm(direction)
                 whole = float(np.max(parallax_errors_deg(*ring.spheres, eye, now)))
                 assert ring_translation_error(ring, parallax_errors_deg, now) == whole
+
+
+@pytest.mark.parametrize("with_heights", [False, True])
+def test_the_ring_s_candidates_held_by_their_slack_are_ring_members_at_every_step(with_heights):
+    """`ring_candidates` asks again only of the units whose answer may have changed since it asked all: along a
+    walk of small and large steps, past the ring's radius and its band's edges for many clouds, its answer is
+    `ring_members`' at every step, and a step of centimetres asks nothing of the units it holds the answer of."""
+    rng = np.random.default_rng(5)
+    count = 3000
+    settings = RenderSettings(mode="auto")
+    # clouds crowded about the ring's radius and its elevation band's edge, seen from the eye at 1000 m
+    horizontal = settings.ring_radius * rng.uniform(0.8, 1.6, count)
+    angles = rng.uniform(0.0, 2.0 * np.pi, count)
+    band = np.tan(np.radians(settings.ring_elevation_deg))
+    heights = 1000.0 + horizontal * band * rng.uniform(-1.3, 1.3, count)
+    centres = np.column_stack([horizontal * np.sin(angles), heights, -horizontal * np.cos(angles)])
+    radii = rng.uniform(20.0, 0.3 * settings.ring_radius, count)
+    radii[:10] = 0.0  # empty units: never in the ring
+    reach = np.column_stack([heights - 0.3 * radii, heights + 0.3 * radii]) if with_heights else None
+    units = dataclasses.replace(
+        LodUnits.of_spheres(centres, radii, radii / 8.0, [200.0] * count, 200.0 * (radii / 8.0) ** 2), heights=reach
+    )
+    eye = np.array([0.0, 1000.0, 0.0])
+    held = ring_candidates(None, units, eye, settings)
+    assert np.array_equal(held.members, ring_members(centres, radii, eye, settings, reach))
+    still = ring_candidates(held, units, eye + 0.01, settings)
+    assert still.slack is held.slack and np.array_equal(still.members, held.members)
+    changed = 0
+    for step in [0.5, 3.0, 20.0, 80.0, 300.0] * 8:
+        direction = rng.normal(size=3)
+        eye = eye + step * direction / np.linalg.norm(direction)
+        before = held.members
+        held = ring_candidates(held, units, eye, settings)
+        assert np.array_equal(held.members, ring_members(centres, radii, eye, settings, reach))
+        changed += int(np.count_nonzero(held.members != before))
+    assert changed > 50  # the walk did move clouds into and out of the ring
