@@ -73,7 +73,7 @@ def test_the_gpu_bins_each_tile_far_to_near_and_only_the_kept_splats(renderer, v
     from cloudcore.gl.tile_binning import GpuTileBinning
 
     renderer.render(valley, settings=RASTER)
-    particles = renderer._particles  # the renderer's own, shaded for the scene: no public handle needed elsewhere
+    particles = renderer.particles  # the renderer's own, shaded for the scene (the valley in still air: not carried)
     camera = valley.camera
     view = view_matrix(camera)
     projection = projection_matrix(camera.fov_y_deg, RENDER_WIDTH / RENDER_HEIGHT)
