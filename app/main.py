@@ -5,10 +5,10 @@
 
 The docking layout is remembered between runs (hello_imgui's settings file in
 the user's config folder).  With --self-test the Dear ImGui Test Engine drives
-the real widgets (`app.gui_tests`), writes its results and exits 0 when every
-test passed, 1 otherwise.  With --frames the editor quits after N frames,
+the real widgets (the GUI tests of a source checkout, `tests/gui/editor_tests.py`),
+writes its results and exits 0 when every test passed, 1 otherwise.  With --frames the editor quits after N frames,
 optionally leaving the viewport's last picture at its own size (what
-`cloudview render` of the same view gives: `tests/test_editor_matches_render.py`),
+`cloudview render` of the same view gives: `tests/gui/test_editor_matches_render.py`),
 a screenshot of the whole window, and the per-frame statistics with the time
 between window frames (`scripts/bench_editor.py` summarises them).
 
@@ -20,6 +20,7 @@ or hides the statistics.
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import json
 import os
 import sys
@@ -39,6 +40,9 @@ from app.viewport import Viewport  # noqa: E402
 from cloudcore.collector import freeze_what_is_set_up  # noqa: E402
 from cloudcore.errors import SceneError  # noqa: E402
 from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
+
+#: the GUI tests --self-test runs: a test suite, so it lives with the tests, not in the product
+GUI_TESTS = Path(__file__).resolve().parents[1] / "tests" / "gui" / "editor_tests.py"
 
 
 def runner_params(
@@ -156,6 +160,12 @@ def main(argv=None) -> int:
     )
     parser.add_argument("--frame-stats", type=Path, help="with --frames: write every frame's statistics (JSON)")
     args = parser.parse_args(argv)
+    if args.self_test is not None and not GUI_TESTS.is_file():
+        print(
+            f"cloudview: error: --self-test: no GUI tests at {GUI_TESTS} (they come with a source checkout)",
+            file=sys.stderr,
+        )
+        return 2
     try:
         editor = Editor.open(args.scene)
     except SceneError as error:
@@ -173,11 +183,10 @@ def main(argv=None) -> int:
     )
     outcome = {}
     if args.self_test is not None:
-        from app.gui_tests import EditorUnderTest, install
-
-        install(
+        gui_tests = _imported(GUI_TESTS)
+        gui_tests.install(
             params,
-            EditorUnderTest(editor, viewport, panels, args.self_test, outcome),
+            gui_tests.EditorUnderTest(editor, viewport, panels, args.self_test, outcome),
             only=None if args.tests is None else args.tests.split(","),
         )
     if args.frames is not None:
@@ -193,6 +202,15 @@ def main(argv=None) -> int:
     if args.frame_stats is not None:
         args.frame_stats.write_text(json.dumps(outcome.get("frames", []), indent=1) + "\n")
     return outcome.get("exit_code", 0)
+
+
+def _imported(path: Path):
+    """The module of a file outside the package (the GUI tests), imported under its own name."""
+    spec = importlib.util.spec_from_file_location(path.stem, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[path.stem] = module
+    spec.loader.exec_module(module)
+    return module
 
 
 def window_size(text: str) -> tuple[int, int]:

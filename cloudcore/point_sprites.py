@@ -5,7 +5,7 @@ scales both image axes of a plane parallel to the image plane by the same
 1/depth, so the square projects to a square: a point sprite of that side in
 pixels, centred on the projected centre, covers the same pixels with the same
 kernel coordinates (`gl_PointCoord`), and the picture does not change
-(`tests/test_point_sprites.py`).  On llvmpipe a particle then costs less vertex
+(`tests/render/test_point_sprites.py`).  On llvmpipe a particle then costs less vertex
 set-up (a quad's four vertices against a point's one), which is most of an
 impostor regeneration's cost (docs/journal.md#point-sprites-third-session).
 

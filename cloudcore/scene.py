@@ -423,7 +423,7 @@ def _set_bounded_numbers(record, bounds) -> None:
 
 
 #: the named weathers of `[weather]` (`cloudcore.weather.WEATHER_PRESETS` holds what each sets)
-WEATHER_NAMES = ("fair_weather_cumulus", "scattered", "broken", "overcast")
+WEATHER_NAMES = ("fair_weather_cumulus", "scattered", "broken", "overcast", "towering_cumulus")
 
 
 @dataclass(frozen=True)

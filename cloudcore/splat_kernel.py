@@ -27,7 +27,7 @@ def splat_kernel(d) -> np.ndarray:
 
 def _kernel_diameter_integral(points: int = 64) -> float:
     """The integral of K(|u|) over u in [-1, 1], by Gauss-Legendre on [0, 1] (K is smooth there: exact
-    to rounding at 64 points; tests/test_truth.py checks it against the closed form with erf)."""
+    to rounding at 64 points; tests/unit/light/test_truth.py checks it against the closed form with erf)."""
     nodes, weights = np.polynomial.legendre.leggauss(points)
     return float(np.sum(weights * splat_kernel(0.5 * (nodes + 1.0))))  # 2 * (1/2) * sum over [0, 1]
 

@@ -9,7 +9,8 @@ from the eye, and the tiles' count grows with the log of the reach, not its squa
 
 Neighbouring tiles of different levels meet along an edge that the coarser samples half as often.  Each tile
 hangs a skirt from its edges, `SKIRT_CELLS` of its cells deep, which closes the gap between the two
-(tests/test_terrain_tiles.py checks it).  Why tiles: docs/performance.md, "The world pass: where its time goes".
+(tests/unit/model/test_terrain_tiles.py checks it).
+Why tiles: docs/performance.md, "The world pass: where its time goes".
 """
 
 from __future__ import annotations

@@ -2,7 +2,8 @@
 
 `[weather]` (`cloudcore.scene.Weather`) names one of `WEATHER_PRESETS`, each
 a coverage, a cloud type (`cloudcore.artist.cloudgen.PRESETS`) and the band
-of altitudes the field's particles lie in.  A change of weather (`to`) runs
+of altitudes the field's particles lie in; the towering cumulus also the
+scale of its clouds (the field's cell size and layers).  A change of weather (`to`) runs
 over `duration_s` seconds of the scene clock from `start_s`: the coverage
 follows c(t) = c_from + (c_to - c_from) smoothstep(u), u the share of the
 change elapsed, and the cloud type and altitudes switch halfway.
@@ -21,12 +22,21 @@ import dataclasses
 from cloudcore.ramps import smoothstep
 from cloudcore.scene import CloudField, Weather
 
-#: name -> what it sets of the field: coverage, cloud type, altitude (bottom, top) in metres
+#: name -> what it sets of the field: coverage, cloud type, altitude (bottom, top) in metres, and where the weather's
+#: clouds are of another scale than the field's own, its cell size (a cloud is about three cells across) and layers
 WEATHER_PRESETS = {
     "fair_weather_cumulus": {"coverage": 0.25, "cloud_type": "cumulus_humilis", "altitude": (1200.0, 2000.0)},
     "scattered": {"coverage": 0.4, "cloud_type": "cumulus_humilis", "altitude": (1200.0, 2600.0)},
     "broken": {"coverage": 0.7, "cloud_type": "cumulus_congestus", "altitude": (1000.0, 3200.0)},
     "overcast": {"coverage": 0.95, "cloud_type": "stratocumulus", "altitude": (800.0, 1600.0)},
+    # thunderstorms: towers ten kilometres wide up to the tropopause under their anvils, far apart
+    "towering_cumulus": {
+        "coverage": 0.15,
+        "cloud_type": "cumulonimbus",
+        "altitude": (1000.0, 10000.0),
+        "cell_size": 2000.0,
+        "layers": 8,
+    },
 }
 #: the coverage reaches the field in steps of this: each step remakes the field
 COVERAGE_STEP = 0.05
@@ -56,4 +66,7 @@ def field_under_weather(field: CloudField, weather: Weather | None, time_s: floa
     in_force = weather.to if weather.to is not None and change_progress(weather, time_s) >= 0.5 else weather.preset
     preset = WEATHER_PRESETS[in_force]
     coverage = min(max(round(weather_coverage(weather, time_s) / COVERAGE_STEP) * COVERAGE_STEP, 0.0), 1.0)
-    return dataclasses.replace(field, coverage=coverage, cloud_type=preset["cloud_type"], altitude=preset["altitude"])
+    scale = {name: preset[name] for name in ("cell_size", "layers") if name in preset}
+    return dataclasses.replace(
+        field, coverage=coverage, cloud_type=preset["cloud_type"], altitude=preset["altitude"], **scale
+    )

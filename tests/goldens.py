@@ -7,7 +7,7 @@ change.  On failure the line says why and tests/_failures/golden/ gets the
 rendered image, the golden and an amplified diff.  Goldens are made on
 llvmpipe and rewritten only on purpose (those whose pixels changed):
 
-    ./run tests tests/test_render_golden.py tests/test_render_presets.py --regenerate-goldens
+    ./run tests tests/render/test_render_golden.py tests/render/test_render_presets.py --regenerate-goldens
 """
 
 from pathlib import Path
@@ -20,7 +20,7 @@ GOLDEN = Path(__file__).parent / "golden"
 FAILURES = Path(__file__).parent / "_failures"
 TOLERANCE = Tolerance()
 MIN_PSNR_DB, MAX_ABS = TOLERANCE.min_psnr_db, TOLERANCE.max_diff
-REGENERATE = "./run tests tests/test_render_golden.py tests/test_render_presets.py --regenerate-goldens"
+REGENERATE = "./run tests tests/render/test_render_golden.py tests/render/test_render_presets.py --regenerate-goldens"
 
 
 def check_golden(image, name: str, request) -> None:

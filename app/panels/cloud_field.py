@@ -126,7 +126,9 @@ class CloudFieldPanel:
                 dataclasses.replace(editor.scene, weather=None if choice == 0 else Weather(WEATHER_NAMES[choice - 1]))
             )
         if weather is not None:
-            imgui.text_wrapped("The weather sets the coverage, cloud type and altitudes.")
+            imgui.text_wrapped(
+                "The weather sets the coverage, cloud type and altitudes (the towering cumulus also the clouds' scale)."
+            )
         changed, type_index = imgui.combo("Cloud type", _CLOUD_TYPES.index(field.cloud_type), list(_CLOUD_TYPES))
         if changed:
             changes["cloud_type"] = _CLOUD_TYPES[type_index]

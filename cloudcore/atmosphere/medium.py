@@ -3,7 +3,7 @@
 Hillaire 2020's `sampleMediumRGB`; altitudes below the ground read as the ground's, above the top as 0 density
 falls there anyway.  The phase functions are per steradian (they integrate to 1 over the sphere), whereas
 `cloudcore.light.phase` normalises Harris's to a mean of 1: the same functions divided by 4 pi
-(tests/test_atmosphere.py checks that).
+(tests/unit/atmosphere/test_atmosphere.py checks that).
 """
 
 from __future__ import annotations

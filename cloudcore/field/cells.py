@@ -55,6 +55,9 @@ TOP_SHRINK = 0.35
 RIM_SHRINK = 0.25
 #: the share of the columns at a cloud's rim that are kept, rising to all of them in the core: ragged, thinner edges
 RIM_KEEP = 0.5
+#: an anvil's particles over a core particle's radius: a sheet spread by the wind aloft, smooth where a tower's top
+#: is broken into turrets
+ANVIL_WIDENING = 1.6
 #: the cloud sites' lattice spacing, in inner cells: clouds about a cell across (docs/scene-format.md)
 SITE_SPACING_CELLS = 3.0
 #: a site's reach, in site spacings (its footprint at coverage 1): reaches this long overlap everywhere
@@ -142,7 +145,7 @@ def type_structure(cloud_type: str) -> tuple[float, float, float]:
     aspect = height / (0.25 * (width + depth))
     halves = [0.5 * ((high[0] - low[0]) + (high[2] - low[2])) for low, high in preset.boxes]
     if len(halves) > 1 and halves[-1] > halves[-2]:
-        return aspect, preset.boxes[-1][0][1], halves[-1] / halves[0]
+        return aspect, preset.boxes[-1][0][1], halves[-1] / halves[-2]
     return aspect, 0.0, 0.0
 
 
@@ -178,10 +181,13 @@ def cumulus_columns(field: CloudField, x, z) -> tuple[np.ndarray, np.ndarray, np
         spread = ratio / anvil_spread**2  # (rho / the anvil's reach)^2: inf where the site is clear
         under = spread < 1.0
         anvils = np.where(under, towers * (anvil_low + 0.7 * (1.0 - anvil_low) * np.where(under, spread, 0.0)), np.inf)
-    # the point belongs to the cloud whose column, or anvil, reaches highest over it
-    owner = np.argmax(np.where(np.isfinite(anvils), towers, heights), axis=1)
+    # the point's column is the tallest one standing on it; above it may spread the anvil of the tallest tower whose
+    # anvil reaches over it (of another cloud, or none: its own column's cloud then)
     rows = np.arange(len(u))
-    height, anvil, tower = heights[rows, owner], anvils[rows, owner], towers[rows, owner]
+    owner = np.argmax(heights, axis=1)
+    has_anvil = np.isfinite(anvils)
+    over = np.where(has_anvil.any(axis=1), np.argmax(np.where(has_anvil, towers, -np.inf), axis=1), owner)
+    height, anvil, tower = heights[rows, owner], anvils[rows, over], towers[rows, over]
     rim = np.minimum(ratio[rows, owner], 1.0)
     turrets = 0.5 * (
         value_noise(u / TURRET_WAVELENGTH_SITES, v / TURRET_WAVELENGTH_SITES, field.seed + _TURRET_NOISE) + 1.0
@@ -237,12 +243,15 @@ def cell_clouds(field: CloudField, cells) -> list[Cloud | None]:
             else:
                 y = bottom + (layer + 0.5 + 0.6 * (chance(layer, _JITTER_Y) - 0.5)) * layer_depth
                 above = y - bottom
-                kept = (above <= height) | ((above >= anvil) & (above <= tower))
+                in_anvil = (above > height) & (above >= anvil) & (above <= tower)
+                kept = (above <= height) | in_anvil
             kept &= in_field
             if not kept.any():
                 continue
             share = (y - bottom) / (top - bottom)
             radius = core_radius * (1.0 - TOP_SHRINK * share) * (0.85 + 0.3 * chance(layer, _SIZE))
+            if layer > 0:
+                radius = np.where(in_anvil, ANVIL_WIDENING * core_radius, radius)
             particles = np.column_stack([x, y, z, radius])[kept]
             owners = owner[kept]
             bounds = np.flatnonzero(np.diff(owners)) + 1  # the candidates are cell after cell

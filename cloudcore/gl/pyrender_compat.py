@@ -10,7 +10,7 @@ and the 3x3 uniform matrix setter.  Its PyOpenGL requirement is open
 `cloudcore.gl` takes pyrender from this module.
 
 We reach past pyrender's public API in four places, named in `PRIVATE_API`;
-tests/test_pyrender_compat.py fails if an upgrade removes any of them.
+tests/project/test_pyrender_compat.py fails if an upgrade removes any of them.
 
 Set PYOPENGL_PLATFORM=egl in the environment before this import for headless
 rendering: PyOpenGL chooses its platform on first import.

@@ -17,7 +17,8 @@ the direct beam has lost on the way, T_i - T_0:
 
 so a particle nothing shadows gets 1, no more than a lone particle can scatter (Frostbite's sum of b^i T_i gives
 it 1 + b + b^2 ..., and a slab of sparse opaque particles then sends out more light than reaches it:
-tests/test_octaves.py), and the multiply scattered light is dark at a cloud's lit edge, where the direct light has
+tests/unit/light/test_octaves.py),
+and the multiply scattered light is dark at a cloud's lit edge, where the direct light has
 not yet been scattered, and rises inside: Schneider's "powder" darkening, here from the octaves themselves.  The
 scales are the published ones (a = b = 0.5, three octaves), not fitted to this project's pictures.  The third
 of Wrenninge's scales, the phase function's anisotropy, is 1 here: every octave keeps the scene's phase

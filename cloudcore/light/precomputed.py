@@ -27,7 +27,7 @@ particle occludes (the flux divided by the projected area weighted by opacity, i
 1 - exp(-tau C(b)/C(0)) over the disc), for unit irradiance: times the splat's opacity alpha it is the
 splat's premultiplied colour.  Thin, single scattering then tends to 1 / (4 pi), and the colour to
 Harris's a tau p / (4 pi); in uniform light of radiance 1 a white particle returns alpha exactly, which
-is Harris's ambient term (checked: `tests/test_precomputed.py`).
+is Harris's ambient term (checked: `tests/unit/light/test_precomputed.py`).
 
 Single scattering is a quadrature over the sphere's volume (Gauss-Legendre in radius and polar angle,
 uniform in azimuth) of beta exp(-tau_light) exp(-tau_eye), both depths from the chord table.  Multiple

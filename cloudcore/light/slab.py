@@ -20,7 +20,7 @@ import numpy as np
 
 #: the starting layer is tau / 2^DOUBLINGS thick, its operators exact to first order in that depth
 DOUBLINGS = 30
-#: Gauss nodes per hemisphere: fluxes to 1e-5 (tests/test_slab.py)
+#: Gauss nodes per hemisphere: fluxes to 1e-5 (tests/unit/light/test_slab.py)
 STREAMS = 16
 SLAB_PHASES = ("isotropic", "rayleigh")
 

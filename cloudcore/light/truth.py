@@ -47,7 +47,7 @@ from cloudcore.splat_kernel import KERNEL_DIAMETER_INTEGRAL, splat_kernel
 from cloudcore.terrain import heightfield_mesh
 
 #: voxels across the scene's median particle radius: the line integral through a particle's centre is
-#: within 1% of its tau at 3 (tests/test_truth.py); the default scene then has about 10 million voxels
+#: within 1% of its tau at 3 (tests/unit/light/test_truth.py); the default scene then has about 10 million voxels
 DEFAULT_VOXELS_PER_RADIUS = 3.0
 #: (a, b) of `resolution_gain`, and the radius in voxels below which it stays constant
 RESOLUTION_GAIN_FIT = (1.46, 2.72)
@@ -217,7 +217,7 @@ def resolution_gain(radii_in_voxels) -> np.ndarray:
     """What a particle's peak extinction is multiplied by on a grid of voxels a fraction of its radius.
 
     Interpolating between voxel centres blurs the kernel across a ray, always a loss of optical depth
-    through the centre: measured over random centres and directions (tests/test_truth.py), 16.4% of tau
+    through the centre: measured over random centres and directions (tests/unit/light/test_truth.py), 16.4% of tau
     at 3 voxels a radius, 9.3% at 4, 4.2% at 6, 2.3% at 8.  1 + a / q^2 + b / q^4 in the radius in
     voxels q, fitted to those four, gives the inverse within 0.5%; below 1.5 voxels a radius the grid
     cannot hold a particle's shape and the gain stops growing.

@@ -86,16 +86,16 @@ if wanted editor; then
     --json "$OUT/editor_1280.json"
 fi
 if wanted tests; then
-  step "GPU-path tests" "$python" -m pytest -q "${plugin[@]}" tests/test_gpu_order.py tests/test_impostor_atlas.py \
-    tests/test_splats_shaded_ahead.py tests/test_render_golden.py tests/test_render_lod.py
+  step "GPU-path tests" "$python" -m pytest -q "${plugin[@]}" tests/render/test_gpu_order.py tests/render/test_impostor_atlas.py \
+    tests/render/test_splats_shaded_ahead.py tests/render/test_render_golden.py tests/render/test_render_lod.py
 fi
 if wanted compositing; then
   step "compositing 640x480" "${cloudview[@]}" bench "$scene" --camera-path flythrough --frames "$frames" \
     --sweep mode=full --sweep blending=plain,volume --no-shading --json "$OUT/compositing.json"
 fi
 if wanted compute; then
-  step "compute compositing tests" "$python" -m pytest -q "${plugin[@]}" tests/test_compute_compositing.py \
-    tests/test_render_depth.py
+  step "compute compositing tests" "$python" -m pytest -q "${plugin[@]}" tests/render/test_compute_compositing.py \
+    tests/render/test_render_depth.py
   compute=(--sweep mode=full,auto --sweep splat_order=gpu --sweep compositing=raster,compute --no-shading)
   step "compute 640x480" "${cloudview[@]}" bench "$scene" --camera-path flythrough --frames "$frames" \
     "${compute[@]}" --json "$OUT/compute_640.json"

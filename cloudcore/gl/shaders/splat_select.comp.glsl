@@ -24,7 +24,7 @@
 // Distances come from float32 centres relative to the eye, where the CPU
 // computes them in float64: particles whose distances agree to a float32
 // rounding may swap places, and one on a depth range's or the frustum's
-// boundary may fall on the other side (tests/test_gpu_order.py bounds both).
+// boundary may fall on the other side (tests/render/test_gpu_order.py bounds both).
 
 layout(local_size_x = 64) in;
 

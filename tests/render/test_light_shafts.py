@@ -1,0 +1,187 @@
+"""Light shafts (`cloudcore.light.light_shafts`, `cloudcore.gl.light_shafts`): which part of a ray the clouds' shadow
+map covers, the air's light taken in a shadow of known depth, the GL march against numpy's, and frames with and
+without them."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from cloudcore.atmosphere.aerial_perspective import MAX_DISTANCE_M
+from cloudcore.camera import pixel_rays
+from cloudcore.colour import srgb_decode
+from cloudcore.gl.light_shafts import shaft_reduction, shaft_size
+from cloudcore.light.air_between import air_between
+from cloudcore.light.cloud_shadows import SLICES, light_space, opacity_map
+from cloudcore.light.light_shafts import shadowed_in_scattering, shadowed_share, shaft_segments
+from cloudcore.light.sky_background import HORIZON_MARGIN, over_the_horizon, scene_sky
+from cloudcore.scene import Camera, Lighting, Scene
+from cloudcore.settings import FULL_3D
+from cloudcore.sun import sun_direction
+from tests.conftest import RENDER_HEIGHT, RENDER_WIDTH
+from tests.render.test_cloud_shadows import ball, particles_of
+
+SUN = sun_direction(17.0)
+
+
+def one_cloud_space(resolution=64):
+    """The map's view over one round cloud 1.2 km up, under the 17:00 sun."""
+    centres, radii, _, _ = particles_of([ball((0.0, 1200.0, 0.0), radius_m=400.0)])
+    return light_space(centres, radii, SUN, resolution), centres, radii
+
+
+def test_a_rays_segment_ends_on_the_prisms_faces_and_holds_only_its_points():
+    space, _, _ = one_cloud_space()
+    rng = np.random.default_rng(3)
+    eye = np.array([3000.0, 200.0, 500.0])
+    directions = rng.normal(size=(4000, 3))
+    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+    start, end = shaft_segments(space, eye, directions, np.full(len(directions), 20000.0))
+    met = end > start
+    assert 50 < met.sum() < len(directions)  # some rays cross the prism, most do not
+    to_map = space.world_to_map()
+    for t in (start[met], end[met]):
+        points = eye + directions[met] * t[:, None]
+        u, v, s = (points @ to_map[:3, :3].T + to_map[:3, 3]).T
+        inside = (u > -1e-9) & (u < 1 + 1e-9) & (v > -1e-9) & (v < 1 + 1e-9) & (s > -1e-9)
+        assert inside.all()
+        on_face = np.minimum.reduce([np.abs(u), np.abs(u - 1), np.abs(v), np.abs(v - 1), np.abs(s)]) < 1e-9
+        # a segment starts at the eye or on a face, ends on a face or at the ray's end (20 km)
+        assert (on_face | (np.abs(t) < 1e-9) | (np.abs(t - 20000.0) < 1e-6)).all()
+    # a point of a missed ray, sampled along it, is never inside
+    missed = directions[~met][:200]
+    along = np.linspace(0.0, 20000.0, 400)
+    points = eye + missed[:, None, :] * along[None, :, None]
+    u, v, s = np.moveaxis(points @ to_map[:3, :3].T + to_map[:3, 3], -1, 0)
+    assert not ((u > 0.01) & (u < 0.99) & (v > 0.01) & (v < 0.99) & (s > 0.01)).any()
+
+
+def test_a_ray_in_a_shadow_of_even_depth_loses_that_share_of_its_air_and_one_outside_none():
+    """A map of optical depth tau everywhere in its footprint: a ray that runs inside the footprint behind every
+    slice (under the clouds along the sun) loses 1 - e^-tau of the light its air adds there; one that misses the
+    footprint loses nothing."""
+    space, _, _ = one_cloud_space(resolution=256)
+    width, height = space.size
+    tau = 0.7
+    values = np.full((SLICES, height, width), tau)
+    air = air_between(scene_sky(Lighting(time_of_day=17.0)), (0.0, 0.0, 0.0))
+    # the footprint's middle, on the ground: behind every slice; rays along the ground, short enough to stay in
+    right, up = np.asarray(space.right), np.asarray(space.up)
+    middle = (space.origin[0] + 0.5 * space.texel_m * width) * right + (
+        space.origin[1] + 0.5 * space.texel_m * height
+    ) * up
+    forward = np.asarray(space.forward)
+    eye = middle + forward * (-middle[1] / forward[1])  # slid along the sun down to the ground
+    eye[1] = 10.0
+    directions = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]])
+    distances = np.full(3, 100.0)
+    taken = shadowed_in_scattering(air, space, values, eye, directions, distances)
+    added = air.added(directions, distances)[0] - air.added(directions, np.zeros(3))[0]
+    assert np.all(added > 0.0)
+    np.testing.assert_allclose(taken, -np.expm1(-tau) * added, rtol=1e-6)
+    far_away = eye + 50.0 * space.texel_m * width * right
+    assert np.all(shadowed_in_scattering(air, space, values, far_away, directions, distances) == 0.0)
+
+
+def test_the_light_taken_is_never_more_than_the_air_adds_and_grows_with_the_shadows_depth():
+    space, centres, radii = one_cloud_space()
+    air = air_between(scene_sky(Lighting(time_of_day=17.0)), (0.0, 0.0, 0.0))
+    eye = np.array([2500.0, 100.0, 300.0])
+    directions = pixel_rays(Camera(tuple(eye), (0.0, 600.0, 0.0), 60.0), 24, 18).reshape(-1, 3)
+    distances = np.full(len(directions), MAX_DISTANCE_M)
+    taken = [
+        shadowed_in_scattering(
+            air, space, opacity_map(space, centres, radii, np.full(len(radii), alpha)), eye, directions, distances
+        )
+        for alpha in (0.2, 0.9)
+    ]
+    whole = air.added(directions, distances)[0]
+    assert taken[1].max() > 0.05 * whole.max()  # the cloud's shadow is on some of these rays
+    assert np.all(taken[0] <= taken[1] + 1e-12)
+    assert np.all((taken[1] >= 0.0) & (taken[1] <= whole + 1e-12))
+
+
+def shaft_scene() -> Scene:
+    """A cloud between the eye and the 17:00 sun, the eye in its shadow's air, no terrain: every ray reaches the
+    air volume's end."""
+    cloud = ball((0.0, 1200.0, 0.0), radius_m=400.0, particles=600)
+    flat = np.array([SUN[0], 0.0, SUN[2]]) / np.hypot(SUN[0], SUN[2])
+    eye = -3000.0 * flat + np.array([0.0, 300.0, 0.0])
+    return Scene(
+        camera=Camera(tuple(eye), tuple(eye + 1000.0 * flat + [0.0, 250.0, 0.0]), 60.0),
+        lighting=Lighting(time_of_day=17.0),
+        clouds=(cloud,),
+    )
+
+
+@pytest.mark.gl
+def test_the_gl_march_is_numpys(renderer):
+    scene = shaft_scene()
+    renderer.render(scene, settings=FULL_3D, read_back=False)
+    renderer.context.make_current()
+    march = renderer.light_shafts.read(blurred=False)
+    width, height = shaft_size(RENDER_WIDTH, RENDER_HEIGHT, shaft_reduction(RENDER_WIDTH))
+    assert march.shape == (height, width, 4)
+    centres, radii, _, _ = particles_of(scene.clouds)
+    opacity = -np.expm1(-np.full(len(radii), scene.shading.optical_depth))
+    space = renderer.shadow_map.space
+    values = opacity_map(space, centres, radii, opacity)
+    air = air_between(scene_sky(scene.lighting), scene.camera.position)
+    directions = pixel_rays(scene.camera, width, height).reshape(-1, 3)
+    # no terrain: every ray is the sky's, marched to the volume's end, below the horizon at it (as the sky draws)
+    sky = scene_sky(scene.lighting)
+    low = directions[:, 1] < sky.lowest_up()
+    directions[low] = over_the_horizon(directions[low], sky.lowest_up() - HORIZON_MARGIN)
+    distances = np.full(len(directions), MAX_DISTANCE_M)
+    # the march's dither: interleaved gradient noise at each pixel's centre, rows counted from the bottom
+    column, row = np.meshgrid(np.arange(width) + 0.5, height - 0.5 - np.arange(height))
+    offsets = np.modf(52.9829189 * np.modf(0.06711056 * column + 0.00583715 * row)[0])[0].ravel()
+    taken = shadowed_in_scattering(air, space, values, scene.camera.position, directions, distances, offsets)
+    share = shadowed_share(taken, air.added(directions, distances)[0]).reshape(height, width)
+    assert share.max() > 0.2  # shafts in view
+    assert np.abs(march[..., 3] - share).max() < 0.02
+    taken = taken.reshape(height, width, 3)
+    assert np.abs(march[..., :3] - taken).max() < 0.02 * taken.max()
+    # what the world reads: the march blurred by a 3x3 tent, its edges clamped
+    padded = np.pad(march, ((1, 1), (1, 1), (0, 0)), mode="edge")
+    tent = np.array([1.0, 2.0, 1.0])
+    blurred = (
+        sum(tent[dy] * tent[dx] * padded[dy : dy + height, dx : dx + width] for dy in range(3) for dx in range(3))
+        / 16.0
+    )
+    assert np.abs(renderer.light_shafts.read() - blurred).max() < 2e-3 * max(blurred.max(), 1.0)
+
+
+def frames_with_and_without_shafts(renderer, scene: Scene) -> dict[bool, np.ndarray]:
+    frames = {}
+    for shafts in (True, False):
+        image, _ = renderer.render(scene, settings=dataclasses.replace(FULL_3D, light_shafts=shafts))
+        frames[shafts] = srgb_decode(image / 255.0)
+    return frames
+
+
+@pytest.mark.gl
+def test_shafts_only_darken_and_most_where_most_of_the_air_is_shadowed(renderer):
+    frames = frames_with_and_without_shafts(renderer, shaft_scene())
+    darker = (frames[False] - frames[True]).mean(axis=-1)
+    assert darker.min() > -2.0 / 255.0  # never brighter (the 8-bit dither aside)
+    assert darker.max() > 0.02
+    renderer.context.make_current()
+    block = shaft_reduction(RENDER_WIDTH)
+    shares = np.kron(renderer.light_shafts.read()[..., 3], np.ones((block, block)))
+    shares = shares[:RENDER_HEIGHT, :RENDER_WIDTH]
+    most, least = shares > np.percentile(shares, 80), shares < np.percentile(shares, 20)
+    assert darker[most].mean() > 2.0 * darker[least].mean()
+
+
+@pytest.mark.gl
+def test_a_view_whose_air_no_shadow_reaches_is_drawn_as_without_shafts(renderer):
+    scene = shaft_scene()
+    # on the sun's side of the cloud, looking toward the sun: neither the eye nor its rays are in the shadow's air
+    flat = np.array([SUN[0], 0.0, SUN[2]]) / np.hypot(SUN[0], SUN[2])
+    eye = 3000.0 * flat + np.array([0.0, 300.0, 0.0])
+    camera = Camera(tuple(eye), tuple(eye + 1000.0 * flat + [0.0, 250.0, 0.0]), 60.0)
+    frames = frames_with_and_without_shafts(renderer, dataclasses.replace(scene, camera=camera))
+    renderer.context.make_current()
+    assert renderer.light_shafts.read().max() == 0.0
+    assert np.abs(frames[True] - frames[False]).max() == 0.0
