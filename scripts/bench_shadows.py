@@ -29,10 +29,10 @@ from cloudcore.gl.context import HeadlessContext  # noqa: E402
 from cloudcore.gl.frame import FrameRenderer  # noqa: E402
 from cloudcore.gl.shadow_map import CloudShadowMap  # noqa: E402
 from cloudcore.light.cloud_shadows import sample_map  # noqa: E402
-from cloudcore.light.eye_scattering import ParticleBuffer  # noqa: E402
 from cloudcore.light.illumination import shadowing_sun, sun_through_others  # noqa: E402
 from cloudcore.light.lighting import scene_lights  # noqa: E402
 from cloudcore.measure.benchmark import machine, setting_in_turns, write_report  # noqa: E402
+from cloudcore.particles.buffer import ParticleBuffer  # noqa: E402
 from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
 from cloudcore.scenefile import load_scene  # noqa: E402
 from cloudcore.settings import FULL_3D, RenderSettings  # noqa: E402

@@ -58,7 +58,6 @@ from cloudcore.gl.volume_blending import GpuFeatures, VolumeBlendingPass
 from cloudcore.gl.world import WorldPass
 from cloudcore.light.air_between import air_between
 from cloudcore.light.cloud_shadows import FIELD_MAP_RESOLUTION, MAP_RESOLUTION, PREVIEW_MAP_RESOLUTION
-from cloudcore.light.eye_scattering import ParticleBuffer
 from cloudcore.light.illumination import IlluminationCache, shadowing_sun
 from cloudcore.light.lighting import scene_lights
 from cloudcore.light.live_air import LiveAir
@@ -71,6 +70,7 @@ from cloudcore.lod.units import LodUnits, lod_units
 from cloudcore.measure.frame_stats import FrameStats
 from cloudcore.measure.overdraw import Overdraw, overdraw_statistics
 from cloudcore.measured_way import COMPOSITING_WAYS, MeasuredWay
+from cloudcore.particles.buffer import ParticleBuffer
 from cloudcore.scene import Camera, Lighting, Scene
 from cloudcore.settings import FULL_3D, RenderSettings
 from cloudcore.splat_coverage import analytic_overdraw
@@ -84,6 +84,20 @@ from cloudcore.wind import (
     reshapes,
     shape_change_bound_m,
 )
+
+
+@dataclass(frozen=True)
+class _Asked:
+    """What `FrameRenderer.render` was asked to draw (its arguments but the read-back)."""
+
+    scene: Scene
+    time_of_day: float | None
+    camera: Camera | None
+    illumination_method: str
+    settings: RenderSettings
+    time_s: float
+    costs: CostModel | None
+    lit_at: float | None
 
 
 @dataclass(frozen=True)
@@ -244,13 +258,13 @@ class FrameRenderer:
         to `time_s` (`drawn_clouds`); by default `wind.light_time`'s, the frame waiting for it.  The editor
         passes the last period's while its relighting worker lights the new one.
         """
-        drawing = (scene, time_of_day, camera, illumination_method, settings, time_s, costs, lit_at)
-        stats = self._draw_frame(*drawing)
+        asked = _Asked(scene, time_of_day, camera, illumination_method, settings, time_s, costs, lit_at)
+        stats = self._draw_frame(asked)
         if self._volume.settle():
             # a draw composited by compute had more tile pairs than the room the GPU had for them, and lost its
             # nearest splats: drawn again, each draw's pairs counted first (`cloudcore.gl.tile_binning`)
             first = stats
-            stats = self._draw_frame(*drawing)
+            stats = self._draw_frame(asked)
             self._volume.settle()
             stats = dataclasses.replace(
                 stats, frame_ms=first.frame_ms + stats.frame_ms, cpu_ms=first.cpu_ms + stats.cpu_ms, drawn_again=True
@@ -263,22 +277,13 @@ class FrameRenderer:
         air = self._air_motion(scene)
         return scene.clouds if air is None else air.lit_clouds(lit_at)
 
-    def _draw_frame(
-        self,
-        scene: Scene,
-        time_of_day,
-        camera,
-        illumination_method: str,
-        settings: RenderSettings,
-        time_s,
-        costs,
-        lit_at: float | None,
-    ) -> FrameStats:
+    def _draw_frame(self, asked: _Asked) -> FrameStats:
         """`render`'s frame, left in the render target: prepare, plan, the passes, observe, statistics."""
         self.context.make_current()  # several renderers may share a thread (the benchmarks take turns)
-        ready = self._prepare(scene, time_of_day, camera, illumination_method, settings, time_s, lit_at)
+        settings, time_s = asked.settings, asked.time_s
+        ready = self._prepare(asked)
         planning_started = time.perf_counter()
-        frame = self._plan(ready, settings, time_s, costs)
+        frame = self._plan(ready, settings, time_s, asked.costs)
         before_passes_ms = 1e3 * (time.perf_counter() - planning_started)
         self._splats.particles_as_points = 0  # the passes' draws count theirs
         clock = self._clock
@@ -298,17 +303,10 @@ class FrameRenderer:
             frame, ready.illumination_ms, before_passes_ms, drawn, drawn_by_gpu, rendered + rendered_by_gpu
         )
 
-    def _prepare(
-        self,
-        scene: Scene,
-        time_of_day,
-        camera,
-        illumination_method: str,
-        settings: RenderSettings,
-        time_s: float,
-        lit_at: float | None,
-    ) -> _FrameScene:
+    def _prepare(self, asked: _Asked) -> _FrameScene:
         """The frame's scene made ready (`_FrameScene`), and every resource made from it in step with it."""
+        scene, time_of_day, camera, lit_at = asked.scene, asked.time_of_day, asked.camera, asked.lit_at
+        settings, time_s = asked.settings, asked.time_s
         lighting = (
             scene.lighting if time_of_day is None else dataclasses.replace(scene.lighting, time_of_day=time_of_day)
         )
@@ -324,7 +322,7 @@ class FrameRenderer:
             scene = dataclasses.replace(scene, clouds=air.lit_clouds(lit_at))
         field_carried = field_drift(scene.wind, scene.cloud_field, time_s)
         scene, fade_keys = self._with_field(scene, camera, field_carried)
-        illumination_ms = self._follow_scene(scene, lighting, illumination_method, settings.cloud_shadows)
+        illumination_ms = self._follow_scene(scene, lighting, asked.illumination_method, settings.cloud_shadows)
         # the units follow the particles' places and sizes, not their light: a relit scene keeps them
         self._units.follow((scene.clouds, settings.group_clouds), self._lit.value.particles, authored_clouds)
         particles, units, motion = self._carried(air, field_carried, time_s, lit_at)

@@ -22,10 +22,11 @@ from cloudcore.gl.objects import ObjectPass
 from cloudcore.gl.quads import QuadPass
 from cloudcore.gl.reduced_clouds import ReducedClouds
 from cloudcore.gl.shadow_map import CloudShadowMap
-from cloudcore.gl.splats import SplatBatch, SplatPass, SplatSelection, splat_batch
+from cloudcore.gl.splats import SplatPass
 from cloudcore.gl.volume_blending import VolumeBlendingPass
-from cloudcore.light.eye_scattering import ParticleBuffer
 from cloudcore.lod.plan import FramePlan
+from cloudcore.particles.batch import SplatBatch, SplatSelection, splat_batch
+from cloudcore.particles.buffer import ParticleBuffer
 from cloudcore.scene import Camera
 from cloudcore.settings import RenderSettings
 

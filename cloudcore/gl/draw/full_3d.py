@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 
 from cloudcore.gl.draw.executor import CloudPassFrame, DrawCounts, DrawExecutor, DrawStep, PassTools, draw_kind
-from cloudcore.gl.splats import SplatBatch, SplatSelection
 from cloudcore.light.volume_blending import blending_path
+from cloudcore.particles.batch import SplatBatch, SplatSelection
 
 
 @draw_kind("full")

@@ -10,8 +10,8 @@ import numpy as np
 from cloudcore.gl.draw.executor import CloudPassFrame, DrawCounts, DrawExecutor, DrawStep, draw_kind
 from cloudcore.gl.draw.full_3d import count_splats, draw_splats
 from cloudcore.gl.impostor_atlas import atlas_instances
-from cloudcore.gl.splats import SplatBatch
 from cloudcore.gl.targets import TextureTarget
+from cloudcore.particles.batch import SplatBatch
 
 
 @draw_kind("impostor")

@@ -8,9 +8,9 @@ from OpenGL import GL
 
 from cloudcore.gl.draw.executor import CloudPassFrame, DrawCounts, DrawExecutor, DrawStep, draw_kind
 from cloudcore.gl.quads import SCREEN_CORNERS
-from cloudcore.gl.splats import SplatBatch
 from cloudcore.gl.targets import TextureTarget, blit_depth, depth_renderbuffer
 from cloudcore.lod.impostors import cropped_corners, particle_extent
+from cloudcore.particles.batch import SplatBatch
 
 
 @draw_kind("inside")
