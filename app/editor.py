@@ -137,9 +137,12 @@ class Editor:
 
     @property
     def scene_duration_s(self) -> float:
-        """The last key time of any object path (0 for a scene with static objects only), and under wind at least
-        `WIND_CLOCK_S`: the clouds move as long as the clock runs."""
+        """The last key time of any object path and the end of a change of weather (0 for a scene with neither),
+        and under wind at least `WIND_CLOCK_S`: the clouds move as long as the clock runs."""
         paths = max((float(o.path[-1, 0]) for o in self.scene.objects if o.path is not None), default=0.0)
+        weather = self.scene.weather
+        if weather is not None and weather.to is not None:
+            paths = max(paths, weather.start_s + weather.duration_s)
         return paths if self.scene.wind is None else max(paths, WIND_CLOCK_S)
 
     @classmethod

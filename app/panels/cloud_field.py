@@ -27,6 +27,7 @@ from cloudcore.scene import (
     Weather,
     Wind,
 )
+from cloudcore.weather import WEATHER_PRESETS
 
 #: the float sliders: label -> (field, index in a pair or None, low, high, format)
 _SLIDERS = {
@@ -42,6 +43,12 @@ _SLIDERS = {
 #: the sliders in kilometres, the record in metres
 _KM = ("Extent x (km)", "Extent z (km)", "Centre x (km)", "Centre z (km)")
 _CLOUD_TYPES = tuple(PRESETS)
+
+
+def _governed_by(weather: Weather) -> set[str]:
+    """The field's values the weather sets (either of a change's two weathers): not the panel's to edit."""
+    names = [weather.preset] if weather.to is None else [weather.preset, weather.to]
+    return {name for preset in names for name in ("coverage", "cloud_type", "altitude", *WEATHER_PRESETS[preset])}
 
 
 class CloudFieldPanel:
@@ -89,6 +96,35 @@ class CloudFieldPanel:
         if imgui.button("Remove wind"):
             editor.edit(dataclasses.replace(editor.scene, wind=None))
 
+    def _weather(self, weather: Weather | None) -> None:
+        """`[weather]`: a named weather over the field, and a change to another over the scene clock (the Camera
+        panel's "Scene time")."""
+        editor = self.editor
+        choice = 0 if weather is None else 1 + WEATHER_NAMES.index(weather.preset)
+        changed, choice = imgui.combo("Weather", choice, ["the field's own", *WEATHER_NAMES])
+        if changed:
+            editor.edit(
+                dataclasses.replace(editor.scene, weather=None if choice == 0 else Weather(WEATHER_NAMES[choice - 1]))
+            )
+        if weather is None:
+            return
+        imgui.text_wrapped("The weather sets the field's coverage, cloud type and altitudes (greyed above).")
+        to = 0 if weather.to is None else 1 + WEATHER_NAMES.index(weather.to)
+        changed, to = imgui.combo("Changes to", to, ["no change", *WEATHER_NAMES])
+        changes: dict = {}
+        if changed:
+            changes["to"] = None if to == 0 else WEATHER_NAMES[to - 1]
+        if weather.to is not None:
+            start = self._sliders.slider("Change starts (s)", weather.start_s, 0.0, 3600.0, "%.0f")
+            duration = self._sliders.slider("Change lasts (s)", weather.duration_s, 1.0, 3600.0, "%.0f", True)
+            if start is not None:
+                changes["start_s"] = start
+            if duration is not None:
+                changes["duration_s"] = duration
+        if changes:
+            scene = editor.scene
+            editor.change(lambda: dataclasses.replace(scene, weather=dataclasses.replace(weather, **changes)))
+
     def _field(self) -> None:
         editor = self.editor
         field = editor.scene.cloud_field
@@ -98,13 +134,18 @@ class CloudFieldPanel:
                 editor.edit(dataclasses.replace(editor.scene, cloud_field=CloudField()))
             return
         changes: dict = {}
+        weather = editor.scene.weather
+        # what a named weather sets is shown as it is, not edited (the field's own values come back without it)
+        governed = set() if weather is None else _governed_by(weather)
         changed, seed = imgui.input_int("Seed", field.seed)
         if changed:
             changes["seed"] = seed
         for label, (name, index, low, high, fmt) in _SLIDERS.items():
             scale = 1e3 if label in _KM else 1.0
             held = getattr(field, name)
+            imgui.begin_disabled(name in governed)
             value = self._sliders.slider(label, (held if index is None else held[index]) / scale, low, high, fmt)
+            imgui.end_disabled()
             if value is None:
                 continue
             value *= scale
@@ -115,23 +156,17 @@ class CloudFieldPanel:
                 pair[index] = value
                 changes[name] = tuple(pair)
         for label, name, high in (("Rings", "rings", MAX_RINGS), ("Layers", "layers", MAX_LAYERS)):
+            imgui.begin_disabled(name in governed)
             value = self._sliders.slider_int(label, getattr(field, name), 1, high)
+            imgui.end_disabled()
             if value is not None:
                 changes[name] = value
-        weather = editor.scene.weather
-        choice = 0 if weather is None else 1 + WEATHER_NAMES.index(weather.preset)
-        changed, choice = imgui.combo("Weather", choice, ["the field's own", *WEATHER_NAMES])
-        if changed:
-            editor.edit(
-                dataclasses.replace(editor.scene, weather=None if choice == 0 else Weather(WEATHER_NAMES[choice - 1]))
-            )
-        if weather is not None:
-            imgui.text_wrapped(
-                "The weather sets the coverage, cloud type and altitudes (the towering cumulus also the clouds' scale)."
-            )
+        imgui.begin_disabled("cloud_type" in governed)
         changed, type_index = imgui.combo("Cloud type", _CLOUD_TYPES.index(field.cloud_type), list(_CLOUD_TYPES))
+        imgui.end_disabled()
         if changed:
             changes["cloud_type"] = _CLOUD_TYPES[type_index]
+        self._weather(weather)
         if changes:
             scene = editor.scene
             editor.change(lambda: dataclasses.replace(scene, cloud_field=dataclasses.replace(field, **changes)))

@@ -76,13 +76,26 @@ def opacity_factor(formation: Formation, distances: np.ndarray, time_s: float) -
     if np.isnan(distances).any():
         raise ValueError("core distances must not be NaN")
     done = progress(formation, time_s)
-    if formation.kind == "dissipate":
-        done = 1.0 - done
-    if done == 0.0:
-        return np.zeros(distances.shape)
-    if done == 1.0:
-        return np.ones(distances.shape)
-    return np.clip((done - EDGE_LAG * distances) / (1.0 - EDGE_LAG), 0.0, 1.0)
+    return formed(1.0 - done if formation.kind == "dissipate" else done, distances)
+
+
+def formed(done: float, order: np.ndarray) -> np.ndarray:
+    """Each particle's share formed when `done` in [0, 1] of the cloud has: a particle of `order` in [0, 1] (0 the
+    core's, first; 1 the edge's, last) starts at `EDGE_LAG order` and takes the rest of the animation less the lag;
+    exactly 0 at `done` 0 and 1 at `done` 1."""
+    order = np.asarray(order, dtype=np.float64)
+    if done <= 0.0:
+        return np.zeros(order.shape)
+    if done >= 1.0:
+        return np.ones(order.shape)
+    return np.clip((done - EDGE_LAG * order) / (1.0 - EDGE_LAG), 0.0, 1.0)
+
+
+def progress_for_share(share: float) -> float:
+    """The progress at which `formed` gives a cloud whose particles' orders spread evenly over [0, 1] `share` of its
+    opacity: its mean is 2 p^2 up to p = 1/2 and 1 - 2 (1 - p)^2 beyond (with `EDGE_LAG` 1/2), inverted."""
+    share = min(max(share, 0.0), 1.0)
+    return math.sqrt(0.5 * share) if share <= 0.5 else 1.0 - math.sqrt(0.5 * (1.0 - share))
 
 
 def formation_state(formation: Formation | None, time_s: float):

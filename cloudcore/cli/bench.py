@@ -116,7 +116,7 @@ def run(args) -> int:
         size=lambda group: (args.frames + args.warmup) * (1 + len(group)),
     )
     if spread(args):
-        with closing(run_job(job, args.workers, args.cluster)) as reports:
+        with closing(run_job(job, args.workers, args.cluster, args.gpus_per_task)) as reports:
             report = _merged(list(reports), groups)
     else:  # one group, here, its bar counting each frame
         from tqdm import tqdm

@@ -144,7 +144,7 @@ def run(args) -> int:
     from tqdm import tqdm
 
     checks, entries, written = [], [], 0
-    with closing(run_job(job, args.workers, args.cluster)) as renders:
+    with closing(run_job(job, args.workers, args.cluster, args.gpus_per_task)) as renders:
         for (name, _, view), actual in zip(cases, renders):
             golden = golden_path(args.goldens, name, view.name)
             check = check_view(name, view.name, actual, golden, default_tolerance.for_view(view))

@@ -150,7 +150,7 @@ def run(args) -> int:
             size=len,
         )
         # closed first (exits run last in, first out): a stop kills the workers still drawing, then the video ends
-        runs = outputs.enter_context(closing(run_job(job, args.workers, args.cluster)))
+        runs = outputs.enter_context(closing(run_job(job, args.workers, args.cluster, args.gpus_per_task)))
         for (index, t), (image, stats) in zip(frames, itertools.chain.from_iterable(runs)):
             if video is not None:
                 video.send(image)

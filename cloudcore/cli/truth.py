@@ -218,7 +218,7 @@ def _passes_on_workers(args, camera, seed: int, samples: list[int], grids):
         label=lambda index: f"pass {index} (seed {seed})",
         bar={"disable": True},
     )
-    return run_job(job, args.workers, args.cluster)
+    return run_job(job, args.workers, args.cluster, args.gpus_per_task)
 
 
 class TruthPasses:

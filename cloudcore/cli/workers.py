@@ -8,6 +8,8 @@ both ways run the same code.  Each process is a pool of one (`ProcessPoolExecuto
 time: a pool whose process dies names the piece that was in it, which runs again in a fresh process, at most
 `RETRIES` more times, each rerun said on stderr; one more death fails the job (a SceneError: one line, exit 2).
 On Ray (`_RayTasks`) the same loop hands the pieces out as tasks, Ray's own retries off so that it says so too.
+Where the cluster has GPUs each task asks for one (or the share `--gpus-per-task` says), as many at a time as
+they allow, and its worker draws on the GPU Ray gave it (`_use_the_task_s_gpu`).
 
 Processes are started with `spawn`, never forked: a fork of a process holding a GL context shares the driver's
 state with it.  Workers ignore Ctrl-C (the terminal sends it to the whole process group): this process decides
@@ -56,6 +58,14 @@ def cluster_address(text: str) -> str:
     return text
 
 
+def gpu_share(text: str) -> float:
+    """--gpus-per-task: a share of a GPU in [0, 64]; argparse names this function in its refusal."""
+    value = float(text)
+    if not 0.0 <= value <= 64.0:
+        raise ValueError(text)
+    return value
+
+
 def add_workers_arguments(parser, pieces: str) -> None:
     parser.add_argument(
         "--workers",
@@ -69,7 +79,14 @@ def add_workers_arguments(parser, pieces: str) -> None:
         type=cluster_address,
         metavar="ADDRESS",
         help="run the pieces as tasks on the Ray cluster at ADDRESS ('auto': the one this machine is part of; "
-        "'local': start one here), as many at a time as it has CPUs unless --workers says",
+        "'local': start one here), as many at a time as it has CPUs (or GPUs) unless --workers says",
+    )
+    parser.add_argument(
+        "--gpus-per-task",
+        type=gpu_share,
+        metavar="F",
+        help="with --cluster: the GPUs each task asks Ray for (0.25: four tasks share one); by default 1 where the "
+        "cluster has GPUs, else 0",
     )
 
 
@@ -94,11 +111,13 @@ class Job:
     bar: dict = field(default_factory=dict)  # tqdm's options for the job's one progress bar
 
 
-def run_job(job: Job, workers: int | None, cluster: str | None = None) -> Iterator:
+def run_job(job: Job, workers: int | None, cluster: str | None = None, gpus_per_task: float | None = None) -> Iterator:
     """The results of the job's pieces, in the pieces' order: made in this process when neither `workers` nor
-    `cluster` is given, on `workers` processes, or as Ray tasks on `cluster`."""
+    `cluster` is given, on `workers` processes, or as Ray tasks on `cluster` (each asking `gpus_per_task`)."""
     from tqdm import tqdm
 
+    if gpus_per_task is not None and cluster is None:
+        raise SceneError("--gpus-per-task", f"{gpus_per_task:g}", "asks Ray for GPUs: it needs --cluster")
     with tqdm(total=sum(map(job.size, job.pieces)), desc=job.name, unit=job.unit, **job.bar) as bar:
         if workers is None and cluster is None:
             with job.make_worker(*job.arguments) as worker:
@@ -108,7 +127,9 @@ def run_job(job: Job, workers: int | None, cluster: str | None = None) -> Iterat
                     yield result
         else:
             places = (
-                _RayTasks(job, cluster, workers) if cluster else _LocalProcesses(job, min(workers, len(job.pieces)))
+                _RayTasks(job, cluster, workers, gpus_per_task)
+                if cluster
+                else _LocalProcesses(job, min(workers, len(job.pieces)))
             )
             try:
                 yield from _spread(job, places, bar)
@@ -138,10 +159,26 @@ def _run_piece(index: int, piece, attempt: int, job: tuple | None = None):
     token, make_worker, arguments = job or _job
     _die_if_asked(index, attempt)
     if _worker is None or _worker[0] != token:
+        if job is not None:
+            _use_the_task_s_gpu()
         # never closed: it goes with the process (closing a FrameRenderer stores its cost fit for the next run,
         # which N workers would write over one another)
         _worker = token, make_worker(*arguments)
     return _worker[1](piece)
+
+
+def _use_the_task_s_gpu() -> None:
+    """In a Ray task given a GPU, the headless context made next is made on it (pyrender's `EGL_DEVICE_ID`);
+    without one, or where EGL cannot tell which device it is, on the default device."""
+    import ray
+
+    gpus = ray.get_gpu_ids()
+    if gpus:
+        from cloudcore.gl.context import egl_device_of_cuda
+
+        device = egl_device_of_cuda(int(gpus[0]))
+        if device is not None:
+            os.environ["EGL_DEVICE_ID"] = str(device)
 
 
 def _die_if_asked(index: int, attempt: int) -> None:
@@ -263,11 +300,22 @@ def _check_reachable(address: str) -> None:
         raise SceneError("--cluster", address, f"cannot be reached: {error.strerror or error}") from None
 
 
+def task_gpus(resources: dict, asked: float | None, address: str) -> tuple[float, int]:
+    """(the GPUs a task asks for, the tasks the cluster holds at a time) on a cluster of `resources` (Ray's
+    `cluster_resources`): `asked`, or by default one GPU where it has any; a job asking GPUs of a cluster with too
+    few is refused in one line, since Ray would wait for them forever."""
+    gpus, cpus = float(resources.get("GPU", 0.0)), float(resources.get("CPU", 1.0))
+    share = asked if asked is not None else (1.0 if gpus >= 1.0 else 0.0)
+    if share > gpus:
+        raise SceneError("--gpus-per-task", f"{share:g}", f"the cluster at {address} has {gpus:g} GPUs")
+    return share, max(1, int(gpus // share if share > 0.0 else cpus))
+
+
 class _RayTasks:
     """Pieces as Ray tasks on the cluster at `address`, at most `capacity` at a time (None: its CPUs).  Ray's own
     retries are off: a task whose worker died comes back to `_spread`, which says so and hands it out again."""
 
-    def __init__(self, job: Job, address: str, capacity: int | None):
+    def __init__(self, job: Job, address: str, capacity: int | None, gpus_per_task: float | None = None):
         _check_reachable(address)
         import ray
 
@@ -281,8 +329,13 @@ class _RayTasks:
             )
         except (ConnectionError, RuntimeError, ValueError) as error:
             raise SceneError("--cluster", address, str(error).strip().splitlines()[0]) from None
-        self.capacity = capacity or max(1, int(ray.cluster_resources().get("CPU", 1)))
-        self._run = ray.remote(max_retries=0)(_run_piece)
+        try:
+            share, room = task_gpus(ray.cluster_resources(), gpus_per_task, address)
+        except SceneError:
+            ray.shutdown()
+            raise
+        self.capacity = capacity or room
+        self._run = ray.remote(max_retries=0, num_gpus=share)(_run_piece)
         # put in Ray's object store once, fetched once a node, whatever the pieces; the token tells the jobs apart
         self._job = ray.put((uuid.uuid4().hex, job.make_worker, job.arguments))
         self._pending = set()

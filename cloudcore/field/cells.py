@@ -135,6 +135,17 @@ def coverage_threshold(coverage: float) -> float:
     return float(np.interp(1.0 - coverage, np.linspace(0.0, 1.0, len(quantiles)), quantiles))
 
 
+def formation_order(field: CloudField, x, z) -> np.ndarray:
+    """Per point (x, z), in [0, 1], when its cloud forms there as the field's coverage grows from none to its own:
+    the coverage at which the point turns cloudy over the field's, so a cloud's core, where the density peaks, forms
+    first and its rim last (and an anvil, outside every column, with the rim)."""
+    quantiles = _density_quantiles()
+    turns_cloudy = 1.0 - np.interp(cloud_density(field, x, z), quantiles, np.linspace(0.0, 1.0, len(quantiles)))
+    if field.coverage <= 0.0:
+        return np.ones(np.shape(turns_cloudy))
+    return np.clip(turns_cloudy / field.coverage, 0.0, 1.0)
+
+
 @functools.cache
 def type_structure(cloud_type: str) -> tuple[float, float, float]:
     """(aspect, anvil_low, anvil_spread) of a cloud type, from its preset's size and boxes: a tower's height over

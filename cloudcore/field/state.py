@@ -61,10 +61,30 @@ class FieldFrame:
     weights: np.ndarray  # (particles of `clouds`,) blend weights in [0, 1]
     mean_weights: np.ndarray  # (len(clouds),) each cloud's particles' mean weight (1 for a hole)
     fade_keys: tuple  # per cloud: changes whenever its weights change by more than scaling its impostor hides
+    cloud_starts: np.ndarray  # (len(clouds) + 1,) where each cloud's particles start in `weights`
+
+    @classmethod
+    def weighed(cls, clouds: tuple, weights: np.ndarray, cloud_starts: np.ndarray) -> FieldFrame:
+        """The frame of `clouds` whose particles weigh `weights`, its clouds' means and keys made from them."""
+        return cls(clouds, weights, *_cloud_weights(weights, cloud_starts), cloud_starts)
 
     @property
     def particle_count(self) -> int:
         return len(self.weights)
+
+
+def side_by_side(frames, places, leading: int) -> FieldFrame:
+    """Frames of several fields as one: `leading` holes first, then each frame's clouds in `places` of its own (its
+    count of clouds, or more: holes after them), so a field's clouds keep their indices while another's change."""
+    clouds, weights, starts, end = [HOLE] * leading, [], [np.zeros(leading + 1, dtype=np.int64)], 0
+    for frame, room in zip(frames, places):
+        clouds += [*frame.clouds, *[HOLE] * (room - len(frame.clouds))]
+        weights.append(frame.weights)
+        starts.append(end + frame.cloud_starts[1:])
+        end += frame.particle_count
+        starts.append(np.full(room - len(frame.clouds), end, dtype=np.int64))
+    weights = np.concatenate(weights) if weights else np.zeros(0)
+    return FieldFrame.weighed(tuple(clouds), weights, np.concatenate(starts))
 
 
 def update_field(field: CloudField, eye, state: FieldState = FieldState()) -> tuple[FieldFrame, FieldState]:
@@ -83,7 +103,7 @@ def update_field(field: CloudField, eye, state: FieldState = FieldState()) -> tu
         state = dataclasses.replace(state, made=(), dropped=0)
     clouds = tuple(HOLE if key is None else state.cells[key] for key in state.slots)
     weights = level_weights(field, state.particle_levels, state.particle_xz[:, 0], state.particle_xz[:, 1], eye)
-    return FieldFrame(clouds, weights, *_cloud_weights(weights, state.cloud_starts)), state
+    return FieldFrame.weighed(clouds, weights, state.cloud_starts), state
 
 
 def _placed(field: CloudField, cells: dict, slots: tuple, made: tuple, dropped: int) -> FieldState:

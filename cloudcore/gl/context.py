@@ -231,3 +231,38 @@ def _check_complete(what: str) -> None:
     status = GL.glCheckFramebufferStatus(GL.GL_FRAMEBUFFER)
     if status != GL.GL_FRAMEBUFFER_COMPLETE:
         raise RuntimeError(f"{what} framebuffer incomplete (status 0x{int(status):x})")
+
+
+#: EGL_NV_device_cuda's attribute: the CUDA device an EGL device is
+EGL_CUDA_DEVICE_NV = 0x323A
+
+
+def egl_device_of_cuda(cuda_device: int) -> int | None:
+    """The index among EGL's devices (what pyrender's `EGL_DEVICE_ID` counts) of CUDA device `cuda_device`: Ray
+    names a task's GPUs as CUDA devices, and EGL need not list them in CUDA's order.  None where no device says
+    which it is (Mesa's, or a driver without EGL_NV_device_cuda): the default device is then used."""
+    import ctypes
+
+    from OpenGL import EGL
+
+    def extension(name: str, result, *arguments):
+        address = EGL.eglGetProcAddress(name)
+        return ctypes.CFUNCTYPE(result, *arguments)(address) if address else None
+
+    count = ctypes.c_int(0)
+    query_devices = extension(
+        "eglQueryDevicesEXT", ctypes.c_uint, ctypes.c_int, ctypes.POINTER(ctypes.c_void_p), ctypes.POINTER(ctypes.c_int)
+    )
+    query_attribute = extension(
+        "eglQueryDeviceAttribEXT", ctypes.c_uint, ctypes.c_void_p, ctypes.c_int, ctypes.POINTER(ctypes.c_ssize_t)
+    )
+    if query_devices is None or query_attribute is None or not query_devices(0, None, ctypes.byref(count)):
+        return None
+    devices = (ctypes.c_void_p * max(count.value, 1))()
+    if not query_devices(count.value, devices, ctypes.byref(count)):
+        return None
+    for index in range(count.value):
+        value = ctypes.c_ssize_t(-1)
+        if query_attribute(devices[index], EGL_CUDA_DEVICE_NV, ctypes.byref(value)) and value.value == cuda_device:
+            return index
+    return None

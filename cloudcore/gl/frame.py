@@ -40,7 +40,7 @@ from cloudcore.artist.formation import formation_state
 from cloudcore.artist.particle_styles import particle_styles
 from cloudcore.camera import NEAR_PLANE_M, frustum_planes, projection_matrix, view_matrix
 from cloudcore.colour import linear_to_srgb8
-from cloudcore.field.state import FieldState, update_field
+from cloudcore.field.state import FieldState
 from cloudcore.gl.context import HeadlessContext, WindowContext, check_frame_size
 from cloudcore.gl.derived import Derived
 from cloudcore.gl.draw import CloudPass, CloudPassFrame, DrawCounts, PassTools
@@ -74,11 +74,10 @@ from cloudcore.particles.buffer import ParticleBuffer
 from cloudcore.scene import Camera, Lighting, Scene
 from cloudcore.settings import FULL_3D, RenderSettings
 from cloudcore.splat_coverage import analytic_overdraw
-from cloudcore.weather import field_under_weather
+from cloudcore.weather import WeatherFieldState, update_weather_field, weather_drift
 from cloudcore.wind import (
     AirMotion,
     CloudMotion,
-    field_drift,
     field_speed,
     light_time,
     reshapes,
@@ -186,7 +185,7 @@ class FrameRenderer:
         self.compositing: dict[str, MeasuredWay] = {}
         #: the cloud field's cells made for the last eye, its particles' blend weights and every cloud's mean weight
         #: (None: no field)
-        self.field_state = FieldState()
+        self.weather_state = WeatherFieldState()
         self._field_weights: np.ndarray | None = None
         self._cloud_weights: np.ndarray | None = None
         self._air: AirMotion | None = None  # the wind applied to the authored clouds (None: still air)
@@ -203,6 +202,11 @@ class FrameRenderer:
         """The units (clouds, or groups of interpenetrating clouds) of the scene last rendered, where the wind
         had carried them; a frame may plan some groups apart (`FramePlan.units`)."""
         return self._units.value if self._carry_made is None else self._carry_made[1]
+
+    @property
+    def field_state(self) -> FieldState:
+        """The cloud field's cells for the last eye under the weather in force, or coming during a change."""
+        return self.weather_state.in_force
 
     @property
     def particles(self) -> ParticleBuffer:
@@ -312,16 +316,12 @@ class FrameRenderer:
         )
         camera = scene.camera if camera is None else camera
         authored_clouds = len(scene.clouds)
-        if scene.weather is not None and scene.cloud_field is not None:  # the field as the weather has it now
-            scene = dataclasses.replace(
-                scene, cloud_field=field_under_weather(scene.cloud_field, scene.weather, time_s)
-            )
         air = self._air_motion(scene)
         if air is not None:  # the clouds as their light is made now: at rest, while the wind only carries them
             lit_at = light_time(air.wind, time_s) if lit_at is None else lit_at
             scene = dataclasses.replace(scene, clouds=air.lit_clouds(lit_at))
-        field_carried = field_drift(scene.wind, scene.cloud_field, time_s)
-        scene, fade_keys = self._with_field(scene, camera, field_carried)
+        field_carried = weather_drift(scene.wind, scene.cloud_field, scene.weather, time_s)
+        scene, fade_keys = self._with_field(scene, camera, field_carried, time_s)
         illumination_ms = self._follow_scene(scene, lighting, asked.illumination_method, settings.cloud_shadows)
         # the units follow the particles' places and sizes, not their light: a relit scene keeps them
         self._units.follow((scene.clouds, settings.group_clouds), self._lit.value.particles, authored_clouds)
@@ -501,16 +501,18 @@ class FrameRenderer:
         """GPU memory of every impostor, ring, layer and screen-impostor texture held."""
         return self._impostors.texture_bytes + self._cloud_pass.texture_bytes
 
-    def _with_field(self, scene: Scene, camera: Camera, carried: np.ndarray) -> tuple[Scene, tuple]:
+    def _with_field(self, scene: Scene, camera: Camera, carried: np.ndarray, time_s: float) -> tuple[Scene, tuple]:
         """The scene with its cloud field's clouds for this eye after its own (`cloudcore.field.state`), and
         per cloud the key of its blend weights; the field's weights are held for the particle buffer.  The field's
         grid has drifted `carried` (3,) metres with the wind: its cells are made and weighed for the eye's place
         relative to the air, where the particle buffer's carry (`_carried`) then moves them."""
         if scene.cloud_field is None:
-            self.field_state, self._field_weights, self._cloud_weights = FieldState(), None, None
+            self.weather_state, self._field_weights, self._cloud_weights = WeatherFieldState(), None, None
             return scene, (1.0,) * len(scene.clouds)
         eye_in_air = np.asarray(camera.position, dtype=np.float64) - carried
-        frame, self.field_state = update_field(scene.cloud_field, eye_in_air, self.field_state)
+        frame, self.weather_state = update_weather_field(
+            scene.cloud_field, scene.weather, time_s, eye_in_air, self.weather_state
+        )
         authored = scene.particle_count
         self._field_weights = np.concatenate([np.ones(authored), frame.weights])
         self._cloud_weights = np.concatenate([np.ones(len(scene.clouds)), frame.mean_weights])

@@ -19,10 +19,11 @@ background, the sky the renderer draws (`cloudcore.light.sky_background`: the at
 or the gradient), is added behind the clouds with their transmittance T, computed here by marching the same
 grid, where the pixel's ray misses the terrain.
 
-With `render_truth(terrain=True)` the scene's heightfield terrain is a Lambertian mesh of its colour: the
-clouds shadow it, it sends light back up into them, and what the eye sees of it is path traced with the clouds
-in front of it.  Its radiance is a physical surface's, albedo E cos / pi, where the renderer's terrain colour
-is albedo E (the renderer's values): compare the ground's light with and without the clouds, not its level.
+With `render_truth(terrain=True)` the scene's heightfield terrain is a Lambertian mesh of the colours the
+renderer gives it (its ramp by height, its steep colour by slope): the clouds shadow it, it sends light back up
+into them, and what the eye sees of it is path traced with the clouds in front of it.  Its radiance is a
+physical surface's, albedo E cos / pi, where the renderer's terrain colour is albedo E (the renderer's values):
+compare the ground's light with and without the clouds, not its level.
 
 Mitsuba is imported only inside the
 functions that need it (`cloudview[truth]`), so importing this module never needs it.
@@ -44,7 +45,7 @@ from cloudcore.light.sky_background import scene_sky
 from cloudcore.scene import Camera, Scene, Terrain
 from cloudcore.segments import concatenated_ranges
 from cloudcore.splat_kernel import KERNEL_DIAMETER_INTEGRAL, splat_kernel
-from cloudcore.terrain import heightfield_mesh
+from cloudcore.terrain import ground_colours, heightfield_mesh, samples_across
 
 #: voxels across the scene's median particle radius: the line integral through a particle's centre is
 #: within 1% of its tau at 3 (tests/unit/light/test_truth.py); the default scene then has about 10 million voxels
@@ -402,7 +403,7 @@ def mitsuba_scene_description(
 
 def _largest_albedo(grids: list[MediumGrid], scene: Scene, with_ground: bool) -> float:
     """The largest share of light any bounce keeps: the media's single-scattering albedo, the ground's colour."""
-    ground = max(scene.terrain.color) if with_ground and scene.terrain is not None else 0.0
+    ground = ground_albedo(scene.terrain) if with_ground and scene.terrain is not None else 0.0
     return max([float(ground), *(float(grid.albedo.max()) for grid in grids)])
 
 
@@ -420,8 +421,9 @@ def integrator_description(albedo: float, max_depth: int | None = None) -> dict:
 
 
 def terrain_shape(terrain: Terrain):
-    """The heightfield `terrain` as a Mitsuba mesh (the renderer's: `cloudcore.terrain.heightfield_mesh`),
-    Lambertian of its colour, its faces up.  Call `mitsuba_variant` first."""
+    """The heightfield `terrain` as a Mitsuba mesh (the renderer's: `cloudcore.terrain.heightfield_mesh`), its
+    faces up, Lambertian of the ground's colours the renderer gives it (`cloudcore.terrain.ground_colours`: its ramp
+    by height and its steep colour by slope), interpolated between the vertices.  Call `mitsuba_variant` first."""
     import mitsuba as mi
 
     vertices, faces = heightfield_mesh(terrain)
@@ -430,10 +432,27 @@ def terrain_shape(terrain: Terrain):
     parameters["vertex_positions"] = np.ascontiguousarray(vertices, dtype=np.float32).ravel()
     parameters["faces"] = np.ascontiguousarray(faces, dtype=np.uint32).ravel()
     parameters.update()
-    mesh.set_bsdf(
-        mi.load_dict({"type": "diffuse", "reflectance": {"type": "rgb", "value": list(map(float, terrain.color))}})
-    )
+    colours = ground_colours(terrain, vertices, _heightfield_normals(terrain, vertices))
+    mesh.add_attribute("vertex_color", 3, np.ascontiguousarray(colours, dtype=np.float32).ravel())
+    mesh.set_bsdf(mi.load_dict({"type": "diffuse", "reflectance": {"type": "mesh_attribute", "name": "vertex_color"}}))
     return mesh
+
+
+def _heightfield_normals(terrain: Terrain, vertices: np.ndarray) -> np.ndarray:
+    """(n, 3) unit normals of `heightfield_mesh`'s vertices, by differences over its grid (one-sided at its edges)."""
+    across, rows = samples_across(terrain)
+    heights = vertices[:, 1].reshape(rows, across)
+    slope_z, slope_x = np.gradient(heights, terrain.size[1] / (rows - 1), terrain.size[0] / (across - 1))
+    normals = np.stack([-slope_x, np.ones_like(slope_x), -slope_z], axis=-1).reshape(-1, 3)
+    return normals / np.linalg.norm(normals, axis=1, keepdims=True)
+
+
+def ground_albedo(terrain: Terrain) -> float:
+    """The most light any of the ground's colours keeps at a bounce: its colour or its ramp's, and its steep one."""
+    colours = [terrain.color, *(row[1:] for row in terrain.color_ramp or ())]
+    if terrain.steep_color is not None:
+        colours.append(terrain.steep_color)
+    return float(np.max(colours))
 
 
 def _medium(mi, grid: MediumGrid, phase: dict) -> dict:

@@ -863,6 +863,21 @@ def the_cloud_field_panel_edits_the_field(ctx, app: EditorUnderTest):
     CHECK(app.editor.scene.weather == Weather("broken"))
     ctx.yield_(SETTLE)
     CHECK(abs(app.viewport.renderer.field_state.field.coverage - 0.7) < 1e-9)
+    # a change of weather: the overcast forms as the broken sky dissipates, both drawn halfway through it
+    ctx.combo_click("Changes to/overcast")
+    ctx.item_input_value("Change starts (s)", 10.0)
+    ctx.item_input_value("Change lasts (s)", 40.0)
+    CHECK(app.editor.scene.weather == Weather("broken", to="overcast", start_s=10.0, duration_s=40.0))
+    app.editor.playing = False
+    use_window(ctx, "Camera")
+    for time_s, weathers in ((30.0, ("broken", "overcast")), (50.0, ("overcast",)), (0.0, ("broken",))):
+        ctx.item_input_value("Scene time (s)", time_s)
+        ctx.yield_(SETTLE)
+        CHECK(app.viewport.renderer.weather_state.names == weathers)
+    use_window(ctx, "Cloud field")
+    for _ in range(3):  # the change's length, its start, its weather
+        undo(ctx)
+    CHECK(app.editor.scene.weather == Weather("broken"))
     undo(ctx)
     CHECK(app.editor.scene.weather is None)
     for _ in range(4):  # the rings, the time of day, the rings again, the cloud type

@@ -7,6 +7,7 @@ import numpy as np
 from OpenGL import GL
 
 from cloudcore.gl.impostor_atlas import INSTANCE_FLOATS, AtlasImage, ImpostorAtlas, atlas_instances
+from cloudcore.gl.quads import QuadPass
 from cloudcore.gl.targets import TextureTarget
 from cloudcore.lod.atlas import Cell
 from cloudcore.lod.impostors import cropped_corners
@@ -235,3 +236,27 @@ def test_a_frames_instances_made_at_once_are_each_made_alone():
         np.testing.assert_array_equal(
             together[i], atlas_instances([images[i]], alone[None], [weights[i]], extents[i : i + 1])[0]
         )
+
+
+def test_an_impostor_weighed_over_one_never_darkens_what_lies_behind_it(renderer):
+    """A field's cloud faded in since its impostor was made draws it weighed over 1 (`FrameRenderer._faded`): its
+    opacity stops at 1, its colour scaled as far, so a grey half-transparent impostor weighed 3 over white shows
+    its colour doubled and opaque, never the white behind it taken away (0.25 where the opacity reached 1.5)."""
+    renderer.context.make_current()
+    quads = QuadPass()
+    impostor, target = TextureTarget(4, 4), TextureTarget(4, 4)
+    try:
+        GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, impostor.framebuffer)
+        GL.glViewport(0, 0, 4, 4)
+        GL.glClearColor(0.25, 0.25, 0.25, 0.5)  # premultiplied: a grey of 0.5 at half opacity
+        GL.glClear(GL.GL_COLOR_BUFFER_BIT)
+        GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, target.framebuffer)
+        GL.glClearColor(1.0, 1.0, 1.0, 1.0)
+        GL.glClear(GL.GL_COLOR_BUFFER_BIT)
+        screen = np.array([[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [-1.0, 1.0, 0.0], [1.0, 1.0, 0.0]])
+        quads.draw(screen, np.eye(4), impostor.texture, 3.0, depth_test=False)
+        np.testing.assert_allclose(target.read()[..., :3], 0.5, atol=1e-3)
+    finally:
+        for held in (impostor, target):
+            held.close()
+        quads.close()

@@ -133,7 +133,7 @@ def test_a_frame_lit_at_an_earlier_period_draws_those_shapes_carried_to_now(stil
         np.testing.assert_allclose(renderer.particles.centres, earlier, atol=1e-6)
 
 
-def test_a_field_drifts_with_the_air_its_cells_kept_and_a_change_of_weather_remakes_it_in_steps():
+def test_a_field_drifts_with_the_air_its_cells_kept_and_a_change_of_weather_forms_without_a_jump():
     field = CloudField(seed=2, coverage=0.5, cell_size=600.0, rings=1)
     scene = Scene(camera=Camera((0.0, 1500.0, 0.0), (0.0, 1800.0, -3000.0), 60.0), cloud_field=field, wind=WIND)
     with FrameRenderer(96, 72) as renderer:
@@ -152,11 +152,16 @@ def test_a_field_drifts_with_the_air_its_cells_kept_and_a_change_of_weather_rema
         changing = dataclasses.replace(
             scene, wind=None, weather=Weather("scattered", to="overcast", start_s=0.0, duration_s=100.0)
         )
-        coverages = []
-        for time_s in (0.0, 25.0, 50.0, 75.0, 100.0):
-            renderer.render(changing, settings=FULL_3D, time_s=time_s)
-            coverages.append(renderer.field_state.field.coverage)
-        np.testing.assert_allclose(coverages, [0.4, 0.5, 0.7, 0.85, 0.95], atol=1e-9)
+        previous, largest = None, 0.0
+        for time_s in np.arange(0.0, 101.0, 5.0):
+            image, _ = renderer.render(changing, settings=FULL_3D, time_s=float(time_s))
+            if previous is not None:
+                largest = max(largest, float(np.abs(image.astype(float) - previous).max()))
+            previous = image.astype(float)
+        # the overcast formed as the scattered sky dissipated, each made once: no frame a twentieth of the change
+        # after another differs by more than 20 levels in any pixel (the field remade at each step of the coverage
+        # had jumps of 51)
+        assert renderer.field_state.field.coverage == 0.95 and largest <= 20.0
 
 
 def test_another_wind_at_the_same_time_carries_the_clouds_by_its_own_drift(renderer, still):

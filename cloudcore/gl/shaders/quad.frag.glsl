@@ -36,10 +36,15 @@ void main()
     frag_colour = vec4(1.0);
 #else
 #ifdef ATLAS
-    vec4 colour = weight_layer.x * texture(impostor, vec3(clamp(uv, clamp_rect.xy, clamp_rect.zw), weight_layer.y));
+    float weight = weight_layer.x;
+    vec4 colour = texture(impostor, vec3(clamp(uv, clamp_rect.xy, clamp_rect.zw), weight_layer.y));
 #else
-    vec4 colour = impostor_weight * texture(impostor, uv);
+    float weight = impostor_weight;
+    vec4 colour = texture(impostor, uv);
 #endif
+    // a weight over 1 (a field's cloud faded in since its impostor was made: FrameRenderer._faded) never makes
+    // an opacity over 1, which would darken what lies behind it
+    colour *= min(weight, 1.0 / max(colour.a, 1e-6));
 #ifdef AIR
     colour.rgb = colour.rgb * air_transmittance_at + colour.a * air_in_scattered_at;
 #endif

@@ -7,11 +7,14 @@ import json
 import os
 import subprocess
 import sys
+import types
 
 import pytest
 
 from cloudcore.cli import main
-from cloudcore.cli.workers import KILL_PIECE_ENV, RETRIES
+from cloudcore.cli.workers import KILL_PIECE_ENV, RETRIES, _use_the_task_s_gpu, task_gpus
+from cloudcore.errors import SceneError
+from cloudcore.gl.context import egl_device_of_cuda
 from cloudcore.resources import resource_path
 from cloudcore.scene import Camera, Cloud, Light, Lighting, Scene, Shading
 from cloudcore.scenefile import save_scene
@@ -203,6 +206,36 @@ def test_a_cluster_that_does_not_answer_is_refused_at_once_in_one_line(monkeypat
     assert (
         capsys.readouterr().err == "cloudview: error: --cluster: 127.0.0.1:1: cannot be reached: Connection refused\n"
     )
+
+
+def test_a_task_asks_for_a_gpu_where_the_cluster_has_them_and_a_job_asking_too_many_is_refused():
+    assert task_gpus({"CPU": 16.0}, None, "auto") == (0.0, 16)  # no GPUs: a task a CPU
+    assert task_gpus({"CPU": 16.0, "GPU": 4.0}, None, "auto") == (1.0, 4)  # a GPU a task, four at a time
+    assert task_gpus({"CPU": 16.0, "GPU": 2.0}, 0.25, "auto") == (0.25, 8)  # four tasks share each GPU
+    assert task_gpus({"CPU": 16.0, "GPU": 2.0}, 0.0, "auto") == (0.0, 16)  # the GPUs left to other jobs
+    with pytest.raises(SceneError) as refused:
+        task_gpus({"CPU": 8.0}, 1.0, "head:6379")  # Ray would wait forever for a GPU
+    assert str(refused.value) == "--gpus-per-task: 1: the cluster at head:6379 has 0 GPUs"
+
+
+def test_gpus_without_a_cluster_are_refused_in_one_line(capsys, tmp_path):
+    assert main(["check", str(EXAMPLE), "--goldens", str(tmp_path), "--workers", "2", "--gpus-per-task", "1"]) == 2
+    assert capsys.readouterr().err == "cloudview: error: --gpus-per-task: 1: asks Ray for GPUs: it needs --cluster\n"
+
+
+def test_a_ray_task_draws_on_the_gpu_ray_gave_it(monkeypatch):
+    """Ray names the task's GPU as CUDA does; its context is made on the EGL device that is that CUDA device."""
+    monkeypatch.setitem(sys.modules, "ray", types.SimpleNamespace(get_gpu_ids=lambda: [3]))
+    monkeypatch.setattr("cloudcore.gl.context.egl_device_of_cuda", lambda cuda: {3: 1}.get(cuda))
+    monkeypatch.delenv("EGL_DEVICE_ID", raising=False)
+    _use_the_task_s_gpu()
+    assert os.environ["EGL_DEVICE_ID"] == "1"
+
+
+@pytest.mark.gl
+def test_a_device_that_does_not_say_it_is_a_cuda_device_is_none_of_them():
+    """Mesa's EGL devices (llvmpipe here) have no CUDA device: the default device stays."""
+    assert egl_device_of_cuda(0) is None
 
 
 def test_a_truth_on_a_local_ray_is_the_picture_of_one_process_even_when_a_task_s_worker_dies(truth_scene, tmp_path):

@@ -20,9 +20,9 @@ from cloudcore.field.grid import cell_side
 from cloudcore.field.state import update_field
 from cloudcore.paths import camera_on_path
 from cloudcore.resources import CUMULUS_FIELD
-from cloudcore.scene import CloudField, Weather
+from cloudcore.scene import CloudField
 from cloudcore.scenefile import load_scene
-from cloudcore.weather import WEATHER_PRESETS, field_under_weather
+from cloudcore.weather import WEATHER_PRESETS, preset_field
 
 #: a band deep enough that a humilis's tower is hardly eased into it
 FIELD = CloudField(seed=3, coverage=0.4, cell_size=500.0, rings=4, layers=4, altitude=(1000.0, 6000.0))
@@ -123,7 +123,7 @@ def test_only_a_type_with_an_anvil_spreads_one_over_clear_ground():
 def test_the_towering_cumulus_spreads_anvils_wider_than_its_towers():
     """Its particles high up cover more of the plane than those at mid-height (the anvil over the tower's narrowing
     dome), and are larger there: a sheet, not turrets."""
-    field = field_under_weather(FIELD, Weather("towering_cumulus"), 0.0)
+    field = preset_field(FIELD, "towering_cumulus")
     clouds = cell_clouds(field, [(0, i, j) for i in range(-24, 24) for j in range(-24, 24)])
     particles = np.concatenate([cloud.particles for cloud in clouds if cloud is not None])
     bottom, top = field.altitude
@@ -143,7 +143,7 @@ def test_the_weather_presets_keep_their_meaning():
     cumulus taller than all."""
     median_height = {}
     for name, preset in WEATHER_PRESETS.items():
-        field = field_under_weather(FIELD, Weather(name), 0.0)
+        field = preset_field(FIELD, name)
         heights = cumulus_columns(field, *_plane(400.0 * field.cell_size, 1.2 * field.cell_size))[0]  # 267 sites a side
         assert np.mean(heights > 0.0) == pytest.approx(preset["coverage"], abs=0.03)
         median_height[name] = np.median(heights[heights > 0.0])

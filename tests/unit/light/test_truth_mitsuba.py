@@ -171,6 +171,21 @@ def test_in_the_ambient_light_alone_a_white_cloud_returns_the_model_s_ambient_te
     assert truth.radiance.mean() == pytest.approx(0.5 * truth.alpha.mean(), rel=0.01)
 
 
+def test_the_ground_has_the_colours_the_renderer_gives_it():
+    """The terrain's colour ramp by height reaches the truth's ground: a flat ground whose ramp is red at its height
+    and green above it is red in the picture, as the renderer draws it, not the terrain's plain `color`."""
+    ramp = ((0.0, 0.6, 0.1, 0.1), (500.0, 0.1, 0.6, 0.1))
+    terrain = Terrain(size=(6000.0, 6000.0), resolution=9, height=0.0, color=(0.1, 0.1, 0.6), color_ramp=ramp)
+    scene = Scene(
+        camera=Camera((0.0, 3000.0, 1.0), (0.0, 0.0, 0.0), 40.0),
+        lighting=Lighting(time_of_day=None, lights=(Light((0.0, 1.0, 0.0), (1.0, 1.0, 1.0), 1.0),), ambient=(0.0,) * 3),
+        terrain=terrain,
+    )
+    ground = render_truth(scene, 8, 8, spp=8, seed=1, terrain=True).linear.reshape(-1, 3).mean(axis=0)
+    # lit from straight above: albedo / pi
+    np.testing.assert_allclose(ground, np.array(ramp[0][1:]) / np.pi, rtol=0.03)
+
+
 def test_a_cloud_s_shadow_falls_where_the_sun_s_rays_through_it_meet_the_ground():
     """One thick particle 600 m over a flat grey terrain, the sun 32 degrees from the zenith, seen from straight
     above: the ground is darkest, with the cloud taken away lit evenly, where the sun's ray through the cloud's
