@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -51,7 +50,7 @@ from cloudcore.scene import (
     Wind,
 )
 from cloudcore.settings import MODES, RenderSettings, setting_options
-from cloudcore.toml_table import Table, checked_matrix, field_error
+from cloudcore.toml_table import Table, checked_matrix, field_error, read_toml
 
 PRIMITIVES = ("box", "sphere", "aircraft")
 #: a terrain's side in metres, at least: its noise is scaled to the side, and a side of 5e-324 m halved to 0
@@ -95,21 +94,7 @@ TABLE_KEYS = {
 def load_scene(path) -> Scene:
     """Read and validate a scene file; raise SceneError on any problem."""
     path = Path(path)
-    source = str(path)
-    if path.exists() and not (path.is_file() or path.is_dir()):  # a folder is refused by the read below
-        raise field_error(source, "(file)", "not a regular file (a pipe or a device): reading it would wait forever")
-    try:
-        # utf-8-sig: a byte-order mark (Windows editors write one) is not part of the TOML
-        data = tomllib.loads(path.read_text(encoding="utf-8-sig"))
-    except FileNotFoundError:
-        raise field_error(source, "(file)", "no such file") from None
-    except (OSError, UnicodeDecodeError) as error:
-        raise field_error(source, "(file)", f"cannot read: {error}") from None
-    except RecursionError:
-        raise field_error(source, "(toml)", "arrays or tables nested too deeply") from None
-    except ValueError as error:  # TOMLDecodeError, or tomllib's ValueError for an integer of over 4300 digits
-        raise field_error(source, "(toml)", str(error)) from None
-    return scene_from_dict(data, source, path.parent)
+    return scene_from_dict(read_toml(path), str(path), path.parent)
 
 
 def scene_from_dict(data: dict, source: str = "<scene>", base_dir=Path(".")) -> Scene:
@@ -137,7 +122,7 @@ def scene_from_dict(data: dict, source: str = "<scene>", base_dir=Path(".")) -> 
         description=root.string("description", ""),
         views=views,
         cloud_field=root.table("cloud_field", _cloud_field),
-        wind=root.table("wind", _wind),
+        wind=root.table("wind", read_wind),
         weather=root.table("weather", _weather),
     )
     # what every field allows, the renderer may still not draw: refuse that here, not in the GL code
@@ -189,7 +174,7 @@ def _view(t: Table, camera: Camera, paths: tuple[CameraPath, ...]) -> View:
             t.fail("look_at", "must differ from position")
         t.fail("position", "must differ from look_at (the scene camera's)")
     mode = t.string("mode", "full", choices=MODES)
-    settings = t.table("settings", _view_settings) or ()
+    settings = t.table("settings", settings_overrides) or ()
     try:
         RenderSettings(mode=mode, **dict(settings))
     except ValueError as error:
@@ -216,7 +201,7 @@ def _view(t: Table, camera: Camera, paths: tuple[CameraPath, ...]) -> View:
 VIEW_SETTINGS = tuple(f.name for f in dataclasses.fields(RenderSettings) if f.name != "mode")
 
 
-def _view_settings(t: Table) -> tuple[tuple[str, object], ...]:
+def settings_overrides(t: Table) -> tuple[tuple[str, object], ...]:
     """RenderSettings overrides, each of its field's type; their ranges are RenderSettings' own (checked by the
     caller, with the view's mode)."""
     t.reject_unknown(VIEW_SETTINGS)
@@ -341,7 +326,7 @@ def _cloud_field(t: Table) -> CloudField:
     )
 
 
-def _wind(t: Table) -> Wind:
+def read_wind(t: Table) -> Wind:
     """`[wind]`: types here, ranges by the record itself (the editor's panel edits it too)."""
     t.reject_unknown(TABLE_KEYS["wind"])
     d = Wind()

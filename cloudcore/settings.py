@@ -237,7 +237,7 @@ class RenderSettings:
     )
     #: under the physical sky, the air between the eye and the terrain, objects' ground and clouds
     #: (`cloudcore.light.air_between`, docs/atmosphere.md); off, everything is drawn as if the air were empty in
-    #: front of it, as before (for comparison and its cost: scripts/bench_aerial.py)
+    #: front of it, as before (for comparison and its cost: `cloudview bench --suite world --cases aerial`)
     aerial_perspective: bool = _setting(
         True,
         flag="--no-aerial-perspective",

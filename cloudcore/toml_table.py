@@ -9,6 +9,8 @@ source, the field's dotted path (`clouds[3].particles`) and what is wrong.
 from __future__ import annotations
 
 import math
+import tomllib
+from pathlib import Path
 
 import numpy as np
 
@@ -23,6 +25,24 @@ def field_error(source, field: str, problem: str) -> SceneError:
         return "".join(ch if ch.isprintable() else ascii(ch)[1:-1] for ch in str(text))
 
     return SceneError(one_line(source), one_line(field), one_line(problem))
+
+
+def read_toml(path: Path) -> dict:
+    """The TOML document at `path`, parsed; every problem reading it a one-line SceneError naming the file."""
+    source = str(path)
+    if path.exists() and not (path.is_file() or path.is_dir()):  # a folder is refused by the read below
+        raise field_error(source, "(file)", "not a regular file (a pipe or a device): reading it would wait forever")
+    try:
+        # utf-8-sig: a byte-order mark (Windows editors write one) is not part of the TOML
+        return tomllib.loads(path.read_text(encoding="utf-8-sig"))
+    except FileNotFoundError:
+        raise field_error(source, "(file)", "no such file") from None
+    except (OSError, UnicodeDecodeError) as error:
+        raise field_error(source, "(file)", f"cannot read: {error}") from None
+    except RecursionError:
+        raise field_error(source, "(toml)", "arrays or tables nested too deeply") from None
+    except ValueError as error:  # TOMLDecodeError, or tomllib's ValueError for an integer of over 4300 digits
+        raise field_error(source, "(toml)", str(error)) from None
 
 
 class Table:

@@ -2,6 +2,7 @@
 
     python scripts/bench_cloud_field.py [--stations 8] [--burst 16] [--warmup 6] [--width 320] [--height 240]
                                         [--rings 2,3,4,5,6] [--modes full,impostor] [--cells-from REV]
+                                        [--detail-texels 2,4]
                                         [--json out/bench_cloud_field.json]
 
 The demo scene (`cloudcore/resources/scenes/cumulus_field.toml`: 100 km of cumulus, 6 rings) is flown over
@@ -24,6 +25,8 @@ the particles costs where cells entered (`illumination_ms`), and the pure field 
 each of `--modes` with git revision REV's cells and demo (`cloudcore/field/cells.py`, what a cell's particles
 are, and the demo scene as they were there), interleaved with this tree's, so a change to the clouds'
 structure is measured before and after in one run (each frame of REV's compared with REV's full 3D).
+`--detail-texels V1,V2,...` flies the demo again in impostor mode and in auto at each value of
+`impostor_detail_texels`, beside the rest (the texture detail measured on the field: docs/lod.md).
 """
 
 from __future__ import annotations
@@ -58,6 +61,8 @@ CELLS, DEMO = "cloudcore/field/cells.py", "cloudcore/resources/scenes/cumulus_fi
 FLOWN_M = 20000.0
 #: metres a frame at 200 m/s and 30 frames a second
 FRAME_STEP_M = 200.0 / 30.0
+#: the modes `--detail-texels` flies the demo in at each of its values
+MODES = ("impostor", "auto")
 
 
 def views_along(scene, path_name: str, distances_m) -> list:
@@ -117,6 +122,11 @@ def main() -> None:
     )
     parser.add_argument("--modes", default="full,impostor", help="modes to fly the demo in beside auto ('' none)")
     parser.add_argument("--cells-from", help="a git revision whose cells fly the demo beside this tree's")
+    parser.add_argument(
+        "--detail-texels",
+        default="",
+        help="impostor_detail_texels values to fly the demo at in impostor mode and auto beside the others ('' none)",
+    )
     parser.add_argument("--json", type=Path)
     args = parser.parse_args()
 
@@ -133,8 +143,15 @@ def main() -> None:
     modes = [mode for mode in args.modes.split(",") if mode]
     for mode in modes:
         scenes[f"mode={mode}"], settings[f"mode={mode}"] = demo, RenderSettings(mode=mode)
+    details = [
+        f"mode={mode} detail_texels={value}" for value in args.detail_texels.split(",") if value for mode in MODES
+    ]
+    for name in details:
+        mode, value = (part.split("=")[1] for part in name.split())
+        scenes[name], settings[name] = demo, RenderSettings(mode=mode, impostor_detail_texels=float(value))
     # configuration -> the full 3D configuration its frames are compared with
-    compared = dict.fromkeys([demo_name, *(f"mode={mode}" for mode in modes)], "mode=full") if "full" in modes else {}
+    measured = [demo_name, *(f"mode={mode}" for mode in modes), *details]
+    compared = dict.fromkeys(measured, "mode=full") if "full" in modes else {}
     revision_cells = {}
     if args.cells_from:
         module, revision_demo = cells_of_revision(args.cells_from), demo_of_revision(args.cells_from)
@@ -236,6 +253,7 @@ def main() -> None:
         "command": "python scripts/bench_cloud_field.py "
         f"--stations {args.stations} --burst {args.burst} --warmup {args.warmup} "
         f"--width {args.width} --height {args.height} --rings {args.rings} --modes {args.modes}"
+        + (f" --detail-texels {args.detail_texels}" if args.detail_texels else "")
         + (f" --cells-from {args.cells_from}" if args.cells_from else ""),
         "machine": machine(),
         "date": time.strftime("%Y-%m-%d"),

@@ -13,7 +13,7 @@ The driver reads every buffer and pixel back as zeros, so the frames are drawn t
 no read-back before it draws: the GPU's order (`splat_order = "gpu"`, whose draws are indirect) and the
 raster's compositing.  Auto mode prices its choices with the prior costs (`LLVMPIPE_COSTS`), not with
 times measured here, where drawing costs nothing.  Each case is one process's run, the modes'
-renderers taking turns frame by frame (as `bench_lod.py`); each mode reports its frames' CPU time
+renderers taking turns frame by frame (as `cloudview bench --suite lod`); each mode reports its frames' CPU time
 (`FrameStats.cpu_ms`) with its plan's part (everything before the passes) and the passes' issuing.
 """
 
@@ -33,11 +33,9 @@ os.environ["GALLIUM_NOOP"] = "1"  # read when the driver loads: before the first
 # when a frame's passes are not waited for one by one: a glBufferSubData into a buffer the pass before still
 # uses (auto mode, the 100th flythrough frame or so; never under gdb, never with the thread off)
 os.environ["GALLIUM_THREAD"] = "0"
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-
-from bench_lod import cases  # noqa: E402  (a sibling script: the same scenes, views and sizes)
 from OpenGL import GL  # noqa: E402
 
+from cloudcore.cli.bench_suite import built_cases  # noqa: E402  (the suite `lod`'s scenes, views and sizes)
 from cloudcore.collector import freeze_what_is_set_up  # noqa: E402
 from cloudcore.gl import FrameRenderer  # noqa: E402
 from cloudcore.lod.costs import LLVMPIPE_COSTS  # noqa: E402
@@ -93,7 +91,7 @@ def main() -> None:
     parser.add_argument("--json", type=Path)
     args = parser.parse_args()
     rows = []
-    for name, scene, views, size, warmup in cases(set(args.cases.split(",")), quick=False):
+    for name, scene, views, size, warmup in built_cases("lod", args.cases.split(",")):
         views = views[: args.frames]
         for row in timed_modes(scene, views, size, warmup, args.modes.split(",")):
             rows.append({"case": name, "size": f"{size[0]}x{size[1]}", **row})

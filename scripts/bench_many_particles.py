@@ -4,7 +4,7 @@
                                            [--width 640 --height 480] [--json out/many_particles.json]
 
 The default scene's world (terrain, lighting, camera) under a field of
-cumulus clouds (`cloudcore.artist.cloudgen.cumulus`) of the default scene's density,
+cumulus clouds (`cloudcore.measure.bench_skies.particle_field`) of the default scene's density,
 about 2,700 particles each, on a jittered grid filling the view up the valley
 and beyond.  The clouds' illumination is precomputed once (timed); then
 each mode renders --frames frames of the scene's camera: the first builds
@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import math
 import os
 import time
 from pathlib import Path
@@ -27,37 +26,16 @@ import numpy as np
 
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 
-from cloudcore.artist.cloudgen import cumulus  # noqa: E402
 from cloudcore.gl import FrameRenderer  # noqa: E402
+from cloudcore.measure.bench_skies import particle_field  # noqa: E402
 from cloudcore.measure.benchmark import machine, resident_memory_bytes, write_report  # noqa: E402  (the GL imports need the platform)
 from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
-from cloudcore.scene import Cloud, Scene  # noqa: E402
+from cloudcore.scene import Scene  # noqa: E402
 from cloudcore.scenefile import load_scene  # noqa: E402
 from cloudcore.settings import RenderSettings  # noqa: E402
 
-#: metres between neighbouring clouds of the field (the valley's clouds are 380 to 760 m across)
-SPACING_M = 900.0
 #: the last frames of a mode, averaged as its steady state: by then the ring (8 segments, 8 fade frames) is built
 STEADY_FRAMES = 3
-
-
-def cloud_field(total: int, per_cloud: int, seed: int = 9) -> tuple[Cloud, ...]:
-    """`total` particles in cumulus clouds of `per_cloud` each, on a jittered square grid ahead of the
-    default camera (it looks along -z from z = 3000 m)."""
-    rng = np.random.default_rng(seed)
-    count = math.ceil(total / per_cloud)
-    side = math.ceil(math.sqrt(count))
-    clouds = []
-    for index in range(count):
-        row, column = divmod(index, side)
-        base = np.array([(column - (side - 1) / 2) * SPACING_M, rng.uniform(820.0, 1050.0), 1500.0 - row * SPACING_M])
-        base[[0, 2]] += rng.uniform(-0.2, 0.2, 2) * SPACING_M
-        size = np.array([rng.uniform(380, 760), rng.uniform(200, 380), rng.uniform(380, 760)])
-        particles = min(per_cloud, total - index * per_cloud)
-        clouds.append(
-            Cloud(f"cumulus_{index:03d}", cumulus(base, size, particles, 0.085 * size[[0, 2]].min(), seed + index))
-        )
-    return tuple(clouds)
 
 
 def finite_frame(renderer: FrameRenderer) -> dict:
@@ -111,7 +89,7 @@ def main() -> None:
     args = parser.parse_args()
 
     start = time.perf_counter()
-    scene = dataclasses.replace(load_scene(DEFAULT_SCENE), clouds=cloud_field(args.particles, args.per_cloud))
+    scene = dataclasses.replace(load_scene(DEFAULT_SCENE), clouds=particle_field(args.particles, args.per_cloud))
     generated_s = time.perf_counter() - start
     result = {
         "particles": scene.particle_count,

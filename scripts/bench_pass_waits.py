@@ -23,11 +23,9 @@ from pathlib import Path
 import numpy as np
 
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-
-from bench_lod import cases  # noqa: E402  (a sibling script: the same scenes, views and sizes)
 from OpenGL import GL  # noqa: E402
 
+from cloudcore.cli.bench_suite import built_cases  # noqa: E402  (the suite `lod`'s scenes, views and sizes)
 from cloudcore.gl import FrameRenderer  # noqa: E402
 from cloudcore.gl.pass_clock import PassClock  # noqa: E402
 from cloudcore.measure.benchmark import machine, ratio_interval, write_report  # noqa: E402
@@ -96,7 +94,7 @@ def main() -> None:
     parser.add_argument("--json", type=Path)
     args = parser.parse_args()
     rows = []
-    for name, scene, views, size, warmup in cases(set(args.cases.split(",")), quick=False):
+    for name, scene, views, size, warmup in built_cases("lod", args.cases.split(",")):
         for mode in args.modes.split(","):
             row = {
                 "case": name,

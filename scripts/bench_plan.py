@@ -3,8 +3,8 @@
     python scripts/bench_plan.py [--cases flythrough,harris_circle_12800] [--frames 300] [--against REV]
                                  [--json out/bench_plan.json]
 
-Each case of `bench_lod.py` (Harris's figure 8 among them: `harris_circle_N`, `harris_through_N`, `harris`
-for all) is planned frame by frame in a closed loop, as
+Each case of the benchmark suite `lod` (`cloudview bench --suite lod`; Harris's figure 8 among them:
+`harris_circle_N`, `harris_through_N`, `harris` for all) is planned frame by frame in a closed loop, as
 `cloudcore.gl.FrameRenderer` plans it but with nothing drawn: the units of the scene's clouds (and of its
 cloud field for the eye), the objects' poses, the clouds' lighting keys, the state each plan leaves fed into
 the next, and the frame's measured times replaced by the plan's own prediction, the cloud pass's 10% dearer
@@ -12,8 +12,9 @@ the next, and the frame's measured times replaced by the plan's own prediction, 
 inputs give the same plans anywhere).  The frames after the case's warm-up are timed in `PASSES` passes.
 
 `--against REV` runs this very script again over `cloudcore` of git revision REV (a worktree in a temporary
-directory, on PYTHONPATH) in a child process after this one's cases, and counts the frames whose plans differ
-in any field the GL side reads or the statistics report (`plans_differing`: 0 for a change meant only to be
+directory, on PYTHONPATH) in a child process after this one's cases, the cases' scenes and views made here and
+handed to it pickled (so a revision from before the suite replays the same ones), and counts the frames whose plans
+differ in any field the GL side reads or the statistics report (`plans_differing`: 0 for a change meant only to be
 faster); the first difference of each case is printed.  REV must have the plan's package and
 `cloud_extents` (this script's own revision on); the planner before them is measured in docs/performance.md,
 "The plan at Harris's scale".  Reports the median and the least of each way's passes, in ms a frame.  The
@@ -28,6 +29,7 @@ import dataclasses
 import json
 import math
 import os
+import pickle
 import re
 import subprocess
 import sys
@@ -40,9 +42,6 @@ from types import SimpleNamespace
 import numpy as np
 
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-
-from bench_lod import cases as lod_cases  # noqa: E402  (a sibling script: the same scenes, views and sizes)
 
 from cloudcore.artist.formation import formation_state  # noqa: E402
 from cloudcore.artist.particle_styles import particle_styles  # noqa: E402
@@ -173,10 +172,10 @@ def canonical(plan) -> str:
     )
 
 
-def replay(names, frames: int) -> list[dict]:
-    """Per case and mode: the plans' texts frame by frame (`canonical`), and the timed passes."""
+def replay(chosen, frames: int) -> list[dict]:
+    """Per case ((name, scene, views, size, warmup), as `cloudcore.cli.bench_suite.built_cases` makes them) and
+    mode: the plans' texts frame by frame (`canonical`), and the timed passes."""
     rows = []
-    chosen = lod_cases(names, quick=False)
     for name, scene, views, size, warmup in chosen:
         views = views[: warmup + frames]
         for mode in MODES:
@@ -205,8 +204,9 @@ def replay(names, frames: int) -> list[dict]:
     return rows
 
 
-def against(revision: str, names: str, frames: int) -> list[dict]:
-    """This script's rows over `cloudcore` at git `revision` (a temporary worktree), in a child process."""
+def against(revision: str, chosen: list, frames: int) -> list[dict]:
+    """This script's rows of the cases `chosen` over `cloudcore` at git `revision` (a temporary worktree), in a
+    child process."""
     root = Path(__file__).resolve().parent.parent
     with tempfile.TemporaryDirectory() as folder:
         tree = Path(folder) / "tree"
@@ -214,10 +214,11 @@ def against(revision: str, names: str, frames: int) -> list[dict]:
             ["git", "worktree", "add", "--detach", str(tree), revision], cwd=root, check=True, capture_output=True
         )
         try:
-            out = Path(folder) / "rows.json"
+            out, cases = Path(folder) / "rows.json", Path(folder) / "cases.pickle"
+            cases.write_bytes(pickle.dumps(chosen))
             env = {**os.environ, "PYTHONPATH": str(tree)}
             subprocess.run(
-                [sys.executable, __file__, "--cases", names, "--frames", str(frames), "--rows", str(out)],
+                [sys.executable, __file__, "--cases-from", str(cases), "--frames", str(frames), "--rows", str(out)],
                 env=env,
                 check=True,
             )
@@ -270,13 +271,19 @@ def main() -> None:
     parser.add_argument("--against", help="a git revision whose cloudcore is replayed beside the working tree's")
     parser.add_argument("--json", type=Path)
     parser.add_argument("--rows", type=Path, help=argparse.SUPPRESS)  # the child's rows, for --against
+    parser.add_argument("--cases-from", type=Path, help=argparse.SUPPRESS)  # the child's cases, for --against
     args = parser.parse_args()
-    names = set(args.cases.split(","))
-    rows = replay(names, args.frames)
+    if args.cases_from:  # the child of --against: the cases as the parent's tree made them
+        chosen = pickle.loads(args.cases_from.read_bytes())
+    else:
+        from cloudcore.cli.bench_suite import built_cases
+
+        chosen = built_cases("lod", args.cases.split(","))
+    rows = replay(chosen, args.frames)
     if args.rows:
         args.rows.write_text(json.dumps(rows))
         return
-    theirs = against(args.against, args.cases, args.frames) if args.against else []
+    theirs = against(args.against, chosen, args.frames) if args.against else []
     report = []
     for row in rows:
         other = next((r for r in theirs if (r["case"], r["mode"]) == (row["case"], row["mode"])), None)

@@ -11,6 +11,9 @@ against the reference drawn beside it, on the same machine at the same time, nev
 (`references` lists each group's, `reference_group` says a run's).  Alone on one machine the workers share its
 cores, so their times are slower than one process's; spread over a cluster's machines, each group's times are its
 machine's.
+
+`cloudview bench --suite NAME [--cases A,B]` runs a benchmark suite's cases instead (`cloudcore.cli.bench_suite`),
+each by the same runner (`bench_views`).
 """
 
 from __future__ import annotations
@@ -23,10 +26,12 @@ import os
 from contextlib import closing
 from pathlib import Path
 
+from cloudcore.cli.bench_suite import load_suite, plot_suite, run_suite
 from cloudcore.cli.render import check_outputs, pixel_count, write_output
 from cloudcore.cli.settings_args import SWEEPABLE, add_settings_arguments, parse_sweep, settings_from
 from cloudcore.cli.workers import Job, add_workers_arguments, run_job, spread
 from cloudcore.errors import SceneError
+from cloudcore.limits import frame_memory_problem
 from cloudcore.measure.benchmark import (
     bench_path,
     headless_pyplot,
@@ -37,13 +42,28 @@ from cloudcore.measure.benchmark import (
     still_views,
 )
 from cloudcore.scenefile import load_scene
-from cloudcore.settings import setting_options
+from cloudcore.settings import FULL_3D, RenderSettings, setting_options
+
+DEFAULT_FRAMES = 60
+DEFAULT_SIZE = (640, 480)
 
 
 def add_parser(commands) -> None:
     parser = commands.add_parser("bench", help="frame time and image error of settings against full 3D")
-    parser.add_argument("scene", help="scene file (.toml)")
-    views = parser.add_mutually_exclusive_group(required=True)
+    parser.add_argument("scene", nargs="?", help="scene file (.toml); none with --suite")
+    parser.add_argument(
+        "--suite",
+        metavar="NAME",
+        help="run the benchmark suite NAME (one of cloudcore/resources/bench/, or a suite file NAME.toml) instead "
+        "of a scene: its cases' scenes, views, sizes and settings variants are its own (docs/performance.md)",
+    )
+    parser.add_argument(
+        "--cases", metavar="A,B", help="with --suite: the cases (or groups of cases) to run (default: the suite's)"
+    )
+    parser.add_argument(
+        "--quick", action="store_true", help="with --suite: a thirtieth of each case's frames (a smoke run)"
+    )
+    views = parser.add_mutually_exclusive_group()
     views.add_argument("--camera-path", help="camera path of the scene to fly")
     views.add_argument("--still", action="store_true", help="the scene's camera, still, for --frames frames")
     views.add_argument(
@@ -57,7 +77,9 @@ def add_parser(commands) -> None:
         default=[],
         help=f"NAME=V1,V2,... with NAME one of {', '.join(SWEEPABLE)}; several --sweep options combine",
     )
-    parser.add_argument("--frames", type=int, default=60, help="frames spread along the path (default 60)")
+    parser.add_argument(
+        "--frames", type=int, default=DEFAULT_FRAMES, help=f"frames spread along the path (default {DEFAULT_FRAMES})"
+    )
     parser.add_argument(
         "--warmup",
         type=int,
@@ -65,8 +87,8 @@ def add_parser(commands) -> None:
         help="unmeasured frames of the first view before each run: 20 build a still view's "
         "impostors and ring (default %(default)s)",
     )
-    parser.add_argument("--width", type=pixel_count, default=640)
-    parser.add_argument("--height", type=pixel_count, default=480)
+    parser.add_argument("--width", type=pixel_count, default=DEFAULT_SIZE[0])
+    parser.add_argument("--height", type=pixel_count, default=DEFAULT_SIZE[1])
     parser.add_argument("--plot", type=Path, help="write the error-against-time plot here (PNG)")
     parser.add_argument("--no-shading", action="store_true", help="skip the shading precompute comparison")
     parser.add_argument(
@@ -81,6 +103,15 @@ def add_parser(commands) -> None:
 
 def run(args) -> int:
     check_outputs(args.json, args.plot)
+    if args.suite is not None:
+        return run_suite_command(args)
+    for option, given in (("--cases", args.cases is not None), ("--quick", args.quick)):
+        if given:
+            raise SceneError(option, option.lstrip("-"), "only with --suite NAME")
+    if args.scene is None:
+        raise SceneError("bench", "scene", "name a scene file, or a suite with --suite NAME")
+    if args.camera_path is None and not args.still and args.orbit is None:
+        raise SceneError("bench", "views", "one of --camera-path NAME, --still or --orbit DEG is required")
     scene = load_scene(args.scene)
     if args.without_terrain:
         scene = dataclasses.replace(scene, terrain=None)
@@ -150,6 +181,47 @@ def run(args) -> int:
     return 0
 
 
+def run_suite_command(args) -> int:
+    """`cloudview bench --suite NAME`: every case asked of the suite, the report to --json, the plot to --plot."""
+    given = [
+        option
+        for option, value in (
+            ("SCENE", args.scene),
+            ("--camera-path", args.camera_path),
+            ("--still", args.still or None),
+            ("--orbit", args.orbit),
+            ("--sweep", args.sweep or None),
+            ("--workers", args.workers),
+            ("--cluster", args.cluster),
+            ("--gpus-per-task", args.gpus_per_task),
+            ("--frames", args.frames if args.frames != DEFAULT_FRAMES else None),
+            ("--warmup", args.warmup or None),
+            ("--width/--height", (args.width, args.height) if (args.width, args.height) != DEFAULT_SIZE else None),
+            ("--without-terrain", args.without_terrain or None),
+            ("--no-shading", args.no_shading or None),
+            ("the settings options", True if settings_from(args) != RenderSettings() else None),
+        )
+        if value is not None
+    ]
+    if given:
+        raise SceneError(
+            "--suite", "suite", f"a suite's cases name their own scenes, views, sizes and settings: drop {given[0]}"
+        )
+    suite = load_suite(args.suite)
+    names = None if args.cases is None else [name for name in args.cases.split(",") if name]
+    cases = suite.chosen(names)  # a name no case answers to is refused before any frame
+    for case in cases:
+        problem = frame_memory_problem(*case.size)
+        if problem is not None:
+            raise SceneError(suite.source, f"cases.{case.name}.width/height", problem)
+    result = run_suite(suite, names, args.quick, bench_views)
+    write_output(args.json, lambda path: path.write_text(json.dumps(result, indent=2) + "\n"))
+    if args.plot:
+        plot_suite(result, args.plot)
+    print(f"wrote {args.json}" + (f" and {args.plot}" if args.plot else ""))
+    return 0
+
+
 class BenchSettings:
     """A worker of `cloudcore.cli.workers`: called with a group of settings, the bench report of them beside one
     full-3D reference, frames taking turns, in this process's own GL context."""
@@ -181,33 +253,53 @@ class BenchSettings:
         )
 
     def __call__(self, settings_list: list) -> dict:
-        os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
-        from cloudcore.gl import FrameRenderer
-        from cloudcore.light.illumination import IlluminationCache
-
-        illumination = IlluminationCache()  # the clouds' light, computed once for every run
-        with contextlib.ExitStack() as renderers:
-            return bench_path(
-                [
-                    renderers.enter_context(FrameRenderer(*self.size, illumination=illumination))
-                    for _ in range(1 + len(settings_list))
-                ],
-                self.scene,
-                self.path,
-                self.frames,
-                settings_list,
-                self.size,
-                progress=self.progress,
-                views=self.views,
-                warmup=self.warmup,
-                freeze=True,
-            )
+        return bench_views(
+            self.scene,
+            self.views,
+            settings_list,
+            self.size,
+            self.warmup,
+            path=self.path,
+            frames=self.frames,
+            progress=self.progress,
+        )
 
     def __enter__(self):
         return self
 
     def __exit__(self, *exc):
         pass
+
+
+def bench_views(
+    scene, views, settings_list: list, size, warmup: int, path=None, frames=None, progress=None, reference=FULL_3D
+) -> dict:
+    """The bench's runner: `bench_path`'s report of full 3D (drawn with `reference`) and each of `settings_list`
+    drawing `views` (or `frames` along the camera path `path`) at `size`, frames taking turns, each in a renderer
+    of its own in this process's GL context, after `warmup` unmeasured frames; what this process set up is then
+    kept out of the garbage collector's full passes (a benchmark's own process)."""
+    os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
+    from cloudcore.gl import FrameRenderer
+    from cloudcore.light.illumination import IlluminationCache
+
+    illumination = IlluminationCache()  # the clouds' light, computed once for every run
+    with contextlib.ExitStack() as renderers:
+        return bench_path(
+            [
+                renderers.enter_context(FrameRenderer(*size, illumination=illumination))
+                for _ in range(1 + len(settings_list))
+            ],
+            scene,
+            path,
+            len(views) if views is not None else frames,
+            settings_list,
+            size,
+            progress=progress,
+            views=views,
+            warmup=warmup,
+            freeze=True,
+            reference=reference,
+        )
 
 
 def _merged(reports: list[dict], groups: int) -> dict:

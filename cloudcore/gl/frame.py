@@ -294,6 +294,8 @@ class FrameRenderer:
         with clock.frame():
             with clock.timed("world"):
                 self._draw_world(frame)
+            # the world pass uploaded the air for this eye: the ring's segments and the cloud pass's splats take it
+            self._splats.air = None if frame.air is None else frame.air[0]
             with clock.timed("impostor updates"):
                 rendered = self._impostors.update(
                     frame.plan, frame.particles, settings, time_s, frame.splat_order, self._unit_weights

@@ -111,7 +111,10 @@ class ImpostorStore:
                 target, held = self._ring[generation, segment]
                 extent = _union(held, extent)
             self._ring[generation, segment] = (target, extent)
-            batch = splat_batch(particles, clouds, np.add(generation.eye, plan.ring_build_shift), None, time_s)
+            # seen through the air from the ring's eye, each cloud at its own distance (the panel, drawn without
+            # it, stands at the ring radius while its clouds reach the horizon: docs/lod.md, "Wang's ring")
+            ring_eye = np.add(generation.eye, plan.ring_build_shift)
+            batch = splat_batch(particles, clouds, ring_eye, None, time_s, through_air=True)
             renders.append((target, batch, view, projection, first))
         selections = _cell_selections(particles, time_s, on_gpu)
         self._splats.shade_ahead(

@@ -111,6 +111,10 @@ class LightShaftPass:
         air's light taken, its share (tests)."""
         return self._targets[int(blurred)].read()
 
+    def read_depth(self) -> np.ndarray:
+        """The terrain's window depths (height, width) the last march read, top row first (tests)."""
+        return self._depth.read()
+
     def _targets_of(self, size: tuple[int, int]) -> tuple[TextureTarget, TextureTarget]:
         if self._targets is None or (self._targets[0].width, self._targets[0].height) != size:
             self._close_targets()

@@ -134,6 +134,14 @@ class DepthTexture:
         GL.glClearDepth(1.0)
         GL.glClear(GL.GL_DEPTH_BUFFER_BIT)
 
+    def read(self) -> np.ndarray:
+        """The window depths (height, width) float32, top row first (tests)."""
+        width, height = self._size
+        GL.glBindTexture(GL.GL_TEXTURE_2D, self.texture)
+        data = GL.glGetTexImage(GL.GL_TEXTURE_2D, 0, GL.GL_DEPTH_COMPONENT, GL.GL_FLOAT)
+        GL.glBindTexture(GL.GL_TEXTURE_2D, 0)
+        return np.frombuffer(data, dtype=np.float32).reshape(height, width)[::-1].copy()
+
     def _make(self, size: tuple[int, int]) -> None:
         if self._size == size:
             return

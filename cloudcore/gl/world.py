@@ -38,7 +38,12 @@ from cloudcore.terrain_tiles import TILE_FACES, TILE_VERTICES, TerrainTiles, gri
 #: the light shafts' depth of the terrain takes every 4th vertex of a tile's grid: the frames agree closely with the
 #: whole grid's, whose triangles cost llvmpipe their setup (docs/atmosphere.md#light-shafts)
 _COARSE_STRIDE = 4
-_COARSE_TILE_FACES = tile_faces(_COARSE_STRIDE)
+#: a tile's vertices its coarse surface uses (into its grid's), and the surface's triangles (into these): the coarse
+#: surfaces have a buffer of their own, as llvmpipe drew the same triangles slower from the whole grids' buffer,
+#: whose index range spans all of a tile's vertices for the few the surface uses
+#: (docs/atmosphere.md#the-shafts-cheaper-issue-52s-budget)
+_COARSE_TILE_VERTICES, _COARSE_TILE_FACES = np.unique(tile_faces(_COARSE_STRIDE), return_inverse=True)
+_COARSE_TILE_FACES = _COARSE_TILE_FACES.reshape(-1, 3)
 #: the physical sky's picture's columns, about: read bilinearly from it, the sky is 65 to 86 dB from the sky a pixel
 #: (8-bit sRGB, the sun's disc apart: it is drawn at the screen's), where each pixel's lookup cost llvmpipe more
 #: than the fetch; its error follows the angle its pixels span, not the screen's (docs/atmosphere.md, "The sky at
@@ -52,8 +57,8 @@ def sky_reduction(width: int) -> int:
     return max(1, round(width / SKY_COLUMNS))
 
 
-#: floats a terrain vertex carries: its position, the sun's light and the sky's (terrain.vert.glsl)
-_VERTEX_FLOATS = 9
+#: a terrain vertex's attributes, 3 floats each: its position, the sun's light and the sky's (terrain.vert.glsl)
+_VERTEX_ATTRIBUTES = 3
 
 
 def terrain_vertex_light(normals, base_colour, light: TerrainLight) -> tuple[np.ndarray, np.ndarray]:
@@ -75,33 +80,41 @@ class TerrainMesh:
         self.tiles = TerrainTiles(terrain)
         self._programs: dict[tuple[bool, bool], int] = {}  # per (through the air, light shafts)
         self._depth_program: int | None = None
-        self._coarse_start = 0  # the first of the coarse surfaces' triangles in the index buffer
-        self._vertex_array = GL.glGenVertexArrays(1)
-        self._vertex_buffer, self._index_buffer = (int(b) for b in GL.glGenBuffers(2))
-        GL.glBindVertexArray(self._vertex_array)
-        GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self._vertex_buffer)
-        stride = _VERTEX_FLOATS * 4
-        for location in range(3):
-            GL.glEnableVertexAttribArray(location)
-            GL.glVertexAttribPointer(location, 3, GL.GL_FLOAT, GL.GL_FALSE, stride, ctypes.c_void_p(12 * location))
-        GL.glBindBuffer(GL.GL_ELEMENT_ARRAY_BUFFER, self._index_buffer)
+        self._coarse_in_view: np.ndarray | None = None  # the tiles whose coarse surfaces the coarse indices hold
+        # the tiles' vertices and triangles, and their coarse surfaces' (the light shafts' depth: positions alone)
+        self._buffers = [int(b) for b in GL.glGenBuffers(4)]
+        self._vertex_array, self._coarse_vertex_array = (int(a) for a in GL.glGenVertexArrays(2))
+        for vertex_array, (vertices, indices), attributes in (
+            (self._vertex_array, self._buffers[:2], _VERTEX_ATTRIBUTES),
+            (self._coarse_vertex_array, self._buffers[2:], 1),
+        ):
+            GL.glBindVertexArray(vertex_array)
+            GL.glBindBuffer(GL.GL_ARRAY_BUFFER, vertices)
+            for location in range(attributes):
+                GL.glEnableVertexAttribArray(location)
+                GL.glVertexAttribPointer(
+                    location, 3, GL.GL_FLOAT, GL.GL_FALSE, 12 * attributes, ctypes.c_void_p(12 * location)
+                )
+            GL.glBindBuffer(GL.GL_ELEMENT_ARRAY_BUFFER, indices)
         GL.glBindVertexArray(0)
 
     def _upload(self) -> None:
         tiles = self.tiles
         colours = ground_colours(self._terrain, tiles.positions, tiles.normals)
         sun, sky = terrain_vertex_light(tiles.normals, colours, self._light)
-        vertices = np.ascontiguousarray(np.concatenate([tiles.positions, sun, sky], axis=1), dtype=np.float32)
-        GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self._vertex_buffer)
-        GL.glBufferData(GL.GL_ARRAY_BUFFER, vertices.nbytes, vertices, GL.GL_STATIC_DRAW)
-        # the tiles' triangles, then their coarse surfaces' (the light shafts' depth)
-        tile_starts = np.arange(len(tiles.faces) // len(TILE_FACES)) * TILE_VERTICES
-        coarse = (_COARSE_TILE_FACES[None, :, :] + tile_starts[:, None, None]).reshape(-1, 3)
-        indices = np.ascontiguousarray(np.concatenate([tiles.faces, coarse]), dtype=np.uint32)
-        self._coarse_start = len(tiles.faces)
+        coarse_vertices = tiles.positions.reshape(-1, TILE_VERTICES, 3)[:, _COARSE_TILE_VERTICES].reshape(-1, 3)
+        for vertices, vertex_buffer in (
+            (np.concatenate([tiles.positions, sun, sky], axis=1), self._buffers[0]),
+            (coarse_vertices, self._buffers[2]),
+        ):
+            vertices = np.ascontiguousarray(vertices, dtype=np.float32)
+            GL.glBindBuffer(GL.GL_ARRAY_BUFFER, vertex_buffer)
+            GL.glBufferData(GL.GL_ARRAY_BUFFER, vertices.nbytes, vertices, GL.GL_STATIC_DRAW)
+        indices = np.ascontiguousarray(tiles.faces, dtype=np.uint32)
         GL.glBindVertexArray(self._vertex_array)
         GL.glBufferData(GL.GL_ELEMENT_ARRAY_BUFFER, indices.nbytes, indices, GL.GL_STATIC_DRAW)
         GL.glBindVertexArray(0)
+        self._coarse_in_view = None  # the coarse surfaces' triangles are gathered again
 
     def _program(self, through_air: bool, shafts: bool) -> int:
         if (through_air, shafts) not in self._programs:
@@ -154,10 +167,12 @@ class TerrainMesh:
         GL.glEnable(GL.GL_DEPTH_TEST)
         GL.glDepthFunc(GL.GL_LESS)
         GL.glDepthMask(GL.GL_TRUE)
+        if coarse:
+            self._draw_coarse(in_view)
+            return
         GL.glBindVertexArray(self._vertex_array)
-        faces, stride = (_COARSE_TILE_FACES, _COARSE_STRIDE) if coarse else (TILE_FACES, 1)
-        grid = grid_face_count(stride)
-        first = (self._coarse_start if coarse else 0) + in_view * len(faces)  # each tile's first triangle
+        grid = grid_face_count()
+        first = in_view * len(TILE_FACES)  # each tile's first triangle
         # the grids with their back faces culled: the far sides of hills, hidden behind their near sides, which
         # llvmpipe then does not set up; the skirts not, as either of two neighbours' may be the one that hangs
         # past the other's edge, seen from either side
@@ -165,7 +180,20 @@ class TerrainMesh:
         GL.glCullFace(GL.GL_BACK)
         _draw_ranges(first, grid)
         GL.glDisable(GL.GL_CULL_FACE)
-        _draw_ranges(first + grid, len(faces) - grid)
+        _draw_ranges(first + grid, len(TILE_FACES) - grid)
+        GL.glBindVertexArray(0)
+
+    def _draw_coarse(self, in_view: np.ndarray) -> None:
+        """Draw the coarse surfaces of the tiles `in_view` in one call, none culled (at the march's resolution
+        llvmpipe's cost per draw, a draw per tile, exceeded the triangles' own); their triangles gathered into the
+        coarse index buffer when the tiles in view change."""
+        GL.glBindVertexArray(self._coarse_vertex_array)
+        if self._coarse_in_view is None or not np.array_equal(self._coarse_in_view, in_view):
+            starts = in_view * len(_COARSE_TILE_VERTICES)
+            faces = np.ascontiguousarray(_COARSE_TILE_FACES[None, :, :] + starts[:, None, None], dtype=np.uint32)
+            GL.glBufferData(GL.GL_ELEMENT_ARRAY_BUFFER, faces.nbytes, faces, GL.GL_DYNAMIC_DRAW)
+            self._coarse_in_view = in_view
+        GL.glDrawElements(GL.GL_TRIANGLES, 3 * len(in_view) * len(_COARSE_TILE_FACES), GL.GL_UNSIGNED_INT, None)
         GL.glBindVertexArray(0)
 
     def close(self) -> None:
@@ -173,8 +201,8 @@ class TerrainMesh:
             GL.glDeleteProgram(program)
         if self._depth_program is not None:
             GL.glDeleteProgram(self._depth_program)
-        GL.glDeleteBuffers(2, [self._vertex_buffer, self._index_buffer])
-        GL.glDeleteVertexArrays(1, [self._vertex_array])
+        GL.glDeleteBuffers(len(self._buffers), self._buffers)
+        GL.glDeleteVertexArrays(2, [self._vertex_array, self._coarse_vertex_array])
 
 
 def _draw_ranges(first_triangles: np.ndarray, triangles: int) -> None:

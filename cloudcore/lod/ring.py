@@ -184,8 +184,13 @@ def panel_corners(generation: RingGeneration, segment: int, elevation_deg: float
     return np.array([middle - right - up, middle + right - up, middle - right + up, middle + right + up])
 
 
-def ring_members(centres: np.ndarray, radii: np.ndarray, eye, settings: RenderSettings) -> np.ndarray:
-    """Boolean (N,): clouds wholly beyond the ring radius and wholly inside its elevation band, seen from `eye`."""
+def ring_members(centres: np.ndarray, radii: np.ndarray, eye, settings: RenderSettings, heights=None) -> np.ndarray:
+    """Boolean (N,): clouds wholly beyond the ring radius and wholly inside its elevation band, seen from `eye`.
+
+    Inside the band by their spheres, or, where `heights` gives their splats' lowest and highest reach (N, 2), by
+    those at the sphere's nearest horizontal distance: a cloud field's coarse cells are flat, their spheres
+    kilometres high, and those that grazed the band's edge stayed out, drawn on their own over the panels that
+    hold nearer clouds (docs/lod.md, "Wang's ring")."""
     x, y, z = (np.asarray(centres, dtype=np.float64) - np.asarray(eye, dtype=np.float64)).T
     horizontal_squared = x * x + z * z
     horizontal = np.sqrt(horizontal_squared)
@@ -196,7 +201,16 @@ def ring_members(centres: np.ndarray, radii: np.ndarray, eye, settings: RenderSe
     with np.errstate(invalid="ignore", divide="ignore"):
         cosine = (horizontal * np.sqrt(distance_squared - radii * radii) - np.abs(y) * radii) / distance_squared
     beyond = (radii > 0) & (horizontal - radii > settings.ring_radius)  # so wholly outside the eye's sphere too
-    return beyond & (cosine >= math.cos(math.radians(settings.ring_elevation_deg)))
+    in_band = cosine >= math.cos(math.radians(settings.ring_elevation_deg))
+    if heights is not None:
+        eye_y = float(np.asarray(eye, dtype=np.float64)[1])
+        bottoms, tops = np.asarray(heights, dtype=np.float64).reshape(-1, 2).T
+        # the steepest a splat can be seen at: its reach above or below the eye over the nearest horizontal
+        # distance of the sphere (positive for a cloud beyond the radius)
+        rise = np.maximum(tops - eye_y, eye_y - bottoms)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            in_band |= rise <= math.tan(math.radians(settings.ring_elevation_deg)) * (horizontal - radii)
+    return beyond & in_band
 
 
 def segment_texture_size(viewport_height: int, fov_y_deg: float, settings: RenderSettings) -> tuple[int, int]:
@@ -211,9 +225,17 @@ def segment_texture_size(viewport_height: int, fov_y_deg: float, settings: Rende
 
 
 def new_generation(
-    centres, radii, eye, settings: RenderSettings, cloud_keys, ids: tuple, texture_size: tuple, holds_clouds=True
+    centres,
+    radii,
+    eye,
+    settings: RenderSettings,
+    cloud_keys,
+    ids: tuple,
+    texture_size: tuple,
+    holds_clouds=True,
+    heights=None,
 ) -> RingGeneration:
-    in_ring = ring_members(centres, radii, eye, settings) & holds_clouds
+    in_ring = ring_members(centres, radii, eye, settings, heights) & holds_clouds
     members = frozenset(ids[i] for i in np.flatnonzero(in_ring))
     clouds = np.array([cloud for member in members for cloud in member], dtype=np.int64)
     generation = RingGeneration(
@@ -273,13 +295,20 @@ def _needs_rebuild(
         return True
     if not holds_clouds:
         return False  # holding nothing, nothing goes stale
-    moved = np.asarray(eye, dtype=np.float64) - np.asarray(generation.eye)
     return (
         past_tolerance
         or _relit(generation, cloud_keys, present)
         or _wrong_size(generation, texture_size)
         or generation.radius != settings.ring_radius
-        or math.hypot(moved[0], moved[2]) > settings.ring_rebuild_horizontal * settings.ring_radius
+        or _moved_past(generation, eye, settings)
+    )
+
+
+def _moved_past(generation: RingGeneration, eye, settings: RenderSettings) -> bool:
+    """The eye has moved past Wang's rebuild distance from the generation's eye, horizontally or vertically."""
+    moved = np.asarray(eye, dtype=np.float64) - np.asarray(generation.eye)
+    return (
+        math.hypot(moved[0], moved[2]) > settings.ring_rebuild_horizontal * settings.ring_radius
         or abs(moved[1]) > settings.ring_rebuild_vertical * settings.ring_radius
     )
 
@@ -298,6 +327,7 @@ def plan_ring(
     past_tolerance: bool = False,
     build_ms: Callable[[Hashable], float] | None = None,
     step=None,
+    heights=None,
 ) -> RingPlan | None:
     """Advance the ring by one frame: start a rebuild if needed, build one segment or step the fade.
 
@@ -315,11 +345,13 @@ def plan_ring(
     over the last.  None, or no such ring shown: a segment a frame.  `step`: the eye's motion since the last
     frame (None: still), which sets the rebuild's pace (`rebuild_frames`): where a segment a frame and the fade
     would take longer than the eye takes to move a quarter of a rebuild distance, the segments are built several
-    a frame, whole, and the fade is shortened, down to the whole ring built and shown in one frame.
+    a frame, whole, and the fade is shortened, down to the whole ring built and shown in one frame.  `heights`:
+    the spheres' splats' lowest and highest reach (`ring_members`; None: the spheres alone).
 
     A ring being built when its members' keys change is finished first and rebuilt after: a cloud
     forming in the ring, whose key changes every frame, would otherwise keep the ring from ever
-    completing; one whose members are no longer all units (removed, regrouped) starts again.
+    completing; one whose members are no longer all units (removed, regrouped), or whose eye the eye has
+    moved past the rebuild distance from, starts again (at the eye's pace it is finished within half of it).
     """
     if not settings.uses_ring:
         return None
@@ -330,6 +362,9 @@ def plan_ring(
         or _wrong_size(pending, texture_size)
         or not pending.members <= present  # a member gone (a cloud field's cell left): nothing to render it from
         or pending.holds_clouds != holds_clouds
+        # the eye outran it (a jump): finished at the jump's pace it would show at once, from where the eye was,
+        # the clouds that now fill its members' places (a cloud field's entering cells take the leaving ones')
+        or (pending.holds_clouds and _moved_past(pending, eye, settings))
     ):
         pending = None  # the ring it was being built for is gone: start again
     if pending is None and (
@@ -341,7 +376,7 @@ def plan_ring(
     ):
         if current is not None or state.pending is not None:
             since_rebuild, rebuild_interval = 0, float(since_rebuild)
-        pending = new_generation(centres, radii, eye, settings, cloud_keys, ids, texture_size, holds_clouds)
+        pending = new_generation(centres, radii, eye, settings, cloud_keys, ids, texture_size, holds_clouds, heights)
         built, fade_step = (0 if holds_clouds else SEGMENTS), 0  # a ring of nothing has nothing to build
     built_of_segment = state.built_of_segment if pending is state.pending else 0
     builds, building = (), pending

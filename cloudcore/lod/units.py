@@ -107,6 +107,10 @@ class LodUnits:
     #: a unit of its own for each cloud of a group, for a group planned apart (`apart_rows`; None: no groups)
     clouds: LodUnits | None = None
     sample: SplatSample | None = None  # of every cloud's splats (None: only the spheres are known)
+    #: (units, 2) metres: the lowest and the highest reach of the unit's splats (None: only the spheres are known).
+    #: A cloud field's cells are flat (a coarse cell kilometres wide, its clouds a band of hundreds of metres), and
+    #: their spheres reach far above and below what they hold (Wang's ring's elevation band: `ring_members`)
+    heights: np.ndarray | None = None
 
     @functools.cached_property
     def and_clouds(self) -> LodUnits:
@@ -124,6 +128,7 @@ class LodUnits:
             np.concatenate([u.finest_radii for u in parts]),
             np.concatenate([u.fragment_costs for u in parts]),
             sample=self.sample,
+            heights=None if self.heights is None else np.concatenate([u.heights for u in parts]),
         )
 
     @functools.cached_property
@@ -170,6 +175,7 @@ class LodUnits:
             self.finest_radii[rows],
             self.fragment_costs[rows],
             sample=self.sample,
+            heights=None if self.heights is None else self.heights[rows],
         )
 
     def member_means(self, per_cloud: np.ndarray) -> np.ndarray:
@@ -198,10 +204,14 @@ class LodUnits:
         if sample is not None:
             per_sample = np.repeat(cloud_shifts, np.diff(sample.cloud_starts), axis=0)
             sample = dataclasses.replace(sample, centres=sample.centres + per_sample)
+        reach = grown + spread
         return dataclasses.replace(
             self,
             centres=self.centres + shifts,
-            radii=np.where(self.radii > 0.0, self.radii + grown + spread, 0.0),
+            radii=np.where(self.radii > 0.0, self.radii + reach, 0.0),
+            heights=None
+            if self.heights is None
+            else self.heights + shifts[:, 1:2] + np.column_stack([-reach, reach]).reshape(-1, 2),
             clouds=None if self.clouds is None else self.clouds.moved(cloud_shifts, grown),
             sample=sample,
         )
@@ -298,7 +308,7 @@ def _units_of(particles, members: tuple) -> LodUnits:
     """The units of `particles` whose clouds are `members` (one tuple of cloud indices per unit)."""
     starts = particles.cloud_starts
     sphere_centres, sphere_radii = particles.bounding_centres, particles.bounding_radii
-    centres, radii, counts, squares, finest, fragment_costs = [], [], [], [], [], []
+    centres, radii, counts, squares, finest, fragment_costs, heights = [], [], [], [], [], [], []
     fill_costs = np.where(particles.styles.sprite_index >= 0, SPRITE_FRAGMENT_COST, 1.0)
     for clouds in members:
         ranges = [np.arange(starts[c], starts[c + 1]) for c in clouds]
@@ -315,6 +325,8 @@ def _units_of(particles, members: tuple) -> LodUnits:
         fragment_costs.append(float(np.dot(areas, fill_costs[indices]) / squares[-1]) if squares[-1] > 0.0 else 1.0)
         detail = [particles.finest_radii[c] for c in clouds if particles.finest_radii[c] > 0.0]
         finest.append(min(detail) if detail else 0.0)
+        splat_y, splat_radii = particles.centres[indices, 1], particles.radii[indices]
+        heights.append((np.min(splat_y - splat_radii), np.max(splat_y + splat_radii)) if len(indices) else (0.0, 0.0))
     return LodUnits(
         np.array(centres, dtype=np.float64).reshape(-1, 3),
         np.array(radii, dtype=np.float64),
@@ -323,4 +335,5 @@ def _units_of(particles, members: tuple) -> LodUnits:
         np.array(squares, dtype=np.float64),
         np.array(finest, dtype=np.float64),
         np.array(fragment_costs, dtype=np.float64),
+        heights=np.array(heights, dtype=np.float64).reshape(-1, 2),
     )

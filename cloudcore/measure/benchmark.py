@@ -44,10 +44,12 @@ def resident_memory_bytes() -> int:
     raise RuntimeError("no VmRSS line in /proc/self/status")
 
 
-def path_views(scene: Scene, path_name: str, frames: int) -> list:
-    """(scene clock in seconds, camera) of `frames` frames spread along the path."""
+def path_views(scene: Scene, path_name: str, frames: int, times_s=()) -> list:
+    """(scene clock in seconds, camera) of `frames` frames spread along the path, or at the seconds along it
+    `times_s` in turn where given (a few views drawn again and again)."""
     path = scene.camera_path(path_name)
-    return [(path.keys[0, 0] + t, camera_on_path(path, t, scene.camera.fov_y_deg)) for t in frame_times(path, frames)]
+    times = [times_s[frame % len(times_s)] for frame in range(frames)] if times_s else frame_times(path, frames)
+    return [(path.keys[0, 0] + t, camera_on_path(path, t, scene.camera.fov_y_deg)) for t in times]
 
 
 def still_views(scene: Scene, frames: int) -> list:
@@ -90,11 +92,18 @@ def turns(runs: int, frames: int) -> list[list[int]]:
 
 
 def _interleaved_rows(
-    renderers, scene: Scene, views, settings_list, progress=None, warmup: int = 0, freeze: bool = False
+    renderers,
+    scene: Scene,
+    views,
+    settings_list,
+    progress=None,
+    warmup: int = 0,
+    freeze: bool = False,
+    reference=FULL_3D,
 ) -> list:
     """Per renderer (the reference's first, in full 3D), one row a frame: its statistics and, but for the
     reference's, its error against the reference's image of that frame."""
-    runs = list(zip(renderers, [FULL_3D, *settings_list]))
+    runs = list(zip(renderers, [reference, *settings_list]))
     for renderer, settings in runs:
         for _ in range(warmup):  # unmeasured frames at the first view: caches built, the ring faded in
             renderer.render(scene, camera=views[0][1], settings=settings, time_s=views[0][0])
@@ -157,6 +166,7 @@ def bench_path(
     views=None,
     warmup: int = 0,
     freeze: bool = False,
+    reference=FULL_3D,
 ) -> dict:
     """The report: reference (full 3D) and one run per settings object, errors per frame and overall.
 
@@ -164,15 +174,25 @@ def bench_path(
     render frame by frame in turn.  The frames are `views` ((scene clock, camera) pairs) when given,
     else `frames` along the path; each run first renders `warmup` unmeasured frames of the first view.
     `freeze`: after those, leave what is set up out of the garbage collector's full passes, for the rest of the
-    process (`cloudcore.collector`; a benchmark's own process, not a test's).
+    process (`cloudcore.collector`; a benchmark's own process, not a test's).  `reference`: the full-3D settings
+    the reference is drawn with (a way of drawing every particle measured against another: `compositing`...).
     """
+    if reference.mode != "full":
+        raise ValueError(f"the reference draws every particle (mode 'full'), not {reference.mode!r}")
     if len(renderers) != 1 + len(settings_list):
         raise ValueError(f"{len(renderers)} renderers for the reference and {len(settings_list)} settings")
     views = path_views(scene, path_name, frames) if views is None else views
     for renderer in renderers:  # shading precompute, shader compiles; in full 3D, no impostor made ahead
         renderer.render(scene, camera=views[0][1], settings=FULL_3D)
-    reference_rows, *rows_of_runs = _interleaved_rows(renderers, scene, views, settings_list, progress, warmup, freeze)
-    reference = {"mode": "full", **_summary(reference_rows), "per_frame": reference_rows}
+    reference_rows, *rows_of_runs = _interleaved_rows(
+        renderers, scene, views, settings_list, progress, warmup, freeze, reference
+    )
+    reference = {
+        "mode": "full",
+        "settings": dataclasses.asdict(reference),
+        **_summary(reference_rows),
+        "per_frame": reference_rows,
+    }
     runs = []
     for settings, rows in zip(settings_list, rows_of_runs):
         psnr = np.array([r["psnr_db"] for r in rows])
@@ -284,27 +304,6 @@ def ratio_interval(numerator, denominators, resamples: int = 4000, seed: int = 0
     sampled = ratios(runs[:, picked].sum(axis=2))
     low, high = np.percentile(sampled, [2.5, 97.5])
     return float(ratios(runs.sum(axis=1))), float(low), float(high)
-
-
-def setting_in_turns(renderers, scene, representations: dict, setting: str, timings, repeat: int, warm_up: int):
-    """A boolean `setting` on and off, side by side: per representation (name -> `RenderSettings`), the frames of
-    `scene` drawn with it (turn "on", by `renderers["on"]`) and without ("off", `renderers["off"]`, which may be the
-    same renderer) one after the other frame by frame, so that both see the same machine load; returns
-    {f"{representation}_{turn}_{timing}": the median of `FrameStats.<timing>` over `repeat` frames after `warm_up`}
-    for each of `timings` (ms)."""
-    row = {}
-    for name, settings in representations.items():
-        # one representation at a time: auto's first frames after full 3D's remake impostors
-        turns = {turn: dataclasses.replace(settings, **{setting: turn == "on"}) for turn in ("on", "off")}
-        times = {turn: {timing: [] for timing in timings} for turn in turns}
-        for frame in range(warm_up + repeat):
-            for turn, turn_settings in turns.items():
-                _, stats = renderers[turn].render(scene, settings=turn_settings, read_back=False)
-                for timing in timings if frame >= warm_up else ():
-                    times[turn][timing].append(getattr(stats, timing))
-        for turn, named in times.items():
-            row.update({f"{name}_{turn}_{timing}": float(np.median(values)) for timing, values in named.items()})
-    return row
 
 
 def machine() -> str:

@@ -12,8 +12,8 @@
 #                    here with llvmpipe's (`cloudview render ... --mode full|auto [--splat-order gpu]`)
 #   editor: editor_1280.json   the editor's viewport size (1280x720), auto, orbiting 0.2 degrees a frame
 #   tests:           the tests of the GPU's ways and of the LOD's pictures, in log.txt
-#   field: field.json          the 1.2M-particle field, auto against full 3D (`bench_lod.py --cases field`)
-#   lod: lod.json              `bench_lod.py --cases still,flythrough`: auto against impostor mode and full 3D
+#   field: field.json          the 1.2M-particle field, auto against full 3D (`cloudview bench --suite lod --cases field`)
+#   lod: lod.json              `cloudview bench --suite lod --cases still,flythrough`: auto against impostor mode and full 3D
 #   compositing: compositing.json   full 3D at 640x480 blended by the raster (plain) or by the tiled compute
 #                    pass (volume), 61 frames of the flythrough
 #   sort: sort.json            the GPU's radix sort against numpy's (`bench_gpu_sort.py`), 10k to 1M keys
@@ -111,10 +111,10 @@ if wanted waits; then
 fi
 if wanted lod; then
   # shellcheck disable=SC2086
-  step "lod" "$python" scripts/bench_lod.py --cases still,flythrough $quick --json "$OUT/lod.json"
+  step "lod" "${cloudview[@]}" bench --suite lod --cases still,flythrough $quick --json "$OUT/lod.json"
 fi
 if wanted field; then
   # shellcheck disable=SC2086
-  step "field" "$python" scripts/bench_lod.py --cases field $quick --json "$OUT/field.json"
+  step "field" "${cloudview[@]}" bench --suite lod --cases field $quick --json "$OUT/field.json"
 fi
 echo "done in $SECONDS s"

@@ -8,16 +8,19 @@ import numpy as np
 import pytest
 
 from cloudcore.atmosphere.aerial_perspective import MAX_DISTANCE_M
-from cloudcore.camera import pixel_rays
+from cloudcore.camera import pixel_rays, projection_matrix, view_matrix
 from cloudcore.colour import srgb_decode
 from cloudcore.gl.light_shafts import shaft_reduction, shaft_size
 from cloudcore.light.air_between import air_between
 from cloudcore.light.cloud_shadows import SLICES, light_space, opacity_map
 from cloudcore.light.light_shafts import shadowed_in_scattering, shadowed_share, shaft_segments
 from cloudcore.light.sky_background import HORIZON_MARGIN, over_the_horizon, scene_sky
+from cloudcore.resources import DEFAULT_SCENE
 from cloudcore.scene import Camera, Lighting, Scene
+from cloudcore.scenefile import load_scene
 from cloudcore.settings import FULL_3D
 from cloudcore.sun import sun_direction
+from cloudcore.terrain import height_at
 from tests.conftest import RENDER_HEIGHT, RENDER_WIDTH
 from tests.render.test_cloud_shadows import ball, particles_of
 
@@ -141,7 +144,11 @@ def test_the_gl_march_is_numpys(renderer):
     assert share.max() > 0.2  # shafts in view
     assert np.abs(march[..., 3] - share).max() < 0.02
     taken = taken.reshape(height, width, 3)
-    assert np.abs(march[..., :3] - taken).max() < 0.02 * taken.max()
+    # the worst ray's error is a step's at a shadow's edge, where GL's filtering differs most from numpy's: each of
+    # SHAFT_STEPS weighs 1/SHAFT_STEPS of it (2.3% of the largest at 6 steps, 1.5% at 12); the rest are within 1%
+    error = np.abs(march[..., :3] - taken)
+    assert error.max() < 0.03 * taken.max()
+    assert np.percentile(error, 99) < 0.0125 * taken.max()
     # what the world reads: the march blurred by a 3x3 tent, its edges clamped
     padded = np.pad(march, ((1, 1), (1, 1), (0, 0)), mode="edge")
     tent = np.array([1.0, 2.0, 1.0])
@@ -185,3 +192,47 @@ def test_a_view_whose_air_no_shadow_reaches_is_drawn_as_without_shafts(renderer)
     renderer.context.make_current()
     assert renderer.light_shafts.read().max() == 0.0
     assert np.abs(frames[True] - frames[False]).max() == 0.0
+
+
+def turned(camera: Camera, degrees: float) -> Camera:
+    """`camera` turned `degrees` about the up through its eye."""
+    eye, target = np.asarray(camera.position, dtype=np.float64), np.asarray(camera.look_at, dtype=np.float64)
+    angle = np.radians(degrees)
+    x, z = (target - eye)[[0, 2]]
+    ahead = np.array([x * np.cos(angle) - z * np.sin(angle), (target - eye)[1], x * np.sin(angle) + z * np.cos(angle)])
+    return dataclasses.replace(camera, look_at=tuple(eye + ahead))
+
+
+@pytest.mark.gl
+def test_the_marchs_terrain_depth_is_the_ground_of_each_view_in_turn(renderer):
+    """The march's terrain depth (the coarse surfaces of the tiles in view, drawn in one call from triangles
+    gathered when the tiles in view change) lies on the ground, and covers every ray that meets it, in a view
+    after others looking elsewhere: triangles left over from the view before would leave holes or stray ground."""
+    scene = load_scene(DEFAULT_SCENE)
+    width, height = shaft_size(RENDER_WIDTH, RENDER_HEIGHT, shaft_reduction(RENDER_WIDTH))
+    for degrees in (0.0, 120.0, 240.0, 0.0):
+        camera = turned(scene.camera, degrees)
+        renderer.render(scene, camera=camera, read_back=False)
+        renderer.context.make_current()
+        depth = renderer.light_shafts.read_depth()
+        assert depth.shape == (height, width)
+        projection = projection_matrix(camera.fov_y_deg, RENDER_WIDTH / RENDER_HEIGHT)
+        view_depth = projection[2, 3] / (2.0 * depth.astype(np.float64) - 1.0 + projection[2, 2])
+        rays = pixel_rays(camera, width, height)
+        forward = -view_matrix(camera)[2, :3]
+        eye = np.asarray(camera.position, dtype=np.float64)
+        drawn = depth < 1.0
+        points = eye + rays[drawn] * (view_depth[drawn] / (rays[drawn] @ forward))[:, None]
+        off_ground = np.abs(points[:, 1] - height_at(scene.terrain, points[:, 0], points[:, 2]))
+        # on the coarse surface (every 4th vertex of tiles that grow with the distance): off the ground by a small
+        # share of the distance
+        off_by = off_ground / np.linalg.norm(points - eye, axis=1)
+        assert np.percentile(off_by, 95) < 0.015
+        assert off_by.max() < 0.05
+        # every ray that meets the ground within 8 km, 20 m past it (a silhouette's rays aside), is drawn
+        reach = np.arange(20.0, 8000.0, 20.0)
+        along = eye + rays[..., None, :] * reach[:, None]
+        below = along[..., 1] < height_at(scene.terrain, along[..., 0], along[..., 2]) - 20.0
+        meets = below.any(axis=-1)
+        assert meets.sum() > 0.2 * meets.size  # ground in view
+        assert np.count_nonzero(meets & ~drawn) <= 0.01 * meets.sum()

@@ -53,8 +53,6 @@ class CloudPass:
     def draw(self, frame: CloudPassFrame) -> DrawCounts:
         """Draw `frame`'s cloud pass into the frame's target (bound), or at the plan's reduced size and laid
         over it; what its draws drew."""
-        # the world pass uploaded the air for this eye: the cloud pass's splats take it per particle
-        self._tools.splats.air = None if frame.air is None else frame.air[0]
         executors = self.executors
         steps = []
         for kind, items in draw_steps(frame.plan):

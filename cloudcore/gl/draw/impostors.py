@@ -112,7 +112,8 @@ class Ring(DrawExecutor):
     one after the other, before the plan's draw items."""
 
     def draw(self, frame: CloudPassFrame, step: DrawStep) -> DrawCounts:
-        self.tools.quads.draw_run(self._panels(frame), frame.view_projection, air=frame.air)
+        # not through the air: their segments hold their clouds through it, from the ring's eye
+        self.tools.quads.draw_run(self._panels(frame), frame.view_projection, air=None)
         return DrawCounts()
 
     def count_fragments(self, frame: CloudPassFrame, step: DrawStep) -> tuple:

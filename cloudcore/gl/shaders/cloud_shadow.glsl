@@ -17,9 +17,14 @@ float cloud_shadow_transmittance_mapped(vec3 mapped)
     if (s >= 8.0)  // behind every cloud, as the ground mostly is: one fetch
         return exp(-far.w);
     vec4 near = textureLod(cloud_shadow_slices_1_to_4, mapped.xy, 0.0);
-    float depths[9] = float[9](0.0, near.x, near.y, near.z, near.w, far.x, far.y, far.z, far.w);
-    int below = min(int(s), 7);
-    return exp(-mix(depths[below], depths[below + 1], s - float(below)));
+    // linear between the slices' depths (0 at s = 0, slice k's at s = k) as a sum of each span's rise times how much
+    // of it lies below s: an array indexed per pixel cost the light shafts' march more
+    // (docs/atmosphere.md#the-shafts-cheaper-issue-52s-budget)
+    vec4 near_rise = near - vec4(0.0, near.xyz);
+    vec4 far_rise = far - vec4(near.w, far.xyz);
+    vec4 covered_near = clamp(vec4(s) - vec4(0.0, 1.0, 2.0, 3.0), 0.0, 1.0);
+    vec4 covered_far = clamp(vec4(s) - vec4(4.0, 5.0, 6.0, 7.0), 0.0, 1.0);
+    return exp(-(dot(covered_near, near_rise) + dot(covered_far, far_rise)));
 }
 
 float cloud_shadow_transmittance(vec3 world)

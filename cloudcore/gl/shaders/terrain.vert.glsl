@@ -11,14 +11,15 @@ layout(location = 2) in vec3 sky_light;  // albedo x the sky's dome, the ground'
 uniform mat4 view_projection;
 uniform vec3 eye_position;
 
-out vec3 sun_lit;
-out vec3 sky_lit;
+// what the eye sees of the vertex: the sun's part (which the clouds' shadow dims per pixel) and the rest with the
+// air's light, both through the air; two varyings where the light and the air were four (each varying a pixel
+// interpolates cost llvmpipe: docs/atmosphere.md#the-shafts-cheaper-issue-52s-budget)
+out vec3 sun_seen;
+out vec3 rest_seen;
 // where the clouds' shadow map is read, per pixel (terrain.frag.glsl): the map's coordinates are affine in the
 // world's, so the vertices' interpolate to each pixel's exactly, without the matrix a pixel
 out vec3 shadow_mapped;
 uniform mat4 world_to_cloud_shadow;  // cloud_shadow.glsl's
-out vec3 air_let_through;
-out vec3 air_added;
 
 #if THROUGH_AIR
 #include "aerial_perspective.glsl"
@@ -31,8 +32,7 @@ void main()
 {
     gl_Position = view_projection * vec4(position, 1.0);
     shadow_mapped = (world_to_cloud_shadow * vec4(position, 1.0)).xyz;
-    sun_lit = sun_light;
-    sky_lit = sky_light;
+    vec3 air_let_through, air_added;
 #if THROUGH_AIR
     air_toward(position - eye_position, air_let_through, air_added);
 #if LIGHT_SHAFTS
@@ -45,4 +45,6 @@ void main()
     air_let_through = vec3(1.0);
     air_added = vec3(0.0);
 #endif
+    sun_seen = sun_light * air_let_through;
+    rest_seen = sky_light * air_let_through + air_added;
 }

@@ -227,7 +227,10 @@ def test_a_ray_task_draws_on_the_gpu_ray_gave_it(monkeypatch):
     """Ray names the task's GPU as CUDA does; its context is made on the EGL device that is that CUDA device."""
     monkeypatch.setitem(sys.modules, "ray", types.SimpleNamespace(get_gpu_ids=lambda: [3]))
     monkeypatch.setattr("cloudcore.gl.context.egl_device_of_cuda", lambda cuda: {3: 1}.get(cuda))
-    monkeypatch.delenv("EGL_DEVICE_ID", raising=False)
+    # set, then removed: monkeypatch then takes the variable the task sets out again afterwards (a variable it only
+    # deleted, absent, it would leave set, and every later subprocess's context on EGL device 1)
+    monkeypatch.setenv("EGL_DEVICE_ID", "0")
+    monkeypatch.delenv("EGL_DEVICE_ID")
     _use_the_task_s_gpu()
     assert os.environ["EGL_DEVICE_ID"] == "1"
 

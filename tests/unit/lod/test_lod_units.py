@@ -201,3 +201,19 @@ def test_a_sprite_s_fragments_are_priced_at_what_they_cost_against_a_kernel_spla
     )
     assert sprites.clouds[0].full_ms / plain.clouds[0].full_ms == pytest.approx(units.fragment_costs[0], rel=1e-6)
     assert sprites.clouds[1].full_ms == pytest.approx(plain.clouds[1].full_ms, rel=1e-12)
+
+
+def test_the_units_know_their_splats_lowest_and_highest_reach_and_carry_them_as_they_move():
+    units = lod_units(CLOUDS)
+    for row, members in enumerate(units.members):
+        splats = np.concatenate([np.arange(CLOUDS.cloud_starts[c], CLOUDS.cloud_starts[c + 1]) for c in members])
+        y, radii = CLOUDS.centres[splats, 1], CLOUDS.radii[splats]
+        np.testing.assert_allclose(units.heights[row], [np.min(y - radii), np.max(y + radii)])
+        assert units.heights[row, 1] - units.heights[row, 0] < 2.0 * units.radii[row]
+    np.testing.assert_array_equal(units.and_clouds.take([3]).heights, units.clouds.heights[:1])
+    # the wind carries each cloud: a unit's reach moves with its mean, and widens as its sphere grows
+    shifts = np.array([[0.0, 10.0, 0.0], [0.0, 30.0, 0.0], [0.0, -5.0, 0.0], [0.0, 0.0, 0.0]])
+    moved = units.moved(shifts, grown=2.0)
+    np.testing.assert_allclose(moved.heights[0], units.heights[0] + 20.0 + np.array([-12.0, 12.0]))
+    np.testing.assert_allclose(moved.heights[1], units.heights[1] - 5.0 + np.array([-2.0, 2.0]))
+    assert LodUnits.of_spheres([[0.0, 0.0, 0.0]], [1.0]).heights is None
