@@ -4,12 +4,13 @@
         [--modes auto,full] [--warmup 5] [--json out/bench_frame_against.json]
 
 Two worker processes, this tree's `cloudcore` and the revision's (a temporary worktree on its PYTHONPATH), draw
-the same views of each `bench_lod.py` case (every `--every`th), in each mode, taking turns frame by frame in the
-balanced order of `measure.benchmark.turns`, so that both see the same machine load.  Auto mode prices its
-choices with the prior costs (`LLVMPIPE_COSTS`), not with times measured in each process, so both draw the same
-plans.  Reports per case and mode the ratio of this tree's mean `frame_ms` over the revision's after the warm-up
-with its 95% interval (`measure.benchmark.ratio_interval`), and the PSNR of every fifth picture of this tree
-against the revision's (infinite: the same bytes).
+the same views of each case of the suite `lod` (`cloudcore/resources/bench/lod.toml`, every `--every`th view), in
+each mode, taking turns frame by frame in the balanced order of `measure.benchmark.turns`, so that both see the
+same machine load.  Auto mode prices its choices with the prior costs (`LLVMPIPE_COSTS`), not with times
+measured in each process, so both draw the same plans.  Reports per case and mode the ratio of this tree's mean
+`frame_ms` over the revision's after the warm-up with its 95% interval (`measure.benchmark.ratio_interval`), and
+the PSNR of every fifth picture of this tree against the revision's (infinite: the same bytes).  The revision
+must have the suite (`cloudcore.cli.bench_suite`).
 """
 
 from __future__ import annotations
@@ -30,18 +31,16 @@ from cloudcore.measure.imagecompare import compare as compare_images
 PICTURE_EVERY = 5
 
 
-def worker(tree: Path, case: str, every: int, modes: list[str]) -> None:
+def worker(case: str, every: int, modes: list[str]) -> None:
     """Serve a parent over stdin/stdout: 'frame MODE I [PATH]' draws view I in MODE (saving its picture to PATH)
     and answers its `frame_ms`; the first line answered is the number of views; 'quit'."""
     os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
-    sys.path.insert(0, str(tree / "scripts"))
-    from bench_lod import cases
-
+    from cloudcore.cli.bench_suite import built_cases
     from cloudcore.gl import FrameRenderer
     from cloudcore.lod.costs import LLVMPIPE_COSTS
     from cloudcore.settings import RenderSettings
 
-    _, scene, views, size, _ = cases([case], False)[0]
+    _, scene, views, size, _ = built_cases("lod", [case])[0]
     views = views[::every]
     renderers = {mode: FrameRenderer(*size) for mode in modes}
     print(len(views), flush=True)
@@ -125,11 +124,11 @@ def main() -> None:
     parser.add_argument("--warmup", type=int, default=5, help="frames of each mode not timed")
     parser.add_argument("--json", type=Path)
     parser.add_argument("--case", help=argparse.SUPPRESS)
-    parser.add_argument("--worker", type=Path, help=argparse.SUPPRESS)
+    parser.add_argument("--worker", type=Path, help=argparse.SUPPRESS)  # its tree: the process's PYTHONPATH
     args = parser.parse_args()
     modes = args.modes.split(",")
     if args.worker:
-        return worker(args.worker, args.case, args.every, modes)
+        return worker(args.case, args.every, modes)
     here = Path(__file__).resolve().parents[1]
     with tempfile.TemporaryDirectory() as folder:
         trees = {"this": here, "against": Path(folder) / "against"}

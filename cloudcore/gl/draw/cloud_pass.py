@@ -26,18 +26,18 @@ def draw_steps(plan: FramePlan) -> list[tuple[str, tuple]]:
     """The cloud pass's steps in order, (kind, the draw items it draws): Wang's ring first where there is one,
     then the draw items far to near, consecutive items of `_RUN_KINDS` together, the units the eye is inside in
     their runs (`inside_runs`: one screen impostor each)."""
-    steps = [("ring", ())] if plan.ring is not None else []
-    inside = {run[0]: tuple(run) for run in inside_runs(plan.draw_items, plan.clouds)}
+    steps = [("ring", [])] if plan.ring is not None else []
+    inside = {run[0]: run for run in inside_runs(plan.draw_items, plan.clouds)}
     for item in plan.draw_items:
         kind = plan.clouds[item.index].kind if item.kind == "cloud" else "object"
         if kind == "inside":
             if item in inside:  # the rest of its run is in the same screen impostor
                 steps.append((kind, inside[item]))
         elif kind in _RUN_KINDS and steps and steps[-1][0] == kind:
-            steps[-1] = (kind, steps[-1][1] + (item,))
+            steps[-1][1].append(item)
         else:
-            steps.append((kind, (item,)))
-    return steps
+            steps.append((kind, [item]))
+    return [(kind, tuple(items)) for kind, items in steps]
 
 
 class CloudPass:
