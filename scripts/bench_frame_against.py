@@ -62,7 +62,16 @@ def worker(case: str, every: int, modes: list[str]) -> None:
 
 def compare(trees: dict, case: str, every: int, modes: list[str], warmup: int, folder: Path) -> list[dict]:
     """One row per mode of `case`: this tree's frames against the revision's, and their pictures' PSNR."""
-    command = [sys.executable, __file__, "--case", case, "--every", str(every), "--modes", ",".join(modes)]
+    command = [
+        sys.executable,
+        str(Path(__file__).resolve()),
+        "--case",
+        case,
+        "--every",
+        str(every),
+        "--modes",
+        ",".join(modes),
+    ]
     workers = {
         name: subprocess.Popen(
             [*command, "--worker", str(tree)],
