@@ -91,8 +91,9 @@ class Shading:
     (`cloudcore.light.shading.EYE_PASSES`: Harris's eq. 5, its saturated form, closer to the path-traced
     truth, or Yusov's precomputed reference particle: docs/shading.md) and `light_pass` how the light
     reaching it is found (`LIGHT_PASSES`: Harris's multiple forward scattering, Yusov's occlusion
-    estimate, or Wrenninge's multiple-scattering octaves; "yusov" and "occlusion" together are Yusov's model,
-    "saturated" and "octaves" the octave model: docs/shading.md, "Octaves")."""
+    estimate, Wrenninge's multiple-scattering octaves, or the octaves with the light a lit face sends back;
+    "yusov" and "occlusion" together are Yusov's model, "saturated" and "octaves" the octave model:
+    docs/shading.md, "Octaves")."""
 
     albedo: float = 0.9
     optical_depth: float = 8.0

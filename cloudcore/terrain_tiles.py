@@ -9,7 +9,9 @@ from the eye, and the tiles' count grows with the log of the reach, not its squa
 
 Neighbouring tiles of different levels meet along an edge that the coarser samples half as often.  Each tile
 hangs a skirt from its edges, `SKIRT_CELLS` of its cells deep, which closes the gap between the two
-(tests/unit/model/test_terrain_tiles.py checks it).
+(tests/unit/model/test_terrain_tiles.py checks it), but not below the origin's level (nor its lowest sample), where
+the planet's ground drawn past the square lies; on the square's edge, where no tile neighbours it, down to that
+level.
 Why tiles: docs/performance.md, "The world pass: where its time goes".
 """
 
@@ -165,7 +167,16 @@ def tile_meshes(terrain: Terrain, frame: TileFrame, tiles: np.ndarray) -> tuple[
     grid = grid.reshape(len(xs), -1, 3)
     normals = normals.reshape(len(xs), -1, 3)
     skirt = grid[:, _PERIMETER].copy()
-    skirt[:, :, 1] -= SKIRT_CELLS * (side / TILE_CELLS)[:, None]
+    # no skirt hangs below the level of the scene's origin, where the planet's ground drawn past the square lies
+    # (`cloudcore.light.far_ground`), nor below the tile's lowest sample: seen from outside the square, under the
+    # terrain's edge, a skirt hung lower stood in front of that ground; a neighbour's edge, between samples of the
+    # same heights, lies no lower.  On the square's edge, which no tile neighbours, the skirt is a wall down to
+    # that level, the terrain's base
+    top = skirt[:, :, 1]
+    lowest = np.minimum(heights[:, 1:-1, 1:-1].min(axis=(1, 2)), 0.0)[:, None]
+    hung = np.maximum(top - SKIRT_CELLS * (side / TILE_CELLS)[:, None], lowest)
+    on_edge = np.maximum(np.abs(skirt[:, :, 0]), np.abs(skirt[:, :, 2])) >= half
+    skirt[:, :, 1] = np.where(on_edge, np.minimum(top, 0.0), np.minimum(hung, top))
     return np.concatenate([grid, skirt], axis=1), np.concatenate([normals, normals[:, _PERIMETER]], axis=1)
 
 

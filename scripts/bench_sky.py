@@ -58,7 +58,7 @@ def table_costs(scene) -> dict:
         lambda: multiple_scattering.build_multiple_scattering_table(params, transmittance_table)
     )
     altitude = scene.lighting.air.origin_altitude_m
-    sky_view_ms, table = best_of(
+    sky_view_ms, _ = best_of(
         lambda: sky_view.build_sky_view_table(params, transmittance_table, multiple_table, altitude, sun[1])
     )
     tables = atmosphere_tables(params)

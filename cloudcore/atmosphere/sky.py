@@ -77,13 +77,22 @@ class SkyView:
     tables: AtmosphereTables
     altitude_m: float
     sun_direction: np.ndarray  # (3,) unit, toward the sun
+    #: the air's light along each view, in front of the ground below the horizon (`sky_view.build_sky_view_table`)
     table: np.ndarray  # (108, 192, 3)
+    #: the air's transmittance along each of the table's rows, to the ground below the horizon
+    row_transmittance: np.ndarray  # (108, 3)
     #: a dragged slider's coarser sky (`sky_seen_from`), whose air between the eye and what it sees is coarser too
     preview: bool = False
 
     def radiance(self, directions) -> np.ndarray:
-        """(..., 3): the sky's radiance along unit `directions` (..., 3), the ground's below the horizon."""
+        """(..., 3): the sky's radiance along unit `directions` (..., 3); below the horizon the air's in front of
+        the ground, which it leaves out (`ground_transmittance` lets a ground's light through)."""
         return sky_view.sky_view_lookup(self.tables.params, self.table, self.altitude_m, directions, self.sun_direction)
+
+    def ground_transmittance(self, directions) -> np.ndarray:
+        """(..., 3): the air's transmittance along unit `directions` (..., 3) to the ground, where they meet it."""
+        rows = self.row_transmittance[:, None, :]
+        return sky_view.sky_view_lookup(self.tables.params, rows, self.altitude_m, directions, self.sun_direction)
 
 
 def sky_seen_from(params: AtmosphereParameters, altitude_m: float, sun_direction, preview: bool = False) -> SkyView:
@@ -97,10 +106,10 @@ def sky_seen_from(params: AtmosphereParameters, altitude_m: float, sun_direction
 def _sky_view(params: AtmosphereParameters, altitude_m: float, sun_direction: tuple, preview: bool) -> SkyView:
     tables = atmosphere_tables(params)
     sun = np.asarray(sun_direction, dtype=np.float64)
-    table = sky_view.build_sky_view_table(
+    table, row_transmittance = sky_view.build_sky_view_table(
         params, tables.transmittance, tables.multiple_scattering, altitude_m, float(sun[1]), preview
     )
-    return SkyView(tables, altitude_m, sun, table, preview)
+    return SkyView(tables, altitude_m, sun, table, row_transmittance, preview)
 
 
 def sky_irradiance(tables: AtmosphereTables, altitude_m: float, sun_direction, rings: int = 16, sectors: int = 16):

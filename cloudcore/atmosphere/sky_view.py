@@ -4,7 +4,10 @@ its azimuth from the sun (Hillaire 2020, section 5.3, `SkyViewLutPS`), and the l
 The zenith angle is mapped non-linearly (his `NONLINEARSKYVIEWLUT`): the upper half of the table runs from the
 zenith to the horizon and the lower half from the horizon to the nadir, each squared toward the horizon
 where the sky changes fastest; the azimuth is squared toward the sun.  Rays below the horizon end on the
-ground, which is drawn lit (his sky view leaves it black; ours is also the far ground past a scene's terrain).
+ground: the table holds the air in front of it alone (his sky view leaves the ground black), and each of its rows
+the air's transmittance to the ground, so that the renderer lays its own ground's colour behind the air (the far
+ground past a scene's terrain: `cloudcore.light.far_ground`).  Each half is read without the other's rows: the
+light changes at the horizon from the air's to the ground's, which filtering across it would blur into a band.
 """
 
 from __future__ import annotations
@@ -44,9 +47,12 @@ def sky_view_uv(
     zenith_angle = np.arccos(np.clip(mu, -1.0, 1.0))
     above = np.clip(1.0 - zenith_angle / zenith_horizon, 0.0, 1.0)
     below = np.clip((zenith_angle - zenith_horizon) / np.maximum(beta, 1e-12), 0.0, 1.0)
-    v = np.where(
-        ray_hits_ground(r, mu, params.bottom_radius_m), 0.5 * np.sqrt(below) + 0.5, 0.5 * (1.0 - np.sqrt(above))
-    )
+    ground = ray_hits_ground(r, mu, params.bottom_radius_m)
+    v = np.where(ground, 0.5 * np.sqrt(below) + 0.5, 0.5 * (1.0 - np.sqrt(above)))
+    # each half within its own rows' centres: the last row over the horizon is (height / 2 - 1) / (height - 1) of
+    # the unit range, the first below it (height / 2) / (height - 1)
+    first_ground, last_sky = (height // 2) / (height - 1.0), (height // 2 - 1) / (height - 1.0)
+    v = np.where(ground, np.maximum(v, first_ground), np.minimum(v, last_sky))
     u = np.sqrt(np.clip(0.5 - 0.5 * np.asarray(light_view_cosine), 0.0, 1.0))
     return unit_to_sub_uv(u, width), unit_to_sub_uv(v, height)
 
@@ -77,9 +83,11 @@ def build_sky_view_table(
     altitude_m: float,
     sun_cosine: float,
     preview: bool = False,
-) -> np.ndarray:
-    """(108, 192, 3): the sky's radiance per unit solar irradiance seen from `altitude_m` with the sun at
-    cosine `sun_cosine` to the up; (54, 96, 3) with fewer samples for a `preview`."""
+) -> tuple[np.ndarray, np.ndarray]:
+    """(radiance (108, 192, 3), transmittance (108, 3)): the light the air sends along each view per unit solar
+    irradiance seen from `altitude_m` with the sun at cosine `sun_cosine` to the up, to the ground below the
+    horizon (the ground itself left out), and each row's transmittance to the ray's end (the ground, or the top of
+    the air); (54, 96, 3) and (54, 3) with fewer samples for a `preview`."""
     size, samples = (PREVIEW_TABLE_SIZE, PREVIEW_SAMPLES) if preview else (SKY_VIEW_TABLE_SIZE, SKY_VIEW_SAMPLES)
     r = eye_radius(params, altitude_m)
     mu, light_view_cosine = sky_view_directions(params, r, size)
@@ -88,19 +96,10 @@ def build_sky_view_table(
     # a row's rays differ by their azimuth from the sun alone: one march a row (its first column) serves them all
     row_mu = mu[:, :1]
     distance = distance_to_boundary(r, row_mu, params.bottom_radius_m, params.top_radius_m)
-    radiance, _ = in_scattering(
-        params,
-        transmittance_table,
-        multiple_scattering_table,
-        r,
-        row_mu,
-        mu_s,
-        nu,
-        distance,
-        samples,
-        ground=ray_hits_ground(r, row_mu, params.bottom_radius_m),
+    radiance, transmittance = in_scattering(
+        params, transmittance_table, multiple_scattering_table, r, row_mu, mu_s, nu, distance, samples
     )
-    return radiance
+    return radiance, transmittance[:, 0]
 
 
 def light_view_cosines(directions, sun_direction) -> np.ndarray:
@@ -114,8 +113,9 @@ def light_view_cosines(directions, sun_direction) -> np.ndarray:
 
 
 def sky_view_lookup(params: AtmosphereParameters, table, altitude_m: float, directions, sun_direction) -> np.ndarray:
-    """(..., 3): the sky's radiance along unit `directions` (..., 3; y up) from the table built for this
-    altitude and the sun at unit `sun_direction`."""
+    """(..., channels): `table` (height, width, channels), built for this altitude and the sun at unit
+    `sun_direction`, along unit `directions` (..., 3; y up); a table of one column (the transmittance of
+    `build_sky_view_table`'s rows, (height, 1, channels)) by the row alone."""
     directions = np.asarray(directions, dtype=np.float64)
     height, width = table.shape[:2]
     u, v = sky_view_uv(

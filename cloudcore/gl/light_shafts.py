@@ -63,11 +63,14 @@ class LightShaftPass:
         air: AirVolume,
         shadows: CloudShadowMap,
         sky_lowest_up: float,
+        planet_ground: tuple[float, float] | None = None,
     ) -> None:
         """March the shafts of `shadows` in `air` (bound for `camera`'s eye) for a frame of `screen_size` seen
         through `view` and `projection`, up to the depth `draw_terrain_depth` draws (nothing: the sky everywhere),
-        the sky's rays below `sky_lowest_up` (a cosine to the up) marched at it, as the sky draws them.  Leaves the
-        framebuffer of the march bound: the caller binds its own."""
+        the sky's rays below `sky_lowest_up` (a cosine to the up) marched at it, as the sky draws them; or, where
+        the sky draws the planet's ground past the terrain, `planet_ground` (the eye's altitude over it, its
+        radius; metres), up to that ground.  Leaves the framebuffer of the march bound: the caller binds its
+        own."""
         reduction = shaft_reduction(screen_size[0]) if self._reduction is None else self._reduction
         size = shaft_size(*screen_size, reduction)
         self._depth.bind_cleared(size)
@@ -89,6 +92,7 @@ class LightShaftPass:
         GL.glUniform2f(GL.glGetUniformLocation(program, "depth_terms"), projection[2, 2], projection[2, 3])
         GL.glUniform1i(GL.glGetUniformLocation(program, "steps"), self._steps)
         GL.glUniform1f(GL.glGetUniformLocation(program, "sky_lowest_up"), sky_lowest_up)
+        GL.glUniform2f(GL.glGetUniformLocation(program, "planet_ground"), *(planet_ground or (-1.0, 0.0)))
         air.bind(program)
         shadows.bind(program)
         GL.glBindVertexArray(self._fullscreen_vertex_array)

@@ -27,8 +27,9 @@ from cloudcore.gl.programs import build_program, set_matrix, set_vec3
 from cloudcore.gl.shadow_map import CloudShadowMap
 from cloudcore.gl.targets import TextureTarget, linear_filtering
 from cloudcore.light.air_between import AirBetween, air_between
+from cloudcore.light.far_ground import far_ground_colour
 from cloudcore.light.light_shafts import SHAFT_STEPS
-from cloudcore.light.sky_background import SkyBackground
+from cloudcore.light.sky_background import NIGHT_SKY, SkyBackground, ground_behind_the_air
 from cloudcore.light.terrain_light import TerrainLight
 from cloudcore.limits import DRAWN_TERRAIN_KINDS
 from cloudcore.scene import Camera, Terrain
@@ -57,6 +58,13 @@ def sky_reduction(width: int) -> int:
     return max(1, round(width / SKY_COLUMNS))
 
 
+#: the texture unit of the air's transmittance along the sky-view table's rows (sky.frag.glsl's FAR_GROUND)
+_ROW_TRANSMITTANCE_UNIT = 8
+
+#: metres the far ground's depth is taken below the terrain's lowest vertex (`WorldPass._ground_below_the_terrain`):
+#: more than the depth buffer's step where the terrain meets the planet's level near the eye
+_DEPTH_MARGIN_M = 20.0
+
 #: a terrain vertex's attributes, 3 floats each: its position, the sun's light and the sky's (terrain.vert.glsl)
 _VERTEX_ATTRIBUTES = 3
 
@@ -78,7 +86,7 @@ class TerrainMesh:
             raise ValueError(f"the GL prototype draws heightfield and heightmap terrain only, not {terrain.kind!r}")
         self._terrain, self._light = terrain, light
         self.tiles = TerrainTiles(terrain)
-        self._programs: dict[tuple[bool, bool], int] = {}  # per (through the air, light shafts)
+        self._programs: dict[tuple[bool, bool, bool], int] = {}  # per (through the air, light shafts, far ground)
         self._depth_program: int | None = None
         self._coarse_in_view: np.ndarray | None = None  # the tiles whose coarse surfaces the coarse indices hold
         # the tiles' vertices and triangles, and their coarse surfaces' (the light shafts' depth: positions alone)
@@ -116,11 +124,12 @@ class TerrainMesh:
         GL.glBindVertexArray(0)
         self._coarse_in_view = None  # the coarse surfaces' triangles are gathered again
 
-    def _program(self, through_air: bool, shafts: bool) -> int:
-        if (through_air, shafts) not in self._programs:
-            defines = {"THROUGH_AIR": int(through_air), "LIGHT_SHAFTS": int(shafts)}
-            self._programs[through_air, shafts] = build_program("terrain", defines)
-        return self._programs[through_air, shafts]
+    def _program(self, through_air: bool, shafts: bool, far_ground: bool) -> int:
+        key = through_air, shafts, far_ground and through_air
+        if key not in self._programs:
+            defines = {"THROUGH_AIR": int(key[0]), "LIGHT_SHAFTS": int(key[1]), "FAR_GROUND": int(key[2])}
+            self._programs[key] = build_program("terrain", defines)
+        return self._programs[key]
 
     def draw(
         self,
@@ -129,15 +138,19 @@ class TerrainMesh:
         air: AirVolume | None,
         shadows: CloudShadowMap | None,
         shafts: LightShaftPass | None = None,
+        bind_far_air: Callable[[int], None] | None = None,
     ) -> None:
         """Draw the tiles in view for `camera` into the bound target, depth tested and written, seen through
-        `air` (bound for `camera`'s eye) where there is one, the sun's part in the clouds' `shadows` where given,
-        less the light `shafts` (marched for this view) where given."""
-        program = self._program(air is not None, shafts is not None)
+        `air` (bound for `camera`'s eye) where there is one, past its volume through the air to the planet's
+        ground that `bind_far_air(program)` binds where given (the sky's table: `WorldPass`), the sun's part in
+        the clouds' `shadows` where given, less the light `shafts` (marched for this view) where given."""
+        program = self._program(air is not None, shafts is not None, bind_far_air is not None)
         GL.glUseProgram(program)
         if air is not None:
             air.bind(program)
             set_vec3(program, "eye_position", camera.position)
+            if bind_far_air is not None:
+                bind_far_air(program)
         if shadows is None:
             GL.glUniform1i(GL.glGetUniformLocation(program, "cloud_shadows"), 0)
         else:
@@ -196,6 +209,11 @@ class TerrainMesh:
         GL.glDrawElements(GL.GL_TRIANGLES, 3 * len(in_view) * len(_COARSE_TILE_FACES), GL.GL_UNSIGNED_INT, None)
         GL.glBindVertexArray(0)
 
+    def lowest_m(self) -> float:
+        """The lowest height of the tiles drawn last (their skirts' included), 0 before any."""
+        positions = self.tiles.positions
+        return float(positions[:, 1].min()) if len(positions) else 0.0
+
     def close(self) -> None:
         for program in self._programs.values():
             GL.glDeleteProgram(program)
@@ -234,7 +252,13 @@ class WorldPass:
         self._shaft_quality = shaft_steps, shaft_reduction
         self._sky, self._air_for, self._sky_for = sky, air_for, sky_for
         self._sky_programs: dict[tuple[bool, bool], int] = {}  # per (light shafts, the sun's disc alone)
-        self._sky_view_texture = GL.glGenTextures(1) if sky.physical else None
+        # the sky-view table and the air's transmittance along its rows
+        self._sky_view_textures = [int(t) for t in GL.glGenTextures(2)] if sky.physical else None
+        # the planet's ground past the terrain, drawn by the physical sky below the horizon (none without a terrain:
+        # the air at the horizon is drawn there), as `ground_behind_the_air` adds it to the table's air
+        self._far_ground = (
+            ground_behind_the_air(far_ground_colour(terrain, light)) if sky.physical and terrain is not None else None
+        )
         self._uploaded_view = None  # the sky-view table the texture holds
         # core profile draws nothing without a vertex array, even one with no attributes
         self._fullscreen_vertex_array = GL.glGenVertexArrays(1)
@@ -265,7 +289,7 @@ class WorldPass:
         view_projection = projection @ view
         sky = self._sky_for(self._sky, camera.position)
         if sky.physical and sky.view is not self._uploaded_view:
-            _upload_sky_view(self._sky_view_texture, sky)
+            _upload_sky_view(self._sky_view_textures, sky)
             self._uploaded_view = sky.view
         air = None
         if self._air_volume is not None and through_air:
@@ -284,6 +308,7 @@ class WorldPass:
                 air,
                 shadows,
                 sky.lowest_up(),
+                None if self._far_ground is None else self._ground_below_the_terrain(sky, camera),
             )
         if sky.physical:
             self._draw_sky_picture(sky, camera, view_projection, (context.width, context.height), shafts)
@@ -296,8 +321,9 @@ class WorldPass:
         GL.glDisable(GL.GL_BLEND)
         GL.glDisable(GL.GL_CULL_FACE)  # the sky's triangle is not culled (the terrain's tiles cull their own)
         if self._terrain is not None:
-            self._terrain.draw(camera, view_projection, air, shadows, shafts)
-        self._draw_sky(sky, camera, view_projection, (context.width, context.height), shafts)
+            far_air = None if self._far_ground is None else lambda program: self._set_sky_view_uniforms(program, sky)
+            self._terrain.draw(camera, view_projection, air, shadows, shafts, far_air)
+        self._draw_sky(sky, camera, view, projection, (context.width, context.height))
         if antialiased:
             context.resolve_multisampled_target()
         context.bind_target()
@@ -327,17 +353,26 @@ class WorldPass:
         GL.glBindVertexArray(0)
 
     def _draw_sky(
-        self, sky: SkyBackground, camera: Camera, view_projection: np.ndarray, size: tuple[int, int], shafts
+        self, sky: SkyBackground, camera: Camera, view: np.ndarray, projection: np.ndarray, size: tuple[int, int]
     ) -> None:
         """The sky behind the terrain drawn into the bound target: the physical sky's picture read (with the sun's
-        disc added in its box), or the gradient."""
+        disc added in its box; the ground past the terrain given its depth), or the gradient."""
+        view_projection = projection @ view
         inverse_view_projection = np.linalg.inv(view_projection)
+        far_ground_depth = False
         if sky.physical:
             program = self._sky_read_program()
             GL.glUseProgram(program)
             GL.glActiveTexture(GL.GL_TEXTURE2)
             GL.glBindTexture(GL.GL_TEXTURE_2D, self._sky_target.texture)
             GL.glActiveTexture(GL.GL_TEXTURE0)
+            far_ground_depth = self._far_ground is not None
+            if far_ground_depth:  # the ground past the terrain takes its depth: clouds behind it are hidden
+                set_matrix(program, "inverse_view_projection", inverse_view_projection)
+                below = self._ground_below_the_terrain(sky, camera)
+                GL.glUniform2f(GL.glGetUniformLocation(program, "planet_ground"), *below)
+                set_vec3(program, "view_forward", -view[2, :3])
+                GL.glUniform2f(GL.glGetUniformLocation(program, "depth_terms"), projection[2, 2], projection[2, 3])
         else:
             program = self._sky_program(False)
             GL.glUseProgram(program)
@@ -345,9 +380,10 @@ class WorldPass:
             self._set_sky_uniforms(program, sky, camera, size[1])
         GL.glEnable(GL.GL_DEPTH_TEST)
         GL.glDepthFunc(GL.GL_LEQUAL)
-        GL.glDepthMask(GL.GL_FALSE)
+        GL.glDepthMask(GL.GL_TRUE if far_ground_depth else GL.GL_FALSE)
         GL.glBindVertexArray(self._fullscreen_vertex_array)
         GL.glDrawArrays(GL.GL_TRIANGLES, 0, 3)
+        GL.glDepthMask(GL.GL_FALSE)
         box = sun_box(sky, camera, view_projection, size) if sky.physical else None
         if box is not None:  # the sun's disc added where it can be
             disc = self._sky_program(False, sun_disc=True)
@@ -367,7 +403,9 @@ class WorldPass:
 
     def _sky_read_program(self) -> int:
         if self._sky_read is None:
-            self._sky_read = build_program("sky_read", {"DEPTH": 1.0}, vertex="world")
+            far_ground = int(self._far_ground is not None)
+            defines = {"DEPTH": 1.0, "FAR_GROUND": far_ground, "VIEW_RAY": far_ground}
+            self._sky_read = build_program("sky_read", defines, vertex="world")
         return self._sky_read
 
     def _sky_program(self, shafts: bool, sun_disc: bool = False) -> int:
@@ -376,6 +414,7 @@ class WorldPass:
             # at the far plane (the window depth 1), drawn where the depth is still the clear's
             defines = {
                 "PHYSICAL_SKY": int(self._sky.physical),
+                "FAR_GROUND": int(self._far_ground is not None),
                 "LIGHT_SHAFTS": int(shafts),
                 "SUN_DISC": int(sun_disc),
                 "VIEW_RAY": 1,
@@ -383,6 +422,17 @@ class WorldPass:
             }
             self._sky_programs[shafts, sun_disc] = build_program("sky", defines, vertex="world")
         return self._sky_programs[shafts, sun_disc]
+
+    def _ground_below_the_terrain(self, sky: SkyBackground, camera: Camera) -> tuple[float, float]:
+        """(the eye's altitude over it, its radius) of the planet's ground lowered under every vertex of the terrain
+        drawn (and the sea's level) by `_DEPTH_MARGIN_M`: the far ground's depth is that sphere's, which the terrain
+        always stands in front of (the sphere curves away under the level through its lowest point), so the sky's
+        read pass, depth tested against the terrain, never draws over it; the light shafts' march ends its rays past
+        the terrain there too."""
+        params = sky.view.tables.params
+        lowest = self._terrain.lowest_m() if self._terrain is not None else 0.0
+        level = min(0.0, sky.origin_altitude_m + lowest) - _DEPTH_MARGIN_M
+        return sky.eye_altitude_m(camera.position) - level, params.bottom_radius_m + level
 
     def _light_shafts(self) -> LightShaftPass:
         if self._shafts is None:
@@ -399,11 +449,26 @@ class WorldPass:
             set_vec3(program, "zenith_colour", sky.zenith)
             set_vec3(program, "horizon_colour", sky.horizon)
             return
+        self._set_sky_view_uniforms(program, sky)
+        set_vec3(program, "sun_disc_scale", sky.sun_disc_scale())
+        GL.glUniform1f(
+            GL.glGetUniformLocation(program, "pixel_angle"),
+            float(np.radians(camera.fov_y_deg) / max(viewport_height, 1)),
+        )
+
+    def _set_sky_view_uniforms(self, program: int, sky: SkyBackground) -> None:
+        """Bind the sky-view table of `sky` for `program` (shaders/sky_view.glsl), with the far ground's where there
+        is one."""
         params = sky.view.tables.params
         r = eye_radius(params, sky.view.altitude_m)
         _, zenith_horizon = horizon_angles(params, r)
         GL.glActiveTexture(GL.GL_TEXTURE1)
-        GL.glBindTexture(GL.GL_TEXTURE_2D, self._sky_view_texture)
+        GL.glBindTexture(GL.GL_TEXTURE_2D, self._sky_view_textures[0])
+        if self._far_ground is not None:
+            GL.glActiveTexture(GL.GL_TEXTURE0 + _ROW_TRANSMITTANCE_UNIT)
+            GL.glBindTexture(GL.GL_TEXTURE_2D, self._sky_view_textures[1])
+            set_vec3(program, "far_ground", self._far_ground)
+            set_vec3(program, "night_sky", NIGHT_SKY)
         height, width = sky.view.table.shape[:2]
         GL.glUniform2f(GL.glGetUniformLocation(program, "sky_view_size"), float(width), float(height))
         GL.glUniform1f(GL.glGetUniformLocation(program, "zenith_horizon_angle"), float(zenith_horizon))
@@ -411,11 +476,6 @@ class WorldPass:
             GL.glGetUniformLocation(program, "horizon_cosine"), float(horizon_cosine(r, params.bottom_radius_m))
         )
         set_vec3(program, "sun_direction", sky.view.sun_direction)
-        set_vec3(program, "sun_disc_scale", sky.sun_disc_scale())
-        GL.glUniform1f(
-            GL.glGetUniformLocation(program, "pixel_angle"),
-            float(np.radians(camera.fov_y_deg) / max(viewport_height, 1)),
-        )
         GL.glActiveTexture(GL.GL_TEXTURE0)
 
     @property
@@ -425,8 +485,8 @@ class WorldPass:
 
     def close(self) -> None:
         """Free the GL objects (the context must be current)."""
-        if self._sky_view_texture is not None:
-            GL.glDeleteTextures([self._sky_view_texture])
+        if self._sky_view_textures is not None:
+            GL.glDeleteTextures(self._sky_view_textures)
         if self._air_volume is not None:
             self._air_volume.close()
         if self._terrain is not None:
@@ -467,13 +527,15 @@ def sun_box(
     return int(low[0]), int(low[1]), int(high[0] - low[0]), int(high[1] - low[1])
 
 
-def _upload_sky_view(texture: int, sky: SkyBackground) -> None:
-    """Fill `texture` with the sky-view table of `sky` in the renderer's values, as floats, sampled linearly and
-    clamped to its edge texels as `cloudcore.atmosphere.table_sampling` reads it."""
-    GL.glBindTexture(GL.GL_TEXTURE_2D, texture)
-    linear_filtering(GL.GL_TEXTURE_2D)
-    # row 0 of the table is v's first texel: GL's first row, so the shader reads it with the numpy side's (u, v)
-    pixels = np.ascontiguousarray(sky.table(), dtype=np.float32)
-    height, width = pixels.shape[:2]
-    GL.glTexImage2D(GL.GL_TEXTURE_2D, 0, GL.GL_RGB32F, width, height, 0, GL.GL_RGB, GL.GL_FLOAT, pixels)
+def _upload_sky_view(textures: list[int], sky: SkyBackground) -> None:
+    """Fill `textures` with the sky-view table of `sky` in the renderer's values and the air's transmittance along
+    its rows (a column), as floats, sampled linearly and clamped to their edge texels as
+    `cloudcore.atmosphere.table_sampling` reads them."""
+    # row 0 of a table is v's first texel: GL's first row, so the shader reads it with the numpy side's (u, v)
+    for texture, table in zip(textures, (sky.table(), sky.view.row_transmittance[:, None, :]), strict=True):
+        GL.glBindTexture(GL.GL_TEXTURE_2D, texture)
+        linear_filtering(GL.GL_TEXTURE_2D)
+        pixels = np.ascontiguousarray(table, dtype=np.float32)
+        height, width = pixels.shape[:2]
+        GL.glTexImage2D(GL.GL_TEXTURE_2D, 0, GL.GL_RGB32F, width, height, 0, GL.GL_RGB, GL.GL_FLOAT, pixels)
     GL.glBindTexture(GL.GL_TEXTURE_2D, 0)

@@ -115,10 +115,10 @@ def illuminate_direction(
 
 def light_pass_method(shading: Shading, method: str) -> str:
     """The incident-light method that runs when `method` is asked under `shading`: Yusov's occlusion
-    estimate or Harris's pass with multiple-scattering octaves in place of Harris's exact and raster passes
-    where `shading.light_pass` says so; the editor's preview (Harris's, fast while a slider moves) and an
-    explicit method stay as asked."""
-    if shading.light_pass in ("occlusion", "octaves") and method in ("exact", "raster"):
+    estimate or Harris's pass with multiple-scattering octaves (with or without the light a lit face sends back)
+    in place of Harris's exact and raster passes where `shading.light_pass` says so; the editor's preview
+    (Harris's, fast while a slider moves) and an explicit method stay as asked."""
+    if shading.light_pass in ("occlusion", "octaves", "octaves-lit-face") and method in ("exact", "raster"):
         return shading.light_pass
     return method
 

@@ -40,6 +40,9 @@ Two methods:
   light plus Wrenninge's multiple-scattering octaves, transmittances toward the light through the particles
   ahead with their optical depths scaled, each counting only the light the direct beam has lost
   (`cloudcore.light.octaves`); no light order is needed.
+* "octaves-lit-face": the octaves, each particle's light then increased by what the medium behind it (away
+  from the light) reflects back to it (`cloudcore.light.lit_face`): one more product, over the overlaps behind each
+  particle, which the same search finds.
 """
 
 from __future__ import annotations
@@ -47,6 +50,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
+from cloudcore.light.lit_face import lit_face_return
 from cloudcore.light.occlusion import occlusion_estimate
 from cloudcore.light.octaves import most_light, octave_light, octave_optical_depths
 from cloudcore.light.phase import check_phase, phase_function
@@ -54,7 +58,7 @@ from cloudcore.light.precomputed import eye_pass_profiles
 from cloudcore.segments import concatenated_ranges
 from cloudcore.splat_kernel import splat_kernel
 
-METHODS = ("exact", "raster", "preview", "occlusion", "octaves")
+METHODS = ("exact", "raster", "preview", "occlusion", "octaves", "octaves-lit-face")
 #: what a particle sends toward the eye (`cloudcore.particles.buffer`): Harris's eq. 5 as printed,
 #: "saturated", its scattering coefficient and ambient term made those of a thick medium, or "yusov", the
 #: light leaving Yusov's precomputed reference particle (`cloudcore.light.precomputed`)
@@ -62,8 +66,9 @@ EYE_PASSES = ("harris", "saturated", "yusov")
 #: how the light reaching each particle is found (`[shading] light_pass`): Harris's multiple forward
 #: scattering (computed by the method asked: exact, raster or the editor's preview) or Yusov's
 #: light-space occlusion estimate (the method "occlusion" in place of exact and raster), or Wrenninge's
-#: multiple-scattering octaves over Harris's light-plane overlaps (the method "octaves": `cloudcore.light.octaves`)
-LIGHT_PASSES = ("harris", "occlusion", "octaves")
+#: multiple-scattering octaves over Harris's light-plane overlaps (the method "octaves": `cloudcore.light.octaves`),
+#: or the octaves with the light a cloud's lit face sends back (`cloudcore.light.lit_face`)
+LIGHT_PASSES = ("harris", "occlusion", "octaves", "octaves-lit-face")
 FOUR_PI = 4.0 * np.pi
 
 #: raster grid cells across the widest axis of a cloud's light-plane footprint.
@@ -160,10 +165,16 @@ def incident_light(
     toward_light = positions @ light
     alpha = -np.expm1(-tau)
     sigma = scattering_coefficient(tau, albedo, phase, g) * float(phase_function(1.0, phase, g))
-    if method == "octaves":
-        octave_tau = octave_optical_depths(tau)
-        through = _transmittance_exact(plane, toward_light, radii, -np.expm1(-octave_tau), groups)
-        return np.clip(octave_light(np.clip(through, 0.0, 1.0)), 0.0, most_light())
+    if method in ("octaves", "octaves-lit-face"):
+        octave_alpha = -np.expm1(-octave_optical_depths(tau))
+        if method == "octaves":
+            through = _transmittance_exact(plane, toward_light, radii, octave_alpha, groups)
+            return np.clip(octave_light(np.clip(through, 0.0, 1.0)), 0.0, most_light())
+        through, behind = _transmittance_exact(plane, toward_light, radii, octave_alpha, groups, behind=alpha[:, None])
+        light = np.clip(octave_light(np.clip(through, 0.0, 1.0)), 0.0, most_light())
+        # the optical thickness behind each particle (away from the light), as the product of 1 - alpha K there
+        depth_behind = -np.log(np.clip(behind[:, 0], np.finfo(np.float64).tiny, 1.0))
+        return light * (1.0 + lit_face_return(depth_behind, albedo, phase, g))
     if method == "exact":
         result = _incident_exact(plane, toward_light, radii, alpha, sigma, groups)
     elif method == "occlusion":
@@ -223,10 +234,18 @@ def _light_plane_axes(light: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def _overlaps_in_light_order(plane: np.ndarray, radii: np.ndarray):
     """Pairs (i, j), i < j, of particles already sorted in light order, with j inside i's splat.
 
-    Returns (source i, target j, K_i(x_j)) sorted by target, then source.  One
-    radius-wide pair query when the radii are alike; otherwise sources are
-    bucketed by radius octave so that one huge particle among tiny ones does not
-    make every query as wide as itself.
+    Returns (source i, target j, K_i(x_j)) sorted by target, then source (`_covering_pairs`, ahead only).
+    """
+    source, target, weight = _covering_pairs(plane, radii, ahead_only=True)
+    by_target = np.argsort(target * len(plane) + source)
+    return source[by_target], target[by_target], weight[by_target]
+
+
+def _covering_pairs(plane: np.ndarray, radii: np.ndarray, ahead_only: bool = False):
+    """(source i, target j, K_i(x_j)), unsorted: the pairs of particles (already sorted in light order) with j
+    inside i's splat, i < j (i ahead of j) only or either way round.  One radius-wide pair query when the radii
+    are alike; otherwise sources are bucketed by radius octave so that one huge particle among tiny ones does
+    not make every query as wide as itself.
     """
     tree = cKDTree(plane)
     positive = radii > 0
@@ -236,6 +255,8 @@ def _overlaps_in_light_order(plane: np.ndarray, radii: np.ndarray):
     if largest <= 4.0 * smallest:
         pairs = tree.query_pairs(float(largest), output_type="ndarray")  # i < j guaranteed
         source, target = pairs[:, 0], pairs[:, 1]
+        if not ahead_only:
+            source, target = np.concatenate([source, target]), np.concatenate([target, source])
     else:
         octave = np.floor(np.log2(np.where(positive, radii, 1.0))).astype(np.int64)
         found_source, found_target = [], []
@@ -247,15 +268,13 @@ def _overlaps_in_light_order(plane: np.ndarray, radii: np.ndarray):
             found_source.append(in_band[found["i"]])
             found_target.append(found["j"])
         source, target = np.concatenate(found_source), np.concatenate(found_target)
-        later = source < target
-        source, target = source[later], target[later]
+        kept = source < target if ahead_only else source != target
+        source, target = source[kept], target[kept]
     offset = plane[target] - plane[source]
     squared = offset[:, 0] ** 2 + offset[:, 1] ** 2
     inside = squared < radii[source] ** 2
     source, target, squared = source[inside], target[inside], squared[inside]
-    by_target = np.argsort(target * len(plane) + source)
-    source, target = source[by_target], target[by_target]
-    return source, target, splat_kernel(np.sqrt(squared[by_target]) / radii[source])
+    return source, target, splat_kernel(np.sqrt(squared) / radii[source])
 
 
 def _incident_exact(plane, toward_light, radii, alpha, sigma, groups):
@@ -266,30 +285,40 @@ def _incident_exact(plane, toward_light, radii, alpha, sigma, groups):
     return incident
 
 
-def _transmittance_exact(plane, toward_light, radii, alpha, groups):
+def _transmittance_exact(plane, toward_light, radii, alpha, groups, behind=None):
     """(N, K): the product of 1 - alpha_j K_j over the particles j ahead of each (toward the light) whose splat
     covers its centre, for each of the K columns of `alpha` (N, K): the frame buffer of Harris's pass with no
-    light scattered on, which needs no light order."""
-    order, source, target, weight = _overlaps_by_group(plane, toward_light, radii, groups)
-    blocked = alpha[order][source] * weight[:, None]
-    log_through = np.log(np.maximum(1.0 - blocked, np.finfo(np.float64).tiny))
-    through = np.empty(alpha.shape)
-    through[order] = np.exp(
-        np.stack([np.bincount(target, column, minlength=len(plane)) for column in log_through.T], axis=1)
-    )
-    return through
+    light scattered on, which needs no light order.  Given `behind` (N, K'), also (N, K') the same product over
+    the particles behind each (away from the light), from the same search: (ahead, behind)."""
+    pairs = _overlaps_in_light_order if behind is None else _covering_pairs
+    order, source, target, weight = _overlaps_by_group(plane, toward_light, radii, groups, pairs)
+    ahead = source < target
+
+    def product(columns, chosen):
+        blocked = columns[order][source[chosen]] * weight[chosen, None]
+        log_through = np.log(np.maximum(1.0 - blocked, np.finfo(np.float64).tiny))
+        through = np.empty(columns.shape)
+        through[order] = np.exp(
+            np.stack([np.bincount(target[chosen], c, minlength=len(plane)) for c in log_through.T], axis=1)
+        )
+        return through
+
+    if behind is None:
+        return product(alpha, ahead)
+    return product(alpha, ahead), product(behind, ~ahead)
 
 
-def _overlaps_by_group(plane, toward_light, radii, groups):
-    """(light order, source, target, K_source(x_target)): the overlaps of `_overlaps_in_light_order` found group
-    by group, indices into the light order (group-major; ties, coincident particles, keep their index order)."""
+def _overlaps_by_group(plane, toward_light, radii, groups, pairs=_overlaps_in_light_order):
+    """(light order, source, target, K_source(x_target)): the overlaps `pairs` finds (`_overlaps_in_light_order`
+    or `_covering_pairs`) group by group, indices into the light order (group-major; ties, coincident particles,
+    keep their index order)."""
     n = len(plane)
     order = np.lexsort((np.arange(n), -toward_light, groups))
     plane, radii = plane[order], radii[order]
     sources, targets, weights = [], [], []
     bounds = np.flatnonzero(np.diff(groups[order])) + 1
     for start, stop in zip(np.concatenate([[0], bounds]), np.concatenate([bounds, [n]])):
-        source, target, weight = _overlaps_in_light_order(plane[start:stop], radii[start:stop])
+        source, target, weight = pairs(plane[start:stop], radii[start:stop])
         sources.append(source + start)
         targets.append(target + start)
         weights.append(weight)

@@ -38,9 +38,8 @@ HORIZON_MARGIN = 1e-3
 
 def over_the_horizon(directions, horizon: float) -> np.ndarray:
     """Unit `directions` (..., 3) raised to just over the `horizon` (the cosine to the up of the ray grazing the
-    planet), each keeping its azimuth.  Below the horizon the terrain stands for the planet's ground: where it
-    does not reach (past the world's edge), the air at the horizon is drawn, as a far terrain would fade into
-    it, not the table's grey ground of one albedo (sky.frag.glsl does the same)."""
+    planet), each keeping its azimuth: below the horizon of a scene without a terrain, the air at the horizon is
+    drawn (sky.frag.glsl does the same); with one, the ground past it (`cloudcore.light.far_ground`)."""
     directions = np.asarray(directions, dtype=np.float64)
     up = horizon + HORIZON_MARGIN
     across = np.linalg.norm(directions[..., [0, 2]], axis=-1, keepdims=True)
@@ -59,6 +58,14 @@ def sky_view_altitude(params, eye_altitude_m: float) -> float:
 #: the night's sky under the moon and the stars, which the atmosphere (the sun's light alone) leaves black: the
 #: gradient's night zenith, as the ambient keeps its night floor (`lighting.NIGHT_AMBIENT`)
 NIGHT_SKY = 0.8 * NIGHT_AMBIENT
+
+
+def ground_behind_the_air(far_ground) -> np.ndarray:
+    """(3,): what the far ground of colour `far_ground` adds to the sky's air in front of it per unit of the air's
+    transmittance: the table holds the night's sky whole, where the air hides a surface only in part (the air's
+    volume keeps the night's sky where it hides what is behind, `air_between`), so the ground takes its share off
+    (the sum stays positive: the share is at most the night's sky)."""
+    return np.asarray(far_ground, dtype=np.float64) - NIGHT_SKY
 
 
 @dataclass(frozen=True, eq=False)
@@ -114,9 +121,11 @@ class SkyBackground:
         params = self.view.tables.params
         return float(horizon_cosine(eye_radius(params, self.view.altitude_m), params.bottom_radius_m)) + HORIZON_MARGIN
 
-    def radiance(self, directions, pixel_angle: float) -> np.ndarray:
+    def radiance(self, directions, pixel_angle: float, far_ground=None) -> np.ndarray:
         """(..., 3): the sky along unit `directions` (..., 3), the sun's disc with its rim spread over
-        `pixel_angle` (radians, a pixel's side)."""
+        `pixel_angle` (radians, a pixel's side); below the horizon the planet's ground of the renderer's colour
+        `far_ground` (3,) seen through the air (`cloudcore.light.far_ground`), or without one the air at the
+        horizon (`over_the_horizon`)."""
         directions = np.asarray(directions, dtype=np.float64)
         if not self.physical:
             return sky_gradient(directions, self.zenith, self.horizon)
@@ -124,9 +133,14 @@ class SkyBackground:
         r = eye_radius(params, self.view.altitude_m)
         above = ~ray_hits_ground(r, directions[..., 1], params.bottom_radius_m)
         horizon = float(horizon_cosine(r, params.bottom_radius_m))
-        low = directions[..., 1:2] < horizon + HORIZON_MARGIN
-        seen = np.where(low, over_the_horizon(directions, horizon), directions)
-        sky = np.pi * PHYSICAL_EXPOSURE * self.view.radiance(seen) + NIGHT_SKY
+        if far_ground is None:
+            low = directions[..., 1:2] < horizon + HORIZON_MARGIN
+            seen = np.where(low, over_the_horizon(directions, horizon), directions)
+            sky = np.pi * PHYSICAL_EXPOSURE * self.view.radiance(seen) + NIGHT_SKY
+        else:
+            through = (~above)[..., None] * self.view.ground_transmittance(directions)
+            sky = np.pi * PHYSICAL_EXPOSURE * self.view.radiance(directions) + NIGHT_SKY
+            sky = sky + through * ground_behind_the_air(far_ground)
         # the angle from the sun's centre by its chord, exact near 0 where acos is not
         chord = np.linalg.norm(directions - self.view.sun_direction, axis=-1)
         angle = 2.0 * np.arcsin(np.clip(0.5 * chord, 0.0, 1.0))

@@ -88,4 +88,6 @@ def test_dragging_the_time_of_day_on_the_default_scene_relights_in_the_worker(tm
             "\nlive time of day, default scene: "
             + ", ".join(f"{k} {v:.3g}" for k, v in live.items() if isinstance(v, float | int))
         )
-    assert live["shading_ms_on_the_gui_thread_max"] < 100.0  # every relight came from the worker
+    # every relight came from the worker: shading the look where the GUI runs takes about 2 s here, the new look's
+    # buffer 5-7 ms; the bound is far from both, since a loaded machine drew that buffer in 176 ms
+    assert live["shading_ms_on_the_gui_thread_max"] < 1000.0

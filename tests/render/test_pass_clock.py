@@ -41,18 +41,22 @@ def test_a_frame_waits_for_the_gpu_once_not_after_each_pass(renderer, clock, mon
 
 
 def test_the_passes_wall_times_add_up_to_the_frames_and_count_the_cpu_between_them(renderer, clock):
-    started = time.perf_counter()
+    # the passes fill the frame: at least its body, at most the body with the frame's own start and end (a fixed
+    # tolerance around one measure failed on a loaded machine, where the process may wait anywhere)
+    outside = time.perf_counter()
     with clock.frame():
+        inside = time.perf_counter()
         with clock.timed("draw"):
             clear_screen(renderer)
         time.sleep(0.02)  # the CPU's work between two passes is the second's
         with clock.timed("wait"):
             time.sleep(0.03)
-    frame_ms = 1e3 * (time.perf_counter() - started)
+        body_ms = 1e3 * (time.perf_counter() - inside)
+    frame_ms = 1e3 * (time.perf_counter() - outside)
     draw, wait = clock.times["draw"], clock.times["wait"]
-    print(f"draw {draw}, wait {wait}, frame {frame_ms:.2f} ms")
+    print(f"draw {draw}, wait {wait}, body {body_ms:.2f} ms, frame {frame_ms:.2f} ms")
     assert wait.cpu_ms >= 30.0 and wait.wall_ms >= 50.0
-    assert draw.wall_ms + wait.wall_ms == pytest.approx(frame_ms, abs=2.0)
+    assert body_ms <= draw.wall_ms + wait.wall_ms <= frame_ms
     for time_of in (draw, wait):
         assert 0.0 <= time_of.gpu_ms <= time_of.wall_ms + 1.0  # the GPU's time within the pass's share of the frame
 

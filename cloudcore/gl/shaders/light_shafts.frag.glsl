@@ -8,6 +8,7 @@
 
 #include "aerial_perspective.glsl"
 #include "cloud_shadow.glsl"
+#include "planet_ground.glsl"
 
 layout(binding = 0) uniform sampler2D terrain_depth;  // this target's size
 uniform vec3 eye_position;
@@ -18,6 +19,9 @@ uniform vec2 focal;        // the projection's [0][0] and [1][1]
 uniform vec2 depth_terms;  // the projection's [2][2] and [2][3]
 uniform int steps;         // cloudcore.light.light_shafts.SHAFT_STEPS
 uniform float sky_lowest_up;  // the sky draws a ray below this cosine to the up as the one at it (sky.frag.glsl)
+// with the far ground (sky.frag.glsl's FAR_GROUND): (the eye's altitude over the planet's ground, the planet's
+// radius), metres, and a ray below the horizon past the terrain ends on the ground; x < 0: none
+uniform vec2 planet_ground;
 
 out vec4 shadowed_and_share;
 
@@ -48,9 +52,11 @@ void main()
     float depth = texelFetch(terrain_depth, pixel, 0).r;
     float view_depth = depth_terms.y / (2.0 * depth - 1.0 + depth_terms.x);  // along the view's forward
     float distance = depth >= 1.0 ? air_max_distance : min(view_depth * length(vec3(across, 1.0)), air_max_distance);
-    if (depth >= 1.0 && direction.y < sky_lowest_up) {
-        // past the terrain's edge the sky draws the air at the horizon: its shafts too, not those of air under
-        // the ground
+    if (depth >= 1.0 && planet_ground.x >= 0.0)
+        distance = min(distance, distance_to_ground(planet_ground.x, planet_ground.y, direction.y));
+    else if (depth >= 1.0 && direction.y < sky_lowest_up) {
+        // past the terrain's edge (of a sky without the far ground) the sky draws the air at the horizon: its
+        // shafts too, not those of air under the ground
         vec2 level = normalize(direction.xz + vec2(1e-12, 0.0)) * sqrt(1.0 - sky_lowest_up * sky_lowest_up);
         direction = vec3(level.x, sky_lowest_up, level.y);
     }

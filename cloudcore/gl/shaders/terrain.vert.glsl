@@ -24,6 +24,9 @@ uniform mat4 world_to_cloud_shadow;  // cloud_shadow.glsl's
 #if THROUGH_AIR
 #include "aerial_perspective.glsl"
 #endif
+#if FAR_GROUND
+#include "sky_view.glsl"
+#endif
 #if LIGHT_SHAFTS
 #include "light_shafts_read.glsl"
 #endif
@@ -35,6 +38,21 @@ void main()
     vec3 air_let_through, air_added;
 #if THROUGH_AIR
     air_toward(position - eye_position, air_let_through, air_added);
+#if FAR_GROUND
+    // the air's volume ends at air_max_distance; past it the sky draws the planet's ground through the air it
+    // tables to the ground: over the volume's last eighth the terrain's air turns into that one, so that the
+    // terrain's edge, anywhere past the volume, meets the ground drawn past it without a line (a vertex over the
+    // horizon keeps the volume's: the table's rays there do not end on the ground)
+    vec3 from_eye = position - eye_position;
+    float beyond = smoothstep(0.875 * air_max_distance, air_max_distance, length(from_eye));
+    vec3 ray = normalize(from_eye);
+    if (beyond > 0.0 && ray.y < horizon_cosine) {
+        vec3 far_let_through, far_added;
+        air_to_the_ground(ray, far_let_through, far_added);
+        air_let_through = mix(air_let_through, far_let_through, beyond);
+        air_added = mix(air_added, far_added, beyond);
+    }
+#endif
 #if LIGHT_SHAFTS
     // read where the vertex falls on the screen (the shafts change little across a triangle); none behind the
     // eye, where the air is the eye's own

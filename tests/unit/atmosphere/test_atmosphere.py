@@ -318,15 +318,15 @@ def test_other_air_is_built_once_and_then_read_from_the_user_s_cache(monkeypatch
     np.testing.assert_array_equal(first.multiple_scattering, second.multiple_scattering)
 
 
-def test_below_the_horizon_the_sky_is_the_air_at_the_horizon_not_the_table_s_grey_ground():
-    """Past the terrain's edge a ray below the horizon meets the planet's ground of one grey albedo in the
-    table: the sky drawn there is the air just over the horizon at the same azimuth, as a far terrain fades."""
+def test_below_the_horizon_a_sky_without_a_terrain_is_the_air_at_the_horizon():
+    """Without a terrain (no far ground: test_far_ground.py) a ray below the horizon is drawn as the air just over
+    the horizon at the same azimuth, not the table's air in front of a ground it leaves out."""
     background = scene_sky(Lighting(time_of_day=12.0))
     level = np.array([[0.6, 0.0, -0.8]])
     down = np.array([[0.6 * np.cos(0.2), -np.sin(0.2), -0.8 * np.cos(0.2)]])
     below, at_horizon = background.radiance(down, 1e-3), background.radiance(level, 1e-3)
     np.testing.assert_allclose(below, at_horizon, rtol=0.02)
     ground = np.pi * PHYSICAL_EXPOSURE * background.view.radiance(down) + NIGHT_SKY
-    assert np.max(np.abs(ground - below) / below) > 0.1  # the table's ground is not what is drawn
+    assert np.max(np.abs(ground - below) / below) > 0.1  # the table's air to the ground is not what is drawn
     straight_down = background.radiance(np.array([[0.0, -1.0, 0.0]]), 1e-3)
     assert np.all(np.isfinite(straight_down)) and np.all(straight_down > 0.0)

@@ -1,0 +1,43 @@
+"""The planet's ground past a terrain's drawn square, to the horizon: one colour, lit as the terrain is.
+
+The terrain is drawn to its square (`terrain_tiles`, at most `reach` from the origin, as far as the air's
+volume goes); past it the sky's rays below the horizon meet the planet's ground, which the sky draws as the air's
+light in front of it plus its colour through the air (`SkyBackground.radiance`, shaders/sky.frag.glsl; Hillaire's
+sky view with the ground, his `MultipleScattering` ground term, lit as our terrain rather than by the sun alone).
+Its colour is the terrain's at the square's edge on level ground, lit by the terrain's own light (the sun's beam,
+the sky's dome, the floor: `TerrainLight`), so that the terrain's edge and the ground past it differ only by
+what the air's volume and the sky's table differ by at that distance (docs/atmosphere.md, "The ground past the
+terrain").  No cloud shadows it: a scene's clouds lie over its terrain.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from cloudcore.light.terrain_light import TerrainLight
+from cloudcore.scene import Terrain
+from cloudcore.terrain import ground_colours, height_at
+from cloudcore.terrain_tiles import tile_frame
+
+#: points along each side of the drawn square whose ground colours are averaged into the far ground's
+EDGE_SAMPLES = 64
+
+
+def edge_colour(terrain: Terrain) -> np.ndarray:
+    """(3,) linear RGB: the mean ground colour (`ground_colours`, by height, level) along the edge of the square
+    the terrain's tiles are drawn to."""
+    half = tile_frame(terrain).half_side_m
+    along = np.linspace(-half, half, EDGE_SAMPLES)
+    ends = np.full(EDGE_SAMPLES, half)
+    x = np.concatenate([along, along, -ends, ends])
+    z = np.concatenate([-ends, ends, along, along])
+    positions = np.stack([x, height_at(terrain, x, z), z], axis=1)
+    level = np.broadcast_to([0.0, 1.0, 0.0], positions.shape)
+    return ground_colours(terrain, positions, level).mean(axis=0)
+
+
+def far_ground_colour(terrain: Terrain, light: TerrainLight) -> np.ndarray:
+    """(3,) the renderer's linear values: the level ground past `terrain`'s square, of its edge's colour, in
+    `light` (the sun's beam unshadowed)."""
+    up = np.array([[0.0, 1.0, 0.0]])
+    return edge_colour(terrain) * (light.sun_irradiance(up) + light.unshadowed_irradiance(up))[0]
