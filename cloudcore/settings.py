@@ -219,7 +219,7 @@ class RenderSettings:
     #: with the world and clouds are depth-tested against them (the naive picture, for comparison)
     split_objects: bool = True
     #: draw batches of plain splats as point sprites (one vertex per particle) where the picture is the
-    #: same (`cloudcore.point_sprites`); off, always as quads (for comparison:
+    #: same (`cloudcore.particles.point_sprites`); off, always as quads (for comparison:
     #: docs/journal.md#point-sprites-third-session)
     point_sprites: bool = _setting(
         True,

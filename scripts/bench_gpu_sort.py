@@ -1,4 +1,4 @@
-"""The far-to-near sort on the CPU (`cloudcore.lod.depth_order.far_to_near`) against the GPU's radix sort
+"""The far-to-near sort on the CPU (`cloudcore.particles.depth_order.far_to_near`) against the GPU's radix sort
 (`cloudcore.gl.depth_sort.GpuDepthSort`), side by side in one run, with their orders compared. JSON out.
 
     python scripts/bench_gpu_sort.py [--counts 10000,100000,1000000] [--repeat 7] [--json out/bench_gpu_sort.json]
@@ -31,8 +31,8 @@ from OpenGL import GL  # noqa: E402  (the GL imports need the platform)
 from cloudcore.gl.context import HeadlessContext  # noqa: E402
 from cloudcore.gl.depth_sort import GpuDepthSort  # noqa: E402
 from cloudcore.gl.pass_clock import PassClock  # noqa: E402
-from cloudcore.lod.depth_order import distance_keys, far_to_near  # noqa: E402
 from cloudcore.measure.benchmark import machine, write_report  # noqa: E402
+from cloudcore.particles.depth_order import distance_keys, far_to_near  # noqa: E402
 
 #: how far the default flythrough's eye moves in a frame: 150 m/s at 30 fps
 _FRAME_STEP_M = 5.0

@@ -1,5 +1,5 @@
 """Splats as point sprites against quads, and the cost of a draw call: the numbers behind
-`cloudcore.point_sprites` (SHORTEST_POINT_RUN). JSON out.
+`cloudcore.particles.point_sprites` (SHORTEST_POINT_RUN). JSON out.
 
     python scripts/bench_point_sprites.py [cloudcore/resources/scenes/valley.toml] [--repeat 15]
                                           [--json out/bench_point_sprites.json]
@@ -29,12 +29,13 @@ from OpenGL import GL  # noqa: E402  (the GL imports need the platform above)
 import cloudcore.gl.splats as splats_module  # noqa: E402
 from cloudcore.camera import projection_matrix, view_matrix  # noqa: E402
 from cloudcore.gl.context import HeadlessContext  # noqa: E402
-from cloudcore.gl.splats import SplatPass, splat_batch  # noqa: E402
+from cloudcore.gl.splats import SplatPass  # noqa: E402
 from cloudcore.gl.targets import TextureTarget  # noqa: E402
-from cloudcore.light.eye_scattering import ParticleBuffer  # noqa: E402
 from cloudcore.light.lighting import scene_lights  # noqa: E402
 from cloudcore.lod.impostors import impostor_view  # noqa: E402
 from cloudcore.measure.benchmark import machine, write_report  # noqa: E402
+from cloudcore.particles.batch import splat_batch  # noqa: E402
+from cloudcore.particles.buffer import ParticleBuffer  # noqa: E402
 from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
 from cloudcore.scenefile import load_scene  # noqa: E402
 

@@ -27,10 +27,10 @@ from pathlib import Path
 import numpy as np
 
 from cloudcore.light import precomputed
-from cloudcore.light.eye_scattering import ParticleBuffer
 from cloudcore.light.illumination import illuminate_clouds
 from cloudcore.light.lighting import active_lights, scene_lights
 from cloudcore.measure.benchmark import machine, write_report
+from cloudcore.particles.buffer import ParticleBuffer
 from cloudcore.resources import DEFAULT_SCENE
 from cloudcore.scenefile import load_scene
 

@@ -26,10 +26,10 @@ from OpenGL import GL  # noqa: E402  (after the platform above)
 from cloudcore.gl.context import HeadlessContext  # noqa: E402
 from cloudcore.gl.shadow_map import CloudShadowMap  # noqa: E402
 from cloudcore.light.cloud_shadows import sample_map  # noqa: E402
-from cloudcore.light.eye_scattering import ParticleBuffer  # noqa: E402
 from cloudcore.light.illumination import shadowing_sun, sun_through_others  # noqa: E402
 from cloudcore.light.lighting import scene_lights  # noqa: E402
 from cloudcore.measure.benchmark import machine, write_report  # noqa: E402
+from cloudcore.particles.buffer import ParticleBuffer  # noqa: E402
 from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
 from cloudcore.scenefile import load_scene  # noqa: E402
 from cloudcore.terrain import heightfield_mesh  # noqa: E402

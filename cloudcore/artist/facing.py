@@ -168,7 +168,7 @@ def sprite_corners(centres, radii, normals, rotations) -> np.ndarray:
 class CloudFacings:
     """The facing locks of every cloud of eye-facing sprites in a particle set, frame to frame.
 
-    `particles` is a `cloudcore.light.eye_scattering.ParticleBuffer`.  Only clouds
+    `particles` is a `cloudcore.particles.buffer.ParticleBuffer`.  Only clouds
     whose bounding sphere holds the eye, or that still have a sprite locked,
     are looked at: elsewhere no sprite is within its lock radius.
     """

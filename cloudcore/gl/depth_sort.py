@@ -1,6 +1,6 @@
 """A stable radix sort on the GPU of (key, value) uint32 pairs held in storage buffers.
 
-The GPU counterpart of `cloudcore.lod.depth_order.far_to_near`: given keys
+The GPU counterpart of `cloudcore.particles.depth_order.far_to_near`: given keys
 that are the inverted bit patterns of float32 distances, sorting them
 ascending orders the values (particle indices) far to near, equal distances
 in their input order, exactly as the CPU does.  Eight passes of four bits

@@ -24,15 +24,16 @@ import numpy as np
 from OpenGL import GL
 
 from cloudcore.gl.impostor_atlas import AtlasImage, ImpostorAtlas
-from cloudcore.gl.splats import SplatPass, SplatSelection, splat_batch
+from cloudcore.gl.splats import SplatPass
 from cloudcore.gl.targets import TextureTarget
 from cloudcore.gl.texture_pool import TexturePool
-from cloudcore.light.eye_scattering import ParticleBuffer
 from cloudcore.lod.atlas import power_of_two_at_least
 from cloudcore.lod.impostors import ImpostorView, cropped_corners, impostor_view, particle_extent
 from cloudcore.lod.plan import FramePlan
 from cloudcore.lod.ring import RingGeneration, panel_corners, segment_camera
 from cloudcore.lod.splitting import layer_bounds
+from cloudcore.particles.batch import SplatSelection, splat_batch
+from cloudcore.particles.buffer import ParticleBuffer
 from cloudcore.settings import RenderSettings
 
 #: the atlas layers' side: the default largest impostor, one layer 2 MiB; larger impostors get an atlas of their side

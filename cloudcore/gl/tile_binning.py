@@ -48,7 +48,8 @@ from cloudcore.gl.programs import (
     set_matrix_at,
     uniform_locations,
 )
-from cloudcore.gl.splats import INSTANCE_BYTES, reallocate_storage
+from cloudcore.gl.splat_shading import INSTANCE_BYTES
+from cloudcore.gl.storage import reallocate_storage
 from cloudcore.light.volume_blending import TILE_PIXELS
 from cloudcore.measured_way import software_rasterizer
 

@@ -20,7 +20,6 @@ import numpy as np
 from OpenGL import GL
 
 from cloudcore.gl.programs import build_compute_program, gl_renderer, set_vec3
-from cloudcore.gl.splats import SplatBatch
 from cloudcore.gl.targets import DepthTexture
 from cloudcore.gl.tile_binning import DISCS_BINDING, OCCUPIED_BINDING, BinnedTiles, GpuTileBinning
 from cloudcore.light.volume_blending import (
@@ -29,6 +28,7 @@ from cloudcore.light.volume_blending import (
     TILE_PIXELS,
     Splats,
 )
+from cloudcore.particles.batch import SplatBatch
 from cloudcore.splat_kernel import SPLAT_SHARPNESS
 
 _TILE_STARTS_BINDING, _TILE_ENTRIES_BINDING = 6, 7

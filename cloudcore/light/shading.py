@@ -59,7 +59,7 @@ from cloudcore.segments import concatenated_ranges
 from cloudcore.splat_kernel import splat_kernel
 
 METHODS = ("exact", "raster", "preview", "occlusion", "octaves", "octaves-lit-face")
-#: what a particle sends toward the eye (`cloudcore.light.eye_scattering`): Harris's eq. 5 as printed,
+#: what a particle sends toward the eye (`cloudcore.particles.buffer`): Harris's eq. 5 as printed,
 #: "saturated", its scattering coefficient and ambient term made those of a thick medium, or "yusov", the
 #: light leaving Yusov's precomputed reference particle (`cloudcore.light.precomputed`)
 EYE_PASSES = ("harris", "saturated", "yusov")

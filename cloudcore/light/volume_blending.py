@@ -306,7 +306,7 @@ def _march(splats: Splats, rays, image, opaque, steps: int):
 def blending_path(requested: str, *, compute_shaders: bool, plain_splats_only: bool) -> str:
     """How one full-3D batch is composited: "volume" (the tiled compute pass) where the setting asks for
     it, the GL has compute shaders and every particle is a plain Gaussian splat of one colour
-    (`cloudcore.point_sprites.plain_splats`: the pass draws no sprites nor per-corner colours); else
+    (`cloudcore.particles.point_sprites.plain_splats`: the pass draws no sprites nor per-corner colours); else
     "plain" billboards.  Where a GL has GL_ARB_fragment_shader_interlock, Yusov's own fragment-shader
     path would be a third answer here; none is written (this project has no GL to test one on)."""
     if requested not in BLENDINGS:

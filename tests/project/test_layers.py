@@ -50,8 +50,10 @@ LAYERS = (
     # the particles and how they look besides the light: Wang's artist tools, Yusov's cloud fields, the wind that
     # moves them and the weather over a field
     ("artist", "field", "weather", "wind"),
-    # what is done with the particles: the light, the level of detail, how splats are drawn
-    ("light", "lod", "point_sprites"),
+    # what is done with the particles: the light, the level of detail
+    ("light", "lod"),
+    # the frame's particles: their buffer (lit, carried, weighed), a draw's batch far to near, point sprites
+    ("particles",),
     # measurement
     ("measure",),
     # scenes coming in and changed: the files, what the renderer can draw, the artist's edits, clouds from and to

@@ -69,11 +69,12 @@ def test_the_gpu_bins_each_tile_far_to_near_and_only_the_kept_splats(renderer, v
     ascending (the draw's far-to-near order), every entry a splat the selection kept, and every kept splat
     on screen in the tile of its centre; each tile as many as the numpy binning lists of the same splats (its
     disc's tiles, not its square's), but where float32 rounding puts a disc's edge across a tile's."""
-    from cloudcore.gl.splats import SplatPass, SplatSelection
+    from cloudcore.gl.splats import SplatPass
     from cloudcore.gl.tile_binning import GpuTileBinning
+    from cloudcore.particles.batch import SplatSelection
 
     renderer.render(valley, settings=RASTER)
-    particles = renderer._particles  # the renderer's own, shaded for the scene: no public handle needed elsewhere
+    particles = renderer.particles  # the renderer's own, shaded for the scene (the valley in still air: not carried)
     camera = valley.camera
     view = view_matrix(camera)
     projection = projection_matrix(camera.fov_y_deg, RENDER_WIDTH / RENDER_HEIGHT)
@@ -192,11 +193,12 @@ def test_only_selections_of_plain_splats_are_compositable(renderer):
     """A selection is composited by compute only where all its clouds' particles are plain Gaussian splats of one
     colour; the formation scene's are sprites, the aircraft scene's cloud plain."""
     from cloudcore.artist.particle_styles import particle_styles
-    from cloudcore.gl.splats import SplatPass, SplatSelection
-    from cloudcore.light.eye_scattering import ParticleBuffer
+    from cloudcore.gl.splats import SplatPass
     from cloudcore.light.illumination import IlluminationCache
     from cloudcore.light.lighting import scene_lights
-    from cloudcore.point_sprites import plain_splats
+    from cloudcore.particles.batch import SplatSelection
+    from cloudcore.particles.buffer import ParticleBuffer
+    from cloudcore.particles.point_sprites import plain_splats
 
     sprites = load_scene(resource_path("scenes", "formation.toml"))
     clouds = sprites.clouds + load_scene(resource_path("scenes", "aircraft_in_cloud.toml")).clouds

@@ -11,8 +11,8 @@ import pytest
 
 from cloudcore.camera import frustum_planes, projection_matrix, view_matrix
 from cloudcore.gl.prefix_sum import ONE_GROUP_ITEMS, GpuPrefixSum
-from cloudcore.light.eye_scattering import ParticleBuffer
 from cloudcore.measure.imagecompare import compare
+from cloudcore.particles.buffer import ParticleBuffer
 from cloudcore.scene import Camera, Cloud, Formation, Light, Shading
 from cloudcore.scenefile import load_scene
 from cloudcore.settings import RenderSettings
@@ -152,7 +152,8 @@ def _far_to_near_up_to_ties(order: np.ndarray, particles: ParticleBuffer, eye) -
 
 
 def test_a_selection_chooses_and_orders_the_particles_splat_batch_does(renderer):
-    from cloudcore.gl.splats import SplatPass, SplatSelection, splat_batch
+    from cloudcore.gl.splats import SplatPass
+    from cloudcore.particles.batch import SplatSelection, splat_batch
 
     rng = np.random.default_rng(7)
     forming = Formation(start_s=0.0, duration_s=10.0, kind="form")

@@ -90,7 +90,7 @@ def test_a_target_drawn_after_an_atlas_cell_is_not_clipped_to_the_cell(renderer)
 def _twenty_clouds(rng):
     """Twenty small clouds ahead of the eye at the origin, the eighth of sprites, as a `ParticleBuffer`."""
     from cloudcore.cloud_records import SpriteStyle
-    from cloudcore.light.eye_scattering import ParticleBuffer
+    from cloudcore.particles.buffer import ParticleBuffer
     from cloudcore.scene import Cloud, Light, Shading
 
     clouds = []
@@ -116,7 +116,8 @@ def test_cells_drawn_in_one_multi_draw_hold_what_each_drawn_alone_holds(renderer
     """A frame's regenerations all of point sprites go into the atlas in one multi-draw a 16 cells, each through
     its own viewport, scissor and layer (`SplatPass.draw_point_cells`): the texels must be those of drawing each
     cell by itself, none spilling into a neighbour; a cloud of sprites still needs quads, so a draw of its own."""
-    from cloudcore.gl.splats import SplatPass, splat_batch
+    from cloudcore.gl.splats import SplatPass
+    from cloudcore.particles.batch import splat_batch
 
     rng = np.random.default_rng(11)
     particles = _twenty_clouds(rng)
@@ -165,7 +166,8 @@ def test_cells_chosen_and_sorted_on_the_gpu_hold_what_each_drawn_alone_holds(ren
     sort, one multi-draw of quads a 16 cells (`SplatPass.draw_cells`).  Each cell must hold the particles
     `splat_batch` chooses for it, far to near, and the texels of drawing it alone as quads; a cloud split in two
     layers is in two cells, and the sprites' cell shares the draw."""
-    from cloudcore.gl.splats import SplatPass, SplatSelection, splat_batch
+    from cloudcore.gl.splats import SplatPass
+    from cloudcore.particles.batch import SplatSelection, splat_batch
 
     rng = np.random.default_rng(12)
     particles = _twenty_clouds(rng)

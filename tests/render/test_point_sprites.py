@@ -1,13 +1,13 @@
-"""Plain splats drawn as point sprites give the picture quads give (`cloudcore.point_sprites`)."""
+"""Plain splats drawn as point sprites give the picture quads give (`cloudcore.particles.point_sprites`)."""
 
 import numpy as np
 import pytest
 
 from cloudcore.artist.particle_styles import particle_styles
 from cloudcore.camera import projection_matrix, view_matrix
-from cloudcore.light.eye_scattering import ParticleBuffer
 from cloudcore.lod.impostors import impostor_view
-from cloudcore.point_sprites import draw_runs, plain_splats, point_sprite_mask
+from cloudcore.particles.buffer import ParticleBuffer
+from cloudcore.particles.point_sprites import draw_runs, plain_splats, point_sprite_mask
 from cloudcore.scene import Camera, Cloud, Light, Shading
 
 CAMERA = Camera((0.0, 0.0, 0.0), (0.0, 0.0, -1.0), 60.0)
@@ -72,8 +72,9 @@ def test_an_impostor_drawn_with_points_is_the_one_drawn_with_quads(renderer, cou
     """Through an impostor's off-axis frustum, fitted around the cloud as regenerations are."""
     from OpenGL import GL
 
-    from cloudcore.gl.splats import SplatPass, splat_batch
+    from cloudcore.gl.splats import SplatPass
     from cloudcore.gl.targets import TextureTarget
+    from cloudcore.particles.batch import splat_batch
 
     particles_array = dense_cloud(np.random.default_rng(3), 400)
     particles = ParticleBuffer((Cloud("cumulus", particles_array, optical_depth=1.5),), Shading(), LIGHTS, AMBIENT)
@@ -123,8 +124,9 @@ def test_a_batch_is_drawn_in_its_order_as_runs_and_short_runs_of_points_stay_qua
 def test_splats_around_the_eye_drawn_as_points_and_quads_together_match_quads_alone(renderer):
     """A screen draw next to the eye: centres off screen and large squares keep quads, the rest are points."""
     from cloudcore.camera import frustum_planes
-    from cloudcore.gl.splats import SplatPass, splat_batch
+    from cloudcore.gl.splats import SplatPass
     from cloudcore.gl.targets import TextureTarget
+    from cloudcore.particles.batch import splat_batch
 
     rng = np.random.default_rng(8)
     around = np.column_stack([rng.uniform(-1500.0, 1500.0, (40000, 3)), rng.uniform(10.0, 60.0, 40000)])

@@ -11,7 +11,7 @@ import pytest
 
 from cloudcore.camera import projection_matrix, view_matrix
 from cloudcore.cloud_records import Formation
-from cloudcore.light.eye_scattering import ParticleBuffer
+from cloudcore.particles.buffer import ParticleBuffer
 from cloudcore.scene import Camera, Cloud, Light, Shading
 from cloudcore.splat_kernel import splat_kernel
 
@@ -41,8 +41,9 @@ def particle_grid(z: float) -> np.ndarray:
     ],
 )
 def test_the_shader_colours_particles_as_the_reference_does(renderer, phase, g, eye_pass):
-    from cloudcore.gl.splats import SplatPass, splat_batch
+    from cloudcore.gl.splats import SplatPass
     from cloudcore.gl.targets import TextureTarget
+    from cloudcore.particles.batch import splat_batch
 
     clouds = (
         Cloud("steady", particle_grid(-100.0), optical_depth=2.0, color=(1.0, 0.9, 0.8)),
@@ -98,8 +99,9 @@ def test_the_shader_colours_artist_clouds_as_the_reference_does(renderer):
     from cloudcore.artist.artist_shading import artist_colours
     from cloudcore.artist.particle_styles import particle_styles
     from cloudcore.cloud_records import ArtistShading
-    from cloudcore.gl.splats import SplatPass, splat_batch
+    from cloudcore.gl.splats import SplatPass
     from cloudcore.gl.targets import TextureTarget
+    from cloudcore.particles.batch import splat_batch
     from cloudcore.scene import Lighting
     from cloudcore.sun import sun_direction
 
@@ -166,8 +168,9 @@ def test_a_sprite_the_eye_stands_in_keeps_its_facing_and_fades_as_the_eye_circle
 def test_splats_left_out_by_the_frustum_change_no_pixel(renderer):
     """A cloud around the eye: most of its splats are behind it or off screen, and leaving them out is exact."""
     from cloudcore.camera import frustum_planes
-    from cloudcore.gl.splats import SplatPass, splat_batch
+    from cloudcore.gl.splats import SplatPass
     from cloudcore.gl.targets import TextureTarget
+    from cloudcore.particles.batch import splat_batch
     from cloudcore.splat_coverage import splats_in_frustum
 
     rng = np.random.default_rng(5)

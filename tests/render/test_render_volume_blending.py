@@ -8,9 +8,9 @@ import pytest
 
 from cloudcore.artist.particle_styles import particle_styles
 from cloudcore.camera import pixel_rays, projection_matrix, view_matrix
-from cloudcore.light.eye_scattering import ParticleBuffer
 from cloudcore.light.lighting import scene_lights
 from cloudcore.light.volume_blending import plain_blend, ray_distances, ray_marched, volume_blend
+from cloudcore.particles.buffer import ParticleBuffer
 from cloudcore.scene import Camera, Cloud, Light, Scene, Shading
 from cloudcore.settings import FULL_3D
 
@@ -26,9 +26,10 @@ def test_the_compute_pass_composites_as_the_reference_does(renderer, wall_m):
     depth is a wall that far ahead, between their centres, cutting their chords."""
     from OpenGL import GL
 
-    from cloudcore.gl.splats import SplatPass, splat_batch
+    from cloudcore.gl.splats import SplatPass
     from cloudcore.gl.targets import TextureTarget
     from cloudcore.gl.volume_blending import VolumeBlendingPass, batch_splats
+    from cloudcore.particles.batch import splat_batch
 
     clouds = (
         Cloud("red", [[-1.5, 0.0, -100.0, 6.0]], optical_depth=3.0, color=(1.0, 0.3, 0.2)),
@@ -100,8 +101,8 @@ def test_volumes_are_nearer_the_ray_march_than_billboards(renderer, make_scene, 
     """Two clouds sharing space (colours mixed where they meet), and a layer cut by the terrain (a
     billboard's hard line where its plane meets the ground, a volume's chord cut softly)."""
     from cloudcore.camera import frustum_planes
-    from cloudcore.gl.splats import splat_batch
     from cloudcore.gl.volume_blending import batch_splats
+    from cloudcore.particles.batch import splat_batch
 
     scene = make_scene()
     width, height = renderer.size

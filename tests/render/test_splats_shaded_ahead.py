@@ -4,7 +4,7 @@ batch shaded as it is drawn after them (growing the buffer they are in) leaves t
 import numpy as np
 
 from cloudcore.camera import projection_matrix, view_matrix
-from cloudcore.light.eye_scattering import ParticleBuffer
+from cloudcore.particles.buffer import ParticleBuffer
 from cloudcore.scene import Camera, Cloud, Light, Shading
 
 CAMERA = Camera((0.0, 0.0, 0.0), (0.0, 0.0, -1.0), 60.0)
@@ -18,8 +18,9 @@ def _cloud(rng, name: str, count: int, x: float) -> Cloud:
 
 
 def test_batches_shaded_ahead_draw_as_batches_shaded_alone(renderer):
-    from cloudcore.gl.splats import SplatPass, splat_batch
+    from cloudcore.gl.splats import SplatPass
     from cloudcore.gl.targets import TextureTarget
+    from cloudcore.particles.batch import splat_batch
 
     rng = np.random.default_rng(4)
     clouds = (_cloud(rng, "left", 300, -120.0), _cloud(rng, "right", 500, 120.0), _cloud(rng, "big", 5000, 0.0))

@@ -274,9 +274,10 @@ def test_a_scene_within_every_limit_has_no_problems(small_scene):
 
 
 def test_the_shader_s_light_array_is_sized_by_the_same_constant():
-    from cloudcore.gl import splats
+    from cloudcore.gl import splat_residency, splat_shading
 
-    assert splats.MAX_LIGHTS is MAX_LIGHTS
+    # the particles' records hold MAX_LIGHTS incident lights; the shading shader sums as many
+    assert splat_residency.MAX_LIGHTS is MAX_LIGHTS and splat_shading.MAX_LIGHTS is MAX_LIGHTS
 
 
 @pytest.mark.parametrize("side, status", [(MAX_FRAME_SIDE + 1, 2), (0, 2)])

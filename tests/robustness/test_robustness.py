@@ -205,7 +205,7 @@ def looking_from(eye, at=CLOUD_CENTRE + [0.0, 0.0, -500.0], fov: float = 55.0) -
 
 @pytest.mark.parametrize("mode", ["full", "auto"])
 def test_camera_inside_a_particle(renderer, mode):
-    """The particle holding the eye fades out (`cloudcore.light.eye_scattering`); the others in view are drawn."""
+    """The particle holding the eye fades out (`cloudcore.particles.buffer`); the others in view are drawn."""
     camera = looking_from(BASE.clouds[0].particles[0, :3])
     frame = render_checked(renderer, "camera at a particle's centre", BASE, MODES[mode], camera=camera)
     expected_kind = kind_with_the_eye_inside(renderer, mode)

@@ -1,7 +1,7 @@
 #version 430 core
 // One pass of a stable least-significant-digit radix sort of (key, value)
 // pairs of uint32, ascending by key, on DIGIT_BITS bits of the key from
-// `shift` (reference: cloudcore.lod.depth_order.far_to_near, whose keys are
+// `shift` (reference: cloudcore.particles.depth_order.far_to_near, whose keys are
 // the inverted bit patterns of float32 distances).  A pass is two stages,
 // chosen by the stage defined, around a prefix sum (prefix_sum.comp.glsl):
 //   COUNT    one workgroup a tile: how many of its keys have each digit,

@@ -8,7 +8,7 @@
 // vertex pipeline once per instance).  Corners come relative to the eye,
 // so the view matrix applies without its translation.  With POINT_SPRITE
 // defined, one vertex per particle instead, a point sprite of the quad's
-// square (cloudcore.point_sprites says when the picture is the same); its
+// square (cloudcore.particles.point_sprites says when the picture is the same); its
 // centre and radius come back from the corners, so that one compute shader
 // serves both ways of drawing.  With CELLS defined, the points or quads of many
 // impostors at once, one multi-draw's draw each: its cell's view, projection,

@@ -5,7 +5,7 @@
 // A particle is kept when it has any opacity (the near fade of splats, a
 // transparent colour level, formation and blend weights) and lies in its
 // cloud's depth range and in the frustum; its key is then its distance's
-// far-to-near sort key (cloudcore.lod.depth_order.distance_keys), and the
+// far-to-near sort key (cloudcore.particles.depth_order.distance_keys), and the
 // draw's indirect command counts it.  A particle left out gets the largest
 // key, which no kept one has, so that after the sort (depth_sort.comp.glsl)
 // the kept come first, far to near, in the count the command holds.

@@ -5,7 +5,7 @@
 // rather than at each corner in the vertex shader: on a software rasteriser
 // vertex work is the cost.
 //
-// Colour, Harris (reference cloudcore.light.eye_scattering.ParticleShading.seen_from):
+// Colour, Harris (reference cloudcore.particles.buffer.ParticleShading.seen_from):
 // per light, the incident light of the light pass times the phase function at
 // the angle between the view ray and the light, times the scattering
 // coefficient, plus ambient; for Yusov's eye pass (reference

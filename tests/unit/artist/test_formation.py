@@ -10,7 +10,7 @@ import pytest
 from cloudcore.artist.formation import core_distances, formation_state, opacity_factor, progress
 from cloudcore.cloud_records import Formation
 from cloudcore.errors import SceneError
-from cloudcore.light.eye_scattering import ParticleBuffer
+from cloudcore.particles.buffer import ParticleBuffer
 from cloudcore.scene import Cloud, Light, Shading
 from cloudcore.scenefile import load_scene, save_scene
 

@@ -7,7 +7,6 @@ from scipy.integrate import quad
 
 from cloudcore import disk_cache
 from cloudcore.light import precomputed
-from cloudcore.light.eye_scattering import ParticleBuffer
 from cloudcore.light.illumination import illuminate_direction
 from cloudcore.light.occlusion import occlusion_estimate
 from cloudcore.light.phase import phase_function
@@ -19,6 +18,7 @@ from cloudcore.light.precomputed import (
     reference_tables,
 )
 from cloudcore.light.shading import eye_pass_coefficients, incident_light
+from cloudcore.particles.buffer import ParticleBuffer
 from cloudcore.resources import resource_path
 from cloudcore.scene import Cloud, Light, Scene, Shading
 from cloudcore.scenefile import load_scene, save_scene

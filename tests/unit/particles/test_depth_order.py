@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from cloudcore.lod.depth_order import far_to_near
+from cloudcore.particles.depth_order import far_to_near
 
 
 @pytest.mark.parametrize("seed", range(4))
