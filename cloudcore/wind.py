@@ -166,7 +166,8 @@ class AirMotion:
     one): every particle's offset from its rest place at a time, and the clouds as their light is made for it.
 
     A cloud field's clouds are not among them: the field's grid drifts whole with the wind at its mid altitude
-    (`field_drift`), each cell still made from its seed, so its clouds keep their light.
+    (`field_drift`), each cell still made from its seed, so its clouds keep their light; their particles swirl by
+    the same turbulence about their places in the grid (the renderer adds `turbulent_offsets`), unrelit.
     """
 
     def __init__(self, wind: Wind, clouds):

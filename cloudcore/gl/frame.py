@@ -82,6 +82,7 @@ from cloudcore.wind import (
     light_time,
     reshapes,
     shape_change_bound_m,
+    turbulent_offsets,
 )
 
 
@@ -603,8 +604,8 @@ class FrameRenderer:
         """(the particle buffer, the units, what the wind did to each cloud) at `time_s`: the buffer whose light was
         made for the clouds' shapes at `lit_at` (`AirMotion.lit_clouds`) with every particle carried on to its place
         now, and the units with it (the same arrays moved: no loop over clouds), the authored clouds by `air`, a
-        field's by its grid's drift `field_carried` (`air` is None only in still air: the buffer and units
-        themselves)."""
+        field's by its grid's drift `field_carried` and the turbulence (`air` is None only in still air: the buffer and
+        units themselves)."""
         lit, units = self._lit.value.particles, self._units.value
         if air is None:
             self._carry_source = self._carry_made = None
@@ -617,8 +618,12 @@ class FrameRenderer:
         field_clouds = len(lit.cloud_starts) - 1 - authored
         field_drifts = np.tile(field_carried, (field_clouds, 1))
         field_speeds = np.tile(field_speed(air.wind, self.field_state.field, time_s), (field_clouds, 1))
-        field_particles = len(lit.radii) - int(lit.cloud_starts[authored])
-        offsets = np.concatenate([air.carry(time_s, lit_at), np.tile(field_carried, (field_particles, 1))])
+        # a field's particles swirl by the same turbulence as the authored clouds' about their places in the drifting
+        # grid; their light stays the cells' at rest (docs/lod.md, "Clouds that move with the wind")
+        field_rest = lit.centres[int(lit.cloud_starts[authored]) :]
+        offsets = np.concatenate(
+            [air.carry(time_s, lit_at), field_carried + turbulent_offsets(air.wind, field_rest, time_s)]
+        )
         drifts = np.concatenate([air.drifts(time_s), field_drifts])
         # the authored clouds' light was made where they were at `lit_at`: their buffer carries them on from there
         shifts = np.concatenate([air.drifts(time_s) - air.drifts(lit_at), field_drifts])

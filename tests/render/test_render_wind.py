@@ -189,3 +189,22 @@ def test_wang_s_ring_follows_its_clouds_drifting_alike_without_being_made_again(
         np.testing.assert_allclose(renderer.last_plan.ring_shifts[0], [250.0, 0.0, 0.0], atol=1e-6)
         _, stats = renderer.render(far, settings=ring, time_s=31.0)  # 310 m: the eye relative to the clouds stepped
         assert stats.plan.ring_segments_built > 0
+
+
+def test_a_field_s_particles_swirl_with_the_turbulence_about_their_drifting_places_their_light_kept():
+    """Under a turbulent wind a field's particles leave the grid's drift each by its own offset, within twice the
+    turbulence's amplitude, and the field's clouds are lit once: their light is the cells' at rest."""
+    field = CloudField(seed=2, coverage=0.5, cell_size=600.0, rings=1)
+    camera = Camera((0.0, 1500.0, 0.0), (0.0, 1800.0, -3000.0), 60.0)
+    places, shaded = {}, {}
+    for turbulence in (0.0, 30.0):
+        wind = Wind(bands=((0.0, 10.0, 270.0),), turbulence_m=turbulence)
+        cache = CountingCache()
+        with FrameRenderer(96, 72, illumination=cache) as renderer:
+            for time_s in (0.0, 45.0, 130.0):
+                renderer.render(Scene(camera=camera, cloud_field=field, wind=wind), settings=FULL_3D, time_s=time_s)
+            places[turbulence], shaded[turbulence] = renderer.particles.centres.copy(), cache.shaded
+    swirl = np.linalg.norm(places[30.0] - places[0.0], axis=1)
+    assert len(swirl) > 100 and swirl.max() <= 2.0 * 30.0 + 1e-6
+    assert np.median(swirl) > 3.0 and np.std(places[30.0] - places[0.0], axis=0).min() > 1.0  # each its own way
+    assert shaded[30.0] == shaded[0.0]  # no field cloud relit for its turbulent shape
