@@ -210,9 +210,7 @@ def settings_overrides(t: Table) -> tuple[tuple[str, object], ...]:
     for key in t.data:
         default = getattr(defaults, key)
         if isinstance(default, bool):
-            if not isinstance(t.raw(key), bool):
-                t.fail(key, f"expected true or false, got {t.raw(key)!r}")
-            value = t.raw(key)
+            value = t.boolean(key)
         elif isinstance(default, int):
             value = t.integer(key, None, low=0, high=2**31 - 1)
         elif isinstance(default, str):

@@ -70,6 +70,12 @@ class Table:
     def raw(self, key: str, default=None):
         return self.data.get(key, default)
 
+    def boolean(self, key: str, default: bool = False) -> bool:
+        value = self.raw(key, default)
+        if not isinstance(value, bool):
+            self.fail(key, f"expected true or false, got {value!r}")
+        return value
+
     def number(self, key, default=None, *, low=-math.inf, high=math.inf, low_open=False):
         if key not in self.data:
             if default is None:

@@ -124,7 +124,7 @@ def update_weather_field(
         leading = 0
     else:  # the places of the weathers before the first one kept become holes
         leading = state.leading + sum(state.places[: kept[0]])
-    frames, parts, places, orders = [], [], [], []
+    frames, weights, parts, places, orders = [], [], [], [], []
     for (name, share), index in zip(shares, kept):
         part_field = field if name is None else preset_field(field, name)
         held = (
@@ -133,16 +133,15 @@ def update_weather_field(
             else (state.parts[index], state.places[index], state.orders[index])
         )
         frame, part = update_field(part_field, eye, held[0])
-        order = held[2]
+        order, weighed = held[2], frame.weights
         if share < 1.0:
             if order[0] is not part.particle_xz:  # the cells changed: their particles' order, once
                 order = (part.particle_xz, formation_order(part_field, part.particle_xz[:, 0], part.particle_xz[:, 1]))
-            frame = FieldFrame.weighed(
-                frame.clouds, frame.weights * formed(progress_for_share(share), order[1]), frame.cloud_starts
-            )
+            weighed = weighed * formed(progress_for_share(share), order[1])
         frames.append(frame)
+        weights.append(weighed)
         parts.append(part)
         places.append(max(held[1], len(frame.clouds)))
         orders.append(order)
     state = WeatherFieldState(names, tuple(parts), tuple(places), tuple(orders), leading)
-    return side_by_side(frames, places, leading), state
+    return side_by_side(frames, weights, places, leading), state

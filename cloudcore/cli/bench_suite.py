@@ -196,14 +196,10 @@ def _case(t: Table, defaults: Table) -> Case:
     reference = merged.table("reference", _variant) or FULL_3D
     if reference.mode != "full":
         merged.fail("reference", f"the reference draws every particle: mode must be 'full', got {reference.mode!r}")
-    auto_vs_faster = merged.raw("auto_vs_faster", False)
-    if not isinstance(auto_vs_faster, bool):
-        merged.fail("auto_vs_faster", f"expected true or false, got {auto_vs_faster!r}")
+    auto_vs_faster = merged.boolean("auto_vs_faster")
     if auto_vs_faster and sum(s.mode == "auto" for s in settings) != 1:
         merged.fail("auto_vs_faster", "needs exactly one variant in mode 'auto'")
-    without_terrain = merged.raw("without_terrain", False)
-    if not isinstance(without_terrain, bool):
-        merged.fail("without_terrain", f"expected true or false, got {without_terrain!r}")
+    without_terrain = merged.boolean("without_terrain")
     scene = merged.string("scene", "valley.toml")
     return Case(
         name=name,
@@ -271,7 +267,7 @@ def case_scene(case: Case) -> Scene:
     if kind == "harris":
         return bench_skies.harris_scene(scene, *values)
     if kind == "wang":
-        return bench_skies.wang_scene(scene, *values)[0]
+        return bench_skies.wang_scene(scene, *values)
     if kind == "own":
         return bench_skies.own_scene(scene, *values)
     if kind == "untuned":

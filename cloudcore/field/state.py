@@ -73,18 +73,20 @@ class FieldFrame:
         return len(self.weights)
 
 
-def side_by_side(frames, places, leading: int) -> FieldFrame:
-    """Frames of several fields as one: `leading` holes first, then each frame's clouds in `places` of its own (its
-    count of clouds, or more: holes after them), so a field's clouds keep their indices while another's change."""
-    clouds, weights, starts, end = [HOLE] * leading, [], [np.zeros(leading + 1, dtype=np.int64)], 0
+def side_by_side(frames, weights, places, leading: int) -> FieldFrame:
+    """Frames of several fields as one, their particles weighing `weights` (one array a frame: its own, or scaled):
+    `leading` holes first, then each frame's clouds in `places` of its own (its count of clouds, or more: holes
+    after them), so a field's clouds keep their indices while another's change.  One frame alone in its places,
+    weighing its own weights, is itself."""
+    if len(frames) == 1 and leading == 0 and places[0] == len(frames[0].clouds) and weights[0] is frames[0].weights:
+        return frames[0]
+    clouds, starts, end = [HOLE] * leading, [np.zeros(leading + 1, dtype=np.int64)], 0
     for frame, room in zip(frames, places):
         clouds += [*frame.clouds, *[HOLE] * (room - len(frame.clouds))]
-        weights.append(frame.weights)
         starts.append(end + frame.cloud_starts[1:])
         end += frame.particle_count
         starts.append(np.full(room - len(frame.clouds), end, dtype=np.int64))
-    weights = np.concatenate(weights) if weights else np.zeros(0)
-    return FieldFrame.weighed(tuple(clouds), weights, np.concatenate(starts))
+    return FieldFrame.weighed(tuple(clouds), np.concatenate(weights), np.concatenate(starts))
 
 
 def update_field(field: CloudField, eye, state: FieldState = FieldState()) -> tuple[FieldFrame, FieldState]:

@@ -171,7 +171,7 @@ class FrameRenderer:
         self._illumination = illumination if illumination is not None else IlluminationCache()
         self._air_for = air if air is not None else air_between
         self._sky_for = air.sky_seen_from if air is not None else SkyBackground.seen_from
-        self._cloud_keys_source, self._cloud_keys_made = None, ((), ())
+        self._keys: Derived[tuple[tuple, tuple]] = Derived(self._keys_of)
         self._key_serial = 0
         #: the level of detail's state between frames (impostor cache, ring, representations, costs)
         self.lod_state = LodState()
@@ -702,17 +702,19 @@ class FrameRenderer:
         (`cloudcore.lod.ring`), with no cloud looked at."""
         lit = self._lit.value
         forming = tuple((index, formation_state(scene.clouds[index].formation, time_s)) for index in lit.forming_clouds)
-        source = (lit.lighting_keys, fade_keys, forming)
-        if source != self._cloud_keys_source:
-            states = dict(forming)
-            colours = tuple((key, states.get(index)) for index, key in enumerate(lit.lighting_keys))
-            self._cloud_keys_source = source
-            held = self._cloud_keys_made[1]
-            self._cloud_keys_made = (
-                tuple((*colour, fade) for colour, fade in zip(colours, fade_keys)),  # unformed: state None
-                held if colours == held else colours,  # only blend weights changed: the ring's keys are as they were
-            )
-        return self._cloud_keys_made
+        self._keys.follow((lit.lighting_keys, fade_keys, forming))
+        return self._keys.value
+
+    def _keys_of(self, source: tuple) -> tuple[tuple, tuple]:
+        """`_cloud_keys`' pair made from its source (the lighting keys, the fade keys, the forming clouds' states)."""
+        lighting_keys, fade_keys, forming = source
+        states = dict(forming)
+        colours = tuple((key, states.get(index)) for index, key in enumerate(lighting_keys))
+        held = () if self._keys.value is None else self._keys.value[1]
+        return (
+            tuple((*colour, fade) for colour, fade in zip(colours, fade_keys)),  # unformed: state None
+            held if colours == held else colours,  # only blend weights changed: the ring's keys are as they were
+        )
 
     def _unit_weights(self, units: list) -> np.ndarray:
         """The mean blend weight of the particles of each unit's members (tuples of cloud indices) of `units`."""

@@ -68,8 +68,7 @@ class ResidentParticles:
         )
         self._plain = plain_splats(particles.styles)
         # per cloud, whether all its particles are plain: asked each frame, of hundreds of clouds on a field
-        not_plain = np.concatenate([[0], np.cumsum(~self._plain)])
-        self._cloud_plain = not_plain[particles.cloud_starts[1:]] == not_plain[particles.cloud_starts[:-1]]
+        self._cloud_plain = ~_any_of_each_cloud(~self._plain, particles.cloud_starts)
         self._sprites = particles.styles.sprite_index >= 0
         if self.atlas is None and np.any(particles.styles.sprite_index >= 0):
             self.atlas = _atlas_texture()
@@ -78,13 +77,10 @@ class ResidentParticles:
         rows = np.zeros(0) if particles.profiles is None else particles.profiles.profiles.ravel()
         store(self.profile_buffer, (rows if rows.size else np.zeros(1)).astype(np.float32))
         per_cloud = [(s.facing != FACING_SPLAT) | (s.artist is not None) << 1 for s in particles.styles.clouds]
-        self._feature_bits = np.array(per_cloud + [0], dtype=np.uint8)[particles.styles.cloud_index]
-        self.profiled = particles.profiles is not None
         self._cloud_feature_bits = np.array(per_cloud + [0], dtype=np.uint8)
-        self._cloud_sprites = np.array(
-            [np.any(self._sprites[a:b]) for a, b in zip(particles.cloud_starts[:-1], particles.cloud_starts[1:])]
-            + [False]
-        )
+        self._feature_bits = self._cloud_feature_bits[particles.styles.cloud_index]
+        self.profiled = particles.profiles is not None
+        self._cloud_sprites = np.append(_any_of_each_cloud(self._sprites, particles.cloud_starts), False)
         store(self.drawn_bits_buffer, np.append(particles.drawn_bits, np.uint32(0)))
         self.particles, self._formation_time = particles, None
 
@@ -196,3 +192,10 @@ def _atlas_texture() -> int:
     GL.glTexParameteri(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_WRAP_T, GL.GL_CLAMP_TO_EDGE)
     GL.glBindTexture(GL.GL_TEXTURE_2D, 0)
     return texture
+
+
+def _any_of_each_cloud(flags: np.ndarray, cloud_starts: np.ndarray) -> np.ndarray:
+    """(clouds,) whether any particle of each cloud (its `cloud_starts` range) has its flag: by the flags' running
+    count, no loop over the clouds."""
+    counts = np.concatenate([[0], np.cumsum(flags)])
+    return counts[cloud_starts[1:]] > counts[cloud_starts[:-1]]

@@ -84,11 +84,12 @@ class SplatShading:
         batches_and_views = [(batch, view) for batch, view in batches_and_views if batch.slots]
         if not batches_and_views:
             return
-        self._reserve(sum(_slots(batch.slots) for batch, _ in batches_and_views), keep=False)
+        slots = sum(_slots(batch.slots) for batch, _ in batches_and_views)
+        self._reserve(slots, keep=False)
         firsts = self._shade_all(batches_and_views, 0)
         for (batch, view), first in zip(batches_and_views, firsts):
             self._shaded[id(batch)] = (first, np.array(view, dtype=np.float64), batch)
-        self._slots_ahead = sum(_slots(batch.slots) for batch, _ in batches_and_views)
+        self._slots_ahead = slots
         GL.glMemoryBarrier(_SHADED_BARRIERS)
 
     def shaded_ahead(self, batch: SplatBatch | SplatSelection, view: np.ndarray) -> int | None:
@@ -100,9 +101,9 @@ class SplatShading:
         """(the storage buffer holding the batch's quads and colours for its eye, in its order, the slot of
         its first): those `shade_ahead` made, else shaded now after them (the volume-aware blending pass
         reads them too)."""
-        shaded = self._shaded.get(id(batch))
-        if shaded is not None and np.array_equal(shaded[1], view):
-            return self.instance_buffer, shaded[0]
+        first = self.shaded_ahead(batch, view)
+        if first is not None:
+            return self.instance_buffer, first
         self._reserve(self._slots_ahead + _slots(batch.slots), keep=True)
         self._shade_all([(batch, view)], self._slots_ahead)
         GL.glMemoryBarrier(_SHADED_BARRIERS)

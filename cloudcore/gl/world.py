@@ -211,8 +211,8 @@ class TerrainMesh:
 
     def lowest_m(self) -> float:
         """The lowest height of the tiles drawn last (their skirts' included), 0 before any."""
-        positions = self.tiles.positions
-        return float(positions[:, 1].min()) if len(positions) else 0.0
+        boxes = self.tiles.boxes
+        return float(boxes[:, 0, 1].min()) if len(boxes) else 0.0
 
     def close(self) -> None:
         for program in self._programs.values():
@@ -295,6 +295,8 @@ class WorldPass:
         if self._air_volume is not None and through_air:
             self._air_volume.upload(self._air_for(self._sky, camera.position))
             air = self._air_volume
+        # the planet's ground under the terrain, where the shafts' rays end and the sky's read pass writes its depth
+        below = None if self._far_ground is None else self._ground_below_the_terrain(sky, camera)
         shafts = None
         if light_shafts and air is not None and shadows is not None and shadows.space is not None:
             shafts = self._light_shafts()
@@ -308,7 +310,7 @@ class WorldPass:
                 air,
                 shadows,
                 sky.lowest_up(),
-                None if self._far_ground is None else self._ground_below_the_terrain(sky, camera),
+                below,
             )
         if sky.physical:
             self._draw_sky_picture(sky, camera, view_projection, (context.width, context.height), shafts)
@@ -323,7 +325,7 @@ class WorldPass:
         if self._terrain is not None:
             far_air = None if self._far_ground is None else lambda program: self._set_sky_view_uniforms(program, sky)
             self._terrain.draw(camera, view_projection, air, shadows, shafts, far_air)
-        self._draw_sky(sky, camera, view, projection, (context.width, context.height))
+        self._draw_sky(sky, camera, view, projection, (context.width, context.height), below)
         if antialiased:
             context.resolve_multisampled_target()
         context.bind_target()
@@ -353,10 +355,17 @@ class WorldPass:
         GL.glBindVertexArray(0)
 
     def _draw_sky(
-        self, sky: SkyBackground, camera: Camera, view: np.ndarray, projection: np.ndarray, size: tuple[int, int]
+        self,
+        sky: SkyBackground,
+        camera: Camera,
+        view: np.ndarray,
+        projection: np.ndarray,
+        size: tuple[int, int],
+        below: tuple[float, float] | None,
     ) -> None:
         """The sky behind the terrain drawn into the bound target: the physical sky's picture read (with the sun's
-        disc added in its box; the ground past the terrain given its depth), or the gradient."""
+        disc added in its box; the ground past the terrain, `below` (`_ground_below_the_terrain`), given its
+        depth), or the gradient."""
         view_projection = projection @ view
         inverse_view_projection = np.linalg.inv(view_projection)
         far_ground_depth = False
@@ -369,7 +378,6 @@ class WorldPass:
             far_ground_depth = self._far_ground is not None
             if far_ground_depth:  # the ground past the terrain takes its depth: clouds behind it are hidden
                 set_matrix(program, "inverse_view_projection", inverse_view_projection)
-                below = self._ground_below_the_terrain(sky, camera)
                 GL.glUniform2f(GL.glGetUniformLocation(program, "planet_ground"), *below)
                 set_vec3(program, "view_forward", -view[2, :3])
                 GL.glUniform2f(GL.glGetUniformLocation(program, "depth_terms"), projection[2, 2], projection[2, 3])

@@ -215,9 +215,7 @@ class LodUnits:
             self,
             centres=self.centres + shifts,
             radii=np.where(self.radii > 0.0, self.radii + reach, 0.0),
-            heights=None
-            if self.heights is None
-            else self.heights + shifts[:, 1:2] + np.column_stack([-reach, reach]).reshape(-1, 2),
+            heights=None if self.heights is None else self.heights + shifts[:, 1:2] + np.column_stack([-reach, reach]),
             clouds=None if self.clouds is None else self.clouds.moved(cloud_shifts, grown),
             sample=sample,
         )

@@ -19,7 +19,7 @@ import math
 import numpy as np
 
 from cloudcore.artist.cloudgen import cumulus, preset_cloud
-from cloudcore.measure.overdraw import WANG_BLOCK_SIZE_M, cloud_block_overdraw, scene_block_overdraw_statistics
+from cloudcore.measure.overdraw import WANG_BLOCK_SIZE_M, cloud_block_overdraw
 from cloudcore.scene import Camera, CameraPath, Cloud, Scene
 
 FRAMES_PER_S = 30.0
@@ -146,11 +146,9 @@ def wang_flight_views(scenario: str, frames: int) -> list:
     return views
 
 
-def wang_scene(world: Scene, scenario: str) -> tuple[Scene, float]:
-    """(`world` with the clouds of `scenario`, their cloud-block overdraw)."""
-    clouds = wang_clouds(scenario)
-    overdraw = scene_block_overdraw_statistics(clouds)["block_overdraw_mean"]
-    return dataclasses.replace(world, clouds=clouds, objects=(), cloud_field=None), overdraw
+def wang_scene(world: Scene, scenario: str) -> Scene:
+    """`world` with the clouds of `scenario`."""
+    return dataclasses.replace(world, clouds=wang_clouds(scenario), objects=(), cloud_field=None)
 
 
 # Skies of our own: a line of towering cumulus flown beside at low level (`cumulus_line`: few clouds, many

@@ -33,14 +33,13 @@ frames = 3
 """
 
 
-def test_every_shipped_suite_loads_and_its_default_cases_are_some_of_its_cases():
+def test_every_shipped_suite_loads_with_default_cases_and_scenes_that_exist():
     assert {"lod", "world", "compositing", "wind"} <= set(suite_names())
     for name in suite_names():
         suite = load_suite(name)
-        chosen = suite.chosen(None)
-        assert chosen and set(chosen) <= set(suite.cases), name
+        assert suite.chosen(None), name
         for case in suite.cases:
-            assert case.scene.is_file() and case.variants, (name, case.name)
+            assert case.scene.is_file(), (name, case.name)
 
 
 def test_the_lod_suite_holds_harris_figure_8_and_wang_s_scenarios_as_the_issue_asks():
