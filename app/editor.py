@@ -20,7 +20,13 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from cloudcore.editing import (
+from cloudcore.maths.paths import camera_on_path
+from cloudcore.model.errors import SceneError
+from cloudcore.model.particle_files import particles_folder
+from cloudcore.model.scene import Camera, Lighting, Scene, Shading
+from cloudcore.model.settings import RenderSettings
+from cloudcore.resources import DEFAULT_SCENE
+from cloudcore.scenes.editing import (
     History,
     delete_cloud,
     delete_particles,
@@ -30,17 +36,11 @@ from cloudcore.editing import (
     with_camera_path,
     without_camera_key,
 )
-from cloudcore.errors import SceneError
-from cloudcore.interop.camera_paths import read_camera_path, write_camera_path
-from cloudcore.interop.vdb_clouds import DEFAULT_PARTICLES, export_vdb, free_name, import_vdb_clouds
-from cloudcore.limits import scene_limit_problems
-from cloudcore.measure.frame_stats import FrameStats
-from cloudcore.particle_files import particles_folder
-from cloudcore.paths import camera_on_path
-from cloudcore.resources import DEFAULT_SCENE
-from cloudcore.scene import Camera, Lighting, Scene, Shading
-from cloudcore.scenefile import load_scene, save_scene
-from cloudcore.settings import RenderSettings
+from cloudcore.scenes.files import load_scene, save_scene
+from cloudcore.scenes.interop.camera_paths import read_camera_path, write_camera_path
+from cloudcore.scenes.interop.vdb_clouds import DEFAULT_PARTICLES, export_vdb, free_name, import_vdb_clouds
+from cloudcore.scenes.limits import scene_limit_problems
+from cloudcore.stats.frame_stats import FrameStats
 
 AUTOSAVE_SECONDS = 60.0
 #: the editor's frame budget (`RenderSettings.frame_budget_ms`), the LOD panel's starting value: a new
@@ -196,7 +196,7 @@ class Editor:
         return self.scene.lighting.time_of_day
 
     def edit(self, scene: Scene) -> bool:
-        """Apply an edit (undoable).  One the renderer could not draw (`cloudcore.limits`, the
+        """Apply an edit (undoable).  One the renderer could not draw (`cloudcore.scenes.limits`, the
         limits the scene loader checks too) is refused with a message; the scene stays as it was."""
         problems = scene_limit_problems(scene, unchanged=self.scene)
         if problems:

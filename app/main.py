@@ -37,9 +37,9 @@ from app.editor import Editor  # noqa: E402
 from app.panels import Panels  # noqa: E402
 from app.panels.widgets import labels_in_full  # noqa: E402
 from app.viewport import Viewport  # noqa: E402
-from cloudcore.collector import freeze_what_is_set_up  # noqa: E402
-from cloudcore.errors import SceneError  # noqa: E402
+from cloudcore.model.errors import SceneError  # noqa: E402
 from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
+from cloudcore.runtime.collector import freeze_what_is_set_up  # noqa: E402
 
 #: the GUI tests --self-test runs: a test suite, so it lives with the tests, not in the product
 GUI_TESTS = Path(__file__).resolve().parents[1] / "tests" / "gui" / "editor_tests.py"

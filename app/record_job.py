@@ -18,8 +18,8 @@ import tempfile
 import threading
 from pathlib import Path
 
-from cloudcore.scene import Scene
-from cloudcore.scenefile import save_scene
+from cloudcore.model.scene import Scene
+from cloudcore.scenes.files import save_scene
 
 
 def standalone(scene: Scene, folder: Path) -> Scene:

@@ -1,7 +1,7 @@
 """The viewport's left-mouse tools: place a particle, brush particles on or off, move a cloud or a particle.
 
 The viewport turns the mouse into a ray each frame and calls `press`, `hold`
-and `release`; the maths is `cloudcore.editing`.  A brush stroke and a drag
+and `release`; the maths is `cloudcore.scenes.editing`.  A brush stroke and a drag
 are each one undo step (`Editor.begin_gesture`).
 """
 
@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from app.editor import Editor
-from cloudcore.editing import (
+from cloudcore.scenes.editing import (
     BrushStroke,
     add_particle,
     add_particles,

@@ -8,8 +8,8 @@ drag turns the camera, the wheel flies forward.  Keys while the viewport is
 hovered: W/S forward/back, A/D sideways, Q/E down/up.
 
 Over the picture it outlines the impostors and ring segments of the frame plan
-(`cloudcore.measure.overlays`) when asked, and shows the overdraw heat map
-(`cloudcore.measure.heatmap`) in place of the frame when that is on.
+(`cloudcore.stats.overlays`) when asked, and shows the overdraw heat map
+(`cloudcore.stats.heatmap`) in place of the frame when that is on.
 """
 
 from __future__ import annotations
@@ -22,17 +22,17 @@ from imgui_bundle import imgui
 
 from app.editor import Editor, ShownFrame
 from app.tools import ViewportTools
-from cloudcore.editing import pick_ray
 from cloudcore.gl.context import WindowContext
 from cloudcore.gl.frame import FrameRenderer
 from cloudcore.gl.image_texture import ImageTexture
 from cloudcore.light.illumination import IlluminationCache
 from cloudcore.light.live_air import LiveAir
 from cloudcore.light.relighting import EXACT_METHOD, PREVIEW_METHOD, LiveIllumination, Look
-from cloudcore.measure.heatmap import heat_image, ramp_colours
-from cloudcore.measure.overlays import impostor_outlines, ring_outlines, to_pixels
-from cloudcore.navigation import moved, turned
-from cloudcore.wind import light_time, reshapes
+from cloudcore.scenes.editing import pick_ray
+from cloudcore.stats.heatmap import heat_image, ramp_colours
+from cloudcore.stats.overlays import impostor_outlines, ring_outlines, to_pixels
+from cloudcore.world.navigation import moved, turned
+from cloudcore.world.wind import light_time, reshapes
 
 TURN_DEG_PER_PIXEL = 0.2
 #: a frame that shows the picture again while the relighting worker runs waits this long first: the
@@ -60,7 +60,7 @@ class Viewport:
         self.show_ring_segments = False
         self.capture_next = False  # a GUI test asks for the next frame's pixels (as shown)
         self.captured: np.ndarray | None = None
-        self.outlines_drawn: list = []  # this frame's overlay outlines (`cloudcore.measure.overlays.Outline`)
+        self.outlines_drawn: list = []  # this frame's overlay outlines (`cloudcore.stats.overlays.Outline`)
         self.regenerations_total = 0
         self.relighting = LiveIllumination(IlluminationCache())
         self.relighting.start()
@@ -197,7 +197,7 @@ class Viewport:
 
     def _choose_lit_at(self, scene, look: Look) -> float:
         """The scene time whose shapes the wind gives the clouds are drawn lit: the clock's relight period
-        (`cloudcore.wind.light_time`) once its light is at hand, else the one drawn before while the relighting
+        (`cloudcore.world.wind.light_time`) once its light is at hand, else the one drawn before while the relighting
         worker lights the new shapes: the window keeps drawing, where shading them here held it 2 seconds."""
         now = light_time(scene.wind, self.editor.scene_time_s)
         if self.lit_at is None or self.lit_at == now or not reshapes(scene.wind):

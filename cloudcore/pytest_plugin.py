@@ -116,7 +116,6 @@ def _cloudview_session(request, tmp_path_factory):
 def cloudview_check(request, _cloudview_session):
     """`cloudview_check(scene, view="default", *, size=(320, 240), tolerance_psnr=None, max_diff=None)`: render
     the view and fail the test unless it matches its golden; returns the `ViewCheck`."""
-    from cloudcore.errors import SceneError
     from cloudcore.measure.screenshot_check import (
         DEFAULT_SIZE,
         Tolerance,
@@ -126,8 +125,9 @@ def cloudview_check(request, _cloudview_session):
         keep_images,
         update_golden,
     )
-    from cloudcore.scene import DEFAULT_VIEW_NAME
-    from cloudcore.scenefile import load_scene
+    from cloudcore.model.errors import SceneError
+    from cloudcore.model.scene import DEFAULT_VIEW_NAME
+    from cloudcore.scenes.files import load_scene
 
     session, here = _cloudview_session, request.path.parent
 

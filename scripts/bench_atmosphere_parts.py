@@ -26,9 +26,9 @@ os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 
 from cloudcore.gl.frame import FrameRenderer  # noqa: E402  (after the platform above)
 from cloudcore.measure.benchmark import machine, write_report  # noqa: E402
+from cloudcore.model.settings import RenderSettings  # noqa: E402
 from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
-from cloudcore.scenefile import load_scene  # noqa: E402
-from cloudcore.settings import RenderSettings  # noqa: E402
+from cloudcore.scenes.files import load_scene  # noqa: E402
 
 TIMINGS = ("frame_ms", "world_ms", "cloud_ms")
 

@@ -48,12 +48,12 @@ os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 import cloudcore.field.state  # noqa: E402
 from cloudcore.field.state import FieldState, update_field  # noqa: E402
 from cloudcore.gl import FrameRenderer  # noqa: E402
+from cloudcore.maths.paths import camera_on_path  # noqa: E402
 from cloudcore.measure.benchmark import machine, write_report  # noqa: E402
 from cloudcore.measure.imagecompare import compare  # noqa: E402
-from cloudcore.paths import camera_on_path  # noqa: E402
+from cloudcore.model.settings import RenderSettings  # noqa: E402
 from cloudcore.resources import CUMULUS_FIELD  # noqa: E402
-from cloudcore.scenefile import load_scene  # noqa: E402
-from cloudcore.settings import RenderSettings  # noqa: E402
+from cloudcore.scenes.files import load_scene  # noqa: E402
 
 #: the cells' module and the demo scene, as paths in the repository (`--cells-from`)
 CELLS, DEMO = "cloudcore/field/cells.py", "cloudcore/resources/scenes/cumulus_field.toml"

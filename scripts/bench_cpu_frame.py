@@ -36,11 +36,11 @@ os.environ["GALLIUM_THREAD"] = "0"
 from OpenGL import GL  # noqa: E402
 
 from cloudcore.cli.bench_suite import built_cases  # noqa: E402  (the suite `lod`'s scenes, views and sizes)
-from cloudcore.collector import freeze_what_is_set_up  # noqa: E402
 from cloudcore.gl import FrameRenderer  # noqa: E402
 from cloudcore.lod.costs import LLVMPIPE_COSTS  # noqa: E402
 from cloudcore.measure.benchmark import machine, write_report  # noqa: E402
-from cloudcore.settings import RenderSettings  # noqa: E402
+from cloudcore.model.settings import RenderSettings  # noqa: E402
+from cloudcore.runtime.collector import freeze_what_is_set_up  # noqa: E402
 
 #: the unmeasured frames a renderer draws first: its shaders compiled, its buffers made
 WARMUP_FRAMES = 5

@@ -38,7 +38,7 @@ def worker(case: str, every: int, modes: list[str]) -> None:
     from cloudcore.cli.bench_suite import built_cases
     from cloudcore.gl import FrameRenderer
     from cloudcore.lod.costs import LLVMPIPE_COSTS
-    from cloudcore.settings import RenderSettings
+    from cloudcore.model.settings import RenderSettings
 
     _, scene, views, size, _ = built_cases("lod", [case])[0]
     views = views[::every]

@@ -21,9 +21,9 @@ os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 
 from cloudcore.gl import FrameRenderer  # noqa: E402
 from cloudcore.measure.benchmark import machine, path_views, write_report  # noqa: E402  (the GL imports need the platform above)
+from cloudcore.model.settings import FULL_3D  # noqa: E402
 from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
-from cloudcore.scenefile import load_scene  # noqa: E402
-from cloudcore.settings import FULL_3D  # noqa: E402
+from cloudcore.scenes.files import load_scene  # noqa: E402
 
 _TIMES = ("frame_ms", "world_ms", "cloud_ms")
 

@@ -30,20 +30,20 @@ os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 
 from OpenGL import GL  # noqa: E402  (after the platform above)
 
-from cloudcore.camera import projection_matrix, view_matrix  # noqa: E402
-from cloudcore.colour import linear_to_srgb8  # noqa: E402
 from cloudcore.gl.frame import FrameRenderer  # noqa: E402
 from cloudcore.gl.world import WorldPass  # noqa: E402
 from cloudcore.light.lighting import scene_lights  # noqa: E402
 from cloudcore.light.sky_background import scene_sky  # noqa: E402
 from cloudcore.light.terrain_light import terrain_light  # noqa: E402
+from cloudcore.maths.colour import linear_to_srgb8  # noqa: E402
 from cloudcore.measure.benchmark import machine, write_report  # noqa: E402
 from cloudcore.measure.imagecompare import compare  # noqa: E402
+from cloudcore.model.scene import Camera  # noqa: E402
+from cloudcore.model.settings import FULL_3D  # noqa: E402
 from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
-from cloudcore.scene import Camera  # noqa: E402
-from cloudcore.scenefile import load_scene  # noqa: E402
-from cloudcore.settings import FULL_3D  # noqa: E402
-from cloudcore.sun import sun_direction  # noqa: E402
+from cloudcore.scenes.files import load_scene  # noqa: E402
+from cloudcore.world.camera import projection_matrix, view_matrix  # noqa: E402
+from cloudcore.world.sun import sun_direction  # noqa: E402
 
 #: (steps, screen pixels a shaft pixel spans per axis) of the reference
 REFERENCE = (96, 1)

@@ -27,9 +27,9 @@ os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 
 from cloudcore.gl import FrameRenderer  # noqa: E402
 from cloudcore.measure.benchmark import machine, path_views, resident_memory_bytes, write_report  # noqa: E402  (the GL imports need the platform)
+from cloudcore.model.settings import MODES, RenderSettings  # noqa: E402
 from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
-from cloudcore.scenefile import load_scene  # noqa: E402
-from cloudcore.settings import MODES, RenderSettings  # noqa: E402
+from cloudcore.scenes.files import load_scene  # noqa: E402
 
 
 def sample(renderer: FrameRenderer, started: float, frames: int, frame_ms: list[float]) -> dict:

@@ -29,10 +29,10 @@ os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 from cloudcore.gl import FrameRenderer  # noqa: E402
 from cloudcore.measure.bench_skies import particle_field  # noqa: E402
 from cloudcore.measure.benchmark import machine, resident_memory_bytes, write_report  # noqa: E402  (the GL imports need the platform)
+from cloudcore.model.scene import Scene  # noqa: E402
+from cloudcore.model.settings import RenderSettings  # noqa: E402
 from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
-from cloudcore.scene import Scene  # noqa: E402
-from cloudcore.scenefile import load_scene  # noqa: E402
-from cloudcore.settings import RenderSettings  # noqa: E402
+from cloudcore.scenes.files import load_scene  # noqa: E402
 
 #: the last frames of a mode, averaged as its steady state: by then the ring (8 segments, 8 fade frames) is built
 STEADY_FRAMES = 3

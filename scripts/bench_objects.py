@@ -29,14 +29,14 @@ import numpy as np
 
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 
-from cloudcore.camera import screen_box  # noqa: E402
 from cloudcore.gl import FrameRenderer  # noqa: E402
 from cloudcore.measure.benchmark import headless_pyplot, path_views, save_figure  # noqa: E402  (GL needs the platform above)
 from cloudcore.measure.imagecompare import compare  # noqa: E402
-from cloudcore.objects import object_poses  # noqa: E402
+from cloudcore.model.settings import FULL_3D, RenderSettings  # noqa: E402
 from cloudcore.resources import resource_path  # noqa: E402
-from cloudcore.scenefile import load_scene  # noqa: E402
-from cloudcore.settings import FULL_3D, RenderSettings  # noqa: E402
+from cloudcore.scenes.files import load_scene  # noqa: E402
+from cloudcore.world.camera import screen_box  # noqa: E402
+from cloudcore.world.objects import object_poses  # noqa: E402
 
 SCENES = resource_path("scenes")
 VARIANTS = {

@@ -18,7 +18,7 @@ from cloudcore.light.illumination import illuminate_direction, light_directions
 from cloudcore.light.lighting import scene_lights
 from cloudcore.measure.benchmark import machine, ratio_interval, write_report
 from cloudcore.resources import DEFAULT_SCENE
-from cloudcore.scenefile import load_scene
+from cloudcore.scenes.files import load_scene
 
 METHODS = ("exact", "octaves", "octaves-lit-face")
 

@@ -29,7 +29,7 @@ from cloudcore.cli.bench_suite import built_cases  # noqa: E402  (the suite `lod
 from cloudcore.gl import FrameRenderer  # noqa: E402
 from cloudcore.gl.pass_clock import PassClock  # noqa: E402
 from cloudcore.measure.benchmark import machine, ratio_interval, write_report  # noqa: E402
-from cloudcore.settings import RenderSettings  # noqa: E402
+from cloudcore.model.settings import RenderSettings  # noqa: E402
 
 #: the unmeasured frames each renderer draws first: its shaders compiled, its buffers made
 WARMUP_FRAMES = 5

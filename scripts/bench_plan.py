@@ -48,14 +48,14 @@ from cloudcore.artist.particle_styles import particle_styles  # noqa: E402
 from cloudcore.field.state import FieldState, update_field  # noqa: E402
 from cloudcore.lod.plan import LodState, plan_frame  # noqa: E402
 from cloudcore.lod.units import lod_units  # noqa: E402
-from cloudcore.objects import object_poses  # noqa: E402
+from cloudcore.world.objects import object_poses  # noqa: E402
 
 try:
     from cloudcore.particles.buffer import cloud_extents  # noqa: E402
 except ImportError:  # a revision before the particles' package (issue 55), replayed by --against: the light's
     from cloudcore.light.eye_scattering import cloud_extents  # noqa: E402
-from cloudcore.scene import Lighting  # noqa: E402
-from cloudcore.settings import RenderSettings  # noqa: E402
+from cloudcore.model.scene import Lighting  # noqa: E402
+from cloudcore.model.settings import RenderSettings  # noqa: E402
 
 MODES = ("full", "impostor", "auto")
 PASSES = 5
@@ -102,7 +102,7 @@ def planned_frames(scene, views, size, mode: str):
         keys = last_keys if keys == last_keys else keys  # the renderer's keys are the same tuple while unchanged
         last_keys = keys
         if spheres is None and scene.objects:
-            from cloudcore.objects import mesh_sphere, object_mesh
+            from cloudcore.world.objects import mesh_sphere, object_mesh
 
             spheres = [mesh_sphere(object_mesh(o)) for o in scene.objects]
         poses = object_poses(scene.objects, time_s, spheres) if scene.objects else ()

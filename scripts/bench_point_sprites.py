@@ -27,7 +27,6 @@ os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 from OpenGL import GL  # noqa: E402  (the GL imports need the platform above)
 
 import cloudcore.gl.splats as splats_module  # noqa: E402
-from cloudcore.camera import projection_matrix, view_matrix  # noqa: E402
 from cloudcore.gl.context import HeadlessContext  # noqa: E402
 from cloudcore.gl.splats import SplatPass  # noqa: E402
 from cloudcore.gl.targets import TextureTarget  # noqa: E402
@@ -37,7 +36,8 @@ from cloudcore.measure.benchmark import machine, write_report  # noqa: E402
 from cloudcore.particles.batch import splat_batch  # noqa: E402
 from cloudcore.particles.buffer import ParticleBuffer  # noqa: E402
 from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
-from cloudcore.scenefile import load_scene  # noqa: E402
+from cloudcore.scenes.files import load_scene  # noqa: E402
+from cloudcore.world.camera import projection_matrix, view_matrix  # noqa: E402
 
 
 def timed_ms(draw, repeat: int) -> float:

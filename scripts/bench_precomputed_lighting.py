@@ -32,7 +32,7 @@ from cloudcore.light.lighting import active_lights, scene_lights
 from cloudcore.measure.benchmark import machine, write_report
 from cloudcore.particles.buffer import ParticleBuffer
 from cloudcore.resources import DEFAULT_SCENE
-from cloudcore.scenefile import load_scene
+from cloudcore.scenes.files import load_scene
 
 EYE_PASSES = ("harris", "yusov")
 LIGHT_METHODS = ("exact", "occlusion")
@@ -111,7 +111,7 @@ def eye_pass_reference(scene, repeat: int) -> dict:
 
 def gl_frames(scene, width: int, height: int, frames: int) -> dict:
     from cloudcore.gl import FrameRenderer
-    from cloudcore.settings import FULL_3D
+    from cloudcore.model.settings import FULL_3D
 
     renderers = {eye_pass: FrameRenderer(width, height) for eye_pass in EYE_PASSES}
     scenes = {e: dataclasses.replace(scene, shading=dataclasses.replace(scene.shading, eye_pass=e)) for e in EYE_PASSES}

@@ -17,7 +17,7 @@ from pathlib import Path
 from cloudcore.light.shading import DEFAULT_RASTER_RESOLUTION
 from cloudcore.measure.benchmark import machine, shading_comparison, write_report
 from cloudcore.resources import DEFAULT_SCENE
-from cloudcore.scenefile import load_scene
+from cloudcore.scenes.files import load_scene
 
 
 def main() -> None:

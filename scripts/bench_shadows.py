@@ -31,8 +31,8 @@ from cloudcore.light.lighting import scene_lights  # noqa: E402
 from cloudcore.measure.benchmark import machine, write_report  # noqa: E402
 from cloudcore.particles.buffer import ParticleBuffer  # noqa: E402
 from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
-from cloudcore.scenefile import load_scene  # noqa: E402
-from cloudcore.terrain import heightfield_mesh  # noqa: E402
+from cloudcore.scenes.files import load_scene  # noqa: E402
+from cloudcore.world.terrain import heightfield_mesh  # noqa: E402
 
 RESOLUTIONS = (256, 384, 512, 768, 1024)
 REFERENCE_RESOLUTION = 2048

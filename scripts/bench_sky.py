@@ -27,17 +27,17 @@ from OpenGL import GL  # noqa: E402  (after the platform above)
 
 from cloudcore.atmosphere import aerial_perspective, multiple_scattering, sky_view, transmittance  # noqa: E402
 from cloudcore.atmosphere.sky import atmosphere_tables  # noqa: E402
-from cloudcore.camera import projection_matrix, view_matrix  # noqa: E402
 from cloudcore.gl.frame import FrameRenderer  # noqa: E402
 from cloudcore.gl.world import WorldPass  # noqa: E402
 from cloudcore.light.lighting import atmosphere_parameters, scene_lights  # noqa: E402
 from cloudcore.light.sky_background import scene_sky  # noqa: E402
 from cloudcore.light.terrain_light import terrain_light  # noqa: E402
 from cloudcore.measure.benchmark import machine, write_report  # noqa: E402
+from cloudcore.model.scene import Air  # noqa: E402
 from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
-from cloudcore.scene import Air  # noqa: E402
-from cloudcore.scenefile import load_scene  # noqa: E402
-from cloudcore.sun import scene_hour, sun_direction  # noqa: E402
+from cloudcore.scenes.files import load_scene  # noqa: E402
+from cloudcore.world.camera import projection_matrix, view_matrix  # noqa: E402
+from cloudcore.world.sun import scene_hour, sun_direction  # noqa: E402
 
 
 def best_of(build, times: int = 3) -> tuple[float, object]:

@@ -22,13 +22,13 @@ import numpy as np
 
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 
-from cloudcore.cloud_records import SpriteStyle  # noqa: E402  (the GL imports need the platform above)
 from cloudcore.gl import FrameRenderer  # noqa: E402
 from cloudcore.measure.benchmark import machine, write_report  # noqa: E402
+from cloudcore.model.cloud_records import SpriteStyle  # noqa: E402  (the GL imports need the platform above)
+from cloudcore.model.scene import Camera, Cloud  # noqa: E402
+from cloudcore.model.settings import RenderSettings  # noqa: E402
 from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
-from cloudcore.scene import Camera, Cloud  # noqa: E402
-from cloudcore.scenefile import load_scene  # noqa: E402
-from cloudcore.settings import RenderSettings  # noqa: E402
+from cloudcore.scenes.files import load_scene  # noqa: E402
 
 SIZES = ((640, 480), (1280, 800))
 #: particles, and their radius against their spread: large splats, so the fragments are the pass

@@ -28,8 +28,6 @@ import numpy as np
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 
 from cloudcore.artist.particle_styles import particle_styles  # noqa: E402  (the GL imports need the platform)
-from cloudcore.camera import NEAR_PLANE_M, frustum_planes, pixel_rays, projection_matrix, view_matrix  # noqa: E402
-from cloudcore.colour import linear_to_srgb8  # noqa: E402
 from cloudcore.gl.frame import FrameRenderer  # noqa: E402
 from cloudcore.gl.volume_blending import batch_splats  # noqa: E402
 from cloudcore.light.lighting import scene_lights  # noqa: E402
@@ -42,15 +40,17 @@ from cloudcore.light.volume_blending import (  # noqa: E402
     tile_pixels,
     volume_blend,
 )
+from cloudcore.maths.colour import linear_to_srgb8  # noqa: E402
 from cloudcore.measure.benchmark import machine, write_report  # noqa: E402
 from cloudcore.measure.imagecompare import compare, diff_image  # noqa: E402
+from cloudcore.model.scene import Camera, Cloud, Scene, Terrain  # noqa: E402
+from cloudcore.model.settings import FULL_3D  # noqa: E402
 from cloudcore.particles.batch import splat_batch  # noqa: E402
 from cloudcore.particles.buffer import ParticleBuffer  # noqa: E402
 from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
-from cloudcore.scene import Camera, Cloud, Scene, Terrain  # noqa: E402
-from cloudcore.scenefile import load_scene  # noqa: E402
-from cloudcore.settings import FULL_3D  # noqa: E402
-from cloudcore.terrain import height_at  # noqa: E402
+from cloudcore.scenes.files import load_scene  # noqa: E402
+from cloudcore.world.camera import NEAR_PLANE_M, frustum_planes, pixel_rays, projection_matrix, view_matrix  # noqa: E402
+from cloudcore.world.terrain import height_at  # noqa: E402
 
 BLENDINGS = ("plain", "volume")
 

@@ -40,22 +40,22 @@ def worker(size: str, strip_reach: bool, finer: bool, gradient: bool) -> None:
     import dataclasses
 
     from cloudcore.gl.frame import FrameRenderer
+    from cloudcore.model.settings import RenderSettings
     from cloudcore.resources import DEFAULT_SCENE
-    from cloudcore.scenefile import load_scene
-    from cloudcore.settings import RenderSettings
+    from cloudcore.scenes.files import load_scene
 
     scene = load_scene(DEFAULT_SCENE)
     if strip_reach:
         scene = dataclasses.replace(scene, terrain=dataclasses.replace(scene.terrain, relief=0.0, reach=0.0))
     settings = RenderSettings()
     if gradient:  # the plain world pass of a revision with the atmosphere: the gradient, no air
-        from cloudcore.scene import Air
+        from cloudcore.model.scene import Air
 
         scene = dataclasses.replace(scene, lighting=dataclasses.replace(scene.lighting, air=Air(sky="gradient")))
         if "aerial_perspective" in {field.name for field in dataclasses.fields(settings)}:
             settings = dataclasses.replace(settings, aerial_perspective=False)
     if finer:
-        from cloudcore import terrain_tiles
+        from cloudcore.world import terrain_tiles
 
         terrain_tiles.SPLIT_DISTANCE *= FINER
     width, height = (int(v) for v in size.split("x"))

@@ -2,7 +2,7 @@
 
     python scripts/cloud_optics.py [cloudcore/resources/scenes/valley.toml] [--json out/cloud_optics.json]
 
-The medium is the truth's (`cloudcore.light.truth.medium_grids`, 3 voxels a median radius): the extinction at a
+The medium is the truth's (`cloudcore.measure.truth.medium_grids`, 3 voxels a median radius): the extinction at a
 median particle's centre, the voxels' extinction where it is above 5% of the largest, and the optical depth along
 a vertical line through each cloud's mean centre.  docs/shading.md ("Optical properties with physical meaning").
 """
@@ -15,10 +15,10 @@ from pathlib import Path
 import numpy as np
 
 from cloudcore.light.illumination import cloud_optics
-from cloudcore.light.truth import medium_grids, optical_depths, peak_extinction
 from cloudcore.measure.benchmark import write_report
+from cloudcore.measure.truth import medium_grids, optical_depths, peak_extinction
 from cloudcore.resources import DEFAULT_SCENE
-from cloudcore.scenefile import load_scene
+from cloudcore.scenes.files import load_scene
 
 #: voxels counted as inside a cloud: extinction above this share of the largest
 INSIDE_SHARE = 0.05

@@ -16,8 +16,8 @@ from pathlib import Path
 import numpy as np
 
 from cloudcore.artist.cloudgen import cumulus
-from cloudcore.scene import Camera, CameraPath, Cloud, Lighting, Scene, SceneObject, Shading, View
-from cloudcore.scenefile import save_scene
+from cloudcore.model.scene import Camera, CameraPath, Cloud, Lighting, Scene, SceneObject, Shading, View
+from cloudcore.scenes.files import save_scene
 
 SEED = 311
 CLOUD_BASE = np.array([0.0, 1000.0, 0.0])

@@ -15,12 +15,12 @@ from __future__ import annotations
 import functools
 import time
 
-from cloudcore import disk_cache
 from cloudcore.atmosphere import sky
 from cloudcore.light.lighting import atmosphere_parameters
 from cloudcore.light.precomputed import CACHE_KIND, TableResolution, build_tables, cache_key
 from cloudcore.resources import resource_path
-from cloudcore.scenefile import load_scene
+from cloudcore.runtime import disk_cache
+from cloudcore.scenes.files import load_scene
 
 
 def shipped_scenes():

@@ -21,9 +21,9 @@ from pathlib import Path
 import numpy as np
 
 from cloudcore.artist.cloudgen import preset_cloud
-from cloudcore.cloud_records import Formation
-from cloudcore.scene import Camera, CameraPath, Lighting, Scene, Shading, Terrain
-from cloudcore.scenefile import save_scene
+from cloudcore.model.cloud_records import Formation
+from cloudcore.model.scene import Camera, CameraPath, Lighting, Scene, Shading, Terrain
+from cloudcore.scenes.files import save_scene
 
 SEED = 2004
 CLOUD_BASE_Y = 1000.0

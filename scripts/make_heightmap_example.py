@@ -15,10 +15,10 @@ from pathlib import Path
 
 import numpy as np
 
-from cloudcore.interop.heightmap import write_heightmap
 from cloudcore.resources import DEFAULT_SCENE, resource_path
-from cloudcore.scenefile import load_scene
-from cloudcore.terrain import height_at
+from cloudcore.scenes.files import load_scene
+from cloudcore.scenes.interop.heightmap import write_heightmap
+from cloudcore.world.terrain import height_at
 
 SAMPLES = 257
 

@@ -3,7 +3,7 @@
     python scripts/make_sprite_atlas.py [--out cloudcore/resources/sprites/atlas.png] [--seed 2004]
 
 A 4x4 sheet of 256 px cells, one kind per row from the top: flat-bottom,
-foggy, puffy, wispy (`cloudcore.cloud_records.ROWS`), four variants each, drawn
+foggy, puffy, wispy (`cloudcore.model.cloud_records.ROWS`), four variants each, drawn
 from hashed noise by `cloudcore.artist.sprite_art`: the same file on every machine.
 RGBA, 8 bits: alpha is opacity, RGB brightness.
 """

@@ -17,7 +17,7 @@ from pathlib import Path
 import imageio.v3 as iio
 import numpy as np
 
-from cloudcore.colour import linear_to_srgb8
+from cloudcore.maths.colour import linear_to_srgb8
 from cloudcore.measure.imagecompare import load_rgb8
 from cloudcore.measure.truth_comparison import luminance
 

@@ -17,8 +17,8 @@ from pathlib import Path
 import numpy as np
 
 from cloudcore.artist.cloudgen import cumulus
-from cloudcore.scene import Camera, CameraPath, Cloud, Lighting, Scene, SceneObject, Shading, Terrain
-from cloudcore.scenefile import save_scene
+from cloudcore.model.scene import Camera, CameraPath, Cloud, Lighting, Scene, SceneObject, Shading, Terrain
+from cloudcore.scenes.files import save_scene
 
 SEED = 2002
 CLOUD_COUNT = 34

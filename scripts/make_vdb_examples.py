@@ -1,11 +1,11 @@
-"""Write the example density grids (`cloudcore.interop.example_grids`) as OpenVDB files to import:
+"""Write the example density grids (`cloudcore.scenes.interop.example_grids`) as OpenVDB files to import:
 `python scripts/make_vdb_examples.py FOLDER` writes FOLDER/sphere.vdb and FOLDER/noise.vdb."""
 
 import sys
 from pathlib import Path
 
-from cloudcore.interop.example_grids import noise_grid, sphere_grid
-from cloudcore.interop.vdb import write_density_grids
+from cloudcore.scenes.interop.example_grids import noise_grid, sphere_grid
+from cloudcore.scenes.interop.vdb import write_density_grids
 
 if __name__ == "__main__":
     folder = Path(sys.argv[1] if len(sys.argv) > 1 else ".")

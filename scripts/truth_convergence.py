@@ -2,7 +2,7 @@
 
     python scripts/truth_convergence.py [SCENE] [--spp 16,64,256] [--time-of-day 12] [--json out/truth_convergence.json]
 
-At each sample count the default view is path traced with two seeds (`cloudcore.light.truth.render_truth`);
+At each sample count the default view is path traced with two seeds (`cloudcore.measure.truth.render_truth`);
 the PSNR between the two pictures measures the noise (one picture against the converged one is about
 3 dB better, the two noises being independent).  Results for this machine are in docs/shading.md.
 """
@@ -13,12 +13,12 @@ import argparse
 import platform
 from pathlib import Path
 
-from cloudcore.colour import linear_to_srgb8
-from cloudcore.light.truth import render_truth
+from cloudcore.maths.colour import linear_to_srgb8
 from cloudcore.measure.benchmark import machine, write_report
 from cloudcore.measure.imagecompare import compare
+from cloudcore.measure.truth import render_truth
 from cloudcore.resources import DEFAULT_SCENE
-from cloudcore.scenefile import load_scene
+from cloudcore.scenes.files import load_scene
 
 
 def main() -> None:

@@ -24,14 +24,14 @@ import numpy as np
 
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 
-from cloudcore.colour import srgb_decode  # noqa: E402
 from cloudcore.gl.frame import FrameRenderer  # noqa: E402
-from cloudcore.light.truth import render_truth  # noqa: E402
+from cloudcore.maths.colour import srgb_decode  # noqa: E402
 from cloudcore.measure.benchmark import machine, write_report  # noqa: E402
+from cloudcore.measure.truth import render_truth  # noqa: E402
+from cloudcore.model.scene import Camera  # noqa: E402
+from cloudcore.model.settings import FULL_3D  # noqa: E402
 from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
-from cloudcore.scene import Camera  # noqa: E402
-from cloudcore.scenefile import load_scene  # noqa: E402
-from cloudcore.settings import FULL_3D  # noqa: E402
+from cloudcore.scenes.files import load_scene  # noqa: E402
 
 #: above the default valley's south end, looking north and down across it: the sun of the afternoon from the left
 VIEW = Camera((0.0, 5000.0, 3000.0), (500.0, 0.0, -500.0), 60.0)

@@ -21,10 +21,10 @@ os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 from cloudcore.gl import FrameRenderer  # noqa: E402
 from cloudcore.measure.benchmark import machine, write_report  # noqa: E402
 from cloudcore.measure.imagecompare import compare  # noqa: E402
+from cloudcore.model.scene import Wind  # noqa: E402
+from cloudcore.model.settings import FULL_3D  # noqa: E402
 from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
-from cloudcore.scene import Wind  # noqa: E402
-from cloudcore.scenefile import load_scene  # noqa: E402
-from cloudcore.settings import FULL_3D  # noqa: E402
+from cloudcore.scenes.files import load_scene  # noqa: E402
 
 #: the winds' bands (altitude m, speed m/s, from degrees): a westerly, and the suite `wind`'s churning bands
 ONE_BAND = ((0.0, 10.0, 270.0),)

@@ -5,9 +5,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from cloudcore.cloud_records import ArtistShading, SpriteStyle
+from cloudcore.model.cloud_records import ArtistShading, SpriteStyle
+from cloudcore.model.scene import Camera, CameraPath, Cloud, Light, Lighting, Scene, SceneObject, Shading, Terrain, View
 from cloudcore.resources import DEFAULT_SCENE
-from cloudcore.scene import Camera, CameraPath, Cloud, Light, Lighting, Scene, SceneObject, Shading, Terrain, View
 
 ROOT = Path(__file__).resolve().parents[1]
 VALLEY = DEFAULT_SCENE
@@ -98,8 +98,8 @@ def small_scene() -> Scene:
 
 def assert_file_refused_in_one_line(path, field: str, problem: str) -> None:
     """Loading the scene file `path` raises one `SceneError` naming `field` and `problem`, in one line."""
-    from cloudcore.errors import SceneError
-    from cloudcore.scenefile import load_scene
+    from cloudcore.model.errors import SceneError
+    from cloudcore.scenes.files import load_scene
 
     with pytest.raises(SceneError) as caught:
         load_scene(path)

@@ -9,7 +9,7 @@ sigma > alpha); `stable=True` applies the documented cap.
 import numpy as np
 
 from cloudcore.light.phase import phase_function
-from cloudcore.splat_kernel import splat_kernel
+from cloudcore.maths.splat_kernel import splat_kernel
 
 
 def literal_incident_light(positions, radii, tau, albedo, light_dir, phase="rayleigh", g=0.0, stable=True):

@@ -7,7 +7,7 @@ from imgui_bundle import imgui
 from app.editor import Editor
 from app.panels.widgets import bounded_slider
 from cloudcore.artist.cloudgen import PRESETS, TYPICAL_CULL_FRACTION
-from cloudcore.editing import add_preset_cloud, fill_box, pick_ray, point_at_altitude
+from cloudcore.scenes.editing import add_preset_cloud, fill_box, pick_ray, point_at_altitude
 
 
 class BuildPanel:

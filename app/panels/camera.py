@@ -12,8 +12,8 @@ from app.editor import Editor
 from app.panels.widgets import bounded_slider
 from app.record_job import RecordJob
 from app.viewport import Viewport
-from cloudcore.errors import SceneError
-from cloudcore.navigation import orbited
+from cloudcore.model.errors import SceneError
+from cloudcore.world.navigation import orbited
 
 
 class CameraPanel:

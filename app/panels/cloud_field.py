@@ -3,7 +3,7 @@ widgets.
 
 Each widget edits the scene through the editor's history, on release (a
 slider dragged does not remake the field every frame); the record refuses
-what the scene file would (`cloudcore.scene.CloudField`), and the refusal
+what the scene file would (`cloudcore.model.scene.CloudField`), and the refusal
 becomes a message.
 """
 
@@ -17,7 +17,8 @@ from app.editor import Editor
 from app.panels.widgets import ReleasedSliders
 from app.viewport import Viewport
 from cloudcore.artist.cloudgen import PRESETS
-from cloudcore.scene import (
+from cloudcore.field.weather import WEATHER_PRESETS
+from cloudcore.model.scene import (
     MAX_LAYERS,
     MAX_RINGS,
     MAX_TURBULENCE_M,
@@ -27,7 +28,6 @@ from cloudcore.scene import (
     Weather,
     Wind,
 )
-from cloudcore.weather import WEATHER_PRESETS
 
 #: the float sliders: label -> (field, index in a pair or None, low, high, format)
 _SLIDERS = {

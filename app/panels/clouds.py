@@ -8,7 +8,7 @@ from imgui_bundle import imgui
 
 from app.editor import TOOLS, Editor
 from app.panels.widgets import ReleasedSliders, bounded_slider
-from cloudcore.editing import add_cloud, delete_cloud, replace_cloud, with_mean_radius
+from cloudcore.scenes.editing import add_cloud, delete_cloud, replace_cloud, with_mean_radius
 
 
 class CloudsPanel:

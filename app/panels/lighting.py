@@ -11,8 +11,8 @@ from app.panels.widgets import ReleasedSliders
 from cloudcore.light.lighting import SKIES
 from cloudcore.light.phase import PHASE_NAMES
 from cloudcore.light.shading import EYE_PASSES, LIGHT_PASSES
-from cloudcore.limits import FIELD_RANGES
-from cloudcore.scene import Air
+from cloudcore.model.scene import Air
+from cloudcore.scenes.limits import FIELD_RANGES
 
 #: the shading sliders: label -> (`Shading` field, low, high)
 _SHADING_SLIDERS = {
@@ -22,7 +22,7 @@ _SHADING_SLIDERS = {
 }
 
 #: the air's sliders: label -> (`Air` field, format, logarithmic); their ranges are the scene file's
-#: (`cloudcore.limits.FIELD_RANGES`).  The haze spans clear air to a hundred times its aerosols, and the altitude
+#: (`cloudcore.scenes.limits.FIELD_RANGES`).  The haze spans clear air to a hundred times its aerosols, and the altitude
 #: sea level to 50 km: decades a linear slider would crowd into its first pixels
 _AIR_SLIDERS = {
     "Haze (x Earth's aerosols)": ("mie_density_scale", "%.2f", True),

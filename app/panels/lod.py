@@ -9,7 +9,7 @@ from imgui_bundle import imgui
 
 from app.editor import Editor
 from app.viewport import Viewport
-from cloudcore.settings import Option, RenderSettings, setting_options
+from cloudcore.model.settings import Option, RenderSettings, setting_options
 
 
 class LodPanel:
@@ -17,7 +17,7 @@ class LodPanel:
         self.editor, self.viewport = editor, viewport
 
     def draw(self) -> None:
-        """The settings' widgets, in their fields' order, made from their `Option`s (`cloudcore.settings`)."""
+        """The settings' widgets, in their fields' order, made from their `Option`s (`cloudcore.model.settings`)."""
         editor = self.editor
         settings = editor.settings
         changes = {}

@@ -29,8 +29,8 @@ import math
 
 import numpy as np
 
-from cloudcore.cloud_records import ArtistShading
-from cloudcore.vectors import unit_rows
+from cloudcore.maths.vectors import unit_rows
+from cloudcore.model.cloud_records import ArtistShading
 
 #: shading groups: grid cells this many median particle radii wide, a few to a few tens of
 #: sprites each in the presets (Wang: groups of 1 to 30 sprites)
@@ -196,7 +196,7 @@ def shading_groups(centres, group_size_m: float) -> tuple[np.ndarray, np.ndarray
 
 
 def shading_grid_fits(centres, group_size_m: float) -> bool:
-    """Whether `shading_groups` can number this cloud's groups (cloudcore.limits checks scenes with it)."""
+    """Whether `shading_groups` can number this cloud's groups (cloudcore.scenes.limits checks scenes with it)."""
     centres = np.asarray(centres, dtype=np.float64).reshape(-1, 3)
     return len(centres) == 0 or _cells_exact(_grid_cells(centres, group_size_m))
 

@@ -26,8 +26,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from cloudcore.cloud_records import FOGGY, PUFFY, WISPY, ArtistShading, SpriteStyle
-from cloudcore.scene import Cloud, Vec3
+from cloudcore.model.cloud_records import FOGGY, PUFFY, WISPY, ArtistShading, SpriteStyle
+from cloudcore.model.scene import Cloud, Vec3
 
 #: Wang's cull distance for typical clouds, as a fraction of the sprite size (its diameter)
 TYPICAL_CULL_FRACTION = 1.0 / 3.0

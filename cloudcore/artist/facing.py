@@ -20,8 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cloudcore.ramps import smoothstep
-from cloudcore.vectors import row_lengths, unit_rows
+from cloudcore.maths.ramps import smoothstep
+from cloudcore.maths.vectors import row_lengths, unit_rows
 
 #: Wang: lock "when the camera comes within half of the sprite radius"
 LOCK_RADII = 0.5

@@ -23,7 +23,7 @@ import math
 
 import numpy as np
 
-from cloudcore.cloud_records import Formation
+from cloudcore.model.cloud_records import Formation
 
 #: fraction of the animation by which the farthest particle lags the core:
 #: one half, so the edge starts when the core is fully opaque (Wang section 4)

@@ -19,8 +19,8 @@ import numpy as np
 
 from cloudcore.artist.artist_shading import artist_uniforms, default_group_size, shading_groups
 from cloudcore.artist.sprites import particle_sprites
-from cloudcore.scene import Lighting
-from cloudcore.sun import scene_hour, sun_direction
+from cloudcore.model.scene import Lighting
+from cloudcore.world.sun import scene_hour, sun_direction
 
 #: how a cloud's quads are oriented: splats parallel to the image plane, sprites turned toward the
 #: eye (`cloudcore.artist.facing.sprite_axes`), or sprites parallel to the ground

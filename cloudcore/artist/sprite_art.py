@@ -2,7 +2,7 @@
 
 Wang's artists painted 16 textures "with interesting features that resemble
 eddies and wisps" so that few sprites make a detailed cloud.  These are drawn
-from hashed value noise (`cloudcore.noise`), four variants per kind, so the
+from hashed value noise (`cloudcore.maths.noise`), four variants per kind, so the
 sheet is the same on every machine and `scripts/make_sprite_atlas.py`
 regenerates `cloudcore/resources/sprites/atlas.png` exactly.
 
@@ -20,9 +20,9 @@ from __future__ import annotations
 import numpy as np
 
 from cloudcore.artist.sprites import CELL_MARGIN_PIXELS, CELL_PIXELS
-from cloudcore.cloud_records import ATLAS_GRID, FLAT_BOTTOM, FOGGY, PUFFY, WISPY
-from cloudcore.noise import hash01, value_noise
-from cloudcore.ramps import smoothstep
+from cloudcore.maths.noise import hash01, value_noise
+from cloudcore.maths.ramps import smoothstep
+from cloudcore.model.cloud_records import ATLAS_GRID, FLAT_BOTTOM, FOGGY, PUFFY, WISPY
 
 ATLAS_SEED = 2004
 #: where alpha has reached 0, as a fraction of the half cell: the margin starts there
@@ -36,7 +36,7 @@ FOGGY_TINT = np.array([0.92, 0.95, 1.0])
 def render_atlas(seed: int = ATLAS_SEED) -> np.ndarray:
     """The whole sheet, (ATLAS_GRID * CELL_PIXELS,) * 2 + (4,) RGBA float64 in [0, 1], rows top first.
 
-    Atlas row r (top to bottom) holds kind r of `cloudcore.cloud_records.ROWS`, four variants across.
+    Atlas row r (top to bottom) holds kind r of `cloudcore.model.cloud_records.ROWS`, four variants across.
     """
     kinds = {FLAT_BOTTOM: _flat_bottom, FOGGY: _foggy, PUFFY: _puffy, WISPY: _wispy}
     rows = []

@@ -29,8 +29,8 @@ import math
 import numpy as np
 
 from cloudcore.artist.artist_shading import height_fractions
-from cloudcore.cloud_records import ATLAS_GRID, FLAT_BOTTOM, SpriteStyle
-from cloudcore.noise import hash01
+from cloudcore.maths.noise import hash01
+from cloudcore.model.cloud_records import ATLAS_GRID, FLAT_BOTTOM, SpriteStyle
 from cloudcore.resources import ATLAS
 
 ATLAS_PATH = ATLAS

@@ -14,14 +14,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cloudcore import disk_cache
 from cloudcore.atmosphere import multiple_scattering, sky_view, transmittance
 from cloudcore.atmosphere.geometry import distance_to_top, horizon_cosine
 from cloudcore.atmosphere.parameters import AtmosphereParameters
 from cloudcore.atmosphere.scattering import in_scattering
 from cloudcore.atmosphere.sun_disc import visible_fraction
+from cloudcore.runtime import disk_cache
 
-#: the disk cache's name for the transmittance and multiple-scattering tables (`cloudcore.disk_cache`)
+#: the disk cache's name for the transmittance and multiple-scattering tables (`cloudcore.runtime.disk_cache`)
 CACHE_KIND = "atmosphere"
 #: bump when what the tables hold or how they are computed changes: older cache entries are rebuilt
 FORMAT_VERSION = 2

@@ -12,7 +12,7 @@ import platform
 import sys
 from importlib import metadata
 
-from cloudcore.errors import SceneError
+from cloudcore.model.errors import SceneError
 
 
 class _OneLineParser(argparse.ArgumentParser):
@@ -78,7 +78,7 @@ def main(argv=None) -> int:
 def _check_frame_memory(args) -> None:
     """A command's frame size (`--width` and `--height`, or `--size`) fits in this machine's memory: refused
     before any work, where the kernel killed a frame too large after minutes, without a word."""
-    from cloudcore.limits import frame_memory_problem
+    from cloudcore.scenes.limits import frame_memory_problem
 
     if hasattr(args, "width") and hasattr(args, "height"):
         size = args.width, args.height

@@ -30,8 +30,6 @@ from cloudcore.cli.bench_suite import load_suite, plot_suite, run_suite
 from cloudcore.cli.render import check_outputs, pixel_count, write_output
 from cloudcore.cli.settings_args import SWEEPABLE, add_settings_arguments, parse_sweep, settings_from
 from cloudcore.cli.workers import Job, add_workers_arguments, run_job, spread
-from cloudcore.errors import SceneError
-from cloudcore.limits import frame_memory_problem
 from cloudcore.measure.benchmark import (
     bench_path,
     headless_pyplot,
@@ -41,8 +39,10 @@ from cloudcore.measure.benchmark import (
     shading_comparison,
     still_views,
 )
-from cloudcore.scenefile import load_scene
-from cloudcore.settings import FULL_3D, RenderSettings, setting_options
+from cloudcore.model.errors import SceneError
+from cloudcore.model.settings import FULL_3D, RenderSettings, setting_options
+from cloudcore.scenes.files import load_scene
+from cloudcore.scenes.limits import frame_memory_problem
 
 DEFAULT_FRAMES = 60
 DEFAULT_SIZE = (640, 480)

@@ -21,7 +21,6 @@ from pathlib import Path
 
 import numpy as np
 
-from cloudcore.errors import SceneError
 from cloudcore.measure import bench_skies
 from cloudcore.measure.benchmark import (
     headless_pyplot,
@@ -32,11 +31,12 @@ from cloudcore.measure.benchmark import (
     save_figure,
     still_views,
 )
+from cloudcore.model.errors import SceneError
+from cloudcore.model.scene import Scene, Wind
+from cloudcore.model.settings import FULL_3D, RenderSettings
+from cloudcore.model.toml_table import Table, field_error, read_toml
 from cloudcore.resources import resource_path
-from cloudcore.scene import Scene, Wind
-from cloudcore.scenefile import load_scene, read_wind, settings_overrides
-from cloudcore.settings import FULL_3D, RenderSettings
-from cloudcore.toml_table import Table, field_error, read_toml
+from cloudcore.scenes.files import load_scene, read_wind, settings_overrides
 
 #: the suites shipped, one TOML file each
 SUITES_FOLDER = resource_path("bench")

@@ -13,12 +13,12 @@ from __future__ import annotations
 import dataclasses
 from pathlib import Path
 
-from cloudcore.errors import SceneError
-from cloudcore.interop.camera_paths import DEFAULT_LOOK_DISTANCE_M, read_camera_path, write_camera_path
-from cloudcore.interop.vdb_clouds import free_name
-from cloudcore.limits import scene_limit_problems
-from cloudcore.scene import Camera, Scene
-from cloudcore.scenefile import load_scene, save_scene
+from cloudcore.model.errors import SceneError
+from cloudcore.model.scene import Camera, Scene
+from cloudcore.scenes.files import load_scene, save_scene
+from cloudcore.scenes.interop.camera_paths import DEFAULT_LOOK_DISTANCE_M, read_camera_path, write_camera_path
+from cloudcore.scenes.interop.vdb_clouds import free_name
+from cloudcore.scenes.limits import scene_limit_problems
 
 
 def add_import_arguments(parser) -> None:

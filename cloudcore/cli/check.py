@@ -20,7 +20,6 @@ from pathlib import Path
 from cloudcore.cli.compare import decibels
 from cloudcore.cli.render import pixel_count
 from cloudcore.cli.workers import Job, add_workers_arguments, run_job
-from cloudcore.errors import SceneError
 from cloudcore.measure.screenshot_check import (
     DEFAULT_MAX_DIFF,
     DEFAULT_MIN_PSNR_DB,
@@ -32,7 +31,8 @@ from cloudcore.measure.screenshot_check import (
     update_golden,
     write_report,
 )
-from cloudcore.scenefile import load_scene
+from cloudcore.model.errors import SceneError
+from cloudcore.scenes.files import load_scene
 
 
 def add_parser(commands) -> None:

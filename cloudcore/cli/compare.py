@@ -13,8 +13,8 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from cloudcore.errors import SceneError
 from cloudcore.measure.imagecompare import compare, diff_image, load_rgb8
+from cloudcore.model.errors import SceneError
 
 DEFAULT_TOLERANCE_DB = 40.0  # the golden render tests' threshold
 

@@ -26,11 +26,11 @@ from types import SimpleNamespace
 from cloudcore.cli.render import add_scene_argument, pixel_count, write_output
 from cloudcore.cli.settings_args import add_settings_arguments, settings_from
 from cloudcore.cli.workers import Job, add_workers_arguments, run_job, spread
-from cloudcore.collector import freeze_what_is_set_up
-from cloudcore.errors import SceneError
+from cloudcore.maths.paths import camera_on_path
 from cloudcore.measure.recording import COLUMNS, frame_row, frame_times
-from cloudcore.paths import camera_on_path
-from cloudcore.scenefile import load_scene
+from cloudcore.model.errors import SceneError
+from cloudcore.runtime.collector import freeze_what_is_set_up
+from cloudcore.scenes.files import load_scene
 
 
 def add_parser(commands) -> None:
@@ -199,7 +199,7 @@ class RecordFrames:
         )
         if self.overdraw:
             stats = stats.with_overdraw(self.renderer.measure_overdraw()[1])
-        if self.drawn == 0:  # the renderer set up: out of the collector's full passes (`cloudcore.collector`)
+        if self.drawn == 0:  # the renderer set up: out of the collector's full passes (`cloudcore.runtime.collector`)
             freeze_what_is_set_up()
         self.drawn += 1
         return image, stats

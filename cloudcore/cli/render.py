@@ -10,14 +10,14 @@ import os
 from pathlib import Path
 
 from cloudcore.cli.settings_args import add_settings_arguments, settings_from
-from cloudcore.errors import SceneError
-from cloudcore.limits import MAX_FRAME_SIDE
-from cloudcore.measure.heatmap import heat_image
-from cloudcore.measure.overdraw import scene_block_overdraw_statistics
-from cloudcore.paths import camera_on_path
+from cloudcore.maths.paths import camera_on_path
+from cloudcore.model.errors import SceneError
+from cloudcore.model.scene import Camera
 from cloudcore.resources import DEFAULT_SCENE
-from cloudcore.scene import Camera
-from cloudcore.scenefile import load_scene
+from cloudcore.scenes.files import load_scene
+from cloudcore.scenes.limits import MAX_FRAME_SIDE
+from cloudcore.stats.heatmap import heat_image
+from cloudcore.stats.overdraw import scene_block_overdraw_statistics
 
 
 def add_parser(commands) -> None:

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from cloudcore.errors import SceneError
-from cloudcore.settings import RenderSettings, setting_options
+from cloudcore.model.errors import SceneError
+from cloudcore.model.settings import RenderSettings, setting_options
 
 
 def _boolean(text: str) -> bool:

@@ -10,7 +10,7 @@ from cloudcore.cli.render import add_scene_argument
 from cloudcore.light.illumination import illuminate_clouds
 from cloudcore.light.lighting import active_lights, scene_lights
 from cloudcore.light.shading import METHODS
-from cloudcore.scenefile import load_scene
+from cloudcore.scenes.files import load_scene
 
 
 def add_parser(commands) -> None:

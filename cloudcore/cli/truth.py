@@ -3,7 +3,7 @@
 The models are Harris's with each of his illumination methods of `cloudcore.light.shading` and the saturated
 eye pass with the exact one, or those --models names (any eye pass with any illumination method).  The
 truth and the models both show the clouds over the sky, the terrain and objects left out
-(`cloudcore.light.truth` says what the medium and the lights are); --terrain path traces the terrain too, the
+(`cloudcore.measure.truth` says what the medium and the lights are); --terrain path traces the terrain too, the
 clouds' shadows on it, for a picture alone.  The report renders the truth again
 with the next seed, for its own noise, and each model through the GL renderer in full 3D.  --workers N (or
 --cluster) path traces the passes of 16 samples on N processes (`cloudcore.cli.workers`): the same picture.
@@ -30,10 +30,11 @@ from cloudcore.cli.render import (
     write_output,
 )
 from cloudcore.cli.workers import Job, add_workers_arguments, run_job, spread
-from cloudcore.colour import linear_to_srgb8
-from cloudcore.errors import SceneError
 from cloudcore.light.shading import EYE_PASSES, METHODS
-from cloudcore.light.truth import (
+from cloudcore.maths.colour import linear_to_srgb8
+from cloudcore.measure.benchmark import PSNR_CAP_DB
+from cloudcore.measure.imagecompare import compare, diff_image
+from cloudcore.measure.truth import (
     DEFAULT_VOXELS_PER_RADIUS,
     SAMPLES_PER_PASS,
     VARIANTS,
@@ -41,11 +42,10 @@ from cloudcore.light.truth import (
     mitsuba_variant,
     render_truth,
 )
-from cloudcore.measure.benchmark import PSNR_CAP_DB
-from cloudcore.measure.imagecompare import compare, diff_image
 from cloudcore.measure.truth_comparison import BODY_ALPHA, CLOUD_ALPHA, region_errors, truth_regions
-from cloudcore.scenefile import load_scene
-from cloudcore.sun import scene_hour
+from cloudcore.model.errors import SceneError
+from cloudcore.scenes.files import load_scene
+from cloudcore.world.sun import scene_hour
 
 REGION_DEFINITION = (
     f"from the truth: sky where its alpha (1 - transmittance along the pixel's central ray) < {CLOUD_ALPHA}, "
@@ -264,7 +264,7 @@ def _model_renders(scene, camera, args) -> dict[str, tuple[np.ndarray, dict, flo
     # headless: EGL must be chosen before OpenGL is first imported
     os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
     from cloudcore.gl import FrameRenderer
-    from cloudcore.settings import FULL_3D
+    from cloudcore.model.settings import FULL_3D
 
     world = dataclasses.replace(scene, terrain=None, objects=())
     renders = {}

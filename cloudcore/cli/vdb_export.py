@@ -11,10 +11,10 @@ from __future__ import annotations
 from pathlib import Path
 
 from cloudcore.cli import camera_path_files
-from cloudcore.interop.camera_paths import CAMERA_PATH_SUFFIXES
-from cloudcore.interop.vdb_clouds import export_vdb
-from cloudcore.light.truth import DEFAULT_VOXELS_PER_RADIUS
-from cloudcore.scenefile import load_scene
+from cloudcore.measure.truth import DEFAULT_VOXELS_PER_RADIUS
+from cloudcore.scenes.files import load_scene
+from cloudcore.scenes.interop.camera_paths import CAMERA_PATH_SUFFIXES
+from cloudcore.scenes.interop.vdb_clouds import export_vdb
 
 
 def add_parser(commands) -> None:

@@ -3,7 +3,7 @@ or a camera path from a glTF (.gltf, .glb) or CSV file (`cloudcore.cli.camera_pa
 
 The clouds are added to SCENE.toml where it exists, else a new scene is made that looks at them; their
 particles go into .npy files beside it.  One line per cloud says its particles and the density error the fit
-leaves (`cloudcore.interop.density_fit`).  A file that cannot be imported is one line and exit 2, and the
+leaves (`cloudcore.scenes.interop.density_fit`).  A file that cannot be imported is one line and exit 2, and the
 scene is not touched.
 """
 
@@ -15,12 +15,12 @@ from pathlib import Path
 import numpy as np
 
 from cloudcore.cli import camera_path_files
-from cloudcore.errors import SceneError
-from cloudcore.interop.camera_paths import CAMERA_PATH_SUFFIXES
-from cloudcore.interop.vdb_clouds import DEFAULT_PARTICLES, import_vdb_clouds
-from cloudcore.limits import scene_limit_problems
-from cloudcore.scene import Camera, Scene, splats_bounding_sphere
-from cloudcore.scenefile import load_scene, save_scene
+from cloudcore.model.errors import SceneError
+from cloudcore.model.scene import Camera, Scene, splats_bounding_sphere
+from cloudcore.scenes.files import load_scene, save_scene
+from cloudcore.scenes.interop.camera_paths import CAMERA_PATH_SUFFIXES
+from cloudcore.scenes.interop.vdb_clouds import DEFAULT_PARTICLES, import_vdb_clouds
+from cloudcore.scenes.limits import scene_limit_problems
 
 
 def add_parser(commands) -> None:

@@ -33,7 +33,7 @@ from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, field
 from typing import Any
 
-from cloudcore.errors import SceneError
+from cloudcore.model.errors import SceneError
 
 #: times a piece whose worker died is run again before the job fails
 RETRIES = 2

@@ -30,7 +30,7 @@ column spacing, and the particle radius with it, follows the cell's side, so a
 coarser ring has a quarter as many particles per area, each twice as large:
 the same share of the sky covered, the same clouds.  Every random choice is an
 integer hash of (seed, level, layer, column) or of a site, never a
-generator stream (`cloudcore.noise`), so a cell is the same on every machine
+generator stream (`cloudcore.maths.noise`), so a cell is the same on every machine
 and numpy.
 """
 
@@ -42,8 +42,8 @@ import numpy as np
 
 from cloudcore.artist.cloudgen import PRESETS
 from cloudcore.field.grid import cell_side
-from cloudcore.noise import hash01, value_noise
-from cloudcore.scene import Cloud, CloudField
+from cloudcore.maths.noise import hash01, value_noise
+from cloudcore.model.scene import Cloud, CloudField
 
 #: candidate columns along a cell's side
 CANDIDATES_PER_SIDE = 8

@@ -23,8 +23,8 @@ import math
 
 import numpy as np
 
-from cloudcore.ramps import smoothstep
-from cloudcore.scene import CloudField
+from cloudcore.maths.ramps import smoothstep
+from cloudcore.model.scene import CloudField
 
 #: how many of its own cells a ring reaches from the eye (Chebyshev): each ring is 2 x 4 cells across, its
 #: inner part under the finer rings; 4 leaves a solid band of one cell between the two blend bands

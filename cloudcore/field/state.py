@@ -24,7 +24,7 @@ import numpy as np
 
 from cloudcore.field.cells import cell_clouds
 from cloudcore.field.grid import cells_in_reach, level_weights
-from cloudcore.scene import Cloud, CloudField
+from cloudcore.model.scene import Cloud, CloudField
 
 #: a cell: (level, i, j)
 CellKey = tuple[int, int, int]

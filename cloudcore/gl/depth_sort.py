@@ -15,9 +15,9 @@ from __future__ import annotations
 
 from OpenGL import GL
 
+from cloudcore.gl.measured_way import software_rasterizer
 from cloudcore.gl.prefix_sum import GpuPrefixSum
 from cloudcore.gl.programs import build_compute_program, gl_renderer, uniform_locations
-from cloudcore.measured_way import software_rasterizer
 
 #: bits of the key a pass sorts by; see the shader for why four
 DIGIT_BITS = 4

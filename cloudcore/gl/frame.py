@@ -38,14 +38,14 @@ from OpenGL import GL
 from cloudcore.artist.facing import CloudFacings
 from cloudcore.artist.formation import formation_state
 from cloudcore.artist.particle_styles import particle_styles
-from cloudcore.camera import NEAR_PLANE_M, frustum_planes, projection_matrix, view_matrix
-from cloudcore.colour import linear_to_srgb8
 from cloudcore.field.state import FieldState
+from cloudcore.field.weather import WeatherFieldState, update_weather_field, weather_drift
 from cloudcore.gl.context import HeadlessContext, WindowContext, check_frame_size
 from cloudcore.gl.derived import Derived
 from cloudcore.gl.draw import CloudPass, CloudPassFrame, DrawCounts, PassTools
 from cloudcore.gl.impostor_store import ImpostorStore
 from cloudcore.gl.light_shafts import LightShaftPass
+from cloudcore.gl.measured_way import MeasuredWay
 from cloudcore.gl.objects import ObjectPass
 from cloudcore.gl.pass_clock import PassClock
 from cloudcore.gl.programs import build_program
@@ -66,16 +66,16 @@ from cloudcore.light.sky_background import SkyBackground, scene_sky
 from cloudcore.light.terrain_light import terrain_light
 from cloudcore.lod.costs import CostEstimator, CostModel, remember_fit, remembered_prior
 from cloudcore.lod.plan import FramePlan, LodState, plan_frame
+from cloudcore.lod.splat_coverage import analytic_overdraw
 from cloudcore.lod.units import LodUnits, lod_units
-from cloudcore.measure.frame_stats import FrameStats
-from cloudcore.measure.overdraw import Overdraw, overdraw_statistics
-from cloudcore.measured_way import COMPOSITING_WAYS, MeasuredWay
+from cloudcore.maths.colour import linear_to_srgb8
+from cloudcore.model.scene import Camera, Lighting, Scene
+from cloudcore.model.settings import COMPOSITING_WAYS, FULL_3D, RenderSettings
 from cloudcore.particles.buffer import ParticleBuffer
-from cloudcore.scene import Camera, Lighting, Scene
-from cloudcore.settings import FULL_3D, RenderSettings
-from cloudcore.splat_coverage import analytic_overdraw
-from cloudcore.weather import WeatherFieldState, update_weather_field, weather_drift
-from cloudcore.wind import (
+from cloudcore.stats.frame_stats import FrameStats
+from cloudcore.stats.overdraw import Overdraw, overdraw_statistics
+from cloudcore.world.camera import NEAR_PLANE_M, frustum_planes, projection_matrix, view_matrix
+from cloudcore.world.wind import (
     AirMotion,
     CloudMotion,
     field_speed,
@@ -590,7 +590,7 @@ class FrameRenderer:
         return 1e3 * (time.perf_counter() - start) if self.shadow_map.made != made else 0.0
 
     def _air_motion(self, scene: Scene) -> AirMotion | None:
-        """The wind applied to the scene's authored clouds (`cloudcore.wind.AirMotion`), made again for other
+        """The wind applied to the scene's authored clouds (`cloudcore.world.wind.AirMotion`), made again for other
         clouds or another wind; None in still air."""
         if scene.wind is None:
             self._air = None

@@ -32,9 +32,9 @@ from cloudcore.lod.impostors import ImpostorView, cropped_corners, impostor_view
 from cloudcore.lod.plan import FramePlan
 from cloudcore.lod.ring import RingGeneration, panel_corners, segment_camera
 from cloudcore.lod.splitting import layer_bounds
+from cloudcore.model.settings import RenderSettings
 from cloudcore.particles.batch import SplatSelection, splat_batch
 from cloudcore.particles.buffer import ParticleBuffer
-from cloudcore.settings import RenderSettings
 
 #: the atlas layers' side: the default largest impostor, one layer 2 MiB; larger impostors get an atlas of their side
 ATLAS_LAYER_SIDE = 512

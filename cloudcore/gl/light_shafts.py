@@ -17,7 +17,7 @@ from cloudcore.gl.programs import build_program, set_vec3
 from cloudcore.gl.shadow_map import CloudShadowMap
 from cloudcore.gl.targets import DepthTexture, TextureTarget
 from cloudcore.light.light_shafts import SHAFT_STEPS
-from cloudcore.scene import Camera
+from cloudcore.model.scene import Camera
 
 #: the march's columns, about: its error against a fine march is set by how many rays it has, not by the screen's
 #: pixels, and its cost with them (docs/atmosphere.md#light-shafts)

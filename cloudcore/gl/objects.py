@@ -21,7 +21,13 @@ import math
 import numpy as np
 from OpenGL import GL
 
-from cloudcore.camera import (
+from cloudcore.gl.air_volume import AirVolume
+from cloudcore.gl.programs import build_program, set_matrix, set_vec3
+from cloudcore.gl.pyrender_compat import pyrender
+from cloudcore.gl.shadow_map import CloudShadowMap
+from cloudcore.light.lighting import active_lights
+from cloudcore.model.scene import Camera
+from cloudcore.world.camera import (
     FAR_PLANE_M,
     NEAR_PLANE_M,
     camera_pose,
@@ -29,13 +35,7 @@ from cloudcore.camera import (
     projection_matrix,
     view_matrix,
 )
-from cloudcore.gl.air_volume import AirVolume
-from cloudcore.gl.programs import build_program, set_matrix, set_vec3
-from cloudcore.gl.pyrender_compat import pyrender
-from cloudcore.gl.shadow_map import CloudShadowMap
-from cloudcore.light.lighting import active_lights
-from cloudcore.objects import mesh_sphere, object_mesh, object_poses
-from cloudcore.scene import Camera
+from cloudcore.world.objects import mesh_sphere, object_mesh, object_poses
 
 _UP = np.array([0.0, 1.0, 0.0])
 

@@ -1,5 +1,5 @@
 """The cloud pass drawn at a fraction of the screen's resolution and laid over the world by a depth-aware upsampling
-(Yusov 2014, section 5.4; what it tests against and how a pixel picks its texels: `cloudcore.depth_upsampling`).
+(Yusov 2014, section 5.4; what it tests against and how a pixel picks its texels: `cloudcore.maths.depth_upsampling`).
 
 `ReducedClouds.begin` fills the reduced pass's depth with the nearest world depth of each block of the screen's
 pixels and clears its colour; the frame's cloud draws (splats, impostors, ring panels, crossfades, screen impostors'
@@ -15,10 +15,10 @@ import math
 import numpy as np
 from OpenGL import GL
 
-from cloudcore.camera import FAR_PLANE_M, NEAR_PLANE_M
-from cloudcore.depth_upsampling import BEHIND_TOLERANCE, DEPTH_TOLERANCE, NO_MATCH_WEIGHT
 from cloudcore.gl.programs import build_program, uniform_locations
 from cloudcore.gl.targets import DepthTexture, TextureTarget
+from cloudcore.maths.depth_upsampling import BEHIND_TOLERANCE, DEPTH_TOLERANCE, NO_MATCH_WEIGHT
+from cloudcore.world.camera import FAR_PLANE_M, NEAR_PLANE_M
 
 #: the side of the composite's tiles, in screen pixels: llvmpipe's own tiles, whose loading and storing a draw pays
 #: for each it touches
@@ -144,7 +144,7 @@ class ReducedClouds:
 
     def read(self) -> tuple[np.ndarray, np.ndarray]:
         """(its colour (h, w, 4), the depth it was tested against (h, w)) as float32, bottom row first (GL's order,
-        `cloudcore.depth_upsampling`'s): what the last composite laid over the screen, for tests."""
+        `cloudcore.maths.depth_upsampling`'s): what the last composite laid over the screen, for tests."""
         GL.glBindTexture(GL.GL_TEXTURE_2D, self._depth.texture)
         GL.glPixelStorei(GL.GL_PACK_ALIGNMENT, 1)
         depth = GL.glGetTexImage(GL.GL_TEXTURE_2D, 0, GL.GL_DEPTH_COMPONENT, GL.GL_FLOAT)

@@ -17,7 +17,7 @@ from OpenGL import GL
 from cloudcore.gl.programs import build_program, set_matrix
 from cloudcore.gl.targets import linear_filtering
 from cloudcore.light.cloud_shadows import SLICES, LightSpace, light_space
-from cloudcore.splat_kernel import SPLAT_SHARPNESS
+from cloudcore.maths.splat_kernel import SPLAT_SHARPNESS
 
 #: the texture units of the map's two targets (slices 1-4, 5-8), as shaders/cloud_shadow.glsl declares them
 SHADOW_UNITS = (5, 6)

@@ -16,9 +16,9 @@ from cloudcore.gl.depth_sort import GpuDepthSort, key_bits_for
 from cloudcore.gl.programs import build_compute_program, dispatch, set_vec3_at, uniform_locations
 from cloudcore.gl.splat_residency import PARTICLE_FLOATS, ResidentParticles
 from cloudcore.gl.storage import bind_storage, copy_buffer, reallocate_storage, store
+from cloudcore.maths.splat_kernel import SPLAT_REACH
 from cloudcore.particles.batch import SplatSelection
 from cloudcore.particles.buffer import FADE_START_RADII
-from cloudcore.splat_kernel import SPLAT_REACH
 
 #: splat_select.comp.glsl's buffers
 (

@@ -17,10 +17,10 @@ from cloudcore.artist.facing import FacingState
 from cloudcore.artist.particle_styles import FACING_SPLAT, ParticleStyles
 from cloudcore.artist.sprites import ATLAS_MAX_MIP_LEVEL, load_atlas
 from cloudcore.gl.storage import store
-from cloudcore.limits import MAX_LIGHTS
 from cloudcore.particles.batch import SplatBatch, SplatSelection
 from cloudcore.particles.buffer import ParticleBuffer
 from cloudcore.particles.point_sprites import plain_splats
+from cloudcore.scenes.limits import MAX_LIGHTS
 
 #: the shader's `Particle` in std430 layout: five vec4 then MAX_LIGHTS floats
 PARTICLE_FLOATS = 20 + MAX_LIGHTS
@@ -141,7 +141,7 @@ class ResidentParticles:
 def _particle_records(particles: ParticleBuffer) -> np.ndarray:
     """The shader's `Particle` array (n, PARTICLE_FLOATS) float32: the view-independent terms of `seen_from`."""
     lights = len(particles.light_directions)
-    if lights > MAX_LIGHTS:  # the scene loader and the editor refuse these first (cloudcore.limits)
+    if lights > MAX_LIGHTS:  # the scene loader and the editor refuse these first (cloudcore.scenes.limits)
         raise ValueError(f"at most {MAX_LIGHTS} lights can shine on clouds at once, the scene has {lights}")
     records = np.zeros((max(len(particles.radii), 1), PARTICLE_FLOATS), dtype=np.float32)
     n = len(particles.radii)

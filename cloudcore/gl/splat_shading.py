@@ -18,9 +18,9 @@ from cloudcore.gl.splat_order import GpuSplatOrder
 from cloudcore.gl.splat_residency import ResidentParticles
 from cloudcore.gl.storage import bind_storage, copy_buffer, store
 from cloudcore.light.phase import PHASE_NAMES
-from cloudcore.limits import MAX_LIGHTS
 from cloudcore.particles.batch import SplatBatch, SplatSelection
 from cloudcore.particles.buffer import FADE_END_RADII, FADE_START_RADII, ParticleBuffer
+from cloudcore.scenes.limits import MAX_LIGHTS
 
 #: per particle, written by the compute shader: four corners and four colours (vec4 each)
 INSTANCE_BYTES = 8 * 16

@@ -21,7 +21,6 @@ import numpy as np
 from OpenGL import GL
 
 from cloudcore.artist.facing import FacingState
-from cloudcore.cloud_records import ATLAS_GRID
 from cloudcore.gl.air_volume import AirVolume
 from cloudcore.gl.blending import cloud_blending
 from cloudcore.gl.programs import build_program, set_matrix_at, uniform_locations
@@ -29,10 +28,11 @@ from cloudcore.gl.splat_order import COMMAND_UINTS, GpuSplatOrder
 from cloudcore.gl.splat_residency import ResidentParticles
 from cloudcore.gl.splat_shading import INSTANCES_BINDING, SplatShading
 from cloudcore.gl.storage import store
+from cloudcore.maths.splat_kernel import SPLAT_SHARPNESS
+from cloudcore.model.cloud_records import ATLAS_GRID
 from cloudcore.particles.batch import SplatBatch, SplatSelection
 from cloudcore.particles.buffer import ParticleBuffer
 from cloudcore.particles.point_sprites import draw_runs, guard_band, point_sprite_mask
-from cloudcore.splat_kernel import SPLAT_SHARPNESS
 
 #: two triangles over a particle's four corners (lower left, lower right, upper left, upper right)
 _QUAD_TRIANGLES = np.array([0, 1, 2, 2, 1, 3], dtype=np.uint32)

@@ -37,8 +37,8 @@ from dataclasses import dataclass
 import numpy as np
 from OpenGL import GL
 
-from cloudcore.camera import NEAR_PLANE_M
 from cloudcore.gl.depth_sort import GpuDepthSort, key_bits_for
+from cloudcore.gl.measured_way import software_rasterizer
 from cloudcore.gl.prefix_sum import GpuPrefixSum
 from cloudcore.gl.programs import (
     build_compute_program,
@@ -51,7 +51,7 @@ from cloudcore.gl.programs import (
 from cloudcore.gl.splat_shading import INSTANCE_BYTES
 from cloudcore.gl.storage import reallocate_storage
 from cloudcore.light.volume_blending import TILE_PIXELS
-from cloudcore.measured_way import software_rasterizer
+from cloudcore.world.camera import NEAR_PLANE_M
 
 #: the storage bindings of tile_bin.comp.glsl (instances and command as the splat pass binds them)
 _INSTANCES, _COMMAND, _TOTALS, _PAIR_SLOTS, _PAIR_TILES, _TILE_STARTS, _PAIR_STARTS = 3, 6, 9, 10, 11, 12, 13

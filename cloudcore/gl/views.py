@@ -8,7 +8,7 @@ from cloudcore.gl.frame import FrameRenderer
 from cloudcore.lod.costs import LLVMPIPE_COSTS
 from cloudcore.lod.plan import LodState
 from cloudcore.measure.screenshot_check import view_camera, view_settings
-from cloudcore.scene import Scene, View
+from cloudcore.model.scene import Scene, View
 
 
 class ViewRenderer:

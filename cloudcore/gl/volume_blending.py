@@ -28,8 +28,8 @@ from cloudcore.light.volume_blending import (
     TILE_PIXELS,
     Splats,
 )
+from cloudcore.maths.splat_kernel import SPLAT_SHARPNESS
 from cloudcore.particles.batch import SplatBatch
-from cloudcore.splat_kernel import SPLAT_SHARPNESS
 
 _TILE_STARTS_BINDING, _TILE_ENTRIES_BINDING = 6, 7
 #: volume_blend.comp.glsl's constants, both variants'

@@ -1,7 +1,7 @@
 """The world pass: the terrain's tiles, lit per vertex and seen through the air, then the sky where they leave it.
 
 The terrain is drawn straight into the linear target with its depth (shaders/terrain.*.glsl): its tiles
-follow the eye (`cloudcore.terrain_tiles`), their light is baked per vertex (`TerrainLight`, the sun's part
+follow the eye (`cloudcore.world.terrain_tiles`), their light is baked per vertex (`TerrainLight`, the sun's part
 apart), and under the physical sky the air between the eye and each vertex is read per vertex.  The sky
 follows, a full-screen triangle at the far plane that the depth test keeps off the terrain (shaders/sky.frag.glsl,
 compiled for the sky it draws).  Where each millisecond went before, and what this cut: docs/performance.md,
@@ -19,7 +19,6 @@ from OpenGL import GL
 from cloudcore.atmosphere.geometry import horizon_cosine
 from cloudcore.atmosphere.sky_view import eye_radius, horizon_angles
 from cloudcore.atmosphere.sun_disc import SUN_ANGULAR_RADIUS
-from cloudcore.camera import frustum_planes
 from cloudcore.gl.air_volume import AirVolume
 from cloudcore.gl.context import HeadlessContext
 from cloudcore.gl.light_shafts import LightShaftPass
@@ -31,10 +30,11 @@ from cloudcore.light.far_ground import far_ground_colour
 from cloudcore.light.light_shafts import SHAFT_STEPS
 from cloudcore.light.sky_background import NIGHT_SKY, SkyBackground, ground_behind_the_air
 from cloudcore.light.terrain_light import TerrainLight
-from cloudcore.limits import DRAWN_TERRAIN_KINDS
-from cloudcore.scene import Camera, Terrain
-from cloudcore.terrain import ground_colours
-from cloudcore.terrain_tiles import TILE_FACES, TILE_VERTICES, TerrainTiles, grid_face_count, tile_faces
+from cloudcore.model.scene import Camera, Terrain
+from cloudcore.scenes.limits import DRAWN_TERRAIN_KINDS
+from cloudcore.world.camera import frustum_planes
+from cloudcore.world.terrain import ground_colours
+from cloudcore.world.terrain_tiles import TILE_FACES, TILE_VERTICES, TerrainTiles, grid_face_count, tile_faces
 
 #: the light shafts' depth of the terrain takes every 4th vertex of a tile's grid: the frames agree closely with the
 #: whole grid's, whose triangles cost llvmpipe their setup (docs/atmosphere.md#light-shafts)
@@ -82,7 +82,7 @@ class TerrainMesh:
     the tiles, drawn tile by tile where a tile's box meets the view."""
 
     def __init__(self, terrain: Terrain, light: TerrainLight):
-        if terrain.kind not in DRAWN_TERRAIN_KINDS:  # the scene loader refuses these first (cloudcore.limits)
+        if terrain.kind not in DRAWN_TERRAIN_KINDS:  # the scene loader refuses these first (cloudcore.scenes.limits)
             raise ValueError(f"the GL prototype draws heightfield and heightmap terrain only, not {terrain.kind!r}")
         self._terrain, self._light = terrain, light
         self.tiles = TerrainTiles(terrain)

@@ -4,7 +4,7 @@ An opacity shadow map (Kim and Neumann 2001; Yusov's light-space cloud transpare
 seen along the sun: an orthographic view over the clouds' footprint (whatever lies outside it is in no cloud's
 shadow), `SLICES` depths across the clouds, and per texel and depth the optical depth of the particles in front
 of it.  A particle of beam opacity b and radius r lets 1 - b K(rho / r) through at a distance rho from its axis
-(`cloudcore.splat_kernel`), so it adds the optical depth -ln(1 - b K) there: the transmittance through many is
+(`cloudcore.maths.splat_kernel`), so it adds the optical depth -ln(1 - b K) there: the transmittance through many is
 exp(-sum), the product of theirs.
 
 What a particle takes out of the beam differs by who receives it.  Another cloud's particles: the beam opacity
@@ -38,8 +38,8 @@ import numpy as np
 
 from cloudcore.light.phase import phase_function
 from cloudcore.light.shading import scattering_coefficient
-from cloudcore.segments import concatenated_ranges
-from cloudcore.splat_kernel import splat_kernel
+from cloudcore.maths.segments import concatenated_ranges
+from cloudcore.maths.splat_kernel import splat_kernel
 
 #: the depths the map holds the optical depth at: the GL map's two RGBA targets
 SLICES = 8

@@ -15,9 +15,9 @@ from __future__ import annotations
 import numpy as np
 
 from cloudcore.light.terrain_light import TerrainLight
-from cloudcore.scene import Terrain
-from cloudcore.terrain import ground_colours, height_at
-from cloudcore.terrain_tiles import tile_frame
+from cloudcore.model.scene import Terrain
+from cloudcore.world.terrain import ground_colours, height_at
+from cloudcore.world.terrain_tiles import tile_frame
 
 #: points along each side of the drawn square whose ground colours are averaged into the far ground's
 EDGE_SAMPLES = 64

@@ -15,7 +15,7 @@ import numpy as np
 from cloudcore.light.cloud_shadows import beam_opacity, between_clouds_transmittance
 from cloudcore.light.lighting import active_lights
 from cloudcore.light.shading import DEFAULT_RASTER_RESOLUTION, incident_light
-from cloudcore.scene import Cloud, Shading
+from cloudcore.model.scene import Cloud, Shading
 
 
 def cloud_optics(cloud: Cloud, shading: Shading) -> tuple[np.ndarray, np.ndarray]:

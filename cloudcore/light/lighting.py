@@ -1,4 +1,4 @@
-"""Time of day to lights: sun colour, skylight, ambient; the sun's direction is `cloudcore.sun`'s.
+"""Time of day to lights: sun colour, skylight, ambient; the sun's direction is `cloudcore.world.sun`'s.
 
 Skylight is a second light from the zenith (Harris section 2.3.1); lights that contribute nothing are
 dropped (`active_lights`).  Where a scene's sky is "physical" (`Air.sky`, the default) the light comes
@@ -16,9 +16,9 @@ import numpy as np
 
 from cloudcore.atmosphere.parameters import EARTH, AtmosphereParameters
 from cloudcore.atmosphere.sky import SkyView, atmosphere_tables, sky_irradiance, sky_seen_from, sun_transmittance
-from cloudcore.ramps import smoothstep
-from cloudcore.scene import Air, Light, Lighting
-from cloudcore.sun import elevation_deg, scene_hour, sun_direction
+from cloudcore.maths.ramps import smoothstep
+from cloudcore.model.scene import Air, Light, Lighting
+from cloudcore.world.sun import elevation_deg, scene_hour, sun_direction
 
 #: the skies a scene may have (`Air.sky`)
 SKIES = ("physical", "gradient")

@@ -32,8 +32,8 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from cloudcore.light.precomputed import chord_depth, chord_depths
-from cloudcore.segments import concatenated_ranges
-from cloudcore.splat_kernel import splat_kernel
+from cloudcore.maths.segments import concatenated_ranges
+from cloudcore.maths.splat_kernel import splat_kernel
 
 #: tiles across a group's footprint in the light's view (the paper's typical grid is 64 x 64)
 TILES = 64

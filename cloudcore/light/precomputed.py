@@ -1,7 +1,7 @@
 """Yusov's precomputed lighting of the reference particle (HPG 2014, sections 4-5.1), numpy float64.
 
 The reference particle is a unit sphere whose extinction follows the splat kernel,
-beta(x) = tau K(|x|) / I_K, the same blob the path-traced truth is made of (`cloudcore.light.truth`),
+beta(x) = tau K(|x|) / I_K, the same blob the path-traced truth is made of (`cloudcore.measure.truth`),
 so that the optical depth through its centre is the particle's tau and a chord at distance b from the
 centre has tau C(b) / C(0), C(b) the kernel's line integral.  Three tables:
 
@@ -41,7 +41,7 @@ toward mu is the source of each order times the transmittance to the sphere's ed
 summed over the voxels and averaged over azimuths about the light.  Orders beyond the last are a
 geometric tail, their ratio that of the last two orders.
 
-The tables are cached on disk (`cloudcore.disk_cache`), keyed by the phase function, g, the
+The tables are cached on disk (`cloudcore.runtime.disk_cache`), keyed by the phase function, g, the
 resolutions and `FORMAT_VERSION`; `reference_tables` builds them once (docs/shading.md has the time
 and the size).
 """
@@ -55,9 +55,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cloudcore import disk_cache
 from cloudcore.light.phase import check_phase, phase_function
-from cloudcore.splat_kernel import KERNEL_DIAMETER_INTEGRAL, splat_kernel
+from cloudcore.maths.splat_kernel import KERNEL_DIAMETER_INTEGRAL, splat_kernel
+from cloudcore.runtime import disk_cache
 
 #: bump when what the tables hold or how they are computed changes: older cache entries are rebuilt
 FORMAT_VERSION = 1
@@ -231,7 +231,7 @@ def reference_tables(
 _held: dict[tuple, ReferenceTables] = {}
 
 
-#: the disk cache's name for the tables (`cloudcore.disk_cache`)
+#: the disk cache's name for the tables (`cloudcore.runtime.disk_cache`)
 CACHE_KIND = "reference-particle"
 
 

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 from cloudcore.light.illumination import IlluminationCache, illuminate_direction
 from cloudcore.light.lighting import scene_lights
-from cloudcore.scene import Lighting, Scene, Shading
+from cloudcore.model.scene import Lighting, Scene, Shading
 
 #: the light pass while a slider is dragged (`cloudcore.light.shading`: a coarse raster), and once it is let go
 PREVIEW_METHOD, EXACT_METHOD = "preview", "exact"

@@ -9,7 +9,7 @@ splatted with
     value = sigma_k * I_k * K_k(x) + (1 - alpha_k * K_k(x)) * value
 
 where alpha_k = 1 - exp(-tau_k), sigma_k = a_k tau_k p(0) / (4 pi) and K is the
-splat kernel (`cloudcore.splat_kernel`).
+splat kernel (`cloudcore.maths.splat_kernel`).
 
 Stability.  Where sigma_k > alpha_k (tau above about 9.3 at albedo 0.9 with
 Rayleigh) the literal recurrence sends on more light than reached the particle.
@@ -55,8 +55,8 @@ from cloudcore.light.occlusion import occlusion_estimate
 from cloudcore.light.octaves import most_light, octave_light, octave_optical_depths
 from cloudcore.light.phase import check_phase, phase_function
 from cloudcore.light.precomputed import eye_pass_profiles
-from cloudcore.segments import concatenated_ranges
-from cloudcore.splat_kernel import splat_kernel
+from cloudcore.maths.segments import concatenated_ranges
+from cloudcore.maths.splat_kernel import splat_kernel
 
 METHODS = ("exact", "raster", "preview", "occlusion", "octaves", "octaves-lit-face")
 #: what a particle sends toward the eye (`cloudcore.particles.buffer`): Harris's eq. 5 as printed,

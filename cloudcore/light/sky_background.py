@@ -24,8 +24,8 @@ from cloudcore.light.lighting import (
     sky_colors,
     sky_gradient,
 )
-from cloudcore.scene import Lighting
-from cloudcore.sun import scene_hour
+from cloudcore.model.scene import Lighting
+from cloudcore.world.sun import scene_hour
 
 #: the brightest the sun's disc is drawn, in the renderer's linear values (its physical peak is about 4e4): the
 #: 16-bit float targets' blending rounds a cloud's 1 - alpha to 2^-11, so a brighter disc would show through

@@ -16,8 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from cloudcore.light.lighting import NIGHT_AMBIENT, active_lights, ground_irradiance, physical_irradiances
-from cloudcore.scene import Light, Lighting
-from cloudcore.sun import scene_hour
+from cloudcore.model.scene import Light, Lighting
+from cloudcore.world.sun import scene_hour
 
 
 @dataclass(frozen=True)

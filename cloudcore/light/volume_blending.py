@@ -5,7 +5,7 @@ particle, so that a lone particle looks exactly as its splat does):
 
 - the ray hits the splat's plane (through the centre, spanned by the view's right and up axes) at
   distance d from the centre, in radii, as `splat.frag.glsl` measures it; the splat draws opacity
-  a = alpha K(d) and premultiplied colour c K(d) (`cloudcore.splat_kernel`, `ParticleBuffer.seen_from`);
+  a = alpha K(d) and premultiplied colour c K(d) (`cloudcore.maths.splat_kernel`, `ParticleBuffer.seen_from`);
 - the particle is a sphere of that radius, homogeneous along the ray: the segment is the chord
   [t_c - h, t_c + h] around the ray's closest approach t_c to the centre, h = r sqrt(1 - d^2);
 - its optical depth tau = -ln(1 - a) (capped at `MAX_OPTICAL_DEPTH`), so its transmittance is the
@@ -37,8 +37,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cloudcore.settings import BLENDINGS
-from cloudcore.splat_kernel import splat_kernel
+from cloudcore.maths.splat_kernel import splat_kernel
+from cloudcore.model.settings import BLENDINGS
 
 #: optical depth a segment is capped at: e^-50 of light gets through, nothing a 16-bit target holds,
 #: and tau stays finite where a splat's opacity rounds to 1 (-ln 0)

@@ -27,7 +27,7 @@ from functools import cached_property
 
 import numpy as np
 
-from cloudcore import disk_cache
+from cloudcore.runtime import disk_cache
 
 
 @dataclass(frozen=True, slots=True)

@@ -25,8 +25,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cloudcore.camera import camera_pose, points_in_eye_space, pose_to_view, projection_matrix
-from cloudcore.scene import Camera
+from cloudcore.model.scene import Camera
+from cloudcore.world.camera import camera_pose, points_in_eye_space, pose_to_view, projection_matrix
 
 #: an impostor texture at least this many times finer than needed is remade smaller (saves memory;
 #: the factor keeps a cloud at a steady distance from flipping between two sizes)
@@ -52,7 +52,7 @@ class ImpostorRecord:
     #: the middle and half the depth, along the view axis from `eye`, of what the texture holds (its particles'
     #: discs; `content_depth`): the near and far points of Harris's parallax (None: the bounding sphere's)
     content: tuple[tuple[float, float, float], float] | None = None
-    #: metres the wind had carried the unit when it was made, and the scene time then (`cloudcore.wind`): the
+    #: metres the wind had carried the unit when it was made, and the scene time then (`cloudcore.world.wind`): the
     #: quad follows the unit's drift since, and the error counts the eye's place relative to the moved unit and
     #: how far turbulence may have changed it
     drift: tuple[float, float, float] = (0.0, 0.0, 0.0)

@@ -26,10 +26,10 @@ from typing import NamedTuple
 
 import numpy as np
 
-from cloudcore.camera import camera_pose, frustum_planes, projection_matrix, spheres_in_frustum, view_matrix
 from cloudcore.lod.impostors import SHRINK_FACTOR, required_size
-from cloudcore.scene import Camera
-from cloudcore.settings import RenderSettings
+from cloudcore.model.scene import Camera
+from cloudcore.model.settings import RenderSettings
+from cloudcore.world.camera import camera_pose, frustum_planes, projection_matrix, spheres_in_frustum, view_matrix
 
 SEGMENTS = 8
 SEGMENT_DEG = 360.0 / SEGMENTS

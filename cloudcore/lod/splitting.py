@@ -18,7 +18,7 @@ import math
 
 import numpy as np
 
-from cloudcore.vectors import row_lengths
+from cloudcore.maths.vectors import row_lengths
 
 
 def objects_reaching(

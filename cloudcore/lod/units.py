@@ -37,7 +37,7 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from cloudcore.lod.costs import SPRITE_FRAGMENT_COST
-from cloudcore.scene import splats_bounding_sphere
+from cloudcore.model.scene import splats_bounding_sphere
 
 #: two splats interpenetrate when their centres are closer than this times the sum of their radii
 TOUCH_RADII = 0.5
@@ -198,7 +198,7 @@ class LodUnits:
 
     def moved(self, cloud_shifts: np.ndarray, grown: float) -> LodUnits:
         """These units with their clouds moved by `cloud_shifts` (clouds, 3) metres and each cloud's particles
-        strayed at most `grown` metres besides (the wind: `cloudcore.wind`): a unit moves by its members' mean
+        strayed at most `grown` metres besides (the wind: `cloudcore.world.wind`): a unit moves by its members' mean
         shift, and its sphere grows by `grown` and by the farthest a member moved from that mean."""
         cloud_shifts = np.asarray(cloud_shifts, dtype=np.float64).reshape(-1, 3)
         shifts, spread = self.member_means(cloud_shifts), np.zeros(len(self.members))

@@ -19,8 +19,8 @@ import math
 import numpy as np
 
 from cloudcore.artist.cloudgen import cumulus, preset_cloud
-from cloudcore.measure.overdraw import WANG_BLOCK_SIZE_M, cloud_block_overdraw
-from cloudcore.scene import Camera, CameraPath, Cloud, Scene
+from cloudcore.model.scene import Camera, CameraPath, Cloud, Scene
+from cloudcore.stats.overdraw import WANG_BLOCK_SIZE_M, cloud_block_overdraw
 
 FRAMES_PER_S = 30.0
 
@@ -94,7 +94,7 @@ def through_views(frames: int) -> list:
 
 
 # Wang's scenarios.  Wang flew Flight Simulator 2004 through three weathers told apart by cloud-block overdraw
-# (the summed sprite areas over each 4 km ground block, `cloudcore.measure.overdraw.cloud_block_overdraw`): sparse
+# (the summed sprite areas over each 4 km ground block, `cloudcore.stats.overdraw.cloud_block_overdraw`): sparse
 # (170%), scattered (200%) and overcast (475%), at 1024x768.  `wang_scene` fills 16 km by 16 km with the artist
 # presets of each weather (`cloudcore.artist.cloudgen.preset_cloud`), cloud by cloud from a seed, until every
 # block holds clouds and their mean overdraw reaches Wang's figure; the eye flies at 120 m/s through the clouds'

@@ -23,14 +23,14 @@ from pathlib import Path
 
 import numpy as np
 
-from cloudcore.collector import freeze_what_is_set_up
 from cloudcore.light.illumination import illuminate_clouds
 from cloudcore.light.lighting import active_lights, scene_lights
+from cloudcore.maths.paths import camera_on_path, frame_times
 from cloudcore.measure.imagecompare import compare
-from cloudcore.navigation import orbited
-from cloudcore.paths import camera_on_path, frame_times
-from cloudcore.scene import Scene
-from cloudcore.settings import FULL_3D
+from cloudcore.model.scene import Scene
+from cloudcore.model.settings import FULL_3D
+from cloudcore.runtime.collector import freeze_what_is_set_up
+from cloudcore.world.navigation import orbited
 
 PSNR_CAP_DB = 100.0
 
@@ -174,7 +174,7 @@ def bench_path(
     render frame by frame in turn.  The frames are `views` ((scene clock, camera) pairs) when given,
     else `frames` along the path; each run first renders `warmup` unmeasured frames of the first view.
     `freeze`: after those, leave what is set up out of the garbage collector's full passes, for the rest of the
-    process (`cloudcore.collector`; a benchmark's own process, not a test's).  `reference`: the full-3D settings
+    process (`cloudcore.runtime.collector`; a benchmark's own process, not a test's).  `reference`: the full-3D settings
     the reference is drawn with (a way of drawing every particle measured against another: `compositing`...).
     """
     if reference.mode != "full":

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from cloudcore.errors import SceneError
+from cloudcore.model.errors import SceneError
 
 
 @dataclass(frozen=True)

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from cloudcore.measure.frame_stats import FrameStats
+from cloudcore.stats.frame_stats import FrameStats
 
 #: the columns of `cloudview record --stats`, in order; other_ms is frame_ms less the cloud pass and impostor updates
 #: (the plan and the world),

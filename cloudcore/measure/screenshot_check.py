@@ -18,12 +18,12 @@ from pathlib import Path
 
 import numpy as np
 
-from cloudcore.errors import SceneError
+from cloudcore.maths.paths import camera_on_path
 from cloudcore.measure.imagecompare import Difference, compare, diff_image, load_rgb8
-from cloudcore.particle_files import atomic_write
-from cloudcore.paths import camera_on_path
-from cloudcore.scene import Camera, Scene, View
-from cloudcore.settings import RenderSettings
+from cloudcore.model.errors import SceneError
+from cloudcore.model.particle_files import atomic_write
+from cloudcore.model.scene import Camera, Scene, View
+from cloudcore.model.settings import RenderSettings
 
 #: the goldens' tolerance unless a view or the command line says otherwise (as our own tests/golden: llvmpipe
 #: builds and GPUs may differ by rounding, not by a visible change)

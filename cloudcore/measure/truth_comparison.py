@@ -1,4 +1,4 @@
-"""A model's picture against the path-traced truth (`cloudcore.light.truth`), region by region: the regions
+"""A model's picture against the path-traced truth (`cloudcore.measure.truth`), region by region: the regions
 (sky, silhouette, the body lit and shadowed) read from the truth alone, and per region the PSNR and the error in
 luminance (numpy; `cloudview truth` reports them).
 """
@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cloudcore.colour import srgb_decode
+from cloudcore.maths.colour import srgb_decode
 from cloudcore.measure.benchmark import PSNR_CAP_DB
 from cloudcore.measure.imagecompare import compare
 

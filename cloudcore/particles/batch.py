@@ -12,10 +12,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from cloudcore.lod.splat_coverage import splats_in_frustum
+from cloudcore.maths.vectors import row_lengths
 from cloudcore.particles.buffer import ParticleBuffer
 from cloudcore.particles.depth_order import far_to_near
-from cloudcore.splat_coverage import splats_in_frustum
-from cloudcore.vectors import row_lengths
 
 
 @dataclass(frozen=True)
@@ -121,7 +121,7 @@ def splat_batch(
     near < distance from `eye` <= far: one layer of a cloud split around objects.
     `time_s`, the scene clock, fades forming and dissipating clouds (`ParticleBuffer.seen_from`), and
     the buffer's blend weights fade a cloud field's rings.
-    `frustum`, the draw's planes (`cloudcore.camera.frustum_planes`), leaves out the splats outside it.
+    `frustum`, the draw's planes (`cloudcore.world.camera.frustum_planes`), leaves out the splats outside it.
     `through_air`: `SplatBatch.through_air`.
     """
     starts = particles.cloud_starts

@@ -39,8 +39,8 @@ from cloudcore.light.lighting import active_lights
 from cloudcore.light.phase import phase_function
 from cloudcore.light.precomputed import eye_pass_profiles
 from cloudcore.light.shading import eye_pass_coefficients
-from cloudcore.ramps import smoothstep
-from cloudcore.scene import Lighting, Shading
+from cloudcore.maths.ramps import smoothstep
+from cloudcore.model.scene import Lighting, Shading
 
 #: a particle fades out between these distances from the eye, in radii, so the
 #: camera inside one never gets a screen-filling quad.
@@ -127,7 +127,7 @@ class ParticleBuffer:
 
     def carried(self, offsets: np.ndarray, cloud_shifts: np.ndarray, grown: float) -> ParticleBuffer:
         """These particles, each moved by `offsets` (n, 3) metres, with the light, styles and formation they have:
-        the wind's drift and turbulence since their light was made (`cloudcore.wind.AirMotion.carry`).  Each
+        the wind's drift and turbulence since their light was made (`cloudcore.world.wind.AirMotion.carry`).  Each
         cloud's bounding sphere moves by its `cloud_shifts` (clouds, 3) and grows by `grown` metres, the most a
         particle strays from its cloud's shift."""
         moved = copy.copy(self)

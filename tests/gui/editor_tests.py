@@ -22,16 +22,16 @@ from imgui_bundle.imgui.test_engine_checks import CHECK
 
 from app.editor import discard_recovery, recovery_path
 from cloudcore.artist.cloudgen import cumulus
-from cloudcore.editing import add_cloud
-from cloudcore.interop.example_grids import sphere_grid
-from cloudcore.interop.vdb import write_density_grids
+from cloudcore.maths.paths import camera_on_path
 from cloudcore.measure.imagecompare import compare
-from cloudcore.measure.overlays import to_pixels
-from cloudcore.navigation import orbited
-from cloudcore.paths import camera_on_path
-from cloudcore.scene import Cloud, CloudField, Weather, Wind
-from cloudcore.scenefile import load_scene, save_scene
-from cloudcore.settings import RenderSettings
+from cloudcore.model.scene import Cloud, CloudField, Weather, Wind
+from cloudcore.model.settings import RenderSettings
+from cloudcore.scenes.editing import add_cloud
+from cloudcore.scenes.files import load_scene, save_scene
+from cloudcore.scenes.interop.example_grids import sphere_grid
+from cloudcore.scenes.interop.vdb import write_density_grids
+from cloudcore.stats.overlays import to_pixels
+from cloudcore.world.navigation import orbited
 
 if TYPE_CHECKING:
     from app.editor import Editor

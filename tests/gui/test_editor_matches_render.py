@@ -34,8 +34,8 @@ import os, sys
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 import imageio.v3 as iio
 from cloudcore.gl import FrameRenderer
-from cloudcore.scenefile import load_scene
-from cloudcore.settings import RenderSettings
+from cloudcore.scenes.files import load_scene
+from cloudcore.model.settings import RenderSettings
 scene_path, width, height, frames, out = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4]), sys.argv[5]
 scene = load_scene(scene_path)
 with FrameRenderer(width, height) as renderer:

@@ -13,9 +13,9 @@ import sys
 import pytest
 
 from cloudcore.artist.cloudgen import cumulus
+from cloudcore.model.scene import Camera, CameraPath, Cloud, Lighting, Scene, Terrain
 from cloudcore.resources import DEFAULT_SCENE
-from cloudcore.scene import Camera, CameraPath, Cloud, Lighting, Scene, Terrain
-from cloudcore.scenefile import save_scene
+from cloudcore.scenes.files import save_scene
 from tests.gui.editor_tests import GUI_TESTS
 
 pytestmark = pytest.mark.gui

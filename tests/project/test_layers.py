@@ -14,51 +14,30 @@ from tests.conftest import ROOT
 ENGINE = ROOT / "cloudcore"
 GL_LIBRARIES = ("OpenGL", "pyrender", "imgui_bundle", "glfw")
 #: the scene model: records only, so every feature may read them and none is needed to make one
-MODEL_MODULES = ("scene.py", "cloud_records.py")
-MODEL_MAY_IMPORT = ("cloudcore.cloud_records", "cloudcore.errors")
+MODEL_MODULES = ("model/scene.py", "model/cloud_records.py", "model/settings.py")
+MODEL_MAY_IMPORT = ("cloudcore.model.cloud_records", "cloudcore.model.errors")
 #: the engine's parts (a package of cloudcore, or one of its top-level modules), lowest layer first: a module
 #: imports from its own layer and the layers below, never from one above
 LAYERS = (
-    # the scene model
-    ("errors", "cloud_records", "scene"),
-    # what knows no feature: maths of the camera, the sun, the air and the splats, files, settings, small tools
-    (
-        "atmosphere",
-        "camera",
-        "collector",
-        "colour",
-        "depth_upsampling",
-        "disk_cache",
-        "measured_way",
-        "navigation",
-        "noise",
-        "objects",
-        "particle_files",
-        "paths",
-        "ramps",
-        "resources",
-        "segments",
-        "settings",
-        "splat_coverage",
-        "splat_kernel",
-        "sun",
-        "terrain",
-        "terrain_tiles",
-        "toml_table",
-        "vectors",
-    ),
-    # the particles and how they look besides the light: Wang's artist tools, Yusov's cloud fields, the wind that
-    # moves them and the weather over a field
-    ("artist", "field", "weather", "wind"),
+    # the scene model: its records, the settings, the one error, the low-level readers of its files
+    ("model",),
+    # what knows no feature: small maths, the process, shipped data
+    ("maths", "runtime", "resources"),
+    # the world around the clouds (the camera, the sun, the terrain, objects, the wind) and the air
+    ("world", "atmosphere"),
+    # the particles and how they look besides the light: Wang's artist tools, Yusov's cloud fields and their weather
+    ("artist", "field"),
     # what is done with the particles: the light, the level of detail
     ("light", "lod"),
     # the frame's particles: their buffer (lit, carried, weighed), a draw's batch far to near, point sprites
     ("particles",),
-    # measurement
+    # what a frame drew and cost
+    ("stats",),
+    # offline measurement: benchmarks, recordings, screenshot checks, the path-traced truth and comparisons with it
     ("measure",),
     # scenes coming in and changed: the files, what the renderer can draw, the artist's edits, clouds from and to
     # other tools' files
-    ("editing", "limits", "scenefile", "interop"),
+    ("scenes",),
     # OpenGL
     ("gl",),
     # the command and the pytest plugin

@@ -6,9 +6,6 @@ import dataclasses
 import numpy as np
 import pytest
 
-from cloudcore.camera import projection_matrix, view_matrix
-from cloudcore.cloud_records import Formation
-from cloudcore.colour import srgb_decode
 from cloudcore.light.cloud_shadows import (
     SLICES,
     beam_opacity,
@@ -19,9 +16,12 @@ from cloudcore.light.cloud_shadows import (
 )
 from cloudcore.light.illumination import IlluminationCache, illuminate_clouds, shadowing_sun
 from cloudcore.light.lighting import scene_lights
-from cloudcore.scene import Camera, Cloud, Light, Lighting, Scene, Shading, Terrain
-from cloudcore.settings import FULL_3D
-from cloudcore.sun import sun_direction
+from cloudcore.maths.colour import srgb_decode
+from cloudcore.model.cloud_records import Formation
+from cloudcore.model.scene import Camera, Cloud, Light, Lighting, Scene, Shading, Terrain
+from cloudcore.model.settings import FULL_3D
+from cloudcore.world.camera import projection_matrix, view_matrix
+from cloudcore.world.sun import sun_direction
 from tests.conftest import RENDER_HEIGHT, RENDER_WIDTH
 
 SUN = sun_direction(15.5)

@@ -7,12 +7,12 @@ import dataclasses
 import numpy as np
 import pytest
 
-from cloudcore.camera import NEAR_PLANE_M, projection_matrix, view_matrix
 from cloudcore.light.volume_blending import TILE_PIXELS, screen_tiles
 from cloudcore.measure.imagecompare import compare
+from cloudcore.model.settings import RenderSettings
 from cloudcore.resources import resource_path
-from cloudcore.scenefile import load_scene
-from cloudcore.settings import RenderSettings
+from cloudcore.scenes.files import load_scene
+from cloudcore.world.camera import NEAR_PLANE_M, projection_matrix, view_matrix
 from tests.conftest import RENDER_HEIGHT, RENDER_WIDTH, VALLEY
 from tests.render.test_render_golden import inside_a_cloud, into_the_sun
 

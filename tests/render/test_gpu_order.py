@@ -9,13 +9,13 @@ import dataclasses
 import numpy as np
 import pytest
 
-from cloudcore.camera import frustum_planes, projection_matrix, view_matrix
 from cloudcore.gl.prefix_sum import ONE_GROUP_ITEMS, GpuPrefixSum
 from cloudcore.measure.imagecompare import compare
+from cloudcore.model.scene import Camera, Cloud, Formation, Light, Shading
+from cloudcore.model.settings import RenderSettings
 from cloudcore.particles.buffer import ParticleBuffer
-from cloudcore.scene import Camera, Cloud, Formation, Light, Shading
-from cloudcore.scenefile import load_scene
-from cloudcore.settings import RenderSettings
+from cloudcore.scenes.files import load_scene
+from cloudcore.world.camera import frustum_planes, projection_matrix, view_matrix
 from tests.conftest import VALLEY
 
 

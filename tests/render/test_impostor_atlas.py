@@ -11,8 +11,8 @@ from cloudcore.gl.quads import QuadPass
 from cloudcore.gl.targets import TextureTarget
 from cloudcore.lod.atlas import Cell
 from cloudcore.lod.impostors import cropped_corners
-from cloudcore.scenefile import load_scene
-from cloudcore.settings import RenderSettings
+from cloudcore.model.settings import RenderSettings
+from cloudcore.scenes.files import load_scene
 from tests.conftest import VALLEY
 from tests.unit.lod.test_atlas import overlaps
 
@@ -89,9 +89,9 @@ def test_a_target_drawn_after_an_atlas_cell_is_not_clipped_to_the_cell(renderer)
 
 def _twenty_clouds(rng):
     """Twenty small clouds ahead of the eye at the origin, the eighth of sprites, as a `ParticleBuffer`."""
-    from cloudcore.cloud_records import SpriteStyle
+    from cloudcore.model.cloud_records import SpriteStyle
+    from cloudcore.model.scene import Cloud, Light, Shading
     from cloudcore.particles.buffer import ParticleBuffer
-    from cloudcore.scene import Cloud, Light, Shading
 
     clouds = []
     for index in range(20):

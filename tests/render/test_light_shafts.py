@@ -8,19 +8,19 @@ import numpy as np
 import pytest
 
 from cloudcore.atmosphere.aerial_perspective import MAX_DISTANCE_M
-from cloudcore.camera import pixel_rays, projection_matrix, view_matrix
-from cloudcore.colour import srgb_decode
 from cloudcore.gl.light_shafts import shaft_reduction, shaft_size
 from cloudcore.light.air_between import air_between
 from cloudcore.light.cloud_shadows import SLICES, light_space, opacity_map
 from cloudcore.light.light_shafts import shadowed_in_scattering, shadowed_share, shaft_segments
 from cloudcore.light.sky_background import HORIZON_MARGIN, over_the_horizon, scene_sky
+from cloudcore.maths.colour import srgb_decode
+from cloudcore.model.scene import Camera, Lighting, Scene
+from cloudcore.model.settings import FULL_3D
 from cloudcore.resources import DEFAULT_SCENE
-from cloudcore.scene import Camera, Lighting, Scene
-from cloudcore.scenefile import load_scene
-from cloudcore.settings import FULL_3D
-from cloudcore.sun import sun_direction
-from cloudcore.terrain import height_at
+from cloudcore.scenes.files import load_scene
+from cloudcore.world.camera import pixel_rays, projection_matrix, view_matrix
+from cloudcore.world.sun import sun_direction
+from cloudcore.world.terrain import height_at
 from tests.conftest import RENDER_HEIGHT, RENDER_WIDTH
 from tests.render.test_cloud_shadows import ball, particles_of
 

@@ -4,11 +4,11 @@ import numpy as np
 import pytest
 
 from cloudcore.artist.particle_styles import particle_styles
-from cloudcore.camera import projection_matrix, view_matrix
 from cloudcore.lod.impostors import impostor_view
+from cloudcore.model.scene import Camera, Cloud, Light, Shading
 from cloudcore.particles.buffer import ParticleBuffer
 from cloudcore.particles.point_sprites import draw_runs, plain_splats, point_sprite_mask
-from cloudcore.scene import Camera, Cloud, Light, Shading
+from cloudcore.world.camera import projection_matrix, view_matrix
 
 CAMERA = Camera((0.0, 0.0, 0.0), (0.0, 0.0, -1.0), 60.0)
 LIGHTS = (Light((0.0, 0.6, -0.8), (1.0, 0.95, 0.9), 1.0),)
@@ -123,10 +123,10 @@ def test_a_batch_is_drawn_in_its_order_as_runs_and_short_runs_of_points_stay_qua
 
 def test_splats_around_the_eye_drawn_as_points_and_quads_together_match_quads_alone(renderer):
     """A screen draw next to the eye: centres off screen and large squares keep quads, the rest are points."""
-    from cloudcore.camera import frustum_planes
     from cloudcore.gl.splats import SplatPass
     from cloudcore.gl.targets import TextureTarget
     from cloudcore.particles.batch import splat_batch
+    from cloudcore.world.camera import frustum_planes
 
     rng = np.random.default_rng(8)
     around = np.column_stack([rng.uniform(-1500.0, 1500.0, (40000, 3)), rng.uniform(10.0, 60.0, 40000)])

@@ -9,7 +9,7 @@ from cloudcore.artist.cloudgen import preset_cloud
 from cloudcore.field.grid import level_reach
 from cloudcore.light.illumination import IlluminationCache
 from cloudcore.light.lighting import active_lights, scene_lights
-from cloudcore.scene import (
+from cloudcore.model.scene import (
     MAX_CELL_SIZE,
     MAX_LAYERS,
     MAX_RINGS,
@@ -21,7 +21,7 @@ from cloudcore.scene import (
     Scene,
     Terrain,
 )
-from cloudcore.settings import FULL_3D, RenderSettings
+from cloudcore.model.settings import FULL_3D, RenderSettings
 
 pytestmark = pytest.mark.gl
 
@@ -226,7 +226,7 @@ def test_the_ring_s_panels_hold_their_clouds_through_the_air_at_the_clouds_own_d
     from cloudcore.lod.ring import SEGMENTS
     from cloudcore.measure.imagecompare import compare
     from cloudcore.resources import CUMULUS_FIELD
-    from cloudcore.scenefile import load_scene
+    from cloudcore.scenes.files import load_scene
 
     demo = load_scene(CUMULUS_FIELD)
     scene = dataclasses.replace(demo, lighting=dataclasses.replace(demo.lighting, air=Air(mie_density_scale=25.0)))
@@ -253,7 +253,7 @@ def test_the_ring_over_the_field_holds_its_flat_coarse_cells_that_reach_the_hori
     from cloudcore.lod.ring import SEGMENTS
     from cloudcore.measure.imagecompare import compare
     from cloudcore.resources import CUMULUS_FIELD
-    from cloudcore.scenefile import load_scene
+    from cloudcore.scenes.files import load_scene
 
     scene = load_scene(CUMULUS_FIELD)
     camera = Camera((-1916.0, 2232.0, 3000.0), (-916.0, 2211.0, 3000.0), 60.0)

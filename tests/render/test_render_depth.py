@@ -7,9 +7,9 @@ full 3D composited by the compute pass.
 import numpy as np
 import pytest
 
-from cloudcore.scene import Camera, Cloud, Lighting, Scene, Terrain
-from cloudcore.settings import FULL_3D, RenderSettings
-from cloudcore.terrain import height_at
+from cloudcore.model.scene import Camera, Cloud, Lighting, Scene, Terrain
+from cloudcore.model.settings import FULL_3D, RenderSettings
+from cloudcore.world.terrain import height_at
 
 pytestmark = pytest.mark.gl
 

@@ -9,11 +9,11 @@ the kernel altogether and must match the reference closely.
 import numpy as np
 import pytest
 
-from cloudcore.camera import projection_matrix, view_matrix
-from cloudcore.cloud_records import Formation
+from cloudcore.maths.splat_kernel import splat_kernel
+from cloudcore.model.cloud_records import Formation
+from cloudcore.model.scene import Camera, Cloud, Light, Shading
 from cloudcore.particles.buffer import ParticleBuffer
-from cloudcore.scene import Camera, Cloud, Light, Shading
-from cloudcore.splat_kernel import splat_kernel
+from cloudcore.world.camera import projection_matrix, view_matrix
 
 WIDTH, HEIGHT = 160, 120
 CAMERA = Camera((0.0, 0.0, 0.0), (0.0, 0.0, -1.0), 60.0)
@@ -98,12 +98,12 @@ def test_the_shader_colours_artist_clouds_as_the_reference_does(renderer):
     its lower-right and upper-left corners, so it gets their mean."""
     from cloudcore.artist.artist_shading import artist_colours
     from cloudcore.artist.particle_styles import particle_styles
-    from cloudcore.cloud_records import ArtistShading
     from cloudcore.gl.splats import SplatPass
     from cloudcore.gl.targets import TextureTarget
+    from cloudcore.model.cloud_records import ArtistShading
+    from cloudcore.model.scene import Lighting
     from cloudcore.particles.batch import splat_batch
-    from cloudcore.scene import Lighting
-    from cloudcore.sun import sun_direction
+    from cloudcore.world.sun import sun_direction
 
     particles_xyzr = np.array([[0.0, -20.0, -100.0, 40.0], [0.0, 20.0, -100.0, 40.0], [30.0, 0.0, -160.0, 40.0]])
     cloud = Cloud("artist", particles_xyzr, artist=ArtistShading(), shading_group_size=1000.0)
@@ -142,9 +142,9 @@ def test_a_sprite_the_eye_stands_in_keeps_its_facing_and_fades_as_the_eye_circle
     simply be gone: the near fade)."""
     import dataclasses
 
-    from cloudcore.cloud_records import PUFFY, SpriteStyle
-    from cloudcore.scene import Lighting, Scene
-    from cloudcore.settings import FULL_3D
+    from cloudcore.model.cloud_records import PUFFY, SpriteStyle
+    from cloudcore.model.scene import Lighting, Scene
+    from cloudcore.model.settings import FULL_3D
 
     cloud = Cloud("sprite", [[0.0, 0.0, 0.0, 100.0]], sprite=SpriteStyle(rows=(PUFFY,), rotation_deg=(0.0, 0.0)))
     scene = Scene(lighting=Lighting(12.0), clouds=(cloud,))
@@ -167,11 +167,11 @@ def test_a_sprite_the_eye_stands_in_keeps_its_facing_and_fades_as_the_eye_circle
 
 def test_splats_left_out_by_the_frustum_change_no_pixel(renderer):
     """A cloud around the eye: most of its splats are behind it or off screen, and leaving them out is exact."""
-    from cloudcore.camera import frustum_planes
     from cloudcore.gl.splats import SplatPass
     from cloudcore.gl.targets import TextureTarget
+    from cloudcore.lod.splat_coverage import splats_in_frustum
     from cloudcore.particles.batch import splat_batch
-    from cloudcore.splat_coverage import splats_in_frustum
+    from cloudcore.world.camera import frustum_planes
 
     rng = np.random.default_rng(5)
     around = np.column_stack([rng.uniform(-300.0, 300.0, (2000, 3)), rng.uniform(4.0, 40.0, 2000)])

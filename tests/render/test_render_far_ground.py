@@ -4,14 +4,14 @@ numpy sky does, the terrain's edge meets it without a line, and it hides a cloud
 import numpy as np
 import pytest
 
-from cloudcore.camera import pixel_rays
-from cloudcore.colour import linear_to_srgb8
 from cloudcore.light.far_ground import far_ground_colour
 from cloudcore.light.lighting import scene_lights
 from cloudcore.light.sky_background import scene_sky
 from cloudcore.light.terrain_light import terrain_light
-from cloudcore.scene import Camera, Cloud, Lighting, Scene, Terrain
-from cloudcore.settings import FULL_3D
+from cloudcore.maths.colour import linear_to_srgb8
+from cloudcore.model.scene import Camera, Cloud, Lighting, Scene, Terrain
+from cloudcore.model.settings import FULL_3D
+from cloudcore.world.camera import pixel_rays
 from tests.conftest import RENDER_HEIGHT, RENDER_WIDTH
 
 pytestmark = pytest.mark.gl

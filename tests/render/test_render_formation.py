@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 
 from cloudcore.artist.cloudgen import preset_cloud
-from cloudcore.cloud_records import Formation
-from cloudcore.scene import Camera, Scene
-from cloudcore.settings import FULL_3D, RenderSettings
+from cloudcore.model.cloud_records import Formation
+from cloudcore.model.scene import Camera, Scene
+from cloudcore.model.settings import FULL_3D, RenderSettings
 
 START_S, DURATION_S = 1.0, 2.0
 END_S = START_S + DURATION_S

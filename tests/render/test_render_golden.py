@@ -5,12 +5,12 @@ import dataclasses
 
 import pytest
 
+from cloudcore.maths.paths import sample
 from cloudcore.measure.imagecompare import compare, diff_image
-from cloudcore.paths import sample
-from cloudcore.scene import Camera, Scene
-from cloudcore.scenefile import load_scene
-from cloudcore.settings import FULL_3D
-from cloudcore.sun import sun_direction
+from cloudcore.model.scene import Camera, Scene
+from cloudcore.model.settings import FULL_3D
+from cloudcore.scenes.files import load_scene
+from cloudcore.world.sun import sun_direction
 from tests.conftest import VALLEY
 from tests.goldens import MAX_ABS, MIN_PSNR_DB, check_golden
 

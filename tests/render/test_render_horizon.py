@@ -7,8 +7,8 @@ import dataclasses
 import numpy as np
 import pytest
 
-from cloudcore.scene import Camera
-from cloudcore.scenefile import load_scene
+from cloudcore.model.scene import Camera
+from cloudcore.scenes.files import load_scene
 from tests.conftest import RENDER_HEIGHT, VALLEY
 
 pytestmark = pytest.mark.gl

@@ -21,10 +21,10 @@ from cloudcore.lod.costs import LLVMPIPE_COSTS, CostModel
 from cloudcore.lod.plan import LodState
 from cloudcore.lod.ring import SEGMENTS
 from cloudcore.measure.imagecompare import compare
-from cloudcore.navigation import orbited
-from cloudcore.scene import Air, Camera
-from cloudcore.scenefile import load_scene
-from cloudcore.settings import FULL_3D, RenderSettings
+from cloudcore.model.scene import Air, Camera
+from cloudcore.model.settings import FULL_3D, RenderSettings
+from cloudcore.scenes.files import load_scene
+from cloudcore.world.navigation import orbited
 from tests.conftest import VALLEY
 from tests.render.test_render_golden import inside_a_cloud, into_the_sun
 from tests.unit.lod.test_frameplan import FILL_BOUND, UPKEEP_BOUND

@@ -14,15 +14,15 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from cloudcore.camera import projection_matrix, screen_box
 from cloudcore.gl.objects import scissor_box
 from cloudcore.gl.pyrender_compat import pyrender
 from cloudcore.measure.imagecompare import compare
-from cloudcore.objects import object_poses
+from cloudcore.model.scene import Camera
+from cloudcore.model.settings import FULL_3D, RenderSettings
 from cloudcore.resources import DEFAULT_SCENE, resource_path
-from cloudcore.scene import Camera
-from cloudcore.scenefile import load_scene
-from cloudcore.settings import FULL_3D, RenderSettings
+from cloudcore.scenes.files import load_scene
+from cloudcore.world.camera import projection_matrix, screen_box
+from cloudcore.world.objects import object_poses
 
 AIRCRAFT_IN_CLOUD = resource_path("scenes", "aircraft_in_cloud.toml")
 SPLIT_IMPOSTOR = RenderSettings(mode="impostor")

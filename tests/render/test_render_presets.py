@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from cloudcore.artist.cloudgen import PRESETS, preset_cloud
-from cloudcore.scene import Camera, Lighting, Scene
-from cloudcore.settings import FULL_3D
+from cloudcore.model.scene import Camera, Lighting, Scene
+from cloudcore.model.settings import FULL_3D
 from tests.goldens import check_golden
 
 HOURS = {"noon": 12.0, "sunset": 18.6}

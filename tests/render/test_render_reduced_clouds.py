@@ -5,14 +5,14 @@ between them, and a bad scale is refused."""
 import numpy as np
 import pytest
 
-from cloudcore.camera import FAR_PLANE_M, NEAR_PLANE_M, screen_box
-from cloudcore.depth_upsampling import upsample, window_distance
+from cloudcore.maths.depth_upsampling import upsample, window_distance
 from cloudcore.measure.imagecompare import compare
-from cloudcore.objects import object_poses
+from cloudcore.model.settings import FULL_3D, RenderSettings
 from cloudcore.resources import resource_path
-from cloudcore.scenefile import load_scene
-from cloudcore.settings import FULL_3D, RenderSettings
-from cloudcore.terrain import height_at
+from cloudcore.scenes.files import load_scene
+from cloudcore.world.camera import FAR_PLANE_M, NEAR_PLANE_M, screen_box
+from cloudcore.world.objects import object_poses
+from cloudcore.world.terrain import height_at
 from tests.render.test_render_depth import TERRAIN, puff, scene_with
 
 pytestmark = pytest.mark.gl

@@ -4,15 +4,15 @@ numpy side reads them (the truth composites that one), and the gradient as befor
 import numpy as np
 import pytest
 
-from cloudcore.camera import pixel_rays
-from cloudcore.colour import linear_to_srgb8
 from cloudcore.gl.frame import FrameRenderer
 from cloudcore.gl.world import sky_reduction
 from cloudcore.light.relighting import PREVIEW_METHOD
 from cloudcore.light.sky_background import SUN_DISC_PEAK, scene_sky
+from cloudcore.maths.colour import linear_to_srgb8
 from cloudcore.measure.imagecompare import compare
-from cloudcore.scene import Air, Camera, Lighting, Scene
-from cloudcore.sun import sun_direction
+from cloudcore.model.scene import Air, Camera, Lighting, Scene
+from cloudcore.world.camera import pixel_rays
+from cloudcore.world.sun import sun_direction
 from tests.conftest import RENDER_HEIGHT, RENDER_WIDTH
 
 pytestmark = pytest.mark.gl

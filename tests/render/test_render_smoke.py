@@ -8,12 +8,12 @@ import dataclasses
 import numpy as np
 import pytest
 
-from cloudcore.camera import pixel_rays
-from cloudcore.colour import linear_to_srgb8
 from cloudcore.light.sky_background import scene_sky
-from cloudcore.scene import Air, Camera, Lighting
-from cloudcore.scenefile import load_scene
-from cloudcore.settings import FULL_3D
+from cloudcore.maths.colour import linear_to_srgb8
+from cloudcore.model.scene import Air, Camera, Lighting
+from cloudcore.model.settings import FULL_3D
+from cloudcore.scenes.files import load_scene
+from cloudcore.world.camera import pixel_rays
 from tests.conftest import RENDER_HEIGHT as HEIGHT
 from tests.conftest import RENDER_WIDTH as WIDTH
 from tests.conftest import VALLEY
@@ -97,8 +97,8 @@ def test_midnight_is_dark_blue_not_black_holes(renderer, valley):
 
 
 def test_depth_of_world_and_clouds_agree_with_pyrender(renderer):
-    from cloudcore.camera import camera_pose, projection_matrix, view_matrix
     from cloudcore.gl.pyrender_compat import pyrender
+    from cloudcore.world.camera import camera_pose, projection_matrix, view_matrix
 
     camera = Camera((10.0, 500.0, 300.0), (-200.0, 900.0, -100.0), 45.0)
     ours = projection_matrix(camera.fov_y_deg, WIDTH / HEIGHT)

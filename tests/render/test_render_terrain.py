@@ -1,14 +1,14 @@
 """The terrain's tiles as the world pass draws them: their back faces culled, their two-sided skirts still close
-every gap between tiles of different sizes (`cloudcore.terrain_tiles`)."""
+every gap between tiles of different sizes (`cloudcore.world.terrain_tiles`)."""
 
 import dataclasses
 
 import numpy as np
 import pytest
 
-from cloudcore.scene import Air, Camera, Lighting, Scene
-from cloudcore.scenefile import load_scene
-from cloudcore.settings import RenderSettings
+from cloudcore.model.scene import Air, Camera, Lighting, Scene
+from cloudcore.model.settings import RenderSettings
+from cloudcore.scenes.files import load_scene
 from tests.conftest import VALLEY
 
 pytestmark = pytest.mark.gl

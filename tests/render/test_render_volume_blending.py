@@ -7,12 +7,12 @@ import numpy as np
 import pytest
 
 from cloudcore.artist.particle_styles import particle_styles
-from cloudcore.camera import pixel_rays, projection_matrix, view_matrix
 from cloudcore.light.lighting import scene_lights
 from cloudcore.light.volume_blending import plain_blend, ray_distances, ray_marched, volume_blend
+from cloudcore.model.scene import Camera, Cloud, Light, Scene, Shading
+from cloudcore.model.settings import FULL_3D
 from cloudcore.particles.buffer import ParticleBuffer
-from cloudcore.scene import Camera, Cloud, Light, Scene, Shading
-from cloudcore.settings import FULL_3D
+from cloudcore.world.camera import pixel_rays, projection_matrix, view_matrix
 
 WIDTH, HEIGHT = 40, 30
 CAMERA = Camera((0.0, 0.0, 0.0), (0.0, 0.0, -1.0), 30.0)
@@ -85,8 +85,8 @@ def interpenetrating_clouds() -> Scene:
 
 def fog_on_the_ground() -> Scene:
     """A flat layer of particles half sunk into the default terrain, seen from just above."""
-    from cloudcore.scene import Terrain
-    from cloudcore.terrain import height_at
+    from cloudcore.model.scene import Terrain
+    from cloudcore.world.terrain import height_at
 
     terrain = Terrain()
     ground = float(height_at(terrain, np.array([0.0]), np.array([-300.0]))[0])
@@ -100,9 +100,9 @@ def fog_on_the_ground() -> Scene:
 def test_volumes_are_nearer_the_ray_march_than_billboards(renderer, make_scene, ratio):
     """Two clouds sharing space (colours mixed where they meet), and a layer cut by the terrain (a
     billboard's hard line where its plane meets the ground, a volume's chord cut softly)."""
-    from cloudcore.camera import frustum_planes
     from cloudcore.gl.volume_blending import batch_splats
     from cloudcore.particles.batch import splat_batch
+    from cloudcore.world.camera import frustum_planes
 
     scene = make_scene()
     width, height = renderer.size
@@ -153,9 +153,9 @@ def test_sprites_fall_back_to_billboards(renderer):
 def test_a_crossfading_unit_composites_its_full_3d_layer_as_volumes(renderer):
     """The full-3D image a unit fades in from its impostor goes through the volume pass too (into the
     screen layer): mid-fade the frame is the plan's weighted mean of the volume picture and the impostor."""
-    from cloudcore.navigation import orbited
-    from cloudcore.scenefile import load_scene
-    from cloudcore.settings import RenderSettings
+    from cloudcore.model.settings import RenderSettings
+    from cloudcore.scenes.files import load_scene
+    from cloudcore.world.navigation import orbited
     from tests.conftest import VALLEY
     from tests.render.test_render_lod import FULL_CHEAP
     from tests.unit.lod.test_frameplan import FILL_BOUND

@@ -9,9 +9,9 @@ import pytest
 from cloudcore.artist.cloudgen import preset_cloud
 from cloudcore.gl.frame import FrameRenderer
 from cloudcore.light.illumination import IlluminationCache
-from cloudcore.scene import Camera, CloudField, Scene, Weather, Wind
-from cloudcore.settings import FULL_3D, RenderSettings
-from cloudcore.wind import drift
+from cloudcore.model.scene import Camera, CloudField, Scene, Weather, Wind
+from cloudcore.model.settings import FULL_3D, RenderSettings
+from cloudcore.world.wind import drift
 
 pytestmark = pytest.mark.gl
 

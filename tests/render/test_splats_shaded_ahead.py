@@ -3,9 +3,9 @@ batch shaded as it is drawn after them (growing the buffer they are in) leaves t
 
 import numpy as np
 
-from cloudcore.camera import projection_matrix, view_matrix
+from cloudcore.model.scene import Camera, Cloud, Light, Shading
 from cloudcore.particles.buffer import ParticleBuffer
-from cloudcore.scene import Camera, Cloud, Light, Shading
+from cloudcore.world.camera import projection_matrix, view_matrix
 
 CAMERA = Camera((0.0, 0.0, 0.0), (0.0, 0.0, -1.0), 60.0)
 LIGHTS = (Light((0.0, 0.6, -0.8), (1.0, 0.95, 0.9), 1.0),)

@@ -21,10 +21,10 @@ import numpy as np
 import pytest
 
 from app.editor import AUTOSAVE_SECONDS, Editor, recovery_path
-from cloudcore.particle_files import particles_folder
+from cloudcore.model.particle_files import particles_folder
+from cloudcore.model.scene import Camera, Cloud, Scene
 from cloudcore.resources import DEFAULT_SCENE
-from cloudcore.scene import Camera, Cloud, Scene
-from cloudcore.scenefile import INLINE_PARTICLE_LIMIT, load_scene, save_scene
+from cloudcore.scenes.files import INLINE_PARTICLE_LIMIT, load_scene, save_scene
 from tests.conftest import ROOT
 
 pytestmark = pytest.mark.skipif(not hasattr(signal, "SIGKILL"), reason="needs SIGKILL (POSIX)")
@@ -50,7 +50,7 @@ SAVING_CHILD = (
     ANNOUNCE_RENAMES
     + """
 import itertools, sys
-from cloudcore.scenefile import load_scene, save_scene
+from cloudcore.scenes.files import load_scene, save_scene
 
 old, new = (load_scene(path) for path in sys.argv[1:3])
 target = sys.argv[3]

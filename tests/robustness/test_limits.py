@@ -15,10 +15,12 @@ import numpy as np
 import pytest
 
 from app.editor import Editor
-from cloudcore.cloud_records import ArtistShading
-from cloudcore.editing import add_particle
-from cloudcore.errors import SceneError
-from cloudcore.limits import (
+from cloudcore.model.cloud_records import ArtistShading
+from cloudcore.model.errors import SceneError
+from cloudcore.model.scene import Camera, Cloud, Light, Lighting, Scene, Shading, Terrain
+from cloudcore.scenes.editing import add_particle
+from cloudcore.scenes.files import load_scene, save_scene
+from cloudcore.scenes.limits import (
     DRAWN_TERRAIN_KINDS,
     MAX_FRAME_SIDE,
     MAX_LIGHTS,
@@ -27,8 +29,6 @@ from cloudcore.limits import (
     frame_memory_problem,
     scene_limit_problems,
 )
-from cloudcore.scene import Camera, Cloud, Light, Lighting, Scene, Shading, Terrain
-from cloudcore.scenefile import load_scene, save_scene
 
 pytestmark = pytest.mark.gl
 

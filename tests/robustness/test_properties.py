@@ -9,11 +9,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from cloudcore.errors import SceneError
 from cloudcore.light.phase import MAX_ABS_G, PHASE_NAMES
 from cloudcore.light.shading import incident_light
-from cloudcore.scene import Camera, Cloud, Lighting, Scene, Shading
-from cloudcore.scenefile import load_scene, save_scene, scene_to_dict
+from cloudcore.model.errors import SceneError
+from cloudcore.model.scene import Camera, Cloud, Lighting, Scene, Shading
+from cloudcore.scenes.files import load_scene, save_scene, scene_to_dict
 
 finite = st.floats(-1e6, 1e6, allow_nan=False)
 positive = st.floats(1e-6, 1e6, allow_nan=False, exclude_min=False)

@@ -20,20 +20,20 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from cloudcore.camera import NEAR_PLANE_M, frustum_planes, projection_matrix, view_matrix
-from cloudcore.errors import SceneError
 from cloudcore.gl.context import WindowContext
 from cloudcore.gl.frame import FrameRenderer
 from cloudcore.light.lighting import scene_lights
 from cloudcore.lod.plan.unit_plans import TEXTURED
 from cloudcore.lod.ring import SEGMENTS
-from cloudcore.measure.frame_stats import FrameStats
-from cloudcore.scene import Camera, Cloud, Light, Lighting, Scene, Terrain
-from cloudcore.scenefile import scene_from_dict
-from cloudcore.settings import FULL_3D, RenderSettings
-from cloudcore.splat_coverage import splats_in_frustum
-from cloudcore.sun import elevation_deg, sun_direction
-from cloudcore.terrain import height_at
+from cloudcore.lod.splat_coverage import splats_in_frustum
+from cloudcore.model.errors import SceneError
+from cloudcore.model.scene import Camera, Cloud, Light, Lighting, Scene, Terrain
+from cloudcore.model.settings import FULL_3D, RenderSettings
+from cloudcore.scenes.files import scene_from_dict
+from cloudcore.stats.frame_stats import FrameStats
+from cloudcore.world.camera import NEAR_PLANE_M, frustum_planes, projection_matrix, view_matrix
+from cloudcore.world.sun import elevation_deg, sun_direction
+from cloudcore.world.terrain import height_at
 
 #: a sanity bound, not a timing test: llvmpipe on two shared cores draws these 160x120 frames in milliseconds
 FRAME_TIME_LIMIT_MS = 20_000.0

@@ -33,10 +33,10 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
-from cloudcore.errors import SceneError
-from cloudcore.limits import MAX_MAGNITUDE
-from cloudcore.scene import Scene
-from cloudcore.scenefile import load_scene, save_scene
+from cloudcore.model.errors import SceneError
+from cloudcore.model.scene import Scene
+from cloudcore.scenes.files import load_scene, save_scene
+from cloudcore.scenes.limits import MAX_MAGNITUDE
 from tests.conftest import ROOT
 
 # CLOUDVIEW_FUZZ_EXAMPLES=5000 fuzzes deeper; the default keeps this file to a few seconds.
@@ -699,8 +699,8 @@ def test_a_header_of_empty_items_or_a_negative_dimension_is_refused_not_a_crash(
 #: a child's load of a scene: the field and message of its refusal, tab-separated
 LOAD_AND_SAY = """
 import sys
-from cloudcore.errors import SceneError
-from cloudcore.scenefile import load_scene
+from cloudcore.model.errors import SceneError
+from cloudcore.scenes.files import load_scene
 try:
     load_scene(sys.argv[1])
 except SceneError as error:

@@ -25,10 +25,10 @@ from cloudcore.gl.shadow_map import CloudShadowMap
 from cloudcore.gl.splats import SplatPass
 from cloudcore.gl.volume_blending import VolumeBlendingPass
 from cloudcore.lod.plan import FramePlan
+from cloudcore.model.scene import Camera
+from cloudcore.model.settings import RenderSettings
 from cloudcore.particles.batch import SplatBatch, SplatSelection, splat_batch
 from cloudcore.particles.buffer import ParticleBuffer
-from cloudcore.scene import Camera
-from cloudcore.settings import RenderSettings
 
 
 @dataclass(frozen=True)
@@ -42,7 +42,7 @@ class CloudPassFrame:
     view: np.ndarray
     projection: np.ndarray
     view_projection: np.ndarray
-    frustum: np.ndarray  # the view's planes (`cloudcore.camera.frustum_planes`)
+    frustum: np.ndarray  # the view's planes (`cloudcore.world.camera.frustum_planes`)
     poses: tuple
     time_s: float
     splat_order: str  # splats chosen and sorted on the "cpu" or the "gpu" (the setting, "auto" resolved)

@@ -1,7 +1,7 @@
 #version 330 core
 // The reduced cloud pass's depth: the nearest of the world's depths in the block of the screen's pixels that each
 // texel covers (its pixels' centres), drawn over the screen triangle of world.vert into a depth-only target.  Why
-// the nearest: cloudcore/depth_upsampling.py, whose block_nearest_depth is its twin.
+// the nearest: cloudcore/maths/depth_upsampling.py, whose block_nearest_depth is its twin.
 
 uniform sampler2D world_depth;  // the screen's
 uniform ivec2 screen_size;

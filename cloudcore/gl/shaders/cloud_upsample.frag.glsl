@@ -4,7 +4,7 @@
 // was tested against (the nearest of its block) is to the pixel's own world depth, so that terrain, objects and the
 // horizon crossing clouds keep their edges; where none is near, the one nearest in depth of the nine around its
 // own texel, whole.  Drawn over the screen triangle of world.vert, blended ONE, ONE_MINUS_SRC_ALPHA.  Its twin, and
-// why: cloudcore/depth_upsampling.py.
+// why: cloudcore/maths/depth_upsampling.py.
 //
 // llvmpipe pays each pixel's fetches and arithmetic, and most pixels need neither: where the four texels were
 // tested against the pixel's own depth (the sky's, mostly) the weights are the bilinear shares, one filtered fetch;

@@ -1,6 +1,6 @@
 #version 330 core
 // The frame's linear colour to 8-bit sRGB for the editor's viewport: the GPU
-// twin of cloudcore.colour.linear_to_srgb8 (clamp to [0, 1], NaN to 0, the
+// twin of cloudcore.maths.colour.linear_to_srgb8 (clamp to [0, 1], NaN to 0, the
 // IEC 61966-2-1 transfer, then the same 4x4 ordered dither: each pixel rounds
 // down past its own threshold, written as an exact level of the RGBA8 target),
 // drawn over the screen triangle of world.vert.

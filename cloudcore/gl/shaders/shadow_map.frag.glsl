@@ -16,7 +16,7 @@ const float MOST_OPACITY = 1.0 - 1e-6;  // cloud_shadows.py's _MOST_OPACITY
 
 float splat_kernel(float d)
 {
-    // cloudcore/splat_kernel.py
+    // cloudcore/maths/splat_kernel.py
     float floor_value = exp(-SPLAT_SHARPNESS);
     float k = (exp(-SPLAT_SHARPNESS * d * d) - floor_value) / (1.0 - floor_value);
     return d < 1.0 ? max(k, 0.0) : 0.0;

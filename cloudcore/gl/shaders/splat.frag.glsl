@@ -1,5 +1,5 @@
 #version 430 core
-// A Gaussian splat: the kernel of cloudcore.splat_kernel, K(d) = (exp(-s d^2) - exp(-s)) / (1 - exp(-s))
+// A Gaussian splat: the kernel of cloudcore.maths.splat_kernel, K(d) = (exp(-s d^2) - exp(-s)) / (1 - exp(-s))
 // for d < 1, else 0, SPLAT_SHARPNESS (s) injected from Python.  Or an atlas sprite
 // (cloudcore.artist.sprites): its cell's texture, alpha the sprite's opacity and rgb a
 // brightness that multiplies the colour; only the ATLAS_SPRITES variant has that

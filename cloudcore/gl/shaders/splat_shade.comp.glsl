@@ -103,7 +103,7 @@ float phase(float mu)
     return phase_kind == 1 ? lobe : 2.0 * rayleigh / (2.0 + g * g) * lobe;
 }
 
-// cloudcore.ramps.smoothstep; GLSL's own is undefined for a zero-width ramp
+// cloudcore.maths.ramps.smoothstep; GLSL's own is undefined for a zero-width ramp
 float ramp(float edge0, float edge1, float x)
 {
     float t = clamp((x - edge0) / max(edge1 - edge0, 1e-30), 0.0, 1.0);

@@ -1,5 +1,5 @@
 #version 420 core
-// The terrain's tiles (cloudcore/terrain_tiles.py) lit as cloudcore/light/terrain_light.py lights them, per
+// The terrain's tiles (cloudcore/world/terrain_tiles.py) lit as cloudcore/light/terrain_light.py lights them, per
 // vertex: the sun's part apart from the sky's (the clouds' shadow dims the sun's alone, per pixel).  With
 // THROUGH_AIR the air between the eye and each vertex is read here, per vertex, not per pixel, and with
 // LIGHT_SHAFTS the light shafts' share of its light taken off: a pixel's lookups cost llvmpipe more than the

@@ -36,7 +36,7 @@ from cloudcore.lod.ring import (
     RingState,
 )
 from cloudcore.lod.units import LodUnits
-from cloudcore.settings import RenderSettings
+from cloudcore.model.settings import RenderSettings
 
 #: auto mode switches a unit's representation only when the other is cheaper by this fraction
 #: (costs measured frame to frame wobble; without it a unit near the break-even point would flicker

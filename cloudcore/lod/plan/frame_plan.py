@@ -46,7 +46,7 @@ class FramePlan:
     #: Wang's rules, its upkeep within the tolerance past `RING_FRAME_MS`)
     accepted_error: float = 0.0
     units: LodUnits | None = None  # the frame's units, which `clouds` index: the groups planned apart opened
-    #: (units, 3) metres the wind has carried each unit (`cloudcore.wind`); None: still air
+    #: (units, 3) metres the wind has carried each unit (`cloudcore.world.wind`); None: still air
     unit_drifts: np.ndarray | None = None
     #: per generation of `ring.draws`, (3,) metres the wind has carried its clouds since it was planned: its panels
     #: follow them

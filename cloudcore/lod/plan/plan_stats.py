@@ -1,5 +1,5 @@
 """What a frame's plan chose, counted: the statistics `FramePlan.stats` gives (pure); a frame's are
-`cloudcore.measure.frame_stats.FrameStats`, this and what the renderer measured."""
+`cloudcore.stats.frame_stats.FrameStats`, this and what the renderer measured."""
 
 from __future__ import annotations
 

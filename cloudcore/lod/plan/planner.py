@@ -8,13 +8,6 @@ from collections.abc import Hashable
 
 import numpy as np
 
-from cloudcore.camera import (
-    frustum_planes,
-    projection_matrix,
-    spheres_in_frustum,
-    view_matrix,
-)
-from cloudcore.depth_upsampling import reduced_size
 from cloudcore.lod.costs import CostModel, Work
 from cloudcore.lod.impostors import (
     INSIDE_RADII,
@@ -83,12 +76,19 @@ from cloudcore.lod.ring import (
     ring_candidates,
     segment_texture_size,
 )
+from cloudcore.lod.splat_coverage import splats_in_view_by_owner
 from cloudcore.lod.splitting import layers_hold, objects_reaching
 from cloudcore.lod.units import LodUnits
-from cloudcore.scene import Camera
-from cloudcore.settings import RenderSettings
-from cloudcore.splat_coverage import splats_in_view_by_owner
-from cloudcore.wind import CloudMotion
+from cloudcore.maths.depth_upsampling import reduced_size
+from cloudcore.model.scene import Camera
+from cloudcore.model.settings import RenderSettings
+from cloudcore.world.camera import (
+    frustum_planes,
+    projection_matrix,
+    spheres_in_frustum,
+    view_matrix,
+)
+from cloudcore.world.wind import CloudMotion
 
 
 def plan_frame(
@@ -110,14 +110,14 @@ def plan_frame(
     `lighting_key` identifies what the particles' colours were computed from: one key for
     all clouds, or a tuple with one per cloud (the editor changes one cloud at a time, and
     only its unit's impostor is stale).  `objects` are the opaque objects' bounding spheres
-    this frame (`cloudcore.objects.ObjectPose`); `cloud_particles(i)` gives cloud i's particle
+    this frame (`cloudcore.world.objects.ObjectPose`); `cloud_particles(i)` gives cloud i's particle
     centres, asked only for units with objects inside.  `costs` prices auto mode's choices;
     by default the model `state.costs` has fitted to the frames so far.  `cloud_splats(i)` gives
     cloud i's (particle centres, radii), asked for units near the eye to count their fragments.
     `ring_keys`, per cloud, is what Wang's ring goes stale by where that is less than `lighting_key`: a cloud
     field's blend weights follow the eye's place, as parallax does, so the ring's rebuild distance bounds their
     change in its panels, while a key that changed with them rebuilt a field's ring every frame (None: the
-    lighting keys).  `motion` (`cloudcore.wind.CloudMotion`) is what the wind has done to the clouds: an
+    lighting keys).  `motion` (`cloudcore.world.wind.CloudMotion`) is what the wind has done to the clouds: an
     impostor follows its unit's drift, and its error counts the unit's motion and change since it was made
     (`held_impostor_errors`); None: still air.
     """

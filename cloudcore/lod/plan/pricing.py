@@ -12,7 +12,6 @@ from typing import NamedTuple
 
 import numpy as np
 
-from cloudcore.camera import spheres_within_frustum
 from cloudcore.lod.costs import CostModel, Work, regeneration_fragments, splat_fragments
 from cloudcore.lod.impostors import (
     TRANSLATION_METRICS,
@@ -31,10 +30,11 @@ from cloudcore.lod.ring import (
     SEGMENTS,
     RingState,
 )
+from cloudcore.lod.splat_coverage import splats_in_frustum
 from cloudcore.lod.units import LodUnits
-from cloudcore.scene import Camera
-from cloudcore.splat_coverage import splats_in_frustum
-from cloudcore.vectors import row_lengths
+from cloudcore.maths.vectors import row_lengths
+from cloudcore.model.scene import Camera
+from cloudcore.world.camera import spheres_within_frustum
 
 #: an impostor predicted to last longer than this many frames is priced as if it lasted this long
 #: (a still eye would otherwise make any regeneration free)
@@ -42,7 +42,7 @@ LONGEST_LIFETIME_FRAMES = 120.0
 
 
 #: bounding radii: a unit nearer than this has its full-3D fragments counted splat by splat, clipped to the
-#: screen (`cloudcore.splat_coverage.splats_in_view`); a ball of discs overestimates a near cloud tenfold, the
+#: screen (`cloudcore.lod.splat_coverage.splats_in_view`); a ball of discs overestimates a near cloud tenfold, the
 #: parts of it beside and behind the eye costing nothing
 NEAR_EXACT_RADII = 3.0
 
@@ -289,7 +289,7 @@ def held_impostor_errors(
     rest are not drawn on their own: out of view, or in the ring); the parallax between the near and far points
     of what it holds (`ImpostorRecord.content`) where the record has them.
 
-    Under wind (`motion`, a `cloudcore.wind.CloudMotion`, and `unit_drifts` (units, 3) now) a unit's drift since
+    Under wind (`motion`, a `cloudcore.world.wind.CloudMotion`, and `unit_drifts` (units, 3) now) a unit's drift since
     its impostor was made is an eye's step the other way, measured as one; the most turbulence may have moved a
     particle within it since then, seen from the eye at the sphere's near side, is added in degrees."""
     rows = [row for row in drawable.tolist() if units.members[row] in records]

@@ -10,9 +10,9 @@ import pytest
 
 from app.editor import Editor, recovery_path
 from app.tools import ViewportTools
-from cloudcore.editing import add_cloud
-from cloudcore.scene import Camera, Cloud, Scene
-from cloudcore.scenefile import load_scene, save_scene
+from cloudcore.model.scene import Camera, Cloud, Scene
+from cloudcore.scenes.editing import add_cloud
+from cloudcore.scenes.files import load_scene, save_scene
 
 
 def one_cloud_scene() -> Scene:

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from app.record_job import RecordJob, standalone
-from cloudcore.scene import CameraPath, Cloud, Scene, SceneObject, Terrain
+from cloudcore.model.scene import CameraPath, Cloud, Scene, SceneObject, Terrain
 
 
 def finished(job: RecordJob, timeout_s: float = 120.0) -> int:

@@ -14,9 +14,9 @@ from cloudcore.artist.artist_shading import (
     vertical_colour,
 )
 from cloudcore.artist.cloudgen import preset_cloud
-from cloudcore.cloud_records import ArtistShading
-from cloudcore.errors import FieldError
-from cloudcore.sun import sun_direction
+from cloudcore.model.cloud_records import ArtistShading
+from cloudcore.model.errors import FieldError
+from cloudcore.world.sun import sun_direction
 
 LEVELS = (
     (0.0, 0.2, 0.3, 0.4, 1.0),

@@ -10,8 +10,8 @@ from scipy.spatial import cKDTree
 from cloudcore.artist.artist_shading import height_fractions
 from cloudcore.artist.cloudgen import PRESETS, box_fill, cull_close, preset_cloud
 from cloudcore.artist.sprites import particle_sprites
-from cloudcore.cloud_records import ATLAS_GRID, FLAT_BOTTOM, FOGGY, WISPY
-from cloudcore.scene import Cloud
+from cloudcore.model.cloud_records import ATLAS_GRID, FLAT_BOTTOM, FOGGY, WISPY
+from cloudcore.model.scene import Cloud
 
 LOW, HIGH = np.array([-500.0, 1000.0, -300.0]), np.array([700.0, 1400.0, 500.0])
 

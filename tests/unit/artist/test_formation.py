@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 
 from cloudcore.artist.formation import core_distances, formation_state, opacity_factor, progress
-from cloudcore.cloud_records import Formation
-from cloudcore.errors import SceneError
+from cloudcore.model.cloud_records import Formation
+from cloudcore.model.errors import SceneError
+from cloudcore.model.scene import Cloud, Light, Shading
 from cloudcore.particles.buffer import ParticleBuffer
-from cloudcore.scene import Cloud, Light, Shading
-from cloudcore.scenefile import load_scene, save_scene
+from cloudcore.scenes.files import load_scene, save_scene
 
 START, DURATION = 10.0, 30.0
 TIMES = np.linspace(START - 5.0, START + DURATION + 5.0, 161)

@@ -13,8 +13,8 @@ from cloudcore.artist.sprites import (
     particle_sprites,
     sprite_choices,
 )
-from cloudcore.cloud_records import ATLAS_GRID, FLAT_BOTTOM, FOGGY, PUFFY, ROWS, WISPY, SpriteStyle
-from cloudcore.errors import FieldError
+from cloudcore.model.cloud_records import ATLAS_GRID, FLAT_BOTTOM, FOGGY, PUFFY, ROWS, WISPY, SpriteStyle
+from cloudcore.model.errors import FieldError
 
 
 def cells(atlas: np.ndarray) -> np.ndarray:

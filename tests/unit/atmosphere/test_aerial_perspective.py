@@ -14,17 +14,17 @@ from cloudcore.atmosphere.scattering import in_scattering
 from cloudcore.atmosphere.sky import atmosphere_tables
 from cloudcore.atmosphere.sky_view import eye_radius
 from cloudcore.atmosphere.transmittance import optical_depth
-from cloudcore.camera import FAR_PLANE_M, NEAR_PLANE_M, camera_pose, pixel_rays
-from cloudcore.colour import srgb_encode
 from cloudcore.light.air_between import AIR_CELL_ANGLE, AIR_MAX_CELLS, air_between, air_cells
 from cloudcore.light.lighting import PHYSICAL_EXPOSURE
 from cloudcore.light.live_air import LiveAir
 from cloudcore.light.sky_background import scene_sky
+from cloudcore.maths.colour import srgb_encode
 from cloudcore.measure.imagecompare import compare
-from cloudcore.scene import Air, Camera, Light, Lighting, Scene, SceneObject, Terrain
-from cloudcore.scenefile import load_scene
-from cloudcore.settings import FULL_3D, RenderSettings
-from cloudcore.sun import sun_direction
+from cloudcore.model.scene import Air, Camera, Light, Lighting, Scene, SceneObject, Terrain
+from cloudcore.model.settings import FULL_3D, RenderSettings
+from cloudcore.scenes.files import load_scene
+from cloudcore.world.camera import FAR_PLANE_M, NEAR_PLANE_M, camera_pose, pixel_rays
+from cloudcore.world.sun import sun_direction
 from tests.conftest import RENDER_HEIGHT, RENDER_WIDTH, VALLEY
 
 TABLES = atmosphere_tables(EARTH)

@@ -14,7 +14,6 @@ import dataclasses
 import numpy as np
 import pytest
 
-from cloudcore import disk_cache
 from cloudcore.atmosphere import sky
 from cloudcore.atmosphere.geometry import distance_to_boundary, distance_to_top, horizon_cosine, ray_hits_ground
 from cloudcore.atmosphere.medium import ISOTROPIC_PHASE, cornette_shanks_phase, rayleigh_phase
@@ -26,7 +25,8 @@ from cloudcore.atmosphere.transmittance import optical_depth, transmittance_to_t
 from cloudcore.light.lighting import PHYSICAL_EXPOSURE
 from cloudcore.light.phase import phase_function
 from cloudcore.light.sky_background import NIGHT_SKY, scene_sky
-from cloudcore.scene import Lighting
+from cloudcore.model.scene import Lighting
+from cloudcore.runtime import disk_cache
 
 R, TOP = EARTH.bottom_radius_m, EARTH.top_radius_m
 

@@ -16,9 +16,9 @@ from cloudcore.light.far_ground import edge_colour, far_ground_colour
 from cloudcore.light.lighting import scene_lights
 from cloudcore.light.sky_background import scene_sky
 from cloudcore.light.terrain_light import terrain_light
-from cloudcore.scene import Lighting, Terrain
-from cloudcore.terrain import height_at
-from cloudcore.terrain_tiles import SKIRT_CELLS, TILE_CELLS, leaf_tiles, tile_frame, tile_meshes
+from cloudcore.model.scene import Lighting, Terrain
+from cloudcore.world.terrain import height_at
+from cloudcore.world.terrain_tiles import SKIRT_CELLS, TILE_CELLS, leaf_tiles, tile_frame, tile_meshes
 
 LIGHTING = Lighting(time_of_day=15.5)
 #: the cumulus field demo's terrain: 120 km square, no reach
@@ -91,7 +91,7 @@ def test_the_far_ground_s_colour_is_the_terrain_s_at_its_edge_lit_as_a_level_ver
 def test_no_skirt_hangs_below_the_origin_s_level_and_the_square_s_edge_is_a_wall_down_to_it():
     """Seen from outside the square, under its edge, a skirt hung below the origin's level stood in front of the
     ground drawn past it (the field's hills are all above it); the skirts still hang past a coarser neighbour's
-    edge (tests/unit/model/test_terrain_tiles.py)."""
+    edge (tests/unit/world/test_terrain_tiles.py)."""
     frame = tile_frame(FIELD)
     positions, _ = tile_meshes(FIELD, frame, leaf_tiles(frame, (-80000.0, 2000.0, 3000.0)))
     grid = (TILE_CELLS + 1) ** 2

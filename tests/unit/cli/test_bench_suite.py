@@ -8,8 +8,8 @@ import sys
 import pytest
 
 from cloudcore.cli.bench_suite import case_scene, case_views, load_suite, suite_from_dict, suite_names
-from cloudcore.errors import SceneError
 from cloudcore.measure import bench_skies
+from cloudcore.model.errors import SceneError
 
 TINY_SUITE = """
 description = "a tiny suite: a few frames at 64x48"

@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 
 from cloudcore.cli import main
-from cloudcore.measure.overlays import to_pixels
 from cloudcore.measure.screenshot_check import Tolerance, check_view, encode_png, view_camera
+from cloudcore.model.scene import Air, Camera, CameraPath, Cloud, Lighting, Scene, View
 from cloudcore.resources import resource_path
-from cloudcore.scene import Air, Camera, CameraPath, Cloud, Lighting, Scene, View
-from cloudcore.scenefile import load_scene, save_scene
+from cloudcore.scenes.files import load_scene, save_scene
+from cloudcore.stats.overlays import to_pixels
 from tests.conftest import ROOT
 
 pytestmark = pytest.mark.gl

@@ -1,7 +1,7 @@
 import subprocess
 import sys
 
-from cloudcore.scenefile import save_scene
+from cloudcore.scenes.files import save_scene
 
 
 def run_cli(*args):

@@ -9,7 +9,7 @@ import pytest
 # The user's pytest runs in this process (pytester), which forgets the modules that run imported; numpy's
 # extension modules cannot load twice, so what the plugin renders with is imported here first.
 import cloudcore.gl.views  # noqa: F401
-from cloudcore.scenefile import load_scene, save_scene
+from cloudcore.scenes.files import load_scene, save_scene
 from tests.unit.cli.test_cli_check import sky_scene
 
 pytest_plugins = ["pytester"]

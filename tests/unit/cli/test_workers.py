@@ -13,11 +13,11 @@ import pytest
 
 from cloudcore.cli import main
 from cloudcore.cli.workers import KILL_PIECE_ENV, RETRIES, _use_the_task_s_gpu, task_gpus
-from cloudcore.errors import SceneError
 from cloudcore.gl.context import egl_device_of_cuda
+from cloudcore.model.errors import SceneError
+from cloudcore.model.scene import Camera, Cloud, Light, Lighting, Scene, Shading
 from cloudcore.resources import resource_path
-from cloudcore.scene import Camera, Cloud, Light, Lighting, Scene, Shading
-from cloudcore.scenefile import save_scene
+from cloudcore.scenes.files import save_scene
 from tests.conftest import VALLEY
 
 EXAMPLE = resource_path("scenes", "aircraft_in_cloud.toml")

@@ -8,7 +8,6 @@ import tomllib
 import numpy as np
 import pytest
 
-from cloudcore.errors import FieldError
 from cloudcore.field.cells import CANDIDATES_PER_SIDE, cell_cloud, cell_clouds, cloud_density, coverage_threshold
 from cloudcore.field.grid import (
     RING_HALF_CELLS,
@@ -19,9 +18,10 @@ from cloudcore.field.grid import (
     level_weights,
 )
 from cloudcore.field.state import FADE_KEY_STEPS, HOLE, FieldState, update_field
+from cloudcore.model.errors import FieldError
+from cloudcore.model.scene import MAX_RINGS, CloudField, Scene
 from cloudcore.resources import CUMULUS_FIELD, DEFAULT_SCENE
-from cloudcore.scene import MAX_RINGS, CloudField, Scene
-from cloudcore.scenefile import TABLE_KEYS, load_scene, save_scene
+from cloudcore.scenes.files import TABLE_KEYS, load_scene, save_scene
 
 FIELD = CloudField(seed=3, coverage=0.5, cell_size=500.0, rings=4, layers=3, extent=(60000.0, 60000.0))
 EYE = np.array([130.0, 2000.0, -270.0])

@@ -18,11 +18,11 @@ from cloudcore.field.cells import (
 )
 from cloudcore.field.grid import cell_side
 from cloudcore.field.state import update_field
-from cloudcore.paths import camera_on_path
+from cloudcore.field.weather import WEATHER_PRESETS, preset_field
+from cloudcore.maths.paths import camera_on_path
+from cloudcore.model.scene import CloudField
 from cloudcore.resources import CUMULUS_FIELD
-from cloudcore.scene import CloudField
-from cloudcore.scenefile import load_scene
-from cloudcore.weather import WEATHER_PRESETS, preset_field
+from cloudcore.scenes.files import load_scene
 
 #: a band deep enough that a humilis's tower is hardly eased into it
 FIELD = CloudField(seed=3, coverage=0.4, cell_size=500.0, rings=4, layers=4, altitude=(1000.0, 6000.0))

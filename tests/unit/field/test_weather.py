@@ -1,4 +1,4 @@
-"""Named weather over a cloud field (`cloudcore.weather`, `[weather]`): the presets, a change of weather whose
+"""Named weather over a cloud field (`cloudcore.field.weather`, `[weather]`): the presets, a change of weather whose
 coverage follows its curve, and the keys refused in one line."""
 
 import dataclasses
@@ -7,13 +7,19 @@ import numpy as np
 import pytest
 
 from cloudcore.artist.formation import formed, progress_for_share
-from cloudcore.errors import FieldError, SceneError
 from cloudcore.field.cells import cumulus_columns, formation_order
 from cloudcore.field.state import HOLE
-from cloudcore.ramps import smoothstep
-from cloudcore.scene import WEATHER_NAMES, CloudField, Scene, Weather
-from cloudcore.scenefile import TABLE_KEYS, load_scene, save_scene
-from cloudcore.weather import WEATHER_PRESETS, preset_field, update_weather_field, weather_coverage, weather_shares
+from cloudcore.field.weather import (
+    WEATHER_PRESETS,
+    preset_field,
+    update_weather_field,
+    weather_coverage,
+    weather_shares,
+)
+from cloudcore.maths.ramps import smoothstep
+from cloudcore.model.errors import FieldError, SceneError
+from cloudcore.model.scene import WEATHER_NAMES, CloudField, Scene, Weather
+from cloudcore.scenes.files import TABLE_KEYS, load_scene, save_scene
 from tests.conftest import assert_file_refused_in_one_line
 
 FIELD = CloudField(seed=4, coverage=0.1, rings=2, cloud_type="cirrus", altitude=(5000.0, 6000.0))

@@ -12,8 +12,8 @@ from cloudcore.gl.derived import Derived
 from cloudcore.gl.draw import EXECUTORS, draw_steps
 from cloudcore.lod.plan import KINDS, LodState, plan_frame
 from cloudcore.lod.units import LodUnits
-from cloudcore.scene import Camera
-from cloudcore.settings import RenderSettings
+from cloudcore.model.scene import Camera
+from cloudcore.model.settings import RenderSettings
 
 NO_RING = RenderSettings(ring_radius=math.inf)
 INSIDE_LOOK = (0.0, 0.0, -500.0)

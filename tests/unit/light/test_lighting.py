@@ -13,8 +13,8 @@ from cloudcore.light.lighting import (
     sky_colors,
     sun_beam,
 )
-from cloudcore.scene import Air, Light, Lighting
-from cloudcore.sun import elevation_deg, sun_direction
+from cloudcore.model.scene import Air, Light, Lighting
+from cloudcore.world.sun import elevation_deg, sun_direction
 
 GRADIENT = Air(sky="gradient")
 

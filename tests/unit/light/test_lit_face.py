@@ -11,8 +11,8 @@ from cloudcore.light.illumination import light_pass_method
 from cloudcore.light.lit_face import MOST_RETURN, lit_face_return
 from cloudcore.light.shading import incident_light
 from cloudcore.light.slab import slab
-from cloudcore.scene import Camera, Scene, Shading
-from cloudcore.scenefile import load_scene, save_scene
+from cloudcore.model.scene import Camera, Scene, Shading
+from cloudcore.scenes.files import load_scene, save_scene
 from tests.unit.light.test_octaves import SUN, random_particles, slab_fluxes
 
 

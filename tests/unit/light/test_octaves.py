@@ -11,9 +11,9 @@ from cloudcore.light.illumination import light_pass_method
 from cloudcore.light.phase import phase_function
 from cloudcore.light.shading import eye_pass_coefficients, incident_light
 from cloudcore.light.slab import slab
-from cloudcore.scene import Camera, Scene, Shading
-from cloudcore.scenefile import load_scene, save_scene
-from cloudcore.splat_kernel import KERNEL_DIAMETER_INTEGRAL, splat_kernel
+from cloudcore.maths.splat_kernel import KERNEL_DIAMETER_INTEGRAL, splat_kernel
+from cloudcore.model.scene import Camera, Scene, Shading
+from cloudcore.scenes.files import load_scene, save_scene
 
 SUN = (0.0, 1.0, 0.0)  # overhead; y is up
 

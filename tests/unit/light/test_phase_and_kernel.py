@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from cloudcore.light.phase import PHASE_NAMES, phase_function
-from cloudcore.splat_kernel import splat_kernel
+from cloudcore.maths.splat_kernel import splat_kernel
 
 
 @pytest.mark.parametrize("phase", PHASE_NAMES)

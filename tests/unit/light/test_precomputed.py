@@ -5,7 +5,6 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from cloudcore import disk_cache
 from cloudcore.light import precomputed
 from cloudcore.light.illumination import illuminate_direction
 from cloudcore.light.occlusion import occlusion_estimate
@@ -18,11 +17,12 @@ from cloudcore.light.precomputed import (
     reference_tables,
 )
 from cloudcore.light.shading import eye_pass_coefficients, incident_light
+from cloudcore.maths.splat_kernel import KERNEL_DIAMETER_INTEGRAL, splat_kernel
+from cloudcore.model.scene import Cloud, Light, Scene, Shading
 from cloudcore.particles.buffer import ParticleBuffer
 from cloudcore.resources import resource_path
-from cloudcore.scene import Cloud, Light, Scene, Shading
-from cloudcore.scenefile import load_scene, save_scene
-from cloudcore.splat_kernel import KERNEL_DIAMETER_INTEGRAL, splat_kernel
+from cloudcore.runtime import disk_cache
+from cloudcore.scenes.files import load_scene, save_scene
 
 #: small enough to build in about a second: for the tests of the cache, not of accuracy
 TINY = TableResolution(

@@ -9,7 +9,7 @@ import pytest
 from cloudcore.light.illumination import IlluminationCache, illuminate_clouds
 from cloudcore.light.lighting import scene_lights
 from cloudcore.light.relighting import SYNCHRONOUS_PARTICLES, LiveIllumination, Look
-from cloudcore.scene import Cloud, Lighting, Scene, Shading
+from cloudcore.model.scene import Cloud, Lighting, Scene, Shading
 
 SHADING = Shading()
 

@@ -192,7 +192,7 @@ def test_the_saturated_eye_pass_is_harris_s_for_thin_particles_and_bounded_for_t
 
 def test_changing_the_eye_pass_shades_nothing_again():
     from cloudcore.light.illumination import IlluminationCache
-    from cloudcore.scene import Cloud, Light, Shading
+    from cloudcore.model.scene import Cloud, Light, Shading
 
     cloud = Cloud("c", [[0.0, 0.0, 0.0, 10.0], [5.0, 5.0, 0.0, 10.0]])
     cache, lights = IlluminationCache(), (Light((0.0, 1.0, 0.0)),)

@@ -6,7 +6,7 @@ import pytest
 
 from cloudcore.light.lighting import NIGHT_AMBIENT, physical_irradiances, scene_lights
 from cloudcore.light.terrain_light import terrain_light
-from cloudcore.scene import Air, Lighting
+from cloudcore.model.scene import Air, Lighting
 
 UP, DOWN = np.array([[0.0, 1.0, 0.0]]), np.array([[0.0, -1.0, 0.0]])
 

@@ -4,7 +4,6 @@ reference where they interpenetrate, finite at the extremes."""
 import numpy as np
 import pytest
 
-from cloudcore.camera import NEAR_PLANE_M, pixel_rays, projection_matrix, view_matrix
 from cloudcore.light.volume_blending import (
     MAX_OPTICAL_DEPTH,
     TILE_PIXELS,
@@ -18,7 +17,8 @@ from cloudcore.light.volume_blending import (
     screen_tiles,
     volume_blend,
 )
-from cloudcore.scene import Camera
+from cloudcore.model.scene import Camera
+from cloudcore.world.camera import NEAR_PLANE_M, pixel_rays, projection_matrix, view_matrix
 
 WIDTH, HEIGHT = 40, 30
 CAMERA = Camera((0.0, 0.0, 0.0), (0.0, 0.0, -1.0), 30.0)

@@ -7,7 +7,6 @@ from decimal import Decimal, getcontext
 import numpy as np
 import pytest
 
-from cloudcore.camera import frustum_planes, projection_matrix, view_matrix
 from cloudcore.lod.costs import CostModel, Work
 from cloudcore.lod.impostors import (
     INSIDE_RADII,
@@ -20,10 +19,11 @@ from cloudcore.lod.plan import FRAME_SETTLE_FRAMES, PROBE_FRAMES, SWITCH_MARGIN,
 from cloudcore.lod.plan.pricing import in_view_work, pricing_of, seen_from
 from cloudcore.lod.plan.state import RING_PRICE_FRAMES, RING_PRICE_TURN_DEG, FrameTime
 from cloudcore.lod.ring import SEGMENTS, RingState, ring_members
+from cloudcore.lod.splat_coverage import splats_in_frustum
 from cloudcore.lod.units import LodUnits, SplatSample
-from cloudcore.scene import Camera
-from cloudcore.settings import RenderSettings
-from cloudcore.splat_coverage import splats_in_frustum
+from cloudcore.model.scene import Camera
+from cloudcore.model.settings import RenderSettings
+from cloudcore.world.camera import frustum_planes, projection_matrix, view_matrix
 
 RADIUS = 100.0
 NO_RING = RenderSettings(ring_radius=math.inf)

@@ -6,7 +6,6 @@ import math
 import numpy as np
 import pytest
 
-from cloudcore import disk_cache
 from cloudcore.lod.costs import (
     FRAMES_TO_REMEMBER,
     LLVMPIPE_COSTS,
@@ -22,7 +21,8 @@ from cloudcore.lod.costs import (
 )
 from cloudcore.lod.plan import SWITCH_MARGIN, LodState
 from cloudcore.resources import DEFAULT_SCENE
-from cloudcore.scenefile import load_scene
+from cloudcore.runtime import disk_cache
+from cloudcore.scenes.files import load_scene
 from tests.unit.lod.test_frameplan import FILL_BOUND, FINEST, NO_RING, RADIUS, camera_at, plan
 
 

@@ -10,8 +10,8 @@ from cloudcore.lod.costs import SPRITE_FRAGMENT_COST, CostModel
 from cloudcore.lod.impostors import parallax_errors_deg
 from cloudcore.lod.plan import LodState, plan_frame
 from cloudcore.lod.units import SAMPLE_PER_CLOUD, LodUnits, SplatSample, interpenetrating_groups, lod_units
-from cloudcore.scene import Camera, splats_bounding_sphere
-from cloudcore.settings import RenderSettings
+from cloudcore.model.scene import Camera, splats_bounding_sphere
+from cloudcore.model.settings import RenderSettings
 
 RNG = np.random.default_rng(11)
 

@@ -3,8 +3,8 @@ impostors are cropped to, must hold every point of every splat (a crop too tight
 
 import numpy as np
 
-from cloudcore.camera import projection_matrix
 from cloudcore.lod.impostors import particle_extent
+from cloudcore.world.camera import projection_matrix
 
 SIZE = (160, 120)
 PROJECTION = projection_matrix(60.0, SIZE[0] / SIZE[1], near=0.1, far=1e4)

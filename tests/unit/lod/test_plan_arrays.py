@@ -7,7 +7,6 @@ import math
 import numpy as np
 import pytest
 
-from cloudcore.camera import frustum_planes, projection_matrix, spheres_in_frustum, view_matrix
 from cloudcore.lod.impostors import parallax_errors_deg
 from cloudcore.lod.plan import LodState, plan_frame
 from cloudcore.lod.plan.draw_items import DrawItem, draw_items
@@ -24,8 +23,9 @@ from cloudcore.lod.ring import (
 )
 from cloudcore.lod.splitting import layer_bounds, layer_sort_key
 from cloudcore.lod.units import LodUnits
-from cloudcore.scene import Camera
-from cloudcore.settings import RenderSettings
+from cloudcore.model.scene import Camera
+from cloudcore.model.settings import RenderSettings
+from cloudcore.world.camera import frustum_planes, projection_matrix, spheres_in_frustum, view_matrix
 
 VIEWPORT = (640, 480)
 CAMERA = Camera((0.0, 1000.0, 0.0), (1000.0, 1000.0, 300.0), 60.0)

@@ -8,10 +8,10 @@ import pytest
 from cloudcore.lod.plan import LodState, plan_frame
 from cloudcore.lod.splitting import layer_of
 from cloudcore.lod.units import LodUnits
-from cloudcore.objects import ObjectPose, object_poses
-from cloudcore.scene import Camera
-from cloudcore.scenefile import load_scene
-from cloudcore.settings import RenderSettings
+from cloudcore.model.scene import Camera
+from cloudcore.model.settings import RenderSettings
+from cloudcore.scenes.files import load_scene
+from cloudcore.world.objects import ObjectPose, object_poses
 from tests.conftest import VALLEY
 
 VIEWPORT = (640, 480)
@@ -150,7 +150,7 @@ def test_no_frame_of_the_default_flythrough_has_a_layer_order_error():
     spheres = [cloud.bounding_sphere() for cloud in scene.clouds]
     centres, radii = np.array([s[0] for s in spheres]), np.array([s[1] for s in spheres])
     path = scene.camera_path("flythrough")
-    from cloudcore.paths import camera_on_path
+    from cloudcore.maths.paths import camera_on_path
 
     units = LodUnits.of_spheres(
         centres,

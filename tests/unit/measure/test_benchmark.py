@@ -11,9 +11,9 @@ import pytest
 from cloudcore.lod.plan.plan_stats import PlanStats
 from cloudcore.measure import benchmark
 from cloudcore.measure.benchmark import bench_path, pareto_front, ratio_interval, turns
-from cloudcore.measure.frame_stats import FrameStats
-from cloudcore.scenefile import load_scene
-from cloudcore.settings import FULL_3D, RenderSettings
+from cloudcore.model.settings import FULL_3D, RenderSettings
+from cloudcore.scenes.files import load_scene
+from cloudcore.stats.frame_stats import FrameStats
 from tests.conftest import VALLEY
 
 CONTRACT_RUN_KEYS = {
@@ -134,7 +134,7 @@ def test_each_run_follows_each_other_equally_often_never_itself_and_takes_each_p
 
 
 def test_a_benchmark_freezes_what_is_set_up_after_the_warm_up_and_before_the_measured_frames(monkeypatch):
-    """A full collection is a 70 ms stall (`cloudcore.collector`): it must not fall in a measured frame."""
+    """A full collection is a 70 ms stall (`cloudcore.runtime.collector`): it must not fall in a measured frame."""
     scene, calls = load_scene(VALLEY), []
     monkeypatch.setattr(benchmark, "freeze_what_is_set_up", lambda: calls.append(("frozen", None)))
     renderers = [FakeRenderer(offset=1, name=name, calls=calls) for name in ("full", "a")]

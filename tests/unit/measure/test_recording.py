@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 from cloudcore.lod.plan.plan_stats import PlanStats
-from cloudcore.measure.frame_stats import FrameStats
-from cloudcore.measure.overdraw import Overdraw
 from cloudcore.measure.recording import COLUMNS, MAX_RECORDED_FRAMES, frame_row, frame_times
+from cloudcore.stats.frame_stats import FrameStats
+from cloudcore.stats.overdraw import Overdraw
 
 
 def test_a_30_s_path_at_30_fps_is_901_frames_ending_on_the_last_key():

@@ -8,7 +8,6 @@ import imageio.v3 as iio
 import numpy as np
 import pytest
 
-from cloudcore.errors import SceneError
 from cloudcore.measure.imagecompare import compare
 from cloudcore.measure.screenshot_check import (
     FAIL,
@@ -26,8 +25,9 @@ from cloudcore.measure.screenshot_check import (
     view_settings,
     write_report,
 )
-from cloudcore.scene import Camera
-from cloudcore.scenefile import load_scene, save_scene, scene_from_dict, scene_to_dict
+from cloudcore.model.errors import SceneError
+from cloudcore.model.scene import Camera
+from cloudcore.scenes.files import load_scene, save_scene, scene_from_dict, scene_to_dict
 
 SCENE = {
     "camera": {"position": [0.0, 500.0, 1500.0], "look_at": [0.0, 800.0, 0.0], "fov_y_deg": 50.0},

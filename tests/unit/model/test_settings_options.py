@@ -7,8 +7,8 @@ import math
 import pytest
 
 from cloudcore.cli.settings_args import SWEEPABLE, add_settings_arguments, parse_sweep, settings_from
-from cloudcore.errors import SceneError
-from cloudcore.settings import RenderSettings, setting_options
+from cloudcore.model.errors import SceneError
+from cloudcore.model.settings import RenderSettings, setting_options
 
 
 def parsed(*argv: str) -> RenderSettings:

@@ -1,0 +1,157 @@
+"""The terrain's tiles (`cloudcore.world.terrain_tiles`): they cover the drawn square once, near the eye at the
+heightfield's own resolution, their skirts close every gap between levels, and their count grows with the log
+of the reach."""
+
+import dataclasses
+import itertools
+
+import numpy as np
+import pytest
+
+from cloudcore.model.scene import Camera, Terrain
+from cloudcore.scenes.files import load_scene
+from cloudcore.world import terrain_tiles
+from cloudcore.world.camera import frustum_planes, projection_matrix, view_matrix
+from cloudcore.world.terrain_tiles import (
+    SKIRT_CELLS,
+    TILE_CELLS,
+    TILE_FACES,
+    TerrainTiles,
+    leaf_tiles,
+    tile_frame,
+    tile_meshes,
+)
+from tests.conftest import VALLEY
+
+VALLEY_TERRAIN = load_scene(VALLEY).terrain
+EYES = [(450.0, 330.0, 2900.0), (-2000.0, 1200.0, -500.0), (9000.0, 2500.0, 15000.0)]
+
+
+def covering_counts(frame, tiles, samples=240):
+    """How many tiles hold each of a grid of points over the drawn square (cell centres, off every edge)."""
+    half = frame.half_side_m
+    points = (np.arange(samples) + 0.5) / samples * 2 * half - half
+    x0, z0, side = frame.corners(tiles)
+    inside_x = (points[None, :] >= x0[:, None]) & (points[None, :] < (x0 + side)[:, None])
+    inside_z = (points[None, :] >= z0[:, None]) & (points[None, :] < (z0 + side)[:, None])
+    return np.einsum("tx,tz->xz", inside_x.astype(int), inside_z.astype(int))
+
+
+@pytest.mark.parametrize("eye", EYES)
+def test_the_tiles_cover_the_drawn_square_once(eye):
+    frame = tile_frame(VALLEY_TERRAIN)
+    assert np.all(covering_counts(frame, leaf_tiles(frame, eye)) == 1)
+
+
+def test_the_ground_under_the_eye_is_at_the_heightfields_resolution():
+    frame = tile_frame(VALLEY_TERRAIN)
+    eye = EYES[0]
+    tiles = leaf_tiles(frame, eye)
+    x0, z0, side = frame.corners(tiles)
+    under = (x0 <= eye[0]) & (eye[0] < x0 + side) & (z0 <= eye[2]) & (eye[2] < z0 + side)
+    assert tiles[under, 0].tolist() == [0]
+    assert side[under][0] / TILE_CELLS == pytest.approx(VALLEY_TERRAIN.size[0] / (VALLEY_TERRAIN.resolution - 1))
+    # and farther, coarser
+    assert tiles[:, 0].max() >= 5
+
+
+def test_the_tiles_grow_with_the_log_of_the_reach_not_its_square():
+    counts = []
+    for reach in (6000.0, 12000.0, 24000.0, 48000.0):
+        frame = tile_frame(dataclasses.replace(VALLEY_TERRAIN, reach=reach))
+        counts.append(len(leaf_tiles(frame, EYES[0])))
+    added = np.diff(counts)
+    # each doubling quadruples the area but adds about one ring of tiles
+    assert np.all(added > 0)
+    assert added.max() <= 1.5 * added.min() + 8
+    assert counts[-1] < 3 * counts[0]
+
+
+def edge(grid, side):
+    """The (n, 3) vertices along one side of a tile's (n, n, 3) grid (rows along z, columns along x)."""
+    return {"low_z": grid[0], "high_z": grid[-1], "low_x": grid[:, 0], "high_x": grid[:, -1]}[side]
+
+
+@pytest.mark.parametrize("eye", EYES[:2])
+def test_the_skirts_close_every_gap_between_neighbouring_tiles(eye):
+    """Along each edge two tiles share, the higher of the two edges hangs a skirt down past the other."""
+    terrain = dataclasses.replace(VALLEY_TERRAIN, reach=12000.0)
+    frame = tile_frame(terrain)
+    tiles = leaf_tiles(frame, eye)
+    positions, _ = tile_meshes(terrain, frame, tiles)
+    n = TILE_CELLS + 1
+    grids = positions[:, : n * n].reshape(len(tiles), n, n, 3)
+    x0, z0, side = frame.corners(tiles)
+    depth = SKIRT_CELLS * side / TILE_CELLS
+    checked = 0
+    for a, b in itertools.permutations(range(len(tiles)), 2):
+        if side[a] > side[b]:
+            continue  # a is the finer (or as fine) of the two
+        for mine, theirs, touching in (
+            ("high_x", "low_x", np.isclose(x0[a] + side[a], x0[b])),
+            ("high_z", "low_z", np.isclose(z0[a] + side[a], z0[b])),
+            ("low_x", "high_x", np.isclose(x0[a], x0[b] + side[b])),
+            ("low_z", "high_z", np.isclose(z0[a], z0[b] + side[b])),
+        ):
+            along = 2 if mine.endswith("x") else 0
+            fine, coarse = edge(grids[a], mine), edge(grids[b], theirs)
+            lo, hi = max(fine[0, along], coarse[0, along]), min(fine[-1, along], coarse[-1, along])
+            if not touching or hi <= lo:
+                continue
+            shared = (fine[:, along] >= lo - 1e-6) & (fine[:, along] <= hi + 1e-6)
+            coarse_heights = np.interp(fine[shared, along], coarse[:, along], coarse[:, 1])
+            fine_heights = fine[shared, 1]
+            gap_above = fine_heights - coarse_heights  # the fine edge over the coarse one: its skirt hangs down
+            assert np.all(gap_above <= depth[a] + 1e-6), (tiles[a], tiles[b], gap_above.max(), depth[a])
+            assert np.all(-gap_above <= depth[b] + 1e-6), (tiles[a], tiles[b], (-gap_above).max(), depth[b])
+            checked += 1
+    assert checked > 20
+
+
+def test_moving_the_eye_meshes_only_the_new_tiles_and_a_still_eye_nothing(monkeypatch):
+    meshed = []
+    original = terrain_tiles.tile_meshes
+    monkeypatch.setattr(
+        terrain_tiles,
+        "tile_meshes",
+        lambda terrain, frame, tiles: meshed.append(len(tiles)) or original(terrain, frame, tiles),
+    )
+    terrain = dataclasses.replace(VALLEY_TERRAIN, seed=VALLEY_TERRAIN.seed + 1)  # no other test's tiles
+    tiles = TerrainTiles(terrain)
+    assert tiles.update(EYES[0])
+    assert meshed == [len(tiles.tiles)]
+    # a new light makes the world pass again, with tiles of its own: none is meshed again
+    assert TerrainTiles(terrain).update(EYES[0]) and meshed == [len(tiles.tiles)]
+    first = dict(zip(map(tuple, tiles.tiles.tolist()), tiles.positions.reshape(len(tiles.tiles), -1, 3)))
+    assert not tiles.update(EYES[0])
+    assert tiles.update((EYES[0][0], EYES[0][1], EYES[0][2] - 1500.0))
+    again = dict(zip(map(tuple, tiles.tiles.tolist()), tiles.positions.reshape(len(tiles.tiles), -1, 3)))
+    kept = set(first) & set(again)
+    assert kept and len(kept) < len(again)
+    assert meshed[1:] == [len(again) - len(kept)]
+    for key in kept:
+        np.testing.assert_array_equal(first[key], again[key])
+    assert len(tiles.faces) == len(tiles.tiles) * len(TILE_FACES)
+    assert tiles.faces.max() == len(tiles.positions) - 1
+
+
+def test_tiles_out_of_view_are_left_out():
+    tiles = TerrainTiles(VALLEY_TERRAIN)
+    camera = Camera(EYES[0], (-250.0, 850.0, -600.0), 60.0)
+    tiles.update(camera.position)
+    in_view = tiles.in_view(frustum_planes(projection_matrix(60.0, 1.3) @ view_matrix(camera)))
+    x0, z0, side = tiles.frame.corners(tiles.tiles)
+    behind = z0 > camera.position[2] + 600.0  # the camera looks toward -z
+    assert 0 < in_view.sum() < len(in_view)
+    assert not np.any(in_view & behind)
+    ahead = (x0 <= -250.0) & (-250.0 < x0 + side) & (z0 <= -600.0) & (-600.0 < z0 + side)
+    assert np.all(in_view[ahead])
+
+
+def test_a_patch_without_reach_is_drawn_to_its_edges_alone():
+    terrain = Terrain(size=(6000.0, 6000.0), resolution=174)
+    tiles = TerrainTiles(terrain)
+    tiles.update(EYES[0])
+    assert np.abs(tiles.positions[:, [0, 2]]).max() == pytest.approx(3000.0)
+    assert np.all(np.isfinite(tiles.positions)) and np.all(np.isfinite(tiles.normals))
+    np.testing.assert_allclose(np.linalg.norm(tiles.normals, axis=1), 1.0)
