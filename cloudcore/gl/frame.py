@@ -1,11 +1,11 @@
 """A whole frame: prepare, plan, world pass, impostor updates, cloud pass, statistics; read back to 8-bit sRGB.
 
 Everything is composed in linear light in a float target; the one transfer to
-sRGB happens on read-back.  `FrameRenderer` keeps its context, GL passes,
-terrain and precomputed cloud illumination between frames, each made again
-only when what it came from changes (`cloudcore.gl.derived`; a scene's cloud
-field adds its clouds for the eye after the scene's own first:
-`cloudcore.field.state`, whose state it holds too); what the level of detail
+sRGB happens on read-back.  `FrameRenderer` keeps its context and GL passes
+between frames, each made again only when what it came from changes
+(`cloudcore.runtime.derived`); the clouds it draws, lit, carried by the wind
+and with a cloud field's for the eye, are the pure
+`cloudcore.particles.frame_clouds.FrameClouds` it holds; what the level of detail
 carries from frame to frame (impostor cache, ring, representations, the
 fitted costs) is the pure `cloudcore.lod.plan.LodState` it holds.  A frame's
 recipe (`FrameRenderer._draw_frame`):
@@ -25,8 +25,6 @@ recipe (`FrameRenderer._draw_frame`):
 from __future__ import annotations
 
 import dataclasses
-import itertools
-import math
 import os
 import platform
 import time
@@ -35,13 +33,9 @@ from dataclasses import dataclass
 import numpy as np
 from OpenGL import GL
 
-from cloudcore.artist.facing import CloudFacings
-from cloudcore.artist.formation import formation_state
-from cloudcore.artist.particle_styles import particle_styles
 from cloudcore.field.state import FieldState
-from cloudcore.field.weather import WeatherFieldState, update_weather_field, weather_drift
+from cloudcore.field.weather import WeatherFieldState
 from cloudcore.gl.context import HeadlessContext, WindowContext, check_frame_size
-from cloudcore.gl.derived import Derived
 from cloudcore.gl.draw import CloudPass, CloudPassFrame, DrawCounts, PassTools
 from cloudcore.gl.impostor_store import ImpostorStore
 from cloudcore.gl.light_shafts import LightShaftPass
@@ -67,23 +61,17 @@ from cloudcore.light.terrain_light import terrain_light
 from cloudcore.lod.costs import CostEstimator, CostModel, remember_fit, remembered_prior
 from cloudcore.lod.plan import FramePlan, LodState, plan_frame
 from cloudcore.lod.splat_coverage import analytic_overdraw
-from cloudcore.lod.units import LodUnits, lod_units
+from cloudcore.lod.units import LodUnits
 from cloudcore.maths.colour import linear_to_srgb8
 from cloudcore.model.scene import Camera, Lighting, Scene
 from cloudcore.model.settings import COMPOSITING_WAYS, FULL_3D, RenderSettings
 from cloudcore.particles.buffer import ParticleBuffer
+from cloudcore.particles.frame_clouds import FrameClouds, PreparedClouds
+from cloudcore.runtime.derived import Derived
 from cloudcore.stats.frame_stats import FrameStats
 from cloudcore.stats.overdraw import Overdraw, overdraw_statistics
 from cloudcore.world.camera import NEAR_PLANE_M, frustum_planes, projection_matrix, view_matrix
-from cloudcore.world.wind import (
-    AirMotion,
-    CloudMotion,
-    field_speed,
-    light_time,
-    reshapes,
-    shape_change_bound_m,
-    turbulent_offsets,
-)
+from cloudcore.world.wind import reshapes
 
 
 @dataclass(frozen=True)
@@ -101,28 +89,12 @@ class _Asked:
 
 
 @dataclass(frozen=True)
-class _LitClouds:
-    """The clouds' particle buffer (their light) and what is made with it."""
-
-    particles: ParticleBuffer
-    facings: CloudFacings  # the facing locks of Wang's sprites, following the eye
-    #: per cloud, changes whenever that cloud's particle colours may have: its impostor is stale
-    lighting_keys: tuple
-    forming_clouds: tuple  # the clouds that form or dissipate, whose colours follow the clock
-
-
-@dataclass(frozen=True)
 class _FrameScene:
-    """A frame's scene made ready to plan: its clouds (a cloud field's for this eye after its own) lit, carried
-    where the wind has them now, and weighed."""
+    """A frame's scene made ready to plan: its lighting and eye, and its clouds prepared (`PreparedClouds`)."""
 
-    scene: Scene
     lighting: Lighting
     camera: Camera
-    particles: ParticleBuffer
-    units: LodUnits
-    motion: CloudMotion | None  # what the wind did to each cloud; None in still air
-    fade_keys: tuple  # per cloud, the key of its blend weights (`_with_field`)
+    clouds: PreparedClouds
     illumination_ms: float  # spent lighting the clouds and making their shadows' map
 
 
@@ -161,18 +133,13 @@ class FrameRenderer:
         #: objects' pass, the clouds' light, the LOD units
         self._world: Derived[WorldPass] = Derived(self._make_world, WorldPass.close)
         self._objects: Derived[ObjectPass | None] = Derived(self._make_objects, ObjectPass.close)
-        self._lit: Derived[_LitClouds] = Derived(self._light_clouds)
-        self._units: Derived[LodUnits] = Derived(
-            lambda source, particles, authored: lod_units(particles, source[1], authored)
-        )
         #: the clouds' transmittance map, and this frame's: None where the clouds shadow nothing
         self.shadow_map = CloudShadowMap()
         self._shadows: CloudShadowMap | None = None
-        self._illumination = illumination if illumination is not None else IlluminationCache()
+        #: the clouds drawn: lit, carried by the wind, a field's for the eye, their units and keys
+        self.clouds = FrameClouds(illumination if illumination is not None else IlluminationCache())
         self._air_for = air if air is not None else air_between
         self._sky_for = air.sky_seen_from if air is not None else SkyBackground.seen_from
-        self._keys: Derived[tuple[tuple, tuple]] = Derived(self._keys_of)
-        self._key_serial = 0
         #: the level of detail's state between frames (impostor cache, ring, representations, costs)
         self.lod_state = LodState()
         self._remember_costs = remember_costs
@@ -184,15 +151,6 @@ class FrameRenderer:
         #: per mode, what composites the GPU's plain full-3D splats, measured (settings' "auto"): on the H200 the
         #: compute pass won in full 3D and lost in auto mode, whose full-3D draws are a few near clouds
         self.compositing: dict[str, MeasuredWay] = {}
-        #: the cloud field's cells made for the last eye, its particles' blend weights and every cloud's mean weight
-        #: (None: no field)
-        self.weather_state = WeatherFieldState()
-        self._field_weights: np.ndarray | None = None
-        self._cloud_weights: np.ndarray | None = None
-        self._air: AirMotion | None = None  # the wind applied to the authored clouds (None: still air)
-        #: this frame's carried particles and units and the clouds' motion, and what they were made from
-        self._carry_source, self._carry_made = None, None
-        self._ring_drift = None  # (ring keys, clouds' drift steps, the keys with them) under wind
         self._shadow_source = (None, MAP_RESOLUTION)  # the sun and the size of the clouds' transmittance map
         self._overdraw_target = None
         self._display = None  # (RGBA8 target, program): the frame in sRGB for the editor
@@ -202,17 +160,22 @@ class FrameRenderer:
     def units(self) -> LodUnits:
         """The units (clouds, or groups of interpenetrating clouds) of the scene last rendered, where the wind
         had carried them; a frame may plan some groups apart (`FramePlan.units`)."""
-        return self._units.value if self._carry_made is None else self._carry_made[1]
+        return self.clouds.units
 
     @property
     def field_state(self) -> FieldState:
         """The cloud field's cells for the last eye under the weather in force, or coming during a change."""
-        return self.weather_state.in_force
+        return self.clouds.field_state
+
+    @property
+    def weather_state(self) -> WeatherFieldState:
+        """The cloud field's cells made for the last eye under each weather over it (`cloudcore.field.weather`)."""
+        return self.clouds.weather_state
 
     @property
     def particles(self) -> ParticleBuffer:
         """The particle buffer of the scene last rendered, where the wind had carried it."""
-        return self._lit.value.particles if self._carry_made is None else self._carry_made[0]
+        return self.clouds.particles
 
     @property
     def light_shafts(self) -> LightShaftPass | None:
@@ -277,10 +240,8 @@ class FrameRenderer:
         return (linear_to_srgb8(self.context.read_linear_rgb()) if read_back else None), stats
 
     def drawn_clouds(self, scene: Scene, lit_at: float) -> tuple:
-        """The authored clouds of `scene` as a frame lit at `lit_at` draws them under its wind: their shapes then
-        (`AirMotion.lit_clouds`), whose light the frame needs; the scene's own in still air."""
-        air = self._air_motion(scene)
-        return scene.clouds if air is None else air.lit_clouds(lit_at)
+        """The authored clouds of `scene` as a frame lit at `lit_at` draws them (`FrameClouds.drawn_clouds`)."""
+        return self.clouds.drawn_clouds(scene, lit_at)
 
     def _draw_frame(self, asked: _Asked) -> FrameStats:
         """`render`'s frame, left in the render target: prepare, plan, the passes, observe, statistics."""
@@ -299,7 +260,7 @@ class FrameRenderer:
             self._splats.air = None if frame.air is None else frame.air[0]
             with clock.timed("impostor updates"):
                 rendered = self._impostors.update(
-                    frame.plan, frame.particles, settings, time_s, frame.splat_order, self._unit_weights
+                    frame.plan, frame.particles, settings, time_s, frame.splat_order, self.clouds.unit_weights
                 )
             with clock.timed("clouds"):
                 self.context.bind_target()
@@ -311,39 +272,55 @@ class FrameRenderer:
         )
 
     def _prepare(self, asked: _Asked) -> _FrameScene:
-        """The frame's scene made ready (`_FrameScene`), and every resource made from it in step with it."""
-        scene, time_of_day, camera, lit_at = asked.scene, asked.time_of_day, asked.camera, asked.lit_at
-        settings, time_s = asked.settings, asked.time_s
+        """The frame's scene made ready (`_FrameScene`), and every resource made from it in step with it: the world
+        pass, the objects' pass, the clouds (`FrameClouds.prepare`) and their shadows' map."""
+        scene, time_of_day, settings = asked.scene, asked.time_of_day, asked.settings
         lighting = (
             scene.lighting if time_of_day is None else dataclasses.replace(scene.lighting, time_of_day=time_of_day)
         )
-        camera = scene.camera if camera is None else camera
-        authored_clouds = len(scene.clouds)
-        air = self._air_motion(scene)
-        if air is not None:  # the clouds as their light is made now: at rest, while the wind only carries them
-            lit_at = light_time(air.wind, time_s) if lit_at is None else lit_at
-            scene = dataclasses.replace(scene, clouds=air.lit_clouds(lit_at))
-        field_carried = weather_drift(scene.wind, scene.cloud_field, scene.weather, time_s)
-        scene, fade_keys = self._with_field(scene, camera, field_carried, time_s)
-        illumination_ms = self._follow_scene(scene, lighting, asked.illumination_method, settings.cloud_shadows)
-        # the units follow the particles' places and sizes, not their light: a relit scene keeps them
-        self._units.follow((scene.clouds, settings.group_clouds), self._lit.value.particles, authored_clouds)
-        particles, units, motion = self._carried(air, field_carried, time_s, lit_at)
-        particles.weigh(self._field_weights)
-        illumination_ms += self._update_shadows(scene, particles, motion, time_s, fade_keys)
-        return _FrameScene(scene, lighting, camera, particles, units, motion, fade_keys, illumination_ms)
+        camera = scene.camera if asked.camera is None else asked.camera
+        lights, ambient = scene_lights(lighting)
+        # a dragged slider's look (the editor's preview) draws the coarse sky, as its clouds are a coarse raster
+        preview = asked.illumination_method == PREVIEW_METHOD
+        self._world.follow((scene.terrain, lighting, preview), lights, ambient)
+        self._objects.follow((scene.objects, lights, tuple(ambient), self.size), ambient)
+        # the clouds shadow one another too, but not a cloud field's: the light pass's part is made again for every
+        # new set of clouds, and a flight through a field brings one every few frames (`sun_through_others`, 100 ms)
+        between_clouds = settings.cloud_shadows and scene.cloud_field is None
+        clouds = self.clouds.prepare(
+            scene,
+            camera,
+            lighting,
+            lights,
+            ambient,
+            asked.illumination_method,
+            settings,
+            asked.time_s,
+            asked.lit_at,
+            between_clouds,
+        )
+        # the clouds shadow the sun's (the first light's) beam where there are clouds and it shines
+        sun = shadowing_sun(lights) if settings.cloud_shadows else None
+        self._shadows = None if sun is None or not clouds.scene.clouds else self.shadow_map
+        self._shadow_source = (
+            sun,
+            PREVIEW_MAP_RESOLUTION if preview else FIELD_MAP_RESOLUTION if scene.cloud_field else MAP_RESOLUTION,
+        )
+        illumination_ms = clouds.illumination_ms + self._update_shadows(clouds, asked.time_s)
+        return _FrameScene(lighting, camera, clouds, illumination_ms)
 
     def _plan(self, ready: _FrameScene, settings: RenderSettings, time_s: float, costs) -> CloudPassFrame:
         """Plan the frame (`plan_frame`), resolve its "auto" ways, and turn Wang's sprites to the eye; what the
         cloud pass's draws share."""
         objects = self._objects.value
         poses = objects.poses(time_s) if objects is not None else ()
-        camera, particles = ready.camera, ready.particles
+        camera, clouds = ready.camera, ready.clouds
+        particles = clouds.particles
         starts = particles.cloud_starts
-        cloud_keys, ring_keys = self._cloud_keys(ready.scene, ready.fade_keys, time_s)
-        ring_keys = self._ring_keys_under_wind(ring_keys, ready.motion, settings)
+        cloud_keys, ring_keys = self.clouds.cloud_keys(clouds.scene, clouds.fade_keys, time_s)
+        ring_keys = self.clouds.ring_keys_under_wind(ring_keys, clouds.motion, settings)
         plan = plan_frame(
-            ready.units,
+            clouds.units,
             camera,
             self.size,
             settings,
@@ -357,14 +334,14 @@ class FrameRenderer:
                 particles.radii[starts[cloud] : starts[cloud + 1]],
             ),
             ring_keys,
-            ready.motion,
+            clouds.motion,
         )
         self.last_plan = plan
         view = view_matrix(camera)
         projection = projection_matrix(camera.fov_y_deg, self.context.width / self.context.height)
         # in the editor's context the GUI leaves its scissor rectangle on, which would clip our targets
         GL.glDisable(GL.GL_SCISSOR_TEST)
-        for start, facing in self._lit.value.facings.update(camera.position, particles):
+        for start, facing in self.clouds.lit.value.facings.update(camera.position, particles):
             self._splats.update_facing(particles, start, facing)
         gl_renderer = self._volume.features.renderer
         compositing = self.compositing.get(settings.mode, MeasuredWay(COMPOSITING_WAYS))
@@ -387,7 +364,7 @@ class FrameRenderer:
             self.context,
             objects,
             self._shadows,
-            self._unit_weights,
+            self.clouds.unit_weights,
         )
 
     def _draw_world(self, frame: CloudPassFrame) -> None:
@@ -504,52 +481,6 @@ class FrameRenderer:
         """GPU memory of every impostor, ring, layer and screen-impostor texture held."""
         return self._impostors.texture_bytes + self._cloud_pass.texture_bytes
 
-    def _with_field(self, scene: Scene, camera: Camera, carried: np.ndarray, time_s: float) -> tuple[Scene, tuple]:
-        """The scene with its cloud field's clouds for this eye after its own (`cloudcore.field.state`), and
-        per cloud the key of its blend weights; the field's weights are held for the particle buffer.  The field's
-        grid has drifted `carried` (3,) metres with the wind: its cells are made and weighed for the eye's place
-        relative to the air, where the particle buffer's carry (`_carried`) then moves them."""
-        if scene.cloud_field is None:
-            self.weather_state, self._field_weights, self._cloud_weights = WeatherFieldState(), None, None
-            return scene, (1.0,) * len(scene.clouds)
-        eye_in_air = np.asarray(camera.position, dtype=np.float64) - carried
-        frame, self.weather_state = update_weather_field(
-            scene.cloud_field, scene.weather, time_s, eye_in_air, self.weather_state
-        )
-        authored = scene.particle_count
-        self._field_weights = np.concatenate([np.ones(authored), frame.weights])
-        self._cloud_weights = np.concatenate([np.ones(len(scene.clouds)), frame.mean_weights])
-        return (
-            dataclasses.replace(scene, clouds=scene.clouds + frame.clouds),
-            (1.0,) * len(scene.clouds) + frame.fade_keys,
-        )
-
-    def _follow_scene(self, scene: Scene, lighting: Lighting, illumination_method: str, cloud_shadows: bool) -> float:
-        """Make the world pass, the objects' pass and the clouds' light again where what they are made from
-        changed, and say which map of the clouds' shadows the frame takes (`_update_shadows` makes it); ms spent
-        lighting the clouds."""
-        lights, ambient = scene_lights(lighting)
-        # a dragged slider's look (the editor's preview) draws the coarse sky, as its clouds are a coarse raster
-        preview = illumination_method == PREVIEW_METHOD
-        # the clouds shadow the sun's (the first light's) beam where there are clouds and it shines
-        sun = shadowing_sun(lights) if cloud_shadows else None
-        # on one another too, but not a cloud field's: the light pass's part is made again for every new set of
-        # clouds, and a flight through a field brings one every few frames (`sun_through_others`, 100 ms)
-        cloud_shadows = cloud_shadows and scene.cloud_field is None
-        self._world.follow((scene.terrain, lighting, preview), lights, ambient)
-        self._objects.follow((scene.objects, lights, tuple(ambient), self.size), ambient)
-        start = time.perf_counter()
-        relit = self._lit.follow(
-            (scene.clouds, scene.shading, lighting, illumination_method, cloud_shadows), lights, ambient
-        )
-        illumination_ms = 1e3 * (time.perf_counter() - start) if relit else 0.0
-        self._shadows = None if sun is None or not scene.clouds else self.shadow_map
-        self._shadow_source = (
-            sun,
-            PREVIEW_MAP_RESOLUTION if preview else FIELD_MAP_RESOLUTION if scene.cloud_field else MAP_RESOLUTION,
-        )
-        return illumination_ms
-
     def _make_world(self, source: tuple, lights, ambient) -> WorldPass:
         """The world pass of `source` (terrain, lighting, whether the sky is the preview's)."""
         terrain, lighting, preview = source
@@ -566,170 +497,26 @@ class FrameRenderer:
         objects, lights, _, size = source
         return ObjectPass(objects, lights, ambient, size) if objects else None
 
-    def _update_shadows(
-        self, scene: Scene, particles: ParticleBuffer, motion: CloudMotion | None, time_s: float, fade_keys: tuple
-    ) -> float:
+    def _update_shadows(self, clouds: PreparedClouds, time_s: float) -> float:
         """Make the clouds' transmittance map again for another particle buffer, sun or size, or when the clouds'
         opacities change (`CloudShadowMap.update`): every frame while a cloud forms or dissipates, when a field's
         clouds' blend weights leave their steps (`fade_keys`: they fade in and out, their shadows with them), never
         while none does; ms spent making it (0 when it was held).  A wind that moves every cloud alike moves the map
         made of their buffer at rest with them; one that changes them otherwise makes it again each frame, of the
-        particles where they are (`particles`, weighed)."""
+        particles where they are (carried, weighed)."""
         if self._shadows is None:
             return 0.0
         start, made = time.perf_counter(), self.shadow_map.made
-        forming = tuple(
-            formation_state(scene.clouds[index].formation, time_s) for index in self._lit.value.forming_clouds
-        )
-        opacity = (particles.opacity_factors(time_s), (forming, fade_keys))
+        forming = self.clouds.forming(clouds.scene, time_s)
+        opacity = (clouds.particles.opacity_factors(time_s), (forming, clouds.fade_keys))
+        motion = clouds.motion
         if motion is not None and not reshapes(motion.wind):
-            self.shadow_map.update(self._lit.value.particles, *self._shadow_source, *opacity, motion.drifts[0])
+            at_rest = self.clouds.lit.value.particles
+            self.shadow_map.update(at_rest, *self._shadow_source, *opacity, motion.drifts[0])
         else:
-            self.shadow_map.update(particles, *self._shadow_source, *opacity)
+            self.shadow_map.update(clouds.particles, *self._shadow_source, *opacity)
         self.context.bind_target()
         return 1e3 * (time.perf_counter() - start) if self.shadow_map.made != made else 0.0
-
-    def _air_motion(self, scene: Scene) -> AirMotion | None:
-        """The wind applied to the scene's authored clouds (`cloudcore.world.wind.AirMotion`), made again for other
-        clouds or another wind; None in still air."""
-        if scene.wind is None:
-            self._air = None
-        elif self._air is None or self._air.wind != scene.wind or self._air.clouds is not scene.clouds:
-            self._air = AirMotion(scene.wind, scene.clouds)
-        return self._air
-
-    def _carried(
-        self, air: AirMotion | None, field_carried: np.ndarray, time_s: float, lit_at: float | None
-    ) -> tuple[ParticleBuffer, LodUnits, CloudMotion | None]:
-        """(the particle buffer, the units, what the wind did to each cloud) at `time_s`: the buffer whose light was
-        made for the clouds' shapes at `lit_at` (`AirMotion.lit_clouds`) with every particle carried on to its place
-        now, and the units with it (the same arrays moved: no loop over clouds), the authored clouds by `air`, a
-        field's by its grid's drift `field_carried` and the turbulence (`air` is None only in still air: the buffer and
-        units themselves)."""
-        lit, units = self._lit.value.particles, self._units.value
-        if air is None:
-            self._carry_source = self._carry_made = None
-            return lit, units, None
-        source = (lit, units, air, time_s, lit_at, tuple(field_carried))
-        held = self._carry_source
-        if held is not None and all(a is b for a, b in zip(held[:3], source[:3])) and held[3:] == source[3:]:
-            return self._carry_made
-        authored = len(air.clouds)
-        field_clouds = len(lit.cloud_starts) - 1 - authored
-        field_drifts = np.tile(field_carried, (field_clouds, 1))
-        field_speeds = np.tile(field_speed(air.wind, self.field_state.field, time_s), (field_clouds, 1))
-        # a field's particles swirl by the same turbulence as the authored clouds' about their places in the drifting
-        # grid; their light stays the cells' at rest (docs/lod.md, "Clouds that move with the wind")
-        field_rest = lit.centres[int(lit.cloud_starts[authored]) :]
-        offsets = np.concatenate(
-            [air.carry(time_s, lit_at), field_carried + turbulent_offsets(air.wind, field_rest, time_s)]
-        )
-        drifts = np.concatenate([air.drifts(time_s), field_drifts])
-        # the authored clouds' light was made where they were at `lit_at`: their buffer carries them on from there
-        shifts = np.concatenate([air.drifts(time_s) - air.drifts(lit_at), field_drifts])
-        grown = shape_change_bound_m(air.wind, math.inf)
-        self._carry_source = source
-        self._carry_made = (
-            lit.carried(offsets, shifts, grown),
-            units.moved(shifts, grown),
-            CloudMotion(drifts, time_s, air.wind, np.concatenate([air.speeds(time_s), field_speeds])),
-        )
-        return self._carry_made
-
-    def _ring_keys_under_wind(self, ring_keys: tuple, motion: CloudMotion | None, settings: RenderSettings) -> tuple:
-        """Wang's ring's panels follow their clouds' mean drift (`FramePlan.ring_shifts`), but the eye's place relative
-        to the clouds moves the other way: a cloud's ring key changes each time the wind has carried it another
-        rebuild distance (`ring_rebuild_horizontal` of `ring_radius`; the first at half of one), the bound Wang's
-        ring keeps on the eye's own steps, and the ring is built again.  The same tuple while no cloud crossed one."""
-        if motion is None or not math.isfinite(settings.ring_radius):
-            return ring_keys
-        # rounded, not floored: a drift across the wind of -1e-14 m is no step
-        steps = np.rint(motion.drifts / (settings.ring_rebuild_horizontal * settings.ring_radius)).astype(np.int64)
-        held = self._ring_drift
-        if held is None or held[0] is not ring_keys or not np.array_equal(held[1], steps):
-            keys = tuple((*key, tuple(step)) for key, step in zip(ring_keys, steps.tolist()))
-            self._ring_drift = (ring_keys, steps, keys)
-        return self._ring_drift[2]
-
-    def _light_clouds(self, source: tuple, lights, ambient) -> _LitClouds:
-        """The clouds' particle buffer (their light) for `source` (the clouds, shading, lighting, light pass method,
-        whether the clouds shadow one another), each cloud's lighting key kept from the last where its light is
-        the same."""
-        clouds, shading, lighting, illumination_method, cloud_shadows = source
-        particles = ParticleBuffer(
-            clouds,
-            shading,
-            lights,
-            ambient,
-            illumination_method,
-            self._illumination,
-            particle_styles(clouds, lighting),
-            between_clouds=cloud_shadows,
-        )
-        old = self._lit.value
-        same_lighting = old is not None and self._lit.source[1:] == source[1:]
-        # by identity, not place: a cloud field's clouds that stay keep their keys when others come and go, unless
-        # the light reaching them changed (the clouds shadow one another: one moved, another's shadow moves)
-        held = (
-            {
-                id(cloud): (key, old.particles.incident[start:stop])
-                for cloud, key, start, stop in zip(
-                    self._lit.source[0],
-                    old.lighting_keys,
-                    old.particles.cloud_starts[:-1],
-                    old.particles.cloud_starts[1:],
-                )
-            }
-            if same_lighting
-            else {}
-        )
-        starts = particles.cloud_starts
-        lighting_keys = tuple(
-            key
-            if (key := _held_key(held.get(id(cloud)), particles.incident[start:stop])) is not None
-            else self._next_key()
-            for cloud, start, stop in zip(clouds, starts[:-1], starts[1:])
-        )
-        forming = tuple(index for index, cloud in enumerate(clouds) if cloud.formation is not None)
-        return _LitClouds(particles, CloudFacings(particles), lighting_keys, forming)
-
-    def _cloud_keys(self, scene: Scene, fade_keys: tuple, time_s: float) -> tuple[tuple, tuple]:
-        """(per cloud, what its colours are made from this frame: its lighting key, and as a forming or
-        dissipating cloud's colours change with the clock and a field's cloud's with its blend weights, those
-        (its impostor is stale meanwhile); the same less the blend weights, what Wang's ring goes stale by:
-        they follow the eye's place, which its rebuild distance bounds (`plan_frame`'s `ring_keys`)).  The same
-        tuples as the frame before while none changed: the plan then finds its ring's clouds unchanged at once
-        (`cloudcore.lod.ring`), with no cloud looked at."""
-        lit = self._lit.value
-        forming = tuple((index, formation_state(scene.clouds[index].formation, time_s)) for index in lit.forming_clouds)
-        self._keys.follow((lit.lighting_keys, fade_keys, forming))
-        return self._keys.value
-
-    def _keys_of(self, source: tuple) -> tuple[tuple, tuple]:
-        """`_cloud_keys`' pair made from its source (the lighting keys, the fade keys, the forming clouds' states)."""
-        lighting_keys, fade_keys, forming = source
-        states = dict(forming)
-        colours = tuple((key, states.get(index)) for index, key in enumerate(lighting_keys))
-        held = () if self._keys.value is None else self._keys.value[1]
-        return (
-            tuple((*colour, fade) for colour, fade in zip(colours, fade_keys)),  # unformed: state None
-            held if colours == held else colours,  # only blend weights changed: the ring's keys are as they were
-        )
-
-    def _unit_weights(self, units: list) -> np.ndarray:
-        """The mean blend weight of the particles of each unit's members (tuples of cloud indices) of `units`."""
-        if self._cloud_weights is None or not units:
-            return np.ones(len(units))
-        clouds = np.fromiter(itertools.chain.from_iterable(units), dtype=np.int64)
-        firsts = np.cumsum([0] + [len(members) for members in units[:-1]])
-        counts = np.diff(self._lit.value.particles.cloud_starts)[clouds]
-        particles = np.add.reduceat(counts, firsts)
-        weighted = np.add.reduceat(self._cloud_weights[clouds] * counts, firsts)
-        return np.divide(weighted, particles, out=np.ones(len(units)), where=particles > 0)
-
-    def _next_key(self) -> int:
-        self._key_serial += 1
-        return self._key_serial
 
     def measure_overdraw(self) -> tuple[np.ndarray, Overdraw]:
         """(fragments per pixel (height, width) float32, statistics) of the last rendered frame's clouds.
@@ -798,12 +585,6 @@ class FrameRenderer:
 
     def __exit__(self, *exc):
         self.close()
-
-
-def _held_key(held, incident: np.ndarray):
-    """A cloud's lighting key from before (`held`: (key, the light that reached its particles then)) while the
-    light reaching it is the same, else None."""
-    return held[0] if held is not None and np.array_equal(held[1], incident) else None
 
 
 def render_full(
