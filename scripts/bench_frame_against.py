@@ -138,23 +138,17 @@ def main() -> None:
     modes = args.modes.split(",")
     if args.worker:
         return worker(args.case, args.every, modes)
+    # here, not at the top: the revision's worker runs this file over its own `cloudcore`, which may not have it
+    from cloudcore.measure.benchmark import revision_trees
+
     here = Path(__file__).resolve().parents[1]
-    with tempfile.TemporaryDirectory() as folder:
-        trees = {"this": here, "against": Path(folder) / "against"}
-        subprocess.run(
-            ["git", "worktree", "add", "--detach", str(trees["against"]), args.against],
-            cwd=here,
-            check=True,
-            capture_output=True,
-        )
-        try:
-            rows = [
-                row
-                for case in args.cases.split(",")
-                for row in compare(trees, case, args.every, modes, args.warmup, Path(folder))
-            ]
-        finally:
-            subprocess.run(["git", "worktree", "remove", "--force", str(trees["against"])], cwd=here, check=False)
+    with tempfile.TemporaryDirectory() as folder, revision_trees({"against": args.against}, here) as against:
+        trees = {"this": here, "against": against["against"]}
+        rows = [
+            row
+            for case in args.cases.split(",")
+            for row in compare(trees, case, args.every, modes, args.warmup, Path(folder))
+        ]
     write_report({"machine": machine(), "against": args.against, "rows": rows}, args.json)
 
 

@@ -16,7 +16,8 @@ directory, on PYTHONPATH) in a child process after this one's cases, the cases' 
 handed to it pickled (so a revision from before the suite replays the same ones), and counts the frames whose plans
 differ in any field the GL side reads or the statistics report (`plans_differing`: 0 for a change meant only to be
 faster); the first difference of each case is printed.  REV must have the plan's package and
-`cloud_extents` (this script's own revision on); the planner before them is measured in docs/performance.md,
+`cloud_extents` and the engine's packages (`cloudcore.model`, `cloudcore.world`: the pickled scenes name their
+modules; from revision ebde165 on); the planner before them is measured in docs/performance.md,
 "The plan at Harris's scale".  Reports the median and the least of each way's passes, in ms a frame.  The
 units' geometry is `ParticleBuffer`'s (`cloud_extents`), without its light.
 """
@@ -207,24 +208,19 @@ def replay(chosen, frames: int) -> list[dict]:
 def against(revision: str, chosen: list, frames: int) -> list[dict]:
     """This script's rows of the cases `chosen` over `cloudcore` at git `revision` (a temporary worktree), in a
     child process."""
+    from cloudcore.measure.benchmark import revision_trees
+
     root = Path(__file__).resolve().parent.parent
-    with tempfile.TemporaryDirectory() as folder:
-        tree = Path(folder) / "tree"
+    with tempfile.TemporaryDirectory() as folder, revision_trees({"tree": revision}, root) as trees:
+        out, cases = Path(folder) / "rows.json", Path(folder) / "cases.pickle"
+        cases.write_bytes(pickle.dumps(chosen))
+        env = {**os.environ, "PYTHONPATH": str(trees["tree"])}
         subprocess.run(
-            ["git", "worktree", "add", "--detach", str(tree), revision], cwd=root, check=True, capture_output=True
+            [sys.executable, __file__, "--cases-from", str(cases), "--frames", str(frames), "--rows", str(out)],
+            env=env,
+            check=True,
         )
-        try:
-            out, cases = Path(folder) / "rows.json", Path(folder) / "cases.pickle"
-            cases.write_bytes(pickle.dumps(chosen))
-            env = {**os.environ, "PYTHONPATH": str(tree)}
-            subprocess.run(
-                [sys.executable, __file__, "--cases-from", str(cases), "--frames", str(frames), "--rows", str(out)],
-                env=env,
-                check=True,
-            )
-            return json.loads(out.read_text())
-        finally:
-            subprocess.run(["git", "worktree", "remove", "--force", str(tree)], cwd=root, check=True)
+        return json.loads(out.read_text())
 
 
 def _same_part(index: int, ours: str, theirs: str) -> bool:

@@ -145,24 +145,11 @@ def main() -> None:
         return
     here = Path(__file__).resolve().parent.parent
     sys.path.insert(0, str(here))
-    from cloudcore.measure.benchmark import machine, write_report
+    from cloudcore.measure.benchmark import machine, revision_trees, write_report
 
-    with tempfile.TemporaryDirectory() as folder:
-        trees = {}
-        try:
-            for against in args.against:
-                name, _, revision = against.partition("=")
-                trees[name] = Path(folder) / name
-                subprocess.run(
-                    ["git", "worktree", "add", "--detach", str(trees[name]), revision],
-                    cwd=here,
-                    check=True,
-                    capture_output=True,
-                )
-            rows = [measure(size, trees, here, args.rounds, Path(folder)) for size in args.sizes.split(",")]
-        finally:
-            for tree in trees.values():
-                subprocess.run(["git", "worktree", "remove", "--force", str(tree)], cwd=here, check=False)
+    revisions = dict(against.partition("=")[::2] for against in args.against)
+    with tempfile.TemporaryDirectory() as folder, revision_trees(revisions, here) as trees:
+        rows = [measure(size, trees, here, args.rounds, Path(folder)) for size in args.sizes.split(",")]
     write_report({"machine": machine(), "against": args.against, "sizes": rows}, args.json)
 
 

@@ -14,9 +14,12 @@ report keys are a contract (issue 7): extend, do not rename.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import json
 import platform
+import subprocess
+import tempfile
 import time
 from collections import Counter
 from pathlib import Path
@@ -309,6 +312,28 @@ def ratio_interval(numerator, denominators, resamples: int = 4000, seed: int = 0
 def machine() -> str:
     """The processor the numbers were measured on, for a report."""
     return platform.processor() or platform.machine()
+
+
+@contextlib.contextmanager
+def revision_trees(revisions: dict[str, str], checkout: Path):
+    """{name: path} of a temporary git worktree of each of `revisions` ({name: git revision}) of `checkout`, for a
+    benchmark to run a revision's `cloudcore` beside this tree's (on a child process's PYTHONPATH); removed on
+    leaving."""
+    with tempfile.TemporaryDirectory() as folder:
+        trees = {}
+        try:
+            for name, revision in revisions.items():
+                trees[name] = Path(folder) / name
+                subprocess.run(
+                    ["git", "worktree", "add", "--detach", str(trees[name]), revision],
+                    cwd=checkout,
+                    check=True,
+                    capture_output=True,
+                )
+            yield trees
+        finally:
+            for tree in trees.values():
+                subprocess.run(["git", "worktree", "remove", "--force", str(tree)], cwd=checkout, check=False)
 
 
 def headless_pyplot():
