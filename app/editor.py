@@ -44,10 +44,10 @@ from cloudcore.stats.frame_stats import FrameStats
 
 AUTOSAVE_SECONDS = 60.0
 #: the editor's frame budget (`RenderSettings.frame_budget_ms`), the LOD panel's starting value: a new
-#: time of day or shading makes every impostor stale, and remaking the default view's 17 in one frame
-#: would hold the window for 150 ms or more; within the budget they follow over a few frames (dragging the
+#: time of day or shading makes every impostor stale, and remaking all of the default view's in one frame
+#: would hold the window for several frames' time; within the budget they follow over a few frames (dragging the
 #: time of day on the default scene, the smaller budgets gave more relit pictures a second and shorter
-#: longest frames, 30 ms the most and the shortest: docs/performance.md, "Live time of day")
+#: longest frames: docs/performance.md, "Live time of day")
 EDITOR_FRAME_BUDGET_MS = 30.0
 RECENT_LIMIT = 8
 #: the Camera panel's scene clock runs to at least this many seconds under wind: ten minutes of drifting clouds

@@ -25,8 +25,7 @@ DIGIT_BITS = 4
 #: workgroup's scan of its invocations' digit counts costs the same whatever its tile: a GPU runs many
 #: workgroups at once, so small tiles keep it busy (the H200's times in docs/performance.md are with 8); llvmpipe
 #: runs each on one thread, stepping its 256 invocations through the scan's 16 barriers, so large tiles
-#: amortise them: with 128 the 16-bit sort of the default view's 510,000 tile pairs took 42 against 214 ms, the
-#: depth sort of its 90,000 particles 15 against 87 (256: the same again)
+#: amortise them, 128 as well as 256 (docs/performance.md, "The GPU's order")
 ITEMS_ON_GPU, ITEMS_ON_CPU = 8, 128
 _STAGES = ("COUNT", "SCATTER")
 #: the shader's storage bindings, past the prefix sum's, so a pass binds its buffers once for both stages

@@ -148,7 +148,7 @@ class ImpostorStore:
         for group in by_atlas.values():
             atlas, as_points, alone = group[0][0].atlas, [], []
             for image, batch, view, projection in group:
-                image.bind_cleared()  # glClearTexSubImage cost llvmpipe more: 1.58 against 1.30 ms a regeneration
+                image.bind_cleared()  # a cleared bound target: glClearTexSubImage cost llvmpipe more a regeneration
                 points = (
                     self._splats.as_points_in(batch, view, projection, image.viewport)
                     if settings.point_sprites

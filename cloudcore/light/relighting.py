@@ -28,8 +28,9 @@ from cloudcore.model.scene import Lighting, Scene, Shading
 
 #: the light pass while a slider is dragged (`cloudcore.light.shading`: a coarse raster), and once it is let go
 PREVIEW_METHOD, EXACT_METHOD = "preview", "exact"
-#: a change that leaves at most this many particles to shade is shaded in the frame that needs it: about
-#: 30 ms exactly on this machine (one cloud of the default scene), less than a frame of the editor
+#: a change that leaves at most this many particles to shade is shaded in the frame that needs it: one cloud of
+#: the default scene, shaded exactly in less than a frame of the editor on llvmpipe (docs/performance.md, "Live
+#: time of day")
 SYNCHRONOUS_PARTICLES = 6000
 
 

@@ -281,7 +281,8 @@ def pareto_front(seconds, errors) -> list[int]:
 
 
 #: frames per block of `ratio_interval`'s bootstrap: llvmpipe's slow phases last several frames (a still view's
-#: identical frames measured 15 to 32 ms of world pass in runs of a few), so single frames are not independent
+#: identical frames' world pass doubles in runs of a few: docs/performance.md, "How we measure"), so single frames
+#: are not independent
 BOOTSTRAP_BLOCK_FRAMES = 10
 
 

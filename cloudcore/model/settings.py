@@ -173,9 +173,9 @@ class RenderSettings:
     )
     #: auto mode plans a group apart, its clouds each a unit of its own, while the eye moves and their impostors
     #: cost less than the group's (`cloudcore.lod.plan.choice.groups_cheaper_apart`); still, or with the eye in its
-    #: sphere, a group is whole.  Side by side, along the default flythrough it saved a sixth of the clouds' time
-    #: for 2 dB of mean PSNR; orbiting the default view, more than half for 9 dB: the blobs of clouds sorted
-    #: whole, while the eye moves (docs/journal.md#the-level-of-detail-by-error-and-cost)
+    #: sphere, a group is whole.  Side by side it saved clouds' time at a small cost in PSNR along the default
+    #: flythrough and much more orbiting the default view, where the blobs of clouds are sorted whole while the eye
+    #: moves (docs/journal.md#the-level-of-detail-by-error-and-cost)
     groups_apart_in_motion: bool = _setting(
         True,
         flag="--no-groups-apart-in-motion",
@@ -293,8 +293,8 @@ class RenderSettings:
 
     #: "raster": full 3D's splats drawn as quads and blended by the raster; "compute": those chosen on the GPU
     #: (`splat_order` "gpu") and plain, composited the same way by a compute pass over screen tiles binned on the
-    #: GPU, for chips whose raster is a small part of them (on an H200, full 3D at 640x480: 7.4 ms of GPU against
-    #: the raster's 17.5); "auto": the one measured faster here, per mode (the raster on llvmpipe, untried)
+    #: GPU, for chips whose raster is a small part of them (docs/performance.md, "Compositing by compute"); "auto":
+    #: the one measured faster here, per mode (the raster on llvmpipe, untried)
     compositing: str = _setting(
         "auto",
         flag="--compositing",
