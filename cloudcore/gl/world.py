@@ -27,7 +27,7 @@ from cloudcore.gl.programs import build_program, set_matrix, set_vec3
 from cloudcore.gl.shadow_map import CloudShadowMap
 from cloudcore.gl.targets import TextureTarget, linear_filtering
 from cloudcore.light.air_between import AirBetween, air_between
-from cloudcore.light.far_ground import far_ground_colour
+from cloudcore.light.far_ground import far_ground_box, far_ground_colour
 from cloudcore.light.light_shafts import SHAFT_STEPS
 from cloudcore.light.sky_background import NIGHT_SKY, SkyBackground, ground_behind_the_air
 from cloudcore.light.terrain_light import TerrainLight
@@ -268,7 +268,7 @@ class WorldPass:
         self._shafts: LightShaftPass | None = None  # built when a frame first has them
         # the physical sky at a fraction of the screen's resolution, and the program that reads it at its own
         self._sky_target: TextureTarget | None = None
-        self._sky_read: int | None = None
+        self._sky_reads: dict[bool, int] = {}  # per whether it writes the far ground's depth
 
     def draw(
         self,
@@ -368,29 +368,41 @@ class WorldPass:
         depth), or the gradient."""
         view_projection = projection @ view
         inverse_view_projection = np.linalg.inv(view_projection)
-        far_ground_depth = False
+        GL.glEnable(GL.GL_DEPTH_TEST)
+        GL.glDepthFunc(GL.GL_LEQUAL)
+        GL.glDepthMask(GL.GL_FALSE)
+        GL.glBindVertexArray(self._fullscreen_vertex_array)
         if sky.physical:
-            program = self._sky_read_program()
+            program = self._sky_read_program(ground_depth=False)
             GL.glUseProgram(program)
             GL.glActiveTexture(GL.GL_TEXTURE2)
             GL.glBindTexture(GL.GL_TEXTURE_2D, self._sky_target.texture)
             GL.glActiveTexture(GL.GL_TEXTURE0)
-            far_ground_depth = self._far_ground is not None
-            if far_ground_depth:  # the ground past the terrain takes its depth: clouds behind it are hidden
-                set_matrix(program, "inverse_view_projection", inverse_view_projection)
-                GL.glUniform2f(GL.glGetUniformLocation(program, "planet_ground"), *below)
-                set_vec3(program, "view_forward", -view[2, :3])
-                GL.glUniform2f(GL.glGetUniformLocation(program, "depth_terms"), projection[2, 2], projection[2, 3])
         else:
             program = self._sky_program(False)
             GL.glUseProgram(program)
             set_matrix(program, "inverse_view_projection", inverse_view_projection)
             self._set_sky_uniforms(program, sky, camera, size[1])
-        GL.glEnable(GL.GL_DEPTH_TEST)
-        GL.glDepthFunc(GL.GL_LEQUAL)
-        GL.glDepthMask(GL.GL_TRUE if far_ground_depth else GL.GL_FALSE)
-        GL.glBindVertexArray(self._fullscreen_vertex_array)
         GL.glDrawArrays(GL.GL_TRIANGLES, 0, 3)
+        ground_box = None
+        if sky.physical and self._far_ground is not None:
+            ground_box = far_ground_box(
+                inverse_view_projection, camera.position, size, below, self._terrain_half_side_m()
+            )
+        if ground_box is not None:
+            # the ground past the terrain takes its depth, so that clouds behind it are hidden; drawn again in the
+            # box where it may be seen alone, as a pass that writes its depth is shaded on every pixel it covers
+            program = self._sky_read_program(ground_depth=True)
+            GL.glUseProgram(program)
+            set_matrix(program, "inverse_view_projection", inverse_view_projection)
+            GL.glUniform2f(GL.glGetUniformLocation(program, "planet_ground"), *below)
+            set_vec3(program, "view_forward", -view[2, :3])
+            GL.glUniform2f(GL.glGetUniformLocation(program, "depth_terms"), projection[2, 2], projection[2, 3])
+            GL.glDepthMask(GL.GL_TRUE)
+            GL.glEnable(GL.GL_SCISSOR_TEST)
+            GL.glScissor(*ground_box)
+            GL.glDrawArrays(GL.GL_TRIANGLES, 0, 3)
+            GL.glDisable(GL.GL_SCISSOR_TEST)
         GL.glDepthMask(GL.GL_FALSE)
         box = sun_box(sky, camera, view_projection, size) if sky.physical else None
         if box is not None:  # the sun's disc added where it can be
@@ -409,12 +421,16 @@ class WorldPass:
         GL.glDepthMask(GL.GL_TRUE)
         GL.glDepthFunc(GL.GL_LESS)
 
-    def _sky_read_program(self) -> int:
-        if self._sky_read is None:
-            far_ground = int(self._far_ground is not None)
-            defines = {"DEPTH": 1.0, "FAR_GROUND": far_ground, "VIEW_RAY": far_ground}
-            self._sky_read = build_program("sky_read", defines, vertex="world")
-        return self._sky_read
+    def _sky_read_program(self, ground_depth: bool) -> int:
+        """The program that reads the sky's picture; writing the far ground's depth where `ground_depth`."""
+        if ground_depth not in self._sky_reads:
+            defines = {"DEPTH": 1.0, "FAR_GROUND": int(ground_depth), "VIEW_RAY": int(ground_depth)}
+            self._sky_reads[ground_depth] = build_program("sky_read", defines, vertex="world")
+        return self._sky_reads[ground_depth]
+
+    def _terrain_half_side_m(self) -> float:
+        """The half side of the square the terrain's tiles are drawn to, about the origin."""
+        return self._terrain.tiles.frame.half_side_m
 
     def _sky_program(self, shafts: bool, sun_disc: bool = False) -> int:
         """The sky's program, less the light `shafts` take where asked; the sun's disc alone for `sun_disc`."""
@@ -503,8 +519,8 @@ class WorldPass:
             self._shafts.close()
         for program in self._sky_programs.values():
             GL.glDeleteProgram(program)
-        if self._sky_read is not None:
-            GL.glDeleteProgram(self._sky_read)
+        for program in self._sky_reads.values():
+            GL.glDeleteProgram(program)
         if self._sky_target is not None:
             self._sky_target.close()
         GL.glDeleteVertexArrays(1, [self._fullscreen_vertex_array])
