@@ -34,7 +34,14 @@ from cloudcore.light.terrain_light import TerrainLight
 from cloudcore.limits import DRAWN_TERRAIN_KINDS
 from cloudcore.scene import Camera, Terrain
 from cloudcore.terrain import ground_colours
-from cloudcore.terrain_tiles import TILE_FACES, TILE_VERTICES, TerrainTiles, grid_face_count, tile_faces
+from cloudcore.terrain_tiles import (
+    SKIRT_SIDES,
+    TILE_FACES,
+    TILE_VERTICES,
+    TerrainTiles,
+    grid_face_count,
+    tile_faces,
+)
 
 #: the light shafts' depth of the terrain takes every 4th vertex of a tile's grid: the frames agree closely with the
 #: whole grid's, whose triangles cost llvmpipe their setup (docs/atmosphere.md#light-shafts)
@@ -188,12 +195,15 @@ class TerrainMesh:
         first = in_view * len(TILE_FACES)  # each tile's first triangle
         # the grids with their back faces culled: the far sides of hills, hidden behind their near sides, which
         # llvmpipe then does not set up; the skirts not, as either of two neighbours' may be the one that hangs
-        # past the other's edge, seen from either side
+        # past the other's edge, seen from either side, and only on the sides that need one (`skirted_sides`)
         GL.glEnable(GL.GL_CULL_FACE)
         GL.glCullFace(GL.GL_BACK)
         _draw_ranges(first, grid)
         GL.glDisable(GL.GL_CULL_FACE)
-        _draw_ranges(first + grid, len(TILE_FACES) - grid)
+        tile, side = np.nonzero(self.tiles.skirts[in_view])
+        per_side = (len(TILE_FACES) - grid) // len(SKIRT_SIDES)
+        if len(tile):
+            _draw_ranges(first[tile] + grid + side * per_side, per_side)
         GL.glBindVertexArray(0)
 
     def _draw_coarse(self, in_view: np.ndarray) -> None:
