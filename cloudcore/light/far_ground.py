@@ -23,7 +23,7 @@ from cloudcore.terrain_tiles import tile_frame
 #: points along each side of the drawn square whose ground colours are averaged into the far ground's
 EDGE_SAMPLES = 64
 #: screen pixels between the rays `far_ground_box` tests, each way
-BOX_STEP = 8
+BOX_STEP = 16
 #: the share of the distance to the square's edge from which a ray's ground counts as past it: room for the float32
 #: distance the shader takes against this float64 one
 _EDGE_MARGIN = 0.95
