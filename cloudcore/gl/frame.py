@@ -42,7 +42,7 @@ from cloudcore.gl.light_shafts import LightShaftPass
 from cloudcore.gl.measured_way import MeasuredWay
 from cloudcore.gl.objects import ObjectPass
 from cloudcore.gl.pass_clock import PassClock
-from cloudcore.gl.programs import build_program
+from cloudcore.gl.programs import ProgramCache, build_program
 from cloudcore.gl.quads import QuadPass
 from cloudcore.gl.reduced_clouds import ReducedClouds
 from cloudcore.gl.shadow_map import CloudShadowMap
@@ -132,6 +132,7 @@ class FrameRenderer:
         #: what is made from the scene, each in step with its source: the world pass (terrain, lighting), the
         #: objects' pass, the clouds' light, the LOD units
         self._world: Derived[WorldPass] = Derived(self._make_world, WorldPass.close)
+        self._world_programs = ProgramCache()  # the world passes', kept across the lights that make them again
         self._objects: Derived[ObjectPass | None] = Derived(self._make_objects, ObjectPass.close)
         #: the clouds' transmittance map, and this frame's: None where the clouds shadow nothing
         self.shadow_map = CloudShadowMap()
@@ -490,6 +491,7 @@ class FrameRenderer:
             scene_sky(lighting, preview),
             self._air_for,
             self._sky_for,
+            programs=self._world_programs,
         )
 
     def _make_objects(self, source: tuple, ambient) -> ObjectPass | None:
@@ -577,6 +579,7 @@ class FrameRenderer:
         self._volume.close()
         self.shadow_map.close()
         self._world.close()
+        self._world_programs.close()
         self._objects.close()
         self.context.close()
 

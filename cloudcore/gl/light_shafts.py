@@ -13,7 +13,7 @@ import numpy as np
 from OpenGL import GL
 
 from cloudcore.gl.air_volume import AirVolume
-from cloudcore.gl.programs import build_program, set_vec3
+from cloudcore.gl.programs import ProgramCache, set_vec3
 from cloudcore.gl.shadow_map import CloudShadowMap
 from cloudcore.gl.targets import DepthTexture, TextureTarget
 from cloudcore.light.light_shafts import SHAFT_STEPS
@@ -42,12 +42,15 @@ class LightShaftPass:
     """The march's targets and program; `march` fills them, `bind` lets the terrain's and the sky's programs read
     them."""
 
-    def __init__(self, steps: int = SHAFT_STEPS, reduction: int | None = None):
+    def __init__(self, steps: int = SHAFT_STEPS, reduction: int | None = None, programs: ProgramCache | None = None):
         """`steps` along each ray, a shaft pixel for each `reduction`-square block of the screen's, by default
-        `shaft_reduction`'s (the benchmark of the choice tries others: scripts/bench_light_shafts.py)."""
+        `shaft_reduction`'s (the benchmark of the choice tries others: scripts/bench_light_shafts.py); the programs
+        from `programs` (the caller's, which it closes), else its own."""
         self._steps, self._reduction = steps, reduction
-        self._program = build_program("light_shafts", vertex="world")
-        self._blur_program = build_program("light_shafts_blur", vertex="world")
+        self._own_programs = programs is None
+        self._programs = ProgramCache() if programs is None else programs
+        self._program = self._programs.program("light_shafts", vertex="world")
+        self._blur_program = self._programs.program("light_shafts_blur", vertex="world")
         self._depth = DepthTexture()
         self._targets: tuple[TextureTarget, TextureTarget] | None = None  # the march's, and its blurred
         # core profile draws nothing without a vertex array, even one with no attributes
@@ -135,6 +138,6 @@ class LightShaftPass:
         """Free the GL objects (the context must be current)."""
         self._depth.close()
         self._close_targets()
-        GL.glDeleteProgram(self._program)
-        GL.glDeleteProgram(self._blur_program)
+        if self._own_programs:
+            self._programs.close()
         GL.glDeleteVertexArrays(1, [self._fullscreen_vertex_array])

@@ -29,6 +29,28 @@ def build_program(name: str, defines: dict[str, int | float] | None = None, vert
     return _link(name, [_compile(kind, file, defines or {}) for kind, file in stages])
 
 
+class ProgramCache:
+    """Programs built once for a GL context and kept while it lives: a pass made again for a new light (each look of
+    a dragged time-of-day slider makes the world pass again) takes its programs from here instead of compiling them
+    again, which cost llvmpipe about 15 ms a program (docs/performance.md, "The world pass within its budget")."""
+
+    def __init__(self):
+        self._programs: dict[tuple, int] = {}
+
+    def program(self, name: str, defines: dict[str, int | float] | None = None, vertex: str | None = None) -> int:
+        """`build_program(name, defines, vertex)`'s program, built on the first call; the context must be current."""
+        key = name, tuple(sorted((defines or {}).items())), vertex
+        if key not in self._programs:
+            self._programs[key] = build_program(name, defines, vertex)
+        return self._programs[key]
+
+    def close(self) -> None:
+        """Delete the programs built (the context must be current)."""
+        for program in self._programs.values():
+            GL.glDeleteProgram(program)
+        self._programs.clear()
+
+
 def build_compute_program(name: str, defines: dict[str, int | float] | None = None) -> int:
     """Compile shaders/NAME.comp.glsl and link it alone; returns the program id."""
     return _link(name, [_compile(GL.GL_COMPUTE_SHADER, f"{name}.comp.glsl", defines or {})])

@@ -22,11 +22,11 @@ from cloudcore.atmosphere.sun_disc import SUN_ANGULAR_RADIUS
 from cloudcore.gl.air_volume import AirVolume
 from cloudcore.gl.context import HeadlessContext
 from cloudcore.gl.light_shafts import LightShaftPass
-from cloudcore.gl.programs import build_program, set_matrix, set_vec3
+from cloudcore.gl.programs import ProgramCache, set_matrix, set_vec3
 from cloudcore.gl.shadow_map import CloudShadowMap
 from cloudcore.gl.targets import TextureTarget, linear_filtering
 from cloudcore.light.air_between import AirBetween, air_between
-from cloudcore.light.far_ground import far_ground_colour
+from cloudcore.light.far_ground import far_ground_box, far_ground_colour
 from cloudcore.light.light_shafts import SHAFT_STEPS
 from cloudcore.light.sky_background import NIGHT_SKY, SkyBackground, ground_behind_the_air
 from cloudcore.light.terrain_light import TerrainLight
@@ -34,7 +34,14 @@ from cloudcore.model.scene import Camera, Terrain
 from cloudcore.scenes.limits import DRAWN_TERRAIN_KINDS
 from cloudcore.world.camera import frustum_planes
 from cloudcore.world.terrain import ground_colours
-from cloudcore.world.terrain_tiles import TILE_FACES, TILE_VERTICES, TerrainTiles, grid_face_count, tile_faces
+from cloudcore.world.terrain_tiles import (
+    SKIRT_SIDES,
+    TILE_FACES,
+    TILE_VERTICES,
+    TerrainTiles,
+    grid_face_count,
+    tile_faces,
+)
 
 #: the light shafts' depth of the terrain takes every 4th vertex of a tile's grid: the frames agree closely with the
 #: whole grid's, whose triangles cost llvmpipe their setup (docs/atmosphere.md#light-shafts)
@@ -81,13 +88,12 @@ class TerrainMesh:
     """The terrain's tiles on the GPU for one terrain and one light: uploaded again when the eye's move changes
     the tiles, drawn tile by tile where a tile's box meets the view."""
 
-    def __init__(self, terrain: Terrain, light: TerrainLight):
+    def __init__(self, terrain: Terrain, light: TerrainLight, programs: ProgramCache):
         if terrain.kind not in DRAWN_TERRAIN_KINDS:  # the scene loader refuses these first (cloudcore.scenes.limits)
             raise ValueError(f"the GL prototype draws heightfield and heightmap terrain only, not {terrain.kind!r}")
         self._terrain, self._light = terrain, light
         self.tiles = TerrainTiles(terrain)
-        self._programs: dict[tuple[bool, bool, bool], int] = {}  # per (through the air, light shafts, far ground)
-        self._depth_program: int | None = None
+        self._programs = programs  # the world pass's
         self._coarse_in_view: np.ndarray | None = None  # the tiles whose coarse surfaces the coarse indices hold
         # the tiles' vertices and triangles, and their coarse surfaces' (the light shafts' depth: positions alone)
         self._buffers = [int(b) for b in GL.glGenBuffers(4)]
@@ -125,11 +131,12 @@ class TerrainMesh:
         self._coarse_in_view = None  # the coarse surfaces' triangles are gathered again
 
     def _program(self, through_air: bool, shafts: bool, far_ground: bool) -> int:
-        key = through_air, shafts, far_ground and through_air
-        if key not in self._programs:
-            defines = {"THROUGH_AIR": int(key[0]), "LIGHT_SHAFTS": int(key[1]), "FAR_GROUND": int(key[2])}
-            self._programs[key] = build_program("terrain", defines)
-        return self._programs[key]
+        defines = {
+            "THROUGH_AIR": int(through_air),
+            "LIGHT_SHAFTS": int(shafts),
+            "FAR_GROUND": int(far_ground and through_air),
+        }
+        return self._programs.program("terrain", defines)
 
     def draw(
         self,
@@ -163,10 +170,9 @@ class TerrainMesh:
         """Draw the depth of the coarse surfaces of the tiles in view for `camera` alone into the bound target (the
         light shafts' march reads it at a fraction of the screen's resolution, where the tiles' triangles are
         mostly smaller than a pixel and cost llvmpipe their setup)."""
-        if self._depth_program is None:
-            self._depth_program = build_program("terrain_depth", {"THROUGH_AIR": 0}, vertex="terrain")
-        GL.glUseProgram(self._depth_program)
-        self._draw_tiles(self._depth_program, camera, view_projection, coarse=True)
+        program = self._programs.program("terrain_depth", {"THROUGH_AIR": 0}, vertex="terrain")
+        GL.glUseProgram(program)
+        self._draw_tiles(program, camera, view_projection, coarse=True)
 
     def _draw_tiles(self, program: int, camera: Camera, view_projection: np.ndarray, coarse: bool = False) -> None:
         """Draw the tiles in view with `program` (in use), depth tested and written; their coarse surfaces where
@@ -188,12 +194,15 @@ class TerrainMesh:
         first = in_view * len(TILE_FACES)  # each tile's first triangle
         # the grids with their back faces culled: the far sides of hills, hidden behind their near sides, which
         # llvmpipe then does not set up; the skirts not, as either of two neighbours' may be the one that hangs
-        # past the other's edge, seen from either side
+        # past the other's edge, seen from either side, and only on the sides that need one (`skirted_sides`)
         GL.glEnable(GL.GL_CULL_FACE)
         GL.glCullFace(GL.GL_BACK)
         _draw_ranges(first, grid)
         GL.glDisable(GL.GL_CULL_FACE)
-        _draw_ranges(first + grid, len(TILE_FACES) - grid)
+        tile, side = np.nonzero(self.tiles.skirts[in_view])
+        per_side = (len(TILE_FACES) - grid) // len(SKIRT_SIDES)
+        if len(tile):
+            _draw_ranges(first[tile] + grid + side * per_side, per_side)
         GL.glBindVertexArray(0)
 
     def _draw_coarse(self, in_view: np.ndarray) -> None:
@@ -215,10 +224,6 @@ class TerrainMesh:
         return float(boxes[:, 0, 1].min()) if len(boxes) else 0.0
 
     def close(self) -> None:
-        for program in self._programs.values():
-            GL.glDeleteProgram(program)
-        if self._depth_program is not None:
-            GL.glDeleteProgram(self._depth_program)
         GL.glDeleteBuffers(len(self._buffers), self._buffers)
         GL.glDeleteVertexArrays(2, [self._vertex_array, self._coarse_vertex_array])
 
@@ -244,14 +249,17 @@ class WorldPass:
         sky_for: Callable[[SkyBackground, np.ndarray], SkyBackground] = SkyBackground.seen_from,
         shaft_steps: int = SHAFT_STEPS,
         shaft_reduction: int | None = None,
+        programs: ProgramCache | None = None,
     ):
         """`air_for(sky, eye)`: the air an eye sees through (`air_between`, or the editor's `LiveAir`), and
         `sky_for(sky, eye)` the sky it sees (`SkyBackground.seen_from`, or `LiveAir.sky_seen_from`); the light
         shafts marched by `shaft_steps` at a pixel for each `shaft_reduction`-square block of the screen's (None:
-        `light_shafts.shaft_reduction`'s)."""
+        `light_shafts.shaft_reduction`'s); the programs from `programs` (the frame's, kept across the world passes a
+        new light makes again: the caller closes it), else its own."""
+        self._own_programs = programs is None
+        self._programs = ProgramCache() if programs is None else programs
         self._shaft_quality = shaft_steps, shaft_reduction
         self._sky, self._air_for, self._sky_for = sky, air_for, sky_for
-        self._sky_programs: dict[tuple[bool, bool], int] = {}  # per (light shafts, the sun's disc alone)
         # the sky-view table and the air's transmittance along its rows
         self._sky_view_textures = [int(t) for t in GL.glGenTextures(2)] if sky.physical else None
         # the planet's ground past the terrain, drawn by the physical sky below the horizon (none without a terrain:
@@ -262,13 +270,12 @@ class WorldPass:
         self._uploaded_view = None  # the sky-view table the texture holds
         # core profile draws nothing without a vertex array, even one with no attributes
         self._fullscreen_vertex_array = GL.glGenVertexArrays(1)
-        self._terrain = TerrainMesh(terrain, light) if terrain is not None else None
+        self._terrain = TerrainMesh(terrain, light, self._programs) if terrain is not None else None
         # the air's volume under the physical sky (the cloud pass reads it too: `air_volume`)
         self._air_volume = AirVolume() if sky.physical else None
         self._shafts: LightShaftPass | None = None  # built when a frame first has them
         # the physical sky at a fraction of the screen's resolution, and the program that reads it at its own
         self._sky_target: TextureTarget | None = None
-        self._sky_read: int | None = None
 
     def draw(
         self,
@@ -368,29 +375,41 @@ class WorldPass:
         depth), or the gradient."""
         view_projection = projection @ view
         inverse_view_projection = np.linalg.inv(view_projection)
-        far_ground_depth = False
+        GL.glEnable(GL.GL_DEPTH_TEST)
+        GL.glDepthFunc(GL.GL_LEQUAL)
+        GL.glDepthMask(GL.GL_FALSE)
+        GL.glBindVertexArray(self._fullscreen_vertex_array)
         if sky.physical:
-            program = self._sky_read_program()
+            program = self._sky_read_program(ground_depth=False)
             GL.glUseProgram(program)
             GL.glActiveTexture(GL.GL_TEXTURE2)
             GL.glBindTexture(GL.GL_TEXTURE_2D, self._sky_target.texture)
             GL.glActiveTexture(GL.GL_TEXTURE0)
-            far_ground_depth = self._far_ground is not None
-            if far_ground_depth:  # the ground past the terrain takes its depth: clouds behind it are hidden
-                set_matrix(program, "inverse_view_projection", inverse_view_projection)
-                GL.glUniform2f(GL.glGetUniformLocation(program, "planet_ground"), *below)
-                set_vec3(program, "view_forward", -view[2, :3])
-                GL.glUniform2f(GL.glGetUniformLocation(program, "depth_terms"), projection[2, 2], projection[2, 3])
         else:
             program = self._sky_program(False)
             GL.glUseProgram(program)
             set_matrix(program, "inverse_view_projection", inverse_view_projection)
             self._set_sky_uniforms(program, sky, camera, size[1])
-        GL.glEnable(GL.GL_DEPTH_TEST)
-        GL.glDepthFunc(GL.GL_LEQUAL)
-        GL.glDepthMask(GL.GL_TRUE if far_ground_depth else GL.GL_FALSE)
-        GL.glBindVertexArray(self._fullscreen_vertex_array)
         GL.glDrawArrays(GL.GL_TRIANGLES, 0, 3)
+        ground_box = None
+        if sky.physical and self._far_ground is not None:
+            ground_box = far_ground_box(
+                inverse_view_projection, camera.position, size, below, self._terrain_half_side_m()
+            )
+        if ground_box is not None:
+            # the ground past the terrain takes its depth, so that clouds behind it are hidden; drawn again in the
+            # box where it may be seen alone, as a pass that writes its depth is shaded on every pixel it covers
+            program = self._sky_read_program(ground_depth=True)
+            GL.glUseProgram(program)
+            set_matrix(program, "inverse_view_projection", inverse_view_projection)
+            GL.glUniform2f(GL.glGetUniformLocation(program, "planet_ground"), *below)
+            set_vec3(program, "view_forward", -view[2, :3])
+            GL.glUniform2f(GL.glGetUniformLocation(program, "depth_terms"), projection[2, 2], projection[2, 3])
+            GL.glDepthMask(GL.GL_TRUE)
+            GL.glEnable(GL.GL_SCISSOR_TEST)
+            GL.glScissor(*ground_box)
+            GL.glDrawArrays(GL.GL_TRIANGLES, 0, 3)
+            GL.glDisable(GL.GL_SCISSOR_TEST)
         GL.glDepthMask(GL.GL_FALSE)
         box = sun_box(sky, camera, view_projection, size) if sky.physical else None
         if box is not None:  # the sun's disc added where it can be
@@ -409,27 +428,27 @@ class WorldPass:
         GL.glDepthMask(GL.GL_TRUE)
         GL.glDepthFunc(GL.GL_LESS)
 
-    def _sky_read_program(self) -> int:
-        if self._sky_read is None:
-            far_ground = int(self._far_ground is not None)
-            defines = {"DEPTH": 1.0, "FAR_GROUND": far_ground, "VIEW_RAY": far_ground}
-            self._sky_read = build_program("sky_read", defines, vertex="world")
-        return self._sky_read
+    def _sky_read_program(self, ground_depth: bool) -> int:
+        """The program that reads the sky's picture; writing the far ground's depth where `ground_depth`."""
+        defines = {"DEPTH": 1.0, "FAR_GROUND": int(ground_depth), "VIEW_RAY": int(ground_depth)}
+        return self._programs.program("sky_read", defines, vertex="world")
+
+    def _terrain_half_side_m(self) -> float:
+        """The half side of the square the terrain's tiles are drawn to, about the origin."""
+        return self._terrain.tiles.frame.half_side_m
 
     def _sky_program(self, shafts: bool, sun_disc: bool = False) -> int:
         """The sky's program, less the light `shafts` take where asked; the sun's disc alone for `sun_disc`."""
-        if (shafts, sun_disc) not in self._sky_programs:
-            # at the far plane (the window depth 1), drawn where the depth is still the clear's
-            defines = {
-                "PHYSICAL_SKY": int(self._sky.physical),
-                "FAR_GROUND": int(self._far_ground is not None),
-                "LIGHT_SHAFTS": int(shafts),
-                "SUN_DISC": int(sun_disc),
-                "VIEW_RAY": 1,
-                "DEPTH": 1.0,
-            }
-            self._sky_programs[shafts, sun_disc] = build_program("sky", defines, vertex="world")
-        return self._sky_programs[shafts, sun_disc]
+        # at the far plane (the window depth 1), drawn where the depth is still the clear's
+        defines = {
+            "PHYSICAL_SKY": int(self._sky.physical),
+            "FAR_GROUND": int(self._far_ground is not None),
+            "LIGHT_SHAFTS": int(shafts),
+            "SUN_DISC": int(sun_disc),
+            "VIEW_RAY": 1,
+            "DEPTH": 1.0,
+        }
+        return self._programs.program("sky", defines, vertex="world")
 
     def _ground_below_the_terrain(self, sky: SkyBackground, camera: Camera) -> tuple[float, float]:
         """(the eye's altitude over it, its radius) of the planet's ground lowered under every vertex of the terrain
@@ -444,7 +463,7 @@ class WorldPass:
 
     def _light_shafts(self) -> LightShaftPass:
         if self._shafts is None:
-            self._shafts = LightShaftPass(*self._shaft_quality)
+            self._shafts = LightShaftPass(*self._shaft_quality, programs=self._programs)
         return self._shafts
 
     @property
@@ -501,10 +520,8 @@ class WorldPass:
             self._terrain.close()
         if self._shafts is not None:
             self._shafts.close()
-        for program in self._sky_programs.values():
-            GL.glDeleteProgram(program)
-        if self._sky_read is not None:
-            GL.glDeleteProgram(self._sky_read)
+        if self._own_programs:
+            self._programs.close()
         if self._sky_target is not None:
             self._sky_target.close()
         GL.glDeleteVertexArrays(1, [self._fullscreen_vertex_array])

@@ -126,9 +126,11 @@ def tile_faces(stride: int = 1) -> np.ndarray:
     top, following = _PERIMETER[kept], np.roll(_PERIMETER[kept], -1)
     bottom = n * n + kept
     bottom_following = np.roll(bottom, -1)
-    skirt = np.concatenate(
-        [np.stack([top, bottom, following], axis=1), np.stack([following, bottom, bottom_following], axis=1)]
-    )
+    # a quad's two triangles together, the quads in the perimeter's order: each side's skirt a run of its own
+    # (`SKIRT_SIDES`), which the world pass draws or leaves out (`skirted_sides`)
+    skirt = np.stack(
+        [np.stack([top, bottom, following], axis=1), np.stack([following, bottom, bottom_following], axis=1)], axis=1
+    ).reshape(-1, 3)
     return np.concatenate([grid, skirt])
 
 
@@ -140,15 +142,43 @@ def grid_face_count(stride: int = 1) -> int:
     return 2 * (TILE_CELLS // stride) ** 2
 
 
+#: a tile's sides in the order of its skirt's runs of triangles (`tile_faces`), as the (level, i, j) step to the
+#: neighbour of the same level across each: low z, high x, high z, low x
+SKIRT_SIDES = np.array([[0, 0, -1], [0, 1, 0], [0, 0, 1], [0, -1, 0]], dtype=np.int64)
+
+
+def skirted_sides(tiles: np.ndarray) -> np.ndarray:
+    """(n, 4) bool, per tile of `tiles` (`leaf_tiles`' rows) and side (`SKIRT_SIDES`): whether its skirt is needed
+    there: where the neighbour across is not a tile of its own level (a coarser or finer one, whose edge samples the
+    ground at other points, or none: the square's edge, where the skirt is the terrain's base).  Two tiles of one
+    level share their edge's vertices, so no gap opens between them; their skirts, hanging below the ground, were
+    hidden and cost llvmpipe their triangles (docs/performance.md, "The world pass within its budget")."""
+    tiles = np.asarray(tiles, dtype=np.int64).reshape(-1, 3)
+    neighbours = tiles[:, None, :] + SKIRT_SIDES[None, :, :]
+    # a key per (level, i, j): i and j lie within [-1, 2^(root level)] (off the square by one at most)
+    span = int(np.abs(neighbours[..., 1:]).max(initial=0)) + 2
+
+    def keys(rows: np.ndarray) -> np.ndarray:
+        return (rows[..., 0] * span + rows[..., 1] + 1) * span + rows[..., 2] + 1
+
+    return ~np.isin(keys(neighbours), keys(tiles))
+
+
 def tile_meshes(terrain: Terrain, frame: TileFrame, tiles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Positions and unit normals (T, TILE_VERTICES, 3) of `tiles`: each tile's grid, then its skirt's lower
     edge (the normals of the edge above it).  Normals by central differences over the tile's own cells, so a
     coarse tile is lit as the ground it stands for, smoothed."""
-    x0, z0, side = frame.corners(tiles)
-    steps = np.arange(-1, _SIDE_VERTICES + 1) / TILE_CELLS  # one cell beyond each edge, for the differences
+    tiles = np.asarray(tiles, dtype=np.int64).reshape(-1, 3)
+    steps = np.arange(-1, _SIDE_VERTICES + 1)  # one cell beyond each edge, for the differences
     half = frame.half_side_m
-    xs = np.clip(x0[:, None] + side[:, None] * steps, -half, half)
-    zs = np.clip(z0[:, None] + side[:, None] * steps, -half, half)
+    # in whole finest cells from the root's low corner, so that two tiles place the vertices they share on the same
+    # float64 (`skirted_sides` leaves out the skirt between two tiles of a level)
+    cells = np.exp2(tiles[:, 0:1]).astype(np.int64)
+    root_half = 0.5 * float(frame.sides(frame.root_level))
+    xs, zs = (
+        np.clip((tiles[:, axis : axis + 1] * TILE_CELLS + steps) * cells * frame.cell_m - root_half, -half, half)
+        for axis in (1, 2)
+    )
     x = np.broadcast_to(xs[:, None, :], (len(xs), len(steps), len(steps)))
     z = np.broadcast_to(zs[:, :, None], x.shape)
     heights = height_at(terrain, x, z)
@@ -174,7 +204,7 @@ def tile_meshes(terrain: Terrain, frame: TileFrame, tiles: np.ndarray) -> tuple[
     # that level, the terrain's base
     top = skirt[:, :, 1]
     lowest = np.minimum(heights[:, 1:-1, 1:-1].min(axis=(1, 2)), 0.0)[:, None]
-    hung = np.maximum(top - SKIRT_CELLS * (side / TILE_CELLS)[:, None], lowest)
+    hung = np.maximum(top - SKIRT_CELLS * (cells * frame.cell_m), lowest)
     on_edge = np.maximum(np.abs(skirt[:, :, 0]), np.abs(skirt[:, :, 2])) >= half
     skirt[:, :, 1] = np.where(on_edge, np.minimum(top, 0.0), np.minimum(hung, top))
     return np.concatenate([grid, skirt], axis=1), np.concatenate([normals, normals[:, _PERIMETER]], axis=1)
@@ -201,6 +231,8 @@ class TerrainTiles:
         self.faces = np.zeros((0, 3), dtype=np.int64)
         #: per tile, the (low, high) corners of the box around its mesh, skirt and all
         self.boxes = np.zeros((0, 2, 3))
+        #: per tile and side (`SKIRT_SIDES`), whether its skirt is drawn (`skirted_sides`)
+        self.skirts = np.zeros((0, 4), dtype=bool)
 
     def update(self, eye) -> bool:
         """Choose the tiles for `eye`; whether they changed (then `positions`, `normals`, `faces` are new)."""
@@ -223,6 +255,7 @@ class TerrainTiles:
         self.faces = (TILE_FACES[None, :, :] + offsets[:, None, None]).reshape(-1, 3)
         tile_positions = self.positions.reshape(len(keys), TILE_VERTICES, 3)
         self.boxes = np.stack([tile_positions.min(axis=1), tile_positions.max(axis=1)], axis=1)
+        self.skirts = skirted_sides(tiles)
         return True
 
     def in_view(self, planes: np.ndarray) -> np.ndarray:

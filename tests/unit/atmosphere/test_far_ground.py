@@ -12,11 +12,12 @@ from cloudcore.atmosphere.sky_view import eye_radius
 from cloudcore.atmosphere.transmittance import optical_depth
 from cloudcore.gl.world import terrain_vertex_light
 from cloudcore.light.air_between import air_between
-from cloudcore.light.far_ground import edge_colour, far_ground_colour
+from cloudcore.light.far_ground import edge_colour, far_ground_box, far_ground_colour
 from cloudcore.light.lighting import scene_lights
 from cloudcore.light.sky_background import scene_sky
 from cloudcore.light.terrain_light import terrain_light
-from cloudcore.model.scene import Lighting, Terrain
+from cloudcore.model.scene import Camera, Lighting, Terrain
+from cloudcore.world.camera import pixel_rays, projection_matrix, view_matrix
 from cloudcore.world.terrain import height_at
 from cloudcore.world.terrain_tiles import SKIRT_CELLS, TILE_CELLS, leaf_tiles, tile_frame, tile_meshes
 
@@ -102,3 +103,62 @@ def test_no_skirt_hangs_below_the_origin_s_level_and_the_square_s_edge_is_a_wall
     assert on_edge.any() and np.all(skirts[on_edge][:, 1] == 0.0)
     # inside the square, where the skirts close the gaps between levels, they still hang
     assert np.any(skirts[~on_edge][:, 1] < surface[..., 1].min() + SKIRT_CELLS * frame.cell_m)
+
+
+def _every_pixel_past_the_edge(camera: Camera, size, planet_ground, half_side_m) -> np.ndarray:
+    """(height, width) bool, bottom row first: each pixel centre's ray meets the ground at least as far as the
+    square's nearest edge, below the horizon (the pixels whose ground may show past the terrain)."""
+    width, height = size
+    rays = pixel_rays(camera, width, height)[::-1]  # bottom row first, as the window's boxes count
+    altitude, radius = planet_ground
+    ground = distance_to_ground(radius + altitude, rays[..., 1], radius)
+    eye = np.asarray(camera.position)
+    edge = max(min(half_side_m - abs(eye[0]), half_side_m - abs(eye[2])), 0.0)
+    return np.isfinite(ground) & (ground >= edge)
+
+
+def _box_of(camera: Camera, size, planet_ground, half_side_m):
+    projection = projection_matrix(camera.fov_y_deg, size[0] / size[1])
+    inverse = np.linalg.inv(projection @ view_matrix(camera))
+    return far_ground_box(inverse, camera.position, size, planet_ground, half_side_m)
+
+
+def test_the_far_ground_s_box_holds_every_pixel_whose_ground_lies_past_the_square():
+    """The box the world pass writes the far ground's depth in (a pass writing its pixels' depth costs llvmpipe
+    every pixel it covers) holds every pixel whose ray meets the ground past the square's nearest edge, tested at
+    every pixel: from the default view (a band a few pixels deep along the horizon, not the screen below it), from
+    10 km up, rolled toward the horizon's ends, and from outside the square (every pixel below the horizon)."""
+    size, half = (640, 480), 40000.0
+    planet = (EARTH.bottom_radius_m,)
+    views = {
+        "default": (Camera((450.0, 330.0, 2900.0), (-250.0, 850.0, -600.0)), 350.0),
+        "from 10 km": (Camera((-20000.0, 10000.0, 3000.0), (0.0, 9000.0, 30000.0), 70.0), 10020.0),
+        "down a slope": (Camera((30000.0, 600.0, -1000.0), (39000.0, 200.0, -9000.0)), 620.0),
+        "outside": (Camera((-80000.0, 2000.0, 3000.0), (0.0, 1000.0, 3000.0)), 2020.0),
+    }
+    heights = {}
+    for name, (camera, altitude) in views.items():
+        ground = (altitude, planet[0] - 20.0)
+        needed = _every_pixel_past_the_edge(camera, size, ground, half)
+        assert needed.any(), name  # each view sees some ground past the square
+        box = _box_of(camera, size, ground, half)
+        assert box is not None, name
+        x, y, width, height = box
+        inside = np.zeros(needed.shape, dtype=bool)
+        inside[y : y + height, x : x + width] = True
+        assert not (needed & ~inside).any(), name
+        heights[name] = height
+    assert heights["default"] < 0.15 * size[1]  # the band along the horizon, not the terrain below it
+    below_horizon = _every_pixel_past_the_edge(views["outside"][0], size, (2020.0, planet[0] - 20.0), half)
+    assert heights["outside"] >= np.flatnonzero(below_horizon.any(axis=1)).size
+
+
+def test_no_far_ground_box_where_the_view_sees_no_ground_past_the_square():
+    """Looking up from the valley, or down into it from within the square, no pixel's ground lies past the edge."""
+    size, half = (320, 240), 40000.0
+    ground = (350.0, EARTH.bottom_radius_m - 20.0)
+    up = Camera((0.0, 330.0, 0.0), (0.0, 2000.0, -1000.0))
+    down = Camera((0.0, 330.0, 0.0), (0.0, -2000.0, -1000.0))
+    for camera in (up, down):
+        assert not _every_pixel_past_the_edge(camera, size, ground, half).any()
+        assert _box_of(camera, size, ground, half) is None

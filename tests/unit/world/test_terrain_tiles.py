@@ -14,10 +14,13 @@ from cloudcore.world import terrain_tiles
 from cloudcore.world.camera import frustum_planes, projection_matrix, view_matrix
 from cloudcore.world.terrain_tiles import (
     SKIRT_CELLS,
+    SKIRT_SIDES,
     TILE_CELLS,
     TILE_FACES,
     TerrainTiles,
     leaf_tiles,
+    skirted_sides,
+    tile_faces,
     tile_frame,
     tile_meshes,
 )
@@ -106,6 +109,42 @@ def test_the_skirts_close_every_gap_between_neighbouring_tiles(eye):
             assert np.all(-gap_above <= depth[b] + 1e-6), (tiles[a], tiles[b], (-gap_above).max(), depth[b])
             checked += 1
     assert checked > 20
+
+
+@pytest.mark.parametrize("eye", EYES)
+def test_a_skirt_is_left_out_only_where_a_neighbour_of_the_same_level_shares_the_edge_s_vertices(eye):
+    """A side without its skirt (`skirted_sides`) has a tile of its own level across it whose edge vertices are its
+    own, to the float32 the GPU draws (no gap to close); every other side (a coarser or finer neighbour, or the
+    square's edge) keeps its skirt; and most sides need none."""
+    terrain = dataclasses.replace(VALLEY_TERRAIN, reach=12000.0)
+    frame = tile_frame(terrain)
+    tiles = leaf_tiles(frame, eye)
+    skirts = skirted_sides(tiles)
+    positions, _ = tile_meshes(terrain, frame, tiles)
+    n = TILE_CELLS + 1
+    grids = positions[:, : n * n].reshape(len(tiles), n, n, 3).astype(np.float32)
+    index = {tuple(tile): k for k, tile in enumerate(tiles.tolist())}
+    mine_and_theirs = (("low_z", "high_z"), ("high_x", "low_x"), ("high_z", "low_z"), ("low_x", "high_x"))
+    for k, tile in enumerate(tiles):
+        for side, (mine, theirs) in enumerate(mine_and_theirs):
+            across = index.get(tuple((tile + SKIRT_SIDES[side]).tolist()))
+            assert skirts[k, side] == (across is None), (tile, side)
+            if across is not None:
+                np.testing.assert_array_equal(edge(grids[k], mine), edge(grids[across], theirs))
+    assert skirts.mean() < 0.5
+
+
+def test_each_side_s_skirt_is_a_run_of_its_own():
+    """The skirt's triangles come side after side (`SKIRT_SIDES`' order), each side's hanging from that side's edge
+    alone, so that the world pass draws a side's run or leaves it out."""
+    n = TILE_CELLS + 1
+    grid = np.arange(n * n).reshape(n, n)
+    for stride in (1, 4):
+        faces = tile_faces(stride)[2 * (TILE_CELLS // stride) ** 2 :]
+        runs = faces.reshape(len(SKIRT_SIDES), -1, 3)
+        for side, mine in enumerate(("low_z", "high_x", "high_z", "low_x")):
+            on_the_grid = runs[side][runs[side] < n * n]
+            assert set(on_the_grid.tolist()) <= set(edge(grid, mine).tolist()), (stride, side)
 
 
 def test_moving_the_eye_meshes_only_the_new_tiles_and_a_still_eye_nothing(monkeypatch):
