@@ -1,10 +1,11 @@
 """The particles on the GPU: a `ParticleBuffer`'s per-particle terms uploaded once, and what the CPU keeps of them.
 
 `ResidentParticles` uploads the buffer's centres, radii, scattering, ambient and incident light per light (the
-shader's `Particle`), the part of that light a lit face sent back (where the light pass sends any), its clouds' styles, the sprites' facing locks, the opacity factors of a scene time (a
-formation, a cloud field's blend weights), Yusov's eye-pass profile rows and the bits of the particles a draw
-may leave out, each into a storage buffer, when the particles change; the shading, the GPU's selection and
-the raster read them there.  On the CPU it keeps per particle and per cloud what a draw is shaded and drawn by:
+shader's `Particle`), the part of that light a lit face sent back (where the light pass sends any), its clouds'
+styles, the sprites' facing locks, the opacity factors of a scene time (a formation, a cloud field's blend
+weights), Yusov's eye-pass profile rows and the bits of the particles a draw may leave out, each into a storage
+buffer, when the particles change; the shading, the GPU's selection and the raster read them there.  On the CPU
+it keeps per particle and per cloud what a draw is shaded and drawn by:
 plain Gaussian splats (`cloudcore.particles.point_sprites.plain_splats`), atlas sprites, the shader features.
 """
 
