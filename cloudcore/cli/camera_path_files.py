@@ -17,7 +17,7 @@ from cloudcore.errors import SceneError
 from cloudcore.interop.camera_paths import DEFAULT_LOOK_DISTANCE_M, read_camera_path, write_camera_path
 from cloudcore.interop.vdb_clouds import free_name
 from cloudcore.limits import scene_limit_problems
-from cloudcore.scene import Camera, Scene
+from cloudcore.scene import NEW_SCENE_SHADING, Camera, Scene
 from cloudcore.scenefile import load_scene, save_scene
 
 
@@ -42,7 +42,7 @@ def run_import(file: Path, out: Path, name: str | None, look_distance_m: float) 
     path = read_camera_path(file, name, look_distance_m)
     if scene is None:
         first = path.keys[0]
-        scene = Scene(camera=Camera(tuple(first[1:4].tolist()), tuple(first[4:7].tolist())))
+        scene = Scene(camera=Camera(tuple(first[1:4].tolist()), tuple(first[4:7].tolist())), shading=NEW_SCENE_SHADING)
     path = dataclasses.replace(path, name=free_name(path.name, [p.name for p in scene.camera_paths]))
     scene = dataclasses.replace(scene, camera_paths=scene.camera_paths + (path,))
     problems = scene_limit_problems(scene)

@@ -19,7 +19,7 @@ from cloudcore.errors import SceneError
 from cloudcore.interop.camera_paths import CAMERA_PATH_SUFFIXES
 from cloudcore.interop.vdb_clouds import DEFAULT_PARTICLES, import_vdb_clouds
 from cloudcore.limits import scene_limit_problems
-from cloudcore.scene import Camera, Scene, splats_bounding_sphere
+from cloudcore.scene import NEW_SCENE_SHADING, Camera, Scene, splats_bounding_sphere
 from cloudcore.scenefile import load_scene, save_scene
 
 
@@ -79,7 +79,7 @@ def run(args) -> int:
     )
     clouds = tuple(item.cloud for item in imported)
     if scene is None:
-        scene = Scene(camera=camera_looking_at(clouds))
+        scene = Scene(camera=camera_looking_at(clouds), shading=NEW_SCENE_SHADING)
     scene = dataclasses.replace(scene, clouds=scene.clouds + clouds)
     problems = scene_limit_problems(scene)
     if problems:

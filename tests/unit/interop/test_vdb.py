@@ -2,6 +2,7 @@
 within the stated error, scenes' clouds exported and read back, and every bad file refused with one line and
 exit status 2, the scene untouched."""
 
+import dataclasses
 import struct
 
 import numpy as np
@@ -15,7 +16,7 @@ from cloudcore.interop.density_fit import fit_particles, particle_integral, samp
 from cloudcore.interop.example_grids import noise_grid, sphere_grid
 from cloudcore.interop.vdb import DensityGrid, read_density_grids, write_density_grids
 from cloudcore.interop.vdb_clouds import cloud_density_grids, import_vdb_clouds
-from cloudcore.scene import Cloud, Scene
+from cloudcore.scene import NEW_SCENE_SHADING, Cloud, Scene, Shading
 from cloudcore.scenefile import load_scene, save_scene
 
 #: the density errors docs/interop.md states (`cloudview import` prints them), with a margin of rounding
@@ -88,8 +89,12 @@ def test_cli_import_into_a_new_scene_then_an_existing_one(tmp_path, capsys):
     (cloud,) = scene.clouds
     # a hostile grid name stays a name: its particles are in the scene's own folder
     assert (tmp_path / cloud.particles_file).resolve().parent == (tmp_path / "scene.particles").resolve()
+    assert scene.shading == NEW_SCENE_SHADING != Shading()  # a new scene's, kept in its file
+    save_scene(dataclasses.replace(scene, shading=Shading()), scene_path)
     assert main(["import", str(tmp_path / "ball.vdb"), "--out", str(scene_path), "--particles", "2000"]) == 0
-    assert [c.name for c in load_scene(scene_path).clouds] == ["../../ball", "../../ball-2"]
+    again = load_scene(scene_path)
+    assert [c.name for c in again.clouds] == ["../../ball", "../../ball-2"]
+    assert again.shading == Shading()  # an existing scene keeps its own
 
 
 def two_cloud_scene() -> Scene:
