@@ -104,9 +104,9 @@ class Shading:
 
 
 #: the shading a scene made from nothing starts with (`cloudview import` into a new file): the model closest to the
-#: path-traced truth at a realistic albedo on the views it was not chosen on (docs/shading.md, "The default for new
-#: scenes"); a scene file that does not name its passes keeps `Shading()`'s, Harris's, so the shipped scenes and
-#: their golden images keep their pictures
+#: path-traced truth at a realistic albedo on the views it was not chosen on (docs/shading.md, "Five views with the
+#: lit face in the eye pass: the default for new scenes"); a scene file that does not name its passes keeps
+#: `Shading()`'s, Harris's, so the shipped scenes and their golden images keep their pictures
 NEW_SCENE_SHADING = Shading(albedo=0.99, eye_pass="saturated", light_pass="octaves-lit-face")
 
 
