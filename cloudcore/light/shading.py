@@ -138,33 +138,10 @@ def eye_pass_coefficients(
     return np.minimum(albedo * alpha / FOUR_PI, alpha / p_forward), alpha * (1.0 - s) / (1.0 + s)
 
 
-def incident_light(
-    positions,
-    radii,
-    optical_depth,
-    albedo,
-    light_dir,
-    *,
-    phase: str = "rayleigh",
-    g: float = 0.0,
-    method: str = "exact",
-    groups=None,
-    resolution: int = DEFAULT_RASTER_RESOLUTION,
-) -> np.ndarray:
+def incident_light(positions, radii, optical_depth, albedo, light_dir, **options) -> np.ndarray:
     """Fraction of the light from `light_dir` that reaches each particle centre, float64 (N,): all of it (the
-    column `ALL_LIGHT` of `light_parts`, which says what the arguments are)."""
-    return light_parts(
-        positions,
-        radii,
-        optical_depth,
-        albedo,
-        light_dir,
-        phase=phase,
-        g=g,
-        method=method,
-        groups=groups,
-        resolution=resolution,
-    )[:, ALL_LIGHT]
+    column `ALL_LIGHT` of `light_parts`, which says what the arguments and keyword `options` are)."""
+    return light_parts(positions, radii, optical_depth, albedo, light_dir, **options)[:, ALL_LIGHT]
 
 
 def light_parts(
