@@ -14,7 +14,7 @@ import dataclasses
 from pathlib import Path
 
 from cloudcore.model.errors import SceneError
-from cloudcore.model.scene import Camera, Scene
+from cloudcore.model.scene import NEW_SCENE_SHADING, Camera, Scene
 from cloudcore.scenes.files import load_scene, save_scene
 from cloudcore.scenes.interop.camera_paths import DEFAULT_LOOK_DISTANCE_M, read_camera_path, write_camera_path
 from cloudcore.scenes.interop.vdb_clouds import free_name
@@ -42,7 +42,7 @@ def run_import(file: Path, out: Path, name: str | None, look_distance_m: float) 
     path = read_camera_path(file, name, look_distance_m)
     if scene is None:
         first = path.keys[0]
-        scene = Scene(camera=Camera(tuple(first[1:4].tolist()), tuple(first[4:7].tolist())))
+        scene = Scene(camera=Camera(tuple(first[1:4].tolist()), tuple(first[4:7].tolist())), shading=NEW_SCENE_SHADING)
     path = dataclasses.replace(path, name=free_name(path.name, [p.name for p in scene.camera_paths]))
     scene = dataclasses.replace(scene, camera_paths=scene.camera_paths + (path,))
     problems = scene_limit_problems(scene)

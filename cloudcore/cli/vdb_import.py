@@ -16,7 +16,7 @@ import numpy as np
 
 from cloudcore.cli import camera_path_files
 from cloudcore.model.errors import SceneError
-from cloudcore.model.scene import Camera, Scene, splats_bounding_sphere
+from cloudcore.model.scene import NEW_SCENE_SHADING, Camera, Scene, splats_bounding_sphere
 from cloudcore.scenes.files import load_scene, save_scene
 from cloudcore.scenes.interop.camera_paths import CAMERA_PATH_SUFFIXES
 from cloudcore.scenes.interop.vdb_clouds import DEFAULT_PARTICLES, import_vdb_clouds
@@ -79,7 +79,7 @@ def run(args) -> int:
     )
     clouds = tuple(item.cloud for item in imported)
     if scene is None:
-        scene = Scene(camera=camera_looking_at(clouds))
+        scene = Scene(camera=camera_looking_at(clouds), shading=NEW_SCENE_SHADING)
     scene = dataclasses.replace(scene, clouds=scene.clouds + clouds)
     problems = scene_limit_problems(scene)
     if problems:

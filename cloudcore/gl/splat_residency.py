@@ -1,10 +1,11 @@
 """The particles on the GPU: a `ParticleBuffer`'s per-particle terms uploaded once, and what the CPU keeps of them.
 
 `ResidentParticles` uploads the buffer's centres, radii, scattering, ambient and incident light per light (the
-shader's `Particle`), its clouds' styles, the sprites' facing locks, the opacity factors of a scene time (a
-formation, a cloud field's blend weights), Yusov's eye-pass profile rows and the bits of the particles a draw
-may leave out, each into a storage buffer, when the particles change; the shading, the GPU's selection and
-the raster read them there.  On the CPU it keeps per particle and per cloud what a draw is shaded and drawn by:
+shader's `Particle`), the part of that light a lit face sent back (where the light pass sends any), its clouds'
+styles, the sprites' facing locks, the opacity factors of a scene time (a formation, a cloud field's blend
+weights), Yusov's eye-pass profile rows and the bits of the particles a draw may leave out, each into a storage
+buffer, when the particles change; the shading, the GPU's selection and the raster read them there.  On the CPU
+it keeps per particle and per cloud what a draw is shaded and drawn by:
 plain Gaussian splats (`cloudcore.particles.point_sprites.plain_splats`), atlas sprites, the shader features.
 """
 
@@ -40,7 +41,8 @@ class ResidentParticles:
             self.facing_buffer,
             self.profile_buffer,
             self.drawn_bits_buffer,
-        ) = self._buffers = GL.glGenBuffers(6)
+            self.returned_buffer,
+        ) = self._buffers = GL.glGenBuffers(7)
         self.particles: ParticleBuffer | None = None
         self.atlas: int | None = None  # the sprite atlas texture, made when a cloud first needs it
         self._plain: np.ndarray = np.zeros(0, dtype=bool)  # of the resident particles: `plain_splats`
@@ -49,6 +51,8 @@ class ResidentParticles:
         #: of the resident particles: per particle, (facing, artist) as bits; whether there are Yusov's profiles
         self._feature_bits: np.ndarray = np.zeros(0, dtype=np.uint8)
         self.profiled = False
+        #: whether the resident particles have light sent back by a lit face (`ParticleBuffer.returned`)
+        self.returning = False
         #: of the resident particles' clouds: (facing, artist) as bits, whether any is an atlas sprite; what a
         #: `SplatSelection`'s shading and drawing go by, its particles unknown to the CPU
         self._cloud_feature_bits: np.ndarray = np.zeros(1, dtype=np.uint8)
@@ -80,6 +84,10 @@ class ResidentParticles:
         self._cloud_feature_bits = np.array(per_cloud + [0], dtype=np.uint8)
         self._feature_bits = self._cloud_feature_bits[particles.styles.cloud_index]
         self.profiled = particles.profiles is not None
+        # the light a lit face sent back, per particle and light; one float where there is none
+        returned = np.zeros(1) if particles.returned is None or not particles.returned.size else particles.returned
+        store(self.returned_buffer, np.ascontiguousarray(returned, dtype=np.float32).ravel())
+        self.returning = particles.returned is not None
         self._cloud_sprites = np.append(_any_of_each_cloud(self._sprites, particles.cloud_starts), False)
         store(self.drawn_bits_buffer, np.append(particles.drawn_bits, np.uint32(0)))
         self.particles, self._formation_time = particles, None

@@ -33,7 +33,8 @@ INSTANCE_BYTES = 8 * 16
     _FACING_BINDING,
     _PROFILES_BINDING,
     _BATCHES_BINDING,
-) = range(8)
+    _RETURNED_BINDING,
+) = range(9)
 #: floats of splat_shade.comp.glsl's `Batch`: first slot and count (as uints), eye, image plane's right and up
 _BATCH_FLOATS = 16
 #: the compute shader's local_size_x
@@ -42,8 +43,9 @@ _SHADE_GROUP = 64
 #: storage buffer range GL allows, so that any batch's can be bound alone
 _SLOT_ALIGNMENT = 256 // INSTANCE_BYTES
 #: splat_shade.comp.glsl's optional code, in the order of a variant's key: sprites that do not lie in the
-#: image plane, Wang's artist colours, Yusov's eye-pass profiles, the air between the eye and each particle
-_SHADE_FEATURES = ("FACING", "ARTIST", "PROFILES", "AIR")
+#: image plane, Wang's artist colours, Yusov's eye-pass profiles, the air between the eye and each particle, the
+#: light a lit face sent back (`cloudcore.particles.buffer.ParticleBuffer.returned`)
+_SHADE_FEATURES = ("FACING", "ARTIST", "PROFILES", "AIR", "RETURNED")
 #: what a draw after shading waits for: the instances (and a selection's indirect command)
 _SHADED_BARRIERS = GL.GL_SHADER_STORAGE_BARRIER_BIT | GL.GL_COMMAND_BARRIER_BIT
 
@@ -188,6 +190,9 @@ class SplatShading:
             (_PROFILES_BINDING, self._resident.profile_buffer),
             (_BATCHES_BINDING, self._batch_buffer),
         )
+        if features[_SHADE_FEATURES.index("RETURNED")]:
+            # binding 8 is others' between dispatches (the splats' cells, the tiles' occupancy): bound only here
+            bind_storage((_RETURNED_BINDING, self._resident.returned_buffer))
         program, uniforms = self._shade_program(features)
         first, end = run[0][2], run[-1][2] + run[-1][0].slots
         GL.glUseProgram(program)
@@ -198,12 +203,13 @@ class SplatShading:
         GL.glUniform1ui(uniforms["batch_count"], len(rows))
         dispatch(-(-(end - first) // _SHADE_GROUP))
 
-    def _features(self, batch: SplatBatch | SplatSelection) -> tuple[bool, bool, bool, bool]:
+    def _features(self, batch: SplatBatch | SplatSelection) -> tuple[bool, bool, bool, bool, bool]:
         """The shader features (`_SHADE_FEATURES`) `batch`'s particles need."""
         bits = self._resident.feature_bits(batch)
-        return bool(bits & 1), bool(bits & 2), self._resident.profiled, batch.through_air and self.air is not None
+        air = batch.through_air and self.air is not None
+        return bool(bits & 1), bool(bits & 2), self._resident.profiled, air, self._resident.returning
 
-    def _shade_program(self, features: tuple[bool, bool, bool, bool]) -> tuple[int, dict]:
+    def _shade_program(self, features: tuple[bool, bool, bool, bool, bool]) -> tuple[int, dict]:
         """The compute shader variant with `features`, its light uniforms those of the resident particles; and
         its uniforms' locations."""
         if features not in self._programs:

@@ -14,7 +14,7 @@ import numpy as np
 
 from cloudcore.light.cloud_shadows import beam_opacity, between_clouds_transmittance
 from cloudcore.light.lighting import active_lights
-from cloudcore.light.shading import DEFAULT_RASTER_RESOLUTION, incident_light
+from cloudcore.light.shading import ALL_LIGHT, DEFAULT_RASTER_RESOLUTION, RETURNED_LIGHT, light_parts
 from cloudcore.model.scene import Cloud, Shading
 
 
@@ -35,15 +35,18 @@ def illuminate_clouds(
     resolution: int = DEFAULT_RASTER_RESOLUTION,
     between_clouds: bool = False,
 ) -> list[np.ndarray]:
-    """Incident light (N_i, L) of each cloud for each light that contributes (`active_lights`); with
-    `between_clouds`, the sun's (the first light's) through the other clouds too (`sun_through_others`)."""
+    """Incident light (N_i, L) of each cloud for each light that contributes (`active_lights`), all of it
+    (`ALL_LIGHT`); with `between_clouds`, the sun's (the first light's) through the other clouds too
+    (`sun_through_others`)."""
     clouds = list(clouds)
     columns = [
         illuminate_direction(clouds, shading, light.direction, method, resolution=resolution)
         for light in active_lights(lights)
     ]
     incident = [
-        np.column_stack([column[i] for column in columns]) if columns else np.zeros((len(cloud.particles), 0))
+        np.column_stack([column[i][:, ALL_LIGHT] for column in columns])
+        if columns
+        else np.zeros((len(cloud.particles), 0))
         for i, cloud in enumerate(clouds)
     ]
     sun = shadowing_sun(lights) if between_clouds else None
@@ -86,7 +89,8 @@ def _dimmed(incident: list[np.ndarray], through: list[np.ndarray]) -> list[np.nd
 def illuminate_direction(
     clouds, shading: Shading, direction, method: str = "exact", *, resolution: int = DEFAULT_RASTER_RESOLUTION
 ) -> list[np.ndarray]:
-    """The fraction (N_i,) of light from `direction` that reaches each particle of each cloud.
+    """The fraction (N_i, 2) of light from `direction` that reaches each particle of each cloud: all of it and the
+    part a lit face sends back (`cloudcore.light.shading.light_parts`).
 
     All clouds go through one `incident_light` call, each its own shadowing group,
     which lets the raster method share its slab walk.  What fraction arrives does
@@ -95,10 +99,10 @@ def illuminate_direction(
     clouds = list(clouds)
     counts = [len(c.particles) for c in clouds]
     if sum(counts) == 0:
-        return [np.zeros(n) for n in counts]
+        return [np.zeros((n, 2)) for n in counts]
     optics = [cloud_optics(c, shading) for c in clouds]
     method = light_pass_method(shading, method)
-    incident = incident_light(
+    incident = light_parts(
         np.concatenate([c.centres for c in clouds]),
         np.concatenate([c.radii for c in clouds]),
         np.concatenate([o[0] for o in optics]),
@@ -143,7 +147,7 @@ class IlluminationCache:
     """
 
     def __init__(self):
-        #: (id of the cloud, shading, method) -> (the cloud, {light direction: incident (N,)})
+        #: (id of the cloud, shading, method) -> (the cloud, {light direction: incident (N, 2): `light_parts`})
         self._entries: dict[tuple, tuple[Cloud, dict[tuple, np.ndarray]]] = {}
         self.last_recomputed = 0  # (cloud, light direction) pairs shaded by the last call
         #: ((the clouds, shading, sun direction), the sun through the others per cloud): the last asked
@@ -155,6 +159,12 @@ class IlluminationCache:
     ) -> list[np.ndarray]:
         """`illuminate_clouds(clouds, shading, lights, method, between_clouds=...)`, from what is held where it
         can be."""
+        return self.light_parts(clouds, shading, lights, method, between_clouds=between_clouds)[0]
+
+    def light_parts(
+        self, clouds, shading: Shading, lights, method: str = "exact", *, between_clouds: bool = False
+    ) -> tuple[list[np.ndarray], list[np.ndarray]]:
+        """(`incident`, and per cloud (N_i, L) the part of it a lit face sends back: `RETURNED_LIGHT`)."""
         clouds = list(clouds)
         work = self.missing(clouds, shading, lights, method)
         for direction, stale in work:
@@ -164,12 +174,20 @@ class IlluminationCache:
         kept = {key: (cloud, {d: self._entries[key][1][d] for d in directions}) for key, cloud in zip(keys, clouds)}
         self._entries = kept
         self.last_recomputed = sum(len(stale) for _, stale in work)
-        incident = [
-            np.column_stack([kept[key][1][d] for d in directions]) if directions else np.zeros((len(c.particles), 0))
-            for key, c in zip(keys, clouds)
+        parts = [
+            [
+                np.column_stack([kept[key][1][d][:, part] for d in directions])
+                if directions
+                else np.zeros((len(c.particles), 0))
+                for key, c in zip(keys, clouds)
+            ]
+            for part in (ALL_LIGHT, RETURNED_LIGHT)
         ]
         sun = shadowing_sun(lights) if between_clouds else None
-        return incident if sun is None else _dimmed(incident, self._sun_through_others(clouds, shading, sun, method))
+        if sun is None:
+            return parts[0], parts[1]
+        through = self._sun_through_others(clouds, shading, sun, method)
+        return _dimmed(parts[0], through), _dimmed(parts[1], through)
 
     def _sun_through_others(self, clouds, shading: Shading, sun, method: str) -> list[np.ndarray]:
         """`sun_through_others`, kept while the clouds (by identity), their optics and the sun stay.  A dragged

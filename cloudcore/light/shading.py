@@ -42,7 +42,8 @@ Two methods:
   (`cloudcore.light.octaves`); no light order is needed.
 * "octaves-lit-face": the octaves, each particle's light then increased by what the medium behind it (away
   from the light) reflects back to it (`cloudcore.light.lit_face`): one more product, over the overlaps behind each
-  particle, which the same search finds.
+  particle, which the same search finds.  That light arrives from every direction behind the particle, so
+  `light_parts` gives it apart (`RETURNED_LIGHT`) for the eye pass to scatter with the phase function's mean.
 """
 
 from __future__ import annotations
@@ -69,7 +70,14 @@ EYE_PASSES = ("harris", "saturated", "yusov")
 #: multiple-scattering octaves over Harris's light-plane overlaps (the method "octaves": `cloudcore.light.octaves`),
 #: or the octaves with the light a cloud's lit face sends back (`cloudcore.light.lit_face`)
 LIGHT_PASSES = ("harris", "occlusion", "octaves", "octaves-lit-face")
+#: the light passes that send light back (`RETURNED_LIGHT`): the eye pass reads a second light column for them
+RETURNING_LIGHT_PASSES = ("octaves-lit-face",)
 FOUR_PI = 4.0 * np.pi
+#: the columns of `light_parts`: all the light that reaches a particle, and the part of it the medium behind the
+#: particle sends back (a cloud's lit face, `cloudcore.light.lit_face`; 0 in the other light passes), which
+#: arrives from every direction behind it, so the eye pass scatters it with the phase function's mean (1) rather
+#: than at the angle between the view and the light
+ALL_LIGHT, RETURNED_LIGHT = 0, 1
 
 #: raster grid cells across the widest axis of a cloud's light-plane footprint.
 DEFAULT_RASTER_RESOLUTION = 48
@@ -130,7 +138,13 @@ def eye_pass_coefficients(
     return np.minimum(albedo * alpha / FOUR_PI, alpha / p_forward), alpha * (1.0 - s) / (1.0 + s)
 
 
-def incident_light(
+def incident_light(positions, radii, optical_depth, albedo, light_dir, **options) -> np.ndarray:
+    """Fraction of the light from `light_dir` that reaches each particle centre, float64 (N,): all of it (the
+    column `ALL_LIGHT` of `light_parts`, which says what the arguments and keyword `options` are)."""
+    return light_parts(positions, radii, optical_depth, albedo, light_dir, **options)[:, ALL_LIGHT]
+
+
+def light_parts(
     positions,
     radii,
     optical_depth,
@@ -143,7 +157,8 @@ def incident_light(
     groups=None,
     resolution: int = DEFAULT_RASTER_RESOLUTION,
 ) -> np.ndarray:
-    """Fraction of the light from `light_dir` that reaches each particle centre, float64 (N,).
+    """Fraction of the light from `light_dir` that reaches each particle centre, float64 (N, 2): all of it and
+    the part the medium behind the particle sends back (the columns `ALL_LIGHT`, `RETURNED_LIGHT`).
 
     positions (N, 3); radii (N,); optical_depth (N,) = tau through the centre;
     albedo (N,) in [0, 1]; light_dir (3,) points from the scene toward the light.
@@ -157,7 +172,7 @@ def incident_light(
         raise ValueError(f"unknown shading method {method!r}; valid: {', '.join(METHODS)}")
     n = len(positions)
     if n == 0:
-        return np.zeros(0)
+        return np.zeros((0, 2))
     groups = np.zeros(n, dtype=np.int64) if groups is None else np.asarray(groups).reshape(n)
 
     u, v = _light_plane_axes(light)
@@ -169,12 +184,13 @@ def incident_light(
         octave_alpha = -np.expm1(-octave_optical_depths(tau))
         if method == "octaves":
             through = _transmittance_exact(plane, toward_light, radii, octave_alpha, groups)
-            return np.clip(octave_light(np.clip(through, 0.0, 1.0)), 0.0, most_light())
+            return _along_the_light(np.clip(octave_light(np.clip(through, 0.0, 1.0)), 0.0, most_light()))
         through, behind = _transmittance_exact(plane, toward_light, radii, octave_alpha, groups, behind=alpha[:, None])
         light = np.clip(octave_light(np.clip(through, 0.0, 1.0)), 0.0, most_light())
         # the optical thickness behind each particle (away from the light), as the product of 1 - alpha K there
         depth_behind = -np.log(np.clip(behind[:, 0], np.finfo(np.float64).tiny, 1.0))
-        return light * (1.0 + lit_face_return(depth_behind, albedo, phase, g))
+        returned = light * lit_face_return(depth_behind, albedo, phase, g)
+        return np.column_stack([light + returned, returned])
     if method == "exact":
         result = _incident_exact(plane, toward_light, radii, alpha, sigma, groups)
     elif method == "occlusion":
@@ -184,7 +200,12 @@ def incident_light(
         grid = PREVIEW_RASTER_RESOLUTION if method == "preview" else int(resolution)
         result = _incident_raster(plane, toward_light, radii, alpha, sigma, groups, grid)
     # Every step is a convex combination of values in [0, 1]; clip only rounding.
-    return np.clip(result, 0.0, 1.0)
+    return _along_the_light(np.clip(result, 0.0, 1.0))
+
+
+def _along_the_light(light: np.ndarray) -> np.ndarray:
+    """`light_parts` of a pass whose light (N,) all comes along the light's direction: none sent back."""
+    return np.column_stack([light, np.zeros(len(light))])
 
 
 def _validated(positions, radii, optical_depth, albedo, light_dir):

@@ -103,6 +103,13 @@ class Shading:
     light_pass: str = "harris"
 
 
+#: the shading a scene made from nothing starts with (`cloudview import` into a new file): the model closest to the
+#: path-traced truth at a realistic albedo on the views it was not chosen on (docs/shading.md, "Five views with the
+#: lit face in the eye pass: the default for new scenes"); a scene file that does not name its passes keeps
+#: `Shading()`'s, Harris's, so the shipped scenes and their golden images keep their pictures
+NEW_SCENE_SHADING = Shading(albedo=0.99, eye_pass="saturated", light_pass="octaves-lit-face")
+
+
 @dataclass(frozen=True, eq=False)
 class Cloud(_Record):
     """Particles as rows (x, y, z, radius); optional per-cloud shading overrides and formation.

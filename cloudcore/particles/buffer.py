@@ -34,11 +34,11 @@ import numpy as np
 from cloudcore.artist.formation import core_distances, opacity_factor
 from cloudcore.artist.particle_styles import ParticleStyles, particle_styles
 from cloudcore.artist.sprites import CELL_PIXELS
-from cloudcore.light.illumination import IlluminationCache, cloud_optics, illuminate_clouds
+from cloudcore.light.illumination import IlluminationCache, cloud_optics, light_pass_method
 from cloudcore.light.lighting import active_lights
 from cloudcore.light.phase import phase_function
 from cloudcore.light.precomputed import eye_pass_profiles
-from cloudcore.light.shading import eye_pass_coefficients
+from cloudcore.light.shading import RETURNING_LIGHT_PASSES, eye_pass_coefficients
 from cloudcore.maths.ramps import smoothstep
 from cloudcore.model.scene import Lighting, Shading
 
@@ -99,13 +99,17 @@ class ParticleBuffer:
             eye_pass_profiles(tau, albedo, shading.phase, shading.g) if shading.eye_pass == "yusov" else None
         )
         self.tint = np.repeat(np.array([c.color for c in clouds], dtype=np.float64).reshape(-1, 3), counts, axis=0)
-        incident = (
-            cache.incident(clouds, shading, scene_lights, method, between_clouds=between_clouds)
-            if cache is not None
-            else illuminate_clouds(clouds, shading, scene_lights, method, between_clouds=between_clouds)
-        )
-        #: (n, lights): light that reached each particle, per light (Harris's light pass)
+        cache = IlluminationCache() if cache is None else cache
+        incident, returned = cache.light_parts(clouds, shading, scene_lights, method, between_clouds=between_clouds)
+        #: (n, lights): light that reached each particle, per light (Harris's light pass), all of it
         self.incident = _concatenated(incident, (0, len(lights)))
+        #: (n, lights): the part of `incident` a cloud's lit face sent back (`cloudcore.light.lit_face`), which
+        #: arrives from every direction; None where the light pass sends none back
+        self.returned = (
+            _concatenated(returned, (0, len(lights)))
+            if light_pass_method(shading, method) in RETURNING_LIGHT_PASSES
+            else None
+        )
 
         #: (clouds,) metres: the finest detail in each cloud (0 for an empty one), which bounds how
         #: fine an impostor texture needs to be (`cloudcore.lod.impostors.detail_size_px`); each cloud's
@@ -149,11 +153,15 @@ class ParticleBuffer:
         scattered = np.zeros((len(indices), 3))
         for light, (direction, radiance) in enumerate(zip(self.light_directions, self.light_radiance)):
             mu = view @ direction
-            phase = phase_function(mu, self.phase, self.g)
+            # the light along the light's direction at the angle mu; what a lit face sends back, from every
+            # direction behind the particle, with the phase function's mean over the sphere, 1 (Rayleigh's over
+            # either hemisphere too)
+            phase, around = phase_function(mu, self.phase, self.g), 1.0
             if self.profiles is not None:
                 single, multiple = self.profiles.at(indices, mu)
-                phase = phase * single + multiple
-            scattered += (self.incident[indices, light] * phase)[:, None] * radiance
+                phase, around = phase * single + multiple, single + multiple
+            back = 0.0 if self.returned is None else self.returned[indices, light]
+            scattered += ((self.incident[indices, light] - back) * phase + back * around)[:, None] * radiance
         alpha = self.alpha[indices]
         ambient = self.ambient * self.ambient_weight[indices, None]
         colour = (scattered * self.scattering[indices, None] + ambient) * self.tint[indices]

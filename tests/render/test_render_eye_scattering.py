@@ -31,16 +31,20 @@ def particle_grid(z: float) -> np.ndarray:
 
 
 @pytest.mark.parametrize(
-    "phase, g, eye_pass",
+    "phase, g, eye_pass, light_pass",
     [
-        ("rayleigh", 0.0, "harris"),
-        ("henyey-greenstein", 0.8, "harris"),
-        ("cornette-shanks", -0.5, "harris"),
-        ("rayleigh", 0.0, "saturated"),
-        ("rayleigh", 0.0, "yusov"),
+        ("rayleigh", 0.0, "harris", "harris"),
+        ("henyey-greenstein", 0.8, "harris", "harris"),
+        ("cornette-shanks", -0.5, "harris", "harris"),
+        ("rayleigh", 0.0, "saturated", "harris"),
+        ("rayleigh", 0.0, "yusov", "harris"),
+        # the light a lit face sends back, a second light column scattered with the phase function's mean
+        ("rayleigh", 0.0, "saturated", "octaves-lit-face"),
+        ("henyey-greenstein", 0.8, "saturated", "octaves-lit-face"),
+        ("rayleigh", 0.0, "yusov", "octaves-lit-face"),
     ],
 )
-def test_the_shader_colours_particles_as_the_reference_does(renderer, phase, g, eye_pass):
+def test_the_shader_colours_particles_as_the_reference_does(renderer, phase, g, eye_pass, light_pass):
     from cloudcore.gl.splats import SplatPass
     from cloudcore.gl.targets import TextureTarget
     from cloudcore.particles.batch import splat_batch
@@ -54,7 +58,10 @@ def test_the_shader_colours_particles_as_the_reference_does(renderer, phase, g, 
             formation=Formation("form", 0.0, 10.0),
         ),
     )
-    particles = ParticleBuffer(clouds, Shading(albedo=0.85, phase=phase, g=g, eye_pass=eye_pass), LIGHTS, AMBIENT)
+    shading = Shading(albedo=0.85, phase=phase, g=g, eye_pass=eye_pass, light_pass=light_pass)
+    particles = ParticleBuffer(clouds, shading, LIGHTS, AMBIENT)
+    # the lit face sends light back to the particles with others behind them (the rows along the third light)
+    assert (particles.returned is not None and particles.returned.max() > 0.1) == (light_pass != "harris")
     view, projection = view_matrix(CAMERA), projection_matrix(CAMERA.fov_y_deg, WIDTH / HEIGHT)
     time_s = 4.0  # the forming cloud's core is in, its edge not yet
     renderer.context.make_current()

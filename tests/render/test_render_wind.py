@@ -90,10 +90,10 @@ class CountingCache(IlluminationCache):
 
     shaded = 0
 
-    def incident(self, *args, **kwargs):
-        incident = super().incident(*args, **kwargs)
+    def light_parts(self, *args, **kwargs):
+        parts = super().light_parts(*args, **kwargs)
         self.shaded += self.last_recomputed
-        return incident
+        return parts
 
 
 def test_a_drift_keeps_the_light_and_turbulence_relights_at_its_period(still):

@@ -12,7 +12,9 @@
 // cloudcore.light.precomputed.EyePassProfiles.at) the phase function times the
 // reference particle's single scattering plus its multiple scattering, both
 // read from the particle's profile row linearly in mu, stand in for the
-// phase function.  Colour, Wang's artist model (reference
+// phase function.  The part of a particle's light that a cloud's lit face sent
+// back (RETURNED) arrives from every direction: the phase function's mean, 1,
+// stands in for the phase function there.  Colour, Wang's artist model (reference
 // cloudcore.artist.artist_shading.artist_colours): the cloud's five vertical colour
 // levels at each corner's height plus the directional term of its shading
 // group, per corner.  Opacity: splats fade out next to the eye; sprites lock
@@ -26,7 +28,7 @@
 // keeps tiny particles far from the origin their size.
 //
 // Variants: FACING (sprites not in the image plane), ARTIST (Wang's colours),
-// PROFILES (Yusov's eye pass) and AIR (aerial perspective by the particle's
+// PROFILES (Yusov's eye pass), RETURNED (the lit face's light) and AIR (aerial perspective by the particle's
 // distance from the eye, for the cloud pass's batches, never an impostor's,
 // whose texture is seen from elsewhere) compile their code in only for batches that
 // have them: llvmpipe paid for the code behind the branches, so a batch of Harris's
@@ -75,6 +77,10 @@ struct Batch {
     vec4 view_up;
 };
 layout(std430, binding = 7) readonly buffer Batches { Batch batches[]; };
+#ifdef RETURNED
+// per particle and light (light_count a particle): the part of its incident light a lit face sent back
+layout(std430, binding = 8) readonly buffer Returned { float returned[]; };
+#endif
 
 uniform uint first;  // the dispatch's first slot, that of its first batch
 uniform uint slot_count;  // the slots it covers: its batches' and the alignment gaps between them
@@ -119,18 +125,27 @@ float profile(int row, int part, float mu)
     return mix(profiles[start], profiles[start + 1], position - float(below));
 }
 
-vec4 harris_colour(Particle p, vec3 view_ray)
+vec4 harris_colour(Particle p, uint index, vec3 view_ray)
 {
     int row = int(p.sprite.z);
     vec3 scattered = vec3(0.0);
     for (int light = 0; light < light_count; ++light) {
         float mu = dot(view_ray, light_direction[light]);
         float factor = phase(mu);
+        float around = 1.0;  // the phase function's mean, for the light sent back from every direction
 #ifdef PROFILES
-        if (row >= 0)
-            factor = factor * profile(row, 0, mu) + profile(row, 1, mu);
+        if (row >= 0) {
+            float single = profile(row, 0, mu), multiple = profile(row, 1, mu);
+            factor = factor * single + multiple;
+            around = single + multiple;
+        }
 #endif
+#ifdef RETURNED
+        float back = returned[index * uint(light_count) + uint(light)];
+        scattered += ((p.incident[light] - back) * factor + back * around) * light_radiance[light];
+#else
         scattered += p.incident[light] * factor * light_radiance[light];
+#endif
     }
     return vec4(scattered * p.scattering_opacity.rgb + p.ambient.rgb, p.scattering_opacity.a);
 }
@@ -201,9 +216,9 @@ void shade(uint invocation)
 
 #ifdef ARTIST
     bool artist = style.last_height_extent.w > 0.5;
-    vec4 colour = artist ? vec4(0.0) : harris_colour(p, view_ray) * fade;
+    vec4 colour = artist ? vec4(0.0) : harris_colour(p, index, view_ray) * fade;
 #else
-    vec4 colour = harris_colour(p, view_ray) * fade;
+    vec4 colour = harris_colour(p, index, view_ray) * fade;
 #endif
 #ifdef AIR
     // the air in front of the particle, by its centre, added where it covers what is behind

@@ -121,3 +121,27 @@ def test_the_depth_behind_is_the_direct_light_from_the_other_side(monkeypatch, s
     behind = incident_light(positions, radii, tau, 0.99, tuple(-v for v in light), method="octaves")
     expected = plain * (1.0 + lit_face_return(-np.log(np.maximum(behind, np.finfo(np.float64).tiny)), 0.99))
     np.testing.assert_allclose(lit, expected, rtol=1e-9, atol=1e-12)
+
+
+def test_the_eye_pass_scatters_the_returned_light_with_the_phase_function_s_mean():
+    """Two particles in a row along the sun: the front one's light is the sun's along its direction plus what the
+    one behind sends back, which arrives from every direction; seen from anywhere, the eye pass scatters the first
+    part at the angle to the sun and the second as the phase function's mean, 1."""
+    from cloudcore.light.phase import phase_function
+    from cloudcore.model.scene import Cloud, Light
+    from cloudcore.particles.buffer import ParticleBuffer
+
+    sun = Light(SUN, (1.0, 0.9, 0.8), 2.0)
+    cloud = Cloud("pair", [[0.0, 10.0, 0.0, 5.0], [0.0, 0.0, 0.0, 5.0]], optical_depth=6.0)
+    shading = Shading(albedo=0.99, eye_pass="saturated", light_pass="octaves-lit-face")
+    particles = ParticleBuffer((cloud,), shading, (sun,), (0.0, 0.0, 0.0))
+    plain = ParticleBuffer((cloud,), dataclasses.replace(shading, light_pass="octaves"), (sun,), (0.0, 0.0, 0.0))
+    assert plain.returned is None
+    back = particles.returned[0, 0]
+    assert back == pytest.approx(particles.incident[0, 0] - plain.incident[0, 0], rel=1e-12) and back > 1.0
+    for eye in ([0.0, 100.0, 0.0], [100.0, 10.0, 0.0], [0.0, 10.0, 100.0], [30.0, -80.0, 10.0]):
+        colour, _ = particles.seen_from(eye, np.array([0]))
+        view = (particles.centres[0] - eye) / np.linalg.norm(particles.centres[0] - eye)
+        along = plain.incident[0, 0] * phase_function(view @ plain.light_directions[0], "rayleigh", 0.0)
+        expected = particles.scattering[0] * (along + back) * np.array(sun.color) * sun.intensity
+        np.testing.assert_allclose(colour[0], expected, rtol=1e-12)

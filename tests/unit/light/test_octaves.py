@@ -9,7 +9,7 @@ import pytest
 from cloudcore.light import octaves, shading
 from cloudcore.light.illumination import light_pass_method
 from cloudcore.light.phase import phase_function
-from cloudcore.light.shading import eye_pass_coefficients, incident_light
+from cloudcore.light.shading import ALL_LIGHT, RETURNED_LIGHT, eye_pass_coefficients, incident_light, light_parts
 from cloudcore.light.slab import slab
 from cloudcore.maths.splat_kernel import KERNEL_DIAMETER_INTEGRAL, splat_kernel
 from cloudcore.model.scene import Camera, Scene, Shading
@@ -88,7 +88,8 @@ def slab_fluxes(eye_pass, method, albedo, column_tau, tau=8.0, phase="rayleigh",
     The model's picture averaged over where the particles fall: a ray meets splats at the rate n pi r^2 per unit
     length, each covering it with the kernel's mean over its disc, and is let through by the ones in front on
     average as exp(-n pi r^2 <alpha K> s) (independent positions); each splat sends its eye-pass colour, the
-    scattering coefficient times the phase function times its light.  The light comes from the model's pass over
+    scattering coefficient times the phase function times its light (the part a lit face sent back times the
+    phase function's mean, 1).  The light comes from the model's pass over
     the particles, those within a margin of the sides left out (they miss their neighbours' shadows).
     """
     mean_kernel, blob_integral = _kernel_means()
@@ -96,12 +97,15 @@ def slab_fluxes(eye_pass, method, albedo, column_tau, tau=8.0, phase="rayleigh",
     rng = np.random.default_rng(seed)
     count = int(round(density * WIDTH * WIDTH * HEIGHT))
     positions = rng.uniform([-WIDTH / 2, 0.0, -WIDTH / 2], [WIDTH / 2, HEIGHT, WIDTH / 2], (count, 3))
-    light = incident_light(positions, 1.0, tau, albedo, SUN, phase=phase, method=method)
+    parts = light_parts(positions, 1.0, tau, albedo, SUN, phase=phase, method=method)
     scattering, _ = eye_pass_coefficients(np.full(count, tau), np.full(count, albedo), phase, 0.0, eye_pass)
     inside = np.all(np.abs(positions[:, [0, 2]]) < WIDTH / 2 - MARGIN, axis=1)
     area = (WIDTH - 2 * MARGIN) ** 2
     extinction = density * np.pi * -np.expm1(-tau) * mean_kernel  # the splats' <alpha K> per unit length
-    colour = scattering[inside] * light[inside]
+    # the light along the sun's direction, scattered at the angle to it; what a lit face sent back, from every
+    # direction, with the phase function's mean
+    returned = scattering[inside] * parts[inside, RETURNED_LIGHT]
+    along = scattering[inside] * parts[inside, ALL_LIGHT] - returned
     below_top, above_bottom = HEIGHT - positions[inside, 1], positions[inside, 1]
 
     def flux(depth, toward_light):
@@ -110,8 +114,7 @@ def slab_fluxes(eye_pass, method, albedo, column_tau, tau=8.0, phase="rayleigh",
                 np.pi
                 * mean_kernel
                 / (mu * area)
-                * colour
-                * phase_function(toward_light * mu, phase, 0.0)
+                * (along * phase_function(toward_light * mu, phase, 0.0) + returned)
                 * np.exp(-extinction * depth / mu)
             )
             for mu in GAUSS_MU

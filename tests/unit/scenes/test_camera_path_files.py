@@ -10,7 +10,7 @@ import pytest
 
 from cloudcore.cli import main
 from cloudcore.maths.paths import sample
-from cloudcore.model.scene import Camera, CameraPath, Scene
+from cloudcore.model.scene import NEW_SCENE_SHADING, Camera, CameraPath, Scene
 from cloudcore.resources import DEFAULT_SCENE
 from cloudcore.scenes.files import load_scene, save_scene
 from cloudcore.scenes.interop.camera_paths import (
@@ -62,7 +62,9 @@ def test_the_cli_exports_and_imports_the_default_scenes_flythrough(tmp_path, cap
     for suffix in (".csv", ".gltf", ".glb"):
         assert main(["export", str(DEFAULT_SCENE), "--out", str(tmp_path / f"fly{suffix}")]) == 0
         assert main(["import", str(tmp_path / f"fly{suffix}"), "--out", str(tmp_path / "s.toml")]) == 0
-    paths = load_scene(tmp_path / "s.toml").camera_paths
+    scene = load_scene(tmp_path / "s.toml")
+    assert scene.shading == NEW_SCENE_SHADING  # a new scene's, kept through the imports into it
+    paths = scene.camera_paths
     assert [p.name for p in paths] == ["fly", "fly-2", "fly-3"]  # the names in the scene kept apart
     assert np.array_equal(paths[0].keys, flythrough.keys)  # CSV: exactly
     for gltf in paths[1:]:

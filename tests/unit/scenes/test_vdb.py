@@ -2,6 +2,7 @@
 within the stated error, scenes' clouds exported and read back, and every bad file refused with one line and
 exit status 2, the scene untouched."""
 
+import dataclasses
 import struct
 
 import numpy as np
@@ -10,7 +11,7 @@ from scipy.spatial import cKDTree
 
 from cloudcore.cli import main
 from cloudcore.model.errors import SceneError
-from cloudcore.model.scene import Cloud, Scene
+from cloudcore.model.scene import NEW_SCENE_SHADING, Cloud, Scene, Shading
 from cloudcore.scenes.files import load_scene, save_scene
 from cloudcore.scenes.interop import vdb
 from cloudcore.scenes.interop.density_fit import fit_particles, particle_integral, sampled_density
@@ -88,8 +89,12 @@ def test_cli_import_into_a_new_scene_then_an_existing_one(tmp_path, capsys):
     (cloud,) = scene.clouds
     # a hostile grid name stays a name: its particles are in the scene's own folder
     assert (tmp_path / cloud.particles_file).resolve().parent == (tmp_path / "scene.particles").resolve()
+    assert scene.shading == NEW_SCENE_SHADING != Shading()  # a new scene's, kept in its file
+    save_scene(dataclasses.replace(scene, shading=Shading()), scene_path)
     assert main(["import", str(tmp_path / "ball.vdb"), "--out", str(scene_path), "--particles", "2000"]) == 0
-    assert [c.name for c in load_scene(scene_path).clouds] == ["../../ball", "../../ball-2"]
+    again = load_scene(scene_path)
+    assert [c.name for c in again.clouds] == ["../../ball", "../../ball-2"]
+    assert again.shading == Shading()  # an existing scene keeps its own
 
 
 def two_cloud_scene() -> Scene:
