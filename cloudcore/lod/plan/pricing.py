@@ -470,9 +470,9 @@ AUTO_CLOUD_SCALE = 0.25
 def reduced_pass_work(drawn: Work, scale: float, screen_pixels: float, composites: int) -> Work:
     """The cloud pass whose draws are `drawn` at the screen's resolution drawn at `scale` of it per axis instead:
     the fragments and quad pixels its draws blend fall with its pixels, as scale^2; it adds its `composites` at full
-    resolution (a screen of quad pixels each: once, and once more after each object between cloud layers) and its
-    fixed cost (`Work.reduced_passes`)."""
+    resolution (once, and once more after each object between cloud layers), a screen of upsampled pixels each with
+    the wait before them (`Work.upsampled_pixels`)."""
     pixels_share = scale * scale
     return dataclasses.replace(
         drawn, fragments=drawn.fragments * pixels_share, quad_pixels=drawn.quad_pixels * pixels_share
-    ) + Work(quad_pixels=composites * screen_pixels, quads=float(composites), reduced_passes=1.0)
+    ) + Work(quads=float(composites), upsampled_pixels=composites * screen_pixels)

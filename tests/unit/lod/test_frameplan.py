@@ -442,10 +442,10 @@ def test_a_reduced_cloud_pass_is_planned_at_its_size_and_its_composite_priced_as
     full = plan(eye)
     reduced = plan(eye, dataclasses.replace(NO_RING, cloud_resolution_scale=0.25))
     assert full.cloud_size == VIEWPORT and reduced.cloud_size == (160, 120) and reduced.cloud_scale == 0.25
-    assert full.cloud_work.quad_pixels > 0.0 and full.cloud_work.reduced_passes == 0.0
-    drawn = full.cloud_work.quad_pixels / 16.0
-    assert reduced.cloud_work.quad_pixels == pytest.approx(drawn + VIEWPORT[0] * VIEWPORT[1], rel=1e-12)
-    assert reduced.cloud_work.quads == full.cloud_work.quads + 1 and reduced.cloud_work.reduced_passes == 1.0
+    assert full.cloud_work.quad_pixels > 0.0 and full.cloud_work.upsampled_pixels == 0.0
+    assert reduced.cloud_work.quad_pixels == pytest.approx(full.cloud_work.quad_pixels / 16.0, rel=1e-12)
+    assert reduced.cloud_work.quads == full.cloud_work.quads + 1
+    assert reduced.cloud_work.upsampled_pixels == VIEWPORT[0] * VIEWPORT[1]
 
 
 AUTO_SCALE_FULL_3D = RenderSettings(mode="full", ring_radius=math.inf, cloud_resolution_scale="auto")
@@ -460,16 +460,16 @@ def test_auto_scale_reduces_the_cloud_pass_where_its_fill_dominates_and_not_wher
     assert filled.priced and filled.cloud_scale == AUTO_CLOUD_SCALE and filled.cloud_size == (160, 120)
     at_screen = plan(near, dataclasses.replace(AUTO_SCALE_FULL_3D, cloud_resolution_scale=1.0), costs=CostModel())
     assert at_screen.cloud_work == Work()  # full 3D at a set scale prices nothing
-    assert filled.cloud_work.reduced_passes == 1.0 and filled.cloud_work.fragments > 1e5
+    assert filled.cloud_work.upsampled_pixels == VIEWPORT[0] * VIEWPORT[1] and filled.cloud_work.fragments > 1e5
     # priced below the screen's fill alone
     assert filled.costs.ms(filled.cloud_work) < filled.costs.fragments * 16.0 * filled.cloud_work.fragments
     distant = plan(far, AUTO_SCALE_FULL_3D)
-    assert distant.cloud_scale == 1.0 and distant.cloud_size == VIEWPORT and distant.cloud_work.reduced_passes == 0.0
+    assert distant.cloud_scale == 1.0 and distant.cloud_size == VIEWPORT and distant.cloud_work.upsampled_pixels == 0.0
     assert 0.0 < distant.cloud_work.fragments < 1e5
     as_impostor = plan(near, dataclasses.replace(NO_RING, cloud_resolution_scale="auto"))
     assert as_impostor.clouds[0].kind == "impostor" and as_impostor.cloud_scale == 1.0
     # what decides is the model: a machine whose reduced pass waits longer for the world keeps the screen's
-    assert plan(near, AUTO_SCALE_FULL_3D, costs=CostModel(reduced_passes=100.0)).cloud_scale == 1.0
+    assert plan(near, AUTO_SCALE_FULL_3D, costs=CostModel(upsampled_pixels=3e-4)).cloud_scale == 1.0
 
 
 def test_auto_scale_keeps_last_frame_s_scale_within_the_switch_margin():
@@ -498,8 +498,11 @@ def test_a_reduced_pass_no_finer_than_the_screen_impostor_draws_the_cloud_the_ey
     screen = VIEWPORT[0] * VIEWPORT[1]
     # the screen impostor's fragments at its quarter, its composite over the screen
     assert quarter.cloud_work.fragments == pytest.approx(alone.cloud_work.fragments, rel=1e-12)
-    assert alone.cloud_work.quad_pixels == screen and quarter.cloud_work.quad_pixels == screen
-    assert half.cloud_work.quad_pixels == pytest.approx(screen / 4.0 + screen, rel=1e-12)
+    assert alone.cloud_work.quad_pixels == screen and alone.cloud_work.upsampled_pixels == 0.0
+    assert quarter.cloud_work.quad_pixels == 0.0 and quarter.cloud_work.upsampled_pixels == screen
+    # at a half, the screen impostor's composite into the pass at the pass's pixels
+    assert half.cloud_work.quad_pixels == pytest.approx(screen / 4.0, rel=1e-12)
+    assert half.cloud_work.upsampled_pixels == screen
     assert quarter.cloud_work.batches == alone.cloud_work.batches == 1
 
 
