@@ -9,7 +9,7 @@ from imgui_bundle import imgui
 
 from app.editor import Editor
 from app.viewport import Viewport
-from cloudcore.model.settings import Option, RenderSettings, setting_options
+from cloudcore.model.settings import AUTO_SCALE, Option, RenderSettings, setting_options
 
 
 class LodPanel:
@@ -79,5 +79,21 @@ def _impostor_size_widgets(settings: RenderSettings, option: Option) -> dict:
     return {"impostor_min_size": 2 ** min(sizes), "impostor_max_size": 2 ** max(sizes)} if changed else {}
 
 
+def _cloud_scale_widgets(settings: RenderSettings, option: Option) -> dict:
+    """The cloud pass's scale chosen per frame by the plan, or set on the slider."""
+    chosen = settings.cloud_resolution_scale == AUTO_SCALE
+    changed_auto, chosen = imgui.checkbox("Cloud pass scale per frame", chosen)
+    imgui.set_item_tooltip("Auto mode chooses the cloud pass's resolution each frame by its predicted cost.")
+    held = settings.cloud_resolution_scale if settings.cloud_resolution_scale != AUTO_SCALE else 1.0
+    changed_scale, scale = _setting_widget(option, held)
+    if chosen and changed_scale:  # the slider moved: a scale set by hand
+        chosen = False
+    return {"cloud_resolution_scale": AUTO_SCALE if chosen else scale} if changed_auto or changed_scale else {}
+
+
 #: settings drawn by one widget of their own (the panel leaves their fellows, such as the largest size, out)
-_COMPOUND_WIDGETS = {"ring_radius": _ring_widgets, "impostor_min_size": _impostor_size_widgets}
+_COMPOUND_WIDGETS = {
+    "ring_radius": _ring_widgets,
+    "impostor_min_size": _impostor_size_widgets,
+    "cloud_resolution_scale": _cloud_scale_widgets,
+}

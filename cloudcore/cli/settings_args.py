@@ -13,14 +13,16 @@ def _boolean(text: str) -> bool:
     return text == "true"
 
 
-def _value_parser(default):
+def _value_parser(option, default):
     """The parser of a command-line or sweep value of a setting whose default is `default`."""
+    if option.parse is not None:
+        return option.parse
     return _boolean if isinstance(default, bool) else type(default)
 
 
 #: --sweep NAME=... -> (settings field, value parser)
 SWEEPABLE = {
-    option.sweep_name: (name, _value_parser(getattr(RenderSettings(), name)))
+    option.sweep_name: (name, _value_parser(option, getattr(RenderSettings(), name)))
     for name, option in setting_options().items()
 }
 
@@ -40,7 +42,7 @@ def add_settings_arguments(parser, default_mode: str = "auto") -> None:
             parser.add_argument(
                 option.flag,
                 dest=name,
-                type=type(default),
+                type=_value_parser(option, default),
                 choices=option.choices or None,
                 default=default,
                 metavar=None if option.choices else option.sweep_name.upper(),

@@ -41,6 +41,10 @@ class Work:
     quads: float = 0.0  # those quads drawn, whatever their pixels: an instance of a run's draw, or a draw call
     regenerations: float = 0.0  # impostor textures (or ring segments) remade: target switch, clear, draw call
     batches: float = 0.0  # splat draws of the cloud pass: an upload of the order, a dispatch, a draw call
+    #: screen pixels a cloud pass drawn at a reduced resolution is laid over (`cloudcore.gl.reduced_clouds`), once a
+    #: composite: its upsampling, the tiles it covers, its blocks' nearest depth and the wait for the world's depth
+    #: before it; a field of its own, as a quad's pixel it made the screen impostors' composites look dearer
+    upsampled_pixels: float = 0.0
 
     # the planner adds and prices works tens of times a unit each frame, hundreds of units on a cloud field:
     # field by field by name, not numpy arrays of seven nor a loop over `fields` (3 of the 1.2M field's
@@ -54,6 +58,7 @@ class Work:
             float(self.quads),
             float(self.regenerations),
             float(self.batches),
+            float(self.upsampled_pixels),
         )
 
     def __add__(self, other: Work) -> Work:
@@ -65,6 +70,7 @@ class Work:
             self.quads + other.quads,
             self.regenerations + other.regenerations,
             self.batches + other.batches,
+            self.upsampled_pixels + other.upsampled_pixels,
         )
 
     def scaled(self, factor: float) -> Work:
@@ -85,6 +91,7 @@ class CostModel:
     quads: float = 0.044
     regenerations: float = 0.5
     batches: float = 0.3
+    upsampled_pixels: float = 6.7e-5
 
     def vector(self) -> np.ndarray:
         return np.array([getattr(self, f.name) for f in fields(self)], dtype=np.float64)
@@ -99,6 +106,7 @@ class CostModel:
                 self.quads * work.quads,
                 self.regenerations * work.regenerations,
                 self.batches * work.batches,
+                self.upsampled_pixels * work.upsampled_pixels,
             )
         )
 
@@ -113,7 +121,9 @@ SPRITE_FRAGMENT_COST = 3.1
 #: the prior: coefficients measured on llvmpipe, 2 cores (docs/performance.md, "The cost model"): a
 #: particle's shading, vertices and sort 0.85 us; a splat fragment 8 ns on the screen or in a texture
 #: (RGBA16F, blended); a regeneration's target switch, clear and draw 0.5 ms; a quad's draw call 44 us
-#: beside its pixels (111 impostors drawn again at 160x120, 320x240 and 640x480: 4.9 ms of draws)
+#: beside its pixels (111 impostors drawn again at 160x120, 320x240 and 640x480: 4.9 ms of draws); a reduced cloud
+#: pass 21 ms at 640x480 beside its draws, most of it llvmpipe's wait for the world's raster, the rest its composite
+#: (docs/performance.md, "The cloud pass at a reduced resolution")
 LLVMPIPE_COSTS = CostModel()
 
 

@@ -16,6 +16,7 @@ and `app.panels.lod` the LOD panel's widgets, so a setting is named in one place
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field, fields
 
 MODES = ("auto", "full", "impostor")
@@ -59,11 +60,23 @@ class Option:
     high: float = 1.0
     display: str = ""
     zero_display: str = ""
+    #: how the command line and sweeps read a value (None: as the default's type)
+    parse: Callable[[str], object] | None = None
 
     @property
     def sweep_name(self) -> str:
         """The setting's name in `cloudview bench --sweep NAME=...`: the flag's words."""
         return self.flag.removeprefix("--").removeprefix("no-").replace("-", "_")
+
+
+#: `cloud_resolution_scale`'s value that lets the plan choose the cloud pass's scale frame by frame
+AUTO_SCALE = "auto"
+
+
+def cloud_resolution_value(text: str) -> float | str:
+    """A command-line or sweep value of `cloud_resolution_scale`: "auto", or a number; argparse names this function
+    on refusal."""
+    return AUTO_SCALE if text == AUTO_SCALE else float(text)
 
 
 def _setting(default, **option):
@@ -198,19 +211,22 @@ class RenderSettings:
     )
     #: per axis: the whole cloud pass (splats, impostors, ring panels, crossfades, screen impostors' composites) is
     #: drawn at this fraction of the screen's resolution and upsampled against the world's depth (Yusov 2014, 5.4;
-    #: `cloudcore.maths.depth_upsampling`); 1 draws it at the screen's, as before.  1 by default: in full 3D a quarter
-    #: cut the frame to 0.17-0.77 within the tolerance, but auto mode already draws what costs fill at a reduced cost
-    #: and on llvmpipe lost 14-22% of its frame to the pass's wait for the world's depth and its composite
-    #: (docs/performance.md, "The cloud pass at a reduced resolution")
-    cloud_resolution_scale: float = _setting(
+    #: `cloudcore.maths.depth_upsampling`); 1 draws it at the screen's, as before; "auto": the plan chooses per frame
+    #: between the screen's and `pricing.AUTO_CLOUD_SCALE` by their predicted cost (`choice.cloud_pass_scale`;
+    #: full 3D, which prices nothing, draws at the screen's).  1 by default: in full 3D a quarter cut the frame to
+    #: 0.17-0.77 within the tolerance, but auto mode already draws what costs fill at a reduced cost and on llvmpipe
+    #: lost 14-22% of its frame to the pass's wait for the world's depth and its composite (docs/performance.md,
+    #: "The cloud pass at a reduced resolution")
+    cloud_resolution_scale: float | str = _setting(
         1.0,
         flag="--cloud-resolution",
         help="per axis, the fraction of the screen's resolution the cloud pass is drawn at, then upsampled against "
-        "the world's depth; 1: the screen's",
+        "the world's depth; 1: the screen's; auto: chosen per frame by its predicted cost",
         label="Cloud pass scale",
         low=LOWEST_SCALE,
         high=1.0,
         display="%.3f",
+        parse=cloud_resolution_value,
     )
     #: the ring is rebuilt when the eye has moved this fraction of ring_radius horizontally / vertically
     ring_rebuild_horizontal: float = 0.15
@@ -343,9 +359,12 @@ class RenderSettings:
             problems.append(f"transition_frames must be an integer >= 1, got {self.transition_frames!r}")
         if not 0.0 < self.inside_resolution_scale <= 1.0:
             problems.append(f"inside_resolution_scale must be within (0, 1], got {self.inside_resolution_scale}")
-        if not LOWEST_SCALE <= self.cloud_resolution_scale <= 1.0:
+        scale = self.cloud_resolution_scale
+        if scale != AUTO_SCALE and not (
+            isinstance(scale, (int, float)) and not isinstance(scale, bool) and LOWEST_SCALE <= scale <= 1.0
+        ):
             problems.append(
-                f"cloud_resolution_scale must be within [{LOWEST_SCALE}, 1], got {self.cloud_resolution_scale}"
+                f"cloud_resolution_scale must be {AUTO_SCALE!r} or within [{LOWEST_SCALE}, 1], got {scale!r}"
             )
         if not (self.ring_rebuild_horizontal > 0.0 and self.ring_rebuild_vertical > 0.0):
             problems.append("ring rebuild fractions must be > 0")

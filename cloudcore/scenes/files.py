@@ -47,7 +47,7 @@ from cloudcore.model.scene import (
     Weather,
     Wind,
 )
-from cloudcore.model.settings import MODES, RenderSettings, setting_options
+from cloudcore.model.settings import AUTO_SCALE, MODES, RenderSettings, setting_options
 from cloudcore.model.toml_table import Table, checked_matrix, field_error, read_toml
 from cloudcore.scenes.interop.heightmap import Heightmap, read_heightmap_file, store_heightmap
 from cloudcore.scenes.limits import FIELD_RANGES, camera_path_keys_problem, scene_limit_problems
@@ -217,6 +217,8 @@ def settings_overrides(t: Table) -> tuple[tuple[str, object], ...]:
             value = t.string(key, choices=setting_options()[key].choices)
         elif key == "ring_radius" and t.raw(key) == math.inf:  # inf: no ring, as on the command line
             value = math.inf
+        elif key == "cloud_resolution_scale" and t.raw(key) == AUTO_SCALE:  # chosen per frame, as on the command line
+            value = AUTO_SCALE
         else:
             value = t.number(key)
         values.append((key, value))

@@ -547,7 +547,8 @@ def delete_key_and_statistics_toggle(ctx, app: EditorUnderTest):
 
 def the_cloud_pass_at_a_quarter_resolution_in_the_window(ctx, app: EditorUnderTest):
     """The LOD panel's "Cloud pass scale" draws the clouds into a reduced pass in the window's own context and lays it
-    over the world (`cloudcore.gl.reduced_clouds`): the same picture, its clouds' rims softer."""
+    over the world (`cloudcore.gl.reduced_clouds`): the same picture, its clouds' rims softer; "Cloud pass scale per
+    frame" lets the plan choose it."""
     use_window(ctx, "LOD")
     ctx.combo_click("Mode/full")
     ctx.yield_(SETTLE)
@@ -560,6 +561,12 @@ def the_cloud_pass_at_a_quarter_resolution_in_the_window(ctx, app: EditorUnderTe
     CHECK(app.viewport.renderer.last_plan.cloud_size == (math.ceil(width / 4), math.ceil(height / 4)))
     ctx.item_input_value("Cloud pass scale", 1.0)
     ctx.combo_click("Mode/auto")
+    ctx.item_click("Cloud pass scale per frame")  # the plan chooses the scale frame by frame
+    CHECK(app.editor.settings.cloud_resolution_scale == "auto")
+    ctx.yield_(SETTLE)
+    CHECK(app.viewport.renderer.last_plan.cloud_scale in (1.0, 0.25))
+    ctx.item_click("Cloud pass scale per frame")
+    CHECK(app.editor.settings.cloud_resolution_scale == 1.0)
     difference = compare(full, reduced)
     app.outcome["cloud_pass_at_a_quarter"] = {"psnr_db": difference.psnr_db, "max_abs": difference.max_abs}
     CHECK(bool(30.0 < difference.psnr_db < math.inf))  # drawn otherwise, and close

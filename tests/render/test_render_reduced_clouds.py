@@ -2,9 +2,12 @@
 behind a ridge crosses no terrain in front of it and keeps its part over the sky, objects between cloud layers stay
 between them, and a bad scale is refused."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 
+from cloudcore.lod.costs import LLVMPIPE_COSTS, CostModel
 from cloudcore.maths.depth_upsampling import upsample, window_distance
 from cloudcore.measure.imagecompare import compare
 from cloudcore.model.settings import FULL_3D, RenderSettings
@@ -86,3 +89,33 @@ def test_at_full_scale_the_pass_is_the_screens(renderer):
     assert renderer.last_plan.cloud_size == renderer.size
     renderer.render(scene_with(over_the_ridge()), settings=RenderSettings(**PLAIN, cloud_resolution_scale=0.25))
     assert renderer.last_plan.cloud_size == (40, 30)
+
+
+def test_the_cloud_the_eye_is_in_is_drawn_into_a_quarter_pass_as_its_screen_impostor_was(renderer):
+    """The in-cloud screen impostor, a case of the reduced pass: at a quarter (its own scale) the puff around the eye
+    is drawn in full 3D into the reduced pass, laid over the world once, and looks as its screen impostor did."""
+    around_the_eye = scene_with(puff([60.0, 130.0, 0.0]))
+    settings = RenderSettings(mode="auto", cloud_shadows=False, light_shafts=False)
+    as_screen_impostor = renderer.render(around_the_eye, settings=settings)[0]
+    assert renderer.last_plan.clouds[0].kind == "inside" and renderer.last_plan.cloud_scale == 1.0
+    quarter = dataclasses.replace(settings, cloud_resolution_scale=0.25)
+    in_the_pass = renderer.render(around_the_eye, settings=quarter)[0]
+    assert renderer.last_plan.clouds[0].kind == "full" and renderer.last_plan.cloud_size == (40, 30)
+    difference = compare(in_the_pass, as_screen_impostor)
+    print(f"the puff around the eye at a quarter, against its screen impostor: {difference}")
+    assert np.abs(in_the_pass.astype(int) - renderer.render(scene_with(), settings=settings)[0]).max() > 20  # seen
+    assert difference.psnr_db >= 35.0
+
+
+def test_auto_scale_draws_at_the_plan_s_scale(renderer):
+    """`cloud_resolution_scale = "auto"` in full 3D: the pass is drawn at the scale the plan chose, by the cost model it
+    is given: a puff near the eye where a fragment is dear at a quarter, within the tolerance of the screen's picture;
+    at this small screen under the llvmpipe prior, at the screen's."""
+    chosen = RenderSettings(**PLAIN, cloud_resolution_scale="auto")
+    near = scene_with(puff([160.0, 150.0, 0.0]))
+    reference = renderer.render(near, settings=RenderSettings(**PLAIN))[0]
+    reduced = renderer.render(near, settings=chosen, costs=CostModel(fragments=1e-3))[0]
+    assert renderer.last_plan.cloud_scale == 0.25 and renderer.last_plan.cloud_size == (40, 30)
+    assert compare(reduced, reference).psnr_db >= 30.0
+    renderer.render(near, settings=chosen, costs=LLVMPIPE_COSTS)
+    assert renderer.last_plan.cloud_scale == 1.0 and renderer.last_plan.cloud_size == renderer.size

@@ -36,7 +36,7 @@ from cloudcore.lod.ring import (
     RingState,
 )
 from cloudcore.lod.units import LodUnits
-from cloudcore.model.settings import RenderSettings
+from cloudcore.model.settings import AUTO_SCALE, RenderSettings
 
 #: auto mode switches a unit's representation only when the other is cheaper by this fraction
 #: (costs measured frame to frame wobble; without it a unit near the break-even point would flicker
@@ -50,8 +50,9 @@ SCENE_CHANGE_RATIO = 1.25
 
 
 def prices_units(settings: RenderSettings) -> bool:
-    """Whether the plan prices its units: full 3D draws every unit in view whatever it costs, so it does not."""
-    return settings.mode != "full"
+    """Whether the plan prices its units: full 3D draws every unit in view whatever it costs, so it does not, unless
+    it chooses its cloud pass's scale by price (`cloud_pass_scale`)."""
+    return settings.mode != "full" or settings.cloud_resolution_scale == AUTO_SCALE
 
 
 def cheapest(held: str | None, prices: dict) -> str:
@@ -260,3 +261,11 @@ def next_frame_choice(state: LodState, drawn_as: str, predicted: Callable[[], di
         return cheapest(drawn_as, {choice: state.frame_times[choice].mean_ms for choice in (drawn_as, other)})
     times = predicted()
     return other if times[other] < PLAUSIBLE_RATIO * times[drawn_as] else drawn_as
+
+
+def cloud_pass_scale(held_scale: float | None, screen_ms: float, reduced_ms: float, scale: float) -> float:
+    """The cloud pass's scale this frame: `scale` where its pass (`reduced_ms`, `pricing.reduced_pass_work`) is
+    cheaper than the pass at the screen's resolution (`screen_ms`), else 1; the scale `held_scale` last frame while
+    the other is not cheaper by `SWITCH_MARGIN` (the picture changes a little at each switch)."""
+    held = None if held_scale is None else ("reduced" if held_scale < 1.0 else "screen")
+    return scale if cheapest(held, {"screen": screen_ms, "reduced": reduced_ms}) == "reduced" else 1.0

@@ -33,6 +33,7 @@ class FramePlan:
     inside_size: tuple = (0, 0)  # the screen impostor's texture size (width, height)
     #: the cloud pass's size (width, height): the screen's, or less (`settings.cloud_resolution_scale`), upsampled
     cloud_size: tuple = (0, 0)
+    cloud_scale: float = 1.0  # per axis, the cloud pass's fraction of the screen's resolution
     draw_items: DrawItems | None = None  # the cloud pass, far to near
     objects_with_world: tuple = ()  # visible objects outside split clouds: drawn before the cloud pass
     update_work: Work = Work()  # predicted work of the impostor updates (regenerations, ring segment)
@@ -110,6 +111,7 @@ class FramePlan:
             measured_units_ms=self._measured_ms("units"),
             measured_full_ms=self._measured_ms("full"),
             costs=self.costs,
+            cloud_scale=self.cloud_scale,
         )
 
     def _measured_ms(self, choice: str) -> float:

@@ -35,3 +35,4 @@ class PlanStats:
     measured_units_ms: float = 0.0
     measured_full_ms: float = 0.0
     costs: CostModel = field(default_factory=CostModel)  # the coefficients the plan priced its choices with
+    cloud_scale: float = 1.0  # per axis, the cloud pass's fraction of the screen's resolution (`FramePlan.cloud_scale`)

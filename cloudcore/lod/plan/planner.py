@@ -19,6 +19,7 @@ from cloudcore.lod.impostors import (
 )
 from cloudcore.lod.plan.choice import (
     cheapest,
+    cloud_pass_scale,
     comparable,
     groups_cheaper_apart,
     next_frame_choice,
@@ -32,6 +33,7 @@ from cloudcore.lod.plan.choice import (
 from cloudcore.lod.plan.draw_items import draw_items, full_runs, inside_runs
 from cloudcore.lod.plan.frame_plan import FramePlan
 from cloudcore.lod.plan.pricing import (
+    AUTO_CLOUD_SCALE,
     NEAR_EXACT_RADII,
     Pricing,
     Seen,
@@ -40,6 +42,7 @@ from cloudcore.lod.plan.pricing import (
     ms_drawn_alone,
     panel_pixels,
     pricing_of,
+    reduced_pass_work,
     representation_prices,
     ring_panels_work,
     ring_translation_error,
@@ -81,13 +84,8 @@ from cloudcore.lod.splitting import layers_hold, objects_reaching
 from cloudcore.lod.units import LodUnits
 from cloudcore.maths.depth_upsampling import reduced_size
 from cloudcore.model.scene import Camera
-from cloudcore.model.settings import RenderSettings
-from cloudcore.world.camera import (
-    frustum_planes,
-    projection_matrix,
-    spheres_in_frustum,
-    view_matrix,
-)
+from cloudcore.model.settings import AUTO_SCALE, RenderSettings
+from cloudcore.world.camera import frustum_planes, projection_matrix, spheres_in_frustum, view_matrix
 from cloudcore.world.wind import CloudMotion
 
 
@@ -481,6 +479,8 @@ def _plan_units(
     if settings.mode == "full":
         # every unit in view in full 3D, nothing priced: only the units holding objects are looked at one by one
         kinds[drawable], full_weights[drawable] = FULL, 1.0
+        if priced:  # for the cloud pass's scale alone
+            cloud_work = sum(full_3d_of(drawable.tolist()), cloud_work)
         for index in sorted(holding.intersection(drawable.tolist())):
             decided(index, FULL, *split_at(index, eye), full_weight=1.0)
         holders = outside = np.zeros(0, dtype=np.int64)
@@ -491,6 +491,9 @@ def _plan_units(
     ordered = eye_in[np.argsort(-distances[drawable], kind="stable")]
     composites = np.count_nonzero(ordered & ~np.concatenate([[False], ordered[:-1]]))
     composite = Work(quad_pixels=screen_pixels, quads=1, batches=1).scaled(composites / max(len(holders), 1))
+    # the units the eye is in drawn as screen impostors: their work so, and in full 3D (a reduced cloud pass no finer
+    # than their screen impostor draws them into itself: `_cloud_pass`)
+    inside_screen, inside_full = Work(), Work()
     for index, full in zip(holders.tolist(), full_3d_of(holders.tolist())):
         distance, members = float(distances[index]), units.members[index]
         individual = float(individuals[index])
@@ -513,7 +516,8 @@ def _plan_units(
                 cloud_work += full
                 continue
         decided(index, INSIDE, inside, splits, individual, full_ms, inside_ms)
-        cloud_work += screen_impostor
+        inside_screen += screen_impostor
+        inside_full += full
     if len(outside):
         splits_of = {index: split_at(index, eye) for index in holding.intersection(outside.tolist())}
         layers = np.ones(len(outside))  # textures of an impostor: one more than the objects that cut it
@@ -658,16 +662,21 @@ def _plan_units(
     drawn = np.flatnonzero(of_kinds(kinds, *DRAWN))
     draw_order = tuple(drawn[np.argsort(-distances[drawn], kind="stable")].tolist())
     inside_size = reduced_size(viewport, settings.inside_resolution_scale)
-    cloud_size = reduced_size(viewport, settings.cloud_resolution_scale)
     items = draw_items(plans, draw_order, radii, object_centres, objects_visible, eye)
-    screen_impostors = len(inside_runs(items, plans))
-    # a reduced cloud pass is laid over the screen once, and once more after each object between cloud layers
-    upsamplings = 0 if cloud_size == tuple(viewport) else 1 + len(items.objects)
-    cloud_work += Work(
-        batches=float(full_runs(kinds[list(draw_order)]) + screen_impostors),
-        quad_pixels=(screen_impostors + upsamplings) * screen_pixels,
-        quads=float(screen_impostors + upsamplings),
+    cloud_scale, plans, items, cloud_work = _cloud_pass(
+        plans,
+        items,
+        lambda unit_plans: draw_items(unit_plans, draw_order, radii, object_centres, objects_visible, eye),
+        draw_order,
+        cloud_work,
+        inside_screen,
+        inside_full,
+        screen_pixels,
+        settings,
+        state.cloud_scale,
+        costs if priced else None,
     )
+    cloud_size = reduced_size(viewport, cloud_scale)
     between = set(items.objects)
     with_world = tuple(i for i in range(len(object_radii)) if objects_visible[i] and i not in between)
     drawn_as = frame_choice = None
@@ -697,6 +706,7 @@ def _plan_units(
         representations=representations,
         eye=tuple(float(v) for v in eye),
         costs=state.costs,
+        cloud_scale=cloud_scale,
         frame_choice=frame_choice,
         drawn_as=drawn_as,
         frames_drawn_as=state.frames_drawn_as + 1 if state.drawn_as == drawn_as else 1,
@@ -717,6 +727,7 @@ def _plan_units(
         state=next_state,
         inside_size=inside_size,
         cloud_size=cloud_size,
+        cloud_scale=cloud_scale,
         draw_items=items,
         objects_with_world=with_world,
         update_work=update_work if priced else Work(),
@@ -734,6 +745,54 @@ def _plan_units(
             else np.zeros(3)
         ),
     )
+
+
+def _cloud_pass(
+    plans: UnitPlans,
+    items,
+    items_of,
+    draw_order: tuple,
+    drawn: Work,
+    inside_screen: Work,
+    inside_full: Work,
+    screen_pixels: float,
+    settings: RenderSettings,
+    held_scale: float | None,
+    costs: CostModel | None,
+) -> tuple:
+    """(scale, plans, draw items, work) of the cloud pass: at the screen's resolution, or at a fraction of it
+    (`settings.cloud_resolution_scale`; "auto": the cheaper of the two by `costs`, None where the plan prices
+    nothing, whose pass is the screen's).  `drawn` is the work of its draws but those of the units the eye is in,
+    `inside_screen` and `inside_full` theirs as screen impostors and in full 3D; `items_of(plans)` makes the draw
+    items of other plans, of the units `draw_order`.  A pass no finer than the screen impostor draws the units the
+    eye is in into itself in full 3D: it is their screen impostor, laid over the screen once with the rest (Harris's
+    quarter, Yusov's reduced pass)."""
+    reduced_scale = settings.cloud_resolution_scale
+    if reduced_scale == AUTO_SCALE:
+        reduced_scale = AUTO_CLOUD_SCALE if costs is not None else 1.0
+
+    def at(scale: float, unit_plans: UnitPlans, unit_items) -> Work:
+        screen_impostors = len(inside_runs(unit_items, unit_plans))
+        # the pass's own draws, their pixels the pass's; a screen impostor's splats are drawn at its own size
+        work = (drawn if screen_impostors else drawn + inside_full) + Work(
+            batches=float(full_runs(unit_plans.kinds[list(draw_order)]) + screen_impostors),
+            quad_pixels=screen_impostors * screen_pixels,
+            quads=float(screen_impostors),
+        )
+        if scale < 1.0:  # laid over the screen once, and once more after each object between cloud layers
+            work = reduced_pass_work(work, scale, screen_pixels, 1 + len(unit_items.objects))
+        return work + inside_screen if screen_impostors else work
+
+    reduced_plans, reduced_items = plans, items
+    if reduced_scale < 1.0 and reduced_scale <= settings.inside_resolution_scale and plans.count("inside"):
+        reduced_plans = plans.inside_as_full()
+        reduced_items = items_of(reduced_plans)
+    if settings.cloud_resolution_scale == AUTO_SCALE and reduced_scale < 1.0:
+        screen_work, reduced_work = at(1.0, plans, items), at(reduced_scale, reduced_plans, reduced_items)
+        reduced_scale = cloud_pass_scale(held_scale, costs.ms(screen_work), costs.ms(reduced_work), reduced_scale)
+    if reduced_scale == 1.0:
+        return 1.0, plans, items, at(1.0, plans, items)
+    return reduced_scale, reduced_plans, reduced_items, at(reduced_scale, reduced_plans, reduced_items)
 
 
 def _ring_shift(generation, rows: np.ndarray, centres: np.ndarray) -> np.ndarray:

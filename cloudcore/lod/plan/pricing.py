@@ -458,3 +458,21 @@ def ring_translation_error(generation, translation_error, eye) -> float:
     if rest_near > step and math.degrees(step * rest_rate * (rest_near / (rest_near - step)) ** 2) <= largest:
         return largest
     return float(np.max(parallax_errors_deg(centres, radii, then, now), initial=0.0))
+
+
+#: the fraction of the screen's resolution per axis of the cloud pass when auto chooses a reduced one
+#: (`cloud_resolution_scale = "auto"`): at a quarter, full 3D stayed within the level of detail's tolerance on the
+#: three scenes measured (41-52 dB mean, 39-50 worst against the screen's resolution), and a half, whose pass has
+#: the same fixed cost, saved less (docs/performance.md, "The cloud pass at a reduced resolution")
+AUTO_CLOUD_SCALE = 0.25
+
+
+def reduced_pass_work(drawn: Work, scale: float, screen_pixels: float, composites: int) -> Work:
+    """The cloud pass whose draws are `drawn` at the screen's resolution drawn at `scale` of it per axis instead:
+    the fragments and quad pixels its draws blend fall with its pixels, as scale^2; it adds its `composites` at full
+    resolution (once, and once more after each object between cloud layers), a screen of upsampled pixels each with
+    the wait before them (`Work.upsampled_pixels`)."""
+    pixels_share = scale * scale
+    return dataclasses.replace(
+        drawn, fragments=drawn.fragments * pixels_share, quad_pixels=drawn.quad_pixels * pixels_share
+    ) + Work(quads=float(composites), upsampled_pixels=composites * screen_pixels)

@@ -98,6 +98,9 @@ class LodState:
     near_work: tuple | None = None
     #: last frame's scene clock under wind (None: still air): the wind's step since carries the units
     time_s: float | None = None
+    #: the scale of last frame's cloud pass (`FramePlan.cloud_scale`; None: no frame planned yet), which a choice by
+    #: price keeps within a margin
+    cloud_scale: float | None = None
 
     def measured(self, measurements, fit: bool = True) -> LodState:
         """The state with this frame's (predicted work, measured ms) pairs folded into the cost fit (unless not

@@ -11,7 +11,7 @@ questions (how many clouds of each kind, whether anything is left to converge) a
 from __future__ import annotations
 
 from collections.abc import Iterator, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import NamedTuple
 
 import numpy as np
@@ -118,6 +118,12 @@ class UnitPlans(Sequence):
     def count(self, *kinds: str) -> int:
         """How many units are of `kinds`."""
         return int(np.count_nonzero(of_kinds(self.kinds, *kinds)))
+
+    def inside_as_full(self) -> UnitPlans:
+        """The plans with the units the eye is in drawn in full 3D (whole: not fading into the ring), as a reduced cloud
+        pass no finer than their screen impostor draws them."""
+        kinds = np.where((self.kinds == INSIDE) & (self.full_weights == 1.0), FULL, self.kinds).astype(np.int8)
+        return replace(self, kinds=kinds)
 
     def clouds_by_kind(self) -> dict:
         """Clouds (not units) per kind, every kind of KINDS named."""

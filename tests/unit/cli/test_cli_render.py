@@ -77,8 +77,9 @@ def test_render_writes_the_png_and_the_stats(rendered):
         (["--time-of-day", "25"], "--time-of-day: time_of_day: must be within [0, 24]"),
         (["--camera-path", "nowhere"], "no camera path named 'nowhere'"),
         (["--mode", "sideways"], "--mode"),
-        (["--cloud-resolution", "0.01"], "cloud_resolution_scale must be within [0.125, 1], got 0.01"),
-        (["--cloud-resolution", "nan"], "cloud_resolution_scale must be within [0.125, 1], got nan"),
+        (["--cloud-resolution", "0.01"], "cloud_resolution_scale must be 'auto' or within [0.125, 1], got 0.01"),
+        (["--cloud-resolution", "nan"], "cloud_resolution_scale must be 'auto' or within [0.125, 1], got nan"),
+        (["--cloud-resolution", "often"], "--cloud-resolution"),
     ],
 )
 def test_bad_render_arguments_exit_2_in_one_line(tmp_path, args, message):

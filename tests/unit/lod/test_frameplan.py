@@ -16,7 +16,7 @@ from cloudcore.lod.impostors import (
     translation_error_deg,
 )
 from cloudcore.lod.plan import FRAME_SETTLE_FRAMES, PROBE_FRAMES, SWITCH_MARGIN, LodState, inside_runs, plan_frame
-from cloudcore.lod.plan.pricing import in_view_work, pricing_of, seen_from
+from cloudcore.lod.plan.pricing import AUTO_CLOUD_SCALE, in_view_work, pricing_of, seen_from
 from cloudcore.lod.plan.state import RING_PRICE_FRAMES, RING_PRICE_TURN_DEG, FrameTime
 from cloudcore.lod.ring import SEGMENTS, RingState, ring_members
 from cloudcore.lod.splat_coverage import splats_in_frustum
@@ -436,13 +436,74 @@ def test_the_eye_inside_a_cloud_gets_the_screen_impostor(position):
 
 
 def test_a_reduced_cloud_pass_is_planned_at_its_size_and_its_composite_priced_as_the_screen():
-    """`cloud_resolution_scale`: the pass's size rounds up; laying it over the screen is one screen of quad pixels."""
+    """`cloud_resolution_scale`: the pass's size rounds up; its draws' pixels fall with its own, and laying it over the
+    screen is one screen of quad pixels and the reduced pass's fixed cost."""
     eye = orbit(2000.0, 0.0)
     full = plan(eye)
     reduced = plan(eye, dataclasses.replace(NO_RING, cloud_resolution_scale=0.25))
-    assert full.cloud_size == VIEWPORT and reduced.cloud_size == (160, 120)
-    extra = reduced.cloud_work.quad_pixels - full.cloud_work.quad_pixels
-    assert extra == VIEWPORT[0] * VIEWPORT[1] and reduced.cloud_work.quads == full.cloud_work.quads + 1
+    assert full.cloud_size == VIEWPORT and reduced.cloud_size == (160, 120) and reduced.cloud_scale == 0.25
+    assert full.cloud_work.quad_pixels > 0.0 and full.cloud_work.upsampled_pixels == 0.0
+    assert reduced.cloud_work.quad_pixels == pytest.approx(full.cloud_work.quad_pixels / 16.0, rel=1e-12)
+    assert reduced.cloud_work.quads == full.cloud_work.quads + 1
+    assert reduced.cloud_work.upsampled_pixels == VIEWPORT[0] * VIEWPORT[1]
+
+
+AUTO_SCALE_FULL_3D = RenderSettings(mode="full", ring_radius=math.inf, cloud_resolution_scale="auto")
+
+
+def test_auto_scale_reduces_the_cloud_pass_where_its_fill_dominates_and_not_where_the_clouds_are_cheap():
+    """`cloud_resolution_scale = "auto"`: a cloud filling the screen in full 3D (about 5M fragments, 42 ms by the
+    prior) is drawn at a quarter, its fragments a sixteenth, for the composite and the pass's fixed cost; the same
+    cloud far off, or near but drawn as an impostor quad (auto mode), costs less than that fixed cost: the screen's."""
+    near, far = orbit(1.5 * RADIUS, 0.0), orbit(50.0 * RADIUS, 0.0)
+    filled = plan(near, AUTO_SCALE_FULL_3D)
+    assert filled.priced and filled.cloud_scale == AUTO_CLOUD_SCALE and filled.cloud_size == (160, 120)
+    at_screen = plan(near, dataclasses.replace(AUTO_SCALE_FULL_3D, cloud_resolution_scale=1.0), costs=CostModel())
+    assert at_screen.cloud_work == Work()  # full 3D at a set scale prices nothing
+    assert filled.cloud_work.upsampled_pixels == VIEWPORT[0] * VIEWPORT[1] and filled.cloud_work.fragments > 1e5
+    # priced below the screen's fill alone
+    assert filled.costs.ms(filled.cloud_work) < filled.costs.fragments * 16.0 * filled.cloud_work.fragments
+    distant = plan(far, AUTO_SCALE_FULL_3D)
+    assert distant.cloud_scale == 1.0 and distant.cloud_size == VIEWPORT and distant.cloud_work.upsampled_pixels == 0.0
+    assert 0.0 < distant.cloud_work.fragments < 1e5
+    as_impostor = plan(near, dataclasses.replace(NO_RING, cloud_resolution_scale="auto"))
+    assert as_impostor.clouds[0].kind == "impostor" and as_impostor.cloud_scale == 1.0
+    # what decides is the model: a machine whose reduced pass waits longer for the world keeps the screen's
+    assert plan(near, AUTO_SCALE_FULL_3D, costs=CostModel(upsampled_pixels=3e-4)).cloud_scale == 1.0
+
+
+def test_auto_scale_keeps_last_frame_s_scale_within_the_switch_margin():
+    """Between a cloud filling the screen and one far off lie distances where the two passes cost about the same:
+    there the pass keeps last frame's scale, coming from either side; nearer every frame is reduced, farther none."""
+    held = {scale: LodState(cloud_scale=scale) for scale in (AUTO_CLOUD_SCALE, 1.0)}
+    kept = []  # per distance, the scale chosen after each
+    for distance in np.geomspace(1.5 * RADIUS, 50.0 * RADIUS, 40):
+        chosen = {before: plan(orbit(distance, 0.0), AUTO_SCALE_FULL_3D, state=held[before]) for before in held}
+        assert all(p.state.cloud_scale == p.cloud_scale for p in chosen.values())
+        kept.append(tuple(chosen[before].cloud_scale for before in held))
+    assert kept[0] == (AUTO_CLOUD_SCALE, AUTO_CLOUD_SCALE) and kept[-1] == (1.0, 1.0)
+    band = [k for k in kept if k == (AUTO_CLOUD_SCALE, 1.0)]
+    assert len(band) >= 2 and set(kept) == {(AUTO_CLOUD_SCALE, AUTO_CLOUD_SCALE), (AUTO_CLOUD_SCALE, 1.0), (1.0, 1.0)}
+
+
+def test_a_reduced_pass_no_finer_than_the_screen_impostor_draws_the_cloud_the_eye_is_in():
+    """The in-cloud screen impostor is a case of the reduced pass: at a quarter (the screen impostor's scale) the
+    unit the eye is in is drawn in full 3D into the pass, laid over the screen once; at a half it keeps its own."""
+    inside = camera_at((0.0, 0.0, 0.0), look_at=(0.0, 0.0, -500.0))
+    alone = plan(inside)
+    quarter = plan(inside, dataclasses.replace(NO_RING, cloud_resolution_scale=0.25))
+    half = plan(inside, dataclasses.replace(NO_RING, cloud_resolution_scale=0.5))
+    assert alone.clouds[0].kind == half.clouds[0].kind == "inside" and quarter.clouds[0].kind == "full"
+    assert inside_runs(quarter.draw_items, quarter.clouds) == []
+    screen = VIEWPORT[0] * VIEWPORT[1]
+    # the screen impostor's fragments at its quarter, its composite over the screen
+    assert quarter.cloud_work.fragments == pytest.approx(alone.cloud_work.fragments, rel=1e-12)
+    assert alone.cloud_work.quad_pixels == screen and alone.cloud_work.upsampled_pixels == 0.0
+    assert quarter.cloud_work.quad_pixels == 0.0 and quarter.cloud_work.upsampled_pixels == screen
+    # at a half, the screen impostor's composite into the pass at the pass's pixels
+    assert half.cloud_work.quad_pixels == pytest.approx(screen / 4.0, rel=1e-12)
+    assert half.cloud_work.upsampled_pixels == screen
+    assert quarter.cloud_work.batches == alone.cloud_work.batches == 1
 
 
 def test_an_impostor_quad_past_the_screen_is_priced_as_the_screen():

@@ -90,6 +90,31 @@ def test_the_estimator_recovers_the_coefficients_that_made_the_times():
     assert CostEstimator().model() == LLVMPIPE_COSTS  # before any frame, the prior
 
 
+def test_the_estimator_learns_a_reduced_pass_s_fixed_cost_from_the_frames_drawn_with_one():
+    """Frames now at the screen's resolution, now through a reduced pass whose fixed cost (the wait for the world's
+    depth) is a third of the prior's: the fit finds it, and leaves the other coefficients where they were."""
+    truth = dataclasses.replace(LLVMPIPE_COSTS, upsampled_pixels=LLVMPIPE_COSTS.upsampled_pixels / 3.0)
+    rng = np.random.default_rng(5)
+    estimator = CostEstimator()
+    for frame in range(120):
+        reduced = frame % 3 == 0
+        clouds = Work(
+            particles=rng.uniform(1e3, 3e4),
+            fragments=rng.uniform(1e5, 4e6) / (16.0 if reduced else 1.0),
+            quad_pixels=rng.uniform(0, 3e5) / (16.0 if reduced else 1.0),
+            quads=rng.integers(1, 100),
+            batches=rng.integers(1, 4),
+            upsampled_pixels=3e5 if reduced else 0.0,
+        )
+        estimator = estimator.observe([(clouds, truth.ms(clouds))])
+    fitted = estimator.model()
+    # from three times the truth to within 30% of it (the prior still pulls, and its composite's pixels share the
+    # frames it is drawn in)
+    assert fitted.upsampled_pixels == pytest.approx(truth.upsampled_pixels, rel=0.3)
+    for name in ("particles", "fragments", "quad_pixels"):
+        assert getattr(fitted, name) == pytest.approx(getattr(truth, name), rel=SWITCH_MARGIN), name
+
+
 def test_the_estimator_ignores_broken_timings_and_keeps_coefficients_positive():
     estimator = CostEstimator().observe(
         [(Work(particles=1e4), math.nan), (Work(particles=1e4), -5.0), (Work(particles=1e4), math.inf)]

@@ -63,6 +63,8 @@ def test_view_settings_and_tolerance():
     assert (settings.mode, settings.ring_radius, settings.tolerance_px) == ("impostor", math.inf, 2.0)
     assert Tolerance(38.0, 10).for_view(scene.views[0]) == Tolerance(38.0, 30)
     assert view_settings(scene.all_views[0]).mode == "full"  # the default view is the reference picture
+    chosen = scene_with({"mode": "auto", "settings": {"cloud_resolution_scale": "auto"}})
+    assert view_settings(chosen.views[0]).cloud_resolution_scale == "auto"  # chosen per frame
 
 
 @pytest.mark.parametrize(
@@ -88,6 +90,8 @@ def test_view_settings_and_tolerance():
         ({"settings": {"transition_frames": 1.5}}, "views[0].settings.transition_frames", "expected an integer"),
         ({"settings": {"translation_metric": "x"}}, "views[0].settings.translation_metric", "is not one of"),
         ({"settings": {"ring_radius": math.nan}}, "views[0].settings.ring_radius", "must be finite"),
+        ({"settings": {"cloud_resolution_scale": 2.0}}, "views[0].settings", "'auto' or within [0.125, 1], got 2.0"),
+        ({"settings": {"cloud_resolution_scale": "often"}}, "views[0].settings.cloud_resolution_scale", "a number"),
         ({"tolerance_psnr": -1}, "views[0].tolerance_psnr", "must be within [0.0, inf]"),
         ({"max_diff": 256}, "views[0].max_diff", "must be within [0, 255]"),
         ({"fov_y_deg": 0.5}, "views[0].fov_y_deg", "must be within [1.0, 170.0]"),

@@ -73,3 +73,13 @@ def test_every_panel_widget_has_a_range_that_holds_its_default():
             continue
         assert option.low <= default <= option.high, name
         assert option.display, name
+
+
+def test_the_cloud_pass_scale_may_be_chosen_per_frame_and_is_refused_out_of_range_in_one_line():
+    assert parsed("--cloud-resolution", "auto").cloud_resolution_scale == "auto"
+    assert parse_sweep("cloud_resolution=1,0.25,auto") == ("cloud_resolution_scale", [1.0, 0.25, "auto"])
+    for value in (0.0, 1.5, math.nan, "often", True):
+        with pytest.raises(ValueError, match=r"^cloud_resolution_scale must be 'auto' or within \[0.125, 1\], got"):
+            RenderSettings(cloud_resolution_scale=value)
+    with pytest.raises(SceneError, match="cloud_resolution_scale must be 'auto' or within"):
+        parsed("--cloud-resolution", "2")
