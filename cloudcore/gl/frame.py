@@ -40,6 +40,7 @@ from cloudcore.artist.formation import formation_state
 from cloudcore.artist.particle_styles import particle_styles
 from cloudcore.camera import NEAR_PLANE_M, frustum_planes, projection_matrix, view_matrix
 from cloudcore.colour import linear_to_srgb8
+from cloudcore.field.shadow_cells import cell_shadowing
 from cloudcore.field.state import FieldState
 from cloudcore.gl.context import HeadlessContext, WindowContext, check_frame_size
 from cloudcore.gl.derived import Derived
@@ -189,6 +190,8 @@ class FrameRenderer:
         self.weather_state = WeatherFieldState()
         self._field_weights: np.ndarray | None = None
         self._cloud_weights: np.ndarray | None = None
+        #: (what it was made from, how the field's clouds shadow one another): (None, None) without a field
+        self._cell_shadowing: tuple = (None, None)
         self._air: AirMotion | None = None  # the wind applied to the authored clouds (None: still air)
         #: this frame's carried particles and units and the clouds' motion, and what they were made from
         self._carry_source, self._carry_made = None, None
@@ -511,6 +514,7 @@ class FrameRenderer:
         relative to the air, where the particle buffer's carry (`_carried`) then moves them."""
         if scene.cloud_field is None:
             self.weather_state, self._field_weights, self._cloud_weights = WeatherFieldState(), None, None
+            self._cell_shadowing = (None, None)
             return scene, (1.0,) * len(scene.clouds)
         eye_in_air = np.asarray(camera.position, dtype=np.float64) - carried
         frame, self.weather_state = update_weather_field(
@@ -519,10 +523,21 @@ class FrameRenderer:
         authored = scene.particle_count
         self._field_weights = np.concatenate([np.ones(authored), frame.weights])
         self._cloud_weights = np.concatenate([np.ones(len(scene.clouds)), frame.mean_weights])
+        self._follow_cells(len(scene.clouds), authored)
         return (
             dataclasses.replace(scene, clouds=scene.clouds + frame.clouds),
             (1.0,) * len(scene.clouds) + frame.fade_keys,
         )
+
+    def _follow_cells(self, authored_clouds: int, authored_particles: int) -> None:
+        """Make how the field's clouds shadow one another (`cell_shadowing`) again when its cells changed: the
+        weather's parts' cells and places, by identity (an unchanged part is the same object)."""
+        state = self.weather_state
+        source = (authored_clouds, authored_particles, state.places, state.leading, [p.cells for p in state.parts])
+        held = self._cell_shadowing[0]
+        if held is None or held[:4] != source[:4] or any(a is not b for a, b in zip(held[4], source[4], strict=True)):
+            shadowing = cell_shadowing(authored_clouds, authored_particles, state.parts, state.places, state.leading)
+            self._cell_shadowing = (source, shadowing)
 
     def _follow_scene(self, scene: Scene, lighting: Lighting, illumination_method: str, cloud_shadows: bool) -> float:
         """Make the world pass, the objects' pass and the clouds' light again where what they are made from
@@ -533,15 +548,12 @@ class FrameRenderer:
         preview = illumination_method == PREVIEW_METHOD
         # the clouds shadow the sun's (the first light's) beam where there are clouds and it shines
         sun = shadowing_sun(lights) if cloud_shadows else None
-        # on one another too, but not a cloud field's: the light pass's part is made again for every new set of
-        # clouds, and a flight through a field brings one every few frames (`sun_through_others`, 100 ms)
-        cloud_shadows = cloud_shadows and scene.cloud_field is None
+        # on one another too: a field's cells pair by pair, made again for the clouds a new set of cells reaches
+        between = cloud_shadows and (self._cell_shadowing[1] if scene.cloud_field is not None else True)
         self._world.follow((scene.terrain, lighting, preview), lights, ambient)
         self._objects.follow((scene.objects, lights, tuple(ambient), self.size), ambient)
         start = time.perf_counter()
-        relit = self._lit.follow(
-            (scene.clouds, scene.shading, lighting, illumination_method, cloud_shadows), lights, ambient
-        )
+        relit = self._lit.follow((scene.clouds, scene.shading, lighting, illumination_method, between), lights, ambient)
         illumination_ms = 1e3 * (time.perf_counter() - start) if relit else 0.0
         self._shadows = None if sun is None or not scene.clouds else self.shadow_map
         self._shadow_source = (
@@ -655,7 +667,7 @@ class FrameRenderer:
         """The clouds' particle buffer (their light) for `source` (the clouds, shading, lighting, light pass method,
         whether the clouds shadow one another), each cloud's lighting key kept from the last where its light is
         the same."""
-        clouds, shading, lighting, illumination_method, cloud_shadows = source
+        clouds, shading, lighting, illumination_method, between = source
         particles = ParticleBuffer(
             clouds,
             shading,
@@ -664,10 +676,12 @@ class FrameRenderer:
             illumination_method,
             self._illumination,
             particle_styles(clouds, lighting),
-            between_clouds=cloud_shadows,
+            between_clouds=between,
         )
         old = self._lit.value
-        same_lighting = old is not None and self._lit.source[1:] == source[1:]
+        # a field's new cells shadow anew (another `CellShadowing`): the keys stay where the light stays
+        same_lighting = old is not None and self._lit.source[1:4] == source[1:4]
+        same_lighting = same_lighting and (self._lit.source[4] is False) == (between is False)
         # by identity, not place: a cloud field's clouds that stay keep their keys when others come and go, unless
         # the light reaching them changed (the clouds shadow one another: one moved, another's shadow moves)
         held = (
