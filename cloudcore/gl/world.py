@@ -27,7 +27,7 @@ from cloudcore.gl.programs import build_program, set_matrix, set_vec3
 from cloudcore.gl.shadow_map import CloudShadowMap
 from cloudcore.gl.targets import TextureTarget, linear_filtering
 from cloudcore.light.air_between import AirBetween, air_between
-from cloudcore.light.far_ground import far_ground_colour
+from cloudcore.light.far_ground import far_ground_colour, far_ground_level, far_ground_sun
 from cloudcore.light.light_shafts import SHAFT_STEPS
 from cloudcore.light.sky_background import NIGHT_SKY, SkyBackground, ground_behind_the_air
 from cloudcore.light.terrain_light import TerrainLight
@@ -259,6 +259,10 @@ class WorldPass:
         self._far_ground = (
             ground_behind_the_air(far_ground_colour(terrain, light)) if sky.physical and terrain is not None else None
         )
+        #: (its sun's part, its level) where the clouds' shadows fall on it (sky_read.frag.glsl's FAR_GROUND_SHADOWS)
+        self._far_ground_shadowed = (
+            None if self._far_ground is None else (far_ground_sun(terrain, light), far_ground_level(terrain))
+        )
         self._uploaded_view = None  # the sky-view table the texture holds
         # core profile draws nothing without a vertex array, even one with no attributes
         self._fullscreen_vertex_array = GL.glGenVertexArrays(1)
@@ -268,7 +272,7 @@ class WorldPass:
         self._shafts: LightShaftPass | None = None  # built when a frame first has them
         # the physical sky at a fraction of the screen's resolution, and the program that reads it at its own
         self._sky_target: TextureTarget | None = None
-        self._sky_read: int | None = None
+        self._sky_read: dict[bool, int] = {}  # per whether the far ground takes the clouds' shadows
 
     def draw(
         self,
@@ -325,7 +329,7 @@ class WorldPass:
         if self._terrain is not None:
             far_air = None if self._far_ground is None else lambda program: self._set_sky_view_uniforms(program, sky)
             self._terrain.draw(camera, view_projection, air, shadows, shafts, far_air)
-        self._draw_sky(sky, camera, view, projection, (context.width, context.height), below)
+        self._draw_sky(sky, camera, view, projection, (context.width, context.height), below, shadows)
         if antialiased:
             context.resolve_multisampled_target()
         context.bind_target()
@@ -362,15 +366,17 @@ class WorldPass:
         projection: np.ndarray,
         size: tuple[int, int],
         below: tuple[float, float] | None,
+        shadows: CloudShadowMap | None = None,
     ) -> None:
         """The sky behind the terrain drawn into the bound target: the physical sky's picture read (with the sun's
         disc added in its box; the ground past the terrain, `below` (`_ground_below_the_terrain`), given its
-        depth), or the gradient."""
+        depth and its sun's part the clouds' `shadows`), or the gradient."""
         view_projection = projection @ view
         inverse_view_projection = np.linalg.inv(view_projection)
         far_ground_depth = False
         if sky.physical:
-            program = self._sky_read_program()
+            shadowed = self._far_ground is not None and shadows is not None
+            program = self._sky_read_program(shadowed)
             GL.glUseProgram(program)
             GL.glActiveTexture(GL.GL_TEXTURE2)
             GL.glBindTexture(GL.GL_TEXTURE_2D, self._sky_target.texture)
@@ -381,6 +387,8 @@ class WorldPass:
                 GL.glUniform2f(GL.glGetUniformLocation(program, "planet_ground"), *below)
                 set_vec3(program, "view_forward", -view[2, :3])
                 GL.glUniform2f(GL.glGetUniformLocation(program, "depth_terms"), projection[2, 2], projection[2, 3])
+            if shadowed:
+                self._set_far_ground_shadows(program, sky, camera, shadows)
         else:
             program = self._sky_program(False)
             GL.glUseProgram(program)
@@ -409,12 +417,30 @@ class WorldPass:
         GL.glDepthMask(GL.GL_TRUE)
         GL.glDepthFunc(GL.GL_LESS)
 
-    def _sky_read_program(self) -> int:
-        if self._sky_read is None:
+    def _sky_read_program(self, shadowed: bool) -> int:
+        """The program that reads the sky's picture; with the far ground in the clouds' shadows where `shadowed`."""
+        if shadowed not in self._sky_read:
             far_ground = int(self._far_ground is not None)
-            defines = {"DEPTH": 1.0, "FAR_GROUND": far_ground, "VIEW_RAY": far_ground}
-            self._sky_read = build_program("sky_read", defines, vertex="world")
-        return self._sky_read
+            defines = {
+                "DEPTH": 1.0,
+                "FAR_GROUND": far_ground,
+                "VIEW_RAY": far_ground,
+                "FAR_GROUND_SHADOWS": int(shadowed),
+            }
+            self._sky_read[shadowed] = build_program("sky_read", defines, vertex="world")
+        return self._sky_read[shadowed]
+
+    def _set_far_ground_shadows(
+        self, program: int, sky: SkyBackground, camera: Camera, shadows: CloudShadowMap
+    ) -> None:
+        """The far ground's uniforms for the clouds' shadows on it: the map, the sky-view table's rows' air, its sun's
+        part and level, the eye."""
+        shadows.bind(program)
+        self._set_sky_view_uniforms(program, sky)
+        sun_part, level = self._far_ground_shadowed
+        set_vec3(program, "far_ground_sun", sun_part)
+        set_vec3(program, "eye", camera.position)
+        GL.glUniform1f(GL.glGetUniformLocation(program, "far_ground_y"), level)
 
     def _sky_program(self, shafts: bool, sun_disc: bool = False) -> int:
         """The sky's program, less the light `shafts` take where asked; the sun's disc alone for `sun_disc`."""
@@ -503,8 +529,8 @@ class WorldPass:
             self._shafts.close()
         for program in self._sky_programs.values():
             GL.glDeleteProgram(program)
-        if self._sky_read is not None:
-            GL.glDeleteProgram(self._sky_read)
+        for program in self._sky_read.values():
+            GL.glDeleteProgram(program)
         if self._sky_target is not None:
             self._sky_target.close()
         GL.glDeleteVertexArrays(1, [self._fullscreen_vertex_array])

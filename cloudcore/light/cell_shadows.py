@@ -86,12 +86,14 @@ class _Particles:
         """(len(receivers),) the optical depth `occluders` (particle indices) put in front of `receivers`'."""
         q, p, distance = _pairs(self.uv[occluders], self.radii[occluders], self.uv[receivers])
         q, receiver = occluders[q], receivers[p]
+        # another cloud's particles in front (most pairs are a cloud's own, or behind): the cheap tests first
+        keep = (self.owner[q] != self.owner[receiver]) & (self.depth[q] - self.radii[q] < self.depth[receiver])
+        q, p, distance, receiver = q[keep], p[keep], distance[keep], receiver[keep]
         owner = self.owner[receiver]
         corner, side = self.shadowing.corners[owner], self.shadowing.sides[owner]
         place = self.centres[q][:, [0, 2]]
         own_cell = np.all((place >= corner) & (place < corner + side[:, None]), axis=1)  # NaN: never
-        keep = (self.owner[q] != owner) & ~own_cell
-        q, p, distance, receiver = q[keep], p[keep], distance[keep], receiver[keep]
+        q, p, distance, receiver = q[~own_cell], p[~own_cell], distance[~own_cell], receiver[~own_cell]
         radius = self.radii[q]
         opacity = np.minimum(self.opacity[q] * splat_kernel(distance / radius), MOST_OPACITY)
         in_front = slab_share(self.depth[receiver], self.depth[q], radius)

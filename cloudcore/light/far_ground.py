@@ -7,7 +7,9 @@ sky view with the ground, his `MultipleScattering` ground term, lit as our terra
 Its colour is the terrain's at the square's edge on level ground, lit by the terrain's own light (the sun's beam,
 the sky's dome, the floor: `TerrainLight`), so that the terrain's edge and the ground past it differ only by
 what the air's volume and the sky's table differ by at that distance (docs/atmosphere.md, "The ground past the
-terrain").  No cloud shadows it: a scene's clouds lie over its terrain.
+terrain").  The clouds shadow its sun's part (`far_ground_sun`) where the map of their shadows reaches past the
+terrain (a cloud field's rings do), read on the level ground at its edge's height (`far_ground_level`): the
+terrain's shadows go on across its edge (docs/atmosphere.md, "The far ground's cloud shadows").
 """
 
 from __future__ import annotations
@@ -23,17 +25,27 @@ from cloudcore.terrain_tiles import tile_frame
 EDGE_SAMPLES = 64
 
 
-def edge_colour(terrain: Terrain) -> np.ndarray:
-    """(3,) linear RGB: the mean ground colour (`ground_colours`, by height, level) along the edge of the square
-    the terrain's tiles are drawn to."""
+def _edge_points(terrain: Terrain) -> np.ndarray:
+    """(4 EDGE_SAMPLES, 3): points along the edge of the square the terrain's tiles are drawn to, at its heights."""
     half = tile_frame(terrain).half_side_m
     along = np.linspace(-half, half, EDGE_SAMPLES)
     ends = np.full(EDGE_SAMPLES, half)
     x = np.concatenate([along, along, -ends, ends])
     z = np.concatenate([-ends, ends, along, along])
-    positions = np.stack([x, height_at(terrain, x, z), z], axis=1)
+    return np.stack([x, height_at(terrain, x, z), z], axis=1)
+
+
+def edge_colour(terrain: Terrain) -> np.ndarray:
+    """(3,) linear RGB: the mean ground colour (`ground_colours`, by height, level) along the edge of the square
+    the terrain's tiles are drawn to."""
+    positions = _edge_points(terrain)
     level = np.broadcast_to([0.0, 1.0, 0.0], positions.shape)
     return ground_colours(terrain, positions, level).mean(axis=0)
+
+
+def far_ground_level(terrain: Terrain) -> float:
+    """The world height (m) of the level ground past `terrain`'s square: its edge's mean."""
+    return float(_edge_points(terrain)[:, 1].mean())
 
 
 def far_ground_colour(terrain: Terrain, light: TerrainLight) -> np.ndarray:
@@ -41,3 +53,8 @@ def far_ground_colour(terrain: Terrain, light: TerrainLight) -> np.ndarray:
     `light` (the sun's beam unshadowed)."""
     up = np.array([[0.0, 1.0, 0.0]])
     return edge_colour(terrain) * (light.sun_irradiance(up) + light.unshadowed_irradiance(up))[0]
+
+
+def far_ground_sun(terrain: Terrain, light: TerrainLight) -> np.ndarray:
+    """(3,) the part of `far_ground_colour` the sun's beam gives: what the clouds' shadows take."""
+    return edge_colour(terrain) * light.sun_irradiance(np.array([[0.0, 1.0, 0.0]]))[0]
