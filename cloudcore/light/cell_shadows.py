@@ -99,11 +99,6 @@ class _Particles:
         in_front = slab_share(self.depth[receiver], self.depth[q], radius)
         return np.bincount(p, weights=-np.log1p(-opacity) * in_front, minlength=len(receivers))
 
-    def reached(self, occluders) -> np.ndarray:
-        """The clouds with a particle some of `occluders` (indices) would put optical depth in front of."""
-        receivers = np.arange(len(self.radii))
-        return np.unique(self.owner[np.flatnonzero(self.optical_depths(occluders, receivers) > 0.0)])
-
 
 def sun_through_other_cells(
     centres, radii, opacity, cloud_starts, shadowing: CellShadowing, sun_direction
@@ -167,14 +162,12 @@ class SunThroughCells:
         gone_then[theirs] = occluding_then[theirs] & ~occluding_now[mine]
         changed = np.zeros(len(clouds), dtype=bool)
         changed[came] = True
-        changed[now.reached(np.flatnonzero(new_now))] = True
-        # the occluders that left, where they were, against the particles now
+        # the occluders that left (where they were) and those that came, against the particles now: one query
         gone = np.flatnonzero(gone_then)
-        if len(gone):
-            both = _joined(then, gone, now)
-            receivers = np.arange(len(gone), len(both.radii))
-            hit = both.optical_depths(np.arange(len(gone)), receivers) > 0.0
-            changed[now.owner[hit]] = True
+        both = _joined(then, gone, now)
+        occluders = np.concatenate([np.arange(len(gone)), len(gone) + np.flatnonzero(new_now)])
+        receivers = np.arange(len(gone), len(both.radii))
+        changed[now.owner[both.optical_depths(occluders, receivers) > 0.0]] = True
         kept = {int(index): shares[before_index[index]] for index in np.flatnonzero(~changed)}
         return np.flatnonzero(changed), kept
 
