@@ -19,7 +19,7 @@ from OpenGL import GL
 from cloudcore.atmosphere.geometry import horizon_cosine
 from cloudcore.atmosphere.sky_view import eye_radius, horizon_angles
 from cloudcore.atmosphere.sun_disc import SUN_ANGULAR_RADIUS
-from cloudcore.camera import frustum_planes
+from cloudcore.camera import frustum_planes, pixel_rays
 from cloudcore.gl.air_volume import AirVolume
 from cloudcore.gl.context import HeadlessContext
 from cloudcore.gl.light_shafts import LightShaftPass
@@ -27,14 +27,14 @@ from cloudcore.gl.programs import build_program, set_matrix, set_vec3
 from cloudcore.gl.shadow_map import CloudShadowMap
 from cloudcore.gl.targets import TextureTarget, linear_filtering
 from cloudcore.light.air_between import AirBetween, air_between
-from cloudcore.light.far_ground import far_ground_colour, far_ground_level, far_ground_sun
+from cloudcore.light.far_ground import far_ground_colour, far_ground_level, far_ground_sun, in_shadow_map
 from cloudcore.light.light_shafts import SHAFT_STEPS
 from cloudcore.light.sky_background import NIGHT_SKY, SkyBackground, ground_behind_the_air
 from cloudcore.light.terrain_light import TerrainLight
 from cloudcore.limits import DRAWN_TERRAIN_KINDS
 from cloudcore.scene import Camera, Terrain
 from cloudcore.terrain import ground_colours
-from cloudcore.terrain_tiles import TILE_FACES, TILE_VERTICES, TerrainTiles, grid_face_count, tile_faces
+from cloudcore.terrain_tiles import TILE_FACES, TILE_VERTICES, TerrainTiles, grid_face_count, tile_faces, tile_frame
 
 #: the light shafts' depth of the terrain takes every 4th vertex of a tile's grid: the frames agree closely with the
 #: whole grid's, whose triangles cost llvmpipe their setup (docs/atmosphere.md#light-shafts)
@@ -58,6 +58,9 @@ def sky_reduction(width: int) -> int:
     return max(1, round(width / SKY_COLUMNS))
 
 
+#: the columns of rays `WorldPass` finds the far ground in the clouds' shadows at (its rows by the aspect): a box of
+#: the screen a cell wider than what they find takes the map's read
+FAR_GROUND_SHADOW_GRID = 32
 #: the texture unit of the air's transmittance along the sky-view table's rows (sky.frag.glsl's FAR_GROUND)
 _ROW_TRANSMITTANCE_UNIT = 8
 
@@ -259,9 +262,12 @@ class WorldPass:
         self._far_ground = (
             ground_behind_the_air(far_ground_colour(terrain, light)) if sky.physical and terrain is not None else None
         )
-        #: (its sun's part, its level) where the clouds' shadows fall on it (sky_read.frag.glsl's FAR_GROUND_SHADOWS)
+        #: (its sun's part, its level, the terrain's half side) where the clouds' shadows fall on it
+        #: (sky_read.frag.glsl's FAR_GROUND_SHADOWS)
         self._far_ground_shadowed = (
-            None if self._far_ground is None else (far_ground_sun(terrain, light), far_ground_level(terrain))
+            None
+            if self._far_ground is None
+            else (far_ground_sun(terrain, light), far_ground_level(terrain), tile_frame(terrain).half_side_m)
         )
         self._uploaded_view = None  # the sky-view table the texture holds
         # core profile draws nothing without a vertex array, even one with no attributes
@@ -375,20 +381,8 @@ class WorldPass:
         inverse_view_projection = np.linalg.inv(view_projection)
         far_ground_depth = False
         if sky.physical:
-            shadowed = self._far_ground is not None and shadows is not None
-            program = self._sky_read_program(shadowed)
-            GL.glUseProgram(program)
-            GL.glActiveTexture(GL.GL_TEXTURE2)
-            GL.glBindTexture(GL.GL_TEXTURE_2D, self._sky_target.texture)
-            GL.glActiveTexture(GL.GL_TEXTURE0)
             far_ground_depth = self._far_ground is not None
-            if far_ground_depth:  # the ground past the terrain takes its depth: clouds behind it are hidden
-                set_matrix(program, "inverse_view_projection", inverse_view_projection)
-                GL.glUniform2f(GL.glGetUniformLocation(program, "planet_ground"), *below)
-                set_vec3(program, "view_forward", -view[2, :3])
-                GL.glUniform2f(GL.glGetUniformLocation(program, "depth_terms"), projection[2, 2], projection[2, 3])
-            if shadowed:
-                self._set_far_ground_shadows(program, sky, camera, shadows)
+            self._use_sky_read(False, sky, camera, view, projection, below, shadows)
         else:
             program = self._sky_program(False)
             GL.glUseProgram(program)
@@ -399,6 +393,13 @@ class WorldPass:
         GL.glDepthMask(GL.GL_TRUE if far_ground_depth else GL.GL_FALSE)
         GL.glBindVertexArray(self._fullscreen_vertex_array)
         GL.glDrawArrays(GL.GL_TRIANGLES, 0, 3)
+        shadowed = None if not far_ground_depth else self._far_ground_shadow_box(camera, size, shadows)
+        if shadowed is not None:  # read again where the far ground can be in the clouds' shadows
+            self._use_sky_read(True, sky, camera, view, projection, below, shadows)
+            GL.glEnable(GL.GL_SCISSOR_TEST)
+            GL.glScissor(*shadowed)
+            GL.glDrawArrays(GL.GL_TRIANGLES, 0, 3)
+            GL.glDisable(GL.GL_SCISSOR_TEST)
         GL.glDepthMask(GL.GL_FALSE)
         box = sun_box(sky, camera, view_projection, size) if sky.physical else None
         if box is not None:  # the sun's disc added where it can be
@@ -430,17 +431,56 @@ class WorldPass:
             self._sky_read[shadowed] = build_program("sky_read", defines, vertex="world")
         return self._sky_read[shadowed]
 
-    def _set_far_ground_shadows(
-        self, program: int, sky: SkyBackground, camera: Camera, shadows: CloudShadowMap
+    def _use_sky_read(
+        self,
+        shadowed: bool,
+        sky: SkyBackground,
+        camera: Camera,
+        view: np.ndarray,
+        projection: np.ndarray,
+        below: tuple[float, float] | None,
+        shadows: CloudShadowMap | None,
     ) -> None:
-        """The far ground's uniforms for the clouds' shadows on it: the map, the sky-view table's rows' air, its sun's
-        part and level, the eye."""
-        shadows.bind(program)
-        self._set_sky_view_uniforms(program, sky)
-        sun_part, level = self._far_ground_shadowed
-        set_vec3(program, "far_ground_sun", sun_part)
-        set_vec3(program, "eye", camera.position)
-        GL.glUniform1f(GL.glGetUniformLocation(program, "far_ground_y"), level)
+        """Use the program that reads the sky's picture (with the far ground in the clouds' `shadows` where
+        `shadowed`), its uniforms set."""
+        program = self._sky_read_program(shadowed)
+        GL.glUseProgram(program)
+        GL.glActiveTexture(GL.GL_TEXTURE2)
+        GL.glBindTexture(GL.GL_TEXTURE_2D, self._sky_target.texture)
+        GL.glActiveTexture(GL.GL_TEXTURE0)
+        if self._far_ground is not None:  # the ground past the terrain takes its depth: clouds behind it are hidden
+            set_matrix(program, "inverse_view_projection", np.linalg.inv(projection @ view))
+            GL.glUniform2f(GL.glGetUniformLocation(program, "planet_ground"), *below)
+            set_vec3(program, "view_forward", -view[2, :3])
+            GL.glUniform2f(GL.glGetUniformLocation(program, "depth_terms"), projection[2, 2], projection[2, 3])
+        if shadowed:
+            shadows.bind(program)
+            self._set_sky_view_uniforms(program, sky)
+            sun_part, level, _ = self._far_ground_shadowed
+            set_vec3(program, "far_ground_sun", sun_part)
+            set_vec3(program, "eye", camera.position)
+            GL.glUniform1f(GL.glGetUniformLocation(program, "far_ground_y"), level)
+
+    def _far_ground_shadow_box(
+        self, camera: Camera, size: tuple[int, int], shadows: CloudShadowMap | None
+    ) -> tuple[int, int, int, int] | None:
+        """(x, y, width, height) of the screen (GL's, bottom up) where the far ground can be in the clouds'
+        `shadows` (`in_shadow_map` at a coarse grid of rays, widened by a cell), None where it is nowhere."""
+        if shadows is None or shadows.space is None:
+            return None
+        columns = FAR_GROUND_SHADOW_GRID
+        rows = max(1, round(columns * size[1] / size[0]))
+        _, level, half_side = self._far_ground_shadowed
+        rays = pixel_rays(camera, columns, rows)
+        hit = in_shadow_map(camera.position, rays, shadows.space, half_side, level).reshape(rows, columns)
+        if not hit.any():
+            return None
+        hit_rows, hit_columns = np.flatnonzero(hit.any(axis=1)), np.flatnonzero(hit.any(axis=0))
+        left, right = max(hit_columns[0] - 1, 0), min(hit_columns[-1] + 2, columns)
+        top, bottom = max(hit_rows[0] - 1, 0), min(hit_rows[-1] + 2, rows)
+        x0, x1 = (size[0] * np.array([left, right])) // columns
+        y0, y1 = size[1] - (size[1] * np.array([bottom, top])) // rows
+        return int(x0), int(y0), int(x1 - x0), int(y1 - y0)
 
     def _sky_program(self, shafts: bool, sun_disc: bool = False) -> int:
         """The sky's program, less the light `shafts` take where asked; the sun's disc alone for `sun_disc`."""

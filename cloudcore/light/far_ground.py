@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from cloudcore.light.cloud_shadows import LightSpace
 from cloudcore.light.terrain_light import TerrainLight
 from cloudcore.scene import Terrain
 from cloudcore.terrain import ground_colours, height_at
@@ -58,3 +59,21 @@ def far_ground_colour(terrain: Terrain, light: TerrainLight) -> np.ndarray:
 def far_ground_sun(terrain: Terrain, light: TerrainLight) -> np.ndarray:
     """(3,) the part of `far_ground_colour` the sun's beam gives: what the clouds' shadows take."""
     return edge_colour(terrain) * light.sun_irradiance(np.array([[0.0, 1.0, 0.0]]))[0]
+
+
+def in_shadow_map(eye, rays, space: LightSpace, half_side_m: float, level_m: float) -> np.ndarray:
+    """(n,) whether each of unit `rays` (n, 3) from `eye` meets the level ground at `level_m` past the square of
+    half side `half_side_m` (the terrain's) inside the footprint of the clouds' shadow map of `space`: where the
+    far ground can be in a cloud's shadow.  The world pass reads the map there alone: llvmpipe runs a shader's
+    branch on every pixel, and the read over the whole sky cost it a third of the world pass
+    (docs/atmosphere.md#the-far-grounds-cloud-shadows)."""
+    rays = np.asarray(rays, dtype=np.float64).reshape(-1, 3)
+    eye = np.asarray(eye, dtype=np.float64)
+    down = rays[:, 1] < 0.0
+    along = np.where(down, (eye[1] - level_m) / np.where(down, -rays[:, 1], 1.0), 0.0)
+    ground = eye + along[:, None] * rays
+    x, y, _ = space.texel_coordinates(ground)
+    width, height = space.size
+    inside = (x >= 0.0) & (x <= width) & (y >= 0.0) & (y <= height)
+    past = np.any(np.abs(ground[:, [0, 2]]) > half_side_m, axis=1)
+    return down & (along > 0.0) & past & inside
