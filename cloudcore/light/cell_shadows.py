@@ -69,6 +69,8 @@ class _Particles:
 
     @classmethod
     def along(cls, centres, radii, opacity, cloud_starts, shadowing: CellShadowing, sun_direction) -> _Particles:
+        """The particles at `centres` (n, 3) of `radii` and beam `opacity`, their clouds at `cloud_starts`, seen along
+        the sun's light (toward `sun_direction`)."""
         right, up, forward = light_basis(sun_direction)
         centres = np.asarray(centres, dtype=np.float64).reshape(-1, 3)
         radii, opacity = np.asarray(radii, dtype=np.float64), np.asarray(opacity, dtype=np.float64)
@@ -174,7 +176,8 @@ class SunThroughCells:
 
 def _joined(then: _Particles, gone: np.ndarray, now: _Particles) -> _Particles:
     """The particles `gone` of `then`, each its own cloud, before those of `now` (whose clouds and footprints
-    they keep): what the occluders that left put in front of the particles now."""
+    they keep), `gone` the occluders: so that the occluders that left, where they were, and those that came are
+    met with the particles now in one query."""
     shadowing = CellShadowing(
         np.concatenate([np.full((len(gone), 2), np.nan), now.shadowing.corners]),
         np.concatenate([np.full(len(gone), np.nan), now.shadowing.sides]),

@@ -14,7 +14,7 @@ from cloudcore.light.sky_background import scene_sky
 from cloudcore.light.terrain_light import terrain_light
 from cloudcore.scene import Camera, Cloud, Lighting, Scene, Terrain
 from cloudcore.settings import FULL_3D
-from tests.conftest import RENDER_HEIGHT, RENDER_WIDTH
+from tests.conftest import RENDER_HEIGHT, RENDER_WIDTH, ball
 
 pytestmark = pytest.mark.gl
 
@@ -94,10 +94,7 @@ def shadow_across_the_edge() -> tuple[Scene, np.ndarray]:
     sun = np.asarray(scene_lights(LIGHTING)[0][0].direction)
     shadow = np.array([-HALF_SIDE, 0.0, 0.0])
     centre = shadow + (3000.0 / sun[1]) * sun
-    rng = np.random.default_rng(4)
-    offsets = rng.normal(size=(800, 3))
-    offsets *= (250.0 * rng.uniform(0.0, 1.0, 800) ** (1 / 3) / np.linalg.norm(offsets, axis=1))[:, None]
-    cloud = Cloud("over the edge", np.column_stack([centre + offsets, np.full(800, 40.0)]))
+    cloud = ball(centre, particles=800, seed=4)
     # level: the far ground lies at its edge's height, so a hill's edge would step the shadow by its height
     flat = dataclasses.replace(PATCH, height=0.0)
     return Scene(lighting=LIGHTING, terrain=flat, clouds=(cloud,)), shadow

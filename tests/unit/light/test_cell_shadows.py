@@ -10,20 +10,13 @@ from cloudcore.field.shadow_cells import CellShadowing, cell_shadowing
 from cloudcore.field.state import FieldState, update_field
 from cloudcore.light.cell_shadows import SunThroughCells, sun_through_other_cells
 from cloudcore.light.illumination import IlluminationCache, beam_of, illuminate_clouds
-from cloudcore.scene import Cloud, CloudField, Light, Shading
+from cloudcore.scene import CloudField, Light, Shading
 from cloudcore.sun import sun_direction
+from tests.conftest import ball
 
 SUN = sun_direction(15.5)
 FIELD = CloudField(seed=2014, coverage=0.4, cell_size=500.0, rings=4, layers=4, altitude=(1200.0, 2400.0))
 EYE = np.array([-12000.0, 2000.0, 3000.0])
-
-
-def puff(centre, seed, particles=400, radius_m=200.0) -> Cloud:
-    """A round cloud of `particles` 40 m particles within `radius_m` of `centre`."""
-    rng = np.random.default_rng(seed)
-    offsets = rng.normal(size=(particles, 3))
-    offsets *= (radius_m * rng.uniform(0.0, 1.0, particles) ** (1 / 3) / np.linalg.norm(offsets, axis=1))[:, None]
-    return Cloud(f"puff {seed}", np.column_stack([np.asarray(centre) + offsets, np.full(particles, 40.0)]))
 
 
 def cells_of(clouds, corners, side=500.0) -> CellShadowing:
@@ -39,9 +32,9 @@ def through(clouds, shadowing, sun=SUN) -> list[np.ndarray]:
 
 def test_a_field_cloud_behind_another_toward_the_sun_receives_less_light():
     front_centre = np.array([250.0, 1800.0, 250.0])
-    front = puff(front_centre, 1)
-    behind = puff(front_centre - 900.0 * np.asarray(SUN), 2)  # along the light, in another cell
-    aside = puff(front_centre + [0.0, 0.0, 2000.0], 3)
+    front = ball(front_centre, 200.0, 400, seed=1)
+    behind = ball(front_centre - 900.0 * np.asarray(SUN), 200.0, 400, seed=2)  # along the light, in another cell
+    aside = ball(front_centre + [0.0, 0.0, 2000.0], 200.0, 400, seed=3)
     corners = [[0.0, 0.0], np.floor(behind.centres.mean(axis=0)[[0, 2]] / 500.0) * 500.0, [0.0, 2000.0]]
     assert not np.array_equal(corners[0], corners[1])
     shares = through([front, behind, aside], cells_of([front, behind, aside], corners))
@@ -56,8 +49,8 @@ def test_a_field_cloud_behind_another_toward_the_sun_receives_less_light():
 def test_a_particle_whose_place_lies_in_the_receiver_s_cell_does_not_shadow_it():
     """The blend bands' twin: a coarser cell's particles over a finer cell's footprint are the same cloud."""
     front_centre = np.array([250.0, 1800.0, 250.0])
-    front = puff(front_centre, 1)
-    behind = puff(front_centre - 300.0 * np.asarray(SUN), 2)
+    front = ball(front_centre, 200.0, 400, seed=1)
+    behind = ball(front_centre - 300.0 * np.asarray(SUN), 200.0, 400, seed=2)
     # `behind`'s cell, 2 km across, holds `front`'s place too: `front` stands for part of the same cloud
     shares = through([front, behind], cells_of([front, behind], [[0.0, 0.0], [-1000.0, -1000.0]], 2000.0))
     assert shares[1].tolist() == [1.0] * len(shares[1])
