@@ -121,3 +121,11 @@ def pytest_addoption(parser):
         action="store_true",
         help="rewrite tests/golden/*.png from the current renderer instead of comparing",
     )
+
+
+def ball(centre, radius_m=250.0, particles=1000, seed=1) -> Cloud:
+    """A round cloud of `particles` 40 m particles within `radius_m` of `centre`."""
+    rng = np.random.default_rng(seed)
+    offsets = rng.normal(size=(particles, 3))
+    offsets *= (radius_m * rng.uniform(0.0, 1.0, particles) ** (1 / 3) / np.linalg.norm(offsets, axis=1))[:, None]
+    return Cloud(f"ball {seed}", np.column_stack([np.asarray(centre) + offsets, np.full(particles, 40.0)]))

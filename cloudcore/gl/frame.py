@@ -285,9 +285,6 @@ class FrameRenderer:
         preview = asked.illumination_method == PREVIEW_METHOD
         self._world.follow((scene.terrain, lighting, preview), lights, ambient)
         self._objects.follow((scene.objects, lights, tuple(ambient), self.size), ambient)
-        # the clouds shadow one another too, but not a cloud field's: the light pass's part is made again for every
-        # new set of clouds, and a flight through a field brings one every few frames (`sun_through_others`, 100 ms)
-        between_clouds = settings.cloud_shadows and scene.cloud_field is None
         clouds = self.clouds.prepare(
             scene,
             camera,
@@ -298,7 +295,6 @@ class FrameRenderer:
             settings,
             asked.time_s,
             asked.lit_at,
-            between_clouds,
         )
         # the clouds shadow the sun's (the first light's) beam where there are clouds and it shines
         sun = shadowing_sun(lights) if settings.cloud_shadows else None

@@ -26,13 +26,19 @@ from cloudcore.gl.programs import ProgramCache, set_matrix, set_vec3
 from cloudcore.gl.shadow_map import CloudShadowMap
 from cloudcore.gl.targets import TextureTarget, linear_filtering
 from cloudcore.light.air_between import AirBetween, air_between
-from cloudcore.light.far_ground import far_ground_box, far_ground_colour
+from cloudcore.light.far_ground import (
+    far_ground_box,
+    far_ground_colour,
+    far_ground_level,
+    far_ground_sun,
+    in_shadow_map,
+)
 from cloudcore.light.light_shafts import SHAFT_STEPS
 from cloudcore.light.sky_background import NIGHT_SKY, SkyBackground, ground_behind_the_air
 from cloudcore.light.terrain_light import TerrainLight
 from cloudcore.model.scene import Camera, Terrain
 from cloudcore.scenes.limits import DRAWN_TERRAIN_KINDS
-from cloudcore.world.camera import frustum_planes
+from cloudcore.world.camera import frustum_planes, pixel_rays
 from cloudcore.world.terrain import ground_colours
 from cloudcore.world.terrain_tiles import (
     SKIRT_SIDES,
@@ -41,6 +47,7 @@ from cloudcore.world.terrain_tiles import (
     TerrainTiles,
     grid_face_count,
     tile_faces,
+    tile_frame,
 )
 
 #: the light shafts' depth of the terrain takes every 4th vertex of a tile's grid: the frames agree closely with the
@@ -65,6 +72,9 @@ def sky_reduction(width: int) -> int:
     return max(1, round(width / SKY_COLUMNS))
 
 
+#: the columns of rays at which `WorldPass` asks whether the far ground can be in the clouds' shadows (its rows
+#: by the aspect): where none can, the sky's read does not branch into the map
+FAR_GROUND_SHADOW_GRID = 32
 #: the texture unit of the air's transmittance along the sky-view table's rows (sky.frag.glsl's FAR_GROUND)
 _ROW_TRANSMITTANCE_UNIT = 8
 
@@ -267,6 +277,13 @@ class WorldPass:
         self._far_ground = (
             ground_behind_the_air(far_ground_colour(terrain, light)) if sky.physical and terrain is not None else None
         )
+        #: (its sun's part, its level, the terrain's half side) where the clouds' shadows fall on it
+        #: (sky_read.frag.glsl's FAR_GROUND_SHADOWS)
+        self._far_ground_shadowed = (
+            None
+            if self._far_ground is None
+            else (far_ground_sun(terrain, light), far_ground_level(terrain), tile_frame(terrain).half_side_m)
+        )
         self._uploaded_view = None  # the sky-view table the texture holds
         # core profile draws nothing without a vertex array, even one with no attributes
         self._fullscreen_vertex_array = GL.glGenVertexArrays(1)
@@ -332,7 +349,7 @@ class WorldPass:
         if self._terrain is not None:
             far_air = None if self._far_ground is None else lambda program: self._set_sky_view_uniforms(program, sky)
             self._terrain.draw(camera, view_projection, air, shadows, shafts, far_air)
-        self._draw_sky(sky, camera, view, projection, (context.width, context.height), below)
+        self._draw_sky(sky, camera, view, projection, (context.width, context.height), below, shadows)
         if antialiased:
             context.resolve_multisampled_target()
         context.bind_target()
@@ -369,10 +386,11 @@ class WorldPass:
         projection: np.ndarray,
         size: tuple[int, int],
         below: tuple[float, float] | None,
+        shadows: CloudShadowMap | None = None,
     ) -> None:
         """The sky behind the terrain drawn into the bound target: the physical sky's picture read (with the sun's
         disc added in its box; the ground past the terrain, `below` (`_ground_below_the_terrain`), given its
-        depth), or the gradient."""
+        depth and its sun's part the clouds' `shadows`), or the gradient."""
         view_projection = projection @ view
         inverse_view_projection = np.linalg.inv(view_projection)
         GL.glEnable(GL.GL_DEPTH_TEST)
@@ -380,11 +398,7 @@ class WorldPass:
         GL.glDepthMask(GL.GL_FALSE)
         GL.glBindVertexArray(self._fullscreen_vertex_array)
         if sky.physical:
-            program = self._sky_read_program(ground_depth=False)
-            GL.glUseProgram(program)
-            GL.glActiveTexture(GL.GL_TEXTURE2)
-            GL.glBindTexture(GL.GL_TEXTURE_2D, self._sky_target.texture)
-            GL.glActiveTexture(GL.GL_TEXTURE0)
+            self._use_sky_read(False, False, sky, camera, view, projection, below, shadows)
         else:
             program = self._sky_program(False)
             GL.glUseProgram(program)
@@ -398,13 +412,10 @@ class WorldPass:
             )
         if ground_box is not None:
             # the ground past the terrain takes its depth, so that clouds behind it are hidden; drawn again in the
-            # box where it may be seen alone, as a pass that writes its depth is shaded on every pixel it covers
-            program = self._sky_read_program(ground_depth=True)
-            GL.glUseProgram(program)
-            set_matrix(program, "inverse_view_projection", inverse_view_projection)
-            GL.glUniform2f(GL.glGetUniformLocation(program, "planet_ground"), *below)
-            set_vec3(program, "view_forward", -view[2, :3])
-            GL.glUniform2f(GL.glGetUniformLocation(program, "depth_terms"), projection[2, 2], projection[2, 3])
+            # box where it may be seen alone, as a pass that writes its depth is shaded on every pixel it covers;
+            # its sun's part in the clouds' shadows where any of it can be in them
+            shadowed = self._far_ground_in_shadows(camera, size, shadows)
+            self._use_sky_read(True, shadowed, sky, camera, view, projection, below, shadows)
             GL.glDepthMask(GL.GL_TRUE)
             GL.glEnable(GL.GL_SCISSOR_TEST)
             GL.glScissor(*ground_box)
@@ -428,14 +439,62 @@ class WorldPass:
         GL.glDepthMask(GL.GL_TRUE)
         GL.glDepthFunc(GL.GL_LESS)
 
-    def _sky_read_program(self, ground_depth: bool) -> int:
-        """The program that reads the sky's picture; writing the far ground's depth where `ground_depth`."""
-        defines = {"DEPTH": 1.0, "FAR_GROUND": int(ground_depth), "VIEW_RAY": int(ground_depth)}
+    def _sky_read_program(self, ground_depth: bool, shadowed: bool) -> int:
+        """The program that reads the sky's picture; writing the far ground's depth where `ground_depth`, its sun's
+        part in the clouds' shadows where `shadowed`."""
+        defines = {
+            "DEPTH": 1.0,
+            "FAR_GROUND": int(ground_depth),
+            "VIEW_RAY": int(ground_depth),
+            "FAR_GROUND_SHADOWS": int(shadowed),
+        }
         return self._programs.program("sky_read", defines, vertex="world")
 
     def _terrain_half_side_m(self) -> float:
         """The half side of the square the terrain's tiles are drawn to, about the origin."""
         return self._terrain.tiles.frame.half_side_m
+
+    def _use_sky_read(
+        self,
+        ground_depth: bool,
+        shadowed: bool,
+        sky: SkyBackground,
+        camera: Camera,
+        view: np.ndarray,
+        projection: np.ndarray,
+        below: tuple[float, float] | None,
+        shadows: CloudShadowMap | None,
+    ) -> None:
+        """Use the program that reads the sky's picture (writing the far ground's depth where `ground_depth`, its
+        sun's part in the clouds' `shadows` where `shadowed`), its uniforms set."""
+        program = self._sky_read_program(ground_depth, shadowed)
+        GL.glUseProgram(program)
+        GL.glActiveTexture(GL.GL_TEXTURE2)
+        GL.glBindTexture(GL.GL_TEXTURE_2D, self._sky_target.texture)
+        GL.glActiveTexture(GL.GL_TEXTURE0)
+        if ground_depth:
+            set_matrix(program, "inverse_view_projection", np.linalg.inv(projection @ view))
+            GL.glUniform2f(GL.glGetUniformLocation(program, "planet_ground"), *below)
+            set_vec3(program, "view_forward", -view[2, :3])
+            GL.glUniform2f(GL.glGetUniformLocation(program, "depth_terms"), projection[2, 2], projection[2, 3])
+        if shadowed:
+            shadows.bind(program)
+            self._set_sky_view_uniforms(program, sky)
+            sun_part, level, _ = self._far_ground_shadowed
+            set_vec3(program, "far_ground_sun", sun_part)
+            set_vec3(program, "eye", camera.position)
+            GL.glUniform1f(GL.glGetUniformLocation(program, "far_ground_y"), level)
+
+    def _far_ground_in_shadows(self, camera: Camera, size: tuple[int, int], shadows: CloudShadowMap | None) -> bool:
+        """Whether the far ground can be in the clouds' `shadows` anywhere on the screen (`in_shadow_map` at a
+        coarse grid of rays): the sky's read branches into the map only then."""
+        if shadows is None or shadows.space is None:
+            return False
+        columns = FAR_GROUND_SHADOW_GRID
+        rows = max(1, round(columns * size[1] / size[0]))
+        _, level, half_side = self._far_ground_shadowed
+        rays = pixel_rays(camera, columns, rows)
+        return bool(in_shadow_map(camera.position, rays, shadows.space, half_side, level).any())
 
     def _sky_program(self, shafts: bool, sun_disc: bool = False) -> int:
         """The sky's program, less the light `shafts` take where asked; the sun's disc alone for `sun_disc`."""

@@ -55,7 +55,7 @@ FIELD_MAP_RESOLUTION = 256
 #: not the texels (docs/atmosphere.md#cloud-shadows)
 BETWEEN_CLOUDS_RESOLUTION = 128
 #: a particle's opacity times its kernel is capped at this, so that float32's 1 - b K stays above 0
-_MOST_OPACITY = 1.0 - 1e-6
+MOST_OPACITY = 1.0 - 1e-6
 
 
 def beam_opacity(optical_depth, albedo, phase: str = "rayleigh", g: float = 0.0) -> np.ndarray:
@@ -233,7 +233,7 @@ def _deposits(space: LightSpace, centres, radii, alpha) -> tuple[np.ndarray, ...
     texel_y = y0[particle] + texel // columns[particle]
     k = first[particle] + step
     distance = np.hypot(texel_x + 0.5 - x[particle], texel_y + 0.5 - y[particle]) / reach[particle]
-    opacity = np.minimum(np.asarray(alpha, dtype=np.float64)[particle] * splat_kernel(distance), _MOST_OPACITY)
+    opacity = np.minimum(np.asarray(alpha, dtype=np.float64)[particle] * splat_kernel(distance), MOST_OPACITY)
     centre, thickness = s[particle], half[particle]
     # the last slice takes the rest: behind every slice, every particle counts whole
     behind = np.where(k == SLICES, 1.0, slab_share(k, centre, thickness))

@@ -3,7 +3,7 @@
 Harris shades each cloud on its own once per light; this module maps a scene's clouds, shading defaults and
 lights onto `cloudcore.light.shading.incident_light`.  The sun (the first light) then reaches each cloud through
 the others too, where asked (`between_clouds`): the clouds' light-space map less each cloud's own part
-(`cloudcore.light.cloud_shadows`).
+(`cloudcore.light.cloud_shadows`), or for a cloud field's cells, pair by pair (`cloudcore.light.cell_shadows`).
 """
 
 from __future__ import annotations
@@ -12,6 +12,8 @@ import dataclasses
 
 import numpy as np
 
+from cloudcore.field.shadow_cells import CellShadowing
+from cloudcore.light.cell_shadows import SunThroughCells, sun_through_other_cells
 from cloudcore.light.cloud_shadows import beam_opacity, between_clouds_transmittance
 from cloudcore.light.lighting import active_lights
 from cloudcore.light.shading import ALL_LIGHT, DEFAULT_RASTER_RESOLUTION, RETURNED_LIGHT, light_parts
@@ -33,11 +35,11 @@ def illuminate_clouds(
     method: str = "exact",
     *,
     resolution: int = DEFAULT_RASTER_RESOLUTION,
-    between_clouds: bool = False,
+    between_clouds: bool | CellShadowing = False,
 ) -> list[np.ndarray]:
     """Incident light (N_i, L) of each cloud for each light that contributes (`active_lights`), all of it
     (`ALL_LIGHT`); with `between_clouds`, the sun's (the first light's) through the other clouds too
-    (`sun_through_others`)."""
+    (`sun_through_others`; a `CellShadowing`: a cloud field's cells through one another, `sun_through_other_cells`)."""
     clouds = list(clouds)
     columns = [
         illuminate_direction(clouds, shading, light.direction, method, resolution=resolution)
@@ -49,8 +51,14 @@ def illuminate_clouds(
         else np.zeros((len(cloud.particles), 0))
         for i, cloud in enumerate(clouds)
     ]
-    sun = shadowing_sun(lights) if between_clouds else None
-    return incident if sun is None else _dimmed(incident, sun_through_others(clouds, shading, sun))
+    sun = shadowing_sun(lights) if between_clouds is not False else None
+    if sun is None:
+        return incident
+    if isinstance(between_clouds, CellShadowing):
+        centres, radii, opacity, starts = beam_of(clouds, shading)
+        through = sun_through_other_cells(centres, radii, opacity, starts, between_clouds, sun)
+        return _dimmed(incident, np.split(through, starts[1:-1]))
+    return _dimmed(incident, sun_through_others(clouds, shading, sun))
 
 
 def shadowing_sun(lights) -> tuple[float, ...] | None:
@@ -64,21 +72,24 @@ def sun_through_others(clouds, shading: Shading, sun_direction) -> list[np.ndarr
     """Per cloud (N_i,): the share of the sun's beam from `sun_direction` the other clouds let reach each
     particle (`cloudcore.light.cloud_shadows.between_clouds_transmittance`)."""
     clouds = list(clouds)
-    counts = [len(c.particles) for c in clouds]
-    if sum(counts) == 0:
-        return [np.ones(n) for n in counts]
+    centres, radii, opacity, starts = beam_of(clouds, shading)
+    if len(radii) == 0:
+        return [np.ones(0) for _ in clouds]
+    return np.split(between_clouds_transmittance(centres, radii, opacity, starts, sun_direction), starts[1:-1])
+
+
+def beam_of(clouds, shading: Shading) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(centres (n, 3), radii (n,), beam opacity (n,), where each cloud's particles start (clouds + 1,)): the
+    clouds' particles concatenated as they take the sun's beam out (`beam_opacity`)."""
+    clouds = list(clouds)
+    starts = np.concatenate([[0], np.cumsum([len(c.particles) for c in clouds])]).astype(np.int64)
+    if not clouds:
+        return np.zeros((0, 3)), np.zeros(0), np.zeros(0), starts
     optics = [cloud_optics(c, shading) for c in clouds]
     opacity = beam_opacity(
         np.concatenate([o[0] for o in optics]), np.concatenate([o[1] for o in optics]), shading.phase, shading.g
     )
-    through = between_clouds_transmittance(
-        np.concatenate([c.centres for c in clouds]),
-        np.concatenate([c.radii for c in clouds]),
-        opacity,
-        np.concatenate([[0], np.cumsum(counts)]),
-        sun_direction,
-    )
-    return np.split(through, np.cumsum(counts)[:-1])
+    return np.concatenate([c.centres for c in clouds]), np.concatenate([c.radii for c in clouds]), opacity, starts
 
 
 def _dimmed(incident: list[np.ndarray], through: list[np.ndarray]) -> list[np.ndarray]:
@@ -150,19 +161,27 @@ class IlluminationCache:
         #: (id of the cloud, shading, method) -> (the cloud, {light direction: incident (N, 2): `light_parts`})
         self._entries: dict[tuple, tuple[Cloud, dict[tuple, np.ndarray]]] = {}
         self.last_recomputed = 0  # (cloud, light direction) pairs shaded by the last call
-        #: ((the clouds, shading, sun direction), the sun through the others per cloud): the last asked
+        #: ((the clouds, shading, sun direction, how they shadow one another), the sun through the others per
+        #: cloud): the last asked
         self._between: tuple[tuple, list[np.ndarray]] | None = None
         self.between_made = 0  # how many times the sun through the others was made
+        self._cells = SunThroughCells()  # a cloud field's cells through one another, per cloud
 
     def incident(
-        self, clouds, shading: Shading, lights, method: str = "exact", *, between_clouds: bool = False
+        self,
+        clouds,
+        shading: Shading,
+        lights,
+        method: str = "exact",
+        *,
+        between_clouds: bool | CellShadowing = False,
     ) -> list[np.ndarray]:
         """`illuminate_clouds(clouds, shading, lights, method, between_clouds=...)`, from what is held where it
         can be."""
         return self.light_parts(clouds, shading, lights, method, between_clouds=between_clouds)[0]
 
     def light_parts(
-        self, clouds, shading: Shading, lights, method: str = "exact", *, between_clouds: bool = False
+        self, clouds, shading: Shading, lights, method: str = "exact", *, between_clouds: bool | CellShadowing = False
     ) -> tuple[list[np.ndarray], list[np.ndarray]]:
         """(`incident`, and per cloud (N_i, L) the part of it a lit face sends back: `RETURNED_LIGHT`)."""
         clouds = list(clouds)
@@ -183,24 +202,33 @@ class IlluminationCache:
             ]
             for part in (ALL_LIGHT, RETURNED_LIGHT)
         ]
-        sun = shadowing_sun(lights) if between_clouds else None
+        sun = shadowing_sun(lights) if between_clouds is not False else None
         if sun is None:
             return parts[0], parts[1]
-        through = self._sun_through_others(clouds, shading, sun, method)
+        through = self._sun_through_others(clouds, shading, sun, method, between_clouds)
         return _dimmed(parts[0], through), _dimmed(parts[1], through)
 
-    def _sun_through_others(self, clouds, shading: Shading, sun, method: str) -> list[np.ndarray]:
-        """`sun_through_others`, kept while the clouds (by identity), their optics and the sun stay.  A dragged
+    def _sun_through_others(
+        self, clouds, shading: Shading, sun, method: str, between_clouds: bool | CellShadowing
+    ) -> list[np.ndarray]:
+        """`sun_through_others`, or a cloud field's cells' (`SunThroughCells`, which makes again only the clouds a
+        new set of cells reaches), kept while the clouds (by identity), their optics and the sun stay.  A dragged
         slider's look (the preview method) takes the one held for these clouds and optics whatever its sun: made on
         the thread that draws every look, it held a time-of-day drag's frames over a second (docs/atmosphere.md,
         "Cloud shadows": the clouds on one another); the look after the drag (the exact pass) makes it for its
         sun."""
-        source = (clouds, dataclasses.replace(shading, eye_pass=Shading().eye_pass), sun)
+        source = (clouds, dataclasses.replace(shading, eye_pass=Shading().eye_pass), sun, between_clouds)
         held = self._between
-        if held is not None and _same_clouds(held[0][0], clouds) and held[0][1] == source[1]:
+        # a field's shadowing can change with the same clouds (a clear cell came): held by its identity too
+        same_shadowing = held is not None and held[0][3] is between_clouds
+        if same_shadowing and _same_clouds(held[0][0], clouds) and held[0][1] == source[1]:
             if held[0][2] == sun or method == "preview":  # `cloudcore.light.shading`'s preview method
                 return held[1]
-        through = sun_through_others(clouds, shading, sun)
+        if isinstance(between_clouds, CellShadowing):
+            centres, radii, opacity, starts = beam_of(clouds, shading)
+            through = self._cells.through(clouds, centres, radii, opacity, starts, between_clouds, sun, source[1])
+        else:
+            through = sun_through_others(clouds, shading, sun)
         self._between = (source, through)
         self.between_made += 1
         return through

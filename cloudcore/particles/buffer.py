@@ -34,6 +34,7 @@ import numpy as np
 from cloudcore.artist.formation import core_distances, opacity_factor
 from cloudcore.artist.particle_styles import ParticleStyles, particle_styles
 from cloudcore.artist.sprites import CELL_PIXELS
+from cloudcore.field.shadow_cells import CellShadowing
 from cloudcore.light.illumination import IlluminationCache, cloud_optics, light_pass_method
 from cloudcore.light.lighting import active_lights
 from cloudcore.light.phase import phase_function
@@ -62,12 +63,13 @@ class ParticleBuffer:
         method: str = "exact",
         cache: IlluminationCache | None = None,
         styles: ParticleStyles | None = None,
-        between_clouds: bool = False,
+        between_clouds: bool | CellShadowing = False,
     ):
         """`cache` keeps the illumination of unchanged clouds between instances (the editor);
         `styles` (`cloudcore.artist.particle_styles`, by default at the default hour) say which clouds
         are sprites or artist-shaded; with `between_clouds` the sun reaches each cloud through the others
-        (`cloudcore.light.illumination.sun_through_others`)."""
+        (`cloudcore.light.illumination.sun_through_others`; a `CellShadowing`: a cloud field's cells through one
+        another)."""
         clouds = tuple(clouds)
         self.styles = styles if styles is not None else particle_styles(clouds, Lighting())
         self.phase, self.g = shading.phase, shading.g

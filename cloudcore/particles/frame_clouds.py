@@ -20,6 +20,7 @@ import numpy as np
 from cloudcore.artist.facing import CloudFacings
 from cloudcore.artist.formation import formation_state
 from cloudcore.artist.particle_styles import particle_styles
+from cloudcore.field.shadow_cells import CellShadowing, cell_shadowing
 from cloudcore.field.state import FieldState
 from cloudcore.field.weather import WeatherFieldState, update_weather_field, weather_drift
 from cloudcore.light.illumination import IlluminationCache
@@ -80,6 +81,8 @@ class FrameClouds:
         self.weather_state = WeatherFieldState()
         self._field_weights: np.ndarray | None = None
         self._cloud_weights: np.ndarray | None = None
+        #: (what it was made from, how the field's clouds shadow one another): (None, None) without a field
+        self._cell_shadowing: tuple[tuple | None, CellShadowing | None] = (None, None)
         self._air: AirMotion | None = None  # the wind applied to the authored clouds (None: still air)
         #: this frame's carried particles and units and the clouds' motion, and what they were made from
         self._carry_source, self._carry_made = None, None
@@ -117,11 +120,10 @@ class FrameClouds:
         settings: RenderSettings,
         time_s: float,
         lit_at: float | None,
-        between_clouds: bool,
     ) -> PreparedClouds:
         """The frame's clouds at the scene clock `time_s` for the eye `camera`, lit by `lights` and `ambient` of
-        `lighting` (`between_clouds`: the clouds shadow one another in the light pass), their light made for their
-        shapes at `lit_at` (by default `wind.light_time`'s) and carried on to `time_s`."""
+        `lighting` (with `settings.cloud_shadows`, the sun's light through the other clouds too), their light made
+        for their shapes at `lit_at` (by default `wind.light_time`'s) and carried on to `time_s`."""
         authored_clouds = len(scene.clouds)
         air = self._air_motion(scene)
         if air is not None:  # the clouds as their light is made now: at rest, while the wind only carries them
@@ -129,6 +131,9 @@ class FrameClouds:
             scene = dataclasses.replace(scene, clouds=air.lit_clouds(lit_at))
         field_carried = weather_drift(scene.wind, scene.cloud_field, scene.weather, time_s)
         scene, fade_keys = self._with_field(scene, camera, field_carried, time_s)
+        # the clouds shadow one another: a field's cells pair by pair, made again for the clouds a new set of cells
+        # reaches (`cloudcore.light.cell_shadows`)
+        between_clouds = settings.cloud_shadows and (self._cell_shadowing[1] if scene.cloud_field is not None else True)
         start = time.perf_counter()
         relit = self.lit.follow(
             (scene.clouds, scene.shading, lighting, illumination_method, between_clouds), lights, ambient
@@ -188,6 +193,7 @@ class FrameClouds:
         relative to the air, where the particle buffer's carry (`_carried`) then moves them."""
         if scene.cloud_field is None:
             self.weather_state, self._field_weights, self._cloud_weights = WeatherFieldState(), None, None
+            self._cell_shadowing = (None, None)
             return scene, (1.0,) * len(scene.clouds)
         eye_in_air = np.asarray(camera.position, dtype=np.float64) - carried
         frame, self.weather_state = update_weather_field(
@@ -196,10 +202,21 @@ class FrameClouds:
         authored = scene.particle_count
         self._field_weights = np.concatenate([np.ones(authored), frame.weights])
         self._cloud_weights = np.concatenate([np.ones(len(scene.clouds)), frame.mean_weights])
+        self._follow_cells(len(scene.clouds), authored)
         return (
             dataclasses.replace(scene, clouds=scene.clouds + frame.clouds),
             (1.0,) * len(scene.clouds) + frame.fade_keys,
         )
+
+    def _follow_cells(self, authored_clouds: int, authored_particles: int) -> None:
+        """Make how the field's clouds shadow one another (`cell_shadowing`) again when its cells changed: the
+        weather's parts' cells and places, by identity (an unchanged part is the same object)."""
+        state = self.weather_state
+        source = (authored_clouds, authored_particles, state.places, state.leading, [p.cells for p in state.parts])
+        held = self._cell_shadowing[0]
+        if held is None or held[:4] != source[:4] or any(a is not b for a, b in zip(held[4], source[4], strict=True)):
+            shadowing = cell_shadowing(authored_clouds, authored_particles, state.parts, state.places, state.leading)
+            self._cell_shadowing = (source, shadowing)
 
     def _air_motion(self, scene: Scene) -> AirMotion | None:
         """The wind applied to the scene's authored clouds (`cloudcore.world.wind.AirMotion`), made again for other
@@ -264,7 +281,9 @@ class FrameClouds:
             between_clouds=between_clouds,
         )
         old = self.lit.value
-        same_lighting = old is not None and self.lit.source[1:] == source[1:]
+        # a field's new cells shadow anew (another `CellShadowing`): the keys stay where the light stays
+        same_lighting = old is not None and self.lit.source[1:4] == source[1:4]
+        same_lighting = same_lighting and (self.lit.source[4] is False) == (between_clouds is False)
         # by identity, not place: a cloud field's clouds that stay keep their keys when others come and go, unless
         # the light reaching them changed (the clouds shadow one another: one moved, another's shadow moves)
         held = (

@@ -18,21 +18,13 @@ from cloudcore.light.illumination import IlluminationCache, illuminate_clouds, s
 from cloudcore.light.lighting import scene_lights
 from cloudcore.maths.colour import srgb_decode
 from cloudcore.model.cloud_records import Formation
-from cloudcore.model.scene import Camera, Cloud, Light, Lighting, Scene, Shading, Terrain
+from cloudcore.model.scene import Camera, Light, Lighting, Scene, Shading, Terrain
 from cloudcore.model.settings import FULL_3D
 from cloudcore.world.camera import projection_matrix, view_matrix
 from cloudcore.world.sun import sun_direction
-from tests.conftest import RENDER_HEIGHT, RENDER_WIDTH
+from tests.conftest import RENDER_HEIGHT, RENDER_WIDTH, ball
 
 SUN = sun_direction(15.5)
-
-
-def ball(centre, radius_m=250.0, particles=1000, seed=1) -> Cloud:
-    """A round cloud of `particles` 40 m particles within `radius_m` of `centre`."""
-    rng = np.random.default_rng(seed)
-    offsets = rng.normal(size=(particles, 3))
-    offsets *= (radius_m * rng.uniform(0.0, 1.0, particles) ** (1 / 3) / np.linalg.norm(offsets, axis=1))[:, None]
-    return Cloud(f"ball {seed}", np.column_stack([np.asarray(centre) + offsets, np.full(particles, 40.0)]))
 
 
 def ground_point_along_sun(point, sun, ground_y=0.0) -> np.ndarray:

@@ -155,7 +155,9 @@ def test_the_field_s_ring_is_kept_while_only_blend_weights_change_and_keeps_up_w
     from cloudcore.lod.ring import SEGMENTS
     from cloudcore.measure.imagecompare import compare
 
-    settings = RenderSettings(mode="impostor", ring_radius=2000.0)
+    # without the clouds' shadows: with them, the cells that enter at 12 m shadow clouds behind them, whose light
+    # and so the ring's panels change (docs/atmosphere.md#a-cloud-fields-clouds-on-one-another)
+    settings = RenderSettings(mode="impostor", ring_radius=2000.0, cloud_shadows=False)
     scene = Scene(camera=ABOVE, cloud_field=FIELD)
 
     def at(x: float) -> Camera:  # just above the field, looking ahead: its far clouds within the ring's band
@@ -176,7 +178,7 @@ def test_the_field_s_ring_is_kept_while_only_blend_weights_change_and_keeps_up_w
         ring = impostors.lod_state.ring
         assert ring.current.eye == at(2000.0).position and ring.pending is None
         assert stats.plan.ring_segments_built > 0 and stats.plan.clouds_by_kind["ring"] > 0
-        reference, _ = full.render(scene, camera=at(2000.0), settings=FULL_3D)
+        reference, _ = full.render(scene, camera=at(2000.0), settings=dataclasses.replace(FULL_3D, cloud_shadows=False))
         assert compare(image, reference).psnr_db > 35.0
 
 

@@ -1,6 +1,8 @@
 """The planet's ground past the terrain's square (`cloudcore.light.far_ground`): the world pass's sky draws it as the
 numpy sky does, the terrain's edge meets it without a line, and it hides a cloud behind it as the terrain would."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -12,7 +14,7 @@ from cloudcore.maths.colour import linear_to_srgb8
 from cloudcore.model.scene import Camera, Cloud, Lighting, Scene, Terrain
 from cloudcore.model.settings import FULL_3D
 from cloudcore.world.camera import pixel_rays
-from tests.conftest import RENDER_HEIGHT, RENDER_WIDTH
+from tests.conftest import RENDER_HEIGHT, RENDER_WIDTH, ball
 
 pytestmark = pytest.mark.gl
 
@@ -85,3 +87,48 @@ def test_a_cloud_behind_the_ground_past_the_terrain_is_hidden_by_it(renderer):
         for clouds in ((), (Cloud("buried", buried),))
     ]
     assert np.abs(pictures[1].astype(int) - pictures[0].astype(int)).max() <= 1
+
+
+def shadow_across_the_edge() -> tuple[Scene, np.ndarray]:
+    """A cloud 3 km up whose shadow falls across the patch's edge, and the edge's point at its centre's shadow."""
+    sun = np.asarray(scene_lights(LIGHTING)[0][0].direction)
+    shadow = np.array([-HALF_SIDE, 0.0, 0.0])
+    centre = shadow + (3000.0 / sun[1]) * sun
+    cloud = ball(centre, particles=800, seed=4)
+    # level: the far ground lies at its edge's height, so a hill's edge would step the shadow by its height
+    flat = dataclasses.replace(PATCH, height=0.0)
+    return Scene(lighting=LIGHTING, terrain=flat, clouds=(cloud,)), shadow
+
+
+def test_the_clouds_shadow_the_ground_past_the_terrain_as_the_terrain_without_a_seam(renderer):
+    """Looked down onto a cloud's shadow across the patch's edge (the cloud out of view, above the eye): the ground
+    past the edge is in the shadow as the terrain is, their shadow factors (with over without the shadows) meet at
+    the edge; away from the cloud, off the map, the ground past the edge is drawn as without shadows."""
+    scene, shadow = shadow_across_the_edge()
+    camera = Camera(tuple(shadow + [0.0, 1200.0, 0.0]), tuple(shadow + [0.0, 0.0, 60.0]), 50.0)
+    looks = [
+        renderer.render(scene, camera=camera, settings=dataclasses.replace(FULL_3D, cloud_shadows=on), read_back=False)
+        and renderer.context.read_linear_rgb()
+        for on in (True, False)
+    ]
+    factor = looks[0].mean(axis=-1) / looks[1].mean(axis=-1)
+    hits = ground_hits(camera)
+    past = hits[..., 0] < -HALF_SIDE
+    assert 0.2 < past.mean() < 0.8
+    near_edge = np.abs(hits[..., 0] + HALF_SIDE) < 60.0
+    shaded = near_edge & (factor < 0.8)
+    assert (shaded & past).sum() > 20 and (shaded & ~past).sum() > 20  # the shadow on both sides of the edge
+    assert factor[past].min() < 0.6  # as deep as on the terrain
+    for row in range(RENDER_HEIGHT):  # no step in the factor across the edge beyond its steps on either side
+        edge = int(np.argmin(np.abs(hits[row, :, 0] + HALF_SIDE)))
+        across = abs(factor[row, edge + 1] - factor[row, edge - 1])
+        beside = np.abs(factor[row, edge - 8 : edge + 9][2:] - factor[row, edge - 8 : edge + 9][:-2])
+        assert across <= max(np.delete(beside, 7).max() + 0.02, 0.02), f"row {row}: {factor[row, edge - 8 : edge + 9]}"
+    # off the map (the cloud's footprint along the sun), the ground past the edge as without shadows
+    away = Camera(OUTSIDE.position, tuple(np.asarray(OUTSIDE.look_at) + [0.0, 0.0, 6000.0]), 40.0)
+    pictures = [
+        renderer.render(scene, camera=away, settings=dataclasses.replace(FULL_3D, cloud_shadows=on))[0].astype(int)
+        for on in (True, False)
+    ]
+    far = ground_hits(away)[..., 0] < -HALF_SIDE - 300.0
+    assert far.mean() > 0.2 and np.array_equal(pictures[0][far], pictures[1][far])

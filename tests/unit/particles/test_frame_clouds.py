@@ -30,7 +30,7 @@ def two_clouds() -> Scene:
 
 def prepared(clouds: FrameClouds, scene: Scene, time_s: float = 0.0, settings: RenderSettings = FULL_3D):
     lights, ambient = scene_lights(scene.lighting)
-    return clouds.prepare(scene, scene.camera, scene.lighting, lights, ambient, "exact", settings, time_s, None, True)
+    return clouds.prepare(scene, scene.camera, scene.lighting, lights, ambient, "exact", settings, time_s, None)
 
 
 def test_a_frame_like_the_last_remakes_nothing(two_clouds):
