@@ -267,7 +267,9 @@ class FrameRenderer:
                 self.context.bind_target()
                 drawn = self._cloud_pass.draw(frame)
         drawn_by_gpu, rendered_by_gpu = self._splats.take_selected()
-        self._observe(frame, drawn.compositable, drawn.particles + drawn_by_gpu + rendered + rendered_by_gpu)
+        self._observe(
+            frame, drawn.compositable, drawn.particles + drawn_by_gpu + rendered + rendered_by_gpu, before_passes_ms
+        )
         return self._statistics(
             frame, ready.illumination_ms, before_passes_ms, drawn, drawn_by_gpu, rendered + rendered_by_gpu
         )
@@ -390,13 +392,14 @@ class FrameRenderer:
                 shadows=self._shadows,
             )
 
-    def _observe(self, frame: CloudPassFrame, compositable: int, particles: int) -> None:
+    def _observe(self, frame: CloudPassFrame, compositable: int, particles: int, plan_ms: float) -> None:
         """Fold the timed passes into the plan's cost fit, and into the measured ways' choices: the particles
-        drawn and rendered into impostors, and those of draws either compositing way could composite."""
+        drawn and rendered into impostors, and those of draws either compositing way could composite; auto mode's
+        choice of a frame's way counts the plan's `plan_ms` too."""
         updates, clouds = (self._clock.times[name] for name in ("impostor updates", "clouds"))
         plan, mode = frame.plan, frame.settings.mode
         self.lod_state = plan.state.measured(
-            [(plan.update_work, updates.wall_ms), (plan.cloud_work, clouds.wall_ms)], fit=plan.priced
+            [(plan.update_work, updates.wall_ms), (plan.cloud_work, clouds.wall_ms)], fit=plan.priced, plan_ms=plan_ms
         )
         self.splat_order = self.splat_order.observe(frame.splat_order, updates.wall_ms + clouds.wall_ms, particles)
         compositing = self.compositing.get(mode, MeasuredWay(COMPOSITING_WAYS))

@@ -445,6 +445,7 @@ def plan_ring(
     build_ms: Callable[[Hashable], float] | None = None,
     step=None,
     heights=None,
+    at_once: bool = False,
 ) -> RingPlan | None:
     """Advance the ring by one frame: start a rebuild if needed, build one segment or step the fade.
 
@@ -463,7 +464,9 @@ def plan_ring(
     frame (None: still), which sets the rebuild's pace (`rebuild_frames`): where a segment a frame and the fade
     would take longer than the eye takes to move a quarter of a rebuild distance, the segments are built several
     a frame, whole, and the fade is shortened, down to the whole ring built and shown in one frame.  `heights`:
-    the spheres' splats' lowest and highest reach (`ring_members`; None: the spheres alone).
+    the spheres' splats' lowest and highest reach (`ring_members`; None: the spheres alone).  `at_once`: a ring of
+    no clouds asked for (`holds_clouds` False) is shown in this frame, unfaded: auto mode heading all to full 3D
+    draws the ring's clouds so at once, where a fade would draw each as an impostor made for it.
 
     A ring being built when its members' keys change is finished first and rebuilt after: a cloud
     forming in the ring, whose key changes every frame, would otherwise keep the ring from ever
@@ -491,10 +494,18 @@ def plan_ring(
             and _needs_rebuild(current, eye, settings, cloud_keys, present, texture_size, holds_clouds, past_tolerance)
         )
     ):
-        if current is not None or state.pending is not None:
-            since_rebuild, rebuild_interval = 0, float(since_rebuild)
+        newest = state.pending or current
+        if newest is not None:
+            # the frames a ring of clouds lasted, what its next rebuild is priced over (`pricing.ring_work`); a ring
+            # dropped or taken up by auto mode's choice says nothing of it (dropped a frame after a rebuild began,
+            # the climb's ring was priced at a rebuild a frame, 658 ms, and never taken up again)
+            if newest.holds_clouds and holds_clouds:
+                rebuild_interval = float(since_rebuild)
+            since_rebuild = 0
         pending = new_generation(centres, radii, eye, settings, cloud_keys, ids, texture_size, holds_clouds, heights)
         built, fade_step = (0 if holds_clouds else SEGMENTS), 0  # a ring of nothing has nothing to build
+    if at_once and pending is not None and not pending.holds_clouds:
+        fade_step = settings.ring_fade_frames
     built_of_segment = state.built_of_segment if pending is state.pending else 0
     builds, building = (), pending
     pace = rebuild_pace(step, settings)

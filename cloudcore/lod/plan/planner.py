@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Hashable
 
 import numpy as np
@@ -86,7 +87,7 @@ from cloudcore.maths.depth_upsampling import reduced_size
 from cloudcore.model.scene import Camera
 from cloudcore.model.settings import AUTO_SCALE, RenderSettings
 from cloudcore.world.camera import frustum_planes, projection_matrix, spheres_in_frustum, view_matrix
-from cloudcore.world.wind import CloudMotion
+from cloudcore.world.wind import CloudMotion, shape_change_bound_m
 
 
 def plan_frame(
@@ -160,7 +161,9 @@ def plan_frame(
         if motion is not None and state.time_s is not None
         else None
     )
-    seen = seen_from(priced_units, pricing, priced=prices_units(settings), air_steps=air_steps)
+    seen = seen_from(
+        priced_units, pricing, priced=prices_units(settings), air_steps=air_steps, turbulence=_turbulence(motion, state)
+    )
     arguments = {
         "pricing": pricing,
         "seen": seen,
@@ -342,6 +345,9 @@ def _plan_units(
         build_ms=lambda members: costs.particles * float(units.particle_counts[units.row_of[members]]),
         step=step,
         heights=units.heights,
+        # heading all to full 3D, the ring's clouds are drawn so at once, not faded out through impostors made for
+        # the fade (the churning field: 67 made in the frame of the switch)
+        at_once=all_full,
     )
 
     def particles_of(index: int) -> np.ndarray:
@@ -583,20 +589,29 @@ def _plan_units(
             quad_pixels=float(np.sum(prices.quad_pixels[~whole]) + screen_pixels * np.count_nonzero(fading)),
             quads=float(np.count_nonzero(~whole)),
         )
-        for k in np.flatnonzero(~whole).tolist():
-            index = int(outside[k])
+        # the impostors shown, each asked why it is remade: hundreds a frame where the ring is not kept (the climb)
+        rows_shown = np.flatnonzero(~whole)
+        for k, index, size, error in zip(
+            rows_shown.tolist(),
+            outside[rows_shown].tolist(),
+            prices.textures.sizes[rows_shown].tolist(),
+            held_errors[outside[rows_shown]].tolist(),
+        ):
             record = records.get(units.members[index])
             reason = regeneration_reason(
                 record,
-                int(prices.textures.sizes[k]),
-                unit_key(index),
+                size,
+                unit_key(index) if record is not None else None,  # none held: "new", whatever its key
                 tolerance,
-                float(held_errors[index]),
-                record is not None and layers_changed(index, record),
+                error,
+                # a unit no object reaches, and whose impostor had no layers, keeps them (most: no per-unit call)
+                record is not None
+                and (index in holding or bool(record.split_objects))
+                and layers_changed(index, record),
             )
             if reason is not None:
                 reasons[index] = reason
-                ratio = float(held_errors[index]) / max(tolerance, 1e-300)
+                ratio = error / max(tolerance, 1e-300)
                 split = bool(splits_of.get(index, ((), ()))[1])
                 priority = regeneration_priority(reason, ratio, split, float(prices.textures.pixels[k]))
                 wanted.append((index, priority, prices.remake(k)))
@@ -610,11 +625,15 @@ def _plan_units(
     # the largest translation error drawn, over the tolerance
     accepted = 0.0 if chases_tolerance or ring is None or not ring.draws else ring_error / max(tolerance, 1e-300)
     regenerate, postponed = {}, {}
-    for index in np.flatnonzero(of_kinds(kinds, *TEXTURED)).tolist():
+    textured = np.flatnonzero(of_kinds(kinds, *TEXTURED))
+    # the impostors drawn as they were, not remade this frame: their errors
+    kept = textured[~np.isin(textured, np.fromiter(served, dtype=np.int64, count=len(served)))]
+    kept = kept[np.fromiter((units.members[i] in records for i in kept.tolist()), dtype=bool, count=len(kept))]
+    if len(kept):  # (full mode holds no impostors, and measures no errors)
+        accepted = max(accepted, float(np.max(held_errors[kept])) / max(tolerance, 1e-300))
+    for index in textured.tolist():
         members = units.members[index]
         record = records.get(members)
-        if index not in served and record is not None:
-            accepted = max(accepted, float(held_errors[index]) / max(tolerance, 1e-300))
         if index in served:
             record = next_records[members] = ImpostorRecord(
                 tuple(float(v) for v in eye),
@@ -793,6 +812,15 @@ def _cloud_pass(
     if reduced_scale == 1.0:
         return 1.0, plans, items, at(1.0, plans, items)
     return reduced_scale, reduced_plans, reduced_items, at(reduced_scale, reduced_plans, reduced_items)
+
+
+def _turbulence(motion: CloudMotion | None, state: LodState) -> tuple[float, float] | None:
+    """(metres turbulence may have moved a particle within its cloud since last frame, the most it may move one) under
+    `motion`, for an impostor's lifetime (`seen_from`); None in still air, without turbulence or a last frame."""
+    if motion is None or motion.wind is None or state.time_s is None:
+        return None
+    step = float(motion.shape_change_m([state.time_s])[0])
+    return (step, shape_change_bound_m(motion.wind, math.inf)) if step > 0.0 else None
 
 
 def _ring_shift(generation, rows: np.ndarray, centres: np.ndarray) -> np.ndarray:

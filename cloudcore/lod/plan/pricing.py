@@ -65,11 +65,13 @@ class Seen:
         return Seen(*(getattr(self, field.name)[rows] for field in dataclasses.fields(self)))
 
 
-def seen_from(units: LodUnits, pricing: Pricing, priced: bool = True, air_steps=None) -> Seen:
+def seen_from(units: LodUnits, pricing: Pricing, priced: bool = True, air_steps=None, turbulence=None) -> Seen:
     """What is seen of `units` from this frame's eye (`pricing`).  Not `priced` (full 3D), only the distances:
     every price zero.  `air_steps` (units, 3): how far the wind carried each unit since last frame (None: still
     air); relative to a unit, last frame's eye was that much further along, and its impostor lives as long as the
-    eye's step relative to it allows."""
+    eye's step relative to it allows.  `turbulence`: (metres a frame, metres at most) that turbulence may move a
+    particle within its cloud (None: none), which `held_impostor_errors` adds to an impostor's error: it shortens
+    the impostor's life as the parallax does (`_lifetimes`)."""
     eye, last_eye, focal_px, screen_pixels = pricing.eye, pricing.last_eye, pricing.focal_px, pricing.screen_pixels
     centres, radii = units.centres, units.radii
     distances = row_lengths(centres - eye)
@@ -103,13 +105,33 @@ def seen_from(units: LodUnits, pricing: Pricing, priced: bool = True, air_steps=
         quad_pixels,
         np.minimum.reduce(
             [
-                np.divide(pricing.tolerance, rates, out=np.full(len(radii), math.inf), where=rates > 0.0),
+                _lifetimes(pricing.tolerance, rates, distances - radii, turbulence),
                 split_lifetimes,
                 np.full(len(radii), LONGEST_LIFETIME_FRAMES),
             ]
         ),
         layers,
     )
+
+
+def _lifetimes(tolerance: float, rates, gaps, turbulence) -> np.ndarray:
+    """Frames until an impostor made now passes `tolerance` degrees: its parallax grows by `rates` degrees a frame,
+    and under `turbulence` (metres a frame, metres at most: `seen_from`) the change of its particles seen from the
+    sphere's near side (`gaps` metres off) grows by at most that step's angle a frame, up to the angle of the most
+    (`held_impostor_errors` adds the same).  Under a churning wind an impostor priced by its parallax alone was
+    remade every few frames at a price that had it last until the eye moved."""
+    if turbulence is None or turbulence[0] <= 0.0:
+        return np.divide(tolerance, rates, out=np.full(len(rates), math.inf), where=rates > 0.0)
+    step_m, most_m = turbulence
+    near = np.maximum(gaps, 0.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        shape_rates = np.degrees(np.divide(step_m, near, out=np.full(len(rates), math.inf), where=near > 0.0))
+        most_deg = np.degrees(np.arctan2(most_m, near))
+        # both growing (the angle of a step is at least what it adds to the angle: a bound) until the change
+        # reaches its most; past that, the parallax alone has what the change left of the tolerance
+        together = tolerance / (rates + shape_rates)
+        parallax_after = np.divide(tolerance - most_deg, rates, out=np.full(len(rates), math.inf), where=rates > 0.0)
+        return np.where(together <= most_deg / shape_rates, together, parallax_after)
 
 
 def _split_lifetimes(units: LodUnits, reach, object_radii, depth_steps) -> np.ndarray:

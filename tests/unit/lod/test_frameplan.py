@@ -970,6 +970,50 @@ def test_a_ring_that_stops_paying_fades_its_clouds_back_to_the_plan():
     assert all(p.ring.build_segment is None and p.ring.draws[0][0].members == frozenset() for p in later)
 
 
+def test_a_ring_dropped_by_the_choice_leaves_the_rings_lifetime_alone():
+    """The frames a ring of clouds lasted price its next rebuild; a ring handed back because it stopped paying is no
+    rebuild (the climb's ring, dropped a frame after a rebuild began, was priced at a rebuild a frame after)."""
+    _, state = run_auto_ring(SETTLE, regeneration_heavy(200.0))
+    before = state.ring.rebuild_interval
+    _, state = run_auto_ring(RING.ring_fade_frames + 1, regeneration_heavy(10.0), state)
+    assert not state.ring.current.holds_clouds and state.ring.rebuild_interval == before
+
+
+def test_heading_all_to_full_3d_the_ring_s_clouds_are_drawn_so_at_once():
+    """The frame's measured choice turned to full 3D: the ring's clouds go straight to full 3D, its panels gone in
+    that frame, where a fade would have drawn each from an impostor made for it."""
+    _, state = run_auto_ring(SETTLE, regeneration_heavy(200.0))
+    assert state.ring.current.holds_clouds and state.ring.current.members
+    (switched,), _ = run_auto_ring(1, regeneration_heavy(200.0), dataclasses.replace(state, frame_choice="full"))
+    kinds = {c.kind for c in switched.clouds}
+    assert kinds == {"full", "culled"} and not switched.clouds.regenerate
+    assert [(generation.members, weight) for generation, weight in switched.ring.draws] == [(frozenset(), 1.0)]
+
+
+@pytest.mark.parametrize("frame_choice, kind", [(None, "crossfade"), ("full", "full")])
+def test_heading_all_to_full_3d_an_impostor_within_the_tolerance_switches_at_once(frame_choice, kind):
+    """A unit's own switch to full 3D crossfades from an impostor past half the tolerance; the frame's switch to full
+    3D (measured, at most every `MEASUREMENT_AGE_FRAMES`) takes it at once while within the tolerance, a step no
+    larger than a regeneration's."""
+    settings = dataclasses.replace(NO_RING, mode="auto", transition_frames=4)
+    state = LodState()
+    for frame in range(4):
+        if frame == 3:
+            state = dataclasses.replace(state, frame_choice=frame_choice)
+        p = plan(
+            camera_at((frame * 2.0, 0.0, 300.0), (frame * 2.0, 0.0, 0.0)),
+            settings,
+            state=state,
+            costs=FILL_BOUND if frame < 3 else UPKEEP_BOUND,
+            finest_radii=FINEST,
+        )
+        state = p.state
+    record = state.records[(0,)]
+    error = parallax_error_deg((0.0, 0.0, 0.0), RADIUS, record.eye, (6.0, 0.0, 300.0))
+    assert 0.5 * p.tolerance_deg < error <= p.tolerance_deg  # past half the tolerance, within it
+    assert p.clouds[0].kind == kind
+
+
 def ring_prices_along(looks_at, costs_of=lambda frame: regeneration_heavy(200.0)):
     """The frame each plan's ring prices were made in, auto mode over the far field (the same units each frame,
     as the renderer keeps them) from a still eye looking at `looks_at[i]` in frame i, priced by `costs_of(i)`."""
@@ -1080,6 +1124,9 @@ def test_auto_mode_draws_a_frame_all_in_full_3d_where_that_measures_cheaper():
     drawn = [p.state.drawn_as for p in plans]
     first_full = drawn.index("full")
     assert FRAME_SETTLE_FRAMES + PROBE_FRAMES <= first_full and set(drawn[first_full:]) == {"full"}
+    # the switch made at once (a still eye's impostors are full 3D's picture), the next frame is planned as full
+    # mode plans it, no unit priced
+    assert plans[first_full].priced and not any(p.priced for p in plans[first_full + 1 :])
     assert {c.kind for c in plans[-1].clouds} == {"full"} and plans[-1].ring is None
     assert state.frame_times["full"].mean_ms == pytest.approx(10.0)
     stats = plans[-1].stats()  # what the Statistics panel shows

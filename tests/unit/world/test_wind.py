@@ -11,8 +11,10 @@ import pytest
 
 from cloudcore.field.state import update_field
 from cloudcore.light.cloud_shadows import light_space
+from cloudcore.lod.costs import CostModel
 from cloudcore.lod.impostors import ImpostorRecord, parallax_errors_deg
-from cloudcore.lod.plan.pricing import held_impostor_errors, pricing_of, seen_from
+from cloudcore.lod.plan import plan_frame
+from cloudcore.lod.plan.pricing import LONGEST_LIFETIME_FRAMES, held_impostor_errors, pricing_of, seen_from
 from cloudcore.lod.plan.state import LodState
 from cloudcore.lod.units import LodUnits
 from cloudcore.model.errors import FieldError
@@ -195,6 +197,43 @@ def test_turbulence_since_an_impostor_was_made_adds_its_angle():
     motion = CloudMotion(np.zeros((1, 3)), 120.0, wind, np.zeros((1, 3)))
     error = held_impostor_errors(units, np.array([0]), records, parallax_errors_deg, eye, motion, np.zeros((1, 3)))
     np.testing.assert_allclose(error, [math.degrees(math.atan2(60.0, 3000.0))])
+
+
+def test_turbulence_shortens_an_impostor_s_priced_life_as_it_grows_its_error():
+    """A still eye: in still air an impostor lasts (the longest priced); under turbulence its error grows by the angle
+    of a frame's change seen from the sphere's near side, until the tolerance, or not at all where the most it may
+    change stays within it."""
+    units = LodUnits.of_spheres([[0.0, 1000.0, 0.0]], [300.0])
+    camera = Camera((0.0, 1000.0, 3300.0), (0.0, 1000.0, 0.0), 60.0)
+    settings = RenderSettings(ring_radius=math.inf, tolerance_deg=0.5)
+    pricing = pricing_of(camera, (640, 480), settings, LodState(eye=camera.position), ())
+    still = seen_from(units, pricing).lifetimes[0]
+    churning = seen_from(units, pricing, turbulence=(5.0, 60.0)).lifetimes[0]
+    assert still == LONGEST_LIFETIME_FRAMES
+    assert churning == pytest.approx(0.5 / math.degrees(5.0 / 3000.0), rel=1e-12)  # 5.2 frames
+    # at most 10 m of change, 0.19 degrees from 3 km: the tolerance is never passed by it alone
+    assert seen_from(units, pricing, turbulence=(5.0, 10.0)).lifetimes[0] == LONGEST_LIFETIME_FRAMES
+
+
+def test_under_turbulence_an_impostor_whose_remaking_costs_more_than_it_saves_is_planned_full_3d():
+    """One cloud 3 km off, a still eye, each regeneration 10 ms and full 3D 1 ms: in still air its impostor lasts and
+    is the cheaper; under 30 m of turbulence at 2 s a frame it is remade every few frames, and auto mode heads to
+    full 3D."""
+    units = LodUnits.of_spheres([[0.0, 1000.0, 0.0]], [300.0], None, [1000.0], [1000.0 * 40.0**2])
+    camera = Camera((0.0, 1000.0, 3300.0), (0.0, 1000.0, 0.0), 60.0)
+    settings = RenderSettings(mode="auto", ring_radius=math.inf)
+    costs = CostModel(particles=1e-3, fragments=1e-9, texture_fragments=1e-9, quad_pixels=1e-9, regenerations=10.0)
+    churn = Wind(bands=((0.0, 0.0, 0.0),), turbulence_m=30.0, turbulence_period_s=60.0)
+    targets = {}
+    for name, wind in (("still air", None), ("churn", churn)):
+        state = LodState()
+        for time_s in (0.0, 2.0, 4.0):
+            motion = CloudMotion(np.zeros((1, 3)), time_s, wind, np.zeros((1, 3)))
+            planned = plan_frame(units, camera, (640, 480), settings, state, 1, costs=costs, motion=motion)
+            state = planned.state
+        targets[name] = (state.representations[(0,)].target, planned.clouds[0].impostor_ms)
+    assert targets["still air"][0] == "impostor" and targets["churn"][0] == "full"
+    assert targets["churn"][1] > 10.0 * targets["still air"][1]
 
 
 FILE = """
