@@ -260,13 +260,17 @@ def model_names(text: str) -> tuple[str, ...]:
 
 
 def _model_renders(scene, camera, args) -> dict[str, tuple[np.ndarray, dict, float]]:
-    """Each model's full-3D picture of the truth's world (the sky; no terrain, no objects)."""
+    """Each model's full-3D picture of the truth's world (the sky; no terrain, no objects, no air)."""
     # headless: EGL must be chosen before OpenGL is first imported
     os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
     from cloudcore.gl import FrameRenderer
     from cloudcore.model.settings import FULL_3D
 
     world = dataclasses.replace(scene, terrain=None, objects=())
+    # the truth's clouds hang in empty space before the sky: the models are drawn without the air too (its shafts
+    # and aerial perspective took about 1 dB of every model's PSNR; docs/shading.md, "Five views with the lit face
+    # in the eye pass")
+    settings = dataclasses.replace(FULL_3D, light_shafts=False, aerial_perspective=False)
     renders = {}
     with FrameRenderer(args.width, args.height) as renderer:
         for name in args.models:
@@ -274,7 +278,7 @@ def _model_renders(scene, camera, args) -> dict[str, tuple[np.ndarray, dict, flo
             model_world = dataclasses.replace(world, shading=dataclasses.replace(world.shading, eye_pass=eye_pass))
             start = time.perf_counter()
             image, stats = renderer.render(
-                model_world, camera=camera, time_of_day=args.time_of_day, illumination_method=method, settings=FULL_3D
+                model_world, camera=camera, time_of_day=args.time_of_day, illumination_method=method, settings=settings
             )
             renders[name] = (image, stats, time.perf_counter() - start)
     return renders
