@@ -47,7 +47,6 @@ from cloudcore.world.terrain_tiles import (
     TerrainTiles,
     grid_face_count,
     tile_faces,
-    tile_frame,
 )
 
 #: the light shafts' depth of the terrain takes every 4th vertex of a tile's grid: the frames agree closely with the
@@ -277,12 +276,9 @@ class WorldPass:
         self._far_ground = (
             ground_behind_the_air(far_ground_colour(terrain, light)) if sky.physical and terrain is not None else None
         )
-        #: (its sun's part, its level, the terrain's half side) where the clouds' shadows fall on it
-        #: (sky_read.frag.glsl's FAR_GROUND_SHADOWS)
+        #: (its sun's part, its level) where the clouds' shadows fall on it (sky_read.frag.glsl's FAR_GROUND_SHADOWS)
         self._far_ground_shadowed = (
-            None
-            if self._far_ground is None
-            else (far_ground_sun(terrain, light), far_ground_level(terrain), tile_frame(terrain).half_side_m)
+            None if self._far_ground is None else (far_ground_sun(terrain, light), far_ground_level(terrain))
         )
         self._uploaded_view = None  # the sky-view table the texture holds
         # core profile draws nothing without a vertex array, even one with no attributes
@@ -480,7 +476,7 @@ class WorldPass:
         if shadowed:
             shadows.bind(program)
             self._set_sky_view_uniforms(program, sky)
-            sun_part, level, _ = self._far_ground_shadowed
+            sun_part, level = self._far_ground_shadowed
             set_vec3(program, "far_ground_sun", sun_part)
             set_vec3(program, "eye", camera.position)
             GL.glUniform1f(GL.glGetUniformLocation(program, "far_ground_y"), level)
@@ -492,9 +488,9 @@ class WorldPass:
             return False
         columns = FAR_GROUND_SHADOW_GRID
         rows = max(1, round(columns * size[1] / size[0]))
-        _, level, half_side = self._far_ground_shadowed
         rays = pixel_rays(camera, columns, rows)
-        return bool(in_shadow_map(camera.position, rays, shadows.space, half_side, level).any())
+        level = self._far_ground_shadowed[1]
+        return bool(in_shadow_map(camera.position, rays, shadows.space, self._terrain_half_side_m(), level).any())
 
     def _sky_program(self, shafts: bool, sun_disc: bool = False) -> int:
         """The sky's program, less the light `shafts` take where asked; the sun's disc alone for `sun_disc`."""
