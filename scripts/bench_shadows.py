@@ -34,7 +34,7 @@ from cloudcore.resources import DEFAULT_SCENE  # noqa: E402
 from cloudcore.scenes.files import load_scene  # noqa: E402
 from cloudcore.world.terrain import heightfield_mesh  # noqa: E402
 
-RESOLUTIONS = (256, 384, 512, 768, 1024)
+RESOLUTIONS = (128, 192, 256, 384, 512, 768, 1024)
 REFERENCE_RESOLUTION = 2048
 HOURS = (12.0, 15.5, 18.25)
 

@@ -72,17 +72,52 @@ def atmosphere_tables(params: AtmosphereParameters) -> AtmosphereTables:
 
 @dataclass(frozen=True, eq=False)
 class SkyView:
-    """The sky seen from one altitude under one sun: its sky-view table and the lookup into it."""
+    """The sky seen from one altitude under one sun: its sky-view table and the lookup into it.
+
+    The table is built when first read: the editor's world pass reads the sky from the eye's altitude
+    (`SkyBackground.seen_from`), not the scene origin's it is made from, whose table, built for nothing, cost each
+    look of a dragged time-of-day slider a coarse table more and a released one a full table more
+    (docs/performance.md, "A look's parts")."""
 
     tables: AtmosphereTables
     altitude_m: float
     sun_direction: np.ndarray  # (3,) unit, toward the sun
-    #: the air's light along each view, in front of the ground below the horizon (`sky_view.build_sky_view_table`)
-    table: np.ndarray  # (108, 192, 3)
-    #: the air's transmittance along each of the table's rows, to the ground below the horizon
-    row_transmittance: np.ndarray  # (108, 3)
     #: a dragged slider's coarser sky (`sky_seen_from`), whose air between the eye and what it sees is coarser too
     preview: bool = False
+
+    @property
+    def table(self) -> np.ndarray:
+        """(108, 192, 3): the air's light along each view, in front of the ground below the horizon
+        (`sky_view.build_sky_view_table`)."""
+        return self._tables()[0]
+
+    @property
+    def row_transmittance(self) -> np.ndarray:
+        """(108, 3): the air's transmittance along each of the table's rows, to the ground below the horizon."""
+        return self._tables()[1]
+
+    def built(self) -> SkyView:
+        """This sky with its table built now: where a worker makes it (`cloudcore.light.live_air`), not in the
+        frame that first reads it."""
+        self._tables()
+        return self
+
+    def _tables(self) -> tuple[np.ndarray, np.ndarray]:
+        # held on the instance without a lock (functools.cached_property's is one for every instance in Python
+        # 3.11: the frame would wait on the air worker's build of another sky); two threads that both build it
+        # build the same table
+        tables = self.__dict__.get("_built_tables")
+        if tables is None:
+            tables = sky_view.build_sky_view_table(
+                self.tables.params,
+                self.tables.transmittance,
+                self.tables.multiple_scattering,
+                self.altitude_m,
+                float(self.sun_direction[1]),
+                self.preview,
+            )
+            object.__setattr__(self, "_built_tables", tables)
+        return tables
 
     def radiance(self, directions) -> np.ndarray:
         """(..., 3): the sky's radiance along unit `directions` (..., 3); below the horizon the air's in front of
@@ -104,12 +139,7 @@ def sky_seen_from(params: AtmosphereParameters, altitude_m: float, sun_direction
 
 @functools.lru_cache(maxsize=16)
 def _sky_view(params: AtmosphereParameters, altitude_m: float, sun_direction: tuple, preview: bool) -> SkyView:
-    tables = atmosphere_tables(params)
-    sun = np.asarray(sun_direction, dtype=np.float64)
-    table, row_transmittance = sky_view.build_sky_view_table(
-        params, tables.transmittance, tables.multiple_scattering, altitude_m, float(sun[1]), preview
-    )
-    return SkyView(tables, altitude_m, sun, table, row_transmittance, preview)
+    return SkyView(atmosphere_tables(params), altitude_m, np.asarray(sun_direction, dtype=np.float64), preview)
 
 
 def sky_irradiance(tables: AtmosphereTables, altitude_m: float, sun_direction, rings: int = 16, sectors: int = 16):

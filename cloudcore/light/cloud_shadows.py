@@ -45,8 +45,10 @@ from cloudcore.maths.splat_kernel import splat_kernel
 SLICES = 8
 #: texels across the longer side of the map the terrain and the objects read, and while a slider is dragged: chosen
 #: by the ground's transmittance against a map of 2048 and the making's time (scripts/bench_shadows.py,
-#: docs/atmosphere.md#cloud-shadows, "The resolution, by measurement")
-MAP_RESOLUTION, PREVIEW_MAP_RESOLUTION = 512, 256
+#: docs/atmosphere.md#cloud-shadows, "The resolution, by measurement"); a dragged slider's map is remade every look
+#: and was the largest part of the frame that draws one, and its softer shadow edges cost the dragged picture less
+#: than its coarse light pass does (docs/atmosphere.md#cloud-shadows, "A dragged slider's map at 128")
+MAP_RESOLUTION, PREVIEW_MAP_RESOLUTION = 512, 128
 #: texels across the map of a scene with a cloud field: made again nearly every frame of a flight (its clouds' blend
 #: weights change), of particles hundreds of metres across (docs/atmosphere.md#cloud-shadows)
 FIELD_MAP_RESOLUTION = 256

@@ -106,6 +106,5 @@ class LiveAir:
 def _air_and_sky(tables, altitude_m: float, sun_direction: tuple):
     """The exact aerial-perspective volume and sky-view table for an eye at `altitude_m` (the worker's task)."""
     params = tables.params
-    return aerial_perspective_from(tables, altitude_m, sun_direction), sky_seen_from(
-        params, sky_view_altitude(params, altitude_m), sun_direction
-    )
+    view = sky_seen_from(params, sky_view_altitude(params, altitude_m), sun_direction).built()
+    return aerial_perspective_from(tables, altitude_m, sun_direction), view

@@ -7,6 +7,8 @@ import numpy as np
 import pytest
 
 from cloudcore.light.cloud_shadows import (
+    MAP_RESOLUTION,
+    PREVIEW_MAP_RESOLUTION,
     SLICES,
     beam_opacity,
     between_clouds_transmittance,
@@ -192,6 +194,23 @@ def test_the_map_is_made_again_only_when_the_sun_or_the_clouds_change(renderer):
     moved = dataclasses.replace(scene, clouds=(ball((100.0, 1200.0, 0.0), radius_m=300.0),))
     renderer.render(moved, settings=FULL_3D, time_of_day=14.0, read_back=False)
     assert renderer.shadow_map.made == made + 2
+
+
+@pytest.mark.gl
+def test_a_dragged_slider_s_look_draws_a_coarser_map_and_the_release_the_exact_picture(renderer):
+    """A look of a dragged time-of-day slider (the preview light pass) has its map made at the preview's coarser
+    texels, the ground under the cloud along the sun still in its shadow; the look after the release, at the hour
+    before the drag, draws the very picture drawn before it."""
+    scene, shadow, lit = shadow_scene()
+    exact, _ = renderer.render(scene, settings=FULL_3D)
+    exact_size = renderer.shadow_map.space.size
+    dragged, _ = renderer.render(scene, settings=FULL_3D, time_of_day=15.45, illumination_method="preview")
+    assert max(renderer.shadow_map.space.size) == PREVIEW_MAP_RESOLUTION < max(exact_size) == MAP_RESOLUTION
+    ground = srgb_decode(dragged / 255.0).mean(axis=-1)
+    assert ground[pixel_of(scene.camera, shadow)] < 0.5 * ground[pixel_of(scene.camera, lit)]
+    released, _ = renderer.render(scene, settings=FULL_3D)
+    assert renderer.shadow_map.space.size == exact_size
+    assert np.array_equal(released, exact)
 
 
 def test_the_sun_of_explicit_lights_is_the_first():

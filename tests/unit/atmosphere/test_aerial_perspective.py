@@ -8,6 +8,7 @@ import time
 import numpy as np
 import pytest
 
+from cloudcore.atmosphere import sky_view
 from cloudcore.atmosphere.aerial_perspective import MAX_DISTANCE_M, build_aerial_perspective, volume_texels
 from cloudcore.atmosphere.parameters import EARTH
 from cloudcore.atmosphere.scattering import in_scattering
@@ -230,6 +231,34 @@ def test_a_new_altitude_s_air_is_coarse_until_its_exact_volume_is_built():
         live(sky, climbed)
         built(2)
         assert live.sky_seen_from(sky, climbed).view.altitude_m == 3600.0
+    finally:
+        live.close()
+
+
+def test_a_sky_seen_from_an_eye_builds_the_eye_s_table_alone_and_the_editor_s_worker_builds_it(monkeypatch):
+    """A scene's sky is made over its origin and drawn as an eye above it sees it (`SkyBackground.seen_from`): the
+    eye's table is built, when first read, and the origin's never; the editor's air (`LiveAir`) has its worker
+    build the table, so the frame that reads it builds none."""
+    built = []
+    build = sky_view.build_sky_view_table
+    monkeypatch.setattr(sky_view, "build_sky_view_table", lambda *args: built.append(args[3]) or build(*args))
+    eye = (0.0, 2345.0, 0.0)
+    for preview in (False, True):
+        built.clear()
+        seen = scene_sky(Lighting(time_of_day=10.35), preview).seen_from(eye)  # an hour no other test draws
+        assert built == []
+        assert np.isfinite(seen.view.table).all() and built == [seen.view.altitude_m] == [2300.0]
+    sky = scene_sky(Lighting(time_of_day=10.45))
+    live = LiveAir()
+    try:
+        live(sky, eye)
+        for _ in range(400):
+            if live.built:
+                break
+            time.sleep(0.05)
+        built.clear()
+        assert live.sky_seen_from(sky, eye).view.table.shape == (108, 192, 3)
+        assert built == []
     finally:
         live.close()
 
