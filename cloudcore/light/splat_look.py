@@ -9,18 +9,20 @@ Per pixel, the particle is what the path-traced truth has (`cloudcore.measure.tr
 c K(|x - p| / r).  The pixel's view ray crosses it along a chord; its optical depth there is c r times
 `kernel_chord_integral(b^2)`, b the chord's distance from the centre.  The particle's own optical depth across
 its diameter, tau = -ln(1 - alpha) from the opacity alpha it has per particle, fixes c r; so the pixel's opacity is
-1 - (1 - alpha)^(chord / diameter), alpha itself on a ray through the centre (`chord_opacity`).  The light that
-the light pass gave the particle, the sun's part of it, is varied by the depth into the particle toward the sun
-from the chord's middle (its point nearest the centre, where the kernel is largest): times
-exp(-tau (D(m) - D(0)) / diameter) with D the kernel's integral from m to the sphere's surface along the sun
-(`kernel_ray_integral`), 1 at the centre (`sun_light_factor`), so a ray through the centre sees the particle's
-colour per particle, the lit side brighter and the far side darker.  The light inside falls not by the particle's
-optical depth tau but by tau sqrt(3 (1 - a)), a its albedo (`inner_light_depth`): in a thick particle the sun's
-light is scattered many times, and the diffusion approximation's light falls by that exponent (by tau itself, an
-opaque particle of the default scene, tau 8, was 55 times brighter on its lit rim than at its centre).  The rest of the colour (the ambient light,
-the other lights, the light a lit face sent back from every direction) has no direction: it follows the opacity.
-Yusov reads the light inside the particle from his 4D tables of the reference particle; this project keeps only
-their eye-pass profiles per particle (`cloudcore.light.precomputed`), so the depth toward the sun stands in.
+1 - (1 - alpha)^(chord / diameter), alpha itself on a ray through the centre (`chord_opacity`).
+
+The light that the light pass gave the particle, the sun's part of it, is varied by the depth into the particle
+toward the sun from the chord's middle m (its point nearest the centre, where the kernel is largest): times
+exp(-tau' (D(m) - D(0)) / diameter), D the kernel's integral from m to the sphere's surface along the sun
+(`kernel_ray_integral`), 1 at the centre (`sun_light_factor`): a ray through the centre sees the particle's colour
+per particle, a chord nearer the sun's side more light, one on the far side less (and near the rim, where the light
+crosses little of the particle, more on either side).  tau' is not tau but tau sqrt(3 (1 - a)), a the albedo
+(`inner_light_depth`): in a thick particle the sun's light is scattered many times, and the diffusion
+approximation's light falls by that exponent; by tau itself, the default scene's opaque particles (tau 8) were 55
+times brighter on their lit rims than at their centres.  The rest of the colour (the ambient light, the other
+lights, the light a lit face sent back from every direction) has no direction: it follows the opacity.  Yusov
+reads the light inside the particle from his 4D tables of the reference particle; this project keeps only their
+eye-pass profiles per particle (`cloudcore.light.precomputed`), so the depth toward the sun stands in.
 
 The detail noise multiplies a pixel's optical depth by 1 + a (2 n - 1), n in [0, 1] the value noise of
 `splat.frag.glsl` at the chord's middle in the particle's own frame (metres from its centre over the noise's
