@@ -24,10 +24,12 @@ lights, the light a lit face sent back from every direction) has no direction: i
 reads the light inside the particle from his 4D tables of the reference particle; this project keeps only their
 eye-pass profiles per particle (`cloudcore.light.precomputed`), so the depth toward the sun stands in.
 
-The detail noise multiplies a pixel's optical depth by 1 + a (2 n - 1), n in [0, 1] the value noise of
-`splat.frag.glsl` at the chord's middle in the particle's own frame (metres from its centre over the noise's
-scale, offset by the particle's index): it stays on the particle, and so on its cloud, as the eye moves and
-impostors are made again.
+The detail noise multiplies a pixel's optical depth by 1 + a (2 n - 1), n in [0, 1] two octaves of value noise
+at the chord's middle in the particle's own frame (metres from its centre over the noise's scale, offset by the
+particle's index): it stays on the particle, and so on its cloud, as the eye moves and impostors are made again.
+The noise is a small tiled 3D texture of random lattice values (`detail_noise_lattice`), read with the GL's
+trilinear filter: a fetch an octave, where hashing the eight lattice points of each octave in the fragment
+shader cost llvmpipe more than the splat itself (docs/performance.md, "Per-pixel shading and detail noise").
 """
 
 from __future__ import annotations
@@ -41,6 +43,10 @@ from cloudcore.model.settings import RenderSettings
 
 #: the opacity a pixel's optical depth is taken from at most: an opaque particle's tau would be infinite
 MAX_OPACITY = 1.0 - 1e-6
+#: the settings that make the look (`SplatLook.of`): what `cloudview truth` takes for its models
+LOOK_SETTINGS = ("particle_shading", "detail_noise", "detail_noise_scale_m")
+#: lattice points along each side of the detail noise's tiled texture: 32 KB, and a period of 32 features
+NOISE_LATTICE = 32
 
 
 @dataclass(frozen=True)
@@ -93,3 +99,9 @@ def sun_light_factor(middle, toward_sun, light_depth) -> np.ndarray:
     `inner_light_depth`) from its surface toward the sun to there, over that to the centre."""
     depth = kernel_ray_integral(middle, toward_sun) - kernel_ray_integral(np.zeros(3), toward_sun)
     return np.exp(-np.asarray(light_depth, dtype=np.float64) * depth / KERNEL_DIAMETER_INTEGRAL)
+
+
+def detail_noise_lattice(size: int = NOISE_LATTICE, seed: int = 54) -> np.ndarray:
+    """(size, size, size) float32 in [0, 1]: the detail noise's lattice values, a texture that tiles (the GL reads
+    it with repeat and trilinear filtering: value noise)."""
+    return np.random.default_rng(seed).random((size, size, size)).astype(np.float32)

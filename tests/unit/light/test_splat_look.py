@@ -120,3 +120,16 @@ def test_a_views_bad_look_is_refused_in_one_line_naming_file_and_field(tmp_path,
     )
     full_field = "views[0]." + ("settings" if field == "settings" else f"settings.{field}")
     assert_file_refused_in_one_line(path, full_field, problem)
+
+
+def test_the_closed_form_is_yusovs_chord_table():
+    """The shader's closed form and the reference particle's chord table (`cloudcore.light.precomputed`, by
+    quadrature and read bilinearly) are the same depth: the per-pixel pass needs no table."""
+    from cloudcore.light.precomputed import chord_depths, chord_optical_depth
+
+    rng = np.random.default_rng(3)
+    points = rng.uniform(-0.55, 0.55, (200, 3))
+    directions = rng.normal(size=(200, 3))
+    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+    closed = kernel_ray_integral(points, directions) / KERNEL_DIAMETER_INTEGRAL
+    np.testing.assert_allclose(closed, chord_optical_depth(chord_depths(), points, directions), atol=2e-3)
