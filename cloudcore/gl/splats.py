@@ -28,7 +28,7 @@ from cloudcore.gl.splat_order import COMMAND_UINTS, GpuSplatOrder
 from cloudcore.gl.splat_residency import ResidentParticles
 from cloudcore.gl.splat_shading import INSTANCES_BINDING, TERMS_BINDING, SplatShading
 from cloudcore.gl.storage import store
-from cloudcore.light.splat_look import MAX_OPACITY, NOISE_LATTICE, SplatLook, detail_noise_lattice
+from cloudcore.light.splat_look import MAX_OPACITY, SplatLook
 from cloudcore.maths.splat_kernel import KERNEL_DIAMETER_INTEGRAL, SPLAT_SHARPNESS
 from cloudcore.model.cloud_records import ATLAS_GRID
 from cloudcore.particles.batch import SplatBatch, SplatSelection
@@ -40,9 +40,8 @@ _QUAD_TRIANGLES = np.array([0, 1, 2, 2, 1, 3], dtype=np.uint32)
 #: splat.vert.glsl's `Cell` (CELLS): view rotation, projection, viewport height and layer; its binding
 _CELL_FLOATS = 36
 _CELLS_BINDING = 8
-#: the uniforms of a look other than plain (splat.frag.glsl's PIXEL_LOOK) and the texture unit of the lattice
-_LOOK_UNIFORMS = ("detail_amplitude", "detail_scale", "detail_lattice")
-_LATTICE_UNIT = 1
+#: the uniforms of a look other than plain (splat.frag.glsl's PIXEL_LOOK)
+_LOOK_UNIFORMS = ("detail_amplitude", "detail_scale")
 #: viewports (and scissors) a multi-draw of cells can address: what GL 4.1 guarantees, llvmpipe's and NVIDIA's
 _MAX_VIEWPORTS = 16
 
@@ -71,8 +70,6 @@ class SplatPass:
         #: the programs drawing many cells at once, made when first needed: (points?, atlas sprites?) -> (the
         #: program, its first cell's uniform); points never are sprites
         self._cell_programs: dict[tuple[bool, bool], tuple[int, int]] = {}
-        #: the detail noise's lattice (`detail_noise_lattice`), a 3D texture made when first drawn with
-        self._detail_lattice: int | None = None
 
     @property
     def air(self) -> AirVolume | None:
@@ -359,30 +356,11 @@ class SplatPass:
         self._set_look_uniforms(program)
 
     def _set_look_uniforms(self, program: int) -> None:
-        """The detail noise's amplitude, scale and lattice, where `program` (current) has them."""
+        """The detail noise's amplitude and scale, where `program` (current) has them."""
         uniforms = self._uniforms[program]
-        if uniforms["detail_amplitude"] < 0:
-            return
-        GL.glUniform1f(uniforms["detail_amplitude"], self.look.detail_noise)
-        GL.glUniform1f(uniforms["detail_scale"], self.look.detail_noise_scale_m)
-        GL.glUniform1i(uniforms["detail_lattice"], _LATTICE_UNIT)
-        GL.glActiveTexture(GL.GL_TEXTURE0 + _LATTICE_UNIT)
-        GL.glBindTexture(GL.GL_TEXTURE_3D, self._lattice())
-        GL.glActiveTexture(GL.GL_TEXTURE0)
-
-    def _lattice(self) -> int:
-        """The detail noise's lattice texture, made on first use: tiled, trilinear."""
-        if self._detail_lattice is None:
-            values = detail_noise_lattice()
-            self._detail_lattice = GL.glGenTextures(1)
-            GL.glBindTexture(GL.GL_TEXTURE_3D, self._detail_lattice)
-            for parameter in (GL.GL_TEXTURE_WRAP_S, GL.GL_TEXTURE_WRAP_T, GL.GL_TEXTURE_WRAP_R):
-                GL.glTexParameteri(GL.GL_TEXTURE_3D, parameter, GL.GL_REPEAT)
-            for parameter in (GL.GL_TEXTURE_MIN_FILTER, GL.GL_TEXTURE_MAG_FILTER):
-                GL.glTexParameteri(GL.GL_TEXTURE_3D, parameter, GL.GL_LINEAR)
-            size = values.shape[0]
-            GL.glTexImage3D(GL.GL_TEXTURE_3D, 0, GL.GL_R16F, size, size, size, 0, GL.GL_RED, GL.GL_FLOAT, values)
-        return self._detail_lattice
+        if uniforms["detail_amplitude"] >= 0:
+            GL.glUniform1f(uniforms["detail_amplitude"], self.look.detail_noise)
+            GL.glUniform1f(uniforms["detail_scale"], self.look.detail_noise_scale_m)
 
     def _bind_quads(self, count: int) -> None:
         """Bind what drawing `count` particles' quads reads: the atlas, the instances, the triangles."""
@@ -413,8 +391,6 @@ class SplatPass:
             GL.glDeleteProgram(program)
         GL.glDeleteBuffers(len(self._buffers), list(self._buffers))
         GL.glDeleteVertexArrays(1, [self._vertex_array])
-        if self._detail_lattice is not None:
-            GL.glDeleteTextures(1, [self._detail_lattice])
         self._shading.close()
         self._order.close()
         self._resident.close()
@@ -434,11 +410,7 @@ def _splat_defines(*, points: bool, sprites: bool, look: tuple[bool, bool], coun
     }
     constants = {"SPLAT_SHARPNESS": SPLAT_SHARPNESS, "ATLAS_GRID": ATLAS_GRID}
     if per_pixel or noise:
-        constants |= {
-            "KERNEL_DIAMETER_INTEGRAL": KERNEL_DIAMETER_INTEGRAL,
-            "MAX_OPACITY": MAX_OPACITY,
-            "NOISE_LATTICE": float(NOISE_LATTICE),
-        }
+        constants |= {"KERNEL_DIAMETER_INTEGRAL": KERNEL_DIAMETER_INTEGRAL, "MAX_OPACITY": MAX_OPACITY}
     return constants | {name: 1 for name, on in variant.items() if on}
 
 

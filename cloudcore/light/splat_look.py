@@ -27,9 +27,9 @@ eye-pass profiles per particle (`cloudcore.light.precomputed`), so the depth tow
 The detail noise multiplies a pixel's optical depth by 1 + a (2 n - 1), n in [0, 1] two octaves of value noise
 at the chord's middle in the particle's own frame (metres from its centre over the noise's scale, offset by the
 particle's index): it stays on the particle, and so on its cloud, as the eye moves and impostors are made again.
-The noise is a small tiled 3D texture of random lattice values (`detail_noise_lattice`), read with the GL's
-trilinear filter: a fetch an octave, where hashing the eight lattice points of each octave in the fragment
-shader cost llvmpipe more than the splat itself (docs/performance.md, "Per-pixel shading and detail noise").
+The noise is hashed from its lattice points in the fragment shader (an integer hash, the same on every GL): on
+llvmpipe a tiled 32^3 texture of lattice values read with the GL's trilinear filter, a fetch an octave, cost full
+3D's frame more (2.57 against 1.75 times per particle's, docs/performance.md, "Per-pixel shading and detail noise").
 """
 
 from __future__ import annotations
@@ -45,8 +45,6 @@ from cloudcore.model.settings import RenderSettings
 MAX_OPACITY = 1.0 - 1e-6
 #: the settings that make the look (`SplatLook.of`): what `cloudview truth` takes for its models
 LOOK_SETTINGS = ("particle_shading", "detail_noise", "detail_noise_scale_m")
-#: lattice points along each side of the detail noise's tiled texture: 32 KB, and a period of 32 features
-NOISE_LATTICE = 32
 
 
 @dataclass(frozen=True)
@@ -99,9 +97,3 @@ def sun_light_factor(middle, toward_sun, light_depth) -> np.ndarray:
     `inner_light_depth`) from its surface toward the sun to there, over that to the centre."""
     depth = kernel_ray_integral(middle, toward_sun) - kernel_ray_integral(np.zeros(3), toward_sun)
     return np.exp(-np.asarray(light_depth, dtype=np.float64) * depth / KERNEL_DIAMETER_INTEGRAL)
-
-
-def detail_noise_lattice(size: int = NOISE_LATTICE, seed: int = 54) -> np.ndarray:
-    """(size, size, size) float32 in [0, 1]: the detail noise's lattice values, a texture that tiles (the GL reads
-    it with repeat and trilinear filtering: value noise)."""
-    return np.random.default_rng(seed).random((size, size, size)).astype(np.float32)

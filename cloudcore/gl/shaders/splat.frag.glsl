@@ -31,7 +31,6 @@ flat in vec4 sun_part;     // the sun's part of the colour (rgb); w: the optical
 flat in vec4 sun_light;    // toward the sun; w: the particle's index
 uniform float detail_amplitude;
 uniform float detail_scale;  // metres between the noise's lattice points
-uniform sampler3D detail_lattice;  // random values at lattice points, tiled, read trilinear: value noise
 
 // erf by Abramowitz and Stegun 7.1.26, |error| < 1.5e-7
 float erf_approx(float x)
@@ -54,6 +53,27 @@ float kernel_ray_integral(vec3 start, vec3 direction)
     return max((gaussian - (half_chord - along) * floor_value) / (1.0 - floor_value), 0.0);
 }
 
+// a lattice point's value in [0, 1]: an integer hash, the same on every GL
+float lattice(ivec3 corner)
+{
+    uvec3 u = uvec3(corner) * uvec3(1597334673u, 3812015801u, 2798796415u);
+    uint n = (u.x ^ u.y ^ u.z) * 1597334673u;
+    n ^= n >> 16;
+    return float(n) * (1.0 / 4294967295.0);
+}
+
+// value noise in [0, 1], smooth between lattice points a unit apart
+float value_noise(vec3 x)
+{
+    vec3 base = floor(x), f = x - base, w = f * f * (3.0 - 2.0 * f);
+    ivec3 c = ivec3(base);
+    float low = mix(mix(lattice(c), lattice(c + ivec3(1, 0, 0)), w.x),
+                    mix(lattice(c + ivec3(0, 1, 0)), lattice(c + ivec3(1, 1, 0)), w.x), w.y);
+    float high = mix(mix(lattice(c + ivec3(0, 0, 1)), lattice(c + ivec3(1, 0, 1)), w.x),
+                     mix(lattice(c + ivec3(0, 1, 1)), lattice(c + ivec3(1, 1, 1)), w.x), w.y);
+    return mix(low, high, w.z);
+}
+
 // the pixel of a Gaussian splat whose kernel is `kernel` at `position` (radii in its plane), premultiplied
 vec4 pixel_look(vec2 position, float kernel)
 {
@@ -73,8 +93,7 @@ vec4 pixel_look(vec2 position, float kernel)
 #ifdef DETAIL_NOISE
     vec3 at = middle * (sphere.w / detail_scale)
             + 64.0 * fract(sun_light.w * vec3(0.7548776662, 0.5698402910, 0.3819660113));
-    float n = (2.0 * texture(detail_lattice, at / NOISE_LATTICE).r
-               + texture(detail_lattice, (2.03 * at + 17.0) / NOISE_LATTICE).r) / 3.0;
+    float n = (2.0 * value_noise(at) + value_noise(2.03 * at + 17.0)) / 3.0;
     share *= max(1.0 + detail_amplitude * (2.0 * n - 1.0), 0.0);
 #endif
     float seen = 1.0 - exp(share * log(max(1.0 - base.a, 1.0 - MAX_OPACITY)));
