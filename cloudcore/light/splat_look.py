@@ -28,8 +28,8 @@ The detail noise multiplies a pixel's optical depth by 1 + a (2 n - 1), n in [0,
 at the chord's middle in the particle's own frame (metres from its centre over the noise's scale, offset by the
 particle's index): it stays on the particle, and so on its cloud, as the eye moves and impostors are made again.
 The noise is hashed from its lattice points in the fragment shader (an integer hash, the same on every GL): on
-llvmpipe a tiled 32^3 texture of lattice values read with the GL's trilinear filter, a fetch an octave, cost full
-3D's frame more (2.57 against 1.75 times per particle's, docs/performance.md, "Per-pixel shading and detail noise").
+llvmpipe a tiled 3D texture of lattice values, read with the GL's trilinear filter, cost more (docs/performance.md,
+"Per-pixel shading and detail noise").
 """
 
 from __future__ import annotations

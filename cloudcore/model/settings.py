@@ -238,8 +238,9 @@ class RenderSettings:
     #: "per_particle": a splat is one colour, its opacity the kernel's profile (Harris); "per_pixel": each pixel of
     #: a splat by the view ray's chord through the particle's sphere, its opacity from the chord's optical depth
     #: and the sun's light by the depth into the particle toward the sun (Yusov 2014, 5.4;
-    #: `cloudcore.light.splat_look`).  Per particle by default: per pixel measured no closer to the path-traced
-    #: truth for its cost (docs/shading.md, "Per-pixel shading and detail noise")
+    #: `cloudcore.light.splat_look`).  Per particle by default: per pixel is closer to the path-traced truth at
+    #: realistic albedo, but on a software rasteriser it costs more than the frame gains in error, and the shipped
+    #: scenes keep their pictures (docs/shading.md, "Per-pixel shading and detail noise")
     particle_shading: str = _setting(
         "per_particle",
         flag="--particle-shading",
