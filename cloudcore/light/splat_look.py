@@ -88,7 +88,7 @@ def chord_opacity(opacity, b2) -> np.ndarray:
     """A pixel's opacity per pixel, its view ray at squared distance `b2` (radii squared) from the centre of a
     particle of `opacity` on a ray through its centre."""
     share = kernel_chord_integral(b2) / KERNEL_DIAMETER_INTEGRAL
-    return -np.expm1(share * np.log1p(-np.minimum(np.asarray(opacity, dtype=np.float64), MAX_OPACITY)))
+    return -np.expm1(-share * own_optical_depth(opacity))
 
 
 def sun_light_factor(middle, toward_sun, light_depth) -> np.ndarray:
