@@ -79,7 +79,7 @@ vec4 pixel_look(vec2 position, float kernel)
 {
     vec3 centre = sphere.xyz;
     vec3 ray = normalize(centre + position.x * plane_right + position.y * plane_up);
-    vec3 middle = (ray * dot(centre, ray) - centre) / sphere.w;  // the chord's middle, radii from the centre
+    vec3 middle = (ray * dot(centre, ray) - centre) / max(sphere.w, 1e-30);  // the chord's middle, in radii
 #ifdef PER_PIXEL
     vec4 base = colour;
     // the chord's optical depth over the diameter's: twice its half from the middle on (kernel_chord_integral)
@@ -91,7 +91,7 @@ vec4 pixel_look(vec2 position, float kernel)
     float share = 1.0;
 #endif
 #ifdef DETAIL_NOISE
-    vec3 at = middle * (sphere.w / detail_scale)
+    vec3 at = middle * (sphere.w / max(detail_scale, 1e-30))
             + 64.0 * fract(sun_light.w * vec3(0.7548776662, 0.5698402910, 0.3819660113));
     float n = (2.0 * value_noise(at) + value_noise(2.03 * at + 17.0)) / 3.0;
     share *= max(1.0 + detail_amplitude * (2.0 * n - 1.0), 0.0);
