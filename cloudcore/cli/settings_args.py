@@ -27,9 +27,12 @@ SWEEPABLE = {
 }
 
 
-def add_settings_arguments(parser, default_mode: str = "auto") -> None:
+def add_settings_arguments(parser, default_mode: str = "auto", only: tuple[str, ...] | None = None) -> None:
+    """The settings' options (those named in `only`, if given) on `parser`."""
     defaults = RenderSettings()
     for name, option in setting_options().items():
+        if only is not None and name not in only:
+            continue
         default = default_mode if name == "mode" else getattr(defaults, name)
         if isinstance(default, bool):  # a switch: its flag turns the default around
             parser.add_argument(

@@ -29,8 +29,10 @@ from cloudcore.cli.render import (
     pixel_count,
     write_output,
 )
+from cloudcore.cli.settings_args import add_settings_arguments
 from cloudcore.cli.workers import Job, add_workers_arguments, run_job, spread
 from cloudcore.light.shading import EYE_PASSES, METHODS
+from cloudcore.light.splat_look import LOOK_SETTINGS
 from cloudcore.maths.colour import linear_to_srgb8
 from cloudcore.measure.benchmark import PSNR_CAP_DB
 from cloudcore.measure.imagecompare import compare, diff_image
@@ -44,6 +46,7 @@ from cloudcore.measure.truth import (
 )
 from cloudcore.measure.truth_comparison import BODY_ALPHA, CLOUD_ALPHA, region_errors, truth_regions
 from cloudcore.model.errors import SceneError
+from cloudcore.model.settings import RenderSettings
 from cloudcore.scenes.files import load_scene
 from cloudcore.world.sun import scene_hour
 
@@ -98,6 +101,9 @@ def add_parser(commands) -> None:
         help=f"with --json: the models compared, comma-separated (default {','.join(DEFAULT_MODELS)}; "
         "any eye pass-illumination method: yusov-occlusion is Yusov's whole model)",
     )
+    # the models' splats per particle or per pixel, with detail noise or not (docs/shading.md, "Per-pixel shading
+    # and detail noise")
+    add_settings_arguments(parser, only=LOOK_SETTINGS)
     add_workers_arguments(parser, f"passes of {SAMPLES_PER_PASS} samples")
     parser.set_defaults(run=run)
 
@@ -112,6 +118,10 @@ def run(args) -> int:
     import imageio.v3 as iio
 
     check_outputs(args.out, args.json)
+    try:  # the models' look, refused before any path is traced
+        RenderSettings(**{name: getattr(args, name) for name in LOOK_SETTINGS})
+    except ValueError as error:
+        raise SceneError("cloudview truth", "settings", str(error)) from None
     if args.terrain and args.json is not None:
         raise SceneError("cloudview truth", "--terrain", "compares no models: the models draw no terrain (drop --json)")
     scene = load_scene(args.scene)
@@ -270,7 +280,8 @@ def _model_renders(scene, camera, args) -> dict[str, tuple[np.ndarray, dict, flo
     # the truth's clouds hang in empty space before the sky: the models are drawn without the air too (its shafts
     # and aerial perspective took about 1 dB of every model's PSNR; docs/shading.md, "Five views with the lit face
     # in the eye pass")
-    settings = dataclasses.replace(FULL_3D, light_shafts=False, aerial_perspective=False)
+    looks = {name: getattr(args, name) for name in LOOK_SETTINGS}
+    settings = dataclasses.replace(FULL_3D, light_shafts=False, aerial_perspective=False, **looks)
     renders = {}
     with FrameRenderer(args.width, args.height) as renderer:
         for name in args.models:

@@ -57,6 +57,7 @@ from cloudcore.light.lighting import scene_lights
 from cloudcore.light.live_air import LiveAir
 from cloudcore.light.relighting import PREVIEW_METHOD
 from cloudcore.light.sky_background import SkyBackground, scene_sky
+from cloudcore.light.splat_look import SplatLook
 from cloudcore.light.terrain_light import terrain_light
 from cloudcore.lod.costs import CostEstimator, CostModel, remember_fit, remembered_prior
 from cloudcore.lod.plan import FramePlan, LodState, plan_frame
@@ -259,6 +260,7 @@ class FrameRenderer:
                 self._draw_world(frame)
             # the world pass uploaded the air for this eye: the ring's segments and the cloud pass's splats take it
             self._splats.air = None if frame.air is None else frame.air[0]
+            self._splats.look = SplatLook.of(settings)
             with clock.timed("impostor updates"):
                 rendered = self._impostors.update(
                     frame.plan, frame.particles, settings, time_s, frame.splat_order, self.clouds.unit_weights
@@ -316,7 +318,9 @@ class FrameRenderer:
         camera, clouds = ready.camera, ready.clouds
         particles = clouds.particles
         starts = particles.cloud_starts
-        cloud_keys, ring_keys = self.clouds.cloud_keys(clouds.scene, clouds.fade_keys, time_s)
+        cloud_keys, ring_keys = self.clouds.cloud_keys(
+            clouds.scene, clouds.fade_keys, time_s, SplatLook.of(settings).key
+        )
         ring_keys = self.clouds.ring_keys_under_wind(ring_keys, clouds.motion, settings)
         plan = plan_frame(
             clouds.units,

@@ -158,6 +158,7 @@ def _particle_records(particles: ParticleBuffer) -> np.ndarray:
     records[:n, 4:7] = particles.scattering[:, None] * particles.tint
     records[:n, 7] = particles.alpha
     records[:n, 8:11] = particles.ambient * particles.ambient_weight[:, None] * particles.tint
+    records[:n, 11] = particles.inner_light_depth
     styles = particles.styles
     records[:n, 12:15] = styles.group_centres
     records[:n, 15] = styles.cloud_index

@@ -18,12 +18,16 @@ from cloudcore.gl.splat_order import GpuSplatOrder
 from cloudcore.gl.splat_residency import ResidentParticles
 from cloudcore.gl.storage import bind_storage, copy_buffer, store
 from cloudcore.light.phase import PHASE_NAMES
+from cloudcore.light.splat_look import SplatLook
 from cloudcore.particles.batch import SplatBatch, SplatSelection
 from cloudcore.particles.buffer import FADE_END_RADII, FADE_START_RADII, ParticleBuffer
 from cloudcore.scenes.limits import MAX_LIGHTS
 
 #: per particle, written by the compute shader: four corners and four colours (vec4 each)
 INSTANCE_BYTES = 8 * 16
+#: per particle beside its instance, for a look other than plain (`cloudcore.light.splat_look`): the sun's part of
+#: its colour and its own optical depth, the sun's direction and its index (vec4 each)
+TERMS_BYTES = 2 * 16
 (
     _PARTICLES_BINDING,
     _FORMATION_BINDING,
@@ -34,7 +38,8 @@ INSTANCE_BYTES = 8 * 16
     _PROFILES_BINDING,
     _BATCHES_BINDING,
     _RETURNED_BINDING,
-) = range(9)
+    TERMS_BINDING,  # where splat.vert.glsl reads the pixel terms too
+) = range(10)
 #: floats of splat_shade.comp.glsl's `Batch`: first slot and count (as uints), eye, image plane's right and up
 _BATCH_FLOATS = 16
 #: the compute shader's local_size_x
@@ -44,8 +49,9 @@ _SHADE_GROUP = 64
 _SLOT_ALIGNMENT = 256 // INSTANCE_BYTES
 #: splat_shade.comp.glsl's optional code, in the order of a variant's key: sprites that do not lie in the
 #: image plane, Wang's artist colours, Yusov's eye-pass profiles, the air between the eye and each particle, the
-#: light a lit face sent back (`cloudcore.particles.buffer.ParticleBuffer.returned`)
-_SHADE_FEATURES = ("FACING", "ARTIST", "PROFILES", "AIR", "RETURNED")
+#: light a lit face sent back (`cloudcore.particles.buffer.ParticleBuffer.returned`), the terms a splat is shaded
+#: by per pixel (`SplatLook`, when not plain)
+_SHADE_FEATURES = ("FACING", "ARTIST", "PROFILES", "AIR", "RETURNED", "PIXEL_TERMS")
 #: what a draw after shading waits for: the instances (and a selection's indirect command)
 _SHADED_BARRIERS = GL.GL_SHADER_STORAGE_BARRIER_BIT | GL.GL_COMMAND_BARRIER_BIT
 
@@ -60,7 +66,11 @@ class SplatShading:
 
     def __init__(self, resident: ResidentParticles, order: GpuSplatOrder):
         self._resident, self._order = resident, order
-        (self.instance_buffer, self.order_buffer, self._batch_buffer) = self._buffers = GL.glGenBuffers(3)
+        (self.instance_buffer, self.order_buffer, self._batch_buffer, self.terms_buffer) = self._buffers = (
+            GL.glGenBuffers(4)
+        )
+        #: how the raster shades the splats per pixel: other than plain, each slot's pixel terms are written too
+        self.look = SplatLook()
         #: the frame's air (`cloudcore.gl.air_volume`), uploaded for its eye, which batches `through_air` take;
         #: None: no air (the gradient sky)
         self.air: AirVolume | None = None
@@ -117,17 +127,18 @@ class SplatShading:
         if slots <= self._instance_capacity:
             return
         capacity = max(slots, 2 * self._instance_capacity)
-        kept = self._slots_ahead * INSTANCE_BYTES if keep else 0
-        # the buffer keeps its name (draws and the volume pass bind it by name): what is kept goes through a
-        # scratch copy while it is reallocated; growing happens a few times a session
-        scratch = GL.glGenBuffers(1) if kept else None
-        if kept:
-            copy_buffer(self.instance_buffer, scratch, kept, allocate=True)
-        GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, self.instance_buffer)
-        GL.glBufferData(GL.GL_SHADER_STORAGE_BUFFER, capacity * INSTANCE_BYTES, None, GL.GL_DYNAMIC_COPY)
-        if kept:
-            copy_buffer(scratch, self.instance_buffer, kept, allocate=False)
-            GL.glDeleteBuffers(1, [scratch])
+        for buffer, slot_bytes in ((self.instance_buffer, INSTANCE_BYTES), (self.terms_buffer, TERMS_BYTES)):
+            kept = self._slots_ahead * slot_bytes if keep else 0
+            # the buffer keeps its name (draws and the volume pass bind it by name): what is kept goes through a
+            # scratch copy while it is reallocated; growing happens a few times a session
+            scratch = GL.glGenBuffers(1) if kept else None
+            if kept:
+                copy_buffer(buffer, scratch, kept, allocate=True)
+            GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, buffer)
+            GL.glBufferData(GL.GL_SHADER_STORAGE_BUFFER, capacity * slot_bytes, None, GL.GL_DYNAMIC_COPY)
+            if kept:
+                copy_buffer(scratch, buffer, kept, allocate=False)
+                GL.glDeleteBuffers(1, [scratch])
         GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, self.order_buffer)
         GL.glBufferData(GL.GL_SHADER_STORAGE_BUFFER, capacity * 4, None, GL.GL_STREAM_DRAW)
         GL.glBindBuffer(GL.GL_SHADER_STORAGE_BUFFER, 0)
@@ -193,6 +204,8 @@ class SplatShading:
         if features[_SHADE_FEATURES.index("RETURNED")]:
             # binding 8 is others' between dispatches (the splats' cells, the tiles' occupancy): bound only here
             bind_storage((_RETURNED_BINDING, self._resident.returned_buffer))
+        if features[_SHADE_FEATURES.index("PIXEL_TERMS")]:
+            bind_storage((TERMS_BINDING, self.terms_buffer))
         program, uniforms = self._shade_program(features)
         first, end = run[0][2], run[-1][2] + run[-1][0].slots
         GL.glUseProgram(program)
@@ -203,13 +216,14 @@ class SplatShading:
         GL.glUniform1ui(uniforms["batch_count"], len(rows))
         dispatch(-(-(end - first) // _SHADE_GROUP))
 
-    def _features(self, batch: SplatBatch | SplatSelection) -> tuple[bool, bool, bool, bool, bool]:
+    def _features(self, batch: SplatBatch | SplatSelection) -> tuple[bool, ...]:
         """The shader features (`_SHADE_FEATURES`) `batch`'s particles need."""
         bits = self._resident.feature_bits(batch)
         air = batch.through_air and self.air is not None
-        return bool(bits & 1), bool(bits & 2), self._resident.profiled, air, self._resident.returning
+        returning = self._resident.returning
+        return bool(bits & 1), bool(bits & 2), self._resident.profiled, air, returning, not self.look.plain
 
-    def _shade_program(self, features: tuple[bool, bool, bool, bool, bool]) -> tuple[int, dict]:
+    def _shade_program(self, features: tuple[bool, ...]) -> tuple[int, dict]:
         """The compute shader variant with `features`, its light uniforms those of the resident particles; and
         its uniforms' locations."""
         if features not in self._programs:

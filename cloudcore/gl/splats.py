@@ -26,9 +26,10 @@ from cloudcore.gl.blending import cloud_blending
 from cloudcore.gl.programs import build_program, set_matrix_at, uniform_locations
 from cloudcore.gl.splat_order import COMMAND_UINTS, GpuSplatOrder
 from cloudcore.gl.splat_residency import ResidentParticles
-from cloudcore.gl.splat_shading import INSTANCES_BINDING, SplatShading
+from cloudcore.gl.splat_shading import INSTANCES_BINDING, TERMS_BINDING, SplatShading
 from cloudcore.gl.storage import store
-from cloudcore.maths.splat_kernel import SPLAT_SHARPNESS
+from cloudcore.light.splat_look import MAX_OPACITY, SplatLook
+from cloudcore.maths.splat_kernel import KERNEL_DIAMETER_INTEGRAL, SPLAT_SHARPNESS
 from cloudcore.model.cloud_records import ATLAS_GRID
 from cloudcore.particles.batch import SplatBatch, SplatSelection
 from cloudcore.particles.buffer import ParticleBuffer
@@ -39,6 +40,8 @@ _QUAD_TRIANGLES = np.array([0, 1, 2, 2, 1, 3], dtype=np.uint32)
 #: splat.vert.glsl's `Cell` (CELLS): view rotation, projection, viewport height and layer; its binding
 _CELL_FLOATS = 36
 _CELLS_BINDING = 8
+#: the uniforms of a look other than plain (splat.frag.glsl's PIXEL_LOOK)
+_LOOK_UNIFORMS = ("detail_amplitude", "detail_scale")
 #: viewports (and scissors) a multi-draw of cells can address: what GL 4.1 guarantees, llvmpipe's and NVIDIA's
 _MAX_VIEWPORTS = 16
 
@@ -47,19 +50,14 @@ class SplatPass:
     """The splats' raster, over their residency, shading and the GPU's order (one of each, shared by its draws)."""
 
     def __init__(self):
-        defines = {"SPLAT_SHARPNESS": SPLAT_SHARPNESS, "ATLAS_GRID": ATLAS_GRID}
-        variants = {"POINT_SPRITE": (False, True), "COUNT_FRAGMENTS": (False, True), "ATLAS_SPRITES": (False, True)}
-        #: (points?, counting?, atlas sprites?) -> program; a point is never a sprite
-        self._programs = {
-            key: build_program("splat", defines | {name: 1 for name, on in zip(variants, key) if on})
-            for key in itertools.product(*variants.values())
-            if not (key[0] and key[2])
-        }
+        #: (points?, counting?, atlas sprites?, per pixel?, detail noise?) -> program, made when first drawn with (the
+        #: plain look's at once); a point is never a sprite, and counting fragments has no look
+        self._programs: dict[tuple, int] = {}
         #: per program, the locations of the uniforms every draw sets
-        self._uniforms = {
-            program: uniform_locations(program, ("view_rotation", "projection", "viewport_height"))
-            for program in self._programs.values()
-        }
+        self._uniforms: dict[int, dict[str, int]] = {}
+        for key in itertools.product((False, True), repeat=3):
+            if not (key[0] and key[2]):
+                self._program(*key, (False, False))
         self._point_sizes_px = tuple(float(size) for size in GL.glGetFloatv(GL.GL_POINT_SIZE_RANGE))
         self._resident = ResidentParticles()
         self._order = GpuSplatOrder(self._resident)
@@ -83,6 +81,36 @@ class SplatPass:
     def air(self, air: AirVolume | None) -> None:
         self._shading.air = air
 
+    @property
+    def look(self) -> SplatLook:
+        """How the splats are shaded per pixel (`cloudcore.light.splat_look`): every draw's, impostors' as the
+        screen's, so that a cloud looks one way however it is drawn."""
+        return self._shading.look
+
+    @look.setter
+    def look(self, look: SplatLook) -> None:
+        self._shading.look = look
+
+    def _look_variant(self, counting: bool) -> tuple[bool, bool]:
+        """(per pixel?, detail noise?) of the programs drawing now: none when counting fragments."""
+        look = self._shading.look
+        return (False, False) if counting else (look.per_pixel, look.detail_noise > 0.0)
+
+    def _program(self, points: bool, counting: bool, sprites: bool, look: tuple[bool, bool]) -> int:
+        """The raster's program for a draw of points or quads, counting or blending, with atlas sprites or not, in
+        the `look` variant (`_look_variant`); made on first use."""
+        key = (points, counting, sprites, *look)
+        if key not in self._programs:
+            program = build_program(
+                "splat", _splat_defines(points=points, sprites=sprites, look=look, counting=counting)
+            )
+            self._programs[key] = program
+            self._uniforms[program] = uniform_locations(
+                program,
+                ("view_rotation", "projection", "viewport_height", *_LOOK_UNIFORMS),
+            )
+        return self._programs[key]
+
     def shade_ahead(self, batches_and_views) -> None:
         """`SplatShading.shade_ahead`: the (batch, view) pairs a pass will draw, shaded before any of its draws."""
         self._shading.shade_ahead(batches_and_views)
@@ -102,8 +130,9 @@ class SplatPass:
 
     def plain_selection(self, selection: SplatSelection) -> bool:
         """Whether every particle of a selection's clouds is a plain Gaussian splat of one colour
-        (`cloudcore.particles.point_sprites.plain_splats`): what a compute pass can composite."""
-        return self._resident.plain_selection(selection)
+        (`cloudcore.particles.point_sprites.plain_splats`) and the look is plain: what a compute pass can
+        composite (it draws no pixel terms)."""
+        return self.look.plain and self._resident.plain_selection(selection)
 
     def take_selected(self) -> tuple[int, int]:
         """`GpuSplatOrder.take_selected`: (the particles the selections drawn into targets since the last call
@@ -137,7 +166,10 @@ class SplatPass:
         if viewport is not None:
             GL.glViewport(*viewport)
         with_sprites = self._resident.with_sprites(batch)
-        programs = {points: self._programs[points, counting, with_sprites and not points] for points in (False, True)}
+        look = self._look_variant(counting)
+        programs = {
+            points: self._program(points, counting, with_sprites and not points, look) for points in (False, True)
+        }
         for as_points in {piece[2] for piece in pieces}:
             self._use(programs[as_points], view_rotation, projection, float(viewport[3]) if as_points else None)
         self._bind_quads(len(batch))
@@ -243,15 +275,13 @@ class SplatPass:
     def _use_cells(self, points: bool, with_sprites: bool, cells) -> int:
         """Make the program drawing many cells current, its table of `cells` (view, projection, viewport,
         scissor, layer) uploaded, the instances bound; returns its first cell's uniform."""
-        key = (points, with_sprites)
+        look = self._look_variant(counting=False)
+        key = (points, with_sprites, *look)
         if key not in self._cell_programs:
-            variant = {"POINT_SPRITE": points, "ATLAS_SPRITES": with_sprites}
-            program = build_program(
-                "splat",
-                {"SPLAT_SHARPNESS": SPLAT_SHARPNESS, "ATLAS_GRID": ATLAS_GRID, "CELLS": 1}
-                | {name: 1 for name, on in variant.items() if on},
-            )
+            defines = _splat_defines(points=points, sprites=with_sprites, look=look, counting=False) | {"CELLS": 1}
+            program = build_program("splat", defines)
             self._cell_programs[key] = (program, GL.glGetUniformLocation(program, "first_cell"))
+            self._uniforms[program] = uniform_locations(program, _LOOK_UNIFORMS)
         program, first_cell = self._cell_programs[key]
         table = np.zeros((len(cells), _CELL_FLOATS), dtype=np.float32)
         for row, (view, projection, viewport, _, layer) in enumerate(cells):
@@ -260,7 +290,10 @@ class SplatPass:
             table[row, 32:34] = viewport[3], layer
         store(self._cell_buffer, table, GL.GL_STREAM_DRAW)
         GL.glUseProgram(program)
+        self._set_look_uniforms(program)
         GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, INSTANCES_BINDING, self._shading.instance_buffer)
+        if not self.look.plain:
+            GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, TERMS_BINDING, self._shading.terms_buffer)
         GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, _CELLS_BINDING, self._cell_buffer)
         GL.glBindVertexArray(self._vertex_array)
         return first_cell
@@ -274,7 +307,8 @@ class SplatPass:
         self._shading.shade(selection, view)
         command = self._order.command(selection)
         with_sprites = self._resident.with_sprites(selection)
-        self._use(self._programs[False, counting, with_sprites], _rotation(view), projection, None)
+        program = self._program(False, counting, with_sprites, self._look_variant(counting))
+        self._use(program, _rotation(view), projection, None)
         self._bind_quads(selection.slots)
         GL.glBindBuffer(GL.GL_DRAW_INDIRECT_BUFFER, self._order.command_buffer)
         with cloud_blending(depth_test, counting):
@@ -319,6 +353,14 @@ class SplatPass:
         set_matrix_at(uniforms["projection"], projection)
         if viewport_height is not None:
             GL.glUniform1f(uniforms["viewport_height"], viewport_height)
+        self._set_look_uniforms(program)
+
+    def _set_look_uniforms(self, program: int) -> None:
+        """The detail noise's amplitude and scale, where `program` (current) has them."""
+        uniforms = self._uniforms[program]
+        if uniforms["detail_amplitude"] >= 0:
+            GL.glUniform1f(uniforms["detail_amplitude"], self.look.detail_noise)
+            GL.glUniform1f(uniforms["detail_scale"], self.look.detail_noise_scale_m)
 
     def _bind_quads(self, count: int) -> None:
         """Bind what drawing `count` particles' quads reads: the atlas, the instances, the triangles."""
@@ -326,6 +368,8 @@ class SplatPass:
             GL.glActiveTexture(GL.GL_TEXTURE0)
             GL.glBindTexture(GL.GL_TEXTURE_2D, self._resident.atlas)
         GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, INSTANCES_BINDING, self._shading.instance_buffer)
+        if not self.look.plain:
+            GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, TERMS_BINDING, self._shading.terms_buffer)
         GL.glBindVertexArray(self._vertex_array)
         self._index_quads(count)
 
@@ -350,6 +394,24 @@ class SplatPass:
         self._shading.close()
         self._order.close()
         self._resident.close()
+
+
+def _splat_defines(*, points: bool, sprites: bool, look: tuple[bool, bool], counting: bool) -> dict:
+    """splat.vert.glsl's and splat.frag.glsl's defines for a draw of points or quads, with atlas sprites or not, in
+    the look variant `look` (per pixel?, detail noise?), counting fragments or not."""
+    per_pixel, noise = look
+    variant = {
+        "POINT_SPRITE": points,
+        "COUNT_FRAGMENTS": counting,
+        "ATLAS_SPRITES": sprites,
+        "PIXEL_LOOK": per_pixel or noise,
+        "PER_PIXEL": per_pixel,
+        "DETAIL_NOISE": noise,
+    }
+    constants = {"SPLAT_SHARPNESS": SPLAT_SHARPNESS, "ATLAS_GRID": ATLAS_GRID}
+    if per_pixel or noise:
+        constants |= {"KERNEL_DIAMETER_INTEGRAL": KERNEL_DIAMETER_INTEGRAL, "MAX_OPACITY": MAX_OPACITY}
+    return constants | {name: 1 for name, on in variant.items() if on}
 
 
 def _rotation(view: np.ndarray) -> np.ndarray:

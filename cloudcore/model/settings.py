@@ -37,6 +37,13 @@ SPLAT_ORDERS = ("auto", *SPLAT_ORDER_WAYS)
 #: what composites full 3D's plain splats chosen on the GPU: the raster, or a compute pass over screen tiles
 #: binned on the GPU (`cloudcore.gl.tile_binning`); "auto": `cloudcore.gl.measured_way`, per mode
 COMPOSITINGS = ("auto", *COMPOSITING_WAYS)
+#: how the eye pass shades a Gaussian splat across its pixels (`cloudcore.light.splat_look`): one colour and the
+#: kernel's opacity profile, or each pixel by the view ray's chord through the particle's sphere (Yusov 2014, 5.4)
+PARTICLE_SHADINGS = ("per_particle", "per_pixel")
+#: the largest amplitude of the detail noise: at 1 the noise takes a pixel's optical depth from 0 to twice its own
+MAX_DETAIL_NOISE = 1.0
+#: metres: the largest feature size of the detail noise (a cloud's size; beyond, the noise is no detail)
+MAX_DETAIL_NOISE_SCALE_M = 10000.0
 
 
 @dataclass(frozen=True)
@@ -228,6 +235,43 @@ class RenderSettings:
         display="%.3f",
         parse=cloud_resolution_value,
     )
+    #: "per_particle": a splat is one colour, its opacity the kernel's profile (Harris); "per_pixel": each pixel of
+    #: a splat by the view ray's chord through the particle's sphere, its opacity from the chord's optical depth
+    #: and the sun's light by the depth into the particle toward the sun (Yusov 2014, 5.4;
+    #: `cloudcore.light.splat_look`).  Per particle by default: per pixel is closer to the path-traced truth at
+    #: realistic albedo, but on a software rasteriser it costs more than the frame gains in error, and the shipped
+    #: scenes keep their pictures (docs/shading.md, "Per-pixel shading and detail noise")
+    particle_shading: str = _setting(
+        "per_particle",
+        flag="--particle-shading",
+        help="per_particle: one colour a splat; per_pixel: each pixel by the view ray's chord through the "
+        "particle's sphere, lit by its depth into the particle toward the sun",
+        choices=PARTICLE_SHADINGS,
+        label="Particle shading",
+    )
+    #: the amplitude of 3D noise in each particle's own frame that modulates a splat's optical depth per pixel
+    #: (Yusov 2014, 5.4 and his future work; `cloudcore.light.splat_look`); 0: off, today's picture
+    detail_noise: float = _setting(
+        0.0,
+        flag="--detail-noise",
+        help="the amplitude of the 3D noise that varies each splat's optical depth per pixel (0: none, 1: from "
+        "none to twice its own)",
+        label="Detail noise",
+        high=MAX_DETAIL_NOISE,
+        display="%.2f",
+        zero_display="off",
+    )
+    #: metres: the detail noise's feature size (its lattice's spacing), a fraction of the particles' (25-60 m in
+    #: the default scene)
+    detail_noise_scale_m: float = _setting(
+        20.0,
+        flag="--detail-noise-scale",
+        help="metres between the detail noise's lattice points: the size of its features",
+        label="Detail noise scale (m)",
+        low=1.0,
+        high=200.0,
+        display="%.0f",
+    )
     #: the ring is rebuilt when the eye has moved this fraction of ring_radius horizontally / vertically
     ring_rebuild_horizontal: float = 0.15
     ring_rebuild_vertical: float = 0.02
@@ -366,6 +410,21 @@ class RenderSettings:
             problems.append(
                 f"cloud_resolution_scale must be {AUTO_SCALE!r} or within [{LOWEST_SCALE}, 1], got {scale!r}"
             )
+        if self.particle_shading not in PARTICLE_SHADINGS:
+            problems.append(
+                f"particle_shading must be one of {', '.join(PARTICLE_SHADINGS)}, got {self.particle_shading!r}"
+            )
+        if not _number_within(self.detail_noise, 0.0, MAX_DETAIL_NOISE):
+            problems.append(f"detail_noise must be within [0, {MAX_DETAIL_NOISE:g}], got {self.detail_noise!r}")
+        if not (_number_within(self.detail_noise_scale_m, 0.0, MAX_DETAIL_NOISE_SCALE_M) and self.detail_noise_scale_m):
+            problems.append(
+                f"detail_noise_scale_m must be within (0, {MAX_DETAIL_NOISE_SCALE_M:g}] metres, "
+                f"got {self.detail_noise_scale_m!r}"
+            )
+        if self.blending == "volume" and (self.particle_shading != "per_particle" or self.detail_noise):
+            problems.append(
+                "blending 'volume' composites splats of one colour: it takes neither per-pixel shading nor detail noise"
+            )
         if not (self.ring_rebuild_horizontal > 0.0 and self.ring_rebuild_vertical > 0.0):
             problems.append("ring rebuild fractions must be > 0")
         if not 0.0 < self.ring_elevation_deg < 90.0:
@@ -390,6 +449,11 @@ class RenderSettings:
     @property
     def uses_ring(self) -> bool:
         return self.mode != "full" and math.isfinite(self.ring_radius)
+
+
+def _number_within(value, low: float, high: float) -> bool:
+    """Whether `value` is a real number (not a bool) within [low, high] (NaN is not)."""
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and low <= value <= high
 
 
 def setting_options() -> dict[str, Option]:

@@ -40,6 +40,7 @@ from cloudcore.light.lighting import active_lights
 from cloudcore.light.phase import phase_function
 from cloudcore.light.precomputed import eye_pass_profiles
 from cloudcore.light.shading import RETURNING_LIGHT_PASSES, eye_pass_coefficients
+from cloudcore.light.splat_look import inner_light_depth
 from cloudcore.maths.ramps import smoothstep
 from cloudcore.model.scene import Lighting, Shading
 
@@ -88,6 +89,9 @@ class ParticleBuffer:
         tau = _concatenated([o[0] for o in optics], (0,))
         albedo = _concatenated([o[1] for o in optics], (0,))
         self.alpha = -np.expm1(-tau)
+        #: per particle, the optical depth across it by which the sun's light falls inside it, for the eye pass
+        #: per pixel (`cloudcore.light.splat_look.inner_light_depth`)
+        self.inner_light_depth = inner_light_depth(tau, albedo)
         artist = np.array([c.artist is not None for c in clouds], dtype=bool)
         self._opaque = (self.alpha > 0.0) | np.repeat(artist, counts)
         self._near_faded = self.styles.near_faded

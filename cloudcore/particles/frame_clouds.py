@@ -149,15 +149,17 @@ class FrameClouds:
         """The states at `time_s` of the prepared clouds that form or dissipate."""
         return tuple(formation_state(scene.clouds[index].formation, time_s) for index in self.lit.value.forming_clouds)
 
-    def cloud_keys(self, scene: Scene, fade_keys: tuple, time_s: float) -> tuple[tuple, tuple]:
-        """(per cloud, what its colours are made from this frame: its lighting key, and as a forming or
+    def cloud_keys(self, scene: Scene, fade_keys: tuple, time_s: float, look: tuple = ()) -> tuple[tuple, tuple]:
+        """(per cloud, what its colours are made from this frame: its lighting key, the splats' look other than
+        plain (`cloudcore.light.splat_look.SplatLook.key`: its impostor and ring panels are made again when it
+        changes), and as a forming or
         dissipating cloud's colours change with the clock and a field's cloud's with its blend weights, those
         (its impostor is stale meanwhile); the same less the blend weights, what Wang's ring goes stale by:
         they follow the eye's place, which its rebuild distance bounds (`plan_frame`'s `ring_keys`)).  The same
         tuples as the frame before while none changed: the plan then finds its ring's clouds unchanged at once
         (`cloudcore.lod.ring`), with no cloud looked at."""
         forming = tuple(zip(self.lit.value.forming_clouds, self.forming(scene, time_s)))
-        self._keys.follow((self.lit.value.lighting_keys, fade_keys, forming))
+        self._keys.follow((self.lit.value.lighting_keys, fade_keys, forming, look))
         return self._keys.value
 
     def ring_keys_under_wind(self, ring_keys: tuple, motion: CloudMotion | None, settings: RenderSettings) -> tuple:
@@ -311,9 +313,9 @@ class FrameClouds:
 
     def _keys_of(self, source: tuple) -> tuple[tuple, tuple]:
         """`cloud_keys`' pair made from its source (the lighting keys, the fade keys, the forming clouds' states)."""
-        lighting_keys, fade_keys, forming = source
+        lighting_keys, fade_keys, forming, look = source
         states = dict(forming)
-        colours = tuple((key, states.get(index)) for index, key in enumerate(lighting_keys))
+        colours = tuple((key, states.get(index), *look) for index, key in enumerate(lighting_keys))
         held = () if self._keys.value is None else self._keys.value[1]
         return (
             tuple((*colour, fade) for colour, fade in zip(colours, fade_keys)),  # unformed: state None

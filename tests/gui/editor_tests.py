@@ -572,6 +572,32 @@ def the_cloud_pass_at_a_quarter_resolution_in_the_window(ctx, app: EditorUnderTe
     CHECK(bool(30.0 < difference.psnr_db < math.inf))  # drawn otherwise, and close
 
 
+def per_pixel_shading_and_detail_noise_in_the_window(ctx, app: EditorUnderTest):
+    """The LOD panel's "Particle shading" and "Detail noise" shade the splats per pixel in the window's own context
+    (`cloudcore.light.splat_look`): the picture changes, and comes back byte for byte when they are off again."""
+    use_window(ctx, "LOD")
+    ctx.combo_click("Mode/full")
+    ctx.yield_(SETTLE)
+    plain = app.capture(ctx)
+    ctx.combo_click("Particle shading/per_pixel")
+    CHECK(app.editor.settings.particle_shading == "per_pixel")
+    ctx.yield_(SETTLE)
+    per_pixel = app.capture(ctx)
+    ctx.combo_click("Particle shading/per_particle")
+    ctx.item_input_value("Detail noise", 0.8)
+    CHECK(abs(app.editor.settings.detail_noise - 0.8) < 1e-6)
+    ctx.yield_(SETTLE)
+    noisy = app.capture(ctx)
+    ctx.item_input_value("Detail noise", 0.0)
+    ctx.yield_(SETTLE)
+    again = app.capture(ctx)
+    ctx.combo_click("Mode/auto")
+    app.outcome["per_pixel_psnr_db"] = compare(plain, per_pixel).psnr_db
+    app.outcome["detail_noise_psnr_db"] = compare(plain, noisy).psnr_db
+    CHECK(bool(np.any(per_pixel != plain)) and bool(np.any(noisy != plain)))
+    CHECK(bool(np.array_equal(again, plain)))
+
+
 def heat_map_changes_the_picture(ctx, app: EditorUnderTest):
     # in full 3D, where every splat counts: auto draws this still view from impostors, one a pixel
     use_window(ctx, "LOD")
@@ -1005,6 +1031,7 @@ GUI_TESTS = (
     move_cloud_by_dragging,
     delete_key_and_statistics_toggle,
     heat_map_changes_the_picture,
+    per_pixel_shading_and_detail_noise_in_the_window,
     volume_blending_composites_in_the_window,
     the_cloud_pass_at_a_quarter_resolution_in_the_window,
     the_gpu_sorts_the_splats_in_the_window,

@@ -14,6 +14,8 @@
 // impostors at once, one multi-draw's draw each: its cell's view, projection,
 // viewport and atlas layer come from a table (a frame's regenerations into the
 // atlas in one call; the viewports and scissors are the cells', set per index).
+// With PIXEL_LOOK defined (per-pixel shading or detail noise: cloudcore.light.splat_look), it hands
+// splat.frag.glsl the particle's sphere, its splat's plane and its pixel terms.
 
 struct Instance {
     vec4 corners[4];  // relative to the eye; w: atlas cell (-1: Gaussian splat)
@@ -26,6 +28,29 @@ uniform mat4 projection;
 
 out vec4 colour;          // per corner: the artist model's varies up a sprite
 flat out int sprite;      // atlas cell, -1 for a Gaussian splat
+
+#ifdef PIXEL_LOOK
+struct PixelTerms {
+    vec4 sun;    // the sun's part of the colour (rgb); w: the optical depth the sun's light falls by across it
+    vec4 light;  // toward the sun; w: the particle's index
+};
+layout(std430, binding = 9) readonly buffer Terms { PixelTerms terms[]; };
+flat out vec4 sphere;       // the particle's centre relative to the eye, its radius
+flat out vec3 plane_right;  // the splat's axes, a radius long each: corners are centre -+ right -+ up
+flat out vec3 plane_up;
+flat out vec4 sun_part;
+flat out vec4 sun_light;
+
+// the particle's sphere and splat plane from its instance's corners, and its terms
+void hand_on_look(Instance instance, int slot)
+{
+    plane_right = 0.5 * (instance.corners[1].xyz - instance.corners[0].xyz);
+    plane_up = 0.5 * (instance.corners[2].xyz - instance.corners[0].xyz);
+    sphere = vec4(0.5 * (instance.corners[0].xyz + instance.corners[3].xyz), length(plane_right));
+    sun_part = terms[slot].sun;
+    sun_light = terms[slot].light;
+}
+#endif
 
 #ifdef CELLS
 struct Cell {
@@ -61,6 +86,9 @@ void main()
     gl_PointSize = radius * clip[1][1] * height / gl_Position.w;
     colour = instance.colours[0];
     sprite = -1;
+#ifdef PIXEL_LOOK
+    hand_on_look(instance, gl_VertexID);
+#endif
 }
 #else
 out vec2 splat_position;  // corner in radii: the kernel's d = length(splat_position)
@@ -82,5 +110,8 @@ void main()
     splat_position = CORNERS[k];
     colour = instances[slot].colours[k];
     sprite = int(corner.w);
+#ifdef PIXEL_LOOK
+    hand_on_look(instances[slot], slot);
+#endif
 }
 #endif

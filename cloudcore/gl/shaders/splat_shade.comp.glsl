@@ -28,7 +28,8 @@
 // keeps tiny particles far from the origin their size.
 //
 // Variants: FACING (sprites not in the image plane), ARTIST (Wang's colours),
-// PROFILES (Yusov's eye pass), RETURNED (the lit face's light) and AIR (aerial perspective by the particle's
+// PROFILES (Yusov's eye pass), RETURNED (the lit face's light), PIXEL_TERMS (what
+// splat.frag.glsl shades a splat by per pixel: cloudcore.light.splat_look) and AIR (aerial perspective by the particle's
 // distance from the eye, for the cloud pass's batches, never an impostor's,
 // whose texture is seen from elsewhere) compile their code in only for batches that
 // have them: llvmpipe paid for the code behind the branches, so a batch of Harris's
@@ -44,7 +45,7 @@ layout(local_size_x = 64) in;
 struct Particle {
     vec4 centre_radius;       // world xyz, radius
     vec4 scattering_opacity;  // scattering coefficient x tint (rgb), opacity
-    vec4 ambient;             // ambient x opacity x tint (rgb), unused
+    vec4 ambient;             // ambient x opacity x tint (rgb), the optical depth the sun's light falls by inside it
     vec4 group_cloud;         // shading group centre xyz, cloud index
     vec4 sprite;              // atlas cell (-1: Gaussian splat), rotation (radians), profile row (-1: none), unused
     float incident[MAX_LIGHTS];
@@ -80,6 +81,16 @@ layout(std430, binding = 7) readonly buffer Batches { Batch batches[]; };
 #ifdef RETURNED
 // per particle and light (light_count a particle): the part of its incident light a lit face sent back
 layout(std430, binding = 8) readonly buffer Returned { float returned[]; };
+#endif
+#ifdef PIXEL_TERMS
+// per slot, beside its instance: what the raster shades a splat by per pixel (cloudcore.light.splat_look)
+struct PixelTerms {
+    vec4 sun;    // the part of the colours (rgb, premultiplied) that is the sun's (the first light's) light
+                 // scattered at the phase's angle; w: the optical depth across the particle by which that
+                 // light falls inside it (cloudcore.light.splat_look.inner_light_depth)
+    vec4 light;  // toward the sun; w: the particle's index, its detail noise's offset
+};
+layout(std430, binding = 9) writeonly buffer Terms { PixelTerms terms[]; };
 #endif
 
 uniform uint first;  // the dispatch's first slot, that of its first batch
@@ -125,10 +136,13 @@ float profile(int row, int part, float mu)
     return mix(profiles[start], profiles[start + 1], position - float(below));
 }
 
-vec4 harris_colour(Particle p, uint index, vec3 view_ray)
+// the particle's colour and opacity; `sun`: the part of the colour the first light scattered at the phase's
+// angle (the rest has no direction inside the particle)
+vec4 harris_colour(Particle p, uint index, vec3 view_ray, out vec3 sun)
 {
     int row = int(p.sprite.z);
     vec3 scattered = vec3(0.0);
+    sun = vec3(0.0);
     for (int light = 0; light < light_count; ++light) {
         float mu = dot(view_ray, light_direction[light]);
         float factor = phase(mu);
@@ -142,10 +156,14 @@ vec4 harris_colour(Particle p, uint index, vec3 view_ray)
 #endif
 #ifdef RETURNED
         float back = returned[index * uint(light_count) + uint(light)];
-        scattered += ((p.incident[light] - back) * factor + back * around) * light_radiance[light];
+        vec3 direct = (p.incident[light] - back) * factor * light_radiance[light];
+        scattered += direct + back * around * light_radiance[light];
 #else
-        scattered += p.incident[light] * factor * light_radiance[light];
+        vec3 direct = p.incident[light] * factor * light_radiance[light];
+        scattered += direct;
 #endif
+        if (light == 0)
+            sun = direct * p.scattering_opacity.rgb;
     }
     return vec4(scattered * p.scattering_opacity.rgb + p.ambient.rgb, p.scattering_opacity.a);
 }
@@ -214,17 +232,25 @@ void shade(uint invocation)
 #endif
     fade *= formation[index];
 
+    vec3 sun;
 #ifdef ARTIST
     bool artist = style.last_height_extent.w > 0.5;
-    vec4 colour = artist ? vec4(0.0) : harris_colour(p, index, view_ray) * fade;
+    vec4 colour = artist ? vec4(0.0) : harris_colour(p, index, view_ray, sun) * fade;
+    sun = artist ? vec3(0.0) : sun;  // Wang's colours are the artist's: no light inside the particle
 #else
-    vec4 colour = harris_colour(p, index, view_ray) * fade;
+    vec4 colour = harris_colour(p, index, view_ray, sun) * fade;
 #endif
+    sun *= fade;
 #ifdef AIR
     // the air in front of the particle, by its centre, added where it covers what is behind
     // (cloudcore.light.air_between): read once for its four corners
     vec3 air_transmittance, air_in_scattered;
     air_toward(offset, air_transmittance, air_in_scattered);
+    sun *= air_transmittance;
+#endif
+#ifdef PIXEL_TERMS
+    terms[slot].sun = vec4(sun, p.ambient.w);
+    terms[slot].light = vec4(light_count > 0 ? light_direction[0] : vec3(0.0, 1.0, 0.0), float(index));
 #endif
     for (int k = 0; k < 4; ++k) {
         vec3 corner = offset + radius * (CORNERS[k].x * right + CORNERS[k].y * up);

@@ -80,6 +80,9 @@ def test_render_writes_the_png_and_the_stats(rendered):
         (["--cloud-resolution", "0.01"], "cloud_resolution_scale must be 'auto' or within [0.125, 1], got 0.01"),
         (["--cloud-resolution", "nan"], "cloud_resolution_scale must be 'auto' or within [0.125, 1], got nan"),
         (["--cloud-resolution", "often"], "--cloud-resolution"),
+        (["--particle-shading", "per_voxel"], "--particle-shading"),
+        (["--detail-noise", "3"], "detail_noise must be within [0, 1], got 3.0"),
+        (["--detail-noise-scale", "0"], "detail_noise_scale_m must be within (0, 10000] metres, got 0.0"),
     ],
 )
 def test_bad_render_arguments_exit_2_in_one_line(tmp_path, args, message):

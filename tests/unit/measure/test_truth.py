@@ -191,3 +191,16 @@ def test_cloudview_truth_without_mitsuba_is_one_line_and_exit_2(tmp_path):
     assert result.stderr.strip() == (
         "cloudview: error: cloudview truth: mitsuba: not installed (pip install 'cloudview[truth]')"
     )
+
+
+def test_cloudview_truth_refuses_a_bad_look_for_its_models_in_one_line_before_tracing(tmp_path):
+    pytest.importorskip("mitsuba")
+    result = subprocess.run(
+        [sys.executable, "-m", "cloudcore.cli", "truth", "--out", str(tmp_path / "t.png"), "--detail-noise", "2"],
+        capture_output=True,
+        text=True,
+    )
+    assert result.returncode == 2 and not (tmp_path / "t.png").exists()
+    assert result.stderr.strip() == (
+        "cloudview: error: cloudview truth: settings: detail_noise must be within [0, 1], got 2.0"
+    )
