@@ -1,7 +1,7 @@
 """The frame planner's own time, replayed without drawing, per mode and case (JSON); and whether a change plans alike.
 
     python scripts/bench_plan.py [--cases flythrough,harris_circle_12800] [--frames 300] [--against REV]
-                                 [--json out/bench_plan.json]
+                                 [--cpu-time] [--json out/bench_plan.json]
 
 Each case of the benchmark suite `lod` (`cloudview bench --suite lod`; Harris's figure 8 among them:
 `harris_circle_N`, `harris_through_N`, `harris` for all) is planned frame by frame in a closed loop, as
@@ -173,9 +173,9 @@ def canonical(plan) -> str:
     )
 
 
-def replay(chosen, frames: int) -> list[dict]:
+def replay(chosen, frames: int, clock=time.perf_counter) -> list[dict]:
     """Per case ((name, scene, views, size, warmup), as `cloudcore.cli.bench_suite.built_cases` makes them) and
-    mode: the plans' texts frame by frame (`canonical`), and the timed passes."""
+    mode: the plans' texts frame by frame (`canonical`), and the passes timed by `clock` (seconds)."""
     rows = []
     for name, scene, views, size, warmup in chosen:
         views = views[: warmup + frames]
@@ -187,10 +187,10 @@ def replay(chosen, frames: int) -> list[dict]:
                     texts.append(canonical(plan))
             times = []
             for _ in range(PASSES):
-                start = time.perf_counter()
+                start = clock()
                 for arguments, keywords in calls:
                     plan_frame(*arguments, **keywords)
-                times.append(1e3 * (time.perf_counter() - start) / max(len(calls), 1))
+                times.append(1e3 * (clock() - start) / max(len(calls), 1))
             rows.append(
                 {
                     "case": name,
@@ -205,9 +205,9 @@ def replay(chosen, frames: int) -> list[dict]:
     return rows
 
 
-def against(revision: str, chosen: list, frames: int) -> list[dict]:
+def against(revision: str, chosen: list, frames: int, cpu_time: bool = False) -> list[dict]:
     """This script's rows of the cases `chosen` over `cloudcore` at git `revision` (a temporary worktree), in a
-    child process."""
+    child process (timed in its CPU time where `cpu_time`)."""
     from cloudcore.measure.benchmark import revision_trees
 
     root = Path(__file__).resolve().parent.parent
@@ -216,7 +216,8 @@ def against(revision: str, chosen: list, frames: int) -> list[dict]:
         cases.write_bytes(pickle.dumps(chosen))
         env = {**os.environ, "PYTHONPATH": str(trees["tree"])}
         subprocess.run(
-            [sys.executable, __file__, "--cases-from", str(cases), "--frames", str(frames), "--rows", str(out)],
+            [sys.executable, __file__, "--cases-from", str(cases), "--frames", str(frames), "--rows", str(out)]
+            + (["--cpu-time"] if cpu_time else []),
             env=env,
             check=True,
         )
@@ -266,6 +267,9 @@ def main() -> None:
     parser.add_argument("--frames", type=int, default=300, help="frames planned per case after its warm-up")
     parser.add_argument("--against", help="a git revision whose cloudcore is replayed beside the working tree's")
     parser.add_argument("--json", type=Path)
+    # on a machine other processes load, the wall clock counts their time too: 8-10 times the plan's own at a load
+    # of 10-13 on 2 cores (docs/performance.md, "Issue 51's Must show")
+    parser.add_argument("--cpu-time", action="store_true", help="time the plans in this process's CPU time")
     parser.add_argument("--rows", type=Path, help=argparse.SUPPRESS)  # the child's rows, for --against
     parser.add_argument("--cases-from", type=Path, help=argparse.SUPPRESS)  # the child's cases, for --against
     args = parser.parse_args()
@@ -275,11 +279,11 @@ def main() -> None:
         from cloudcore.cli.bench_suite import built_cases
 
         chosen = built_cases("lod", args.cases.split(","))
-    rows = replay(chosen, args.frames)
+    rows = replay(chosen, args.frames, time.process_time if args.cpu_time else time.perf_counter)
     if args.rows:
         args.rows.write_text(json.dumps(rows))
         return
-    theirs = against(args.against, chosen, args.frames) if args.against else []
+    theirs = against(args.against, chosen, args.frames, args.cpu_time) if args.against else []
     report = []
     for row in rows:
         other = next((r for r in theirs if (r["case"], r["mode"]) == (row["case"], row["mode"])), None)

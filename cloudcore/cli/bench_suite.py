@@ -402,16 +402,19 @@ def variant_label(settings: dict) -> str:
 
 def summary_rows(case: Case, report: dict) -> list[dict]:
     """One row for the reference and one per variant: mean times, PSNR, and each variant's frame, world and cloud
-    time over the reference's with its 95% interval, counted from the case's `first_counted_frame` (the warm-up
-    frames count); where the case asks, auto's frame over the faster of the others."""
+    time (`cloud_ms`: the cloud pass and the impostor updates; `cloud_work_ms`: those and the plan) over the
+    reference's with its 95% interval, counted from the case's `first_counted_frame` (the warm-up frames count);
+    where the case asks, auto's frame over the faster of the others."""
     reference = report["reference"]
     runs = report["runs"]
     skipped = max(case.first_counted_frame - case.warmup, 0)
     counted = slice(skipped if len(reference["per_frame"]) > skipped else 0, None)  # a quick run counts them all
 
     def per_frame(run, key):
-        if key == "cloud_ms":  # the clouds' whole work: their pass and their impostors' updates
+        if key == "cloud_ms":  # the clouds' drawing: their pass and their impostors' updates
             return [f["cloud_ms"] + f.get("impostor_update_ms", 0.0) for f in run["per_frame"][counted]]
+        if key == "cloud_work_ms":  # and their plan too: issue 51's "cloud work", all a frame's clouds cost it
+            return [f["plan_ms"] + f["cloud_ms"] + f.get("impostor_update_ms", 0.0) for f in run["per_frame"][counted]]
         return [f[key] for f in run["per_frame"][counted]]
 
     def row(run, label):
@@ -435,7 +438,7 @@ def summary_rows(case: Case, report: dict) -> list[dict]:
     labels = [variant_label(run["settings"]) for run in runs]
     for run, label in zip(runs, labels):
         ratios = {}
-        for key in ("frame_ms", "world_ms", "cloud_ms", "cloud_gpu_ms"):
+        for key in ("frame_ms", "world_ms", "cloud_ms", "cloud_work_ms", "cloud_gpu_ms"):
             ratio, low, high = ratio_interval(per_frame(run, key), [per_frame(reference, key)])
             ratios |= {f"{key}_vs_reference": ratio, f"{key}_vs_reference_low": low, f"{key}_vs_reference_high": high}
         rows.append(

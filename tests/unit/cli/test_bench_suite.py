@@ -214,7 +214,7 @@ def test_a_tiny_suite_runs_end_to_end_and_writes_the_report_it_promises(tmp_path
     rows = [row for row in report["summary"] if row["case"] == "tiny_still"]
     assert [row["variant"] for row in rows] == ["reference (full 3D)", "impostor", "auto tolerance_deg=2.0"]
     for row in rows[1:]:
-        for key in ("frame_ms", "world_ms", "cloud_ms"):
+        for key in ("frame_ms", "world_ms", "cloud_ms", "cloud_work_ms"):
             low, ratio, high = (row[f"{key}_vs_reference{end}"] for end in ("_low", "", "_high"))
             assert 0 < low <= ratio <= high
         assert 0 < row["psnr_min"] <= row["psnr_mean"] <= 100
@@ -222,4 +222,10 @@ def test_a_tiny_suite_runs_end_to_end_and_writes_the_report_it_promises(tmp_path
     frames = [[f["frame_ms"] for f in run["per_frame"][1:]] for run in (still["reference"], *still["runs"])]
     faster = min(sum(frames[0]), sum(frames[1]))
     assert rows[2]["frame_vs_faster"] == pytest.approx(sum(frames[2]) / faster)
+    # the clouds' whole work, their plan with it, over full 3D's
+    work = [
+        [f["plan_ms"] + f["impostor_update_ms"] + f["cloud_ms"] for f in run["per_frame"][1:]]
+        for run in (still["reference"], *still["runs"])
+    ]
+    assert rows[2]["cloud_work_ms_vs_reference"] == pytest.approx(sum(work[2]) / sum(work[0]))
     assert plot.stat().st_size > 0
