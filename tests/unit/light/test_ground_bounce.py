@@ -1,4 +1,4 @@
-"""The ground's bounce as a light of the clouds' shading (`cloudcore.light.ground_bounce`, `[shading] ground_bounce`)."""
+"""The ground's bounce as a light of the clouds' shading (`cloudcore.light.ground_bounce`)."""
 
 import dataclasses
 
