@@ -5,12 +5,20 @@ import dataclasses
 import numpy as np
 import pytest
 
-from cloudcore.light.ground_bounce import NADIR, bounce_light, cloud_lights, ground_albedo_rgb, level_ground_irradiance
+from cloudcore.light.ground_bounce import (
+    NADIR,
+    bounce_light,
+    cloud_lights,
+    ground_albedo_rgb,
+    ground_light_share,
+    level_ground_irradiance,
+)
 from cloudcore.light.lighting import active_lights, physical_irradiances, scene_lights
 from cloudcore.model.scene import Air, Camera, Cloud, Light, Lighting, Scene, Shading, Terrain
 from cloudcore.particles.buffer import ParticleBuffer
 from cloudcore.scenes.files import load_scene, save_scene
 from cloudcore.world.sun import scene_hour
+from cloudcore.world.terrain import height_at
 from tests.conftest import assert_file_refused_in_one_line
 
 
@@ -53,17 +61,53 @@ def test_the_ground_s_albedo_is_the_terrain_s_colour_its_ramp_s_mean_or_the_air_
     assert ground_albedo_rgb(ramp, Air()) == pytest.approx((0.3, 0.2, 0.1))
 
 
-def test_a_cloud_s_base_gets_the_bounce_its_top_does_not():
-    """Two particles one above the other: the bounce from below reaches the lower whole and the upper through it."""
-    cloud = Cloud("pair", [[0.0, 10.0, 0.0, 5.0], [0.0, 0.0, 0.0, 5.0]], optical_depth=6.0)
+def test_a_cloud_s_base_gets_the_bounce_its_top_less_and_both_the_ground_s_in_their_shadow():
+    """Two particles one above the other, 1 km up, the sun overhead: the ground below them is in their shadow, so
+    the lower particle's bounce is the shadowed ground's share of the light, and the upper one's what passes the
+    lower too; with the sun low the ground below is in full sun and the lower particle gets all of it."""
+    cloud = Cloud("pair", [[0.0, 1010.0, 0.0, 5.0], [0.0, 1000.0, 0.0, 5.0]], optical_depth=6.0)
     shading = Shading(albedo=0.99, eye_pass="saturated", light_pass="octaves", ground_bounce=True)
-    lights, ambient = cloud_lights(
-        (Light((0.0, 1.0, 0.0), (1.0, 1.0, 1.0), 1.0),), (0.1, 0.1, 0.1), shading, (0.3,) * 3
-    )
-    particles = ParticleBuffer((cloud,), shading, lights, ambient)
-    from_below = particles.incident[:, -1]
-    assert from_below[1] == pytest.approx(1.0) and from_below[0] < 0.5
-    np.testing.assert_allclose(particles.light_radiance[-1], [0.3 * (1.0 + 0.1 * np.pi)] * 3, rtol=1e-12)
+    for sun, shadowed in (((0.0, 1.0, 0.0), True), ((0.8, 0.6, 0.0), False)):
+        lights, ambient = cloud_lights((Light(sun, (1.0, 1.0, 1.0), 1.0),), (0.1, 0.1, 0.1), shading, (0.3,) * 3)
+        particles = ParticleBuffer((cloud,), shading, lights, ambient)
+        from_below = particles.incident[:, -1]
+        share = ground_light_share(particles.centres, particles.radii, particles.alpha, lights[:1], [0.1] * 3, None)
+        assert from_below[1] == pytest.approx(share[1], rel=1e-12) and from_below[0] < 0.5 * from_below[1]
+        if shadowed:  # through both particles, whose opacity is 1 - exp(-6) each at their centres
+            expected = (0.1 * np.pi + np.exp(-12.0)) / (0.1 * np.pi + 1.0)
+            assert share[1] == pytest.approx(expected, rel=0.05)
+        else:
+            assert share[1] == pytest.approx(1.0)
+        np.testing.assert_allclose(particles.light_radiance[-1], [0.3 * (sun[1] + 0.1 * np.pi)] * 3, rtol=1e-12)
+
+
+def test_a_light_s_shadow_falls_where_its_beam_goes():
+    """A sun at 45 degrees: an opaque particle 1 km up shadows the ground 1 km downwind, not the ground below it."""
+    sun = (Light((-np.sqrt(0.5), np.sqrt(0.5), 0.0), (1.0, 1.0, 1.0), 1.0),)
+    centres = [[0.0, 1000.0, 0.0], [1000.0, 1000.0, 0.0]]
+    share = ground_light_share(centres, [30.0, 30.0], [0.999, 0.0], sun, (0.0, 0.0, 0.0), None)
+    assert share[0] == pytest.approx(1.0) and share[1] < 0.1
+
+
+def test_the_ground_below_is_the_terrain_s():
+    """The sun overhead and an opaque particle under the valley's side, halfway down to y = 0: it shadows the level
+    ground at y = 0 below the particle above it, not the terrain's ground, which is above it."""
+    terrain = Terrain()
+    height = float(height_at(terrain, 2900.0, 50.0))
+    assert height > 300.0
+    centres = [[2900.0, height + 300.0, 50.0], [2900.0, 0.5 * height, 50.0]]
+    sun = (Light((0.0, 1.0, 0.0), (1.0, 1.0, 1.0), 1.0),)
+    on_terrain = ground_light_share(centres, [30.0, 5.0], [0.0, 0.999], sun, (0.0, 0.0, 0.0), terrain)
+    on_level = ground_light_share(centres, [30.0, 5.0], [0.0, 0.999], sun, (0.0, 0.0, 0.0), None)
+    assert on_terrain[0] == pytest.approx(1.0) and on_level[0] < 0.1
+
+
+def test_the_share_is_one_without_light_or_particles_and_finite_at_extremes():
+    sun = (Light((0.0, 1.0, 0.0), (1.0, 1.0, 1.0), 1.0),)
+    assert ground_light_share(np.zeros((0, 3)), [], [], sun, (0.1,) * 3, None).shape == (0,)
+    assert ground_light_share([[0.0, 500.0, 0.0]], [10.0], [1.0], (), (0.0,) * 3, None)[0] == 1.0
+    share = ground_light_share([[0.0, 1e6, 0.0], [0.0, 500.0, 0.0]], [1e-3, 1e5], [1.0, 1.0], sun, (0.0,) * 3, None)
+    assert np.all(np.isfinite(share)) and np.all((share >= 0.0) & (share <= 1.0))
 
 
 def test_the_setting_round_trips_and_is_refused_unless_true_or_false(tmp_path):
