@@ -2,9 +2,10 @@
 
     python scripts/bench_octaves.py [SCENE] [--repeat 5] [--json out/bench_octaves.json]
 
-For each light that contributes at the scene's hour (and the ground's bounce where the scene turns it on), the methods take turns (`illuminate_direction` over every
-cloud, after one warm-up each), so what the shared machine does falls on all; each octaves pass's ratio to exact
-is reported with its 95% interval (`ratio_interval`) and the range of the turns' own ratios.  Results for this
+For each light that contributes at the scene's hour (and the ground's bounce where the scene turns it on), the
+methods take turns (`illuminate_direction` over every cloud, after one warm-up each), so what the shared machine
+does falls on all; each octaves pass's ratio to exact is reported with its 95% interval (`ratio_interval`) and the
+range of the turns' own ratios.  Results for this
 machine are in docs/shading.md ("Octaves", "The light a lit face sends back").
 """
 
