@@ -93,7 +93,8 @@ class Shading:
     reaching it is found (`LIGHT_PASSES`: Harris's multiple forward scattering, Yusov's occlusion
     estimate, Wrenninge's multiple-scattering octaves, or the octaves with the light a lit face sends back;
     "yusov" and "occlusion" together are Yusov's model, "saturated" and "octaves" the octave model:
-    docs/shading.md, "Octaves")."""
+    docs/shading.md, "Octaves"); `ground_bounce` lights the clouds from below with the ground's bounce in place of
+    the ambient's lower half (`cloudcore.light.ground_bounce`)."""
 
     albedo: float = 0.9
     optical_depth: float = 8.0
@@ -101,6 +102,7 @@ class Shading:
     g: float = 0.0
     eye_pass: str = "harris"
     light_pass: str = "harris"
+    ground_bounce: bool = False
 
 
 #: the shading a scene made from nothing starts with (`cloudview import` into a new file): the model closest to the

@@ -35,6 +35,7 @@ from cloudcore.artist.formation import core_distances, opacity_factor
 from cloudcore.artist.particle_styles import ParticleStyles, particle_styles
 from cloudcore.artist.sprites import CELL_PIXELS
 from cloudcore.field.shadow_cells import CellShadowing
+from cloudcore.light.ground_bounce import bounce_share
 from cloudcore.light.illumination import IlluminationCache, cloud_optics, light_pass_method
 from cloudcore.light.lighting import active_lights
 from cloudcore.light.phase import phase_function
@@ -42,7 +43,7 @@ from cloudcore.light.precomputed import eye_pass_profiles
 from cloudcore.light.shading import RETURNING_LIGHT_PASSES, eye_pass_coefficients
 from cloudcore.light.splat_look import inner_light_depth
 from cloudcore.maths.ramps import smoothstep
-from cloudcore.model.scene import Lighting, Shading
+from cloudcore.model.scene import Lighting, Shading, Terrain
 
 #: a particle fades out between these distances from the eye, in radii, so the
 #: camera inside one never gets a screen-filling quad.
@@ -65,12 +66,14 @@ class ParticleBuffer:
         cache: IlluminationCache | None = None,
         styles: ParticleStyles | None = None,
         between_clouds: bool | CellShadowing = False,
+        ground: Terrain | None = None,
     ):
         """`cache` keeps the illumination of unchanged clouds between instances (the editor);
         `styles` (`cloudcore.artist.particle_styles`, by default at the default hour) say which clouds
         are sprites or artist-shaded; with `between_clouds` the sun reaches each cloud through the others
         (`cloudcore.light.illumination.sun_through_others`; a `CellShadowing`: a cloud field's cells through one
-        another)."""
+        another).  With `shading.ground_bounce`, `lights` and `ambient` are `cloud_lights`' and the bounce comes
+        from the `ground` (its heights; y = 0 without one) below each particle, in the clouds' shadow."""
         clouds = tuple(clouds)
         self.styles = styles if styles is not None else particle_styles(clouds, Lighting())
         self.phase, self.g = shading.phase, shading.g
@@ -116,6 +119,12 @@ class ParticleBuffer:
             if light_pass_method(shading, method) in RETURNING_LIGHT_PASSES
             else None
         )
+        if shading.ground_bounce and lights and lights[-1] is scene_lights[-1]:
+            # the bounce, `cloud_lights`' last light, is the ground's straight below each particle
+            share = bounce_share(self.centres, self.radii, self.alpha, scene_lights, self.ambient, ground)
+            self.incident[:, -1] *= share
+            if self.returned is not None:
+                self.returned[:, -1] *= share
 
         #: (clouds,) metres: the finest detail in each cloud (0 for an empty one), which bounds how
         #: fine an impostor texture needs to be (`cloudcore.lod.impostors.detail_size_px`); each cloud's

@@ -23,6 +23,7 @@ from cloudcore.artist.particle_styles import particle_styles
 from cloudcore.field.shadow_cells import CellShadowing, cell_shadowing
 from cloudcore.field.state import FieldState
 from cloudcore.field.weather import WeatherFieldState, update_weather_field, weather_drift
+from cloudcore.light.ground_bounce import cloud_lights, ground_albedo_rgb
 from cloudcore.light.illumination import IlluminationCache
 from cloudcore.lod.units import LodUnits, lod_units
 from cloudcore.model.scene import Camera, Lighting, Scene
@@ -134,9 +135,12 @@ class FrameClouds:
         # the clouds shadow one another: a field's cells pair by pair, made again for the clouds a new set of cells
         # reaches (`cloudcore.light.cell_shadows`)
         between_clouds = settings.cloud_shadows and (self._cell_shadowing[1] if scene.cloud_field is not None else True)
+        # the ground's bounce follows the ground's colour and heights (`cloudcore.light.ground_bounce`)
+        ground = scene.terrain if scene.shading.ground_bounce else None
+        lights, ambient = cloud_lights(lights, ambient, scene.shading, ground_albedo_rgb(ground, lighting.air))
         start = time.perf_counter()
         relit = self.lit.follow(
-            (scene.clouds, scene.shading, lighting, illumination_method, between_clouds), lights, ambient
+            (scene.clouds, scene.shading, lighting, illumination_method, between_clouds, ground), lights, ambient
         )
         illumination_ms = 1e3 * (time.perf_counter() - start) if relit else 0.0
         # the units follow the particles' places and sizes, not their light: a relit scene keeps them
@@ -271,7 +275,7 @@ class FrameClouds:
         """The clouds' particle buffer (their light) for `source` (the clouds, shading, lighting, light pass method,
         whether the clouds shadow one another), each cloud's lighting key kept from the last where its light is
         the same."""
-        clouds, shading, lighting, illumination_method, between_clouds = source
+        clouds, shading, lighting, illumination_method, between_clouds, ground = source
         particles = ParticleBuffer(
             clouds,
             shading,
@@ -281,11 +285,13 @@ class FrameClouds:
             self._illumination,
             particle_styles(clouds, lighting),
             between_clouds=between_clouds,
+            ground=ground,
         )
         old = self.lit.value
         # a field's new cells shadow anew (another `CellShadowing`): the keys stay where the light stays
         same_lighting = old is not None and self.lit.source[1:4] == source[1:4]
         same_lighting = same_lighting and (self.lit.source[4] is False) == (between_clouds is False)
+        same_lighting = same_lighting and not (self.lit.source[5] != source[5])
         # by identity, not place: a cloud field's clouds that stay keep their keys when others come and go, unless
         # the light reaching them changed (the clouds shadow one another: one moved, another's shadow moves)
         held = (

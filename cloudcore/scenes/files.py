@@ -277,6 +277,7 @@ def _shading(t: Table) -> Shading:
         g=t.number("g", d.g, **_range(Shading, "g")),
         eye_pass=t.string("eye_pass", d.eye_pass, choices=EYE_PASSES),
         light_pass=t.string("light_pass", d.light_pass, choices=LIGHT_PASSES),
+        ground_bounce=t.boolean("ground_bounce", d.ground_bounce),
     )
 
 
@@ -540,7 +541,7 @@ def scene_to_dict(scene: Scene) -> dict:
         lighting["air"] = dataclasses.asdict(scene.lighting.air)
     data["lighting"] = lighting
     data["shading"] = {"albedo": s.albedo, "optical_depth": s.optical_depth, "phase": s.phase, "g": s.g}
-    for key in ("eye_pass", "light_pass"):  # files that keep Harris's passes stay as they were
+    for key in ("eye_pass", "light_pass", "ground_bounce"):  # files that keep Harris's model stay as they were
         if getattr(s, key) != getattr(Shading(), key):
             data["shading"][key] = getattr(s, key)
     if scene.terrain is not None:

@@ -85,3 +85,30 @@ def test_wang_s_ring_keys_step_only_when_a_cloud_crossed_a_rebuild_distance(two_
     assert keys[0] is keys[1] is keys[2] and keys[3] != keys[2]  # the first step at half a rebuild distance
     assert clouds.ring_keys_under_wind(ring_keys, None, settings) is ring_keys
     assert clouds.ring_keys_under_wind(ring_keys, motion, RenderSettings(ring_radius=math.inf)) is ring_keys
+
+
+def test_the_ground_s_bounce_lights_the_clouds_from_below_and_follows_the_terrain(two_clouds):
+    """With `[shading] ground_bounce` the frame's clouds get a light from the nadir of the terrain's colour and the
+    ambient's upper half; a new terrain colour relights them, and turning it off gives the scene's lights back."""
+    from cloudcore.light.ground_bounce import NADIR
+    from cloudcore.model.scene import Terrain
+
+    clouds = FrameClouds(IlluminationCache())
+    plain = prepared(clouds, two_clouds).particles
+    bouncing = dataclasses.replace(
+        two_clouds,
+        shading=dataclasses.replace(two_clouds.shading, ground_bounce=True),
+        terrain=Terrain(color=(0.2, 0.4, 0.1)),
+    )
+    lit = prepared(clouds, bouncing).particles
+    assert len(lit.light_directions) == len(plain.light_directions) + 1
+    np.testing.assert_array_equal(lit.light_directions[-1], NADIR)
+    np.testing.assert_allclose(lit.ambient, 0.5 * plain.ambient)
+    green = lit.light_radiance[-1]
+    assert green[1] > green[0] > green[2] and np.any(lit.incident[:, -1] > 0.0)
+    greyer = dataclasses.replace(bouncing, terrain=Terrain(color=(0.3, 0.3, 0.3)))
+    regrey = prepared(clouds, greyer)
+    assert regrey.illumination_ms > 0.0
+    np.testing.assert_allclose(regrey.particles.light_radiance[-1] / green, [1.5, 0.75, 3.0], rtol=1e-9)
+    back = prepared(clouds, two_clouds).particles
+    np.testing.assert_array_equal(back.light_directions, plain.light_directions)
