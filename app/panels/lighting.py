@@ -79,7 +79,14 @@ class LightingPanel:
             "harris: the light reaching each particle by Harris's multiple forward scattering; occlusion: by "
             "Yusov's light-space occlusion estimate (with the yusov eye pass, Yusov's model)."
         )
+        changed_bounce, ground_bounce = imgui.checkbox("Ground bounce", shading.ground_bounce)
+        imgui.set_item_tooltip(
+            "The clouds lit from below by the sunlit ground, under their own shadows, in place of the ambient's lower "
+            'half (closer to the path-traced truth under a thick cloud: docs/shading.md, "The ground\'s bounce").'
+        )
         changes = {key: value for key, value in changes.items() if value is not None}
+        if changed_bounce:
+            changes["ground_bounce"] = ground_bounce
         if changed_light_pass:
             changes["light_pass"] = LIGHT_PASSES[light_pass_index]
         if changed_phase:

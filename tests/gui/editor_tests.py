@@ -205,6 +205,25 @@ def the_occlusion_light_pass_relights_the_clouds(ctx, app: EditorUnderTest):
     CHECK(bool(changed > 0.02))  # the clouds, not the sky
 
 
+def the_ground_bounce_relights_the_clouds(ctx, app: EditorUnderTest):
+    """The Lighting panel's "Ground bounce" lights the clouds from below in the worker: a new picture of the
+    clouds, the sky and the ground as they were; one undo step."""
+    use_window(ctx, "Lighting")
+    ctx.item_input_value("Time of day", 15.5)
+    app.relit(ctx)
+    before = app.capture(ctx)
+    ctx.item_check("Ground bounce")
+    CHECK(app.editor.scene.shading.ground_bounce)
+    ctx.yield_(SETTLE)
+    app.relit(ctx)
+    after = app.capture(ctx)
+    undo(ctx)
+    CHECK(not app.editor.scene.shading.ground_bounce)
+    changed = (np.abs(before.astype(int) - after.astype(int)).max(axis=2) > 4).mean()
+    app.outcome["ground_bounce_changed_fraction"] = float(changed)
+    CHECK(bool(changed > 0.02))  # the clouds, not the sky
+
+
 def dragging_the_time_of_day_relights_live(ctx, app: EditorUnderTest):
     """The viewport follows the slider while it moves, shaded in the worker; exact once let go."""
     use_window(ctx, "Lighting")
@@ -1016,6 +1035,7 @@ GUI_TESTS = (
     the_air_panel_changes_the_sky_and_the_light,
     the_saturated_eye_pass_darkens_the_clouds,
     the_occlusion_light_pass_relights_the_clouds,
+    the_ground_bounce_relights_the_clouds,
     dragging_the_time_of_day_relights_live,
     tolerance_drives_regeneration,
     save_and_reopen,
