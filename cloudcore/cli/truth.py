@@ -166,7 +166,7 @@ def run(args) -> int:
         "regions": {name: int(mask.sum()) for name, mask in regions.items()},
         "models": {},
     }
-    for name, (model, stats, seconds) in _model_renders(scene, camera, args).items():
+    for name, (model, stats, seconds) in model_renders(scene, camera, args).items():
         report["models"][name] = {
             "seconds": seconds,
             "illumination_ms": stats.illumination_ms,
@@ -269,7 +269,7 @@ def model_names(text: str) -> tuple[str, ...]:
     return names
 
 
-def _model_renders(scene, camera, args) -> dict[str, tuple[np.ndarray, dict, float]]:
+def model_renders(scene, camera, args) -> dict[str, tuple[np.ndarray, dict, float]]:
     """Each model's full-3D picture of the truth's world (the sky; no terrain, no objects, no air)."""
     # headless: EGL must be chosen before OpenGL is first imported
     os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
