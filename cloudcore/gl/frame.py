@@ -38,7 +38,7 @@ from cloudcore.field.weather import WeatherFieldState
 from cloudcore.gl.context import HeadlessContext, WindowContext, check_frame_size
 from cloudcore.gl.draw import CloudPass, CloudPassFrame, DrawCounts, PassTools
 from cloudcore.gl.impostor_store import ImpostorStore
-from cloudcore.gl.light_shafts import LightShaftPass
+from cloudcore.gl.light_shafts import FrameShafts, LightShaftPass
 from cloudcore.gl.measured_way import MeasuredWay
 from cloudcore.gl.objects import ObjectPass
 from cloudcore.gl.pass_clock import PassClock
@@ -53,6 +53,7 @@ from cloudcore.gl.world import WorldPass
 from cloudcore.light.air_between import air_between
 from cloudcore.light.cloud_shadows import FIELD_MAP_RESOLUTION, MAP_RESOLUTION, PREVIEW_MAP_RESOLUTION
 from cloudcore.light.illumination import IlluminationCache, shadowing_sun
+from cloudcore.light.light_shafts import cloud_particle_ranges
 from cloudcore.light.lighting import scene_lights
 from cloudcore.light.live_air import LiveAir
 from cloudcore.light.relighting import PREVIEW_METHOD
@@ -70,7 +71,7 @@ from cloudcore.particles.frame_clouds import FrameClouds, PreparedClouds
 from cloudcore.runtime.derived import Derived
 from cloudcore.stats.frame_stats import FrameStats
 from cloudcore.stats.overdraw import Overdraw, overdraw_statistics
-from cloudcore.world.camera import NEAR_PLANE_M, frustum_planes, projection_matrix, view_matrix
+from cloudcore.world.camera import NEAR_PLANE_M, frustum_planes, projection_matrix, view_matrix, view_rotation
 from cloudcore.world.wind import reshapes
 
 
@@ -256,9 +257,11 @@ class FrameRenderer:
         clock = self._clock
         with clock.frame():
             with clock.timed("world"):
-                self._draw_world(frame)
-            # the world pass uploaded the air for this eye: the ring's segments and the cloud pass's splats take it
+                frame = self._draw_world(frame)
+            # the world pass uploaded the air for this eye: the ring's segments and the cloud pass's splats take it,
+            # less the light shafts' share where it marched them
             self._splats.air = None if frame.air is None else frame.air[0]
+            self._splats.shafts = frame.shafts
             with clock.timed("impostor updates"):
                 rendered = self._impostors.update(
                     frame.plan, frame.particles, settings, time_s, frame.splat_order, self.clouds.unit_weights
@@ -366,11 +369,12 @@ class FrameRenderer:
             self.clouds.unit_weights,
         )
 
-    def _draw_world(self, frame: CloudPassFrame) -> None:
-        """The world pass: terrain and sky, and the objects outside the clouds the plan splits."""
+    def _draw_world(self, frame: CloudPassFrame) -> CloudPassFrame:
+        """The world pass: terrain and sky, and the objects outside the clouds the plan splits; `frame` with the
+        light shafts it marched, cut at the clouds the plan draws (`FrameShafts`), where it marched them."""
         settings = frame.settings
         world = self._world.value
-        world.draw(
+        marched = world.draw(
             self.context,
             frame.camera,
             frame.view,
@@ -379,6 +383,7 @@ class FrameRenderer:
             through_air=settings.aerial_perspective,
             shadows=self._shadows,
             light_shafts=settings.light_shafts,
+            draw_cloud_depth=self._cloud_depth_drawer(frame),
         )
         if frame.plan.objects_with_world:
             frame.objects.draw(
@@ -391,6 +396,24 @@ class FrameRenderer:
                 air=world.air_volume if settings.aerial_perspective else None,
                 shadows=self._shadows,
             )
+        if marched is None:
+            return frame
+        eye_view_projection = frame.projection @ view_rotation(frame.view)
+        return dataclasses.replace(frame, shafts=FrameShafts(marched, frame.eye, eye_view_projection))
+
+    def _cloud_depth_drawer(self, frame: CloudPassFrame):
+        """What draws the nearest depth of the clouds the plan draws (not the ring's: its segments hold their air
+        from the ring's eye) at the light shafts' march size, for the march to end its rays there (Yusov's cut)."""
+        plan, particles = frame.plan, frame.particles
+
+        def draw(size: tuple[int, int]) -> None:
+            clouds = [member for unit in plan.draw_order for member in plan.clouds[unit].members]
+            ranges = cloud_particle_ranges(clouds, particles.cloud_starts)
+            self._splats.draw_nearest_depth(
+                particles, frame.time_s, ranges, frame.eye, frame.view, frame.projection, size[1]
+            )
+
+        return draw
 
     def _observe(self, frame: CloudPassFrame, compositable: int, particles: int, plan_ms: float) -> None:
         """Fold the timed passes into the plan's cost fit, and into the measured ways' choices: the particles

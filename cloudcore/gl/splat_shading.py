@@ -13,6 +13,7 @@ import numpy as np
 from OpenGL import GL
 
 from cloudcore.gl.air_volume import AirVolume
+from cloudcore.gl.light_shafts import FrameShafts
 from cloudcore.gl.programs import build_compute_program, dispatch, uniform_locations
 from cloudcore.gl.splat_order import GpuSplatOrder
 from cloudcore.gl.splat_residency import ResidentParticles
@@ -44,8 +45,9 @@ _SHADE_GROUP = 64
 _SLOT_ALIGNMENT = 256 // INSTANCE_BYTES
 #: splat_shade.comp.glsl's optional code, in the order of a variant's key: sprites that do not lie in the
 #: image plane, Wang's artist colours, Yusov's eye-pass profiles, the air between the eye and each particle, the
-#: light a lit face sent back (`cloudcore.particles.buffer.ParticleBuffer.returned`)
-_SHADE_FEATURES = ("FACING", "ARTIST", "PROFILES", "AIR", "RETURNED")
+#: light a lit face sent back (`cloudcore.particles.buffer.ParticleBuffer.returned`), the light shafts' share
+#: taken off that air (the frame's eye's batches, under the shafts alone)
+_SHADE_FEATURES = ("FACING", "ARTIST", "PROFILES", "AIR", "RETURNED", "LIGHT_SHAFTS")
 #: what a draw after shading waits for: the instances (and a selection's indirect command)
 _SHADED_BARRIERS = GL.GL_SHADER_STORAGE_BARRIER_BIT | GL.GL_COMMAND_BARRIER_BIT
 
@@ -64,6 +66,9 @@ class SplatShading:
         #: the frame's air (`cloudcore.gl.air_volume`), uploaded for its eye, which batches `through_air` take;
         #: None: no air (the gradient sky)
         self.air: AirVolume | None = None
+        #: the frame's light shafts (`FrameShafts`), whose share of the air in front of a particle its air loses
+        #: in the batches of the frame's eye; None: no shafts
+        self.shafts: FrameShafts | None = None
         #: the compute shader's variants by the features a batch has (`_SHADE_FEATURES`), made when first
         #: needed: (program, its uniforms' locations, the particles its light uniforms are of)
         self._programs: dict[tuple, list] = {}
@@ -198,18 +203,22 @@ class SplatShading:
         GL.glUseProgram(program)
         if features[_SHADE_FEATURES.index("AIR")]:
             self.air.bind(program)
+        if features[_SHADE_FEATURES.index("LIGHT_SHAFTS")]:
+            self.shafts.bind(program)
         GL.glUniform1ui(uniforms["first"], first)
         GL.glUniform1ui(uniforms["slot_count"], end - first)
         GL.glUniform1ui(uniforms["batch_count"], len(rows))
         dispatch(-(-(end - first) // _SHADE_GROUP))
 
-    def _features(self, batch: SplatBatch | SplatSelection) -> tuple[bool, bool, bool, bool, bool]:
-        """The shader features (`_SHADE_FEATURES`) `batch`'s particles need."""
+    def _features(self, batch: SplatBatch | SplatSelection) -> tuple[bool, ...]:
+        """The shader features (`_SHADE_FEATURES`) `batch`'s particles need; the light shafts' share only for
+        the frame's eye (a ring's segments are seen from the ring's)."""
         bits = self._resident.feature_bits(batch)
         air = batch.through_air and self.air is not None
-        return bool(bits & 1), bool(bits & 2), self._resident.profiled, air, self._resident.returning
+        shafts = air and self.shafts is not None and self.shafts.seen_from(batch.eye)
+        return bool(bits & 1), bool(bits & 2), self._resident.profiled, air, self._resident.returning, shafts
 
-    def _shade_program(self, features: tuple[bool, bool, bool, bool, bool]) -> tuple[int, dict]:
+    def _shade_program(self, features: tuple[bool, ...]) -> tuple[int, dict]:
         """The compute shader variant with `features`, its light uniforms those of the resident particles; and
         its uniforms' locations."""
         if features not in self._programs:

@@ -95,3 +95,14 @@ def shadowed_share(shadowed, whole) -> np.ndarray:
     by luminance, in [0, 1]."""
     taken, all_of_it = np.asarray(shadowed) @ LUMINANCE, np.asarray(whole) @ LUMINANCE
     return np.clip(taken / np.maximum(all_of_it, 1e-12), 0.0, 1.0)
+
+
+def cloud_particle_ranges(clouds, cloud_starts) -> tuple[np.ndarray, np.ndarray]:
+    """(first particles, counts) int32 of `clouds` (indices into `cloud_starts`, a buffer's first particle of each
+    cloud and its end), those with particles: the clouds whose nearest depth ends the march's rays (Yusov's cut),
+    drawn in one multi-draw."""
+    clouds = np.asarray(clouds, dtype=np.int64).reshape(-1)
+    starts = np.asarray(cloud_starts, dtype=np.int64)
+    firsts, counts = starts[clouds], starts[clouds + 1] - starts[clouds]
+    kept = counts > 0
+    return firsts[kept].astype(np.int32), counts[kept].astype(np.int32)
