@@ -1,5 +1,5 @@
-"""The particles whose nearest depth cuts the light shafts' march (`cloudcore.light.light_shafts.cloud_particle_ranges`):
-each drawn cloud's run of the buffer, in one multi-draw."""
+"""The particles whose nearest depth cuts the light shafts' march
+(`cloudcore.light.light_shafts.cloud_particle_ranges`): each drawn cloud's run of the buffer, in one multi-draw."""
 
 import numpy as np
 
