@@ -45,6 +45,11 @@ _MAX_VIEWPORTS = 16
 #: a particle fainter than this (its opacity times its formation or blend weight) is left out of the clouds'
 #: nearest depth (`draw_nearest_depth`): the light shafts' march ends its ray at a cloud that is seen
 NEAREST_DEPTH_OPACITY = 0.01
+#: of a particle's radius, the disc that cuts the march: out to its kernel's 1/e point (`SPLAT_SHARPNESS`).  A ray cut at
+#: a cloud's thin fringe keeps from the sky behind the fringe the shafts behind the cloud: the whole disc brightened
+#: the edges of a cumulonimbus seen from the side by up to 12 levels, half of it by up to 7
+#: (docs/atmosphere.md#the-shafts-and-the-air-in-front-of-the-clouds)
+NEAREST_DEPTH_CORE = 0.5
 
 
 class SplatPass:
@@ -201,7 +206,8 @@ class SplatPass:
         height: int,
     ) -> None:
         """Draw the depth of the particles of `ranges` (first particles, counts: `cloud_particle_ranges`) into the
-        bound target of `height` pixels, depth tested and written: each a disc at its centre's depth, those too
+        bound target of `height` pixels, depth tested and written: each a disc at its centre's depth (its core,
+        `NEAREST_DEPTH_CORE`), those too
         faint to be seen at `time_s` left out (`NEAREST_DEPTH_OPACITY`); the light shafts' march ends its rays at
         the nearest (docs/atmosphere.md#the-shafts-and-the-air-in-front-of-the-clouds)."""
         firsts, counts = ranges
@@ -216,6 +222,7 @@ class SplatPass:
                     "PARTICLE_FLOATS": PARTICLE_FLOATS,
                     "SEEN_OPACITY": NEAREST_DEPTH_OPACITY,
                     "MAX_POINT_SIZE": self._point_sizes_px[1],
+                    "CORE": NEAREST_DEPTH_CORE,
                 },
             )
             self._depth_program = (

@@ -1,5 +1,5 @@
 #version 430 core
-// A particle's disc at its centre's depth (cloud_depth.vert.glsl): no colour.
+// The core of a particle's disc at its centre's depth (cloud_depth.vert.glsl's point): no colour.
 
 void main()
 {
