@@ -45,9 +45,9 @@ _MAX_VIEWPORTS = 16
 #: a particle fainter than this (its opacity times its formation or blend weight) is left out of the clouds'
 #: nearest depth (`draw_nearest_depth`): the light shafts' march ends its ray at a cloud that is seen
 NEAREST_DEPTH_OPACITY = 0.01
-#: of a particle's radius, the disc that cuts the march: out to its kernel's 1/e point (`SPLAT_SHARPNESS`).  A ray cut at
-#: a cloud's thin fringe keeps from the sky behind the fringe the shafts behind the cloud: the whole disc brightened
-#: the edges of a cumulonimbus seen from the side by up to 12 levels, half of it by up to 7
+#: of a particle's radius, the disc that cuts the march: out to its kernel's 1/e point (`SPLAT_SHARPNESS`).  A ray
+#: cut at a cloud's thin fringe keeps from the sky behind the fringe the shafts behind the cloud: the whole disc
+#: brightened the edges of a cumulonimbus seen from the side more than half of it
 #: (docs/atmosphere.md#the-shafts-and-the-air-in-front-of-the-clouds)
 NEAREST_DEPTH_CORE = 0.5
 
