@@ -258,17 +258,19 @@ class FrameRenderer:
         with clock.frame():
             with clock.timed("world"):
                 frame = self._draw_world(frame)
-            # the world pass uploaded the air for this eye: the ring's segments and the cloud pass's splats take it,
-            # less the light shafts' share where it marched them
+            # the world pass uploaded the air for this eye: the ring's segments and the cloud pass's splats take it
             self._splats.air = None if frame.air is None else frame.air[0]
-            self._splats.shafts = frame.shafts
             with clock.timed("impostor updates"):
                 rendered = self._impostors.update(
                     frame.plan, frame.particles, settings, time_s, frame.splat_order, self.clouds.unit_weights
                 )
             with clock.timed("clouds"):
                 self.context.bind_target()
+                # the cloud pass's splats less the light shafts' share of their air, where the world marched them
+                # (not the ring's segments, made from the ring's eye for other eyes)
+                self._splats.shafts = frame.shafts
                 drawn = self._cloud_pass.draw(frame)
+                self._splats.shafts = None
         drawn_by_gpu, rendered_by_gpu = self._splats.take_selected()
         self._observe(
             frame, drawn.compositable, drawn.particles + drawn_by_gpu + rendered + rendered_by_gpu, before_passes_ms
@@ -398,8 +400,7 @@ class FrameRenderer:
             )
         if marched is None:
             return frame
-        eye_view_projection = frame.projection @ view_rotation(frame.view)
-        return dataclasses.replace(frame, shafts=FrameShafts(marched, frame.eye, eye_view_projection))
+        return dataclasses.replace(frame, shafts=FrameShafts(marched, frame.projection @ view_rotation(frame.view)))
 
     def _cloud_depth_drawer(self, frame: CloudPassFrame):
         """What draws the nearest depth of the clouds the plan draws (not the ring's: its segments hold their air

@@ -46,13 +46,8 @@ class FrameShafts:
     whichever representation draws it (docs/atmosphere.md#the-shafts-and-the-air-in-front-of-the-clouds)."""
 
     march: LightShaftPass
-    eye: np.ndarray  # the frame's eye, metres
     #: the frame's projection times its view's rotation: points relative to the eye onto the march's target
     eye_view_projection: np.ndarray
-
-    def seen_from(self, eye) -> bool:
-        """Whether a draw seen from `eye` is the frame's (a ring's segments are seen from the ring's eye)."""
-        return bool(np.array_equal(np.asarray(eye, dtype=np.float64), self.eye))
 
     def bind(self, program: int) -> None:
         """Bind the march's target (`SHAFTS_UNIT`) and set `program`'s (in use) `shaft_view_projection`."""

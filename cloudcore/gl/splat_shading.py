@@ -46,7 +46,7 @@ _SLOT_ALIGNMENT = 256 // INSTANCE_BYTES
 #: splat_shade.comp.glsl's optional code, in the order of a variant's key: sprites that do not lie in the
 #: image plane, Wang's artist colours, Yusov's eye-pass profiles, the air between the eye and each particle, the
 #: light a lit face sent back (`cloudcore.particles.buffer.ParticleBuffer.returned`), the light shafts' share
-#: taken off that air (the frame's eye's batches, under the shafts alone)
+#: taken off that air (the cloud pass's batches, under the shafts alone)
 _SHADE_FEATURES = ("FACING", "ARTIST", "PROFILES", "AIR", "RETURNED", "LIGHT_SHAFTS")
 #: what a draw after shading waits for: the instances (and a selection's indirect command)
 _SHADED_BARRIERS = GL.GL_SHADER_STORAGE_BARRIER_BIT | GL.GL_COMMAND_BARRIER_BIT
@@ -67,7 +67,8 @@ class SplatShading:
         #: None: no air (the gradient sky)
         self.air: AirVolume | None = None
         #: the frame's light shafts (`FrameShafts`), whose share of the air in front of a particle its air loses
-        #: in the batches of the frame's eye; None: no shafts
+        #: in the batches `through_air`, set for the cloud pass alone (a ring's segments are seen from the ring's
+        #: eye); None: no shafts
         self.shafts: FrameShafts | None = None
         #: the compute shader's variants by the features a batch has (`_SHADE_FEATURES`), made when first
         #: needed: (program, its uniforms' locations, the particles its light uniforms are of)
@@ -211,11 +212,10 @@ class SplatShading:
         dispatch(-(-(end - first) // _SHADE_GROUP))
 
     def _features(self, batch: SplatBatch | SplatSelection) -> tuple[bool, ...]:
-        """The shader features (`_SHADE_FEATURES`) `batch`'s particles need; the light shafts' share only for
-        the frame's eye (a ring's segments are seen from the ring's)."""
+        """The shader features (`_SHADE_FEATURES`) `batch`'s particles need."""
         bits = self._resident.feature_bits(batch)
         air = batch.through_air and self.air is not None
-        shafts = air and self.shafts is not None and self.shafts.seen_from(batch.eye)
+        shafts = air and self.shafts is not None
         return bool(bits & 1), bool(bits & 2), self._resident.profiled, air, self._resident.returning, shafts
 
     def _shade_program(self, features: tuple[bool, ...]) -> tuple[int, dict]:
