@@ -53,7 +53,7 @@ from cloudcore.gl.world import WorldPass
 from cloudcore.light.air_between import air_between
 from cloudcore.light.cloud_shadows import FIELD_MAP_RESOLUTION, MAP_RESOLUTION, PREVIEW_MAP_RESOLUTION
 from cloudcore.light.illumination import IlluminationCache, shadowing_sun
-from cloudcore.light.light_shafts import cloud_particle_ranges
+from cloudcore.light.light_shafts import nearest_depth_particles
 from cloudcore.light.lighting import scene_lights
 from cloudcore.light.live_air import LiveAir
 from cloudcore.light.relighting import PREVIEW_METHOD
@@ -408,10 +408,20 @@ class FrameRenderer:
         plan, particles = frame.plan, frame.particles
 
         def draw(size: tuple[int, int]) -> None:
-            clouds = [member for unit in plan.draw_order for member in plan.clouds[unit].members]
-            ranges = cloud_particle_ranges(clouds, particles.cloud_starts)
+            drawn = list(plan.draw_order)
+            units = plan.units if plan.units is not None else self.clouds.units
+            # a march pixel spans the view's height over its rows
+            pixels_per_radian = size[1] / (2.0 * np.arctan(1.0 / frame.projection[1, 1]))
+            chosen = nearest_depth_particles(
+                [plan.clouds[unit].members for unit in drawn],
+                particles.cloud_starts,
+                units.centres[drawn],
+                units.radii[drawn],
+                frame.eye,
+                pixels_per_radian,
+            )
             self._splats.draw_nearest_depth(
-                particles, frame.time_s, ranges, frame.eye, frame.view, frame.projection, size[1]
+                particles, frame.time_s, chosen, frame.eye, frame.view, frame.projection, size[1]
             )
 
         return draw

@@ -27,7 +27,7 @@ from cloudcore.gl.programs import build_program, set_matrix_at, set_vec3_at, uni
 from cloudcore.gl.splat_order import COMMAND_UINTS, GpuSplatOrder
 from cloudcore.gl.splat_residency import PARTICLE_FLOATS, ResidentParticles
 from cloudcore.gl.splat_shading import INSTANCES_BINDING, SplatShading
-from cloudcore.gl.storage import store
+from cloudcore.gl.storage import bind_storage, store
 from cloudcore.maths.splat_kernel import SPLAT_SHARPNESS
 from cloudcore.model.cloud_records import ATLAS_GRID
 from cloudcore.particles.batch import SplatBatch, SplatSelection
@@ -76,7 +76,8 @@ class SplatPass:
         #: particles drawn as point sprites since the frame's renderer last set it to 0 (for its statistics)
         self.particles_as_points = 0
         self._vertex_array = GL.glGenVertexArrays(1)
-        self._corner_index_buffer, self._cell_buffer = self._buffers = GL.glGenBuffers(2)
+        #: the triangles of the particles' quads, the cells' table, the particles of the clouds' nearest depth
+        self._corner_index_buffer, self._cell_buffer, self._depth_particle_buffer = self._buffers = GL.glGenBuffers(3)
         self._quads_indexed = 0
         #: the programs drawing many cells at once, made when first needed: (points?, atlas sprites?) -> (the
         #: program, its first cell's uniform); points never are sprites
@@ -199,19 +200,17 @@ class SplatPass:
         self,
         particles: ParticleBuffer,
         time_s: float,
-        ranges: tuple[np.ndarray, np.ndarray],
+        chosen: np.ndarray,
         eye: np.ndarray,
         view: np.ndarray,
         projection: np.ndarray,
         height: int,
     ) -> None:
-        """Draw the depth of the particles of `ranges` (first particles, counts: `cloud_particle_ranges`) into the
-        bound target of `height` pixels, depth tested and written: each a disc at its centre's depth (its core,
-        `NEAREST_DEPTH_CORE`), those too
-        faint to be seen at `time_s` left out (`NEAREST_DEPTH_OPACITY`); the light shafts' march ends its rays at
-        the nearest (docs/atmosphere.md#the-shafts-and-the-air-in-front-of-the-clouds)."""
-        firsts, counts = ranges
-        if not len(firsts):
+        """Draw the depth of the `chosen` particles (`nearest_depth_particles`) into the bound target of `height`
+        pixels, depth tested and written: each a disc at its centre's depth (its core, `NEAREST_DEPTH_CORE`), those
+        too faint to be seen at `time_s` left out (`NEAREST_DEPTH_OPACITY`); the light shafts' march ends its rays
+        at the nearest (docs/atmosphere.md#the-shafts-and-the-air-in-front-of-the-clouds)."""
+        if not len(chosen):
             return
         self._resident.hold(particles)
         self._resident.hold_formation(particles, time_s)
@@ -234,16 +233,18 @@ class SplatPass:
         set_matrix_at(uniforms["view_projection"], projection @ view_rotation(view))
         set_vec3_at(uniforms["eye_position"], eye)
         GL.glUniform1f(uniforms["pixels_per_ndc"], 0.5 * height * projection[1, 1])
-        GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, 0, self._resident.particle_buffer)
-        GL.glBindBufferBase(GL.GL_SHADER_STORAGE_BUFFER, 1, self._resident.formation_buffer)
+        store(self._depth_particle_buffer, np.ascontiguousarray(chosen, dtype=np.uint32), GL.GL_STREAM_DRAW)
+        bind_storage(
+            (0, self._resident.particle_buffer),
+            (1, self._resident.formation_buffer),
+            (2, self._depth_particle_buffer),
+        )
         GL.glBindVertexArray(self._vertex_array)
         GL.glEnable(GL.GL_PROGRAM_POINT_SIZE)
         GL.glEnable(GL.GL_DEPTH_TEST)
         GL.glDepthFunc(GL.GL_LESS)
         GL.glDepthMask(GL.GL_TRUE)
-        GL.glMultiDrawArrays(
-            GL.GL_POINTS, np.asarray(firsts, dtype=np.int32), np.asarray(counts, dtype=np.int32), len(firsts)
-        )
+        GL.glDrawArrays(GL.GL_POINTS, 0, len(chosen))
         GL.glDisable(GL.GL_PROGRAM_POINT_SIZE)
         GL.glBindVertexArray(0)
 

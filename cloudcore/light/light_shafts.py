@@ -97,12 +97,36 @@ def shadowed_share(shadowed, whole) -> np.ndarray:
     return np.clip(taken / np.maximum(all_of_it, 1e-12), 0.0, 1.0)
 
 
-def cloud_particle_ranges(clouds, cloud_starts) -> tuple[np.ndarray, np.ndarray]:
-    """(first particles, counts) int32 of `clouds` (indices into `cloud_starts`, a buffer's first particle of each
-    cloud and its end), those with particles: the clouds whose nearest depth ends the march's rays (Yusov's cut),
-    drawn in one multi-draw."""
-    clouds = np.asarray(clouds, dtype=np.int64).reshape(-1)
+#: points of the clouds' nearest depth a march pixel of a unit's disc, at most: a far unit of thousands of particles
+#: over a few march pixels draws a few dozen of them, evenly through its order (its cores cover its pixels still),
+#: where all of them cost the 1.2M-particle field's frame a third more (docs/performance.md#the-light-shafts-cut-at-
+#: the-clouds)
+NEAREST_DEPTH_POINTS_A_PIXEL = 4.0
+
+
+def nearest_depth_particles(members, cloud_starts, centres, radii, eye, pixels_per_radian: float) -> np.ndarray:
+    """(n,) int32: the particles whose nearest depth ends the light shafts' march rays (Yusov's cut), of the units
+    whose clouds are `members` (per unit its cloud indices into `cloud_starts`, a buffer's first particle of each
+    cloud and its end), bounded by spheres at `centres` (units, 3) of `radii` seen from `eye`, through a march of
+    `pixels_per_radian`: every particle of a unit whose disc covers more march pixels than a quarter of its
+    particles, else every k-th of each of its clouds, `NEAREST_DEPTH_POINTS_A_PIXEL` a pixel of its disc."""
     starts = np.asarray(cloud_starts, dtype=np.int64)
-    firsts, counts = starts[clouds], starts[clouds + 1] - starts[clouds]
+    counts = np.array([len(unit) for unit in members], dtype=np.int64)
     kept = counts > 0
-    return firsts[kept].astype(np.int32), counts[kept].astype(np.int32)
+    if not kept.any():
+        return np.zeros(0, dtype=np.int32)
+    members, counts = [unit for unit in members if len(unit)], counts[kept]
+    centres, radii = np.asarray(centres, dtype=np.float64)[kept], np.asarray(radii, dtype=np.float64)[kept]
+    clouds = np.concatenate([np.asarray(unit, dtype=np.int64) for unit in members])
+    firsts, particles = starts[clouds], starts[clouds + 1] - starts[clouds]
+    distance = np.linalg.norm(centres - np.asarray(eye, dtype=np.float64), axis=1)
+    # the disc's radius in march pixels (the eye within the sphere: the whole view, at most)
+    disc = pixels_per_radian * np.arctan2(radii, np.maximum(distance - radii, 0.0))
+    budget = np.maximum(NEAREST_DEPTH_POINTS_A_PIXEL * np.pi * disc**2, 1.0)
+    unit_particles = np.add.reduceat(particles, np.cumsum(counts) - counts)
+    stride = np.repeat(np.maximum(np.floor(unit_particles / budget), 1.0).astype(np.int64), counts)
+    taken = -(-particles // stride)  # ceil: a cloud's first particle, then every stride-th
+    total = int(taken.sum())
+    ends = np.cumsum(taken)
+    within = np.arange(total) - np.repeat(ends - taken, taken)
+    return (np.repeat(firsts, taken) + np.repeat(stride, taken) * within).astype(np.int32)

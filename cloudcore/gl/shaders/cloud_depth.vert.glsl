@@ -8,6 +8,7 @@
 
 layout(std430, binding = 0) readonly buffer Particles { float particle_floats[]; };
 layout(std430, binding = 1) readonly buffer Formation { float formation[]; };
+layout(std430, binding = 2) readonly buffer Chosen { uint chosen[]; };  // cloudcore.light.light_shafts.nearest_depth_particles
 
 uniform mat4 view_projection;  // of points relative to the eye
 uniform vec3 eye_position;
@@ -15,10 +16,11 @@ uniform float pixels_per_ndc;  // half the target's height over the projection's
 
 void main()
 {
-    int record = gl_VertexID * PARTICLE_FLOATS;
+    int particle = int(chosen[gl_VertexID]);
+    int record = particle * PARTICLE_FLOATS;
     vec3 centre = vec3(particle_floats[record], particle_floats[record + 1], particle_floats[record + 2]);
     float radius = particle_floats[record + 3];
-    float opacity = particle_floats[record + 7] * formation[gl_VertexID];
+    float opacity = particle_floats[record + 7] * formation[particle];
     gl_Position = view_projection * vec4(centre - eye_position, 1.0);
     gl_PointSize = clamp(2.0 * CORE * radius * pixels_per_ndc / max(gl_Position.w, 1e-6), 1.0, MAX_POINT_SIZE);
     if (opacity < SEEN_OPACITY || gl_Position.w <= 0.0)
