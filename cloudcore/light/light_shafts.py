@@ -99,8 +99,8 @@ def shadowed_share(shadowed, whole) -> np.ndarray:
 
 #: points of the clouds' nearest depth a march pixel of a unit's disc, at most: a far unit of thousands of particles
 #: over a few march pixels draws a few dozen of them, evenly through its order (its cores cover its pixels still),
-#: where all of them cost the 1.2M-particle field's frame a third more (docs/performance.md#the-light-shafts-cut-at-
-#: the-clouds)
+#: where all of them cost the 1.2M-particle field's frame a third more
+#: (docs/performance.md#the-light-shafts-cut-at-the-clouds)
 NEAREST_DEPTH_POINTS_A_PIXEL = 4.0
 
 

@@ -202,18 +202,18 @@ class FrameClouds:
         authored = scene.particle_count
         self._field_weights = np.concatenate([np.ones(authored), frame.weights])
         self._cloud_weights = np.concatenate([np.ones(len(scene.clouds)), frame.mean_weights])
-        self._follow_cells(len(scene.clouds))
+        casting = np.concatenate([np.ones(authored), casting_weights(frame.mean_weights, frame.cloud_starts)])
+        self._follow_cells(len(scene.clouds), casting)
         return (
             dataclasses.replace(scene, clouds=scene.clouds + frame.clouds),
             (1.0,) * len(scene.clouds) + frame.fade_keys,
         )
 
-    def _follow_cells(self, authored_clouds: int) -> None:
+    def _follow_cells(self, authored_clouds: int, casting: np.ndarray) -> None:
         """Make how the field's clouds shadow one another (`cell_shadowing`) again when its cells changed (the
         weather's parts' cells and places, by identity: an unchanged part is the same object) or what its particles
-        cast (their blend weights' steps, `casting_weights`: the shadows fade with the cells)."""
+        `casting` (their clouds' blend weights' steps, `casting_weights`: the shadows fade with the cells)."""
         state = self.weather_state
-        casting = casting_weights(self._field_weights)
         source = (authored_clouds, state.places, state.leading, [p.cells for p in state.parts], casting)
         held = self._cell_shadowing[0]
         if (
