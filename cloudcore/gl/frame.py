@@ -46,7 +46,7 @@ from cloudcore.gl.programs import ProgramCache, build_program
 from cloudcore.gl.quads import QuadPass
 from cloudcore.gl.reduced_clouds import ReducedClouds
 from cloudcore.gl.shadow_map import CloudShadowMap
-from cloudcore.gl.splats import SplatPass
+from cloudcore.gl.splats import NEAREST_DEPTH_CORE, SplatPass
 from cloudcore.gl.targets import TextureTarget
 from cloudcore.gl.volume_blending import GpuFeatures, VolumeBlendingPass
 from cloudcore.gl.world import WorldPass
@@ -417,6 +417,8 @@ class FrameRenderer:
                 particles.cloud_starts,
                 units.centres[drawn],
                 units.radii[drawn],
+                units.radius_squares[drawn] / np.maximum(units.particle_counts[drawn], 1),
+                NEAREST_DEPTH_CORE,
                 frame.eye,
                 pixels_per_radian,
             )

@@ -307,11 +307,15 @@ def upsampled(values: np.ndarray) -> np.ndarray:
 def test_the_marchs_rays_end_at_the_clouds_nearest_particle():
     """Yusov's cut: a march ray through the cloud ends at the nearest of the particles whose discs' cores
     (`NEAREST_DEPTH_CORE` of their radii) it crosses, at their centres' depth; one that passes clear of every core
-    reaches the air's end."""
+    reaches the air's end.  From 1.3 km, where the cloud's disc needs every particle's core
+    (`nearest_depth_particles`; a far cloud draws every k-th)."""
     from cloudcore.gl.frame import FrameRenderer
     from cloudcore.gl.splats import NEAREST_DEPTH_CORE
 
     scene = shaft_scene()
+    flat = np.array([SUN[0], 0.0, SUN[2]]) / np.hypot(SUN[0], SUN[2])
+    eye = np.array([0.0, 1000.0, 0.0]) - 1300.0 * flat
+    scene = dataclasses.replace(scene, camera=Camera(tuple(eye), (0.0, 1200.0, 0.0), 60.0))
     with FrameRenderer(RENDER_WIDTH, RENDER_HEIGHT) as renderer:
         renderer.render(scene, settings=FULL_3D, read_back=False)
         renderer.context.make_current()
