@@ -6,8 +6,8 @@ made at once."""
 import numpy as np
 import pytest
 
-from cloudcore.field.shadow_cells import CellShadowing, cell_shadowing
-from cloudcore.field.state import FieldState, update_field
+from cloudcore.field.shadow_cells import CellShadowing, casting_weights, cell_shadowing
+from cloudcore.field.state import FADE_KEY_STEPS, FieldState, update_field
 from cloudcore.light.cell_shadows import SunThroughCells, sun_through_other_cells
 from cloudcore.light.illumination import IlluminationCache, beam_of, illuminate_clouds
 from cloudcore.model.scene import CloudField, Light, Shading
@@ -62,12 +62,14 @@ def test_a_particle_whose_place_lies_in_the_receiver_s_cell_does_not_shadow_it()
 @pytest.fixture(scope="module")
 def demo_field() -> tuple:
     frame, state = update_field(FIELD, EYE)
-    return frame, state, cell_shadowing(0, (state,), (len(frame.clouds),), 0, frame.weights)
+    casting = casting_weights(frame.mean_weights, frame.cloud_starts)
+    return frame, state, cell_shadowing(0, (state,), (len(frame.clouds),), 0, casting)
 
 
 def test_a_particle_casts_its_blend_weight_and_twins_in_a_blend_band_take_none_of_each_other(demo_field):
     frame, state, shadowing = demo_field
-    assert np.array_equal(shadowing.casting, frame.weights)
+    steps = np.round(frame.mean_weights * FADE_KEY_STEPS) / FADE_KEY_STEPS  # each cloud's mean weight's step
+    assert np.array_equal(shadowing.casting, np.repeat(steps, np.diff(frame.cloud_starts)))
     assert 0.0 < shadowing.casting.mean() < 1.0  # the rings' bands blend
     assert shadowing.casting.min() == 0.0 and shadowing.casting.max() == 1.0
     # a level-1 cloud whose four finer cells are made, and one of them that is a cloud: the same sky twice; neither
@@ -118,6 +120,9 @@ def test_a_cells_shadow_follows_its_blend_weight_and_enters_at_weight_0_with_non
     # each particle adds -ln(1 - w b K): at half weight the light lies strictly between none of the shadow and all
     half, full = means[2], means[-1]
     assert full < half < 1.0
+    # a cloud under half a step casts nothing
+    weights = [0.0, 0.4 / FADE_KEY_STEPS, 0.6 / FADE_KEY_STEPS, 1.0]
+    assert casting_weights(weights, [0, 1, 3, 4, 6]).tolist() == [0.0, 0.0, 0.0, 0.25, 1.0, 1.0]
 
 
 def test_a_change_of_a_cells_casting_remakes_the_clouds_it_reaches_alone():
@@ -145,7 +150,8 @@ def test_the_shares_kept_between_sets_of_cells_are_those_made_at_once_and_only_t
     before: dict = {}
     for step in range(5):
         frame, state = update_field(FIELD, EYE + [step * 400.0, 0.0, 0.0], state)
-        shadowing = cell_shadowing(0, (state,), (len(frame.clouds),), 0, frame.weights)
+        casting = casting_weights(frame.mean_weights, frame.cloud_starts)
+        shadowing = cell_shadowing(0, (state,), (len(frame.clouds),), 0, casting)
         beam = beam_of(frame.clouds, shading)
         held = cache.through(frame.clouds, *beam, shadowing, SUN)
         at_once = sun_through_other_cells(*beam, shadowing, SUN)
