@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import subprocess
 import sys
 from pathlib import Path
 
@@ -68,17 +67,10 @@ def worker(view: str, size: str) -> None:
 
 def compare(trees: dict, view: str, size: str, frames: int, warmup: int) -> dict:
     """The row of `view`: the four ways' world passes and frames in turns, their ratios."""
-    workers = {
-        name: subprocess.Popen(
-            [sys.executable, str(Path(__file__).resolve()), "--view", view, "--size", size, "--worker", str(tree)],
-            stdin=subprocess.PIPE,
-            stdout=subprocess.PIPE,
-            text=True,
-            env={**os.environ, "PYTHONPATH": str(tree)},
-            cwd=tree,
-        )
-        for name, tree in trees.items()
-    }
+    # here, not at the top: the revision's worker runs this file over its own `cloudcore`, which may not have it
+    from cloudcore.measure.benchmark import tree_workers
+
+    workers = tree_workers([sys.executable, str(Path(__file__).resolve()), "--view", view, "--size", size], trees)
     for process in workers.values():
         process.stdout.readline()
     world, frame = ({way: [] for way in WAYS} for _ in range(2))
