@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
@@ -62,6 +61,9 @@ def worker(case: str, every: int, modes: list[str]) -> None:
 
 def compare(trees: dict, case: str, every: int, modes: list[str], warmup: int, folder: Path) -> list[dict]:
     """One row per mode of `case`: this tree's frames against the revision's, and their pictures' PSNR."""
+    # here, not at the top: the revision's worker runs this file over its own `cloudcore`, which may not have it
+    from cloudcore.measure.benchmark import tree_workers
+
     command = [
         sys.executable,
         str(Path(__file__).resolve()),
@@ -72,17 +74,7 @@ def compare(trees: dict, case: str, every: int, modes: list[str], warmup: int, f
         "--modes",
         ",".join(modes),
     ]
-    workers = {
-        name: subprocess.Popen(
-            [*command, "--worker", str(tree)],
-            stdin=subprocess.PIPE,
-            stdout=subprocess.PIPE,
-            text=True,
-            env={**os.environ, "PYTHONPATH": str(tree)},
-            cwd=tree,
-        )
-        for name, tree in trees.items()
-    }
+    workers = tree_workers(command, trees)
     views = [int(process.stdout.readline()) for process in workers.values()][0]
 
     def ask(name: str, line: str) -> float:

@@ -82,7 +82,7 @@ class LightingPanel:
         changed_bounce, ground_bounce = imgui.checkbox("Ground bounce", shading.ground_bounce)
         imgui.set_item_tooltip(
             "The clouds lit from below by the sunlit ground, under their own shadows, in place of the ambient's lower "
-            'half (closer to the path-traced truth under a thick cloud: docs/shading.md, "The ground\'s bounce").'
+            "half (closer to the path-traced truth under a thick cloud: docs/shading.md#the-grounds-bounce)."
         )
         changes = {key: value for key, value in changes.items() if value is not None}
         if changed_bounce:

@@ -1,14 +1,16 @@
-"""A cloud field's clouds as the light pass's shadows between clouds see them: each cloud's cell, and which
-particles stand for the field in another cloud's shadow.
+"""A cloud field's clouds as the light pass's shadows between clouds see them: each cloud's cell, and how much of
+its opacity each particle casts on the other cells.
 
 The nested grid's rings overlap (`cloudcore.field.grid`): in a blend band a cumulus is made twice, by a cell of
 level k and by the cell of level k + 1 over it, their weights summing to one.  Each representation lit through
 the other would take the same cloud's body twice (Harris's light pass already shades a cell's particles through
-their own cell), so the clouds' shadows on one another read the field as one medium, the finest made at each
-place: a particle shadows other cells unless a made cell of a finer level (cloudy or clear) covers its place, and a
-cell's particles take no shadow from particles whose place lies in its own footprint, of any level (its own
-particles, and the finer cells that stand for the same cloud).  Both follow the cells made, not the eye's place
-within them: the shadows change when cells enter or leave, never as the blend weights slide
+their own cell), so a cell's particles take no shadow from particles whose place lies in its own footprint, of any
+level (its own particles, and the finer cells that stand for the same cloud).  Every other particle casts its
+opacity times its blend weight, the weight it is drawn with: the field is read as one medium whose representations'
+weights sum to one at each place, and a cell that enters or leaves at weight 0 casts nothing then, so that nothing
+steps as it comes or goes.  The weights are those of the frame whose cells changed, each cloud's mean in steps of
+1 / FADE_KEY_STEPS: the light pass is made again when cells enter or leave, as before, and then for the weights of
+that moment; made again at every step of a cloud's weight, it was made in every frame of a flight
 (docs/atmosphere.md#a-cloud-fields-clouds-on-one-another).
 """
 
@@ -19,32 +21,40 @@ from dataclasses import dataclass
 import numpy as np
 
 from cloudcore.field.grid import cell_side
-from cloudcore.field.state import FieldState
+from cloudcore.field.state import FADE_KEY_STEPS, FieldState
 
 
 @dataclass(frozen=True, eq=False)
 class CellShadowing:
     """Per cloud of a frame (the scene's own, then the field's in their places) its cell's footprint, and per
-    particle whether it shadows other clouds.  Compared by identity: a frame renderer makes one per set of cells."""
+    particle how much of its opacity it casts on other clouds.  Compared by identity: a frame renderer makes one per
+    set of cells and of their casting steps."""
 
     corners: np.ndarray  # (clouds, 2) the (x, z) corner of each cloud's cell: NaN for the scene's own clouds
     sides: np.ndarray  # (clouds,) metres: each cell's side (NaN likewise)
-    occludes: np.ndarray  # (particles,) bool: the finest made representation of the field at its place
+    casting: np.ndarray  # (particles,) in [0, 1]: the share of its opacity it casts (`casting_weights`)
 
 
-def cell_shadowing(authored_clouds: int, authored_particles: int, parts, places, leading: int) -> CellShadowing:
-    """The shadowing of a frame made of `authored_clouds` clouds (`authored_particles` particles) and then, after
-    `leading` holes, each `FieldState` of `parts` in `places` of its own (as `cloudcore.field.state.side_by_side`
-    lays them out)."""
+def casting_weights(mean_weights, cloud_starts) -> np.ndarray:
+    """(particles,): the share of its opacity each particle casts on other cells, its cloud's mean blend weight
+    (`mean_weights`, its particles at `cloud_starts`) in steps of 1 / FADE_KEY_STEPS, rounded (a cloud under half a
+    step casts none).  A cloud's step, not each particle's weight: where cells change, only the clouds whose step
+    changed since are met again as casters, where every blending cloud's particles had changed."""
+    steps = np.round(np.clip(np.asarray(mean_weights, dtype=np.float64), 0.0, 1.0) * FADE_KEY_STEPS) / FADE_KEY_STEPS
+    return np.repeat(steps, np.diff(np.asarray(cloud_starts, dtype=np.int64)))
+
+
+def cell_shadowing(authored_clouds: int, parts, places, leading: int, casting) -> CellShadowing:
+    """The shadowing of a frame made of `authored_clouds` clouds and then, after `leading` holes, each `FieldState`
+    of `parts` in `places` of its own (as `cloudcore.field.state.side_by_side` lays them out), its particles (the
+    authored clouds' first) casting `casting` of their opacities (`casting_weights`)."""
     corners = [np.full((authored_clouds + leading, 2), np.nan)]
     sides = [np.full(authored_clouds + leading, np.nan)]
-    occludes = [np.ones(authored_particles, dtype=bool)]
     for part, room in zip(parts, places):
         part_corners, part_sides = _cell_footprints(part)
         corners += [part_corners, np.full((room - len(part.slots), 2), np.nan)]
         sides += [part_sides, np.full(room - len(part.slots), np.nan)]
-        occludes.append(_finest_made(part))
-    return CellShadowing(np.concatenate(corners), np.concatenate(sides), np.concatenate(occludes))
+    return CellShadowing(np.concatenate(corners), np.concatenate(sides), np.asarray(casting, dtype=np.float64))
 
 
 def _cell_footprints(state: FieldState) -> tuple[np.ndarray, np.ndarray]:
@@ -58,28 +68,3 @@ def _cell_footprints(state: FieldState) -> tuple[np.ndarray, np.ndarray]:
             sides[index] = cell_side(state.field, level)
             corners[index] = np.asarray(state.field.centre) + sides[index] * np.array([i, j])
     return corners, sides
-
-
-def _finest_made(state: FieldState) -> np.ndarray:
-    """(particles of the state's slots,) whether no made cell of a finer level covers each particle's place."""
-    levels, xz = state.particle_levels, state.particle_xz
-    finest = np.ones(len(levels), dtype=bool)
-    if state.field is None or not len(levels):
-        return finest
-    made = np.array(list(state.cells), dtype=np.int64).reshape(-1, 3)
-    centre = np.asarray(state.field.centre)
-    for finer in range(int(levels.max())):
-        of_level = made[made[:, 0] == finer, 1:]
-        coarser = np.flatnonzero(levels > finer)
-        if not len(of_level) or not len(coarser):
-            continue
-        cell = np.floor((xz[coarser] - centre) / cell_side(state.field, finer)).astype(np.int64)
-        finest[coarser[_rows_in(cell, of_level)]] = False
-    return finest
-
-
-def _rows_in(rows: np.ndarray, table: np.ndarray) -> np.ndarray:
-    """Whether each (i, j) row of `rows` is one of `table`'s."""
-    low = np.minimum(rows.min(axis=0), table.min(axis=0))
-    span = np.maximum(rows.max(axis=0), table.max(axis=0)) - low + 1
-    return np.isin((rows - low) @ [span[1], 1], (table - low) @ [span[1], 1])

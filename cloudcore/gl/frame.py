@@ -38,7 +38,7 @@ from cloudcore.field.weather import WeatherFieldState
 from cloudcore.gl.context import HeadlessContext, WindowContext, check_frame_size
 from cloudcore.gl.draw import CloudPass, CloudPassFrame, DrawCounts, PassTools
 from cloudcore.gl.impostor_store import ImpostorStore
-from cloudcore.gl.light_shafts import LightShaftPass
+from cloudcore.gl.light_shafts import FrameShafts, LightShaftPass
 from cloudcore.gl.measured_way import MeasuredWay
 from cloudcore.gl.objects import ObjectPass
 from cloudcore.gl.pass_clock import PassClock
@@ -46,13 +46,14 @@ from cloudcore.gl.programs import ProgramCache, build_program
 from cloudcore.gl.quads import QuadPass
 from cloudcore.gl.reduced_clouds import ReducedClouds
 from cloudcore.gl.shadow_map import CloudShadowMap
-from cloudcore.gl.splats import SplatPass
+from cloudcore.gl.splats import NEAREST_DEPTH_CORE, SplatPass
 from cloudcore.gl.targets import TextureTarget
 from cloudcore.gl.volume_blending import GpuFeatures, VolumeBlendingPass
 from cloudcore.gl.world import WorldPass
 from cloudcore.light.air_between import air_between
 from cloudcore.light.cloud_shadows import FIELD_MAP_RESOLUTION, MAP_RESOLUTION, PREVIEW_MAP_RESOLUTION
 from cloudcore.light.illumination import IlluminationCache, shadowing_sun
+from cloudcore.light.light_shafts import nearest_depth_particles
 from cloudcore.light.lighting import scene_lights
 from cloudcore.light.live_air import LiveAir
 from cloudcore.light.relighting import PREVIEW_METHOD
@@ -71,7 +72,7 @@ from cloudcore.particles.frame_clouds import FrameClouds, PreparedClouds
 from cloudcore.runtime.derived import Derived
 from cloudcore.stats.frame_stats import FrameStats
 from cloudcore.stats.overdraw import Overdraw, overdraw_statistics
-from cloudcore.world.camera import NEAR_PLANE_M, frustum_planes, projection_matrix, view_matrix
+from cloudcore.world.camera import NEAR_PLANE_M, frustum_planes, projection_matrix, view_matrix, view_rotation
 from cloudcore.world.wind import reshapes
 
 
@@ -257,7 +258,7 @@ class FrameRenderer:
         clock = self._clock
         with clock.frame():
             with clock.timed("world"):
-                self._draw_world(frame)
+                frame = self._draw_world(frame)
             # the world pass uploaded the air for this eye: the ring's segments and the cloud pass's splats take it
             self._splats.air = None if frame.air is None else frame.air[0]
             self._splats.look = SplatLook.of(settings)
@@ -267,7 +268,11 @@ class FrameRenderer:
                 )
             with clock.timed("clouds"):
                 self.context.bind_target()
+                # the cloud pass's splats less the light shafts' share of their air, where the world marched them
+                # (not the ring's segments, made from the ring's eye for other eyes)
+                self._splats.shafts = frame.shafts
                 drawn = self._cloud_pass.draw(frame)
+                self._splats.shafts = None
         drawn_by_gpu, rendered_by_gpu = self._splats.take_selected()
         self._observe(
             frame, drawn.compositable, drawn.particles + drawn_by_gpu + rendered + rendered_by_gpu, before_passes_ms
@@ -370,11 +375,12 @@ class FrameRenderer:
             self.clouds.unit_weights,
         )
 
-    def _draw_world(self, frame: CloudPassFrame) -> None:
-        """The world pass: terrain and sky, and the objects outside the clouds the plan splits."""
+    def _draw_world(self, frame: CloudPassFrame) -> CloudPassFrame:
+        """The world pass: terrain and sky, and the objects outside the clouds the plan splits; `frame` with the
+        light shafts it marched, cut at the clouds the plan draws (`FrameShafts`), where it marched them."""
         settings = frame.settings
         world = self._world.value
-        world.draw(
+        marched = world.draw(
             self.context,
             frame.camera,
             frame.view,
@@ -383,6 +389,7 @@ class FrameRenderer:
             through_air=settings.aerial_perspective,
             shadows=self._shadows,
             light_shafts=settings.light_shafts,
+            draw_cloud_depth=self._cloud_depth_drawer(frame),
         )
         if frame.plan.objects_with_world:
             frame.objects.draw(
@@ -395,6 +402,35 @@ class FrameRenderer:
                 air=world.air_volume if settings.aerial_perspective else None,
                 shadows=self._shadows,
             )
+        if marched is None:
+            return frame
+        return dataclasses.replace(frame, shafts=FrameShafts(marched, frame.projection @ view_rotation(frame.view)))
+
+    def _cloud_depth_drawer(self, frame: CloudPassFrame):
+        """What draws the nearest depth of the clouds the plan draws (not the ring's: its segments hold their air
+        from the ring's eye) at the light shafts' march size, for the march to end its rays there (Yusov's cut)."""
+        plan, particles = frame.plan, frame.particles
+
+        def draw(size: tuple[int, int]) -> None:
+            drawn = list(plan.draw_order)
+            units = plan.units if plan.units is not None else self.clouds.units
+            # a march pixel spans the view's height over its rows
+            pixels_per_radian = size[1] / (2.0 * np.arctan(1.0 / frame.projection[1, 1]))
+            chosen = nearest_depth_particles(
+                [plan.clouds[unit].members for unit in drawn],
+                particles.cloud_starts,
+                units.centres[drawn],
+                units.radii[drawn],
+                units.radius_squares[drawn] / np.maximum(units.particle_counts[drawn], 1),
+                NEAREST_DEPTH_CORE,
+                frame.eye,
+                pixels_per_radian,
+            )
+            self._splats.draw_nearest_depth(
+                particles, frame.time_s, chosen, frame.eye, frame.view, frame.projection, size[1]
+            )
+
+        return draw
 
     def _observe(self, frame: CloudPassFrame, compositable: int, particles: int, plan_ms: float) -> None:
         """Fold the timed passes into the plan's cost fit, and into the measured ways' choices: the particles

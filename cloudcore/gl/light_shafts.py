@@ -8,12 +8,13 @@ over the screen's pixels, or the terrain's lookup per pixel, cost llvmpipe more 
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 from OpenGL import GL
 
 from cloudcore.gl.air_volume import AirVolume
-from cloudcore.gl.programs import ProgramCache, set_vec3
+from cloudcore.gl.programs import ProgramCache, set_matrix, set_vec3
 from cloudcore.gl.shadow_map import CloudShadowMap
 from cloudcore.gl.targets import DepthTexture, TextureTarget
 from cloudcore.light.light_shafts import SHAFT_STEPS
@@ -36,6 +37,22 @@ def shaft_size(width: int, height: int, reduction: int) -> tuple[int, int]:
     """The march's (width, height) for a frame of `width` x `height`: a pixel for each `reduction`-square block,
     each seeing the same view."""
     return -(-width // reduction), -(-height // reduction)
+
+
+@dataclass(frozen=True, eq=False)
+class FrameShafts:
+    """A frame's march, marched up to the clouds' nearest distance (Yusov's cut), for the clouds' shaders to read:
+    each cloud's own air scaled by the share the shadows leave of the air in front of it, as the terrain's is,
+    whichever representation draws it (docs/atmosphere.md#the-shafts-and-the-air-in-front-of-the-clouds)."""
+
+    march: LightShaftPass
+    #: the frame's projection times its view's rotation: points relative to the eye onto the march's target
+    eye_view_projection: np.ndarray
+
+    def bind(self, program: int) -> None:
+        """Bind the march's target (`SHAFTS_UNIT`) and set `program`'s (in use) `shaft_view_projection`."""
+        self.march.bind()
+        set_matrix(program, "shaft_view_projection", self.eye_view_projection)
 
 
 class LightShaftPass:
@@ -67,18 +84,22 @@ class LightShaftPass:
         shadows: CloudShadowMap,
         sky_lowest_up: float,
         planet_ground: tuple[float, float] | None = None,
+        draw_cloud_depth: Callable[[tuple[int, int]], None] | None = None,
     ) -> None:
         """March the shafts of `shadows` in `air` (bound for `camera`'s eye) for a frame of `screen_size` seen
         through `view` and `projection`, up to the depth `draw_terrain_depth` draws (nothing: the sky everywhere),
         the sky's rays below `sky_lowest_up` (a cosine to the up) marched at it, as the sky draws them; or, where
         the sky draws the planet's ground past the terrain, `planet_ground` (the eye's altitude over it, its
-        radius; metres), up to that ground.  Leaves the framebuffer of the march bound: the caller binds its
-        own."""
+        radius; metres), up to that ground; and up to the clouds' nearest depth that `draw_cloud_depth(size)` draws
+        at the march's size where given (Yusov's cut: `FrameShafts`).  Leaves the framebuffer of the march bound:
+        the caller binds its own."""
         reduction = shaft_reduction(screen_size[0]) if self._reduction is None else self._reduction
         size = shaft_size(*screen_size, reduction)
         self._depth.bind_cleared(size)
         if draw_terrain_depth is not None:
             draw_terrain_depth()
+        if draw_cloud_depth is not None:
+            draw_cloud_depth(size)
         march, blurred = self._targets_of(size)
         march.bind()
         GL.glDisable(GL.GL_DEPTH_TEST)

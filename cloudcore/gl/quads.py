@@ -11,6 +11,7 @@ from OpenGL import GL
 from cloudcore.gl.air_volume import AirVolume
 from cloudcore.gl.blending import cloud_blending
 from cloudcore.gl.impostor_atlas import INSTANCE_FLOATS
+from cloudcore.gl.light_shafts import FrameShafts
 from cloudcore.gl.programs import build_program, set_matrix_at, set_vec3, uniform_locations
 from cloudcore.light.air_between import air_cells
 
@@ -29,13 +30,21 @@ class QuadPass:
             (True, False): build_program("quad", {"AIR": 1}),
             (False, True): build_program("quad", {"COUNT_FRAGMENTS": 1}),
         }
-        #: (crossfade, counting, seen through the air) -> the program drawing instances from the atlas
+        #: (crossfade, counting, seen through the air, less the light shafts' share of it) -> the program drawing
+        #: instances from the atlas
         self._atlas_programs = {
-            (False, False, False): build_program("quad", {"ATLAS": 1}),
-            (True, False, False): build_program("quad", {"ATLAS": 1, "CROSSFADE": 1}),
-            (False, False, True): build_program("quad", {"ATLAS": 1, "AIR": 1}),
-            (True, False, True): build_program("quad", {"ATLAS": 1, "CROSSFADE": 1, "AIR": 1}),
-            (False, True, False): build_program("quad", {"ATLAS": 1, "COUNT_FRAGMENTS": 1}),
+            (False, False, False, False): build_program("quad", {"ATLAS": 1}),
+            (True, False, False, False): build_program("quad", {"ATLAS": 1, "CROSSFADE": 1}),
+            (False, True, False, False): build_program("quad", {"ATLAS": 1, "COUNT_FRAGMENTS": 1}),
+        } | {
+            (crossfade, False, True, shafts): build_program(
+                "quad",
+                {"ATLAS": 1, "AIR": 1}
+                | ({"CROSSFADE": 1} if crossfade else {})
+                | ({"LIGHT_SHAFTS": 1} if shafts else {}),
+            )
+            for crossfade in (False, True)
+            for shafts in (False, True)
         }
         #: per program, the locations of the uniforms every draw sets
         self._uniforms = {}
@@ -119,17 +128,22 @@ class QuadPass:
         layer_texture: int | None = None,
         layer_weight: float = 0.0,
         air: tuple[AirVolume, np.ndarray] | None = None,
+        shafts: FrameShafts | None = None,
     ) -> None:
         """Depth-tested world-space quads from the impostor atlas in one draw, one instance (`INSTANCE_FLOATS`
         float32, `cloudcore.gl.impostor_atlas.AtlasImage.instance`) a row of `instances`, blended in row
         order; with `layer_texture`, a crossfade: each adds `layer_weight` times that screen layer; with `air`
-        (the volume, the eye), seen through it."""
+        (the volume, the eye), seen through it, less the share of that air the frame's light `shafts` take where
+        given."""
         crossfade, through_air = layer_texture is not None and not counting, air is not None and not counting
-        program = self._atlas_programs[crossfade, counting, through_air]
+        with_shafts = through_air and shafts is not None
+        program = self._atlas_programs[crossfade, counting, through_air, with_shafts]
         uniforms = self._uniforms[program]
         GL.glUseProgram(program)
         set_matrix_at(uniforms["view_projection"], view_projection)
         self._see_through(program, air, counting)
+        if with_shafts:
+            shafts.march.bind()
         GL.glUniform1f(uniforms["layer_weight"], float(layer_weight))
         if layer_texture is not None:
             GL.glActiveTexture(GL.GL_TEXTURE1)

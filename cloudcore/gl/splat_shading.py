@@ -13,6 +13,7 @@ import numpy as np
 from OpenGL import GL
 
 from cloudcore.gl.air_volume import AirVolume
+from cloudcore.gl.light_shafts import FrameShafts
 from cloudcore.gl.programs import build_compute_program, dispatch, uniform_locations
 from cloudcore.gl.splat_order import GpuSplatOrder
 from cloudcore.gl.splat_residency import ResidentParticles
@@ -50,8 +51,9 @@ _SLOT_ALIGNMENT = 256 // INSTANCE_BYTES
 #: splat_shade.comp.glsl's optional code, in the order of a variant's key: sprites that do not lie in the
 #: image plane, Wang's artist colours, Yusov's eye-pass profiles, the air between the eye and each particle, the
 #: light a lit face sent back (`cloudcore.particles.buffer.ParticleBuffer.returned`), the terms a splat is shaded
-#: by per pixel (`SplatLook`, when not plain)
-_SHADE_FEATURES = ("FACING", "ARTIST", "PROFILES", "AIR", "RETURNED", "PIXEL_TERMS")
+#: by per pixel (`SplatLook`, when not plain), the light shafts' share taken off that air (the cloud pass's
+#: batches, under the shafts alone)
+_SHADE_FEATURES = ("FACING", "ARTIST", "PROFILES", "AIR", "RETURNED", "PIXEL_TERMS", "LIGHT_SHAFTS")
 #: what a draw after shading waits for: the instances (and a selection's indirect command)
 _SHADED_BARRIERS = GL.GL_SHADER_STORAGE_BARRIER_BIT | GL.GL_COMMAND_BARRIER_BIT
 
@@ -74,6 +76,10 @@ class SplatShading:
         #: the frame's air (`cloudcore.gl.air_volume`), uploaded for its eye, which batches `through_air` take;
         #: None: no air (the gradient sky)
         self.air: AirVolume | None = None
+        #: the frame's light shafts (`FrameShafts`), whose share of the air in front of a particle its air loses
+        #: in the batches `through_air`, set for the cloud pass alone (a ring's segments are seen from the ring's
+        #: eye); None: no shafts
+        self.shafts: FrameShafts | None = None
         #: the compute shader's variants by the features a batch has (`_SHADE_FEATURES`), made when first
         #: needed: (program, its uniforms' locations, the particles its light uniforms are of)
         self._programs: dict[tuple, list] = {}
@@ -211,6 +217,8 @@ class SplatShading:
         GL.glUseProgram(program)
         if features[_SHADE_FEATURES.index("AIR")]:
             self.air.bind(program)
+        if features[_SHADE_FEATURES.index("LIGHT_SHAFTS")]:
+            self.shafts.bind(program)
         GL.glUniform1ui(uniforms["first"], first)
         GL.glUniform1ui(uniforms["slot_count"], end - first)
         GL.glUniform1ui(uniforms["batch_count"], len(rows))
@@ -220,8 +228,9 @@ class SplatShading:
         """The shader features (`_SHADE_FEATURES`) `batch`'s particles need."""
         bits = self._resident.feature_bits(batch)
         air = batch.through_air and self.air is not None
+        shafts = air and self.shafts is not None
         returning = self._resident.returning
-        return bool(bits & 1), bool(bits & 2), self._resident.profiled, air, returning, not self.look.plain
+        return bool(bits & 1), bool(bits & 2), self._resident.profiled, air, returning, not self.look.plain, shafts
 
     def _shade_program(self, features: tuple[bool, ...]) -> tuple[int, dict]:
         """The compute shader variant with `features`, its light uniforms those of the resident particles; and

@@ -23,17 +23,18 @@ from OpenGL import GL
 from cloudcore.artist.facing import FacingState
 from cloudcore.gl.air_volume import AirVolume
 from cloudcore.gl.blending import cloud_blending
-from cloudcore.gl.programs import build_program, set_matrix_at, uniform_locations
+from cloudcore.gl.programs import build_program, set_matrix_at, set_vec3_at, uniform_locations
 from cloudcore.gl.splat_order import COMMAND_UINTS, GpuSplatOrder
-from cloudcore.gl.splat_residency import ResidentParticles
+from cloudcore.gl.splat_residency import PARTICLE_FLOATS, ResidentParticles
 from cloudcore.gl.splat_shading import INSTANCES_BINDING, TERMS_BINDING, SplatShading
-from cloudcore.gl.storage import store
+from cloudcore.gl.storage import bind_storage, store
 from cloudcore.light.splat_look import MAX_OPACITY, SplatLook
 from cloudcore.maths.splat_kernel import KERNEL_DIAMETER_INTEGRAL, SPLAT_SHARPNESS
 from cloudcore.model.cloud_records import ATLAS_GRID
 from cloudcore.particles.batch import SplatBatch, SplatSelection
 from cloudcore.particles.buffer import ParticleBuffer
 from cloudcore.particles.point_sprites import draw_runs, guard_band, point_sprite_mask
+from cloudcore.world.camera import view_rotation
 
 #: two triangles over a particle's four corners (lower left, lower right, upper left, upper right)
 _QUAD_TRIANGLES = np.array([0, 1, 2, 2, 1, 3], dtype=np.uint32)
@@ -44,6 +45,14 @@ _CELLS_BINDING = 8
 _LOOK_UNIFORMS = ("detail_amplitude", "detail_scale")
 #: viewports (and scissors) a multi-draw of cells can address: what GL 4.1 guarantees, llvmpipe's and NVIDIA's
 _MAX_VIEWPORTS = 16
+#: a particle fainter than this (its opacity times its formation or blend weight) is left out of the clouds'
+#: nearest depth (`draw_nearest_depth`): the light shafts' march ends its ray at a cloud that is seen
+NEAREST_DEPTH_OPACITY = 0.01
+#: of a particle's radius, the disc that cuts the march: out to its kernel's 1/e point (`SPLAT_SHARPNESS`).  A ray
+#: cut at a cloud's thin fringe keeps from the sky behind the fringe the shafts behind the cloud: the whole disc
+#: brightened the edges of a cumulonimbus seen from the side more than half of it
+#: (docs/atmosphere.md#the-shafts-and-the-air-in-front-of-the-clouds)
+NEAREST_DEPTH_CORE = 0.5
 
 
 class SplatPass:
@@ -65,11 +74,23 @@ class SplatPass:
         #: particles drawn as point sprites since the frame's renderer last set it to 0 (for its statistics)
         self.particles_as_points = 0
         self._vertex_array = GL.glGenVertexArrays(1)
-        self._corner_index_buffer, self._cell_buffer = self._buffers = GL.glGenBuffers(2)
+        #: the triangles of the particles' quads, the cells' table, the particles of the clouds' nearest depth
+        self._corner_index_buffer, self._cell_buffer, self._depth_particle_buffer = self._buffers = GL.glGenBuffers(3)
         self._quads_indexed = 0
         #: the programs drawing many cells at once, made when first needed: (points?, atlas sprites?) -> (the
         #: program, its first cell's uniform); points never are sprites
         self._cell_programs: dict[tuple[bool, bool], tuple[int, int]] = {}
+        #: the clouds' nearest depth's program and its uniforms (`draw_nearest_depth`), made when first needed
+        self._depth_program: tuple[int, dict] | None = None
+
+    @property
+    def shafts(self):
+        """`SplatShading.shafts`: the frame's light shafts that the cloud pass's splats take off their air."""
+        return self._shading.shafts
+
+    @shafts.setter
+    def shafts(self, shafts) -> None:
+        self._shading.shafts = shafts
 
     @property
     def air(self) -> AirVolume | None:
@@ -160,9 +181,9 @@ class SplatPass:
         if not len(batch):
             return 0
         _, first = self._shading.shade(batch, view)
-        view_rotation = _rotation(view)
+        rotation = view_rotation(view)
         target_viewport = GL.glGetIntegerv(GL.GL_VIEWPORT) if point_sprites else None
-        pieces, projection, viewport = self._pieces(batch, view_rotation, projection, target_viewport)
+        pieces, projection, viewport = self._pieces(batch, rotation, projection, target_viewport)
         if viewport is not None:
             GL.glViewport(*viewport)
         with_sprites = self._resident.with_sprites(batch)
@@ -171,7 +192,7 @@ class SplatPass:
             points: self._program(points, counting, with_sprites and not points, look) for points in (False, True)
         }
         for as_points in {piece[2] for piece in pieces}:
-            self._use(programs[as_points], view_rotation, projection, float(viewport[3]) if as_points else None)
+            self._use(programs[as_points], rotation, projection, float(viewport[3]) if as_points else None)
         self._bind_quads(len(batch))
         GL.glEnable(GL.GL_PROGRAM_POINT_SIZE)
         with cloud_blending(depth_test, counting):
@@ -207,13 +228,65 @@ class SplatPass:
         )
         return draw_runs(plain & fit), projection, viewport
 
+    def draw_nearest_depth(
+        self,
+        particles: ParticleBuffer,
+        time_s: float,
+        chosen: np.ndarray,
+        eye: np.ndarray,
+        view: np.ndarray,
+        projection: np.ndarray,
+        height: int,
+    ) -> None:
+        """Draw the depth of the `chosen` particles (`nearest_depth_particles`) into the bound target of `height`
+        pixels, depth tested and written: each a disc at its centre's depth (its core, `NEAREST_DEPTH_CORE`), those
+        too faint to be seen at `time_s` left out (`NEAREST_DEPTH_OPACITY`); the light shafts' march ends its rays
+        at the nearest (docs/atmosphere.md#the-shafts-and-the-air-in-front-of-the-clouds)."""
+        if not len(chosen):
+            return
+        self._resident.hold(particles)
+        self._resident.hold_formation(particles, time_s)
+        if self._depth_program is None:
+            program = build_program(
+                "cloud_depth",
+                {
+                    "PARTICLE_FLOATS": PARTICLE_FLOATS,
+                    "SEEN_OPACITY": NEAREST_DEPTH_OPACITY,
+                    "MAX_POINT_SIZE": self._point_sizes_px[1],
+                    "CORE": NEAREST_DEPTH_CORE,
+                },
+            )
+            self._depth_program = (
+                program,
+                uniform_locations(program, ("view_projection", "eye_position", "pixels_per_ndc")),
+            )
+        program, uniforms = self._depth_program
+        GL.glUseProgram(program)
+        set_matrix_at(uniforms["view_projection"], projection @ view_rotation(view))
+        set_vec3_at(uniforms["eye_position"], eye)
+        GL.glUniform1f(uniforms["pixels_per_ndc"], 0.5 * height * projection[1, 1])
+        store(self._depth_particle_buffer, np.ascontiguousarray(chosen, dtype=np.uint32), GL.GL_STREAM_DRAW)
+        bind_storage(
+            (0, self._resident.particle_buffer),
+            (1, self._resident.formation_buffer),
+            (2, self._depth_particle_buffer),
+        )
+        GL.glBindVertexArray(self._vertex_array)
+        GL.glEnable(GL.GL_PROGRAM_POINT_SIZE)
+        GL.glEnable(GL.GL_DEPTH_TEST)
+        GL.glDepthFunc(GL.GL_LESS)
+        GL.glDepthMask(GL.GL_TRUE)
+        GL.glDrawArrays(GL.GL_POINTS, 0, len(chosen))
+        GL.glDisable(GL.GL_PROGRAM_POINT_SIZE)
+        GL.glBindVertexArray(0)
+
     def as_points_in(self, batch: SplatBatch, view: np.ndarray, projection: np.ndarray, viewport) -> tuple | None:
         """(the projection, the viewport) through which all of `batch` is drawn as point sprites into a target
         at `viewport` (x, y, width, height) with its scissor, as `draw` would draw it; None when `draw` would
         draw some of it as quads."""
         if not len(batch):
             return None
-        pieces, projection, guarded = self._pieces(batch, _rotation(view), projection, viewport)
+        pieces, projection, guarded = self._pieces(batch, view_rotation(view), projection, viewport)
         return (projection, guarded) if pieces == [(0, len(batch), True)] else None
 
     def draw_point_cells(self, cells) -> None:
@@ -286,7 +359,7 @@ class SplatPass:
         table = np.zeros((len(cells), _CELL_FLOATS), dtype=np.float32)
         for row, (view, projection, viewport, _, layer) in enumerate(cells):
             # GLSL reads matrices by columns
-            table[row, 0:16], table[row, 16:32] = _rotation(view).T.ravel(), np.asarray(projection).T.ravel()
+            table[row, 0:16], table[row, 16:32] = view_rotation(view).T.ravel(), np.asarray(projection).T.ravel()
             table[row, 32:34] = viewport[3], layer
         store(self._cell_buffer, table, GL.GL_STREAM_DRAW)
         GL.glUseProgram(program)
@@ -308,7 +381,7 @@ class SplatPass:
         command = self._order.command(selection)
         with_sprites = self._resident.with_sprites(selection)
         program = self._program(False, counting, with_sprites, self._look_variant(counting))
-        self._use(program, _rotation(view), projection, None)
+        self._use(program, view_rotation(view), projection, None)
         self._bind_quads(selection.slots)
         GL.glBindBuffer(GL.GL_DRAW_INDIRECT_BUFFER, self._order.command_buffer)
         with cloud_blending(depth_test, counting):
@@ -389,6 +462,8 @@ class SplatPass:
             GL.glDeleteProgram(program)
         for program, _ in self._cell_programs.values():
             GL.glDeleteProgram(program)
+        if self._depth_program is not None:
+            GL.glDeleteProgram(self._depth_program[0])
         GL.glDeleteBuffers(len(self._buffers), list(self._buffers))
         GL.glDeleteVertexArrays(1, [self._vertex_array])
         self._shading.close()
@@ -412,13 +487,6 @@ def _splat_defines(*, points: bool, sprites: bool, look: tuple[bool, bool], coun
     if per_pixel or noise:
         constants |= {"KERNEL_DIAMETER_INTEGRAL": KERNEL_DIAMETER_INTEGRAL, "MAX_OPACITY": MAX_OPACITY}
     return constants | {name: 1 for name, on in variant.items() if on}
-
-
-def _rotation(view: np.ndarray) -> np.ndarray:
-    """The view matrix without its translation: corners come relative to the batch's eye, the view's own."""
-    rotation = np.array(view, dtype=np.float64)
-    rotation[:3, 3] = 0.0
-    return rotation
 
 
 def _viewport_groups(cells, viewports, scissors):

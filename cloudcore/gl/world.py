@@ -301,11 +301,14 @@ class WorldPass:
         through_air: bool = True,
         shadows: CloudShadowMap | None = None,
         light_shafts: bool = False,
-    ) -> None:
+        draw_cloud_depth: Callable[[tuple[int, int]], None] | None = None,
+    ) -> LightShaftPass | None:
         """Fill the render target for `camera` seen through `view` and `projection`: terrain colour and depth where
         there is terrain, sky elsewhere (both multisampled 4x when `antialiased`, the terrain seen through the air
         under the physical sky when `through_air`, its sun's part in the clouds' `shadows` where given, and with
-        `light_shafts` the air in their shadow darkened where there are shadows and air)."""
+        `light_shafts` the air in their shadow darkened where there are shadows and air, its rays marched up to
+        the clouds' nearest depth that `draw_cloud_depth(size)` draws at the march's size where given: Yusov's
+        cut).  Returns the light shafts' pass where it marched them, for the clouds to read; else None."""
         view_projection = projection @ view
         sky = self._sky_for(self._sky, camera.position)
         if sky.physical and sky.view is not self._uploaded_view:
@@ -331,6 +334,7 @@ class WorldPass:
                 shadows,
                 sky.lowest_up(),
                 below,
+                draw_cloud_depth,
             )
         if sky.physical:
             self._draw_sky_picture(sky, camera, view_projection, (context.width, context.height), shafts)
@@ -349,6 +353,7 @@ class WorldPass:
         if antialiased:
             context.resolve_multisampled_target()
         context.bind_target()
+        return shafts
 
     def _draw_sky_picture(
         self, sky: SkyBackground, camera: Camera, view_projection: np.ndarray, size: tuple[int, int], shafts

@@ -10,14 +10,14 @@ ray, adds -ln(1 - b K(rho / r)) times the share of its slab (2 r deep along the 
 (`cloud_shadows.slab_share`).  The pairs are found in the light's plane by k-d trees, one per octave of the
 occluders' radii, so the work follows the discs that overlap, not the field's extent.
 
-Which particles shadow which: a particle shadows other clouds where it is the field's finest made representation,
-and a cell takes no shadow from particles whose place lies in its own footprint (`cloudcore.field.shadow_cells`:
-the rings' blend bands hold a cloud twice); the scene's own clouds are each their own (docs/atmosphere.md,
-"A cloud field's clouds on one another").
+Which particles shadow which: a particle casts its opacity times its blend weight (in steps) on other clouds, and
+a cell takes no shadow from particles whose place lies in its own footprint (`cloudcore.field.shadow_cells`: the
+rings' blend bands hold a cloud twice, their weights summing to one); the scene's own clouds are each their own
+(docs/atmosphere.md, "A cloud field's clouds on one another").
 
-A field's flight brings new cells every few frames: `SunThroughCells` keeps each cloud's result and, for a new set of
-cells under the same sun, finds the clouds the cells that came, left or stopped shadowing reach (the pairs of those
-occluders alone) and makes only those again.
+A field's flight brings new cells every few frames and moves its weights' steps: `SunThroughCells` keeps each
+cloud's result and, for a new set of cells or casting under the same sun, finds the clouds the particles that came,
+left or changed what they cast reach (the pairs of those occluders alone) and makes only those again.
 """
 
 from __future__ import annotations
@@ -57,7 +57,7 @@ class _Particles:
 
     centres: np.ndarray  # (n, 3)
     radii: np.ndarray
-    opacity: np.ndarray  # beam opacity
+    opacity: np.ndarray  # beam opacity cast on other clouds (times the particle's casting weight)
     starts: np.ndarray  # (clouds + 1,) where each cloud's particles start
     uv: np.ndarray  # (n, 2) places in the light's plane
     depth: np.ndarray  # along the light's travel
@@ -69,12 +69,13 @@ class _Particles:
 
     @classmethod
     def along(cls, centres, radii, opacity, cloud_starts, shadowing: CellShadowing, sun_direction) -> _Particles:
-        """The particles at `centres` (n, 3) of `radii` and beam `opacity`, their clouds at `cloud_starts`, seen along
-        the sun's light (toward `sun_direction`)."""
+        """The particles at `centres` (n, 3) of `radii` and beam `opacity` (cast times `shadowing`'s casting), their
+        clouds at `cloud_starts`, seen along the sun's light (toward `sun_direction`)."""
         right, up, forward = light_basis(sun_direction)
         centres = np.asarray(centres, dtype=np.float64).reshape(-1, 3)
-        radii, opacity = np.asarray(radii, dtype=np.float64), np.asarray(opacity, dtype=np.float64)
-        occluders = np.flatnonzero(shadowing.occludes & (opacity > 0.0) & (radii > 0.0))
+        radii = np.asarray(radii, dtype=np.float64)
+        opacity = np.asarray(opacity, dtype=np.float64) * shadowing.casting
+        occluders = np.flatnonzero((opacity > 0.0) & (radii > 0.0))
         starts = np.asarray(cloud_starts, dtype=np.int64)
         uv = centres @ np.stack([right, up], axis=1)
         return cls(centres, radii, opacity, starts, uv, centres @ forward, shadowing, occluders)
@@ -153,15 +154,17 @@ class SunThroughCells:
         place_before = {id(cloud): index for index, cloud in enumerate(before)}
         before_index = np.array([place_before.get(id(cloud), -1) for cloud in clouds], dtype=np.int64)
         came = before_index < 0
-        # the occluders now whose cloud came or whose shadowing changed, and those before whose cloud left or changed
+        # the occluders now whose cloud came or whose casting changed, and those before whose cloud left or whose
+        # casting changed (met where and as they were)
         occluding_now, occluding_then = np.zeros(len(now.radii), bool), np.zeros(len(then.radii), bool)
         occluding_now[now.occluders], occluding_then[then.occluders] = True, True
         stayed = np.flatnonzero(~came)
         mine, theirs = now.of_clouds(stayed), then.of_clouds(before_index[stayed])
+        recast = now.opacity[mine] != then.opacity[theirs]
         new_now = occluding_now.copy()
-        new_now[mine] = occluding_now[mine] & ~occluding_then[theirs]
+        new_now[mine] = occluding_now[mine] & (~occluding_then[theirs] | recast)
         gone_then = occluding_then.copy()
-        gone_then[theirs] = occluding_then[theirs] & ~occluding_now[mine]
+        gone_then[theirs] = occluding_then[theirs] & (~occluding_now[mine] | recast)
         changed = np.zeros(len(clouds), dtype=bool)
         changed[came] = True
         # the occluders that left (where they were) and those that came, against the particles now: one query
@@ -181,7 +184,7 @@ def _joined(then: _Particles, gone: np.ndarray, now: _Particles) -> _Particles:
     shadowing = CellShadowing(
         np.concatenate([np.full((len(gone), 2), np.nan), now.shadowing.corners]),
         np.concatenate([np.full(len(gone), np.nan), now.shadowing.sides]),
-        np.concatenate([np.ones(len(gone), bool), now.shadowing.occludes]),
+        np.concatenate([np.ones(len(gone)), now.shadowing.casting]),
     )
     return _Particles(
         np.concatenate([then.centres[gone], now.centres]),

@@ -17,6 +17,7 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import json
+import os
 import platform
 import subprocess
 import tempfile
@@ -335,6 +336,22 @@ def revision_trees(revisions: dict[str, str], checkout: Path):
         finally:
             for tree in trees.values():
                 subprocess.run(["git", "worktree", "remove", "--force", str(tree)], cwd=checkout, check=False)
+
+
+def tree_workers(command: list[str], trees: dict) -> dict:
+    """{name: process} of `command` (a worker's, a list) run once per tree of `trees` ({name: path}), each over its
+    tree's `cloudcore` (its PYTHONPATH and working folder), talking over its stdin and stdout as text."""
+    return {
+        name: subprocess.Popen(
+            [*command, "--worker", str(tree)],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            text=True,
+            env={**os.environ, "PYTHONPATH": str(tree)},
+            cwd=tree,
+        )
+        for name, tree in trees.items()
+    }
 
 
 def headless_pyplot():

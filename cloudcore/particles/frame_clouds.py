@@ -20,7 +20,7 @@ import numpy as np
 from cloudcore.artist.facing import CloudFacings
 from cloudcore.artist.formation import formation_state
 from cloudcore.artist.particle_styles import particle_styles
-from cloudcore.field.shadow_cells import CellShadowing, cell_shadowing
+from cloudcore.field.shadow_cells import CellShadowing, casting_weights, cell_shadowing
 from cloudcore.field.state import FieldState
 from cloudcore.field.weather import WeatherFieldState, update_weather_field, weather_drift
 from cloudcore.light.ground_bounce import cloud_lights, ground_albedo_rgb
@@ -208,20 +208,23 @@ class FrameClouds:
         authored = scene.particle_count
         self._field_weights = np.concatenate([np.ones(authored), frame.weights])
         self._cloud_weights = np.concatenate([np.ones(len(scene.clouds)), frame.mean_weights])
-        self._follow_cells(len(scene.clouds), authored)
+        casting = np.concatenate([np.ones(authored), casting_weights(frame.mean_weights, frame.cloud_starts)])
+        self._follow_cells(len(scene.clouds), casting)
         return (
             dataclasses.replace(scene, clouds=scene.clouds + frame.clouds),
             (1.0,) * len(scene.clouds) + frame.fade_keys,
         )
 
-    def _follow_cells(self, authored_clouds: int, authored_particles: int) -> None:
+    def _follow_cells(self, authored_clouds: int, casting: np.ndarray) -> None:
         """Make how the field's clouds shadow one another (`cell_shadowing`) again when its cells changed: the
-        weather's parts' cells and places, by identity (an unchanged part is the same object)."""
+        weather's parts' cells and places, by identity (an unchanged part is the same object); its particles
+        `casting` as in that frame (their clouds' blend weights' steps, `casting_weights`: a cell entering at weight 0
+        casts nothing, and the shadows fade in and out with the cells at the frames where cells change)."""
         state = self.weather_state
-        source = (authored_clouds, authored_particles, state.places, state.leading, [p.cells for p in state.parts])
+        source = (authored_clouds, state.places, state.leading, [p.cells for p in state.parts])
         held = self._cell_shadowing[0]
-        if held is None or held[:4] != source[:4] or any(a is not b for a, b in zip(held[4], source[4], strict=True)):
-            shadowing = cell_shadowing(authored_clouds, authored_particles, state.parts, state.places, state.leading)
+        if held is None or held[:3] != source[:3] or any(a is not b for a, b in zip(held[3], source[3], strict=True)):
+            shadowing = cell_shadowing(authored_clouds, state.parts, state.places, state.leading, casting)
             self._cell_shadowing = (source, shadowing)
 
     def _air_motion(self, scene: Scene) -> AirMotion | None:

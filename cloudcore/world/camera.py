@@ -51,6 +51,14 @@ def view_matrix(camera: Camera) -> np.ndarray:
     return pose_to_view(camera_pose(camera))
 
 
+def view_rotation(view: np.ndarray) -> np.ndarray:
+    """The view matrix without its translation: for points given relative to its eye (float32 on the GPU keeps
+    them their size far from the origin)."""
+    rotation = np.array(view, dtype=np.float64)
+    rotation[:3, 3] = 0.0
+    return rotation
+
+
 def pose_to_view(pose: np.ndarray) -> np.ndarray:
     """The view matrix of a camera-to-world `pose` of orthonormal axes: its inverse."""
     rotation = pose[:3, :3].T

@@ -15,7 +15,7 @@ from cloudcore.light.light_shafts import shadowed_in_scattering, shadowed_share,
 from cloudcore.light.sky_background import HORIZON_MARGIN, over_the_horizon, scene_sky
 from cloudcore.maths.colour import srgb_decode
 from cloudcore.model.scene import Camera, Lighting, Scene
-from cloudcore.model.settings import FULL_3D
+from cloudcore.model.settings import FULL_3D, RenderSettings
 from cloudcore.resources import DEFAULT_SCENE
 from cloudcore.scenes.files import load_scene
 from cloudcore.world.camera import pixel_rays, projection_matrix, view_matrix
@@ -153,6 +153,19 @@ def shaft_scene() -> Scene:
     )
 
 
+def march_depth_distances(renderer, camera: Camera) -> np.ndarray:
+    """(height, width) metres along each ray of the march to the depth it ended at (the terrain's, the clouds'
+    nearest); inf where nothing was drawn."""
+    depth = renderer.light_shafts.read_depth().astype(np.float64)
+    height, width = depth.shape
+    projection = projection_matrix(camera.fov_y_deg, RENDER_WIDTH / RENDER_HEIGHT)
+    with np.errstate(divide="ignore"):
+        view_depth = projection[2, 3] / (2.0 * depth - 1.0 + projection[2, 2])
+    forward = -view_matrix(camera)[2, :3]
+    along = view_depth / (pixel_rays(camera, width, height) @ forward)
+    return np.where(depth < 1.0, along, np.inf)
+
+
 @pytest.mark.gl
 def test_the_gl_march_is_numpys(renderer):
     scene = shaft_scene()
@@ -167,11 +180,12 @@ def test_the_gl_march_is_numpys(renderer):
     values = opacity_map(space, centres, radii, opacity)
     air = air_between(scene_sky(scene.lighting), scene.camera.position)
     directions = pixel_rays(scene.camera, width, height).reshape(-1, 3)
-    # no terrain: every ray is the sky's, marched to the volume's end, below the horizon at it (as the sky draws)
+    # no terrain: a ray is the sky's, marched to the volume's end, below the horizon at it (as the sky draws), but
+    # where the cloud's nearest depth ends it (Yusov's cut)
+    distances = np.minimum(march_depth_distances(renderer, scene.camera).ravel(), MAX_DISTANCE_M)
     sky = scene_sky(scene.lighting)
-    low = directions[:, 1] < sky.lowest_up()
+    low = (directions[:, 1] < sky.lowest_up()) & (distances >= MAX_DISTANCE_M)
     directions[low] = over_the_horizon(directions[low], sky.lowest_up() - HORIZON_MARGIN)
-    distances = np.full(len(directions), MAX_DISTANCE_M)
     # the march's dither: interleaved gradient noise at each pixel's centre, rows counted from the bottom
     column, row = np.meshgrid(np.arange(width) + 0.5, height - 0.5 - np.arange(height))
     offsets = np.modf(52.9829189 * np.modf(0.06711056 * column + 0.00583715 * row)[0])[0].ravel()
@@ -230,6 +244,10 @@ def test_a_view_whose_air_no_shadow_reaches_is_drawn_as_without_shafts(renderer)
     assert np.abs(frames[True] - frames[False]).max() == 0.0
 
 
+#: a point of the march's depth this high over the ground is a cloud's (the default scene's hang 1 km and more up)
+CLOUDS_OVER_GROUND_M = 300.0
+
+
 def turned(camera: Camera, degrees: float) -> Camera:
     """`camera` turned `degrees` about the up through its eye."""
     eye, target = np.asarray(camera.position, dtype=np.float64), np.asarray(camera.look_at, dtype=np.float64)
@@ -246,6 +264,7 @@ def test_the_marchs_terrain_depth_is_the_ground_of_each_view_in_turn(renderer):
     after others looking elsewhere: triangles left over from the view before would leave holes or stray ground."""
     scene = load_scene(DEFAULT_SCENE)
     width, height = shaft_size(RENDER_WIDTH, RENDER_HEIGHT, shaft_reduction(RENDER_WIDTH))
+    cloud_rays = []
     for degrees in (0.0, 120.0, 240.0, 0.0):
         camera = turned(scene.camera, degrees)
         renderer.render(scene, camera=camera, read_back=False)
@@ -259,10 +278,13 @@ def test_the_marchs_terrain_depth_is_the_ground_of_each_view_in_turn(renderer):
         eye = np.asarray(camera.position, dtype=np.float64)
         drawn = depth < 1.0
         points = eye + rays[drawn] * (view_depth[drawn] / (rays[drawn] @ forward))[:, None]
-        off_ground = np.abs(points[:, 1] - height_at(scene.terrain, points[:, 0], points[:, 2]))
+        over_ground = points[:, 1] - height_at(scene.terrain, points[:, 0], points[:, 2])
+        # the clouds' nearest depth (Yusov's cut) hangs over the ground: never under it
+        clouds = over_ground > CLOUDS_OVER_GROUND_M
+        cloud_rays.append(np.count_nonzero(clouds))
         # on the coarse surface (every 4th vertex of tiles that grow with the distance): off the ground by a small
         # share of the distance
-        off_by = off_ground / np.linalg.norm(points - eye, axis=1)
+        off_by = np.abs(over_ground[~clouds]) / np.linalg.norm(points[~clouds] - eye, axis=1)
         assert np.percentile(off_by, 95) < 0.015
         assert off_by.max() < 0.05
         # every ray that meets the ground within 8 km, 20 m past it (a silhouette's rays aside), is drawn
@@ -272,3 +294,100 @@ def test_the_marchs_terrain_depth_is_the_ground_of_each_view_in_turn(renderer):
         meets = below.any(axis=-1)
         assert meets.sum() > 0.2 * meets.size  # ground in view
         assert np.count_nonzero(meets & ~drawn) <= 0.01 * meets.sum()
+    assert max(cloud_rays) > 0  # the clouds' nearest depth in some view
+
+
+def upsampled(values: np.ndarray) -> np.ndarray:
+    """The march's (height, width, ...) values at the frame's pixels, a march pixel's over its block."""
+    block = shaft_reduction(RENDER_WIDTH)
+    return np.repeat(np.repeat(values, block, axis=0), block, axis=1)[:RENDER_HEIGHT, :RENDER_WIDTH]
+
+
+@pytest.mark.gl
+def test_the_marchs_rays_end_at_the_clouds_nearest_particle():
+    """Yusov's cut: a march ray through the cloud ends at the nearest of the particles whose discs' cores
+    (`NEAREST_DEPTH_CORE` of their radii) it crosses, at their centres' depth; one that passes clear of every core
+    reaches the air's end.  From 1.3 km, where the cloud's disc needs every particle's core
+    (`nearest_depth_particles`; a far cloud draws every k-th)."""
+    from cloudcore.gl.frame import FrameRenderer
+    from cloudcore.gl.splats import NEAREST_DEPTH_CORE
+
+    scene = shaft_scene()
+    flat = np.array([SUN[0], 0.0, SUN[2]]) / np.hypot(SUN[0], SUN[2])
+    eye = np.array([0.0, 1000.0, 0.0]) - 1300.0 * flat
+    scene = dataclasses.replace(scene, camera=Camera(tuple(eye), (0.0, 1200.0, 0.0), 60.0))
+    with FrameRenderer(RENDER_WIDTH, RENDER_HEIGHT) as renderer:
+        renderer.render(scene, settings=FULL_3D, read_back=False)
+        renderer.context.make_current()
+        distances = march_depth_distances(renderer, scene.camera)
+        height, width = distances.shape
+        centres, radii, _, _ = particles_of(scene.clouds)
+        rays = pixel_rays(scene.camera, width, height).reshape(-1, 3)
+        eye = np.asarray(scene.camera.position, dtype=np.float64)
+        forward = -view_matrix(scene.camera)[2, :3]
+        to_centres = centres - eye
+        along = rays @ to_centres.T  # (rays, particles): the centres' distance along each ray
+        across = np.sqrt(np.maximum(np.sum(to_centres**2, axis=1) - along**2, 0.0))
+        # a disc at the centre's depth, seen from the ray: its distance along the ray where the ray meets that depth
+        at_depth = (to_centres @ forward)[None, :] / (rays @ forward)[:, None]
+        core = NEAREST_DEPTH_CORE * radii
+        # a point is at least a pixel wide: a core smaller than a march pixel may cover a pixel whose centre it misses
+        pixel_m = along * 2.0 * np.tan(np.radians(0.5 * scene.camera.fov_y_deg)) / height
+        crossed = across < 0.7 * core  # well inside a core, whatever a march pixel's rasterisation
+        clear = ~np.any(across < 1.3 * core + pixel_m, axis=1)
+        drawn = distances.ravel()
+        hit = np.any(crossed, axis=1)
+        assert hit.sum() > 10 and clear.sum() > 0.5 * len(rays)
+        nearest = np.where(crossed, at_depth, np.inf).min(axis=1)
+        # never behind the nearest core the ray crosses well inside (the window depth's resolution there aside, a
+        # metre at 3 km)
+        assert np.all(drawn[hit] <= nearest[hit] * (1.0 + 1e-3))
+        # and every ray cut is cut at the depth of a particle whose core it crosses, or passes within a march pixel of
+        cut = np.isfinite(drawn)
+        near = (across < 1.3 * core + pixel_m) & (np.abs(at_depth - np.where(cut, drawn, 0.0)[:, None]) < 3.0)
+        assert np.all(near[cut].any(axis=1))
+        assert np.all(np.isinf(drawn[clear]))
+
+
+def darkened_by_the_shafts(renderer, scene: Scene, settings) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(how much darker each pixel is with the shafts than without (linear), the march's cloud pixels (its rays
+    cut at a cloud), the light the march took), each at the frame's pixels, drawn by `settings`."""
+    frames = {}
+    for shafts in (False, True):
+        renderer.render(scene, settings=dataclasses.replace(settings, light_shafts=shafts))  # impostors made
+        image, _ = renderer.render(scene, settings=dataclasses.replace(settings, light_shafts=shafts))
+        frames[shafts] = srgb_decode(image / 255.0)
+    renderer.context.make_current()
+    cloud = upsampled(np.isfinite(march_depth_distances(renderer, scene.camera)))
+    return frames[False] - frames[True], cloud, upsampled(renderer.light_shafts.read()[..., :3])
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize(
+    "settings",
+    [FULL_3D, RenderSettings(mode="impostor"), dataclasses.replace(FULL_3D, cloud_resolution_scale=0.5)],
+    ids=["full_3d", "impostor", "full_3d_at_half_resolution"],
+)
+def test_a_cloud_toward_the_sun_loses_the_light_its_shadow_takes_from_the_air_in_front_of_it(renderer, settings):
+    """The air between the eye and a cloud that hangs between it and the sun lies in the cloud's shadow: the
+    shafts take its light off the cloud's pixels as they take it off the sky's (the march cut at the cloud's
+    nearest depth, each cloud's own air scaled by the share left), whichever representation draws the cloud.
+    Without the cut the cloud kept its air's light but at its thin fringe: its pixels darkened by 27% of the light
+    taken in front of them."""
+    darker, cloud, taken = darkened_by_the_shafts(renderer, shaft_scene(), settings)
+    assert renderer.last_plan.stats().clouds_by_kind[settings.mode] == 1
+    assert cloud.mean() > 0.02
+    assert darker[cloud].mean() > 0.75 * taken[cloud].mean()
+    assert darker[cloud].mean() < 1.1 * taken[cloud].mean()
+    assert darker.min() > -2.0 / 255.0  # never brighter (the 8-bit dither aside)
+
+
+@pytest.mark.gl
+def test_a_cloud_is_darkened_by_the_shafts_alike_in_full_3d_and_as_its_impostor(renderer):
+    """One cloud is never drawn two ways: its impostor's quad reads the shafts' share as its particles do, and the
+    sky around it is the same march's."""
+    full, cloud, _ = darkened_by_the_shafts(renderer, shaft_scene(), FULL_3D)
+    impostor, _, _ = darkened_by_the_shafts(renderer, shaft_scene(), RenderSettings(mode="impostor"))
+    assert abs(impostor[cloud].mean() - full[cloud].mean()) < 0.15 * full[cloud].mean()
+    # the sky's pixels darken alike (the impostor's edge is not its particles' exactly)
+    assert np.percentile(np.abs(impostor - full)[~cloud], 99) < 2.0 / 255.0

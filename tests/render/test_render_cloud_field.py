@@ -233,10 +233,13 @@ def test_the_ring_s_panels_hold_their_clouds_through_the_air_at_the_clouds_own_d
     demo = load_scene(CUMULUS_FIELD)
     scene = dataclasses.replace(demo, lighting=dataclasses.replace(demo.lighting, air=Air(mie_density_scale=25.0)))
     camera = Camera((11000.0, 4200.0, 3000.0), (12000.0, 4100.0, 3000.0), 60.0)
-    ring, alone = RenderSettings(mode="impostor"), RenderSettings(mode="impostor", ring_radius=np.inf)
+    # without the light shafts, whose share of the air the ring's panels do not take (docs/atmosphere.md, "Left for
+    # the next steps of issue 52"): this is the air itself
+    ring = RenderSettings(mode="impostor", light_shafts=False)
+    alone = RenderSettings(mode="impostor", ring_radius=np.inf, light_shafts=False)
     errors, in_ring = {}, {}
     with FrameRenderer(160, 90) as reference:
-        full, _ = reference.render(scene, camera=camera, settings=FULL_3D)
+        full, _ = reference.render(scene, camera=camera, settings=dataclasses.replace(FULL_3D, light_shafts=False))
     for name, settings in (("ring", ring), ("alone", alone)):
         with FrameRenderer(160, 90) as renderer:
             for _ in range(SEGMENTS + settings.ring_fade_frames + 2):
@@ -260,10 +263,11 @@ def test_the_ring_over_the_field_holds_its_flat_coarse_cells_that_reach_the_hori
     scene = load_scene(CUMULUS_FIELD)
     camera = Camera((-1916.0, 2232.0, 3000.0), (-916.0, 2211.0, 3000.0), 60.0)
     errors = {}
+    # without the light shafts, whose share of the air the ring's panels do not take (as above)
     with FrameRenderer(160, 90) as reference:
-        full, _ = reference.render(scene, camera=camera, settings=FULL_3D)
+        full, _ = reference.render(scene, camera=camera, settings=dataclasses.replace(FULL_3D, light_shafts=False))
     for radius in (4000.0, np.inf):
-        settings = RenderSettings(mode="impostor", ring_radius=radius)
+        settings = RenderSettings(mode="impostor", ring_radius=radius, light_shafts=False)
         with FrameRenderer(160, 90) as renderer:
             for _ in range(SEGMENTS + settings.ring_fade_frames + 2):
                 image, _ = renderer.render(scene, camera=camera, settings=settings)

@@ -18,6 +18,7 @@ import numpy as np
 
 from cloudcore.gl.air_volume import AirVolume
 from cloudcore.gl.impostor_store import ImpostorStore
+from cloudcore.gl.light_shafts import FrameShafts
 from cloudcore.gl.objects import ObjectPass
 from cloudcore.gl.quads import QuadPass
 from cloudcore.gl.reduced_clouds import ReducedClouds
@@ -56,6 +57,9 @@ class CloudPassFrame:
     unit_weights: Callable[[list], np.ndarray]
     #: where the cloud draws go: None, the frame's target; else the reduced pass (`plan.cloud_size`)
     reduced: ReducedClouds | None = None
+    #: the world pass's light shafts cut at the clouds, whose share of their air every cloud's draw takes off;
+    #: None: no shafts
+    shafts: FrameShafts | None = None
 
     @property
     def eye(self) -> np.ndarray:

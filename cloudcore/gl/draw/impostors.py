@@ -22,7 +22,9 @@ class Impostors(DrawExecutor):
 
     def draw(self, frame: CloudPassFrame, step: DrawStep) -> DrawCounts:
         for atlas_texture, instances in self._atlas_runs(frame, step):
-            self.tools.quads.draw_instanced(instances, frame.view_projection, atlas_texture, air=frame.air)
+            self.tools.quads.draw_instanced(
+                instances, frame.view_projection, atlas_texture, air=frame.air, shafts=frame.shafts
+            )
         return DrawCounts()
 
     def count_fragments(self, frame: CloudPassFrame, step: DrawStep) -> tuple:
@@ -71,6 +73,7 @@ class Crossfade(DrawExecutor):
             frame.view_projection,
             atlas_texture,
             air=frame.air,
+            shafts=frame.shafts,
             layer_texture=layer.texture,
             layer_weight=full_weight,
         )

@@ -9,7 +9,8 @@
 // one draw, with the rectangle of its cell to clamp to and its layer.  AIR: world-space
 // quads seen through the air from where the eye is now, read at the corners of air_cells x air_cells
 // cells cut from the quad (6 vertices a cell, as triangles) and interpolated: a wide quad's corners are
-// farther than its middle, so a near one takes more cells (cloudcore.light.air_between.air_cells).
+// farther than its middle, so a near one takes more cells (cloudcore.light.air_between.air_cells); with
+// LIGHT_SHAFTS, less the light shafts' share of it (light_shafts_read.glsl).
 
 #ifdef ATLAS
 layout(location = 0) in vec3 corner_0;
@@ -32,6 +33,9 @@ uniform vec3 eye_position;
 uniform int air_cells;
 out vec3 air_transmittance_at;  // the air between the eye and the vertex, applied in quad.frag.glsl
 out vec3 air_in_scattered_at;
+#ifdef LIGHT_SHAFTS
+#include "light_shafts_read.glsl"
+#endif
 // a cell's two triangles, as (column, row) steps from its lower left corner
 const vec2 CELL_CORNERS[6] = vec2[6](vec2(0, 0), vec2(1, 0), vec2(0, 1), vec2(0, 1), vec2(1, 0), vec2(1, 1));
 #endif
@@ -57,4 +61,10 @@ void main()
 #endif
     uv = mix(uv_rect.xy, uv_rect.zw, along);
     gl_Position = view_projection * vec4(point, 1.0);
+#if defined(AIR) && defined(LIGHT_SHAFTS)
+    // Yusov's cut: less the share of that air the clouds' shadows keep from the eye (marched up to the clouds'
+    // nearest distance), read where the vertex falls on the screen, as the splats' and the terrain's
+    if (gl_Position.w > 0.0)
+        air_in_scattered_at *= 1.0 - light_shafts_at(clamp(gl_Position.xy / gl_Position.w, -1.0, 1.0)).a;
+#endif
 }

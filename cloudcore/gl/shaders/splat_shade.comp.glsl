@@ -31,7 +31,7 @@
 // PROFILES (Yusov's eye pass), RETURNED (the lit face's light), PIXEL_TERMS (what
 // splat.frag.glsl shades a splat by per pixel: cloudcore.light.splat_look) and AIR (aerial perspective by the particle's
 // distance from the eye, for the cloud pass's batches, never an impostor's,
-// whose texture is seen from elsewhere) compile their code in only for batches that
+// whose texture is seen from elsewhere; with LIGHT_SHAFTS, less the shafts' share of it) compile their code in only for batches that
 // have them: llvmpipe paid for the code behind the branches, so a batch of Harris's
 // splats paid for the artist colours of every corner.
 //
@@ -104,6 +104,10 @@ uniform float g;
 uniform int profile_samples;
 #ifdef AIR
 #include "aerial_perspective.glsl"
+#endif
+#ifdef LIGHT_SHAFTS
+#include "light_shafts_read.glsl"
+uniform mat4 shaft_view_projection;  // the frame's, of points relative to its eye (the batch's)
 #endif
 
 const int FACING_SPLAT = 0;
@@ -246,6 +250,13 @@ void shade(uint invocation)
     // (cloudcore.light.air_between): read once for its four corners
     vec3 air_transmittance, air_in_scattered;
     air_toward(offset, air_transmittance, air_in_scattered);
+#ifdef LIGHT_SHAFTS
+    // Yusov's cut: less the share of that air the clouds' shadows keep from the eye, marched up to the clouds'
+    // nearest distance where the particle's centre falls on the screen, as the terrain's and the impostors' air
+    vec4 clip = shaft_view_projection * vec4(offset, 1.0);
+    if (clip.w > 0.0)
+        air_in_scattered *= 1.0 - light_shafts_at(clamp(clip.xy / clip.w, -1.0, 1.0)).a;
+#endif
     sun *= air_transmittance;
 #endif
 #ifdef PIXEL_TERMS
