@@ -4,6 +4,7 @@ end, bad suites and cases refused in one line."""
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -40,6 +41,16 @@ def test_every_shipped_suite_loads_with_default_cases_and_scenes_that_exist():
         assert suite.chosen(None), name
         for case in suite.cases:
             assert case.scene.is_file(), (name, case.name)
+
+
+@pytest.mark.parametrize("path", sorted((Path(__file__).parents[3] / "docs" / "suites").glob("*.toml")), ids=str)
+def test_the_suites_the_docs_measured_with_still_load(path):
+    """docs/performance.md's tables name these files in their commands: they must stay runnable as the suites'
+    keys and the scenes change."""
+    suite = load_suite(str(path))
+    assert suite.chosen(None), path
+    for case in suite.cases:
+        assert case.scene.is_file(), (path.name, case.name)
 
 
 def test_the_lod_suite_holds_harris_figure_8_and_wang_s_scenarios_as_the_issue_asks():
