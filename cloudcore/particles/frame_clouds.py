@@ -21,7 +21,7 @@ from cloudcore.artist.facing import CloudFacings
 from cloudcore.artist.formation import formation_state
 from cloudcore.artist.particle_styles import particle_styles
 from cloudcore.field.shadow_cells import CellShadowing, casting_weights, cell_shadowing
-from cloudcore.field.state import FieldState
+from cloudcore.field.state import FieldFrame, FieldState
 from cloudcore.field.weather import WeatherFieldState, update_weather_field, weather_drift
 from cloudcore.light.ground_bounce import cloud_lights, ground_albedo_rgb
 from cloudcore.light.illumination import IlluminationCache
@@ -208,22 +208,25 @@ class FrameClouds:
         authored = scene.particle_count
         self._field_weights = np.concatenate([np.ones(authored), frame.weights])
         self._cloud_weights = np.concatenate([np.ones(len(scene.clouds)), frame.mean_weights])
-        casting = np.concatenate([np.ones(authored), casting_weights(frame.mean_weights, frame.cloud_starts)])
-        self._follow_cells(len(scene.clouds), casting)
+        self._follow_cells(len(scene.clouds), authored, frame)
         return (
             dataclasses.replace(scene, clouds=scene.clouds + frame.clouds),
             (1.0,) * len(scene.clouds) + frame.fade_keys,
         )
 
-    def _follow_cells(self, authored_clouds: int, casting: np.ndarray) -> None:
+    def _follow_cells(self, authored_clouds: int, authored_particles: int, frame: FieldFrame) -> None:
         """Make how the field's clouds shadow one another (`cell_shadowing`) again when its cells changed: the
-        weather's parts' cells and places, by identity (an unchanged part is the same object); its particles
-        `casting` as in that frame (their clouds' blend weights' steps, `casting_weights`: a cell entering at weight 0
-        casts nothing, and the shadows fade in and out with the cells at the frames where cells change)."""
+        weather's parts' cells and places, by identity (an unchanged part is the same object); its particles casting
+        as in that `frame` (the field's clouds' blend weights' steps, `casting_weights`: a cell entering at weight 0
+        casts nothing, and the shadows fade in and out with the cells at the frames where cells change), the
+        authored clouds' wholly."""
         state = self.weather_state
         source = (authored_clouds, state.places, state.leading, [p.cells for p in state.parts])
         held = self._cell_shadowing[0]
         if held is None or held[:3] != source[:3] or any(a is not b for a, b in zip(held[3], source[3], strict=True)):
+            casting = np.concatenate(
+                [np.ones(authored_particles), casting_weights(frame.mean_weights, frame.cloud_starts)]
+            )
             shadowing = cell_shadowing(authored_clouds, state.parts, state.places, state.leading, casting)
             self._cell_shadowing = (source, shadowing)
 
@@ -294,7 +297,7 @@ class FrameClouds:
         # a field's new cells shadow anew (another `CellShadowing`): the keys stay where the light stays
         same_lighting = old is not None and self.lit.source[1:4] == source[1:4]
         same_lighting = same_lighting and (self.lit.source[4] is False) == (between_clouds is False)
-        same_lighting = same_lighting and not (self.lit.source[5] != source[5])
+        same_lighting = same_lighting and self.lit.source[5] == source[5]
         # by identity, not place: a cloud field's clouds that stay keep their keys when others come and go, unless
         # the light reaching them changed (the clouds shadow one another: one moved, another's shadow moves)
         held = (
