@@ -2,6 +2,10 @@
 
     python scripts/bench_frame_against.py --against main [--cases flythrough,field] [--every 10]
         [--modes auto,full] [--warmup 5] [--json out/bench_frame_against.json]
+    python scripts/bench_frame_against.py --against main --cases cumulus_field.toml:flight:50 --modes auto,full
+
+A case `SCENE:PATH:FRAMES` is a scene file's camera path (a file under cloudcore/resources/scenes/ by its name, or a
+path), `FRAMES` views spread along it, at 640x360 (the cumulus field demo's `cloudview bench` row of issue 51).
 
 Two worker processes, this tree's `cloudcore` and the revision's (a temporary worktree on its PYTHONPATH), draw
 the same views of each case of the suite `lod` (`cloudcore/resources/bench/lod.toml`, every `--every`th view), in
@@ -39,7 +43,10 @@ def worker(case: str, every: int, modes: list[str]) -> None:
     from cloudcore.lod.costs import LLVMPIPE_COSTS
     from cloudcore.model.settings import RenderSettings
 
-    _, scene, views, size, _ = built_cases("lod", [case])[0]
+    if case.count(":") == 2:
+        scene, views, size = path_case(case)
+    else:
+        _, scene, views, size, _ = built_cases("lod", [case])[0]
     views = views[::every]
     renderers = {mode: FrameRenderer(*size) for mode in modes}
     print(len(views), flush=True)
@@ -57,6 +64,17 @@ def worker(case: str, every: int, modes: list[str]) -> None:
         print(stats.frame_ms, flush=True)
     for renderer in renderers.values():
         renderer.close()
+
+
+def path_case(case: str) -> tuple:
+    """(scene, views, size) of a case `SCENE:PATH:FRAMES`: `FRAMES` views along the scene's camera path `PATH`."""
+    from cloudcore.measure.benchmark import path_views
+    from cloudcore.resources import resource_path
+    from cloudcore.scenes.files import load_scene
+
+    file, path, frames = case.split(":")
+    scene = load_scene(file if Path(file).exists() else resource_path("scenes", file))
+    return scene, path_views(scene, path, int(frames)), (640, 360)
 
 
 def compare(trees: dict, case: str, every: int, modes: list[str], warmup: int, folder: Path) -> list[dict]:

@@ -7,7 +7,8 @@ same size over directions instead, which the camera's turning leaves valid: the 
 (squared toward it, as the sky view's), its cosine to the up (square-rooted away from the horizontal, where a
 surface's air changes fastest) and the distance, in slices spaced quadratically from 0 (slice 0 is the eye:
 nothing added, everything let through) to `MAX_DISTANCE_M`.  It depends on the eye's altitude and the sun
-alone, so it is remade when the eye climbs or sinks past `ALTITUDE_STEP_M`, not when it turns or flies level.
+alone, so it is remade when the eye climbs or sinks past `ALTITUDE_STEP_M`, not when it turns or flies level:
+built at the altitude knots (`sky.altitude_knots`), blended between them.
 Each texel is `scattering.in_scattering` over its distance, marched on its own; a ray into the planet goes on
 through air of the ground's density (`scattering.march`), as a flat terrain standing over the curved ground's
 horizon sees: stopping it there made neighbouring rows of the volume disagree by 5% in transmittance.
@@ -23,7 +24,7 @@ import numpy as np
 
 from cloudcore.atmosphere.parameters import AtmosphereParameters
 from cloudcore.atmosphere.scattering import in_scattering
-from cloudcore.atmosphere.sky import AtmosphereTables
+from cloudcore.atmosphere.sky import AtmosphereTables, altitude_knots
 from cloudcore.atmosphere.sky_view import eye_radius, light_view_cosines
 from cloudcore.atmosphere.table_sampling import (
     sample_trilinear,
@@ -120,8 +121,8 @@ def aerial_perspective_from(
     tables: AtmosphereTables, eye_altitude_m: float, sun_direction, preview: bool = False
 ) -> AerialPerspective:
     """The volume for an eye at `eye_altitude_m` (rounded to `ALTITUDE_STEP_M`, at least 0), coarser for a
-    `preview`: the last few are kept, so an eye flying level or turning reuses one and a frame asks again at no
-    cost."""
+    `preview`: the volumes built at the knots around it blended (`sky.altitude_knots`); the last few are kept, so
+    an eye flying level or turning reuses one and a frame asks again at no cost."""
     return _aerial_perspective(tables, volume_altitude(eye_altitude_m), tuple(float(c) for c in sun_direction), preview)
 
 
@@ -134,4 +135,20 @@ def volume_altitude(eye_altitude_m: float) -> float:
 def _aerial_perspective(
     tables: AtmosphereTables, altitude_m: float, sun_direction: tuple, preview: bool
 ) -> AerialPerspective:
+    below, above, share = altitude_knots(altitude_m)
+    if share == 0.0:
+        return _knot_volume(tables, below, sun_direction, preview)
+    low, high = (_knot_volume(tables, knot, sun_direction, preview) for knot in (below, above))
+    return AerialPerspective(
+        tables.params,
+        altitude_m,
+        low.sun_direction,
+        (1.0 - share) * low.in_scattered + share * high.in_scattered,
+        (1.0 - share) * low.transmittance + share * high.transmittance,
+    )
+
+
+@functools.lru_cache(maxsize=4)
+def _knot_volume(tables: AtmosphereTables, altitude_m: float, sun_direction: tuple, preview: bool) -> AerialPerspective:
+    """The volume built at a knot (`sky.altitude_knots`), which the steps between it and its neighbours blend."""
     return build_aerial_perspective(tables, altitude_m, sun_direction, preview)

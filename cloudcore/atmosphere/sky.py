@@ -108,14 +108,22 @@ class SkyView:
         # build the same table
         tables = self.__dict__.get("_built_tables")
         if tables is None:
-            tables = sky_view.build_sky_view_table(
-                self.tables.params,
-                self.tables.transmittance,
-                self.tables.multiple_scattering,
-                self.altitude_m,
-                float(self.sun_direction[1]),
-                self.preview,
-            )
+            below, above, share = altitude_knots(self.altitude_m)
+            if share == 0.0 and below == self.altitude_m:
+                tables = sky_view.build_sky_view_table(
+                    self.tables.params,
+                    self.tables.transmittance,
+                    self.tables.multiple_scattering,
+                    self.altitude_m,
+                    float(self.sun_direction[1]),
+                    self.preview,
+                )
+            else:  # between two knots: their tables blended, as `altitude_knots` says
+                sun = tuple(float(c) for c in self.sun_direction)
+                low, high = (
+                    _sky_view(self.tables.params, knot, sun, self.preview)._tables() for knot in (below, above)
+                )
+                tables = tuple((1.0 - share) * a + share * b for a, b in zip(low, high, strict=True))
             object.__setattr__(self, "_built_tables", tables)
         return tables
 
@@ -128,6 +136,27 @@ class SkyView:
         """(..., 3): the air's transmittance along unit `directions` (..., 3) to the ground, where they meet it."""
         rows = self.row_transmittance[:, None, :]
         return sky_view.sky_view_lookup(self.tables.params, rows, self.altitude_m, directions, self.sun_direction)
+
+
+#: the tables seen from an altitude (the sky-view table, the air's volume: `aerial_perspective`) are built at knots
+#: and blended linearly between the two around an altitude between them: a knot at every altitude asked for up to
+#: `KNOTS_FROM_M`, where the horizon's rows and the rays that meet the ground change too fast with the eye's
+#: altitude to blend, then every `KNOT_STEP_M`, where a blend strays from the tables built at its own altitude by
+#: less than two neighbouring 100 m steps' tables differ.  A climb built both tables at every 100 m step, most of a
+#: climbing eye's world pass (docs/atmosphere.md, "The tables between altitude knots")
+KNOTS_FROM_M = 1000.0
+KNOT_STEP_M = 500.0
+
+
+def altitude_knots(altitude_m: float) -> tuple[float, float, float]:
+    """(the knot at or below `altitude_m`, the knot above it, the share of the one above in the blend): the
+    altitudes whose tables make the tables seen from `altitude_m`; (it, it, 0) at a knot."""
+    altitude_m = float(altitude_m)
+    if altitude_m <= KNOTS_FROM_M:
+        return altitude_m, altitude_m, 0.0
+    below = KNOTS_FROM_M + KNOT_STEP_M * np.floor((altitude_m - KNOTS_FROM_M) / KNOT_STEP_M)
+    share = (altitude_m - below) / KNOT_STEP_M
+    return (float(below), float(below), 0.0) if share == 0.0 else (float(below), float(below) + KNOT_STEP_M, share)
 
 
 def sky_seen_from(params: AtmosphereParameters, altitude_m: float, sun_direction, preview: bool = False) -> SkyView:

@@ -237,8 +237,9 @@ def test_a_new_altitude_s_air_is_coarse_until_its_exact_volume_is_built():
 
 def test_a_sky_seen_from_an_eye_builds_the_eye_s_table_alone_and_the_editor_s_worker_builds_it(monkeypatch):
     """A scene's sky is made over its origin and drawn as an eye above it sees it (`SkyBackground.seen_from`): the
-    eye's table is built, when first read, and the origin's never; the editor's air (`LiveAir`) has its worker
-    build the table, so the frame that reads it builds none."""
+    eye's table is made, when first read, from the tables of the altitude knots around it (`altitude_knots`), and
+    the origin's never; the editor's air (`LiveAir`) has its worker build the table, so the frame that reads it
+    builds none."""
     built = []
     build = sky_view.build_sky_view_table
     monkeypatch.setattr(sky_view, "build_sky_view_table", lambda *args: built.append(args[3]) or build(*args))
@@ -247,7 +248,8 @@ def test_a_sky_seen_from_an_eye_builds_the_eye_s_table_alone_and_the_editor_s_wo
         built.clear()
         seen = scene_sky(Lighting(time_of_day=10.35), preview).seen_from(eye)  # an hour no other test draws
         assert built == []
-        assert np.isfinite(seen.view.table).all() and built == [seen.view.altitude_m] == [2300.0]
+        assert seen.view.altitude_m == 2300.0
+        assert np.isfinite(seen.view.table).all() and built == [2000.0, 2500.0]
     sky = scene_sky(Lighting(time_of_day=10.45))
     live = LiveAir()
     try:
