@@ -95,7 +95,7 @@ def terrain_vertex_light(normals, base_colour, light: TerrainLight) -> tuple[np.
 
 class TerrainMesh:
     """The terrain's tiles on the GPU for one terrain and one light: uploaded again when the eye's move changes
-    the tiles, drawn tile by tile where a tile's box meets the view."""
+    the tiles, drawn where a tile's box meets the view (their triangles gathered when those tiles change)."""
 
     def __init__(self, terrain: Terrain, light: TerrainLight, programs: ProgramCache):
         if terrain.kind not in DRAWN_TERRAIN_KINDS:  # the scene loader refuses these first (cloudcore.scenes.limits)
@@ -104,6 +104,9 @@ class TerrainMesh:
         self.tiles = TerrainTiles(terrain)
         self._programs = programs  # the world pass's
         self._coarse_in_view: np.ndarray | None = None  # the tiles whose coarse surfaces the coarse indices hold
+        self._in_view: np.ndarray | None = None  # the tiles whose grids and skirts the indices hold
+        # the indices' first triangles, the grids', then the skirts'
+        self._grid_triangles = self._skirt_triangles = 0
         # the tiles' vertices and triangles, and their coarse surfaces' (the light shafts' depth: positions alone)
         self._buffers = [int(b) for b in GL.glGenBuffers(4)]
         self._vertex_array, self._coarse_vertex_array = (int(a) for a in GL.glGenVertexArrays(2))
@@ -133,11 +136,7 @@ class TerrainMesh:
             vertices = np.ascontiguousarray(vertices, dtype=np.float32)
             GL.glBindBuffer(GL.GL_ARRAY_BUFFER, vertex_buffer)
             GL.glBufferData(GL.GL_ARRAY_BUFFER, vertices.nbytes, vertices, GL.GL_STATIC_DRAW)
-        indices = np.ascontiguousarray(tiles.faces, dtype=np.uint32)
-        GL.glBindVertexArray(self._vertex_array)
-        GL.glBufferData(GL.GL_ELEMENT_ARRAY_BUFFER, indices.nbytes, indices, GL.GL_STATIC_DRAW)
-        GL.glBindVertexArray(0)
-        self._coarse_in_view = None  # the coarse surfaces' triangles are gathered again
+        self._in_view = self._coarse_in_view = None  # the triangles in view are gathered again
 
     def _program(self, through_air: bool, shafts: bool, far_ground: bool) -> int:
         defines = {
@@ -199,20 +198,35 @@ class TerrainMesh:
             self._draw_coarse(in_view)
             return
         GL.glBindVertexArray(self._vertex_array)
-        grid = grid_face_count()
-        first = in_view * len(TILE_FACES)  # each tile's first triangle
+        if self._in_view is None or not np.array_equal(self._in_view, in_view):
+            self._gather(in_view)
         # the grids with their back faces culled: the far sides of hills, hidden behind their near sides, which
         # llvmpipe then does not set up; the skirts not, as either of two neighbours' may be the one that hangs
-        # past the other's edge, seen from either side, and only on the sides that need one (`skirted_sides`)
+        # past the other's edge, seen from either side
         GL.glEnable(GL.GL_CULL_FACE)
         GL.glCullFace(GL.GL_BACK)
-        _draw_ranges(first, grid)
+        GL.glDrawElements(GL.GL_TRIANGLES, 3 * self._grid_triangles, GL.GL_UNSIGNED_INT, None)
         GL.glDisable(GL.GL_CULL_FACE)
+        if self._skirt_triangles:
+            skirts_offset = ctypes.c_void_p(3 * 4 * self._grid_triangles)  # bytes of uint32 indices
+            GL.glDrawElements(GL.GL_TRIANGLES, 3 * self._skirt_triangles, GL.GL_UNSIGNED_INT, skirts_offset)
+        GL.glBindVertexArray(0)
+
+    def _gather(self, in_view: np.ndarray) -> None:
+        """Gather the triangles of the tiles `in_view` into the bound vertex array's indices, in two runs each drawn
+        in one call: their grids, then their skirts on the sides that need one (`skirted_sides`).  Drawn a range a
+        tile and a side (two multi-draws), the tiles cost llvmpipe a draw's setup each, as much as the skirts'
+        triangles themselves (docs/performance.md, "The terrain in two draws")."""
+        grid = grid_face_count()
+        faces = self.tiles.faces.reshape(len(self.tiles.tiles), len(TILE_FACES), 3)
         tile, side = np.nonzero(self.tiles.skirts[in_view])
         per_side = (len(TILE_FACES) - grid) // len(SKIRT_SIDES)
-        if len(tile):
-            _draw_ranges(first[tile] + grid + side * per_side, per_side)
-        GL.glBindVertexArray(0)
+        skirts = faces[in_view[tile][:, None], grid + side[:, None] * per_side + np.arange(per_side)[None, :]]
+        grids = faces[in_view, :grid]
+        indices = np.ascontiguousarray(np.concatenate([grids.reshape(-1, 3), skirts.reshape(-1, 3)]), dtype=np.uint32)
+        GL.glBufferData(GL.GL_ELEMENT_ARRAY_BUFFER, indices.nbytes, indices, GL.GL_DYNAMIC_DRAW)
+        self._in_view = in_view
+        self._grid_triangles, self._skirt_triangles = grids.shape[0] * grid, skirts.shape[0] * per_side
 
     def _draw_coarse(self, in_view: np.ndarray) -> None:
         """Draw the coarse surfaces of the tiles `in_view` in one call, none culled (at the march's resolution
@@ -235,15 +249,6 @@ class TerrainMesh:
     def close(self) -> None:
         GL.glDeleteBuffers(len(self._buffers), self._buffers)
         GL.glDeleteVertexArrays(2, [self._vertex_array, self._coarse_vertex_array])
-
-
-def _draw_ranges(first_triangles: np.ndarray, triangles: int) -> None:
-    """Draw `triangles` triangles of the bound element buffer from each of `first_triangles`, in one call."""
-    counts = np.full(len(first_triangles), 3 * triangles, dtype=np.int32)
-    offsets = (3 * 4 * np.asarray(first_triangles, dtype=np.intp)).tolist()  # bytes of uint32 indices
-    GL.glMultiDrawElements(
-        GL.GL_TRIANGLES, counts, GL.GL_UNSIGNED_INT, (ctypes.c_void_p * len(offsets))(*offsets), len(counts)
-    )
 
 
 class WorldPass:
