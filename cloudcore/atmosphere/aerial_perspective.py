@@ -148,7 +148,7 @@ def _aerial_perspective(
     )
 
 
-@functools.lru_cache(maxsize=4)
+@functools.lru_cache(maxsize=8)
 def _knot_volume(tables: AtmosphereTables, altitude_m: float, sun_direction: tuple, preview: bool) -> AerialPerspective:
     """The volume built at a knot (`sky.altitude_knots`), which the steps between it and its neighbours blend."""
     return build_aerial_perspective(tables, altitude_m, sun_direction, preview)
