@@ -214,9 +214,9 @@ class TerrainMesh:
 
     def _gather(self, in_view: np.ndarray) -> None:
         """Gather the triangles of the tiles `in_view` into the bound vertex array's indices, in two runs each drawn
-        in one call: their grids, then their skirts on the sides that need one (`skirted_sides`).  Drawn a range a
-        tile and a side (two multi-draws), the tiles cost llvmpipe a draw's setup each, as much as the skirts'
-        triangles themselves (docs/performance.md, "The terrain in two draws")."""
+        in one call: their grids, then their skirts on the sides that need one (`skirted_sides`), in the order the
+        tiles come.  Drawn as multi-draws of a range a tile and a side, llvmpipe set each range up as a draw of its
+        own (docs/performance.md, "The terrain in two draws")."""
         grid = grid_face_count()
         faces = self.tiles.faces.reshape(len(self.tiles.tiles), len(TILE_FACES), 3)
         tile, side = np.nonzero(self.tiles.skirts[in_view])
