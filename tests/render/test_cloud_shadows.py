@@ -168,10 +168,17 @@ def test_the_rendered_ground_is_darker_where_the_cloud_shadows_it(renderer):
 
 
 @pytest.mark.gl
-def test_the_gl_map_is_numpys(renderer):
+@pytest.mark.parametrize("widest_m, as_points", [(40.0, True), (900.0, False)])
+def test_the_gl_map_is_numpys(renderer, widest_m, as_points):
+    """The map's particles drawn as point sprites, or as quads where one is wider than the GL's largest point (a
+    particle of 900 m spans most of the 512 texels across this map), give numpy's map."""
     scene, _, _ = shadow_scene()
+    particles = scene.clouds[0].particles.copy()
+    particles[0, 3] = widest_m
+    scene = dataclasses.replace(scene, clouds=(dataclasses.replace(scene.clouds[0], particles=particles),))
     renderer.render(scene, settings=FULL_3D, read_back=False)
     shadow_map = renderer.shadow_map
+    assert shadow_map.drawn_as_points == as_points
     renderer.context.make_current()
     centres, radii, _, _ = particles_of(scene.clouds)
     # the GL map takes the particles' whole opacity (the ground's shadow, nearer the truth's than the beam's)
