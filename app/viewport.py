@@ -35,9 +35,10 @@ from cloudcore.world.navigation import moved, turned
 from cloudcore.world.wind import light_time, reshapes
 
 TURN_DEG_PER_PIXEL = 0.2
-#: a frame that shows the picture again while the relighting worker runs waits this long first: the
-#: window's own drawing (panels, plots, the X server's copy) takes most of a core on llvmpipe, and the
-#: worker needs it; the window still follows the mouse at about 20 frames a second
+#: a frame that shows the picture again while the relighting worker runs waits this long first, or until the
+#: worker's look is in (`LiveIllumination.pause`): the window's own drawing (panels, plots, the X server's copy)
+#: takes most of a core on llvmpipe, and the worker needs it; the window still follows the mouse at about 20
+#: frames a second
 RELIGHT_PAUSE_S = 0.03
 #: outline colours (RGBA): impostors yellow, crossfading clouds orange, ring panels cyan, the picked particle red
 _OUTLINE_COLOURS = {"impostor": (255, 220, 0, 220), "crossfade": (255, 140, 0, 220), "ring": (0, 220, 255, 200)}
@@ -119,7 +120,7 @@ class Viewport:
             # and the cores go to the relighting worker
             stats, reused = self._last_stats, True
             if self.relighting.busy:
-                time.sleep(RELIGHT_PAUSE_S)
+                self.relighting.pause(RELIGHT_PAUSE_S)
         else:
             _, stats = self.renderer.render(
                 scene,

@@ -10,7 +10,8 @@ look), the preview light pass of `IlluminationCache.missing` timed as the religh
 (`cloudcore.light.relighting`), then the frame that draws the look.  Each part of that frame is timed between two
 `glFinish`, so what the GPU does lands in the part that asked for it (the frame is slower for it).  Each way (this
 tree, each `--against` revision's tree) is a child process; the ways take turns, one child each a round, so that
-all see the same machine load.  Medians over the looks; per part, ms a look.
+all see the same machine load.  Medians over the looks; per part, ms a look.  Then the last look's picture against the
+exact look at its hour (`preview_psnr_db`): what the drag's preview gives up.
 """
 
 from __future__ import annotations
@@ -99,31 +100,55 @@ def measure(looks: int, size: tuple[int, int]) -> dict:
     for _ in range(2):  # the exact look before the drag, its impostors made
         renderer.render(scene, time_of_day=9.0, read_back=False, settings=settings)
     spent.update((name, 0.0) for name in spent)
-    light_ms, frame_ms = [], []
+    light_ms, frame_ms, light_cpu_ms, frame_cpu_ms = [], [], [], []
     for step in range(1, looks + 1):
         hours = 9.0 + 0.12 * step
         look = Look(scene.shading, dataclasses.replace(scene.lighting, time_of_day=hours), PREVIEW_METHOD)
         clouds = renderer.drawn_clouds(scene, 0.0)
-        start = time.perf_counter()
+        start, start_cpu = time.perf_counter(), time.process_time()
         for direction, stale in cache.missing(clouds, look.shading, look.lights(), PREVIEW_METHOD):
             incident = illuminate_direction(stale, look.shading, direction, PREVIEW_METHOD)
             cache.store(stale, look.shading, PREVIEW_METHOD, direction, incident)
         light_ms.append(1e3 * (time.perf_counter() - start))
+        light_cpu_ms.append(1e3 * (time.process_time() - start_cpu))
         GL.glFinish()
-        start = time.perf_counter()
+        start, start_cpu = time.perf_counter(), time.process_time()
         renderer.render(
             scene, time_of_day=hours, illumination_method=PREVIEW_METHOD, read_back=False, settings=settings
         )
         renderer.display_texture()
         GL.glFinish()
         frame_ms.append(1e3 * (time.perf_counter() - start))
+        frame_cpu_ms.append(1e3 * (time.process_time() - start_cpu))
+    preview_psnr_db = _preview_error(renderer, scene, hours, settings)
     renderer.close()
     air.close()
     return {
         "worker_light_pass_ms": float(np.median(light_ms)),
         "look_frame_ms": float(np.median(frame_ms)),
+        # the processor time, llvmpipe's threads' included: what the look costs the machine's cores, which a loaded
+        # machine changes far less than the wall clock
+        "worker_light_pass_cpu_ms": float(np.median(light_cpu_ms)),
+        "look_frame_cpu_ms": float(np.median(frame_cpu_ms)),
         "parts_ms": {name: round(total / looks, 1) for name, total in spent.items()},
+        "preview_psnr_db": preview_psnr_db,
     }
+
+
+def _preview_error(renderer, scene, hours: float, settings) -> float:
+    """The PSNR of the last look's picture against the exact look at its hour, both drawn in full 3D (so that no
+    impostor left from another light takes part), the look's preview light held from the drag."""
+    import dataclasses
+
+    from cloudcore.light.relighting import EXACT_METHOD, PREVIEW_METHOD
+    from cloudcore.measure.imagecompare import compare
+
+    full = dataclasses.replace(settings, mode="full")
+    pictures = [
+        [renderer.render(scene, time_of_day=hours, illumination_method=method, settings=full)[0] for _ in range(2)][-1]
+        for method in (PREVIEW_METHOD, EXACT_METHOD)
+    ]
+    return compare(*pictures).psnr_db
 
 
 def main() -> None:

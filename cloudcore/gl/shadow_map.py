@@ -1,7 +1,10 @@
 """The clouds' transmittance map on the GPU: `cloudcore.light.cloud_shadows.opacity_map` drawn from the particles.
 
 Each particle is a square over its disc in the sun's view (shaders/shadow_map.vert.glsl), its optical depth added
-into two RGBA32F targets at once, the running sums at the map's eight slices (shadow_map.frag.glsl).  The map is
+into two RGBA32F targets at once, the running sums at the map's eight slices (shadow_map.frag.glsl).  The view is
+orthographic, so a point sprite of the square's side covers the square's texels: the map's particles are points
+where the largest fits the GL's point sizes (llvmpipe sets up one point for the quad's two triangles, and the
+map's making was triangle-bound: docs/performance.md, "A look's parts"), quads otherwise.  The map is
 made again only when what it is made of changes: the particle buffer (the clouds, their optics, the lighting) or
 the sun's direction, or the texels asked for (a dragged slider's look takes a coarser one); the passes that read it
 (the terrain, the objects) bind it with `bind` (shaders/cloud_shadow.glsl).
@@ -31,7 +34,10 @@ class CloudShadowMap:
     """The map of the last particles and sun it was made for (`update`); none until then, or without particles."""
 
     def __init__(self):
-        self._program = build_program("shadow_map", {"SPLAT_SHARPNESS": SPLAT_SHARPNESS})
+        defines = {"SPLAT_SHARPNESS": SPLAT_SHARPNESS}
+        #: (the quads' program, the points')
+        self._programs = (build_program("shadow_map", defines), build_program("shadow_map", defines | {"POINTS": 1}))
+        self._largest_point = float(GL.glGetFloatv(GL.GL_POINT_SIZE_RANGE)[1])
         self._vertex_array, self._buffer = GL.glGenVertexArrays(1), GL.glGenBuffers(1)
         GL.glBindVertexArray(self._vertex_array)
         GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self._buffer)
@@ -50,6 +56,7 @@ class CloudShadowMap:
         #: the view the map is read in (the one it was drawn in, moved with the clouds), None while there is no map
         self.space: LightSpace | None = None
         self.made = 0  # how many times a map was made
+        self.drawn_as_points = False  # whether the last map made drew its particles as point sprites
 
     def update(
         self,
@@ -87,7 +94,10 @@ class CloudShadowMap:
         GL.glViewport(0, 0, width, height)
         GL.glClearColor(0.0, 0.0, 0.0, 0.0)
         GL.glClear(GL.GL_COLOR_BUFFER_BIT)
-        program = self._program
+        # a particle's square is 2 max(radius, texel) across (shadow_map.vert.glsl)
+        points = 2.0 * max(float(particles.radii.max()), space.texel_m) / space.texel_m <= self._largest_point
+        self.drawn_as_points = points
+        program = self._programs[points]
         GL.glUseProgram(program)
         set_matrix(program, "world_to_map", space.world_to_map())
         GL.glUniform1f(GL.glGetUniformLocation(program, "texel_m"), space.texel_m)
@@ -98,7 +108,12 @@ class CloudShadowMap:
         GL.glEnable(GL.GL_BLEND)
         GL.glBlendFunc(GL.GL_ONE, GL.GL_ONE)
         GL.glBindVertexArray(self._vertex_array)
-        GL.glDrawArraysInstanced(GL.GL_TRIANGLE_STRIP, 0, 4, len(instances))
+        if points:
+            GL.glEnable(GL.GL_PROGRAM_POINT_SIZE)
+            GL.glDrawArraysInstanced(GL.GL_POINTS, 0, 1, len(instances))
+            GL.glDisable(GL.GL_PROGRAM_POINT_SIZE)
+        else:
+            GL.glDrawArraysInstanced(GL.GL_TRIANGLE_STRIP, 0, 4, len(instances))
         GL.glBindVertexArray(0)
         GL.glDisable(GL.GL_BLEND)
 
@@ -153,4 +168,5 @@ class CloudShadowMap:
         GL.glDeleteFramebuffers(1, [self._framebuffer])
         GL.glDeleteBuffers(1, [self._buffer])
         GL.glDeleteVertexArrays(1, [self._vertex_array])
-        GL.glDeleteProgram(self._program)
+        for program in self._programs:
+            GL.glDeleteProgram(program)

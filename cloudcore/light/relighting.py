@@ -18,7 +18,8 @@ the spot, as before: the result is the next frame, and nothing stale shows.
 from __future__ import annotations
 
 import multiprocessing
-from concurrent.futures import Future, ProcessPoolExecutor
+import time
+from concurrent.futures import Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass
 
@@ -66,6 +67,15 @@ class LiveIllumination:
     def busy(self) -> bool:
         """Whether a look is being computed or waits to be."""
         return self._running is not None or self._waiting is not None
+
+    def pause(self, seconds: float) -> None:
+        """Wait `seconds`, or less: until the look being computed is done.  A frame that shows the picture again
+        while the worker runs leaves it the cores this long; the frame after shows the new look as soon as it is
+        in, not a pause later."""
+        if self._running is None:
+            time.sleep(seconds)
+        else:
+            wait([self._running[0]], timeout=seconds)
 
     def look_for(self, scene: Scene, wanted: Look) -> Look:
         """The look to draw `scene` with this frame: `wanted` when it can be shown now, else the last shown."""

@@ -168,10 +168,17 @@ def test_the_rendered_ground_is_darker_where_the_cloud_shadows_it(renderer):
 
 
 @pytest.mark.gl
-def test_the_gl_map_is_numpys(renderer):
+@pytest.mark.parametrize("widest_m, as_points", [(40.0, True), (900.0, False)])
+def test_the_gl_map_is_numpys(renderer, widest_m, as_points):
+    """The map's particles drawn as point sprites, or as quads where one is wider than the GL's largest point (a
+    particle of 900 m spans most of the 512 texels across this map), give numpy's map."""
     scene, _, _ = shadow_scene()
+    particles = scene.clouds[0].particles.copy()
+    particles[0, 3] = widest_m
+    scene = dataclasses.replace(scene, clouds=(dataclasses.replace(scene.clouds[0], particles=particles),))
     renderer.render(scene, settings=FULL_3D, read_back=False)
     shadow_map = renderer.shadow_map
+    assert shadow_map.drawn_as_points == as_points
     renderer.context.make_current()
     centres, radii, _, _ = particles_of(scene.clouds)
     # the GL map takes the particles' whole opacity (the ground's shadow, nearer the truth's than the beam's)
@@ -200,7 +207,7 @@ def test_the_map_is_made_again_only_when_the_sun_or_the_clouds_change(renderer):
 def test_a_dragged_slider_s_look_draws_a_coarser_map_and_the_release_the_exact_picture(renderer):
     """A look of a dragged time-of-day slider (the preview light pass) has its map made at the preview's coarser
     texels, the ground under the cloud along the sun still in its shadow; the look after the release, at the hour
-    before the drag, draws the very picture drawn before it."""
+    before the drag, draws the very picture drawn before it, after a drag of several looks through that hour too."""
     scene, shadow, lit = shadow_scene()
     exact, _ = renderer.render(scene, settings=FULL_3D)
     exact_size = renderer.shadow_map.space.size
@@ -208,6 +215,12 @@ def test_a_dragged_slider_s_look_draws_a_coarser_map_and_the_release_the_exact_p
     assert max(renderer.shadow_map.space.size) == PREVIEW_MAP_RESOLUTION < max(exact_size) == MAP_RESOLUTION
     ground = srgb_decode(dragged / 255.0).mean(axis=-1)
     assert ground[pixel_of(scene.camera, shadow)] < 0.5 * ground[pixel_of(scene.camera, lit)]
+    released, _ = renderer.render(scene, settings=FULL_3D)
+    assert renderer.shadow_map.space.size == exact_size
+    assert np.array_equal(released, exact)
+    for hours in (15.2, 15.5, 15.8):  # each look its preview light, map and sky; the scene's own hour among them
+        look, _ = renderer.render(scene, settings=FULL_3D, time_of_day=hours, illumination_method="preview")
+        assert not np.array_equal(look, exact)
     released, _ = renderer.render(scene, settings=FULL_3D)
     assert renderer.shadow_map.space.size == exact_size
     assert np.array_equal(released, exact)

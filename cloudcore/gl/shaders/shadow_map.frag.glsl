@@ -29,7 +29,11 @@ vec4 shares(vec4 slices)
 
 void main()
 {
+#ifdef POINTS
+    float kernel = splat_kernel(length(gl_PointCoord * 2.0 - 1.0));
+#else
     float kernel = splat_kernel(length(offset));
+#endif
     if (kernel <= 0.0)
         discard;
     float optical_depth = -log(1.0 - min(opacity * kernel, MOST_OPACITY)) * scale;

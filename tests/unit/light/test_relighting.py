@@ -88,6 +88,26 @@ def test_a_large_change_shows_the_last_look_until_the_worker_has_the_new_one_and
         live.close()
 
 
+def test_a_pause_while_the_worker_runs_ends_when_its_look_is_in_and_the_next_frame_shows_it():
+    big = Scene(clouds=(cloud(0, SYNCHRONOUS_PARTICLES), cloud(1, SYNCHRONOUS_PARTICLES)))
+    cache = IlluminationCache()
+    live = LiveIllumination(cache)
+    try:
+        live.start()
+        live.look_for(big, look(12.0))
+        cache.incident(big.clouds, SHADING, look(12.0).lights(), "raster")
+        assert live.look_for(big, look(13.0)) == look(12.0)  # the worker has 13 to light
+        started = time.monotonic()
+        live.pause(120.0)
+        assert time.monotonic() - started < 60.0  # the worker's look, not the pause, ended it
+        assert live.look_for(big, look(13.0)) == look(13.0)
+        started = time.monotonic()
+        live.pause(0.05)  # nothing running: the whole pause
+        assert time.monotonic() - started >= 0.05
+    finally:
+        live.close()
+
+
 def test_an_edit_while_relighting_keeps_the_old_look_and_shades_only_the_edited_cloud_here():
     clouds = (cloud(0, SYNCHRONOUS_PARTICLES), cloud(1, SYNCHRONOUS_PARTICLES))
     cache = IlluminationCache()
