@@ -10,7 +10,7 @@ import pytest
 from cloudcore.lod.impostors import parallax_errors_deg
 from cloudcore.lod.plan import LodState, plan_frame
 from cloudcore.lod.plan.draw_items import DrawItem, draw_items
-from cloudcore.lod.plan.pricing import panel_pixels, ring_translation_error, segments_of
+from cloudcore.lod.plan.pricing import panel_pixels, ring_translation_error
 from cloudcore.lod.plan.unit_plans import FULL, KINDS, UnitPlans
 from cloudcore.lod.ring import (
     SEGMENTS,
@@ -20,6 +20,7 @@ from cloudcore.lod.ring import (
     plan_ring,
     ring_candidates,
     ring_members,
+    segments_of,
 )
 from cloudcore.lod.splitting import layer_bounds, layer_sort_key
 from cloudcore.lod.units import LodUnits
@@ -236,8 +237,8 @@ def test_the_ring_s_largest_parallax_error_is_its_whole_ring_s_whatever_the_step
         for step in (0.0, 0.05, 3.0, 120.0, 2500.0, 6000.0):
             for direction in directions:
                 now = np.asarray(eye) + step * np.asarray(direction) / np.linalg.norm(direction)
-                whole = float(np.max(parallax_errors_deg(*ring.spheres, eye, now)))
-                assert ring_translation_error(ring, parallax_errors_deg, now) == whole
+                whole = float(np.max(parallax_errors_deg(*ring.panel_spans(), eye, now)))
+                assert ring_translation_error(ring, now) == whole
 
 
 @pytest.mark.parametrize("with_heights", [False, True])
