@@ -4,7 +4,9 @@ Clouds wholly beyond the ring radius (horizontally) and within the ring's
 elevation band are rendered, from the eye at which the ring was made, into
 eight textures of 45 degrees each; the panels form an octagon at the ring
 radius.  The ring is remade when the eye has moved more than a fraction of
-the radius (15% horizontally, 2% vertically, as in the paper), the lights
+the radius (15% horizontally, 2% vertically, as in the paper) or, sooner, once
+its panels' translation error passes the impostors' tolerance (a panel
+stands at the radius, its clouds beyond it: `panel_spans`), the lights
 changed, or the screen now asks for finer (or far coarser) segment textures
 than the ring was made with (a window grown from its first, tiny frame): one
 segment a frame, then the new ring crossfades in over a few frames while the
@@ -34,9 +36,8 @@ from cloudcore.world.camera import camera_pose, frustum_planes, projection_matri
 SEGMENTS = 8
 SEGMENT_DEG = 360.0 / SEGMENTS
 #: the ring's share of a frame, ms by the cost model: what its build may take (`plan_ring`'s `build_ms`: a dearer
-#: segment is built in pieces, a member at least each) and, in auto mode, what keeping it within the impostors'
-#: tolerance may cost a frame (`cloudcore.lod.plan`).  A third of a 30 fps frame on llvmpipe: the
-#: 1.2M-particle field's segments, 115 to 418 ms each, then take 12 to 42 frames
+#: segment is built in pieces, a member at least each).  A third of a 30 fps frame on llvmpipe: the 1.2M-particle
+#: field's segments, 115 to 418 ms each, then take 12 to 42 frames
 RING_FRAME_MS = 10.0
 #: metres: the panels never come nearer than this, so a zero ring radius still has a drawable octagon
 MIN_PANEL_DISTANCE = 10.0
@@ -499,9 +500,8 @@ def plan_ring(
     the segment texture size the screen asks for
     (`segment_texture_size`).  `holds_clouds` False asks for a ring of no clouds (it does not pay for
     itself): the ring shown fades out as when it is rebuilt, with nothing to build.  `past_tolerance`: the
-    ring shown holds a cloud whose translation error has passed the impostors' tolerance (auto mode keeps it
-    within it where that costs at most `RING_FRAME_MS` a frame): it is rebuilt as when the eye has moved past
-    the rebuild distance.
+    ring shown holds a cloud whose translation error, its panel's against it (`panel_spans`), has passed the
+    impostors' tolerance: it is rebuilt as when the eye has moved past the rebuild distance.
     `build_ms`: per id, the predicted ms of drawing it into a segment; a ring rebuilt while one holding clouds
     shows draws a segment's members far to near in pieces of at most `RING_FRAME_MS` (one member at least), each
     over the last.  None, or no such ring shown: a segment a frame.  `step`: the eye's motion since the last
