@@ -124,7 +124,7 @@ class Ring(DrawExecutor):
             for generation, target, corners, weight, extent, shift in self._panels(frame)
             for distance in (max(generation.radius, MIN_PANEL_DISTANCE),)
         ]
-        if panels:
+        if panels:  # every segment's camera has the one projection: the band's height, 45 degrees wide
             _, segment_projection = segment_camera(frame.plan.ring.draws[0][0], 0, elevation_deg)
             self.tools.quads.draw_panels(panels, frame.view_projection, segment_projection)
         return DrawCounts()
