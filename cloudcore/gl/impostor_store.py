@@ -43,7 +43,8 @@ ATLAS_LAYER_SIDE = 512
 class ImpostorStore:
     def __init__(self, splats: SplatPass):
         self._splats = splats
-        self.pool = TexturePool()
+        #: Wang's ring's segments, each with its clouds' nearest depth (`ring_panel`)
+        self.pool = TexturePool(own_depth=True)
         self._atlases: dict[int, ImpostorAtlas] = {}  # layer side -> atlas
         #: unit members -> (images of its layers far to near, the view they were made with, the part of
         #: the images its particles can cover: only that part of the quad is drawn, the unit's mean blend
@@ -91,6 +92,7 @@ class ImpostorStore:
             self._release(self._clouds.pop(index)[0])
 
         ring = plan.ring
+        depths = []  # (segment's target, its piece's particles, the ring's eye): their nearest depth, after them
         for segment, piece, members in ring.segment_builds() if ring is not None else ():
             if not members:
                 continue
@@ -116,6 +118,8 @@ class ImpostorStore:
             ring_eye = np.add(generation.eye, plan.ring_build_shift)
             batch = splat_batch(particles, clouds, ring_eye, None, time_s, through_air=True)
             renders.append((target, batch, view, projection, first))
+            starts = particles.cloud_starts
+            depths.append((target, np.concatenate([np.arange(starts[c], starts[c + 1]) for c in clouds]), ring_eye))
         selections = _cell_selections(particles, time_s, on_gpu)
         self._splats.shade_ahead(
             [(batch, view) for _, batch, view, _, _ in renders]
@@ -129,6 +133,18 @@ class ImpostorStore:
                 # the clouds alone, no depth test: the texture holds their premultiplied colour and opacity
                 target.bind_cleared() if cleared else target.bind()
                 self._splats.draw(batch, view, projection, depth_test=False, point_sprites=settings.point_sprites)
+        for (target, _, view, projection, cleared), (_, chosen, eye) in zip(
+            [render for render in renders if not isinstance(render[0], AtlasImage)], depths
+        ):
+            # the nearest of its clouds' particles seen, each texel's: where the panel stands in depth (the
+            # terrain between the ring's radius and a cloud hides it: `ring_panel`), over their whole discs (their
+            # cores left the fringes at the panel's depth, a bright rim over the hills that hid the rest); the
+            # pieces after the first keep the nearer of theirs and what is there
+            target.clear_depth() if cleared else target.bind()
+            GL.glColorMask(GL.GL_FALSE, GL.GL_FALSE, GL.GL_FALSE, GL.GL_FALSE)  # the depth pass writes no colour
+            self._splats.draw_nearest_depth(particles, time_s, chosen, eye, view, projection, target.height, core=1.0)
+            GL.glColorMask(GL.GL_TRUE, GL.GL_TRUE, GL.GL_TRUE, GL.GL_TRUE)
+            GL.glDisable(GL.GL_DEPTH_TEST)
         GL.glDisable(GL.GL_SCISSOR_TEST)  # the last atlas cell's: it would clip the cloud pass
         for side in [side for side, atlas in self._atlases.items() if not atlas.in_use]:
             self._atlases.pop(side).close()
@@ -200,7 +216,9 @@ class ImpostorStore:
     def ring_panel(
         self, generation: RingGeneration, segment: int, elevation_deg: float
     ) -> tuple[TextureTarget, np.ndarray, tuple]:
-        """(texture, cropped world corners, extent) of a ring segment's panel, as `cloud_impostor`."""
+        """(texture, cropped world corners, extent) of a ring segment's panel, as `cloud_impostor`; the texture's
+        `depth_texture` holds, per texel, the depth of its nearest particle seen from the ring's eye through the
+        segment's camera (`segment_camera`), 1 where none."""
         target, extent = self._ring[generation, segment]
         return target, cropped_corners(panel_corners(generation, segment, elevation_deg), extent), extent
 

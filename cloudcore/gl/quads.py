@@ -30,6 +30,8 @@ class QuadPass:
             (True, False): build_program("quad", {"AIR": 1}),
             (False, True): build_program("quad", {"COUNT_FRAGMENTS": 1}),
         }
+        #: Wang's ring's panels, each fragment at its clouds' depth (`draw_panels`)
+        self._panel_program = build_program("quad", {"PANEL_DEPTH": 1})
         #: (crossfade, counting, seen through the air, less the light shafts' share of it) -> the program drawing
         #: instances from the atlas
         self._atlas_programs = {
@@ -48,12 +50,15 @@ class QuadPass:
         }
         #: per program, the locations of the uniforms every draw sets
         self._uniforms = {}
-        for program in (*self._programs.values(), *self._atlas_programs.values()):
+        for program in (*self._programs.values(), *self._atlas_programs.values(), self._panel_program):
             GL.glUseProgram(program)
             GL.glUniform1i(GL.glGetUniformLocation(program, "impostor"), 0)
             GL.glUniform1i(GL.glGetUniformLocation(program, "layer"), 1)
+            GL.glUniform1i(GL.glGetUniformLocation(program, "panel_depth"), 2)
             self._uniforms[program] = uniform_locations(
-                program, ("corners", "uv_rect", "view_projection", "impostor_weight", "layer_weight", "air_cells")
+                program,
+                ("corners", "uv_rect", "view_projection", "impostor_weight", "layer_weight", "air_cells")
+                + (("panel_eye", "panel_distance", "segment_near_far") if program == self._panel_program else ()),
             )
         #: core profile draws nothing without a vertex array, even one with no attributes; shared
         #: with the other attribute-less passes
@@ -116,6 +121,33 @@ class QuadPass:
                     GL.glDrawArrays(GL.GL_TRIANGLE_STRIP, 0, 4)
                 else:
                     _draw_cells(uniforms["air_cells"], int(cells[i]), 1)
+            GL.glBindVertexArray(0)
+
+    def draw_panels(self, panels, view_projection: np.ndarray, segment_projection: np.ndarray) -> None:
+        """Ring panels, each (corners, texture, its nearest depth texture, weight, uv_rect, the ring's eye, the
+        panel's distance from it along its segment's middle), drawn as `draw_run` draws quads but each fragment
+        tested at the depth of the nearest particle its segment holds there (seen through `segment_projection`,
+        `cloudcore.lod.ring.segment_camera`'s): terrain nearer than a panel's clouds hides them, as in full 3D."""
+        program = self._panel_program
+        uniforms = self._uniforms[program]
+        GL.glUseProgram(program)
+        set_matrix_at(uniforms["view_projection"], view_projection)
+        # the planes of an OpenGL perspective projection, from its third row
+        (_, _, z_scale, z_offset) = segment_projection[2]
+        GL.glUniform2f(uniforms["segment_near_far"], z_offset / (z_scale - 1.0), z_offset / (z_scale + 1.0))
+        with cloud_blending(depth_test=True, counting=False):
+            GL.glBindVertexArray(self.vertex_array)
+            for corners, texture, depth_texture, weight, (u0, v0, u1, v1), eye, distance in panels:
+                GL.glUniform3fv(uniforms["corners"], 4, np.ascontiguousarray(corners, dtype=np.float32))
+                GL.glUniform4f(uniforms["uv_rect"], u0, v0, u1, v1)
+                GL.glUniform1f(uniforms["impostor_weight"], weight)
+                GL.glUniform3f(uniforms["panel_eye"], *(float(v) for v in eye))
+                GL.glUniform1f(uniforms["panel_distance"], distance)
+                GL.glActiveTexture(GL.GL_TEXTURE2)
+                GL.glBindTexture(GL.GL_TEXTURE_2D, depth_texture)
+                GL.glActiveTexture(GL.GL_TEXTURE0)
+                GL.glBindTexture(GL.GL_TEXTURE_2D, texture)
+                GL.glDrawArrays(GL.GL_TRIANGLE_STRIP, 0, 4)
             GL.glBindVertexArray(0)
 
     def draw_instanced(

@@ -81,7 +81,7 @@ class SplatPass:
         #: program, its first cell's uniform); points never are sprites
         self._cell_programs: dict[tuple[bool, bool], tuple[int, int]] = {}
         #: the clouds' nearest depth's program and its uniforms (`draw_nearest_depth`), made when first needed
-        self._depth_program: tuple[int, dict] | None = None
+        self._depth_programs: dict[float, tuple[int, dict]] = {}  # by the share of a radius drawn (`CORE`)
 
     @property
     def shafts(self):
@@ -237,30 +237,32 @@ class SplatPass:
         view: np.ndarray,
         projection: np.ndarray,
         height: int,
+        core: float = NEAREST_DEPTH_CORE,
     ) -> None:
         """Draw the depth of the `chosen` particles (`nearest_depth_particles`) into the bound target of `height`
-        pixels, depth tested and written: each a disc at its centre's depth (its core, `NEAREST_DEPTH_CORE`), those
+        pixels, depth tested and written: each a disc at its centre's depth (its `core`, of its radius), those
         too faint to be seen at `time_s` left out (`NEAREST_DEPTH_OPACITY`); the light shafts' march ends its rays
-        at the nearest (docs/atmosphere.md#the-shafts-and-the-air-in-front-of-the-clouds)."""
+        at the nearest (docs/atmosphere.md#the-shafts-and-the-air-in-front-of-the-clouds), and Wang's ring's
+        panels stand there (its whole discs: `cloudcore.gl.impostor_store`)."""
         if not len(chosen):
             return
         self._resident.hold(particles)
         self._resident.hold_formation(particles, time_s)
-        if self._depth_program is None:
+        if core not in self._depth_programs:
             program = build_program(
                 "cloud_depth",
                 {
                     "PARTICLE_FLOATS": PARTICLE_FLOATS,
                     "SEEN_OPACITY": NEAREST_DEPTH_OPACITY,
                     "MAX_POINT_SIZE": self._point_sizes_px[1],
-                    "CORE": NEAREST_DEPTH_CORE,
+                    "CORE": core,
                 },
             )
-            self._depth_program = (
+            self._depth_programs[core] = (
                 program,
                 uniform_locations(program, ("view_projection", "eye_position", "pixels_per_ndc")),
             )
-        program, uniforms = self._depth_program
+        program, uniforms = self._depth_programs[core]
         GL.glUseProgram(program)
         set_matrix_at(uniforms["view_projection"], projection @ view_rotation(view))
         set_vec3_at(uniforms["eye_position"], eye)
@@ -462,8 +464,8 @@ class SplatPass:
             GL.glDeleteProgram(program)
         for program, _ in self._cell_programs.values():
             GL.glDeleteProgram(program)
-        if self._depth_program is not None:
-            GL.glDeleteProgram(self._depth_program[0])
+        for program, _ in self._depth_programs.values():
+            GL.glDeleteProgram(program)
         GL.glDeleteBuffers(len(self._buffers), list(self._buffers))
         GL.glDeleteVertexArrays(1, [self._vertex_array])
         self._shading.close()

@@ -13,7 +13,7 @@ import numpy as np
 from OpenGL import GL
 
 #: bytes per texel of the formats used here, for texture-memory statistics
-_TEXEL_BYTES = {GL.GL_RGBA16F: 8, GL.GL_R32F: 4, GL.GL_RGBA8: 4, GL.GL_R8: 1}
+_TEXEL_BYTES = {GL.GL_RGBA16F: 8, GL.GL_R32F: 4, GL.GL_RGBA8: 4, GL.GL_R8: 1, GL.GL_DEPTH_COMPONENT32F: 4}
 _READ_FORMAT = {
     GL.GL_RGBA16F: (GL.GL_RGBA, 4),
     GL.GL_R32F: (GL.GL_RED, 1),
@@ -43,9 +43,19 @@ class TextureTarget:
         internal_format=GL.GL_RGBA16F,
         depth_renderbuffer: int | None = None,
         depth_texture: int | None = None,
+        own_depth: bool = False,
     ):
-        """With `depth_renderbuffer` or `depth_texture` (one of the two), drawn depth-tested against it."""
+        """With `depth_renderbuffer` or `depth_texture` (one of the two), drawn depth-tested against it; with
+        `own_depth`, a depth texture of its own (`depth_texture`, read by nearest texel: Wang's ring's segments
+        hold their clouds' nearest depth beside their colour)."""
         self.width, self.height, self.internal_format = int(width), int(height), internal_format
+        self.depth_texture = None
+        if own_depth:
+            self.depth_texture = depth_texture = GL.glGenTextures(1)
+            GL.glBindTexture(GL.GL_TEXTURE_2D, depth_texture)
+            GL.glTexStorage2D(GL.GL_TEXTURE_2D, 1, GL.GL_DEPTH_COMPONENT32F, self.width, self.height)
+            GL.glTexParameteri(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_MIN_FILTER, GL.GL_NEAREST)
+            GL.glTexParameteri(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_MAG_FILTER, GL.GL_NEAREST)
         self.texture = GL.glGenTextures(1)
         GL.glBindTexture(GL.GL_TEXTURE_2D, self.texture)
         GL.glTexStorage2D(GL.GL_TEXTURE_2D, 1, internal_format, self.width, self.height)
@@ -65,7 +75,8 @@ class TextureTarget:
 
     @property
     def nbytes(self) -> int:
-        return self.width * self.height * _TEXEL_BYTES[self.internal_format]
+        depth = _TEXEL_BYTES[GL.GL_DEPTH_COMPONENT32F] if self.depth_texture is not None else 0
+        return self.width * self.height * (_TEXEL_BYTES[self.internal_format] + depth)
 
     def bind(self) -> None:
         """Draw into this target from now on, over what it holds."""
@@ -79,6 +90,13 @@ class TextureTarget:
         GL.glClearColor(0.0, 0.0, 0.0, 0.0)
         GL.glClear(GL.GL_COLOR_BUFFER_BIT)
 
+    def clear_depth(self) -> None:
+        """Draw into this target from now on, its depth back at the far plane (colour untouched)."""
+        self.bind()
+        GL.glDepthMask(GL.GL_TRUE)
+        GL.glClearDepth(1.0)
+        GL.glClear(GL.GL_DEPTH_BUFFER_BIT)
+
     def read(self) -> np.ndarray:
         """The texture as float32 (height, width[, channels]), top row first."""
         layout, channels = _READ_FORMAT[self.internal_format]
@@ -90,7 +108,7 @@ class TextureTarget:
 
     def close(self) -> None:
         GL.glDeleteFramebuffers(1, [self.framebuffer])
-        GL.glDeleteTextures([self.texture])
+        GL.glDeleteTextures([self.texture] + ([self.depth_texture] if self.depth_texture is not None else []))
 
 
 def depth_renderbuffer(width: int, height: int) -> int:

@@ -16,9 +16,11 @@ IDLE_LIMIT_BYTES = 32 * 2**20
 
 
 class TexturePool:
-    def __init__(self, idle_limit_bytes: int = IDLE_LIMIT_BYTES):
+    def __init__(self, idle_limit_bytes: int = IDLE_LIMIT_BYTES, own_depth: bool = False):
+        """`own_depth`: each target with a depth texture of its own (`TextureTarget`)."""
         self._idle: OrderedDict[int, TextureTarget] = OrderedDict()  # keyed by id(), oldest first
         self.idle_limit_bytes = idle_limit_bytes
+        self.own_depth = own_depth
         self.bytes_in_use = 0
 
     @property
@@ -35,7 +37,7 @@ class TexturePool:
                 del self._idle[key]
                 break
         else:
-            target = TextureTarget(width, height)
+            target = TextureTarget(width, height, own_depth=self.own_depth)
         self.bytes_in_use += target.nbytes
         return target
 

@@ -4,7 +4,9 @@ Clouds wholly beyond the ring radius (horizontally) and within the ring's
 elevation band are rendered, from the eye at which the ring was made, into
 eight textures of 45 degrees each; the panels form an octagon at the ring
 radius.  The ring is remade when the eye has moved more than a fraction of
-the radius (15% horizontally, 2% vertically, as in the paper), the lights
+the radius (15% horizontally, 2% vertically, as in the paper) or, sooner, once
+its panels' translation error passes the impostors' tolerance (a panel
+stands at the radius, its clouds beyond it: `panel_spans`), the lights
 changed, or the screen now asks for finer (or far coarser) segment textures
 than the ring was made with (a window grown from its first, tiny frame): one
 segment a frame, then the new ring crossfades in over a few frames while the
@@ -34,9 +36,8 @@ from cloudcore.world.camera import camera_pose, frustum_planes, projection_matri
 SEGMENTS = 8
 SEGMENT_DEG = 360.0 / SEGMENTS
 #: the ring's share of a frame, ms by the cost model: what its build may take (`plan_ring`'s `build_ms`: a dearer
-#: segment is built in pieces, a member at least each) and, in auto mode, what keeping it within the impostors'
-#: tolerance may cost a frame (`cloudcore.lod.plan`).  A third of a 30 fps frame on llvmpipe: the
-#: 1.2M-particle field's segments, 115 to 418 ms each, then take 12 to 42 frames
+#: segment is built in pieces, a member at least each).  A third of a 30 fps frame on llvmpipe: the 1.2M-particle
+#: field's segments, 115 to 418 ms each, then take 12 to 42 frames
 RING_FRAME_MS = 10.0
 #: metres: the panels never come nearer than this, so a zero ring radius still has a drawable octagon
 MIN_PANEL_DISTANCE = 10.0
@@ -61,14 +62,15 @@ class RingGeneration:
     #: False: made while the ring did not pay for itself (`cloudcore.lod.plan`): it holds no cloud, and
     #: fading it in hands the last ring's clouds back to the frame plan
     holds_clouds: bool = True
-    #: (centres (M, 3), radii (M,)) of the members' bounding spheres as the panels were rendered: what auto mode
-    #: measures the panels' translation error from each frame, without looking its members up among the units
+    #: (centres (M, 3), radii (M,)) of the members' bounding spheres as the panels were rendered: what the plan
+    #: measures the panels' translation error from each frame (`panel_spans`), without looking its members up
+    #: among the units
     spheres: tuple = field(default=(np.zeros((0, 3)), np.zeros(0)), compare=False, repr=False)
 
     #: what the frames before found of it, so that a ring of thousands is not walked every frame: "rows", the
     #: tuple of ids last planned with and its members' rows in it; "unchanged", the clouds' lighting keys (the
-    #: tuple a frame was planned with) and the set of ids last found to leave it as it was made; "parallax", the
-    #: spheres whose parallax error grows fastest (`fastest_parallax`)
+    #: tuple a frame was planned with) and the set of ids last found to leave it as it was made; "spans", its
+    #: `panel_spans`; "parallax", the spans whose parallax error grows fastest (`fastest_parallax`)
     _memo: dict = field(default_factory=dict, repr=False)
 
     @property
@@ -76,13 +78,22 @@ class RingGeneration:
         """The segments holding a cloud: only they are rendered and drawn."""
         return tuple(segment for segment, clouds in enumerate(self.segment_members) if clouds)
 
+    def panel_spans(self) -> tuple[np.ndarray, np.ndarray]:
+        """(centres (M, 3), radii (M,)): per member, the sphere on its ray from `eye` whose near and far points are
+        the nearest and farthest of its panel's point and its own sphere's near and far points (`panel_spans`),
+        found once: what its translation error is measured on."""
+        held = self._memo.get("spans")
+        if held is None:
+            held = self._memo["spans"] = panel_spans(*self.spheres, self.eye, self.radius)
+        return held
+
     def fastest_parallax(self, count: int) -> tuple[np.ndarray, float, float]:
-        """(the rows of `spheres` of the `count` whose parallax error grows fastest as the eye steps from `eye`,
-        by the rate 2r / ((d - r)(d + r)) (inf: `eye` inside), the largest rate of the others, and their nearest
-        near point d - r), found once."""
+        """(the rows of `panel_spans` of the `count` whose parallax error grows fastest as the eye steps from
+        `eye`, by the rate 2r / ((d - r)(d + r)) (inf: `eye` inside), the largest rate of the others, and their
+        nearest near point d - r), found once."""
         held = self._memo.get("parallax")
         if held is None:
-            centres, radii = self.spheres
+            centres, radii = self.panel_spans()
             distances = np.linalg.norm(centres - np.asarray(self.eye, dtype=np.float64), axis=1)
             near, far = distances - radii, distances + radii
             with np.errstate(divide="ignore", invalid="ignore"):
@@ -171,6 +182,40 @@ def segment_camera(generation: RingGeneration, segment: int, elevation_deg: floa
     camera = Camera(tuple(eye), tuple(eye + segment_direction(segment)), 2.0 * elevation_deg)
     aspect = math.tan(math.radians(SEGMENT_DEG / 2.0)) / math.tan(math.radians(elevation_deg))
     return view_matrix(camera), projection_matrix(camera.fov_y_deg, aspect)
+
+
+def segments_of(centres, eye) -> np.ndarray:
+    """The ring segment (0 to `SEGMENTS` - 1) each of `centres` lies in, by its azimuth about `eye`."""
+    offsets = np.asarray(centres, dtype=np.float64).reshape(-1, 3) - np.asarray(eye, dtype=np.float64)
+    azimuths = np.degrees(np.arctan2(offsets[:, 0], -offsets[:, 2])) % 360.0
+    return (azimuths // SEGMENT_DEG).astype(np.int64) % SEGMENTS  # a tiny negative azimuth % 360 gives 360
+
+
+def panel_spans(centres, radii, eye, radius: float) -> tuple[np.ndarray, np.ndarray]:
+    """(centres (M, 3), radii (M,)): for each of the spheres `centres`, `radii` drawn on the panels of a ring of
+    `radius` made at `eye`, the sphere on the ray from `eye` through its centre that spans the panel's point on
+    that ray and the sphere's own near and far points along it.
+
+    A panel is a flat picture at the ring's radius, not at its clouds' distance: seen from an eye moved s
+    across from where it was made, a cloud at distance D shows s (1/R - 1/D) radians from where it is, 8.6 degrees
+    for a cloud at infinity after Wang's 600 m at 4 km.  Harris's parallax of a span (the angle between the
+    rays to its near and far points, `parallax_errors_deg`) bounds that shift and the cloud's own depth both; for
+    an impostor, whose quad passes through its sphere, the span is the sphere itself (docs/lod.md, "Wang's
+    ring")."""
+    centres = np.asarray(centres, dtype=np.float64).reshape(-1, 3)
+    radii = np.asarray(radii, dtype=np.float64).reshape(-1)
+    offsets = centres - np.asarray(eye, dtype=np.float64)
+    distances = np.linalg.norm(offsets, axis=1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        axes = offsets / distances[:, None]
+        # the panel of the segment the centre lies in, a vertical plane `radius` off along the segment's middle:
+        # the ray meets it at that distance over the cosine between the two
+        azimuths = np.radians((segments_of(centres, eye) + 0.5) * SEGMENT_DEG)
+        facing = axes[:, 0] * np.sin(azimuths) - axes[:, 2] * np.cos(azimuths)
+        panel = max(radius, MIN_PANEL_DISTANCE) / facing
+    near = np.minimum(panel, distances - radii)
+    far = np.maximum(panel, distances + radii)
+    return np.asarray(eye, dtype=np.float64) + axes * (0.5 * (near + far))[:, None], 0.5 * (far - near)
 
 
 def panel_corners(generation: RingGeneration, segment: int, elevation_deg: float) -> np.ndarray:
@@ -455,9 +500,8 @@ def plan_ring(
     the segment texture size the screen asks for
     (`segment_texture_size`).  `holds_clouds` False asks for a ring of no clouds (it does not pay for
     itself): the ring shown fades out as when it is rebuilt, with nothing to build.  `past_tolerance`: the
-    ring shown holds a cloud whose translation error has passed the impostors' tolerance (auto mode keeps it
-    within it where that costs at most `RING_FRAME_MS` a frame): it is rebuilt as when the eye has moved past
-    the rebuild distance.
+    ring shown holds a cloud whose translation error, its panel's against it (`panel_spans`), has passed the
+    impostors' tolerance: it is rebuilt as when the eye has moved past the rebuild distance.
     `build_ms`: per id, the predicted ms of drawing it into a segment; a ring rebuilt while one holding clouds
     shows draws a segment's members far to near in pieces of at most `RING_FRAME_MS` (one member at least), each
     over the last.  None, or no such ring shown: a segment a frame.  `step`: the eye's motion since the last

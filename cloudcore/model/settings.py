@@ -272,7 +272,8 @@ class RenderSettings:
         high=200.0,
         display="%.0f",
     )
-    #: the ring is rebuilt when the eye has moved this fraction of ring_radius horizontally / vertically
+    #: the ring is rebuilt when the eye has moved this fraction of ring_radius horizontally / vertically (Wang's
+    #: rule), or sooner, once its panels' translation error passes the tolerance (docs/lod.md, "Wang's ring")
     ring_rebuild_horizontal: float = 0.15
     ring_rebuild_vertical: float = 0.02
     #: degrees above and below the horizon the ring covers; clouds reaching beyond stay out of it

@@ -168,8 +168,11 @@ def test_the_field_s_ring_is_kept_while_only_blend_weights_change_and_keeps_up_w
             impostors.render(scene, camera=at(0.0), settings=settings)
         shown = impostors.lod_state.ring.current
         assert shown is not None and shown.members
+        # under a tolerance no panel's error reaches: Wang's rule alone, what the blend weights' steps are tested
+        # against (the panels' error, which the tolerance rebuilds the ring by, passed 0.5 degrees within 36 m)
+        walking = dataclasses.replace(settings, tolerance_deg=179.0)
         for x in np.arange(12.0, 0.15 * settings.ring_radius, 12.0):
-            impostors.render(scene, camera=at(x), settings=settings)
+            impostors.render(scene, camera=at(x), settings=walking)
             assert impostors.lod_state.ring.current is shown and impostors.lod_state.ring.pending is None
         before, _ = update_field(FIELD, at(0.0).position)
         after, _ = update_field(FIELD, at(x).position)

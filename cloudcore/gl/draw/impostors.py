@@ -11,6 +11,7 @@ from cloudcore.gl.draw.executor import CloudPassFrame, DrawCounts, DrawExecutor,
 from cloudcore.gl.draw.full_3d import count_splats, draw_splats
 from cloudcore.gl.impostor_atlas import atlas_instances
 from cloudcore.gl.targets import TextureTarget
+from cloudcore.lod.ring import MIN_PANEL_DISTANCE, segment_camera
 from cloudcore.particles.batch import SplatBatch
 
 
@@ -115,22 +116,35 @@ class Ring(DrawExecutor):
     one after the other, before the plan's draw items."""
 
     def draw(self, frame: CloudPassFrame, step: DrawStep) -> DrawCounts:
-        # not through the air: their segments hold their clouds through it, from the ring's eye
-        self.tools.quads.draw_run(self._panels(frame), frame.view_projection, air=None)
+        # not through the air: their segments hold their clouds through it, from the ring's eye; each fragment at
+        # its clouds' depth, not the panel's
+        elevation_deg = frame.settings.ring_elevation_deg
+        panels = [
+            (corners, target.texture, target.depth_texture, weight, extent, np.add(generation.eye, shift), distance)
+            for generation, target, corners, weight, extent, shift in self._panels(frame)
+            for distance in (max(generation.radius, MIN_PANEL_DISTANCE),)
+        ]
+        if panels:  # every segment's camera has the one projection: the band's height, 45 degrees wide
+            _, segment_projection = segment_camera(frame.plan.ring.draws[0][0], 0, elevation_deg)
+            self.tools.quads.draw_panels(panels, frame.view_projection, segment_projection)
         return DrawCounts()
 
     def count_fragments(self, frame: CloudPassFrame, step: DrawStep) -> tuple:
-        self.tools.quads.draw_run(self._panels(frame), frame.view_projection, counting=True)
+        quads = [
+            (corners, target.texture, weight, extent) for _, target, corners, weight, extent, _ in self._panels(frame)
+        ]
+        self.tools.quads.draw_run(quads, frame.view_projection, counting=True)
         return ()
 
     def _panels(self, frame: CloudPassFrame) -> list[tuple]:
-        """(corners, texture, weight, uv_rect) of every panel drawn."""
-        quads = []
+        """(generation, target, corners, weight, uv_rect, the wind's shift of its clouds) of every panel drawn."""
+        panels = []
         shifts = frame.plan.ring_shifts or [np.zeros(3)] * len(frame.plan.ring.draws)
         for (generation, weight), shift in zip(frame.plan.ring.draws, shifts):
             for segment in generation.occupied_segments:
                 target, corners, extent = self.tools.impostors.ring_panel(
                     generation, segment, frame.settings.ring_elevation_deg
                 )
-                quads.append((np.asarray(corners + shift, dtype=np.float32), target.texture, float(weight), extent))
-        return quads
+                corners = np.asarray(corners + shift, dtype=np.float32)
+                panels.append((generation, target, corners, float(weight), extent, shift))
+        return panels

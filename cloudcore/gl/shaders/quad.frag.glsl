@@ -10,7 +10,11 @@
 // ATLAS samples a layer of the impostor atlas within the instance's cell, its
 // weight per instance.  COUNT_FRAGMENTS writes 1 instead.  AIR adds the air between the eye
 // and the quad now (quad.vert.glsl's, interpolated) to the impostor's part (aerial perspective: never in an impostor's texture, which is
-// seen from elsewhere; the crossfade's layer has it already, per particle, from this eye).
+// seen from elsewhere; the crossfade's layer has it already, per particle, from this eye).  PANEL_DEPTH: a
+// ring panel's fragment put at the depth of its segment's nearest particle on the ray from the ring's eye
+// (panel_depth, drawn through the segment's camera: near and far planes segment_near_far), not at the panel's:
+// the panel stands at the ring's radius, and terrain beyond it hid its clouds in full 3D but not on the panel
+// (docs/lod.md, "Wang's ring").
 
 #ifdef ATLAS
 uniform sampler2DArray impostor;
@@ -25,6 +29,15 @@ uniform float layer_weight;
 #ifdef AIR
 in vec3 air_transmittance_at;  // quad.vert.glsl's, at the corners of the quad's cells
 in vec3 air_in_scattered_at;
+#endif
+
+#ifdef PANEL_DEPTH
+uniform sampler2D panel_depth;
+uniform vec3 panel_eye;  // the ring's eye, where the segment was seen from
+uniform float panel_distance;  // metres from panel_eye to the panel along its segment's middle
+uniform vec2 segment_near_far;
+uniform mat4 view_projection;
+in vec3 panel_point;
 #endif
 
 in vec2 uv;
@@ -52,5 +65,19 @@ void main()
     colour += layer_weight * texelFetch(layer, ivec2(gl_FragCoord.xy), 0);
 #endif
     frag_colour = colour;
+#endif
+#ifdef PANEL_DEPTH
+    float stored = texture(panel_depth, uv).r;
+    float depth = gl_FragCoord.z;
+    if (stored < 1.0) {
+        // the segment camera's depth back to metres along its axis, the panel's point moved along the ray from
+        // the ring's eye to that distance, and projected into this frame
+        float near = segment_near_far.x, far = segment_near_far.y;
+        float along = 2.0 * near * far / (far + near - (2.0 * stored - 1.0) * (far - near));
+        vec4 clip = view_projection * vec4(panel_eye + (panel_point - panel_eye) * (along / panel_distance), 1.0);
+        if (clip.w > 0.0)
+            depth = clamp(0.5 * clip.z / clip.w + 0.5, 0.0, 1.0);
+    }
+    gl_FragDepth = depth;
 #endif
 }

@@ -10,7 +10,8 @@
 // quads seen through the air from where the eye is now, read at the corners of air_cells x air_cells
 // cells cut from the quad (6 vertices a cell, as triangles) and interpolated: a wide quad's corners are
 // farther than its middle, so a near one takes more cells (cloudcore.light.air_between.air_cells); with
-// LIGHT_SHAFTS, less the light shafts' share of it (light_shafts_read.glsl).
+// LIGHT_SHAFTS, less the light shafts' share of it (light_shafts_read.glsl).  PANEL_DEPTH: a ring panel, its
+// world point passed on for quad.frag.glsl to put each fragment at its clouds' depth.
 
 #ifdef ATLAS
 layout(location = 0) in vec3 corner_0;
@@ -41,6 +42,9 @@ const vec2 CELL_CORNERS[6] = vec2[6](vec2(0, 0), vec2(1, 0), vec2(0, 1), vec2(0,
 #endif
 
 out vec2 uv;
+#ifdef PANEL_DEPTH
+out vec3 panel_point;
+#endif
 
 void main()
 {
@@ -60,6 +64,9 @@ void main()
     vec3 point = corners[gl_VertexID];
 #endif
     uv = mix(uv_rect.xy, uv_rect.zw, along);
+#ifdef PANEL_DEPTH
+    panel_point = point;
+#endif
     gl_Position = view_projection * vec4(point, 1.0);
 #if defined(AIR) && defined(LIGHT_SHAFTS)
     // Yusov's cut: less the share of that air the clouds' shadows keep from the eye (marched up to the clouds'

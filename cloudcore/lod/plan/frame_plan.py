@@ -43,8 +43,8 @@ class FramePlan:
     priced: bool = True
     costs: CostModel = CostModel()  # the model the plan priced its choices with
     tolerance_deg: float = 0.0  # the translation tolerance in force
-    #: the largest translation error drawn, in tolerances (> 1: a budget postponed it, or auto kept Wang's ring by
-    #: Wang's rules, its upkeep within the tolerance past `RING_FRAME_MS`)
+    #: the largest translation error drawn, in tolerances (> 1: a budget postponed it, or Wang's ring shown while
+    #: its rebuild, begun once its error passed the tolerance, is under way)
     accepted_error: float = 0.0
     units: LodUnits | None = None  # the frame's units, which `clouds` index: the groups planned apart opened
     #: (units, 3) metres the wind has carried each unit (`cloudcore.world.wind`); None: still air

@@ -49,11 +49,9 @@ from cloudcore.lod.plan.pricing import (
     ring_translation_error,
     ring_work,
     seen_from,
-    segments_of,
 )
 from cloudcore.lod.plan.schedule import within_frame_budget
 from cloudcore.lod.plan.state import (
-    RING_CHASE_SHARE,
     LodState,
     Representation,
     RingPrices,
@@ -72,13 +70,13 @@ from cloudcore.lod.plan.unit_plans import (
     of_kinds,
 )
 from cloudcore.lod.ring import (
-    RING_FRAME_MS,
     RingCandidates,
     RingState,
     frames_to_show,
     plan_ring,
     ring_candidates,
     segment_texture_size,
+    segments_of,
 )
 from cloudcore.lod.splat_coverage import splats_in_view_by_owner
 from cloudcore.lod.splitting import layers_hold, objects_reaching
@@ -251,8 +249,7 @@ def _plan_units(
     objects_visible = spheres_in_frustum(planes, object_centres, object_radii)
     # auto mode prices Wang's ring against drawing its clouds each as auto would (the cheaper of full 3D and
     # an impostor): a sparse far field is cheaper drawn than its panels and their rebuilds
-    ring_ms = alone_ms = ring_error = 0.0
-    chases_tolerance = False
+    ring_ms = alone_ms = 0.0
     candidates = np.zeros(len(radii), dtype=bool)
     # auto mode found the last frame cheaper drawn all in full 3D (`next_frame_choice`): every unit heads there
     all_full = settings.mode == "auto" and state.frame_choice == "full"
@@ -273,29 +270,20 @@ def _plan_units(
         else:
             segments = segments_of(centres[candidates], eye)
             seen_alone = visible[candidates]
-            ring_panels, ring_rebuild, moved_lifetime, tolerance_lifetime = ring_work(
+            # the ring is kept within the tolerance, as every impostor is (rebuilt once its panels' error passes
+            # it: `ring_translation_error`), and priced over the frames that lets it last
+            ring_panels, ring_rebuild, lifetime = ring_work(
                 units,
                 candidates,
                 segments,
                 step,
                 ball_fragments,
                 panel_pixels(centres[alone], segments[seen_alone], quad_pixels_of[alone], view_projection, viewport),
-                lifetimes,
+                tolerance,
+                eye,
                 settings,
                 state.ring,
             )
-            # the ring is kept within the tolerance (rebuilt once a cloud of it passes it: Wang's panels are
-            # impostors too) while that costs at most its share of a frame, and adds at most `RING_CHASE_SHARE` of
-            # the frames measured to what Wang's own rules rebuild; past it, only by his rules, as impostor mode
-            # does, and the error it then shows is the plan's accepted error (the 1.2M field and Wang's scattered
-            # sky paid for it in rebuilds for about a dB: docs/lod.md, `RING_CHASE_SHARE`)
-            rebuild_ms = costs.ms(ring_rebuild)
-            extra_ms = rebuild_ms / max(tolerance_lifetime, 1.0) - rebuild_ms / max(moved_lifetime, 1.0)
-            measured = state.frame_times.get("units")
-            chases = rebuild_ms / max(tolerance_lifetime, 1.0) <= RING_FRAME_MS and (
-                measured is None or extra_ms <= RING_CHASE_SHARE * measured.mean_ms
-            )
-            lifetime = tolerance_lifetime if chases else moved_lifetime
             if units.sample is not None:
                 in_view_particles[alone], in_view_fragments[alone] = in_view_work(
                     units, alone, planes, eye, focal_px, screen_pixels, ball_fragments
@@ -313,21 +301,21 @@ def _plan_units(
                 in_view_work=(in_view_particles, in_view_fragments),
                 ring_ms=costs.ms(ring_panels + ring_rebuild.scaled(1.0 / max(lifetime, 1.0))),
                 alone_ms=ms_drawn_alone(units, seen, alone, in_view, focal_px, settings, costs),
-                chases_tolerance=chases,
             )
         ring_ms, alone_ms = ring_prices.ring_ms, ring_prices.alone_ms
-        chases_tolerance = ring_prices.chases_tolerance
+        # a candidate drawn on its own until a ring being built takes it: an impostor made for it now lasts only
+        # that long (Harris's circle at 800 clouds made 136 impostors in its first frame for a ring in 16 frames)
+        lifetimes = np.where(candidates, np.minimum(lifetimes, frames_to_show(state.ring, step, settings)), lifetimes)
+    ring_error = 0.0
+    if settings.uses_ring and state.ring.current is not None:
         # under wind, the eye relative to the ring's clouds, as its panels follow them (`_ring_shift`)
         current = state.ring.current
         ring_eye = (
             eye - _ring_shift(current, current.rows_in(units.members, units.row_of), centres)
-            if unit_drifts is not None and current is not None
+            if unit_drifts is not None
             else eye
         )
-        ring_error = ring_translation_error(current, translation_error, ring_eye)
-        # a candidate drawn on its own until a ring being built takes it: an impostor made for it now lasts only
-        # that long (Harris's circle at 800 clouds made 136 impostors in its first frame for a ring in 16 frames)
-        lifetimes = np.where(candidates, np.minimum(lifetimes, frames_to_show(state.ring, step, settings)), lifetimes)
+        ring_error = ring_translation_error(current, ring_eye)
     ring = plan_ring(
         state.ring,
         centres,
@@ -339,7 +327,7 @@ def _plan_units(
         units.member_set,
         segment_texture_size(height, camera.fov_y_deg, settings),
         holds_clouds=settings.mode != "auto" or (not all_full and ring_pays(state.ring, ring_ms, alone_ms)),
-        past_tolerance=chases_tolerance and ring_error > tolerance,
+        past_tolerance=ring_error > tolerance,
         # a segment is priced as its update is (below), by its particles: what the segment's render takes on
         # llvmpipe (478,000 particles of the 1.2M field, 368 ms: 0.77 us a particle, the fit's prior 0.85)
         build_ms=lambda members: costs.particles * float(units.particle_counts[units.row_of[members]]),
@@ -623,7 +611,8 @@ def _plan_units(
         if index in served:
             update_work += remake
     # the largest translation error drawn, over the tolerance
-    accepted = 0.0 if chases_tolerance or ring is None or not ring.draws else ring_error / max(tolerance, 1e-300)
+    # (the ring shown while its rebuild is under way, past the tolerance as a postponed impostor is)
+    accepted = 0.0 if ring is None or not ring.draws else ring_error / max(tolerance, 1e-300)
     regenerate, postponed = {}, {}
     textured = np.flatnonzero(of_kinds(kinds, *TEXTURED))
     # the impostors drawn as they were, not remade this frame: their errors

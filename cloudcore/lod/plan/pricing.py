@@ -26,9 +26,9 @@ from cloudcore.lod.plan.draw_items import full_runs
 from cloudcore.lod.plan.state import LodState
 from cloudcore.lod.plan.unit_plans import FULL, IMPOSTOR
 from cloudcore.lod.ring import (
-    SEGMENT_DEG,
     SEGMENTS,
     RingState,
+    panel_spans,
 )
 from cloudcore.lod.splat_coverage import splats_in_frustum
 from cloudcore.lod.units import LodUnits
@@ -379,13 +379,6 @@ def ms_drawn_alone(units: LodUnits, seen: Seen, chosen, in_view, focal_px, setti
     return float(np.sum(np.minimum(full, impostor))) + costs.batches * full_runs(kinds)
 
 
-def segments_of(centres, eye) -> np.ndarray:
-    """The ring segment (0 to `SEGMENTS` - 1) each of `centres` lies in, by its azimuth about `eye`."""
-    offsets = np.asarray(centres, dtype=np.float64).reshape(-1, 3) - np.asarray(eye, dtype=np.float64)
-    azimuths = np.degrees(np.arctan2(offsets[:, 0], -offsets[:, 2])) % 360.0
-    return (azimuths // SEGMENT_DEG).astype(np.int64) % SEGMENTS  # a tiny negative azimuth % 360 gives 360
-
-
 def panel_pixels(centres, segments, quad_pixels, view_projection: np.ndarray, viewport) -> float:
     """Pixels on the screen of the ring panels that show the clouds in view at `centres`, in the ring's
     `segments` (`segments_of`), whose own impostor quads would fill `quad_pixels`.
@@ -426,54 +419,70 @@ def ring_panels_work(panels: int, pixels: float) -> Work:
 
 
 def ring_work(
-    units: LodUnits, candidates, segments, step, ball_fragments, pixels, lifetimes, settings, state: RingState
-) -> tuple[Work, Work, float, float]:
-    """(panels, rebuild, moved, tolerated): Wang's ring holding the units `candidates` (mask), in `segments`.
+    units: LodUnits,
+    candidates,
+    segments,
+    step,
+    ball_fragments,
+    pixels,
+    tolerance: float,
+    eye,
+    settings,
+    state: RingState,
+) -> tuple[Work, Work, float]:
+    """(panels, rebuild, lifetime): Wang's ring holding the units `candidates` (mask), in `segments`, made at `eye`.
 
     Its panels drawn a frame (`pixels`: what they fill on the screen, `panel_pixels`), its rebuild (every
     candidate splatted into the segments, whose textures have the screen's pixel density), and the frames
     it lasts: until the eye's current `step` a frame carries it past a rebuild distance, or the frames the
-    last ring lasted when shorter (moved); and that or the frames its clouds' impostors would (`lifetimes`),
-    when shorter still (tolerated).
+    last ring lasted when shorter, or, shorter still, the frames until its panels' translation error could pass
+    `tolerance` (degrees) at that step (the fastest rate of its `panel_spans`: the plan rebuilds it then).
     """
     panels = int(np.count_nonzero(np.bincount(segments, minlength=SEGMENTS)))
-    horizontal, vertical = math.hypot(step[0], step[2]), abs(step[1])
-    moved = min(
+    horizontal, vertical, moving = math.hypot(step[0], step[2]), abs(step[1]), float(np.linalg.norm(step))
+    centres, radii = panel_spans(units.centres[candidates], units.radii[candidates], eye, settings.ring_radius)
+    distances = row_lengths(centres - np.asarray(eye, dtype=np.float64))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rates = np.where(distances > radii, 2.0 * radii / ((distances - radii) * (distances + radii)), math.inf)
+    lifetime = min(
         LONGEST_LIFETIME_FRAMES,
         state.rebuild_interval,
         settings.ring_rebuild_horizontal * settings.ring_radius / max(horizontal, 1e-300),
         settings.ring_rebuild_vertical * settings.ring_radius / max(vertical, 1e-300),
+        # a parallax of s r' 2 / ((d' - r')(d' + r')) radians after a step s, at most (`ring_translation_error`)
+        math.radians(tolerance) / max(float(np.max(rates, initial=0.0)) * moving, 1e-300),
     )
     rebuild = Work(
         particles=float(np.sum(units.particle_counts[candidates])),
         texture_fragments=float(np.sum(ball_fragments[candidates])),
         regenerations=float(panels),
     )
-    tolerated = min(moved, float(np.min(lifetimes[candidates], initial=math.inf)))
-    return ring_panels_work(panels, pixels), rebuild, moved, tolerated
+    return ring_panels_work(panels, pixels), rebuild, lifetime
 
 
 #: the members of a ring whose parallax error is measured each frame; the rest are bounded (`ring_translation_error`)
 RING_ERROR_WATCHED = 64
 
 
-def ring_translation_error(generation, translation_error, eye) -> float:
+def ring_translation_error(generation, eye) -> float:
     """The largest translation error of a cloud of the ring `generation` (None: no ring; 0: none) seen from
-    `eye`: Wang's panels are impostors too.
+    `eye`: Wang's panels are impostors too, pictures at the ring's radius of clouds that lie beyond it.
 
-    By the parallax metric, measured for the `RING_ERROR_WATCHED` clouds whose error grows fastest with the
-    eye's step from where the ring was made (`RingGeneration.fastest_parallax`), and for the rest
-    only where their bound passes those: each parts its near and far rays by at most s 2r / ((d - r - s)(d + r -
-    s)) radians after a step s shorter than d - r, so none of them passes s k (a / (a - s))^2, k the largest rate
-    and a the nearest near point among them: a ring of thousands is measured whole only where that bound does
-    not settle it.
+    Harris's parallax of each member's span from its panel to its own sphere's far side
+    (`RingGeneration.panel_spans`), whatever the impostors' metric: the panel's shift against the cloud is
+    itself a parallax.  Measured for the `RING_ERROR_WATCHED` spans whose error grows fastest with the eye's
+    step from where the ring was made (`RingGeneration.fastest_parallax`), and for the rest only where their
+    bound passes those: each parts its near and far rays by at most s 2r / ((d - r - s)(d + r - s)) radians
+    after a step s shorter than d - r, so none of them passes s k (a / (a - s))^2, k the largest rate and a the
+    nearest near point among them: a ring of thousands is measured whole only where that bound does not settle
+    it.
     """
     if generation is None or not generation.members:
         return 0.0
-    centres, radii = generation.spheres
+    centres, radii = generation.panel_spans()
     then, now = np.asarray(generation.eye, dtype=np.float64), np.asarray(eye, dtype=np.float64)
-    if translation_error is not parallax_errors_deg or len(radii) <= RING_ERROR_WATCHED:
-        return float(np.max(translation_error(centres, radii, then, now), initial=0.0))
+    if len(radii) <= RING_ERROR_WATCHED:
+        return float(np.max(parallax_errors_deg(centres, radii, then, now), initial=0.0))
     rows, rest_rate, rest_near = generation.fastest_parallax(RING_ERROR_WATCHED)
     largest = float(np.max(parallax_errors_deg(centres[rows], radii[rows], then, now)))
     step = float(np.linalg.norm(now - then))

@@ -35,11 +35,6 @@ RING_PRICE_MOVE_SHARE = 0.25
 RING_PRICE_CHANGE_SHARE = 0.1
 
 
-#: auto mode keeps Wang's ring within the impostors' tolerance only where the rebuilds that adds to Wang's own rules
-#: cost at most this share of its measured frames (#51: auto is at most 5% slower than impostor mode)
-RING_CHASE_SHARE = 0.05
-
-
 #: the running mean of a choice's frame times weighs each new frame at least this much
 FRAME_TIME_FORGETTING = 0.1
 
@@ -68,7 +63,6 @@ class RingPrices:
     in_view_work: tuple
     ring_ms: float  # its panels a frame and its rebuild amortised over its lifetime
     alone_ms: float  # its clouds in view drawn each as auto would (`pricing.ms_drawn_alone`)
-    chases_tolerance: bool  # kept within the impostors' tolerance (`RING_FRAME_MS`, `RING_CHASE_SHARE`)
 
 
 @dataclass(frozen=True)

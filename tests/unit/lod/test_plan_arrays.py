@@ -10,16 +10,18 @@ import pytest
 from cloudcore.lod.impostors import parallax_errors_deg
 from cloudcore.lod.plan import LodState, plan_frame
 from cloudcore.lod.plan.draw_items import DrawItem, draw_items
-from cloudcore.lod.plan.pricing import panel_pixels, ring_translation_error, segments_of
+from cloudcore.lod.plan.pricing import panel_pixels, ring_translation_error
 from cloudcore.lod.plan.unit_plans import FULL, KINDS, UnitPlans
 from cloudcore.lod.ring import (
     SEGMENTS,
     RingGeneration,
     RingState,
     frames_to_show,
+    panel_spans,
     plan_ring,
     ring_candidates,
     ring_members,
+    segments_of,
 )
 from cloudcore.lod.splitting import layer_bounds, layer_sort_key
 from cloudcore.lod.units import LodUnits
@@ -236,8 +238,8 @@ def test_the_ring_s_largest_parallax_error_is_its_whole_ring_s_whatever_the_step
         for step in (0.0, 0.05, 3.0, 120.0, 2500.0, 6000.0):
             for direction in directions:
                 now = np.asarray(eye) + step * np.asarray(direction) / np.linalg.norm(direction)
-                whole = float(np.max(parallax_errors_deg(*ring.spheres, eye, now)))
-                assert ring_translation_error(ring, parallax_errors_deg, now) == whole
+                whole = float(np.max(parallax_errors_deg(*ring.panel_spans(), eye, now)))
+                assert ring_translation_error(ring, now) == whole
 
 
 @pytest.mark.parametrize("with_heights", [False, True])
@@ -274,3 +276,27 @@ def test_the_ring_s_candidates_held_by_their_slack_are_ring_members_at_every_ste
         assert np.array_equal(held.members, ring_members(centres, radii, eye, settings, reach))
         changed += int(np.count_nonzero(held.members != before))
     assert changed > 50  # the walk did move clouds into and out of the ring
+
+
+def test_a_panel_span_reaches_from_the_panel_to_the_cloud_s_far_side_and_its_parallax_is_the_panel_s_shift():
+    """A cloud 12 km off along the middle of a segment of a ring of 4 km: its panel's point is 4 km along the same
+    ray, so its span runs from there to the sphere's far side; an eye stepped 100 m across sees the panel's point
+    and the cloud's far side 100 (1/4000 - 1/12200) radians apart, the shift a flat panel shows, which the
+    cloud's own parallax (its sphere's near and far points) is a small part of.  A cloud astride the panel spans
+    its own sphere; off the segment's middle, the ray meets the flat panel farther out."""
+    eye = np.array([0.0, 1000.0, 0.0])
+
+    def along(azimuth_deg: float, distance: float) -> np.ndarray:
+        azimuth = math.radians(azimuth_deg)
+        return eye + distance * np.array([math.sin(azimuth), 0.0, -math.cos(azimuth)])
+
+    centres, radii = np.array([along(22.5, 12000.0), along(22.5, 4050.0), along(40.0, 12000.0)]), np.full(3, 200.0)
+    spans, span_radii = panel_spans(centres, radii, eye, 4000.0)
+    assert spans[0] == pytest.approx(along(22.5, 8100.0)) and span_radii[0] == pytest.approx(4100.0)
+    assert spans[1] == pytest.approx(centres[1]) and span_radii[1] == pytest.approx(radii[1])
+    near_end = np.linalg.norm(spans[2] - eye) - span_radii[2]
+    assert near_end == pytest.approx(4000.0 / math.cos(math.radians(40.0 - 22.5)))
+    across = eye + 100.0 * np.array([math.cos(math.radians(22.5)), 0.0, math.sin(math.radians(22.5))])
+    shift = math.degrees(100.0 * (1.0 / 4000.0 - 1.0 / 12200.0))
+    assert parallax_errors_deg(spans[:1], span_radii[:1], eye, across)[0] == pytest.approx(shift, rel=1e-3)
+    assert parallax_errors_deg(centres[:1], radii[:1], eye, across)[0] < 0.05 * shift
