@@ -168,7 +168,8 @@ def test_another_wind_at_the_same_time_carries_the_clouds_by_its_own_drift(rende
 
 def test_wang_s_ring_follows_its_clouds_drifting_alike_without_being_made_again(still):
     far = dataclasses.replace(still, camera=Camera((0.0, 1100.0, 6500.0), (0.0, 1050.0, 0.0), 50.0), wind=WIND)
-    ring = RenderSettings(mode="impostor", ring_radius=4000.0)
+    # Wang's rule alone (a tolerance no panel's error reaches): the tolerance rebuilds sooner, tested below
+    ring = RenderSettings(mode="impostor", ring_radius=4000.0, tolerance_deg=179.0)
     with FrameRenderer(96, 72) as renderer:
         for _ in range(20):  # its segments built, one a frame, and faded in
             renderer.render(far, settings=ring)
@@ -179,6 +180,19 @@ def test_wang_s_ring_follows_its_clouds_drifting_alike_without_being_made_again(
         np.testing.assert_allclose(renderer.last_plan.ring_shifts[0], [250.0, 0.0, 0.0], atol=1e-6)
         _, stats = renderer.render(far, settings=ring, time_s=31.0)  # 310 m: the eye relative to the clouds stepped
         assert stats.plan.ring_segments_built > 0
+
+
+def test_wang_s_ring_drifting_with_its_clouds_is_made_again_once_its_panels_error_passes_the_tolerance(still):
+    """The panels stand at the ring's radius, their clouds beyond it: carried 250 m across the eye, the panels and
+    the clouds shift apart by about 250 m (1/4000 - 1/D), past the default tolerance long before Wang's 600 m."""
+    far = dataclasses.replace(still, camera=Camera((0.0, 1100.0, 6500.0), (0.0, 1050.0, 0.0), 50.0), wind=WIND)
+    ring = RenderSettings(mode="impostor", ring_radius=4000.0)
+    with FrameRenderer(96, 72) as renderer:
+        for _ in range(20):
+            renderer.render(far, settings=ring)
+        built = renderer.last_plan.ring_state.current
+        _, stats = renderer.render(far, settings=ring, time_s=25.0)
+        assert renderer.last_plan.ring_state.current is not built or stats.plan.ring_segments_built > 0
 
 
 def test_a_field_s_particles_swirl_with_the_turbulence_about_their_drifting_places_their_light_kept():
