@@ -258,6 +258,26 @@ class TerrainTiles:
         self.skirts = skirted_sides(tiles)
         return True
 
+    def under_the_clouds_map(self, space) -> np.ndarray:
+        """(tiles,) bool: whether the clouds' transmittance map of light space `space` (`cloud_shadows.LightSpace`)
+        may dim the sun on any point of each tile's box.  A point off the map across the light (its texels' border
+        is clear, and the bilinear read takes it a half texel in: one texel is left) or in front of every slice
+        (slice coordinate 0 or less) is lit whole, so its pixels need not read the map; the map's coordinates are
+        affine in the world's, so a box's corners bound them.  The far tiles are mostly off the map and their pixels
+        skip its reads (docs/performance.md, "The terrain's pixels off the clouds' map")."""
+        corners = np.stack(
+            [
+                np.where(np.array([k & 1, k & 2, k & 4], dtype=bool), self.boxes[:, 1], self.boxes[:, 0])
+                for k in range(8)
+            ],
+            axis=1,
+        )
+        x, y, s = (c.reshape(-1, 8) for c in space.texel_coordinates(corners.reshape(-1, 3)))
+        width, height = space.size
+        across = (x.max(axis=1) > -1.0) & (x.min(axis=1) < width + 1.0)
+        up = (y.max(axis=1) > -1.0) & (y.min(axis=1) < height + 1.0)
+        return across & up & (s.max(axis=1) > 0.0)
+
     def in_view(self, planes: np.ndarray) -> np.ndarray:
         """(tiles,) bool: whether each tile's box meets the view volume of `planes` (`camera.frustum_planes`):
         for each plane the box's corner farthest along its normal is tested."""

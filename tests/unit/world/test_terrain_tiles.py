@@ -8,6 +8,7 @@ import itertools
 import numpy as np
 import pytest
 
+from cloudcore.light.cloud_shadows import SLICES, light_space, sample_map
 from cloudcore.model.scene import Camera, Terrain
 from cloudcore.scenes.files import load_scene
 from cloudcore.world import terrain_tiles
@@ -17,6 +18,7 @@ from cloudcore.world.terrain_tiles import (
     SKIRT_SIDES,
     TILE_CELLS,
     TILE_FACES,
+    TILE_VERTICES,
     TerrainTiles,
     leaf_tiles,
     skirted_sides,
@@ -194,3 +196,44 @@ def test_a_patch_without_reach_is_drawn_to_its_edges_alone():
     assert np.abs(tiles.positions[:, [0, 2]]).max() == pytest.approx(3000.0)
     assert np.all(np.isfinite(tiles.positions)) and np.all(np.isfinite(tiles.normals))
     np.testing.assert_allclose(np.linalg.norm(tiles.normals, axis=1), 1.0)
+
+
+def test_the_tiles_left_off_the_clouds_map_read_none_of_it_and_the_map_s_middle_is_read():
+    """Where `under_the_clouds_map` says no, the map as the GL side reads it (`sample_map`) gives no optical depth
+    at any point of the tile, whatever the map holds: those tiles' pixels skip its reads and draw the same."""
+    tiles = TerrainTiles(VALLEY_TERRAIN)
+    tiles.update(EYES[0])
+    centres = np.array([[0.0, 1800.0, 0.0], [1500.0, 2000.0, -2500.0], [-800.0, 1600.0, 1200.0]])
+    radii = np.full(len(centres), 500.0)
+    space = light_space(centres, radii, (0.4, 0.6, 0.3), 64)
+    under = tiles.under_the_clouds_map(space)
+    assert 0 < under.sum() < len(under)
+    # a map dense everywhere: any read within reach of a texel would show
+    values = np.full((SLICES, space.size[1], space.size[0]), 5.0)
+    off = np.repeat(~under, TILE_VERTICES)
+    assert np.all(sample_map(space, values, tiles.positions[off]) == 0.0)
+    # and the tiles left in read it: some of their vertices lie under the clouds
+    read = sample_map(space, values, tiles.positions).reshape(len(under), TILE_VERTICES) > 0.0
+    assert np.any(read[under])
+
+
+def test_a_tile_within_a_texel_of_the_clouds_map_reads_it_and_one_farther_does_not():
+    """The map's bilinear read reaches a half texel past its edge (the border clear): a box there is under it."""
+    space = light_space(np.zeros((1, 3)), np.array([500.0]), (0.4, 0.6, 0.3), 64)
+    across = np.linspace(-2.0, 0.5, 26)
+    x, y, s = across, np.full_like(across, 0.5 * space.size[1]), np.full_like(across, 4.0)
+    right, up, forward = (np.asarray(v) for v in (space.right, space.up, space.forward))
+    points = (
+        (space.origin[0] + x[:, None] * space.texel_m) * right
+        + (space.origin[1] + y[:, None] * space.texel_m) * up
+        + (space.near_m + s[:, None] * space.slice_m) * forward
+    )
+    tiles = TerrainTiles(VALLEY_TERRAIN)
+    tiles.boxes = np.stack([points, points], axis=1)  # a box a point
+    under = tiles.under_the_clouds_map(space)
+    read = sample_map(space, np.full((SLICES, space.size[1], space.size[0]), 5.0), points) > 0.0
+    assert np.all(under[read]) and read.any()
+    assert not np.any(under[across < -1.0])
+    # in front of every slice, nothing is read
+    tiles.boxes = np.stack([points, points], axis=1) - 4.5 * space.slice_m * forward
+    assert not tiles.under_the_clouds_map(space).any()
