@@ -22,6 +22,7 @@ from cloudcore.world.terrain_tiles import (
     TerrainTiles,
     leaf_tiles,
     skirted_sides,
+    tile_errors_m,
     tile_faces,
     tile_frame,
     tile_meshes,
@@ -237,3 +238,39 @@ def test_a_tile_within_a_texel_of_the_clouds_map_reads_it_and_one_farther_does_n
     # in front of every slice, nothing is read
     tiles.boxes = np.stack([points, points], axis=1) - 4.5 * space.slice_m * forward
     assert not tiles.under_the_clouds_map(space).any()
+
+
+@pytest.mark.parametrize("eye", EYES[:2])
+def test_a_near_tile_is_left_coarse_only_where_its_ground_strays_less_than_the_angle_from_it(eye):
+    tiles = TerrainTiles(VALLEY_TERRAIN)
+    tiles.update(eye)
+    frame = tiles.frame
+    by_distance = leaf_tiles(frame, eye)
+    assert np.all(covering_counts(frame, tiles.tiles) == 1)
+    keys = {tuple(row) for row in by_distance.tolist()}
+    kept_coarse = np.array([row for row in tiles.tiles.tolist() if tuple(row) not in keys])
+    assert 0 < len(kept_coarse) and len(tiles.tiles) < len(by_distance)
+    # each tile left coarser is one the distance alone would split, and its ground within the angle of it
+    x0, z0, side = frame.corners(kept_coarse)
+    dx = np.maximum.reduce([x0 - eye[0], np.zeros_like(x0), eye[0] - (x0 + side)])
+    dz = np.maximum.reduce([z0 - eye[2], np.zeros_like(z0), eye[2] - (z0 + side)])
+    distance = np.sqrt(dx * dx + dz * dz + max(eye[1] - frame.top_m, 0.0) ** 2)
+    assert np.all(distance < terrain_tiles.SPLIT_DISTANCE * side)
+    errors = tile_errors_m(VALLEY_TERRAIN, frame, kept_coarse)
+    assert np.all(errors <= terrain_tiles.SPLIT_ERROR_RAD * distance)
+
+
+def test_a_tiles_error_is_none_over_a_plane_and_the_grounds_largest_departure_from_its_triangles():
+    terrain = dataclasses.replace(VALLEY_TERRAIN, relief=0.0)
+    frame = tile_frame(terrain)
+    middle = 2 ** (frame.root_level - 2) // 2  # a tile of level 2 at the origin, within the drawn square
+    tile = np.array([[2, middle, middle - 1]])
+    x0, z0, side = (float(v[0]) for v in frame.corners(tile))
+    # the ground's heights at the grid's vertices and halfway along each cell's diagonal
+    fine = np.linspace(0.0, side, 2 * TILE_CELLS + 1)
+    heights = terrain_tiles.height_at(terrain, x0 + fine[None, :], z0 + fine[:, None])
+    vertices = heights[::2, ::2]
+    diagonal = 0.5 * (vertices[1:, :-1] + vertices[:-1, 1:])  # down-across, the two triangles' shared edge
+    assert tile_errors_m(terrain, frame, tile)[0] >= np.abs(heights[1::2, 1::2] - diagonal).max() - 1e-9
+    flat = Terrain(size=(6000.0, 6000.0), resolution=174, height=0.0)
+    assert tile_errors_m(flat, tile_frame(flat), np.array([[1, 2, 2], [0, 3, 4]])).max() == pytest.approx(0.0, abs=1e-9)
