@@ -4,7 +4,8 @@ A tile is a square of `TILE_CELLS` x `TILE_CELLS` cells.  The finest tiles' cell
 spacing (`Terrain.size` over its samples, `terrain.finest_cell_m`: the ground near the eye at full resolution),
 each level's cells twice its children's.  The root, centred on the origin, covers the drawn square (its half
 side the larger of `Terrain.reach` and the patch's half sides; vertices past it are pulled onto its edge), and a
-tile is split while the eye is nearer to it than `SPLIT_DISTANCE` of its sides.  A cell then spans a near constant angle
+tile is split while the eye is nearer to it than `SPLIT_DISTANCE` of its sides and its ground strays from its
+triangles by more than `SPLIT_ERROR_RAD` seen from the eye.  A cell then spans a near constant angle
 from the eye, and the tiles' count grows with the log of the reach, not its square.
 
 Neighbouring tiles of different levels meet along an edge that the coarser samples half as often.  Each tile
@@ -35,6 +36,10 @@ SPLIT_DISTANCE = 1.0
 #: floor near the eye, whose finest tiles add little, is drawn coarser; its hills as before
 #: (docs/performance.md, "The terrain's pixels off the clouds' map")
 SPLIT_ERROR_RAD = 0.003
+#: the coarsest level a near tile is left at for its small error (cells 2 finest cells wide): its light, the air
+#: and the light shafts' share are read per vertex, which near the eye must stay close together (a plain's near
+#: ground left at level 2 and coarser stepped the picture as the eye moved: tests/render/test_render_cloud_field.py)
+COARSEST_NEAR_LEVEL = 1
 #: height samples a cell along each side when a tile's error is measured
 ERROR_SAMPLES = 4
 #: a skirt's depth in its tile's cells: deeper than a coarser neighbour's edge strays from the tile's
@@ -99,8 +104,8 @@ def tile_errors_m(terrain: Terrain, frame: TileFrame, tiles: np.ndarray) -> np.n
 def leaf_tiles(frame: TileFrame, eye, errors_m=None) -> np.ndarray:
     """(n, 3) int64 rows (level, i, j) of the tiles drawn for an eye at `eye` (x, y, z), sorted: split from the
     root down while the eye is nearer than `SPLIT_DISTANCE` sides and, where `errors_m(tiles)` gives the tiles'
-    height errors (`tile_errors_m`), while that error seen from the eye exceeds `SPLIT_ERROR_RAD`; tiles wholly off
-    the drawn square dropped."""
+    height errors (`tile_errors_m`), for tiles of `COARSEST_NEAR_LEVEL` or finer, while that error seen from the eye
+    exceeds `SPLIT_ERROR_RAD`; tiles wholly off the drawn square dropped."""
     ex, ey, ez = (float(v) for v in eye)
     # above the highest ground the eye's height counts toward its distance; below, the ground may be level with it
     above = max(ey - frame.top_m, 0.0)
@@ -118,7 +123,7 @@ def leaf_tiles(frame: TileFrame, eye, errors_m=None) -> np.ndarray:
         dz = np.maximum.reduce([z0 - ez, np.zeros_like(z0), ez - (z0 + side)])
         distance = np.sqrt(dx * dx + dz * dz + above * above)
         split = distance < SPLIT_DISTANCE * side
-        if errors_m is not None and split.any():
+        if errors_m is not None and level <= COARSEST_NEAR_LEVEL and split.any():
             split[split] = errors_m(tiles[split]) > SPLIT_ERROR_RAD * distance[split]
         leaves.append(tiles[~split])
         parents = tiles[split]
