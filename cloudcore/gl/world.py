@@ -26,6 +26,7 @@ from cloudcore.gl.programs import ProgramCache, set_matrix, set_vec3
 from cloudcore.gl.shadow_map import CloudShadowMap
 from cloudcore.gl.targets import TextureTarget, linear_filtering
 from cloudcore.light.air_between import AirBetween, air_between
+from cloudcore.light.cloud_shadows import LightSpace
 from cloudcore.light.far_ground import (
     far_ground_box,
     far_ground_colour,
@@ -105,8 +106,9 @@ class TerrainMesh:
         self._programs = programs  # the world pass's
         self._coarse_in_view: np.ndarray | None = None  # the tiles whose coarse surfaces the coarse indices hold
         self._in_view: np.ndarray | None = None  # the tiles whose grids and skirts the indices hold
-        # the indices' first triangles, the grids', then the skirts'
-        self._grid_triangles = self._skirt_triangles = 0
+        self._shaded: np.ndarray | None = None  # which of them read the clouds' map
+        # the indices' runs: (whether they read the clouds' map, whether grids (else skirts), first triangle, count)
+        self._runs: list[tuple[bool, bool, int, int]] = []
         # the tiles' vertices and triangles, and their coarse surfaces' (the light shafts' depth: positions alone)
         self._buffers = [int(b) for b in GL.glGenBuffers(4)]
         self._vertex_array, self._coarse_vertex_array = (int(a) for a in GL.glGenVertexArrays(2))
@@ -138,11 +140,12 @@ class TerrainMesh:
             GL.glBufferData(GL.GL_ARRAY_BUFFER, vertices.nbytes, vertices, GL.GL_STATIC_DRAW)
         self._in_view = self._coarse_in_view = None  # the triangles in view are gathered again
 
-    def _program(self, through_air: bool, shafts: bool, far_ground: bool) -> int:
+    def _program(self, through_air: bool, shafts: bool, far_ground: bool, shadow_read: bool) -> int:
         defines = {
             "THROUGH_AIR": int(through_air),
             "LIGHT_SHAFTS": int(shafts),
             "FAR_GROUND": int(far_ground and through_air),
+            "CLOUD_SHADOW_READ": int(shadow_read),
         }
         return self._programs.program("terrain", defines)
 
@@ -158,75 +161,113 @@ class TerrainMesh:
         """Draw the tiles in view for `camera` into the bound target, depth tested and written, seen through
         `air` (bound for `camera`'s eye) where there is one, past its volume through the air to the planet's
         ground that `bind_far_air(program)` binds where given (the sky's table: `WorldPass`), the sun's part in
-        the clouds' `shadows` where given, less the light `shafts` (marched for this view) where given."""
-        program = self._program(air is not None, shafts is not None, bind_far_air is not None)
-        GL.glUseProgram(program)
-        if air is not None:
-            air.bind(program)
-            set_vec3(program, "eye_position", camera.position)
-            if bind_far_air is not None:
-                bind_far_air(program)
-        if shadows is None:
-            GL.glUniform1i(GL.glGetUniformLocation(program, "cloud_shadows"), 0)
-        else:
-            shadows.bind(program)
-        if shafts is not None:
-            shafts.bind()
-        self._draw_tiles(program, camera, view_projection)
+        the clouds' `shadows` where given (read by the tiles under their map alone), less the light `shafts`
+        (marched for this view) where given."""
+
+        def use(shadow_read: bool) -> int:
+            program = self._program(air is not None, shafts is not None, bind_far_air is not None, shadow_read)
+            GL.glUseProgram(program)
+            if air is not None:
+                air.bind(program)
+                set_vec3(program, "eye_position", camera.position)
+                if bind_far_air is not None:
+                    bind_far_air(program)
+            if shadow_read:
+                shadows.bind(program)
+            if shafts is not None:
+                shafts.bind()
+            return program
+
+        self._draw_tiles(use, camera, view_projection, None if shadows is None else shadows.space)
 
     def draw_depth(self, camera: Camera, view_projection: np.ndarray) -> None:
         """Draw the depth of the coarse surfaces of the tiles in view for `camera` alone into the bound target (the
         light shafts' march reads it at a fraction of the screen's resolution, where the tiles' triangles are
         mostly smaller than a pixel and cost llvmpipe their setup)."""
-        program = self._programs.program("terrain_depth", {"THROUGH_AIR": 0}, vertex="terrain")
-        GL.glUseProgram(program)
-        self._draw_tiles(program, camera, view_projection, coarse=True)
+        program = self._programs.program("terrain_depth", {"THROUGH_AIR": 0, "CLOUD_SHADOW_READ": 0}, vertex="terrain")
 
-    def _draw_tiles(self, program: int, camera: Camera, view_projection: np.ndarray, coarse: bool = False) -> None:
-        """Draw the tiles in view with `program` (in use), depth tested and written; their coarse surfaces where
-        `coarse`."""
+        def use(_shadow_read: bool) -> int:
+            GL.glUseProgram(program)
+            return program
+
+        self._draw_tiles(use, camera, view_projection, None, coarse=True)
+
+    def _draw_tiles(
+        self,
+        use: Callable[[bool], int],
+        camera: Camera,
+        view_projection: np.ndarray,
+        space: LightSpace | None,
+        coarse: bool = False,
+    ) -> None:
+        """Draw the tiles in view, depth tested and written, each with the program `use(shadow_read)` puts in use
+        (its uniforms set): reading the clouds' map of light `space` for the tiles under it (`space` None: no
+        tile); their coarse surfaces where `coarse`."""
         if self.tiles.update(camera.position):
             self._upload()
         in_view = np.flatnonzero(self.tiles.in_view(frustum_planes(view_projection)))
         if not len(in_view):
             return
-        set_matrix(program, "view_projection", view_projection)
         GL.glEnable(GL.GL_DEPTH_TEST)
         GL.glDepthFunc(GL.GL_LESS)
         GL.glDepthMask(GL.GL_TRUE)
         if coarse:
+            set_matrix(use(False), "view_projection", view_projection)
             self._draw_coarse(in_view)
             return
+        shaded = np.zeros(len(in_view), dtype=bool)
+        if space is not None:
+            shaded = self.tiles.under_the_clouds_map(space)[in_view]
         GL.glBindVertexArray(self._vertex_array)
-        if self._in_view is None or not np.array_equal(self._in_view, in_view):
-            self._gather(in_view)
-        # the grids with their back faces culled: the far sides of hills, hidden behind their near sides, which
-        # llvmpipe then does not set up; the skirts not, as either of two neighbours' may be the one that hangs
-        # past the other's edge, seen from either side
-        GL.glEnable(GL.GL_CULL_FACE)
-        GL.glCullFace(GL.GL_BACK)
-        GL.glDrawElements(GL.GL_TRIANGLES, 3 * self._grid_triangles, GL.GL_UNSIGNED_INT, None)
+        if (
+            self._in_view is None
+            or not np.array_equal(self._in_view, in_view)
+            or not np.array_equal(self._shaded, shaded)
+        ):
+            self._gather(in_view, shaded)
+        programs: dict[bool, int] = {}
+        for shadow_read, grids, first, count in self._runs:
+            if shadow_read not in programs:
+                programs[shadow_read] = use(shadow_read)
+                set_matrix(programs[shadow_read], "view_projection", view_projection)
+            else:
+                GL.glUseProgram(programs[shadow_read])
+            # the grids with their back faces culled: the far sides of hills, hidden behind their near sides, which
+            # llvmpipe then does not set up; the skirts not, as either of two neighbours' may be the one that hangs
+            # past the other's edge, seen from either side
+            (GL.glEnable if grids else GL.glDisable)(GL.GL_CULL_FACE)
+            GL.glCullFace(GL.GL_BACK)
+            offset = ctypes.c_void_p(3 * 4 * first)  # bytes of uint32 indices
+            GL.glDrawElements(GL.GL_TRIANGLES, 3 * count, GL.GL_UNSIGNED_INT, offset)
         GL.glDisable(GL.GL_CULL_FACE)
-        if self._skirt_triangles:
-            skirts_offset = ctypes.c_void_p(3 * 4 * self._grid_triangles)  # bytes of uint32 indices
-            GL.glDrawElements(GL.GL_TRIANGLES, 3 * self._skirt_triangles, GL.GL_UNSIGNED_INT, skirts_offset)
         GL.glBindVertexArray(0)
 
-    def _gather(self, in_view: np.ndarray) -> None:
-        """Gather the triangles of the tiles `in_view` into the bound vertex array's indices, in two runs each drawn
-        in one call: their grids, then their skirts on the sides that need one (`skirted_sides`), in the order the
-        tiles come.  Drawn as multi-draws of a range a tile and a side, llvmpipe set each range up as a draw of its
-        own (docs/performance.md, "The terrain in two draws")."""
+    def _gather(self, in_view: np.ndarray, shaded: np.ndarray) -> None:
+        """Gather the triangles of the tiles `in_view` into the bound vertex array's indices, in runs each drawn in
+        one call: the grids of the tiles `shaded` (under the clouds' map), the other tiles' grids, then their skirts
+        on the sides that need one (`skirted_sides`) in the same two groups, each group in the order the tiles come.
+        Drawn as multi-draws of a range a tile and a side, llvmpipe set each range up as a draw of its own
+        (docs/performance.md, "The terrain in two draws")."""
         grid = grid_face_count()
         faces = self.tiles.faces.reshape(len(self.tiles.tiles), len(TILE_FACES), 3)
-        tile, side = np.nonzero(self.tiles.skirts[in_view])
         per_side = (len(TILE_FACES) - grid) // len(SKIRT_SIDES)
-        skirts = faces[in_view[tile][:, None], grid + side[:, None] * per_side + np.arange(per_side)[None, :]]
-        grids = faces[in_view, :grid]
-        indices = np.ascontiguousarray(np.concatenate([grids.reshape(-1, 3), skirts.reshape(-1, 3)]), dtype=np.uint32)
+        runs, first = [], 0
+        for grids in (True, False):
+            for shadow_read in (True, False):
+                tiles = in_view[shaded == shadow_read]
+                if grids:
+                    triangles = faces[tiles, :grid]
+                else:
+                    tile, side = np.nonzero(self.tiles.skirts[tiles])
+                    triangles = faces[tiles[tile][:, None], grid + side[:, None] * per_side + np.arange(per_side)]
+                triangles = triangles.reshape(-1, 3)
+                if len(triangles):
+                    runs.append((shadow_read, grids, first, len(triangles), triangles))
+                    first += len(triangles)
+        indices = np.ascontiguousarray(np.concatenate([run[4] for run in runs]), dtype=np.uint32)
         GL.glBufferData(GL.GL_ELEMENT_ARRAY_BUFFER, indices.nbytes, indices, GL.GL_DYNAMIC_DRAW)
-        self._in_view = in_view
-        self._grid_triangles, self._skirt_triangles = grids.shape[0] * grid, skirts.shape[0] * per_side
+        self._in_view, self._shaded = in_view, shaded
+        self._runs = [run[:4] for run in runs]
 
     def _draw_coarse(self, in_view: np.ndarray) -> None:
         """Draw the coarse surfaces of the tiles `in_view` in one call, none culled (at the march's resolution

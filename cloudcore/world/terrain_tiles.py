@@ -4,7 +4,8 @@ A tile is a square of `TILE_CELLS` x `TILE_CELLS` cells.  The finest tiles' cell
 spacing (`Terrain.size` over its samples, `terrain.finest_cell_m`: the ground near the eye at full resolution),
 each level's cells twice its children's.  The root, centred on the origin, covers the drawn square (its half
 side the larger of `Terrain.reach` and the patch's half sides; vertices past it are pulled onto its edge), and a
-tile is split while the eye is nearer to it than `SPLIT_DISTANCE` of its sides.  A cell then spans a near constant angle
+tile is split while the eye is nearer to it than `SPLIT_DISTANCE` of its sides and its ground strays from its
+triangles by more than `SPLIT_ERROR_RAD` seen from the eye.  A cell then spans a near constant angle
 from the eye, and the tiles' count grows with the log of the reach, not its square.
 
 Neighbouring tiles of different levels meet along an edge that the coarser samples half as often.  Each tile
@@ -30,6 +31,17 @@ from cloudcore.world.terrain import finest_cell_m, height_at, highest_ground_m
 TILE_CELLS = 16
 #: a tile is split while the eye is nearer to it than this many of its sides
 SPLIT_DISTANCE = 1.0
+#: a tile near enough to split is split only while its height error (`tile_errors_m`) over the eye's distance
+#: exceeds this angle: about 2 pixels of the default view at 880x680 (60 degrees over 680 rows).  The valley's
+#: floor near the eye, whose finest tiles add little, is drawn coarser; its hills as before
+#: (docs/performance.md, "The terrain's pixels off the clouds' map")
+SPLIT_ERROR_RAD = 0.003
+#: the coarsest level a near tile is left at for its small error (cells 2 finest cells wide): its light, the air
+#: and the light shafts' share are read per vertex, which near the eye must stay close together (a plain's near
+#: ground left at level 2 and coarser stepped the picture as the eye moved: tests/render/test_render_cloud_field.py)
+COARSEST_NEAR_LEVEL = 1
+#: height samples a cell along each side when a tile's error is measured
+ERROR_SAMPLES = 4
 #: a skirt's depth in its tile's cells: deeper than a coarser neighbour's edge strays from the tile's
 SKIRT_CELLS = 2.0
 
@@ -66,9 +78,34 @@ def tile_frame(terrain: Terrain) -> TileFrame:
     return TileFrame(cell, root_level, half, highest_ground_m(terrain))
 
 
-def leaf_tiles(frame: TileFrame, eye) -> np.ndarray:
+def tile_errors_m(terrain: Terrain, frame: TileFrame, tiles: np.ndarray) -> np.ndarray:
+    """(n,) the largest height difference (m) between `terrain` and the grid of each of `tiles` (level, i, j rows)
+    over it, `ERROR_SAMPLES` samples a cell along each side (`tile_faces`' cells split along their down-across
+    diagonal)."""
+    tiles = np.asarray(tiles, dtype=np.int64).reshape(-1, 3)
+    x0, z0, side = frame.corners(tiles)
+    samples = TILE_CELLS * ERROR_SAMPLES
+    along = np.arange(samples + 1) / samples
+    half = frame.half_side_m
+    xs = np.clip(x0[:, None] + along[None, :] * side[:, None], -half, half)
+    zs = np.clip(z0[:, None] + along[None, :] * side[:, None], -half, half)
+    heights = height_at(terrain, xs[:, None, :], zs[:, :, None])  # (n, along z, along x)
+    vertices = heights[:, ::ERROR_SAMPLES, ::ERROR_SAMPLES]
+    cell = np.minimum(np.arange(samples + 1) // ERROR_SAMPLES, TILE_CELLS - 1)
+    inside = np.arange(samples + 1) / ERROR_SAMPLES - cell
+    u, v, column, row = inside[None, None, :], inside[None, :, None], cell[None, :], cell[:, None]
+    h00, h01 = vertices[:, row, column], vertices[:, row, column + 1]
+    h10, h11 = vertices[:, row + 1, column], vertices[:, row + 1, column + 1]
+    first = h00 + u * (h01 - h00) + v * (h10 - h00)
+    second = h11 + (1.0 - u) * (h10 - h11) + (1.0 - v) * (h01 - h11)
+    return np.abs(np.where(u + v <= 1.0, first, second) - heights).max(axis=(1, 2))
+
+
+def leaf_tiles(frame: TileFrame, eye, errors_m=None) -> np.ndarray:
     """(n, 3) int64 rows (level, i, j) of the tiles drawn for an eye at `eye` (x, y, z), sorted: split from the
-    root down while the eye is nearer than `SPLIT_DISTANCE` sides, tiles wholly off the drawn square dropped."""
+    root down while the eye is nearer than `SPLIT_DISTANCE` sides and, where `errors_m(tiles)` gives the tiles'
+    height errors (`tile_errors_m`), for tiles of `COARSEST_NEAR_LEVEL` or finer, while that error seen from the eye
+    exceeds `SPLIT_ERROR_RAD`; tiles wholly off the drawn square dropped."""
     ex, ey, ez = (float(v) for v in eye)
     # above the highest ground the eye's height counts toward its distance; below, the ground may be level with it
     above = max(ey - frame.top_m, 0.0)
@@ -84,7 +121,10 @@ def leaf_tiles(frame: TileFrame, eye) -> np.ndarray:
             break
         dx = np.maximum.reduce([x0 - ex, np.zeros_like(x0), ex - (x0 + side)])
         dz = np.maximum.reduce([z0 - ez, np.zeros_like(z0), ez - (z0 + side)])
-        split = np.sqrt(dx * dx + dz * dz + above * above) < SPLIT_DISTANCE * side
+        distance = np.sqrt(dx * dx + dz * dz + above * above)
+        split = distance < SPLIT_DISTANCE * side
+        if errors_m is not None and level <= COARSEST_NEAR_LEVEL and split.any():
+            split[split] = errors_m(tiles[split]) > SPLIT_ERROR_RAD * distance[split]
         leaves.append(tiles[~split])
         parents = tiles[split]
         quarter = np.array([[0, 0], [1, 0], [0, 1], [1, 1]], dtype=np.int64)
@@ -217,6 +257,13 @@ def _meshes_of(terrain: Terrain) -> dict[tuple[int, int, int], tuple[np.ndarray,
     return {}
 
 
+@functools.lru_cache(maxsize=2)
+def _errors_of(terrain: Terrain) -> dict[tuple[int, int, int], float]:
+    """The height errors (`tile_errors_m`) of `terrain`'s tiles weighed for a split so far, by tile: a tile's
+    error is the ground's, measured once."""
+    return {}
+
+
 class TerrainTiles:
     """The tiles drawn for the last eye and their meshes, kept from frame to frame: `update` meshes only the
     tiles the eye's move brings in."""
@@ -236,7 +283,7 @@ class TerrainTiles:
 
     def update(self, eye) -> bool:
         """Choose the tiles for `eye`; whether they changed (then `positions`, `normals`, `faces` are new)."""
-        tiles = leaf_tiles(self.frame, eye)
+        tiles = leaf_tiles(self.frame, eye, self._errors_m)
         if np.array_equal(tiles, self.tiles):
             return False
         keys = list(map(tuple, tiles.tolist()))
@@ -257,6 +304,37 @@ class TerrainTiles:
         self.boxes = np.stack([tile_positions.min(axis=1), tile_positions.max(axis=1)], axis=1)
         self.skirts = skirted_sides(tiles)
         return True
+
+    def _errors_m(self, tiles: np.ndarray) -> np.ndarray:
+        """`tile_errors_m` of `tiles`, those measured before not measured again."""
+        known = _errors_of(self.terrain)
+        keys = list(map(tuple, tiles.tolist()))
+        missing = [index for index, key in enumerate(keys) if key not in known]
+        if missing:
+            known.update(
+                zip((keys[index] for index in missing), tile_errors_m(self.terrain, self.frame, tiles[missing]))
+            )
+        return np.array([known[key] for key in keys])
+
+    def under_the_clouds_map(self, space) -> np.ndarray:
+        """(tiles,) bool: whether the clouds' transmittance map of light space `space` (`cloud_shadows.LightSpace`)
+        may dim the sun on any point of each tile's box.  A point off the map across the light (its texels' border
+        is clear, and the bilinear read takes it a half texel in: one texel is left) or in front of every slice
+        (slice coordinate 0 or less) is lit whole, so its pixels need not read the map; the map's coordinates are
+        affine in the world's, so a box's corners bound them.  The far tiles are mostly off the map and their pixels
+        skip its reads (docs/performance.md, "The terrain's pixels off the clouds' map")."""
+        corners = np.stack(
+            [
+                np.where(np.array([k & 1, k & 2, k & 4], dtype=bool), self.boxes[:, 1], self.boxes[:, 0])
+                for k in range(8)
+            ],
+            axis=1,
+        )
+        x, y, s = (c.reshape(-1, 8) for c in space.texel_coordinates(corners.reshape(-1, 3)))
+        width, height = space.size
+        across = (x.max(axis=1) > -1.0) & (x.min(axis=1) < width + 1.0)
+        up = (y.max(axis=1) > -1.0) & (y.min(axis=1) < height + 1.0)
+        return across & up & (s.max(axis=1) > 0.0)
 
     def in_view(self, planes: np.ndarray) -> np.ndarray:
         """(tiles,) bool: whether each tile's box meets the view volume of `planes` (`camera.frustum_planes`):

@@ -16,10 +16,12 @@ uniform vec3 eye_position;
 // interpolates cost llvmpipe: docs/atmosphere.md#the-shafts-cheaper-issue-52s-budget)
 out vec3 sun_seen;
 out vec3 rest_seen;
+#if CLOUD_SHADOW_READ
 // where the clouds' shadow map is read, per pixel (terrain.frag.glsl): the map's coordinates are affine in the
 // world's, so the vertices' interpolate to each pixel's exactly, without the matrix a pixel
 out vec3 shadow_mapped;
 uniform mat4 world_to_cloud_shadow;  // cloud_shadow.glsl's
+#endif
 
 #if THROUGH_AIR
 #include "aerial_perspective.glsl"
@@ -34,7 +36,9 @@ uniform mat4 world_to_cloud_shadow;  // cloud_shadow.glsl's
 void main()
 {
     gl_Position = view_projection * vec4(position, 1.0);
+#if CLOUD_SHADOW_READ
     shadow_mapped = (world_to_cloud_shadow * vec4(position, 1.0)).xyz;
+#endif
     vec3 air_let_through, air_added;
 #if THROUGH_AIR
     air_toward(position - eye_position, air_let_through, air_added);

@@ -8,6 +8,7 @@ import itertools
 import numpy as np
 import pytest
 
+from cloudcore.light.cloud_shadows import SLICES, light_space, sample_map
 from cloudcore.model.scene import Camera, Terrain
 from cloudcore.scenes.files import load_scene
 from cloudcore.world import terrain_tiles
@@ -17,9 +18,11 @@ from cloudcore.world.terrain_tiles import (
     SKIRT_SIDES,
     TILE_CELLS,
     TILE_FACES,
+    TILE_VERTICES,
     TerrainTiles,
     leaf_tiles,
     skirted_sides,
+    tile_errors_m,
     tile_faces,
     tile_frame,
     tile_meshes,
@@ -194,3 +197,80 @@ def test_a_patch_without_reach_is_drawn_to_its_edges_alone():
     assert np.abs(tiles.positions[:, [0, 2]]).max() == pytest.approx(3000.0)
     assert np.all(np.isfinite(tiles.positions)) and np.all(np.isfinite(tiles.normals))
     np.testing.assert_allclose(np.linalg.norm(tiles.normals, axis=1), 1.0)
+
+
+def test_the_tiles_left_off_the_clouds_map_read_none_of_it_and_the_map_s_middle_is_read():
+    """Where `under_the_clouds_map` says no, the map as the GL side reads it (`sample_map`) gives no optical depth
+    at any point of the tile, whatever the map holds: those tiles' pixels skip its reads and draw the same."""
+    tiles = TerrainTiles(VALLEY_TERRAIN)
+    tiles.update(EYES[0])
+    centres = np.array([[0.0, 1800.0, 0.0], [1500.0, 2000.0, -2500.0], [-800.0, 1600.0, 1200.0]])
+    radii = np.full(len(centres), 500.0)
+    space = light_space(centres, radii, (0.4, 0.6, 0.3), 64)
+    under = tiles.under_the_clouds_map(space)
+    assert 0 < under.sum() < len(under)
+    # a map dense everywhere: any read within reach of a texel would show
+    values = np.full((SLICES, space.size[1], space.size[0]), 5.0)
+    off = np.repeat(~under, TILE_VERTICES)
+    assert np.all(sample_map(space, values, tiles.positions[off]) == 0.0)
+    # and the tiles left in read it: some of their vertices lie under the clouds
+    read = sample_map(space, values, tiles.positions).reshape(len(under), TILE_VERTICES) > 0.0
+    assert np.any(read[under])
+
+
+def test_a_tile_within_a_texel_of_the_clouds_map_reads_it_and_one_farther_does_not():
+    """The map's bilinear read reaches a half texel past its edge (the border clear): a box there is under it."""
+    space = light_space(np.zeros((1, 3)), np.array([500.0]), (0.4, 0.6, 0.3), 64)
+    across = np.linspace(-2.0, 0.5, 26)
+    x, y, s = across, np.full_like(across, 0.5 * space.size[1]), np.full_like(across, 4.0)
+    right, up, forward = (np.asarray(v) for v in (space.right, space.up, space.forward))
+    points = (
+        (space.origin[0] + x[:, None] * space.texel_m) * right
+        + (space.origin[1] + y[:, None] * space.texel_m) * up
+        + (space.near_m + s[:, None] * space.slice_m) * forward
+    )
+    tiles = TerrainTiles(VALLEY_TERRAIN)
+    tiles.boxes = np.stack([points, points], axis=1)  # a box a point
+    under = tiles.under_the_clouds_map(space)
+    read = sample_map(space, np.full((SLICES, space.size[1], space.size[0]), 5.0), points) > 0.0
+    assert np.all(under[read]) and read.any()
+    assert not np.any(under[across < -1.0])
+    # in front of every slice, nothing is read
+    tiles.boxes = np.stack([points, points], axis=1) - 4.5 * space.slice_m * forward
+    assert not tiles.under_the_clouds_map(space).any()
+
+
+@pytest.mark.parametrize("eye", EYES[:2])
+def test_a_near_tile_is_left_coarse_only_where_its_ground_strays_less_than_the_angle_from_it(eye):
+    tiles = TerrainTiles(VALLEY_TERRAIN)
+    tiles.update(eye)
+    frame = tiles.frame
+    by_distance = leaf_tiles(frame, eye)
+    assert np.all(covering_counts(frame, tiles.tiles) == 1)
+    keys = {tuple(row) for row in by_distance.tolist()}
+    kept_coarse = np.array([row for row in tiles.tiles.tolist() if tuple(row) not in keys])
+    assert 0 < len(kept_coarse) and len(tiles.tiles) < len(by_distance)
+    # each tile left coarser is one the distance alone would split, and its ground within the angle of it
+    x0, z0, side = frame.corners(kept_coarse)
+    dx = np.maximum.reduce([x0 - eye[0], np.zeros_like(x0), eye[0] - (x0 + side)])
+    dz = np.maximum.reduce([z0 - eye[2], np.zeros_like(z0), eye[2] - (z0 + side)])
+    distance = np.sqrt(dx * dx + dz * dz + max(eye[1] - frame.top_m, 0.0) ** 2)
+    assert np.all(distance < terrain_tiles.SPLIT_DISTANCE * side)
+    errors = tile_errors_m(VALLEY_TERRAIN, frame, kept_coarse)
+    assert np.all(errors <= terrain_tiles.SPLIT_ERROR_RAD * distance)
+
+
+def test_a_tiles_error_is_none_over_a_plane_and_the_grounds_largest_departure_from_its_triangles():
+    terrain = dataclasses.replace(VALLEY_TERRAIN, relief=0.0)
+    frame = tile_frame(terrain)
+    middle = 2 ** (frame.root_level - 2) // 2  # a tile of level 2 at the origin, within the drawn square
+    tile = np.array([[2, middle, middle - 1]])
+    x0, z0, side = (float(v[0]) for v in frame.corners(tile))
+    # the ground's heights at the grid's vertices and halfway along each cell's diagonal
+    fine = np.linspace(0.0, side, 2 * TILE_CELLS + 1)
+    heights = terrain_tiles.height_at(terrain, x0 + fine[None, :], z0 + fine[:, None])
+    vertices = heights[::2, ::2]
+    diagonal = 0.5 * (vertices[1:, :-1] + vertices[:-1, 1:])  # down-across, the two triangles' shared edge
+    assert tile_errors_m(terrain, frame, tile)[0] >= np.abs(heights[1::2, 1::2] - diagonal).max() - 1e-9
+    flat = Terrain(size=(6000.0, 6000.0), resolution=174, height=0.0)
+    assert tile_errors_m(flat, tile_frame(flat), np.array([[1, 2, 2], [0, 3, 4]])).max() == pytest.approx(0.0, abs=1e-9)
