@@ -66,7 +66,9 @@ class ImpostorStore:
         mean blend weights of a list of units' members, held with their images.  Returns the particles rendered,
         but not those the GPU chose (`SplatPass.take_selected` counts those)."""
         units = plan.units
-        renders = []  # (target, batch, view, projection, cleared first): all sorted, then all shaded, then drawn
+        # (atlas image, batch, view, projection, cleared first): all sorted, then all shaded (the ring's with
+        # them), then drawn
+        renders = []
         on_gpu = []  # (atlas image, eye, clouds, their depth ranges, view, projection): the GPU's way
         regenerated = sorted(plan.clouds.regenerate)
         made_at = unit_weights([plan.clouds[index].members for index in regenerated])
@@ -92,7 +94,7 @@ class ImpostorStore:
             self._release(self._clouds.pop(index)[0])
 
         ring = plan.ring
-        depths = []  # (segment's target, its piece's particles, the ring's eye): their nearest depth, after them
+        ring_renders = []  # (segment's target, batch, view, projection, cleared first): its colour, then its depth
         for segment, piece, members in ring.segment_builds() if ring is not None else ():
             if not members:
                 continue
@@ -117,32 +119,28 @@ class ImpostorStore:
             # it, stands at the ring radius while its clouds reach the horizon: docs/lod.md, "Wang's ring")
             ring_eye = np.add(generation.eye, plan.ring_build_shift)
             batch = splat_batch(particles, clouds, ring_eye, None, time_s, through_air=True)
-            renders.append((target, batch, view, projection, first))
-            starts = particles.cloud_starts
-            depths.append((target, np.concatenate([np.arange(starts[c], starts[c + 1]) for c in clouds]), ring_eye))
+            ring_renders.append((target, batch, view, projection, first))
         selections = _cell_selections(particles, time_s, on_gpu)
         self._splats.shade_ahead(
-            [(batch, view) for _, batch, view, _, _ in renders]
+            [(batch, view) for _, batch, view, _, _ in renders + ring_renders]
             + [(selection, views) for selection, views, _ in selections]
         )
-        self._draw_cells([render[:4] for render in renders if isinstance(render[0], AtlasImage)], settings)
+        self._draw_cells([render[:4] for render in renders], settings)
         for selection, views, images in selections:
             self._draw_cells_on_gpu(selection, views, images)
-        for target, batch, view, projection, cleared in renders:
-            if not isinstance(target, AtlasImage):
-                # the clouds alone, no depth test: the texture holds their premultiplied colour and opacity
-                target.bind_cleared() if cleared else target.bind()
-                self._splats.draw(batch, view, projection, depth_test=False, point_sprites=settings.point_sprites)
-        for (target, _, view, projection, cleared), (_, chosen, eye) in zip(
-            [render for render in renders if not isinstance(render[0], AtlasImage)], depths
-        ):
-            # the nearest of its clouds' particles seen, each texel's: where the panel stands in depth (the
+        for target, batch, view, projection, cleared in ring_renders:
+            # the clouds alone, no depth test: the texture holds their premultiplied colour and opacity
+            target.bind_cleared() if cleared else target.bind()
+            self._splats.draw(batch, view, projection, depth_test=False, point_sprites=settings.point_sprites)
+            # the nearest of its clouds' particles drawn, each texel's: where the panel stands in depth (the
             # terrain between the ring's radius and a cloud hides it: `ring_panel`), over their whole discs (their
             # cores left the fringes at the panel's depth, a bright rim over the hills that hid the rest); the
             # pieces after the first keep the nearer of theirs and what is there
             target.clear_depth() if cleared else target.bind()
             GL.glColorMask(GL.GL_FALSE, GL.GL_FALSE, GL.GL_FALSE, GL.GL_FALSE)  # the depth pass writes no colour
-            self._splats.draw_nearest_depth(particles, time_s, chosen, eye, view, projection, target.height, core=1.0)
+            self._splats.draw_nearest_depth(
+                particles, time_s, batch.order, batch.eye, view, projection, target.height, core=1.0
+            )
             GL.glColorMask(GL.GL_TRUE, GL.GL_TRUE, GL.GL_TRUE, GL.GL_TRUE)
             GL.glDisable(GL.GL_DEPTH_TEST)
         GL.glDisable(GL.GL_SCISSOR_TEST)  # the last atlas cell's: it would clip the cloud pass

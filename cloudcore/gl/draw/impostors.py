@@ -120,9 +120,16 @@ class Ring(DrawExecutor):
         # its clouds' depth, not the panel's
         elevation_deg = frame.settings.ring_elevation_deg
         panels = [
-            (corners, target.texture, target.depth_texture, weight, extent, np.add(generation.eye, shift), distance)
+            (
+                corners,
+                target.texture,
+                target.depth_texture,
+                weight,
+                extent,
+                np.add(generation.eye, shift),
+                max(generation.radius, MIN_PANEL_DISTANCE),
+            )
             for generation, target, corners, weight, extent, shift in self._panels(frame)
-            for distance in (max(generation.radius, MIN_PANEL_DISTANCE),)
         ]
         if panels:  # every segment's camera has the one projection: the band's height, 45 degrees wide
             _, segment_projection = segment_camera(frame.plan.ring.draws[0][0], 0, elevation_deg)
