@@ -52,45 +52,67 @@ def splats_in_view(centres: np.ndarray, radii: np.ndarray, view: np.ndarray, pro
     against 0.68 ms for four clouds' 10,655 splats culled in world space and transformed again, 0.17 against
     0.28 for one cloud's 4,796).
     """
-    kept, overdraws = splats_in_view_by_owner(centres, radii, np.zeros(len(radii), dtype=np.int64), 1, view, projection)
+    kept, overdraws = splats_in_view_per_set(centres, radii, [len(radii)], view, projection)
     return int(kept[0]), float(overdraws[0])
 
 
-def splats_in_view_by_owner(centres, radii, owners, count: int, view, projection) -> tuple[np.ndarray, np.ndarray]:
-    """`splats_in_view` of `count` sets of splats at once, each splat's set its `owners` (0 to `count` - 1):
-    (per set, the splats kept, their `analytic_overdraw`).  The frame plan prices its near units so in one pass
-    (a climb through small cumulus has several near the eye each frame)."""
-    eye_space = points_in_eye_space(centres, view)
-    depth = -eye_space[:, 2]
-    reach = SPLAT_REACH * np.asarray(radii, dtype=np.float64)
+def splats_in_view_per_set(centres, radii, set_sizes, view, projection) -> tuple[np.ndarray, np.ndarray]:
+    """`splats_in_view` of consecutive sets of splats at once, `set_sizes` of them each, in order: (per set, the
+    splats kept, their `analytic_overdraw`).  The frame plan prices its near units so in one pass (a climb through
+    small cumulus has several near the eye each frame; the default flythrough's units the eye is in and those
+    near it, each frame: docs/performance.md, "The plan at Harris's scale")."""
+    centres = np.asarray(centres, dtype=np.float64).reshape(-1, 3)
+    radii = np.asarray(radii, dtype=np.float64)
+    # eye space as three rows, each a product of the centres by a row of the view: no (N, 3) array is made (one of a
+    # near cloud's splats is past the allocator's threshold, and faulted in afresh each time it is made)
+    x, y, z = (np.add(centres @ view[axis, :3], view[axis, 3], out=np.empty(len(radii))) for axis in range(3))
+    depth = np.negative(z, out=z)
+    reach = SPLAT_REACH * radii
     scale, offset = projection[2, 2], projection[2, 3]
     near, far = offset / (scale - 1.0), offset / (scale + 1.0)
-    kept = (depth >= near - reach) & (depth <= far + reach)
-    for axis in (0, 1):
+    kept = depth >= near - reach
+    kept &= depth <= far + reach
+    for axis, across in ((0, x), (1, y)):
         focal = projection[axis, axis]
-        kept &= np.abs(focal * eye_space[:, axis]) <= depth + math.hypot(1.0, focal) * reach
+        bound = math.hypot(1.0, focal) * reach
+        bound += depth
+        kept &= np.abs(focal * across) <= bound
     drawn = np.flatnonzero(kept & (depth > near))
-    owners = np.asarray(owners, dtype=np.int64)
-    areas = np.bincount(owners[drawn], weights=_screen_areas(eye_space, radii, drawn, projection), minlength=count)
-    return np.bincount(owners[kept], minlength=count), np.pi / 16.0 * areas
+    bounds = np.concatenate([[0], np.cumsum(set_sizes, dtype=np.int64)])
+    areas = _run_sums(_screen_areas(x, y, depth, radii, drawn, projection), np.searchsorted(drawn, bounds))
+    return _run_sums(kept, bounds), np.pi / 16.0 * areas
+
+
+def _run_sums(values: np.ndarray, bounds: np.ndarray) -> np.ndarray:
+    """The sums of `values` over the runs between consecutive `bounds` (indices, non-decreasing), an empty run's 0."""
+    dtype = np.int64 if values.dtype == bool else np.float64
+    # a run starting at the end reads the zero appended; reduceat gives an empty run its first value: zeroed
+    sums = np.add.reduceat(np.append(values, np.zeros(1, dtype=values.dtype)), bounds[:-1], dtype=dtype)
+    return np.where(bounds[1:] > bounds[:-1], sums, 0)
 
 
 def _screen_share(eye_space: np.ndarray, radii: np.ndarray, drawn: np.ndarray, projection: np.ndarray) -> float:
     """`analytic_overdraw` of the splats at rows `drawn` (all in front of the near plane), given in eye space."""
-    return float(np.pi / 16.0 * np.sum(_screen_areas(eye_space, radii, drawn, projection)))
+    areas = _screen_areas(eye_space[:, 0], eye_space[:, 1], -eye_space[:, 2], radii, drawn, projection)
+    return float(np.pi / 16.0 * np.sum(areas))
 
 
-def _screen_areas(eye_space: np.ndarray, radii: np.ndarray, drawn: np.ndarray, projection: np.ndarray) -> np.ndarray:
-    """Per splat at rows `drawn` (in front of the near plane, given in eye space), its disc's area on the screen
-    in units of pi / 16 of the screen's."""
-    inverse_depth = -1.0 / eye_space[drawn, 2]
+def _screen_areas(x, y, depth, radii: np.ndarray, drawn: np.ndarray, projection: np.ndarray) -> np.ndarray:
+    """Per splat at rows `drawn` (in front of the near plane; eye space's `x`, `y` and `depth`, -z), its disc's area
+    on the screen in units of pi / 16 of the screen's."""
+    inverse_depth = 1.0 / depth[drawn]
+    drawn_radii = radii[drawn]
     # per axis the disc's bounding box on screen, 2 a wide, and the width w of its part in [-1, 1]; the
     # disc's area pi a_x a_y times the share w_x w_y / (4 a_x a_y) of its box on screen is pi w_x w_y / 4, over
     # the screen's 4: one array per axis, no division by a (the auto mode's planner runs this on every near
-    # cloud's splats, every frame: the area and the share apart cost four times as much)
-    area = np.ones(len(inverse_depth))
-    for axis in (0, 1):
+    # cloud's splats, every frame: the area and the share apart cost four times as much), clipped in place
+    area = None
+    for axis, across in ((0, x), (1, y)):
         scale = projection[axis, axis] * inverse_depth
-        centre, semi_axis = scale * eye_space[drawn, axis], scale * radii[drawn]
-        area *= np.clip(centre + semi_axis, -1.0, 1.0) - np.clip(centre - semi_axis, -1.0, 1.0)
+        low, semi_axis = scale * across[drawn], scale * drawn_radii
+        high = low + semi_axis
+        low -= semi_axis
+        width = np.minimum(np.maximum(high, -1.0, out=high), 1.0, out=high)
+        width -= np.minimum(np.maximum(low, -1.0, out=low), 1.0, out=low)
+        area = width if area is None else area * width
     return area

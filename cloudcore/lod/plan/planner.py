@@ -78,7 +78,7 @@ from cloudcore.lod.ring import (
     segment_texture_size,
     segments_of,
 )
-from cloudcore.lod.splat_coverage import splats_in_view_by_owner
+from cloudcore.lod.splat_coverage import splats_in_view_per_set
 from cloudcore.lod.splitting import layers_hold, objects_reaching
 from cloudcore.lod.units import LodUnits
 from cloudcore.maths.depth_upsampling import reduced_size
@@ -396,7 +396,7 @@ def _plan_units(
     def full_3d_of(indices: list) -> list:
         """Each unit of `indices` drawn in full 3D (`Work`): a ball of discs far off; near, splat by splat, only the
         splats in the frustum (the renderer leaves out the rest), their discs clipped to the screen, every near
-        unit in one pass (`splats_in_view_by_owner`); a still eye's again from last frame (auto mode's plan of the
+        unit in one pass (`splats_in_view_per_set`); a still eye's again from last frame (auto mode's plan of the
         default view 4.65 -> 3.2 ms, best of 40)."""
         if not priced:
             return [Work() for _ in indices]
@@ -414,12 +414,11 @@ def _plan_units(
                 counted.append(index)
         if counted:
             splats = [splats_of(index) for index in counted]
-            owners = np.repeat(np.arange(len(counted)), [len(splat_radii) for _, splat_radii in splats])
-            kept, overdraws = splats_in_view_by_owner(
-                np.concatenate([splat_centres for splat_centres, _ in splats]),
-                np.concatenate([splat_radii for _, splat_radii in splats]),
-                owners,
-                len(counted),
+            kept, overdraws = splats_in_view_per_set(
+                # one unit's splats as they are (a view of the particles): a copy of thousands faults in fresh memory
+                splats[0][0] if len(splats) == 1 else np.concatenate([splat_centres for splat_centres, _ in splats]),
+                splats[0][1] if len(splats) == 1 else np.concatenate([splat_radii for _, splat_radii in splats]),
+                [len(splat_radii) for _, splat_radii in splats],
                 view,
                 projection,
             )
@@ -488,7 +487,17 @@ def _plan_units(
     # the units the eye is in drawn as screen impostors: their work so, and in full 3D (a reduced cloud pass no finer
     # than their screen impostor draws them into itself: `_cloud_pass`)
     inside_screen, inside_full = Work(), Work()
-    for index, full in zip(holders.tolist(), full_3d_of(holders.tolist())):
+    # the units outside the eye near enough to be counted splat by splat
+    near = (
+        np.flatnonzero(distances[outside] < NEAR_EXACT_RADII * radii[outside])
+        if cloud_splats is not None and settings.mode != "impostor"
+        else np.zeros(0, dtype=np.int64)
+    )
+    # those and the units the eye is in counted in one pass: a pass has a fixed cost whatever its splats
+    counted_one_by_one = holders.tolist() + outside[near].tolist()
+    counted_works = dict(zip(counted_one_by_one, full_3d_of(counted_one_by_one)))
+    for index in holders.tolist():
+        full = counted_works[index]
         distance, members = float(distances[index]), units.members[index]
         individual = float(individuals[index])
         inside, splits = split_at(index, eye)
@@ -517,11 +526,6 @@ def _plan_units(
         layers = np.ones(len(outside))  # textures of an impostor: one more than the objects that cut it
         for index, (_, splits) in splits_of.items():
             layers[np.searchsorted(outside, index)] = len(splits) + 1
-        near = (
-            np.flatnonzero(distances[outside] < NEAR_EXACT_RADII * radii[outside])
-            if cloud_splats is not None and settings.mode != "impostor"
-            else np.zeros(0, dtype=np.int64)
-        )
         # the units auto mode prices on their own: not fading into or out of the ring
         priced_each = settings.mode == "auto" and individuals[outside] == 1.0
         prices = representation_prices(
@@ -530,7 +534,7 @@ def _plan_units(
             seen,
             lifetimes,
             layers,
-            dict(zip(near.tolist(), full_3d_of(outside[near].tolist()))),
+            {row: counted_works[index] for row, index in zip(near.tolist(), outside[near].tolist())},
             priced_each,
             pricing,
             settings,

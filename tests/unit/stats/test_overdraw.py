@@ -3,7 +3,12 @@
 import numpy as np
 import pytest
 
-from cloudcore.lod.splat_coverage import analytic_overdraw, splats_in_frustum, splats_in_view
+from cloudcore.lod.splat_coverage import (
+    analytic_overdraw,
+    splats_in_frustum,
+    splats_in_view,
+    splats_in_view_per_set,
+)
 from cloudcore.model.scene import Camera, Cloud, Scene
 from cloudcore.model.settings import FULL_3D
 from cloudcore.stats.overdraw import Overdraw, overdraw_statistics
@@ -84,3 +89,32 @@ def test_splats_in_view_keeps_what_the_frustum_keeps_and_estimates_those():
     count, overdraw = splats_in_view(centres, radii, view, projection)
     assert count == np.count_nonzero(kept)
     assert overdraw == pytest.approx(analytic_overdraw(centres[kept], radii[kept], view, projection, NEAR_PLANE_M))
+
+
+def test_splats_in_view_per_set_is_each_sets_own_in_one_pass():
+    """The planner's near units counted together: each set's splats kept and overdraw as `splats_in_view` gives them
+    for that set alone, an empty set (first, between, last) none, and a set wholly out of view none."""
+    rng = np.random.default_rng(5)
+    camera = Camera((100.0, 50.0, 900.0), (0.0, 30.0, 0.0), 50.0)
+    view, projection = view_matrix(camera), projection_matrix(camera.fov_y_deg, 16 / 9)
+    eye = np.array(camera.position)
+    behind = eye + (eye - np.array(camera.look_at)) / np.linalg.norm(eye - np.array(camera.look_at)) * 500.0
+    sets = [
+        (np.zeros((0, 3)), np.zeros(0)),
+        (eye + rng.normal(scale=300.0, size=(900, 3)), rng.uniform(0.0, 60.0, 900)),
+        (np.zeros((0, 3)), np.zeros(0)),
+        (behind + rng.normal(scale=20.0, size=(50, 3)), rng.uniform(1.0, 5.0, 50)),
+        (np.array(camera.look_at) + rng.normal(scale=200.0, size=(400, 3)), rng.uniform(10.0, 90.0, 400)),
+        (np.zeros((0, 3)), np.zeros(0)),
+    ]
+    kept, overdraws = splats_in_view_per_set(
+        np.concatenate([c for c, _ in sets]),
+        np.concatenate([r for _, r in sets]),
+        [len(r) for _, r in sets],
+        view,
+        projection,
+    )
+    alone = [splats_in_view(c, r, view, projection) if len(r) else (0, 0.0) for c, r in sets]
+    assert kept.tolist() == [count for count, _ in alone]
+    np.testing.assert_allclose(overdraws, [overdraw for _, overdraw in alone], rtol=1e-12, atol=0.0)
+    assert kept[1] > 0 and kept[4] > 0 and overdraws[1] > 0.0 and kept[3] == 0 and overdraws[3] == 0.0
