@@ -27,6 +27,7 @@ from functools import cached_property
 
 import numpy as np
 
+from cloudcore.maths.finite import nan_to_num
 from cloudcore.runtime import disk_cache
 
 
@@ -223,7 +224,7 @@ class CostEstimator:
     def _fitted(self) -> CostModel:
         size = len(self.right)
         ratios = np.linalg.solve(self.normal + PRIOR_WEIGHT * np.eye(size), self.right + PRIOR_WEIGHT)
-        ratios = np.clip(np.nan_to_num(ratios, nan=1.0), 1.0 / RATIO_LIMIT, RATIO_LIMIT)
+        ratios = np.clip(nan_to_num(ratios, nan=1.0), 1.0 / RATIO_LIMIT, RATIO_LIMIT)
         return CostModel(*(ratios * self.prior.vector()))
 
 

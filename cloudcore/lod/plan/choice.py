@@ -201,11 +201,19 @@ def groups_cheaper_apart(units: LodUnits, seen: Seen, settings, state: LodState,
     candidates = outside & moving
     if not candidates.any():  # a still eye: nothing more to price
         return frozenset()
-    part_seen = seen.take(slice(len(units.members), None))
-    group_ms = impostor_ms_of(groups, group_seen, candidates, focal_px, settings, costs)
+    # the candidates' impostors and their clouds' (the rows of `units.and_clouds` after the units) priced in one pass
     # (a cloud whose own sphere holds the eye is priced as a quad over the whole screen: dear, so its group stays);
     # the clouds' units are the groups' members in order
-    part_ms = impostor_ms_of(units.clouds, part_seen, slice(None), focal_px, settings, costs)
+    group_rows = units.group_rows[candidates]
+    impostors_ms = impostor_ms_of(
+        units.and_clouds,
+        seen,
+        np.concatenate([group_rows, np.arange(len(units.members), len(seen.distances))]),
+        focal_px,
+        settings,
+        costs,
+    )
+    group_ms, part_ms = impostors_ms[: len(group_rows)], impostors_ms[len(group_rows) :]
     apart_ms = np.add.reduceat(part_ms, np.cumsum(groups.member_counts) - groups.member_counts)[candidates]
     indices = np.flatnonzero(candidates).tolist()
     held_apart = np.fromiter((groups.members[i] in state.opened for i in indices), dtype=bool, count=len(indices))

@@ -620,7 +620,9 @@ def _plan_units(
     regenerate, postponed = {}, {}
     textured = np.flatnonzero(of_kinds(kinds, *TEXTURED))
     # the impostors drawn as they were, not remade this frame: their errors
-    kept = textured[~np.isin(textured, np.fromiter(served, dtype=np.int64, count=len(served)))]
+    is_served = np.zeros(count, dtype=bool)
+    is_served[list(served)] = True
+    kept = textured[~is_served[textured]]
     kept = kept[np.fromiter((units.members[i] in records for i in kept.tolist()), dtype=bool, count=len(kept))]
     if len(kept):  # (full mode holds no impostors, and measures no errors)
         accepted = max(accepted, float(np.max(held_errors[kept])) / max(tolerance, 1e-300))

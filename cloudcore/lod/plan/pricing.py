@@ -32,6 +32,7 @@ from cloudcore.lod.ring import (
 )
 from cloudcore.lod.splat_coverage import splats_in_frustum
 from cloudcore.lod.units import LodUnits
+from cloudcore.maths.finite import nan_to_num
 from cloudcore.maths.vectors import row_lengths
 from cloudcore.model.scene import Camera
 from cloudcore.world.camera import spheres_within_frustum
@@ -94,7 +95,7 @@ def seen_from(units: LodUnits, pricing: Pricing, priced: bool = True, air_steps=
         split_lifetimes, layers = np.full(len(radii), math.inf), np.ones(len(radii))
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # the eye inside: the whole screen
         half_sides = radii * distances / np.sqrt(np.maximum((distances - radii) * (distances + radii), 1e-300))
-        quad_pixels = np.nan_to_num(
+        quad_pixels = nan_to_num(
             np.minimum((2.0 * focal_px * half_sides / distances) ** 2, screen_pixels), nan=screen_pixels
         )
     return Seen(
@@ -144,7 +145,7 @@ def _split_lifetimes(units: LodUnits, reach, object_radii, depth_steps) -> np.nd
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         covered_shares = np.minimum(((object_radii[None] + typical_radii[:, None]) / radii[:, None]) ** 2, 1.0)
         spacings = 2.0 * radii[:, None] / np.maximum(units.particle_counts[:, None] * covered_shares, 1.0)
-        split_lifetimes = np.nan_to_num(spacings / depth_steps[None], nan=math.inf)
+        split_lifetimes = nan_to_num(spacings / depth_steps[None], nan=math.inf)
     return np.min(np.where(reach, split_lifetimes, math.inf), axis=1, initial=math.inf)
 
 
@@ -295,7 +296,7 @@ def impostor_ms_of(units: LodUnits, seen: Seen, chosen, focal_px, settings, cost
         detail = 2.0 * settings.impostor_detail_texels * half_sides / units.finest_radii[chosen]
         detail = np.where(settings.impostor_detail_texels > 0.0, detail, np.inf)
         texture = np.clip(np.minimum(sides, detail), settings.impostor_min_size, settings.impostor_max_size)
-        texture_fragments = fragments * np.nan_to_num((texture / sides) ** 2, nan=1.0)
+        texture_fragments = fragments * nan_to_num((texture / sides) ** 2, nan=1.0)
     remake = seen.layers[chosen] * (
         costs.particles * units.particle_counts[chosen]
         + costs.texture_fragments * texture_fragments
@@ -329,7 +330,7 @@ def held_impostor_errors(
         centres = np.array([c if h.content is None else h.content[0] for c, h in zip(centres, held)], dtype=np.float64)
         radii = np.array([r if h.content is None else h.content[1] for r, h in zip(radii, held)], dtype=np.float64)
     eyes = np.array([record.eye for record in held], dtype=np.float64)
-    errors[rows] = np.nan_to_num(translation_error(centres, radii, eyes, eyes_now), nan=math.inf)
+    errors[rows] = nan_to_num(translation_error(centres, radii, eyes, eyes_now), nan=math.inf)
     if motion is not None:
         changed = motion.shape_change_m([record.made_at_s for record in held])
         gaps = np.linalg.norm(units.centres[rows] - np.asarray(eye, dtype=np.float64), axis=1) - units.radii[rows]
