@@ -413,12 +413,16 @@ def _plan_units(
             else:
                 counted.append(index)
         if counted:
-            splats = [splats_of(index) for index in counted]
+            # the counted units' clouds' splats copied once, together (not a group's, then every unit's again), or
+            # one cloud's as they are (a view of the particles): a copy of thousands faults in fresh memory
+            clouds = [cloud_splats(cloud) for index in counted for cloud in units.members[index]]
             kept, overdraws = splats_in_view_per_set(
-                # one unit's splats as they are (a view of the particles): a copy of thousands faults in fresh memory
-                splats[0][0] if len(splats) == 1 else np.concatenate([splat_centres for splat_centres, _ in splats]),
-                splats[0][1] if len(splats) == 1 else np.concatenate([splat_radii for _, splat_radii in splats]),
-                [len(splat_radii) for _, splat_radii in splats],
+                clouds[0][0] if len(clouds) == 1 else np.concatenate([cloud_centres for cloud_centres, _ in clouds]),
+                clouds[0][1] if len(clouds) == 1 else np.concatenate([cloud_radii for _, cloud_radii in clouds]),
+                np.add.reduceat(
+                    [len(cloud_radii) for _, cloud_radii in clouds],
+                    np.cumsum([0] + [len(units.members[index]) for index in counted[:-1]]),
+                ),
                 view,
                 projection,
             )

@@ -326,9 +326,12 @@ def held_impostor_errors(
         shifts = unit_drifts[rows] - np.array([record.drift for record in held], dtype=np.float64)
         eyes_now = eyes_now - shifts
         centres = centres - shifts
-    if translation_error is parallax_errors_deg:
-        centres = np.array([c if h.content is None else h.content[0] for c, h in zip(centres, held)], dtype=np.float64)
-        radii = np.array([r if h.content is None else h.content[1] for r, h in zip(radii, held)], dtype=np.float64)
+    if translation_error is parallax_errors_deg:  # what the impostors hold where their records have it (fresh rows)
+        contents = [record.content for record in held if record.content is not None]
+        if contents:
+            holding = np.fromiter((record.content is not None for record in held), dtype=bool, count=len(held))
+            centres[holding] = [centre for centre, _ in contents]
+            radii[holding] = [radius for _, radius in contents]
     eyes = np.array([record.eye for record in held], dtype=np.float64)
     errors[rows] = nan_to_num(translation_error(centres, radii, eyes, eyes_now), nan=math.inf)
     if motion is not None:
