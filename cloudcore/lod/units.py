@@ -295,8 +295,7 @@ def interpenetrating_groups(
 #: a cloud field's cell's impostor is made this many times finer than `impostor_detail_texels` asks where its detail
 #: bounds it: a cell's remake splats a few dozen particles, so its texels cost little, while its near cells' splats,
 #: a hundred metres wide, are magnified many times on the screen and smoothed by the coarser texture's bilinear
-#: read (the cumulus field's flight in impostor mode: 1.7 dB of mean PSNR for 4% of its frame: docs/performance.md,
-#: "The cloud field")
+#: read (measured on the cumulus field's flight: docs/performance.md, "The field's impostors within 35 dB")
 FIELD_CELL_DETAIL_SCALE = 2.0
 
 

@@ -158,8 +158,9 @@ def ring_outrun(state: RingState, step, tolerance_deg: float, settings: RenderSe
     radians after a step s: `ring_translation_error`), and the last ring that held clouds lasted no longer than its
     rebuild takes at this pace (`rebuild_pace`): rebuilt without end, each ring past the tolerance once shown.  The
     cumulus field's flight sampled 160 m a frame rebuilt its whole ring every frame, at more cost than its clouds'
-    own impostors and further from full 3D (docs/performance.md, "The cloud field"); at flying speeds (under 35 m a
-    frame at the default radius and tolerance), or after a single jump, the ring is held as before."""
+    own impostors and further from full 3D (docs/performance.md, "The field's impostors within 35 dB"); at flying
+    speeds (under 35 m a frame at the default radius and tolerance), or after a single jump, the ring is held as
+    before."""
     moving = float(np.linalg.norm(np.asarray(step, dtype=np.float64)))
     if moving <= math.radians(tolerance_deg) * settings.ring_radius:
         return False

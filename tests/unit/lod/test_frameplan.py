@@ -772,7 +772,7 @@ def test_the_ring_keeps_pace_with_the_eye(step_m, frames_to_show):
 def test_impostor_mode_drops_a_ring_the_eye_outruns_and_takes_it_up_again_at_flying_speed():
     """At 40 m a frame a panel 1 km off shifts against its clouds 3 km off by 1.5 degrees a frame, three times the
     tolerance: the ring is rebuilt whole every frame and shown past the tolerance from the next (the cumulus
-    field's flight: 8 segments a frame, 0.46 times full 3D's speed).  Once a ring has lasted only its rebuild,
+    field's flight: 8 segments a frame).  Once a ring has lasted only its rebuild,
     impostor mode draws its clouds from their own impostors, which their distance keeps within the tolerance; a
     single jump does not drop it, and at flying speed the ring holds its clouds again."""
     settled = run_ring_flight(SETTLED)[-1].state

@@ -97,7 +97,7 @@ def test_a_regrouping_drops_the_impostors_of_units_that_no_longer_exist():
 def test_a_cloud_field_s_cells_impostors_are_made_finer_where_their_detail_bounds_them():
     """Two alike clouds 500 m off, the second a cloud field's cell (past `groupable`): where the finest splat bounds
     the texture, below what the screen asks, the cell's is twice as fine (`FIELD_CELL_DETAIL_SCALE`); its few
-    splats cost little to remake, and its magnified splats lost 0.7 dB of the field's flight to the coarser one."""
+    splats cost little to remake, and its magnified splats lost their lumps to the coarser one."""
     points = np.random.default_rng(5).normal(size=(300, 3)) * 40.0  # the module's RNG left to the other tests
     twins = Packed([(points + (x, 0.0, 0.0), np.full(300, 12.0)) for x in (-150.0, 150.0)])
     units = lod_units(twins, groupable=1)
