@@ -150,8 +150,9 @@ def screen_size_px(radius, distance, viewport_height: int, fov_y_deg: float):
     return viewport_height * _tangent(radius, distance) / math.tan(math.radians(fov_y_deg) / 2.0)
 
 
-def detail_size_px(radius, distance, finest_radius, texels: float):
-    """Texture side that gives a particle of `finest_radius` `texels` texels of radius on the quad.
+def detail_size_px(radius, distance, finest_radius, texels):
+    """Texture side that gives a particle of `finest_radius` `texels` texels of radius on the quad (each a scalar
+    or an array, element by element).
 
     A cloud of Gaussian splats holds no detail finer than its smallest splat, so a
     texture finer than this only resamples smooth curves (Nyquist: 3 texels per radius

@@ -111,6 +111,9 @@ class LodUnits:
     #: A cloud field's cells are flat (a coarse cell kilometres wide, its clouds a band of hundreds of metres), and
     #: their spheres reach far above and below what they hold (Wang's ring's elevation band: `ring_members`)
     heights: np.ndarray | None = None
+    #: (units,) how many times finer than `RenderSettings.impostor_detail_texels` asks the unit's impostor is made
+    #: where its detail bounds it (`FIELD_CELL_DETAIL_SCALE` for a cloud field's cells; None: 1 for every unit)
+    detail_scales: np.ndarray | None = None
 
     @functools.cached_property
     def and_clouds(self) -> LodUnits:
@@ -129,7 +132,13 @@ class LodUnits:
             np.concatenate([u.fragment_costs for u in parts]),
             sample=self.sample,
             heights=None if self.heights is None else np.concatenate([u.heights for u in parts]),
+            detail_scales=None if self.detail_scales is None else np.concatenate([u.texel_scales for u in parts]),
         )
+
+    @property
+    def texel_scales(self) -> np.ndarray:
+        """(units,) `detail_scales`, 1 where none are given."""
+        return np.ones(len(self.radii)) if self.detail_scales is None else self.detail_scales
 
     @functools.cached_property
     def member_counts(self) -> np.ndarray:
@@ -182,6 +191,7 @@ class LodUnits:
             self.fragment_costs[rows],
             sample=self.sample,
             heights=None if self.heights is None else self.heights[rows],
+            detail_scales=None if self.detail_scales is None else self.detail_scales[rows],
         )
 
     def member_means(self, per_cloud: np.ndarray) -> np.ndarray:
@@ -282,12 +292,20 @@ def interpenetrating_groups(
     return tuple(sorted((tuple(g) for g in groups.values()), key=lambda g: g[0]))
 
 
+#: a cloud field's cell's impostor is made this many times finer than `impostor_detail_texels` asks where its detail
+#: bounds it: a cell's remake splats a few dozen particles, so its texels cost little, while its near cells' splats,
+#: a hundred metres wide, are magnified many times on the screen and smoothed by the coarser texture's bilinear
+#: read (measured on the cumulus field's flight: docs/performance.md, "The field's impostors within 35 dB")
+FIELD_CELL_DETAIL_SCALE = 2.0
+
+
 def lod_units(particles, group: bool = True, groupable: int | None = None) -> LodUnits:
     """The units of a `ParticleBuffer`: its clouds, interpenetrating ones grouped (`group`).
 
     Only the first `groupable` clouds (None: all) are grouped; the others are units of their own: a cloud
     field's cells, whose nested grid is their level of detail (grouping the touching cells of a field would
-    make it one unit to the horizon, beyond any impostor or ring).
+    make it one unit to the horizon, beyond any impostor or ring), their impostors made finer
+    (`FIELD_CELL_DETAIL_SCALE`).
     """
     starts = particles.cloud_starts
     sphere_centres, sphere_radii = particles.bounding_centres, particles.bounding_radii
@@ -301,7 +319,9 @@ def lod_units(particles, group: bool = True, groupable: int | None = None) -> Lo
         else tuple((i,) for i in range(grouped))
     ) + tuple((i,) for i in range(grouped, clouds))
     sample = SplatSample.of(particles.centres, particles.radii, starts)
-    units = dataclasses.replace(_units_of(particles, members), sample=sample)
+    cells = clouds - grouped
+    scales = np.concatenate([np.ones(len(members) - cells), np.full(cells, FIELD_CELL_DETAIL_SCALE)]) if cells else None
+    units = dataclasses.replace(_units_of(particles, members), sample=sample, detail_scales=scales)
     in_groups = tuple((cloud,) for unit in members if len(unit) > 1 for cloud in unit)
     if not in_groups:
         return units

@@ -33,7 +33,9 @@ from cloudcore.lod.plan.unit_plans import (
     IMPOSTOR,
 )
 from cloudcore.lod.ring import (
+    SEGMENTS,
     RingState,
+    rebuild_pace,
 )
 from cloudcore.lod.units import LodUnits
 from cloudcore.model.settings import AUTO_SCALE, RenderSettings
@@ -148,6 +150,22 @@ def ring_pays(state: RingState, ring_ms: float, alone_ms: float) -> bool:
     newest = state.pending or state.current
     held = None if newest is None else "ring" if newest.holds_clouds else "alone"
     return cheapest(held, {"ring": ring_ms, "alone": alone_ms}) == "ring"
+
+
+def ring_outrun(state: RingState, step, tolerance_deg: float, settings: RenderSettings) -> bool:
+    """Whether the eye outruns Wang's ring, whose clouds impostor mode then draws each from its own impostor: the
+    eye's `step` (3,) this frame moves a panel's picture of a cloud far beyond it past `tolerance_deg` (about s / R
+    radians after a step s: `ring_translation_error`), and the last ring that held clouds lasted no longer than its
+    rebuild takes at this pace (`rebuild_pace`): rebuilt without end, each ring past the tolerance once shown.  The
+    cumulus field's flight sampled 160 m a frame rebuilt its whole ring every frame, at more cost than its clouds'
+    own impostors and further from full 3D (docs/performance.md, "The field's impostors within 35 dB"); at flying
+    speeds (under 35 m a frame at the default radius and tolerance), or after a single jump, the ring is held as
+    before."""
+    moving = float(np.linalg.norm(np.asarray(step, dtype=np.float64)))
+    if moving <= math.radians(tolerance_deg) * settings.ring_radius:
+        return False
+    pace = rebuild_pace(step, settings)
+    return state.rebuild_interval <= math.ceil(SEGMENTS / pace.segments_a_frame) + pace.fade_frames
 
 
 def ring_prices_hold(

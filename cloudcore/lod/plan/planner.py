@@ -26,6 +26,7 @@ from cloudcore.lod.plan.choice import (
     next_frame_choice,
     prices_units,
     represent_units,
+    ring_outrun,
     ring_pays,
     ring_prices_hold,
     settled_in_full_3d,
@@ -326,7 +327,11 @@ def _plan_units(
         units.members,
         units.member_set,
         segment_texture_size(height, camera.fov_y_deg, settings),
-        holds_clouds=settings.mode != "auto" or (not all_full and ring_pays(state.ring, ring_ms, alone_ms)),
+        holds_clouds=(
+            not ring_outrun(state.ring, step, tolerance, settings)
+            if settings.mode != "auto"
+            else not all_full and ring_pays(state.ring, ring_ms, alone_ms)
+        ),
         past_tolerance=ring_error > tolerance,
         # a segment is priced as its update is (below), by its particles: what the segment's render takes on
         # llvmpipe (478,000 particles of the 1.2M field, 368 ms: 0.77 us a particle, the fit's prior 0.85)

@@ -202,7 +202,9 @@ def impostor_textures(units: LodUnits, rows, distances, height: int, fov_y_deg: 
     or the unit's detail asks, in `required_size`'s steps, and the fragments of remaking it."""
     radii, distance = units.radii[rows], distances[rows]
     pixels = screen_size_px(radii, distance, height, fov_y_deg)
-    detail = detail_size_px(radii, distance, units.finest_radii[rows], settings.impostor_detail_texels)
+    detail = detail_size_px(
+        radii, distance, units.finest_radii[rows], settings.impostor_detail_texels * units.texel_scales[rows]
+    )
     sizes = required_size(np.minimum(pixels, detail), settings.impostor_min_size, settings.impostor_max_size)
     half_sides = quad_half_side(radii, distance)
     fragments = units.fragment_costs[rows] * regeneration_fragments(
@@ -293,7 +295,8 @@ def impostor_ms_of(units: LodUnits, seen: Seen, chosen, focal_px, settings, cost
     half_sides, distances, fragments = seen.half_sides[chosen], seen.distances[chosen], seen.ball_fragments[chosen]
     with np.errstate(divide="ignore", invalid="ignore"):
         sides = 2.0 * focal_px * half_sides / distances
-        detail = 2.0 * settings.impostor_detail_texels * half_sides / units.finest_radii[chosen]
+        texels = settings.impostor_detail_texels * units.texel_scales[chosen]
+        detail = 2.0 * texels * half_sides / units.finest_radii[chosen]
         detail = np.where(settings.impostor_detail_texels > 0.0, detail, np.inf)
         texture = np.clip(np.minimum(sides, detail), settings.impostor_min_size, settings.impostor_max_size)
         texture_fragments = fragments * nan_to_num((texture / sides) ** 2, nan=1.0)

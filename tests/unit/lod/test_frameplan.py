@@ -769,6 +769,25 @@ def test_the_ring_keeps_pace_with_the_eye(step_m, frames_to_show):
     assert plans[shown_whole].settled is (frames_to_show > 1)
 
 
+def test_impostor_mode_drops_a_ring_the_eye_outruns_and_takes_it_up_again_at_flying_speed():
+    """At 40 m a frame a panel 1 km off shifts against its clouds 3 km off by 1.5 degrees a frame, three times the
+    tolerance: the ring is rebuilt whole every frame and shown past the tolerance from the next (the cumulus
+    field's flight: 8 segments a frame).  Once a ring has lasted only its rebuild,
+    impostor mode draws its clouds from their own impostors, which their distance keeps within the tolerance; a
+    single jump does not drop it, and at flying speed the ring holds its clouds again."""
+    settled = run_ring_flight(SETTLED)[-1].state
+    (jumped,) = run_ring_flight([(40.0, 0.0, 0.0)], settled)
+    assert jumped.state.ring.current.holds_clouds and len(jumped.ring.builds) == SEGMENTS
+    assert jumped.clouds.count("ring") > 0
+    fast = run_ring_flight([(40.0, 0.0, 0.0)] * 6, settled)
+    assert [len(p.ring.builds) for p in fast[:2]] == [SEGMENTS, SEGMENTS] and fast[1].state.ring.rebuild_interval == 1
+    assert all(p.clouds.count("ring") == 0 and p.clouds.count("impostor") > 0 for p in fast[2:])
+    assert not any(generation.holds_clouds for p in fast[2:] for generation, _ in p.ring.draws)
+    assert sum(len(p.ring.builds) for p in fast[2:]) == 0  # nothing splatted into segments any more
+    slow = run_ring_flight([(2.0, 0.0, 0.0)] * SETTLE, fast[-1].state)
+    assert slow[-1].state.ring.current.holds_clouds and slow[-1].clouds.count("ring") > 0
+
+
 def test_the_ring_goes_stale_by_its_own_keys_where_they_are_given():
     """A cloud field's blend weights change its clouds' keys as the eye moves (their impostors are remade), but
     not the ring's keys: the eye's motion, which rebuilds the ring, bounds them; a change of colours does."""

@@ -9,7 +9,14 @@ import pytest
 from cloudcore.lod.costs import SPRITE_FRAGMENT_COST, CostModel
 from cloudcore.lod.impostors import parallax_errors_deg
 from cloudcore.lod.plan import LodState, plan_frame
-from cloudcore.lod.units import SAMPLE_PER_CLOUD, LodUnits, SplatSample, interpenetrating_groups, lod_units
+from cloudcore.lod.units import (
+    FIELD_CELL_DETAIL_SCALE,
+    SAMPLE_PER_CLOUD,
+    LodUnits,
+    SplatSample,
+    interpenetrating_groups,
+    lod_units,
+)
 from cloudcore.model.scene import Camera, splats_bounding_sphere
 from cloudcore.model.settings import RenderSettings
 
@@ -85,6 +92,26 @@ def test_a_regrouping_drops_the_impostors_of_units_that_no_longer_exist():
     apart = plan_frame(lod_units(CLOUDS, group=False), camera, (640, 480), settings, grouped.state, 1)
     assert [c.regenerate for c in apart.clouds[:3]] == ["new", "new", None]
     assert set(apart.records) == {(0,), (1,), (2,)}
+
+
+def test_a_cloud_field_s_cells_impostors_are_made_finer_where_their_detail_bounds_them():
+    """Two alike clouds 500 m off, the second a cloud field's cell (past `groupable`): where the finest splat bounds
+    the texture, below what the screen asks, the cell's is twice as fine (`FIELD_CELL_DETAIL_SCALE`); its few
+    splats cost little to remake, and its magnified splats lost their lumps to the coarser one."""
+    points = np.random.default_rng(5).normal(size=(300, 3)) * 40.0  # the module's RNG left to the other tests
+    twins = Packed([(points + (x, 0.0, 0.0), np.full(300, 12.0)) for x in (-150.0, 150.0)])
+    units = lod_units(twins, groupable=1)
+    assert units.members == ((0,), (1,)) and units.texel_scales.tolist() == [1.0, FIELD_CELL_DETAIL_SCALE]
+    camera = Camera((0.0, 0.0, 500.0), (0.0, 0.0, 0.0), 60.0)
+    settings = RenderSettings(mode="impostor", ring_radius=np.inf, impostor_max_size=4096)
+    authored, cell = plan_frame(units, camera, (640, 480), settings, LodState(), 1).clouds
+    on_screen = plan_frame(
+        units, camera, (640, 480), dataclasses.replace(settings, impostor_detail_texels=0.0), LodState(), 1
+    ).clouds
+    assert authored.texture_size < cell.texture_size < on_screen[1].texture_size
+    assert cell.texture_size / authored.texture_size == pytest.approx(FIELD_CELL_DETAIL_SCALE, rel=0.2)
+    # every unit of a scene without a field keeps the setting's detail
+    assert lod_units(twins).texel_scales.tolist() == [1.0, 1.0]
 
 
 def test_units_of_spheres_are_one_cloud_each():
