@@ -6,10 +6,11 @@
 
 One process draws the default view in auto mode (`RenderSettings()`) at each size, the terrain's draw
 (`world.TerrainMesh.draw`) timed between two `glFinish`, its ways taking turns, two frames each, round after
-round: as drawn (`drawn`: the clouds' map read by the tiles under it alone), every tile in view reading the map
-(`every_tile_reads`: as 9652f19 drew it), no tile reading it (`no_read`), and its depth alone (`depth`: the same
-triangles, no colour, no varyings).  Reports the medians (ms) and the load average.  A size's pixels scale the
-pixels' share; the triangles' share does not move.
+round: as drawn (`drawn`: the tiles under the clouds' map alone reading the clouds' shadow, baked on the ground
+once the map is held), the tiles under the map reading the map itself per pixel (`map_read`: as 3191b42 drew
+them), every tile in view reading the map's bake (`every_tile_reads`), no tile reading it (`no_read`), and its depth
+alone (`depth`: the same triangles, no colour, no varyings).  Reports the medians (ms) and the load average.  A
+size's pixels scale the pixels' share; the triangles' share does not move.
 
 With `--errors`, instead, the tiles of the default view: the tiles in view and their triangles as drawn (split
 while near and rough), as split while near alone (9652f19's rule), and as a split by screen-space error alone
@@ -29,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 #: the ways of `--sizes`, in the order they take turns
-WAYS = ("drawn", "every_tile_reads", "no_read", "depth")
+WAYS = ("drawn", "map_read", "every_tile_reads", "no_read", "depth")
 #: frames drawn before timing, and in each turn
 WARM_UP, PER_TURN = 3, 2
 
@@ -60,6 +61,9 @@ def time_ways(sizes: list[str], rounds: int) -> list[dict]:
         start = time.perf_counter()
         if way["now"] == "depth":
             mesh.draw_depth_full(camera, view_projection)
+        elif way["now"] == "map_read":
+            mesh._read_baked = False
+            draw(mesh, camera, view_projection, *args, **kwargs)
         else:
             draw(mesh, camera, view_projection, *args, **kwargs)
         GL.glFinish()

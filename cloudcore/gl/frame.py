@@ -37,6 +37,7 @@ from cloudcore.field.state import FieldState
 from cloudcore.field.weather import WeatherFieldState
 from cloudcore.gl.context import HeadlessContext, WindowContext, check_frame_size
 from cloudcore.gl.draw import CloudPass, CloudPassFrame, DrawCounts, PassTools
+from cloudcore.gl.ground_shadows import GroundShadows
 from cloudcore.gl.impostor_store import ImpostorStore
 from cloudcore.gl.light_shafts import FrameShafts, LightShaftPass
 from cloudcore.gl.measured_way import MeasuredWay
@@ -52,6 +53,7 @@ from cloudcore.gl.volume_blending import GpuFeatures, VolumeBlendingPass
 from cloudcore.gl.world import WorldPass
 from cloudcore.light.air_between import air_between
 from cloudcore.light.cloud_shadows import FIELD_MAP_RESOLUTION, MAP_RESOLUTION, PREVIEW_MAP_RESOLUTION
+from cloudcore.light.ground_shadows import steady_map
 from cloudcore.light.illumination import IlluminationCache, shadowing_sun
 from cloudcore.light.light_shafts import nearest_depth_particles
 from cloudcore.light.lighting import scene_lights
@@ -155,6 +157,8 @@ class FrameRenderer:
         #: compute pass won in full 3D and lost in auto mode, whose full-3D draws are a few near clouds
         self.compositing: dict[str, MeasuredWay] = {}
         self._shadow_source = (None, MAP_RESOLUTION)  # the sun and the size of the clouds' transmittance map
+        self._shadows_kind = (False, False)  # whether the map is a dragged slider's look's, a cloud field's
+        self._steady_shadows = False  # whether it is a map the world pass bakes on the ground (`steady_map`)
         self._overdraw_target = None
         self._display = None  # (RGBA8 target, program): the frame in sRGB for the editor
         self.last_plan: FramePlan | None = None
@@ -184,6 +188,11 @@ class FrameRenderer:
     def light_shafts(self) -> LightShaftPass | None:
         """The world pass's light shafts, once a frame has drawn them (tests read their march)."""
         return None if self._world.value is None else self._world.value.light_shafts
+
+    @property
+    def ground_shadows(self) -> GroundShadows | None:
+        """The world pass's clouds' shadow baked on the ground, where it has a terrain (tests read the texture)."""
+        return None if self._world.value is None else self._world.value.ground_shadows
 
     @property
     def reduced_clouds(self) -> ReducedClouds | None:
@@ -312,6 +321,7 @@ class FrameRenderer:
             sun,
             PREVIEW_MAP_RESOLUTION if preview else FIELD_MAP_RESOLUTION if scene.cloud_field else MAP_RESOLUTION,
         )
+        self._shadows_kind = (preview, bool(scene.cloud_field))  # `steady_map`'s first two
         illumination_ms = clouds.illumination_ms + self._update_shadows(clouds, asked.time_s)
         return _FrameScene(lighting, camera, clouds, illumination_ms)
 
@@ -388,6 +398,7 @@ class FrameRenderer:
             antialiased=settings.world_antialiasing,
             through_air=settings.aerial_perspective,
             shadows=self._shadows,
+            steady_shadows=self._steady_shadows,
             light_shafts=settings.light_shafts,
             draw_cloud_depth=self._cloud_depth_drawer(frame),
         )
@@ -551,6 +562,7 @@ class FrameRenderer:
         forming = self.clouds.forming(clouds.scene, time_s)
         opacity = (clouds.particles.opacity_factors(time_s), (forming, clouds.fade_keys))
         motion = clouds.motion
+        self._steady_shadows = steady_map(*self._shadows_kind, moving=motion is not None, forming=bool(forming))
         if motion is not None and not reshapes(motion.wind):
             at_rest = self.clouds.lit.value.particles
             self.shadow_map.update(at_rest, *self._shadow_source, *opacity, motion.drifts[0])

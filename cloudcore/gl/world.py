@@ -21,6 +21,7 @@ from cloudcore.atmosphere.sky_view import eye_radius, horizon_angles
 from cloudcore.atmosphere.sun_disc import SUN_ANGULAR_RADIUS
 from cloudcore.gl.air_volume import AirVolume
 from cloudcore.gl.context import HeadlessContext
+from cloudcore.gl.ground_shadows import GroundShadows
 from cloudcore.gl.light_shafts import LightShaftPass
 from cloudcore.gl.programs import ProgramCache, set_matrix, set_vec3
 from cloudcore.gl.shadow_map import CloudShadowMap
@@ -34,13 +35,14 @@ from cloudcore.light.far_ground import (
     far_ground_sun,
     in_shadow_map,
 )
+from cloudcore.light.ground_shadows import BakePlan, ground_shadow_frame, tile_keys
 from cloudcore.light.light_shafts import SHAFT_STEPS
 from cloudcore.light.sky_background import NIGHT_SKY, SkyBackground, ground_behind_the_air
 from cloudcore.light.terrain_light import TerrainLight
 from cloudcore.model.scene import Camera, Terrain
 from cloudcore.scenes.limits import DRAWN_TERRAIN_KINDS
 from cloudcore.world.camera import frustum_planes, pixel_rays
-from cloudcore.world.terrain import ground_colours
+from cloudcore.world.terrain import ground_colours, highest_ground_m, lowest_ground_m
 from cloudcore.world.terrain_tiles import (
     SKIRT_SIDES,
     TILE_FACES,
@@ -109,19 +111,28 @@ class TerrainMesh:
         self._shaded: np.ndarray | None = None  # which of them read the clouds' map
         # the indices' runs: (whether they read the clouds' map, whether grids (else skirts), first triangle, count)
         self._runs: list[tuple[bool, bool, int, int]] = []
-        # the tiles' vertices and triangles, and their coarse surfaces' (the light shafts' depth: positions alone)
-        self._buffers = [int(b) for b in GL.glGenBuffers(4)]
-        self._vertex_array, self._coarse_vertex_array = (int(a) for a in GL.glGenVertexArrays(2))
-        for vertex_array, (vertices, indices), attributes in (
-            (self._vertex_array, self._buffers[:2], _VERTEX_ATTRIBUTES),
-            (self._coarse_vertex_array, self._buffers[2:], 1),
+        self._eye: tuple[float, float, float] | None = None  # the eye the tiles were last chosen for
+        # the clouds' shadow on the ground, baked for a steady map (`BakePlan`), and whether this frame reads it
+        self.ground_shadows = GroundShadows(programs)
+        self._bakes = BakePlan()
+        self._read_baked = False
+        # the tiles' vertices and triangles, their coarse surfaces' (the light shafts' depth: positions alone), and
+        # the triangles of the grids under the clouds' map (the shadow's bake, from the tiles' vertices)
+        self._buffers = [int(b) for b in GL.glGenBuffers(5)]
+        self._vertex_array, self._coarse_vertex_array, self._bake_vertex_array = (
+            int(a) for a in GL.glGenVertexArrays(3)
+        )
+        for vertex_array, (vertices, indices), attributes, stride in (
+            (self._vertex_array, self._buffers[:2], _VERTEX_ATTRIBUTES, _VERTEX_ATTRIBUTES),
+            (self._coarse_vertex_array, self._buffers[2:4], 1, 1),
+            (self._bake_vertex_array, (self._buffers[0], self._buffers[4]), 1, _VERTEX_ATTRIBUTES),
         ):
             GL.glBindVertexArray(vertex_array)
             GL.glBindBuffer(GL.GL_ARRAY_BUFFER, vertices)
             for location in range(attributes):
                 GL.glEnableVertexAttribArray(location)
                 GL.glVertexAttribPointer(
-                    location, 3, GL.GL_FLOAT, GL.GL_FALSE, 12 * attributes, ctypes.c_void_p(12 * location)
+                    location, 3, GL.GL_FLOAT, GL.GL_FALSE, 12 * stride, ctypes.c_void_p(12 * location)
                 )
             GL.glBindBuffer(GL.GL_ELEMENT_ARRAY_BUFFER, indices)
         GL.glBindVertexArray(0)
@@ -140,12 +151,23 @@ class TerrainMesh:
             GL.glBufferData(GL.GL_ARRAY_BUFFER, vertices.nbytes, vertices, GL.GL_STATIC_DRAW)
         self._in_view = self._coarse_in_view = None  # the triangles in view are gathered again
 
+    def _follow(self, eye) -> None:
+        """The tiles chosen for `eye`, uploaded where they changed; chosen once for an eye the frame's passes share
+        (the shafts' depth, the shadow's bake, the draw), as choosing them is a walk of the quadtree in numpy."""
+        eye = tuple(float(v) for v in eye)
+        if eye == self._eye:
+            return
+        self._eye = eye
+        if self.tiles.update(eye):
+            self._upload()
+
     def _program(self, through_air: bool, shafts: bool, far_ground: bool, shadow_read: bool) -> int:
         defines = {
             "THROUGH_AIR": int(through_air),
             "LIGHT_SHAFTS": int(shafts),
             "FAR_GROUND": int(far_ground and through_air),
             "CLOUD_SHADOW_READ": int(shadow_read),
+            "BAKED_SHADOW": int(shadow_read and self._read_baked),
         }
         return self._programs.program("terrain", defines)
 
@@ -173,7 +195,7 @@ class TerrainMesh:
                 if bind_far_air is not None:
                     bind_far_air(program)
             if shadow_read:
-                shadows.bind(program)
+                (self.ground_shadows if self._read_baked else shadows).bind(program)
             if shafts is not None:
                 shafts.bind()
             return program
@@ -192,6 +214,41 @@ class TerrainMesh:
 
         self._draw_tiles(use, camera, view_projection, None, coarse=True)
 
+    def bake_ground_shadows(self, camera: Camera, shadows: CloudShadowMap | None, steady: bool) -> None:
+        """Bake the clouds' `shadows` (a `steady_map` where `steady`) on the tiles for `camera`'s eye under their map
+        into the texture the tiles' pixels then read, as far as `BakePlan` says (those it holds are not baked
+        again); leaves the texture's framebuffer bound where it bakes."""
+        self._read_baked = False
+        if shadows is None or shadows.space is None:
+            return
+        self._follow(camera.position)
+        under = np.flatnonzero(self.tiles.under_the_clouds_map(shadows.space))
+        step = self._bakes.step((shadows.made, shadows.space), tile_keys(self.tiles.tiles[under]), steady)
+        self._read_baked = step.read_baked
+        if not len(step.tiles):
+            return
+        terrain = self.tiles.terrain
+        frame = ground_shadow_frame(
+            shadows.space, lowest_ground_m(terrain), highest_ground_m(terrain), self.tiles.frame.half_side_m
+        )
+        baked = under[step.tiles]
+
+        def draw_grids() -> None:
+            grid = grid_face_count()
+            faces = self.tiles.faces.reshape(len(self.tiles.tiles), len(TILE_FACES), 3)[baked, :grid]
+            indices = np.ascontiguousarray(faces, dtype=np.uint32)
+            GL.glBindVertexArray(self._bake_vertex_array)
+            GL.glBufferData(GL.GL_ELEMENT_ARRAY_BUFFER, indices.nbytes, indices, GL.GL_DYNAMIC_DRAW)
+            # their edges first, as lines: where a tile meets a finer one the two edges' rounding may leave a texel
+            # between them that neither triangle covers (a lit speck in a shadow); the triangles then cover the rest
+            GL.glPolygonMode(GL.GL_FRONT_AND_BACK, GL.GL_LINE)
+            GL.glDrawElements(GL.GL_TRIANGLES, indices.size, GL.GL_UNSIGNED_INT, None)
+            GL.glPolygonMode(GL.GL_FRONT_AND_BACK, GL.GL_FILL)
+            GL.glDrawElements(GL.GL_TRIANGLES, indices.size, GL.GL_UNSIGNED_INT, None)
+            GL.glBindVertexArray(0)
+
+        self.ground_shadows.bake(frame, shadows, draw_grids, afresh=step.afresh)
+
     def _draw_tiles(
         self,
         use: Callable[[bool], int],
@@ -203,8 +260,7 @@ class TerrainMesh:
         """Draw the tiles in view, depth tested and written, each with the program `use(shadow_read)` puts in use
         (its uniforms set): reading the clouds' map of light `space` for the tiles under it (`space` None: no
         tile); their coarse surfaces where `coarse`."""
-        if self.tiles.update(camera.position):
-            self._upload()
+        self._follow(camera.position)
         in_view = np.flatnonzero(self.tiles.in_view(frustum_planes(view_projection)))
         if not len(in_view):
             return
@@ -289,7 +345,8 @@ class TerrainMesh:
 
     def close(self) -> None:
         GL.glDeleteBuffers(len(self._buffers), self._buffers)
-        GL.glDeleteVertexArrays(2, [self._vertex_array, self._coarse_vertex_array])
+        GL.glDeleteVertexArrays(3, [self._vertex_array, self._coarse_vertex_array, self._bake_vertex_array])
+        self.ground_shadows.close()
 
 
 class WorldPass:
@@ -346,12 +403,14 @@ class WorldPass:
         antialiased: bool = False,
         through_air: bool = True,
         shadows: CloudShadowMap | None = None,
+        steady_shadows: bool = True,
         light_shafts: bool = False,
         draw_cloud_depth: Callable[[tuple[int, int]], None] | None = None,
     ) -> LightShaftPass | None:
         """Fill the render target for `camera` seen through `view` and `projection`: terrain colour and depth where
         there is terrain, sky elsewhere (both multisampled 4x when `antialiased`, the terrain seen through the air
-        under the physical sky when `through_air`, its sun's part in the clouds' `shadows` where given, and with
+        under the physical sky when `through_air`, its sun's part in the clouds' `shadows` where given (baked on the
+        ground where they are `steady_shadows`: `ground_shadows.steady_map`), and with
         `light_shafts` the air in their shadow darkened where there are shadows and air, its rays marched up to
         the clouds' nearest depth that `draw_cloud_depth(size)` draws at the march's size where given: Yusov's
         cut).  Returns the light shafts' pass where it marched them, for the clouds to read; else None."""
@@ -384,6 +443,8 @@ class WorldPass:
             )
         if sky.physical:
             self._draw_sky_picture(sky, camera, view_projection, (context.width, context.height), shafts)
+        if self._terrain is not None:
+            self._terrain.bake_ground_shadows(camera, shadows, steady_shadows)
         framebuffer = context.multisampled_target() if antialiased else context.framebuffer
         GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, framebuffer)
         GL.glViewport(0, 0, context.width, context.height)
@@ -571,6 +632,12 @@ class WorldPass:
         if self._shafts is None:
             self._shafts = LightShaftPass(*self._shaft_quality, programs=self._programs)
         return self._shafts
+
+    @property
+    def ground_shadows(self) -> GroundShadows | None:
+        """The clouds' shadow baked on the terrain's ground (what the terrain's pixels read while the map is held);
+        None without a terrain."""
+        return None if self._terrain is None else self._terrain.ground_shadows
 
     @property
     def light_shafts(self) -> LightShaftPass | None:

@@ -75,6 +75,12 @@ def highest_ground_m(terrain: Terrain) -> float:
     return float(hills) + terrain.relief
 
 
+def lowest_ground_m(terrain: Terrain) -> float:
+    """A height no ground of `terrain` falls below: the heightmap's lowest sample, else the valley's floor, 0 (its
+    noise never takes it lower; the mountains only add)."""
+    return float(terrain.height * terrain.heights.values.min()) if terrain.heights is not None else 0.0
+
+
 def samples_across(terrain: Terrain) -> tuple[int, int]:
     """(along x, along z) samples of the heightfield over `size`: the heightmap's pixels, else `resolution`."""
     if terrain.heights is not None:

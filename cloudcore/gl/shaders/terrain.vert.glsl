@@ -16,7 +16,11 @@ uniform vec3 eye_position;
 // interpolates cost llvmpipe: docs/atmosphere.md#the-shafts-cheaper-issue-52s-budget)
 out vec3 sun_seen;
 out vec3 rest_seen;
-#if CLOUD_SHADOW_READ
+#if CLOUD_SHADOW_READ && BAKED_SHADOW
+// where the shadow's baked texture is read, per pixel (terrain.frag.glsl), affine in the world's coordinates too
+out vec2 ground_shadow_uv;
+uniform mat4 world_to_ground_shadow;  // cloudcore/light/ground_shadows.py's world_to_texture
+#elif CLOUD_SHADOW_READ
 // where the clouds' shadow map is read, per pixel (terrain.frag.glsl): the map's coordinates are affine in the
 // world's, so the vertices' interpolate to each pixel's exactly, without the matrix a pixel
 out vec3 shadow_mapped;
@@ -36,7 +40,9 @@ uniform mat4 world_to_cloud_shadow;  // cloud_shadow.glsl's
 void main()
 {
     gl_Position = view_projection * vec4(position, 1.0);
-#if CLOUD_SHADOW_READ
+#if CLOUD_SHADOW_READ && BAKED_SHADOW
+    ground_shadow_uv = (world_to_ground_shadow * vec4(position, 1.0)).xy;
+#elif CLOUD_SHADOW_READ
     shadow_mapped = (world_to_cloud_shadow * vec4(position, 1.0)).xyz;
 #endif
     vec3 air_let_through, air_added;
