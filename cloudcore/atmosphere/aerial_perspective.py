@@ -41,9 +41,11 @@ MAX_DISTANCE_M = 64000.0
 SAMPLES = 16
 #: the eye's altitude is rounded to this for its volume: within it the volume is reused
 ALTITUDE_STEP_M = 100.0
-#: the preview's volume, while a slider is dragged in the editor (as its sky-view table is coarser then)
-PREVIEW_VOLUME_SIZE = (16, 16, 16)
-PREVIEW_SAMPLES = 8
+#: the preview's volume, while a slider is dragged in the editor (as its sky-view table is coarser then): 8 slices in
+#: distance at 6 samples, built in 3 ms of processor time against 16 slices at 8's 8 (docs/performance.md, "The drag
+#: at 4 looks a second")
+PREVIEW_VOLUME_SIZE = (16, 16, 8)
+PREVIEW_SAMPLES = 6
 
 
 @dataclass(frozen=True, eq=False)

@@ -58,7 +58,7 @@ from cloudcore.light.illumination import IlluminationCache, shadowing_sun
 from cloudcore.light.light_shafts import nearest_depth_particles
 from cloudcore.light.lighting import scene_lights
 from cloudcore.light.live_air import LiveAir
-from cloudcore.light.relighting import PREVIEW_METHOD
+from cloudcore.light.relighting import PREVIEW_METHOD, dragged_look_settings
 from cloudcore.light.sky_background import SkyBackground, scene_sky
 from cloudcore.light.splat_look import SplatLook
 from cloudcore.light.terrain_light import terrain_light
@@ -238,6 +238,8 @@ class FrameRenderer:
         to `time_s` (`drawn_clouds`); by default `wind.light_time`'s, the frame waiting for it.  The editor
         passes the last period's while its relighting worker lights the new one.
         """
+        if illumination_method == PREVIEW_METHOD:
+            settings = dragged_look_settings(settings)
         asked = _Asked(scene, time_of_day, camera, illumination_method, settings, time_s, costs, lit_at)
         stats = self._draw_frame(asked)
         if self._volume.settle():

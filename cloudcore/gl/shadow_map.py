@@ -38,15 +38,19 @@ class CloudShadowMap:
         #: (the quads' program, the points')
         self._programs = (build_program("shadow_map", defines), build_program("shadow_map", defines | {"POINTS": 1}))
         self._largest_point = float(GL.glGetFloatv(GL.GL_POINT_SIZE_RANGE)[1])
-        self._vertex_array, self._buffer = GL.glGenVertexArrays(1), GL.glGenBuffers(1)
-        GL.glBindVertexArray(self._vertex_array)
-        GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self._buffer)
-        for location, floats, offset in ((0, 3, 0), (1, 1, 3), (2, 1, 4)):
-            GL.glEnableVertexAttribArray(location)
-            GL.glVertexAttribPointer(
-                location, floats, GL.GL_FLOAT, GL.GL_FALSE, 4 * _PARTICLE_FLOATS, ctypes.c_void_p(4 * offset)
-            )
-            GL.glVertexAttribDivisor(location, 1)
+        self._buffer = GL.glGenBuffers(1)
+        #: (the quads' vertex array: a particle an instance of four corners, the points': a particle a vertex, which
+        #: llvmpipe draws faster than an instance of one point: docs/performance.md, "The drag at 4 looks a second")
+        self._vertex_arrays = tuple(int(v) for v in GL.glGenVertexArrays(2))
+        for vertex_array, divisor in zip(self._vertex_arrays, (1, 0)):
+            GL.glBindVertexArray(vertex_array)
+            GL.glBindBuffer(GL.GL_ARRAY_BUFFER, self._buffer)
+            for location, floats, offset in ((0, 3, 0), (1, 1, 3), (2, 1, 4)):
+                GL.glEnableVertexAttribArray(location)
+                GL.glVertexAttribPointer(
+                    location, floats, GL.GL_FLOAT, GL.GL_FALSE, 4 * _PARTICLE_FLOATS, ctypes.c_void_p(4 * offset)
+                )
+                GL.glVertexAttribDivisor(location, divisor)
         GL.glBindVertexArray(0)
         self._framebuffer = GL.glGenFramebuffers(1)
         self._textures: list[int] = []
@@ -107,10 +111,10 @@ class CloudShadowMap:
         GL.glDisable(GL.GL_CULL_FACE)
         GL.glEnable(GL.GL_BLEND)
         GL.glBlendFunc(GL.GL_ONE, GL.GL_ONE)
-        GL.glBindVertexArray(self._vertex_array)
+        GL.glBindVertexArray(self._vertex_arrays[points])
         if points:
             GL.glEnable(GL.GL_PROGRAM_POINT_SIZE)
-            GL.glDrawArraysInstanced(GL.GL_POINTS, 0, 1, len(instances))
+            GL.glDrawArrays(GL.GL_POINTS, 0, len(instances))
             GL.glDisable(GL.GL_PROGRAM_POINT_SIZE)
         else:
             GL.glDrawArraysInstanced(GL.GL_TRIANGLE_STRIP, 0, 4, len(instances))
@@ -167,6 +171,6 @@ class CloudShadowMap:
             GL.glDeleteTextures(self._textures)
         GL.glDeleteFramebuffers(1, [self._framebuffer])
         GL.glDeleteBuffers(1, [self._buffer])
-        GL.glDeleteVertexArrays(1, [self._vertex_array])
+        GL.glDeleteVertexArrays(2, list(self._vertex_arrays))
         for program in self._programs:
             GL.glDeleteProgram(program)

@@ -17,6 +17,7 @@ the spot, as before: the result is the next frame, and nothing stale shows.
 
 from __future__ import annotations
 
+import dataclasses
 import multiprocessing
 import time
 from concurrent.futures import Future, ProcessPoolExecutor, wait
@@ -26,6 +27,7 @@ from dataclasses import dataclass
 from cloudcore.light.illumination import IlluminationCache, illuminate_direction
 from cloudcore.light.lighting import scene_lights
 from cloudcore.model.scene import Lighting, Scene, Shading
+from cloudcore.model.settings import RenderSettings
 
 #: the light pass while a slider is dragged (`cloudcore.light.shading`: a coarse raster), and once it is let go
 PREVIEW_METHOD, EXACT_METHOD = "preview", "exact"
@@ -33,6 +35,13 @@ PREVIEW_METHOD, EXACT_METHOD = "preview", "exact"
 #: the default scene, shaded exactly in less than a frame of the editor on llvmpipe (docs/performance.md, "Live
 #: time of day")
 SYNCHRONOUS_PARTICLES = 6000
+
+
+def dragged_look_settings(settings: RenderSettings) -> RenderSettings:
+    """The settings a dragged slider's look (`PREVIEW_METHOD`) is drawn with: `settings` without the light shafts,
+    whose march (the terrain's and the clouds' depths at its size) was the largest part of that frame after the
+    shadows' map; the look on release draws them again (docs/performance.md, "The drag at 4 looks a second")."""
+    return dataclasses.replace(settings, light_shafts=False) if settings.light_shafts else settings
 
 
 @dataclass(frozen=True)

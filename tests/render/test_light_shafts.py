@@ -244,6 +244,24 @@ def test_a_view_whose_air_no_shadow_reaches_is_drawn_as_without_shafts(renderer)
     assert np.abs(frames[True] - frames[False]).max() == 0.0
 
 
+@pytest.mark.gl
+def test_a_dragged_slider_s_look_is_drawn_without_shafts_and_the_release_with_them(renderer):
+    """A dragged time-of-day slider's look (the preview light pass) marches no shafts: the picture it draws with
+    them asked for is the one drawn without them; the look after the release marches them again, the picture
+    with them."""
+    scene = shaft_scene()
+    frames = {}
+    for shafts in (True, False):
+        settings = dataclasses.replace(FULL_3D, light_shafts=shafts)
+        frames[shafts], _ = renderer.render(scene, settings=settings, time_of_day=16.9, illumination_method="preview")
+        assert renderer.light_shafts is None  # the dragged light's world pass never marched
+    assert np.array_equal(frames[True], frames[False])
+    released, _ = renderer.render(scene, settings=FULL_3D)
+    assert renderer.light_shafts is not None
+    without, _ = renderer.render(scene, settings=dataclasses.replace(FULL_3D, light_shafts=False))
+    assert not np.array_equal(released, without)
+
+
 #: a point of the march's depth this high over the ground is a cloud's (the default scene's hang 1 km and more up)
 CLOUDS_OVER_GROUND_M = 300.0
 

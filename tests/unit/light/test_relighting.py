@@ -8,8 +8,9 @@ import pytest
 
 from cloudcore.light.illumination import IlluminationCache, illuminate_clouds
 from cloudcore.light.lighting import scene_lights
-from cloudcore.light.relighting import SYNCHRONOUS_PARTICLES, LiveIllumination, Look
+from cloudcore.light.relighting import SYNCHRONOUS_PARTICLES, LiveIllumination, Look, dragged_look_settings
 from cloudcore.model.scene import Cloud, Lighting, Scene, Shading
+from cloudcore.model.settings import FULL_3D, RenderSettings
 
 SHADING = Shading()
 
@@ -131,3 +132,10 @@ def test_an_edit_while_relighting_keeps_the_old_look_and_shades_only_the_edited_
         assert not cache.missing(edited.clouds, SHADING, look(16.0).lights(), "raster")
     finally:
         live.close()
+
+
+def test_a_dragged_slider_s_look_leaves_out_the_light_shafts_alone():
+    for settings in (RenderSettings(), FULL_3D, dataclasses.replace(FULL_3D, light_shafts=False)):
+        dragged = dragged_look_settings(settings)
+        assert not dragged.light_shafts
+        assert dataclasses.replace(dragged, light_shafts=settings.light_shafts) == settings
