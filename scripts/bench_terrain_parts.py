@@ -9,8 +9,11 @@ One process draws the default view in auto mode (`RenderSettings()`) at each siz
 round: as drawn (`drawn`: the tiles under the clouds' map alone reading the clouds' shadow, baked on the ground
 once the map is held), the tiles under the map reading the map itself per pixel (`map_read`: as 3191b42 drew
 them), every tile in view reading the map's bake (`every_tile_reads`), no tile reading it (`no_read`), and its depth
-alone (`depth`: the same triangles, no colour, no varyings).  Reports the medians (ms) and the load average.  A
-size's pixels scale the pixels' share; the triangles' share does not move.
+alone (`depth`: the same triangles, no colour, no varyings), and as drawn with no pixel (`vertices`: a one-pixel
+scissor, so that what is left is llvmpipe's vertex shading, clipping and triangle setup).  Reports the medians (ms)
+of the wall clock and of the process's CPU time (all its threads: llvmpipe's rasterising threads too, and less of
+the other sessions' load) and the load average.  A size's pixels scale the pixels' share; the triangles' share does
+not move.
 
 With `--errors`, instead, the tiles of the default view: the tiles in view and their triangles as drawn (split
 while near and rough), as split while near alone (9652f19's rule), and as a split by screen-space error alone
@@ -30,7 +33,7 @@ from pathlib import Path
 import numpy as np
 
 #: the ways of `--sizes`, in the order they take turns
-WAYS = ("drawn", "map_read", "every_tile_reads", "no_read", "depth")
+WAYS = ("drawn", "map_read", "every_tile_reads", "no_read", "depth", "vertices")
 #: frames drawn before timing, and in each turn
 WARM_UP, PER_TURN = 3, 2
 
@@ -50,6 +53,7 @@ def time_ways(sizes: list[str], rounds: int) -> list[dict]:
     time_s, camera = still_views(scene, 1)[0]
     way = {"now": WAYS[0]}
     spent: list[float] = []
+    processor: list[float] = []
     draw, under = world.TerrainMesh.draw, TerrainTiles.under_the_clouds_map
 
     def under_as_the_way_says(tiles, space):
@@ -58,8 +62,13 @@ def time_ways(sizes: list[str], rounds: int) -> list[dict]:
 
     def timed_draw(mesh, camera, view_projection, *args, **kwargs):
         GL.glFinish()
-        start = time.perf_counter()
-        if way["now"] == "depth":
+        start, start_processor = time.perf_counter(), time.process_time()
+        if way["now"] == "vertices":
+            GL.glEnable(GL.GL_SCISSOR_TEST)
+            GL.glScissor(0, 0, 1, 1)
+            draw(mesh, camera, view_projection, *args, **kwargs)
+            GL.glDisable(GL.GL_SCISSOR_TEST)
+        elif way["now"] == "depth":
             mesh.draw_depth_full(camera, view_projection)
         elif way["now"] == "map_read":
             mesh._read_baked = False
@@ -68,11 +77,12 @@ def time_ways(sizes: list[str], rounds: int) -> list[dict]:
             draw(mesh, camera, view_projection, *args, **kwargs)
         GL.glFinish()
         spent.append(1e3 * (time.perf_counter() - start))
+        processor.append(1e3 * (time.process_time() - start_processor))
 
     def draw_depth_full(mesh, camera, view_projection):
         program = mesh._programs.program("terrain_depth", {"THROUGH_AIR": 0, "CLOUD_SHADOW_READ": 0}, vertex="terrain")
 
-        def use(_shadow_read):
+        def use(_shadow_read, _far_air):
             GL.glUseProgram(program)
             return program
 
@@ -85,6 +95,7 @@ def time_ways(sizes: list[str], rounds: int) -> list[dict]:
     for size in sizes:
         width, height = (int(v) for v in size.split("x"))
         times: dict[str, list[float]] = {name: [] for name in WAYS}
+        processor_times: dict[str, list[float]] = {name: [] for name in WAYS}
         with FrameRenderer(width, height) as renderer:
 
             def frames(count: int) -> None:
@@ -98,17 +109,22 @@ def time_ways(sizes: list[str], rounds: int) -> list[dict]:
                 for name in WAYS:
                     way["now"] = name
                     spent.clear()
+                    processor.clear()
                     frames(PER_TURN)
                     times[name] += spent
+                    processor_times[name] += processor
         results.append(
             {
                 "size": size,
                 "terrain_ms_medians": {name: float(np.median(t)) for name, t in times.items()},
                 "terrain_ms": times,
+                "terrain_processor_ms_medians": {name: float(np.median(t)) for name, t in processor_times.items()},
+                "terrain_processor_ms": processor_times,
                 "load_average": os.getloadavg(),
             }
         )
         print(size, {name: round(float(np.median(t)), 1) for name, t in times.items()}, os.getloadavg(), flush=True)
+        print("  CPU", {name: round(float(np.median(t)), 1) for name, t in processor_times.items()}, flush=True)
     return results
 
 

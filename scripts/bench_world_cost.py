@@ -22,7 +22,8 @@ each `--against` way's with its 95% interval (`measure.benchmark.ratio_interval`
 and the PSNR of each picture against the one it cuts (`cloudview compare`'s), and of `relief_and_reach`'s against
 each `--against` way's.  With `--parts`, each part of the world pass is also timed between two `glFinish` (so
 the pass is slower for it), ms a frame, medians: the light shafts' march with the terrain's and the clouds' depth
-drawn for it, the sky's picture, the terrain, the sky's read.
+drawn for it, the sky's picture, the terrain, the sky's read; and each part's mean ratio with its interval as the
+pass's.
 """
 
 from __future__ import annotations
@@ -222,6 +223,12 @@ def measure(
         if this is not None and way.name in trees:
             ratio, low, high = ratio_interval(this.times, [way.times])
             row[f"relief_and_reach_world_over_{way.name}"] = [ratio, low, high]
+            # each part's ratio too, where both drew it once a frame (the part a change cuts, out of the pass's noise)
+            row[f"relief_and_reach_parts_over_{way.name}"] = {
+                part: list(ratio_interval(times, [way.parts[part]]))
+                for part, times in this.parts.items()
+                if len(way.parts.get(part, ())) == len(times) == len(this.times)
+            }
     return row
 
 
