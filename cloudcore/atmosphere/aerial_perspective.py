@@ -37,6 +37,9 @@ from cloudcore.atmosphere.table_sampling import (
 VOLUME_SIZE = (32, 32, 32)
 #: the farthest slice; past it a surface gets its air (Hillaire's volume reaches 32 km)
 MAX_DISTANCE_M = 64000.0
+#: from this fraction of `MAX_DISTANCE_M` on, the terrain's air turns into the sky table's air to the planet's ground
+#: (terrain.vert.glsl's FAR_GROUND), which the ground past the terrain is drawn through
+FAR_AIR_FROM = 0.875
 #: samples along each texel's ray from the eye
 SAMPLES = 16
 #: the eye's altitude is rounded to this for its volume: within it the volume is reused

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 from OpenGL import GL
 
-from cloudcore.atmosphere.aerial_perspective import MAX_DISTANCE_M
+from cloudcore.atmosphere.aerial_perspective import FAR_AIR_FROM, MAX_DISTANCE_M
 from cloudcore.gl.programs import set_vec3
 from cloudcore.gl.targets import linear_filtering
 from cloudcore.light.air_between import AirBetween
@@ -47,6 +47,8 @@ class AirVolume:
         depth, height, width = self._volume.in_scattered.shape[:3]
         set_vec3(program, "air_volume_size", np.array([width, height, depth], dtype=np.float64))
         GL.glUniform1f(GL.glGetUniformLocation(program, "air_max_distance"), MAX_DISTANCE_M)
+        # where the terrain's air starts turning into the air to the planet's ground (a program without it ignores it)
+        GL.glUniform1f(GL.glGetUniformLocation(program, "far_air_from"), FAR_AIR_FROM * MAX_DISTANCE_M)
 
     def close(self) -> None:
         GL.glDeleteTextures(self._textures)

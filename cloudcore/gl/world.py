@@ -11,11 +11,13 @@ compiled for the sky it draws).  Where each millisecond went before, and what th
 from __future__ import annotations
 
 import ctypes
+import itertools
 from collections.abc import Callable
 
 import numpy as np
 from OpenGL import GL
 
+from cloudcore.atmosphere.aerial_perspective import FAR_AIR_FROM, MAX_DISTANCE_M
 from cloudcore.atmosphere.geometry import horizon_cosine
 from cloudcore.atmosphere.sky_view import eye_radius, horizon_angles
 from cloudcore.atmosphere.sun_disc import SUN_ANGULAR_RADIUS
@@ -109,8 +111,9 @@ class TerrainMesh:
         self._coarse_in_view: np.ndarray | None = None  # the tiles whose coarse surfaces the coarse indices hold
         self._in_view: np.ndarray | None = None  # the tiles whose grids and skirts the indices hold
         self._shaded: np.ndarray | None = None  # which of them read the clouds' map
-        # the indices' runs: (whether they read the clouds' map, whether grids (else skirts), first triangle, count)
-        self._runs: list[tuple[bool, bool, int, int]] = []
+        self._far: np.ndarray | None = None  # which of them reach the air to the planet's ground
+        # the indices' runs: ((whether they read the clouds' map, whether they reach that air), first triangle, count)
+        self._runs: list[tuple[tuple[bool, bool], int, int]] = []
         self._eye: tuple[float, float, float] | None = None  # the eye the tiles were last chosen for
         # the clouds' shadow on the ground, baked for a steady map (`BakePlan`), and whether this frame reads it
         self.ground_shadows = GroundShadows(programs)
@@ -162,6 +165,8 @@ class TerrainMesh:
             self._upload()
 
     def _program(self, through_air: bool, shafts: bool, far_ground: bool, shadow_read: bool) -> int:
+        """The terrain's program for its kind of tiles: seen `through_air`, less the light `shafts`, with the air to
+        the planet's ground (`far_ground`: tiles reaching past `FAR_AIR_FROM`), reading the clouds' shadow."""
         defines = {
             "THROUGH_AIR": int(through_air),
             "LIGHT_SHAFTS": int(shafts),
@@ -186,13 +191,15 @@ class TerrainMesh:
         the clouds' `shadows` where given (read by the tiles under their map alone), less the light `shafts`
         (marched for this view) where given."""
 
-        def use(shadow_read: bool) -> int:
-            program = self._program(air is not None, shafts is not None, bind_far_air is not None, shadow_read)
+        far_ground = air is not None and bind_far_air is not None
+
+        def use(shadow_read: bool, far_air: bool) -> int:
+            program = self._program(air is not None, shafts is not None, far_ground and far_air, shadow_read)
             GL.glUseProgram(program)
             if air is not None:
                 air.bind(program)
                 set_vec3(program, "eye_position", camera.position)
-                if bind_far_air is not None:
+                if far_ground and far_air:
                     bind_far_air(program)
             if shadow_read:
                 (self.ground_shadows if self._read_baked else shadows).bind(program)
@@ -200,7 +207,8 @@ class TerrainMesh:
                 shafts.bind()
             return program
 
-        self._draw_tiles(use, camera, view_projection, None if shadows is None else shadows.space)
+        far_from_m = FAR_AIR_FROM * MAX_DISTANCE_M if far_ground else None
+        self._draw_tiles(use, camera, view_projection, None if shadows is None else shadows.space, far_from_m)
 
     def draw_depth(self, camera: Camera, view_projection: np.ndarray) -> None:
         """Draw the depth of the coarse surfaces of the tiles in view for `camera` alone into the bound target (the
@@ -208,7 +216,7 @@ class TerrainMesh:
         mostly smaller than a pixel and cost llvmpipe their setup)."""
         program = self._programs.program("terrain_depth", {"THROUGH_AIR": 0, "CLOUD_SHADOW_READ": 0}, vertex="terrain")
 
-        def use(_shadow_read: bool) -> int:
+        def use(_shadow_read: bool, _far_air: bool) -> int:
             GL.glUseProgram(program)
             return program
 
@@ -251,15 +259,17 @@ class TerrainMesh:
 
     def _draw_tiles(
         self,
-        use: Callable[[bool], int],
+        use: Callable[[bool, bool], int],
         camera: Camera,
         view_projection: np.ndarray,
         space: LightSpace | None,
+        far_from_m: float | None = None,
         coarse: bool = False,
     ) -> None:
-        """Draw the tiles in view, depth tested and written, each with the program `use(shadow_read)` puts in use
-        (its uniforms set): reading the clouds' map of light `space` for the tiles under it (`space` None: no
-        tile); their coarse surfaces where `coarse`."""
+        """Draw the tiles in view, depth tested and written, each with the program `use(shadow_read, far_air)` puts
+        in use (its uniforms set): reading the clouds' map of light `space` for the tiles under it (`space` None: no
+        tile), turning into the air to the planet's ground for the tiles reaching past `far_from_m` from the eye
+        (None: no tile); their coarse surfaces where `coarse`."""
         self._follow(camera.position)
         in_view = np.flatnonzero(self.tiles.in_view(frustum_planes(view_projection)))
         if not len(in_view):
@@ -268,40 +278,44 @@ class TerrainMesh:
         GL.glDepthFunc(GL.GL_LESS)
         GL.glDepthMask(GL.GL_TRUE)
         if coarse:
-            set_matrix(use(False), "view_projection", view_projection)
+            set_matrix(use(False, False), "view_projection", view_projection)
             self._draw_coarse(in_view)
             return
         shaded = np.zeros(len(in_view), dtype=bool)
         if space is not None:
             shaded = self.tiles.under_the_clouds_map(space)[in_view]
+        far = np.zeros(len(in_view), dtype=bool)
+        if far_from_m is not None:
+            far = self.tiles.reaching(camera.position, far_from_m)[in_view]
         GL.glBindVertexArray(self._vertex_array)
         if (
             self._in_view is None
             or not np.array_equal(self._in_view, in_view)
             or not np.array_equal(self._shaded, shaded)
+            or not np.array_equal(self._far, far)
         ):
-            self._gather(in_view, shaded)
-        programs: dict[bool, int] = {}
-        for shadow_read, grids, first, count in self._runs:
-            if shadow_read not in programs:
-                programs[shadow_read] = use(shadow_read)
-                set_matrix(programs[shadow_read], "view_projection", view_projection)
+            self._gather(in_view, shaded, far)
+        # back faces culled: the far sides of hills, hidden behind their near sides, and the skirts' sides that face
+        # into their own tiles (`tile_faces`), which llvmpipe then does not set up or rasterise
+        GL.glEnable(GL.GL_CULL_FACE)
+        GL.glCullFace(GL.GL_BACK)
+        programs: dict[tuple[bool, bool], int] = {}
+        for kind, first, count in self._runs:
+            if kind not in programs:
+                programs[kind] = use(*kind)
+                set_matrix(programs[kind], "view_projection", view_projection)
             else:
-                GL.glUseProgram(programs[shadow_read])
-            # the grids with their back faces culled: the far sides of hills, hidden behind their near sides, which
-            # llvmpipe then does not set up; the skirts not, as either of two neighbours' may be the one that hangs
-            # past the other's edge, seen from either side
-            (GL.glEnable if grids else GL.glDisable)(GL.GL_CULL_FACE)
-            GL.glCullFace(GL.GL_BACK)
+                GL.glUseProgram(programs[kind])
             offset = ctypes.c_void_p(3 * 4 * first)  # bytes of uint32 indices
             GL.glDrawElements(GL.GL_TRIANGLES, 3 * count, GL.GL_UNSIGNED_INT, offset)
         GL.glDisable(GL.GL_CULL_FACE)
         GL.glBindVertexArray(0)
 
-    def _gather(self, in_view: np.ndarray, shaded: np.ndarray) -> None:
+    def _gather(self, in_view: np.ndarray, shaded: np.ndarray, far: np.ndarray) -> None:
         """Gather the triangles of the tiles `in_view` into the bound vertex array's indices, in runs each drawn in
-        one call: the grids of the tiles `shaded` (under the clouds' map), the other tiles' grids, then their skirts
-        on the sides that need one (`skirted_sides`) in the same two groups, each group in the order the tiles come.
+        one call: the grids of the tiles `shaded` (under the clouds' map), the other tiles' grids, each of these
+        groups split by whether the tile is `far` (reaching the air to the planet's ground), then their skirts on
+        the sides that need one (`skirted_sides`) in the same groups, each group in the order the tiles come.
         Drawn as multi-draws of a range a tile and a side, llvmpipe set each range up as a draw of its own
         (docs/performance.md, "The terrain in two draws")."""
         grid = grid_face_count()
@@ -309,8 +323,8 @@ class TerrainMesh:
         per_side = (len(TILE_FACES) - grid) // len(SKIRT_SIDES)
         runs, first = [], 0
         for grids in (True, False):
-            for shadow_read in (True, False):
-                tiles = in_view[shaded == shadow_read]
+            for kind in itertools.product((True, False), (False, True)):
+                tiles = in_view[(shaded == kind[0]) & (far == kind[1])]
                 if grids:
                     triangles = faces[tiles, :grid]
                 else:
@@ -318,12 +332,12 @@ class TerrainMesh:
                     triangles = faces[tiles[tile][:, None], grid + side[:, None] * per_side + np.arange(per_side)]
                 triangles = triangles.reshape(-1, 3)
                 if len(triangles):
-                    runs.append((shadow_read, grids, first, len(triangles), triangles))
+                    runs.append((kind, first, len(triangles), triangles))
                     first += len(triangles)
-        indices = np.ascontiguousarray(np.concatenate([run[4] for run in runs]), dtype=np.uint32)
+        indices = np.ascontiguousarray(np.concatenate([run[3] for run in runs]), dtype=np.uint32)
         GL.glBufferData(GL.GL_ELEMENT_ARRAY_BUFFER, indices.nbytes, indices, GL.GL_DYNAMIC_DRAW)
-        self._in_view, self._shaded = in_view, shaded
-        self._runs = [run[:4] for run in runs]
+        self._in_view, self._shaded, self._far = in_view, shaded, far
+        self._runs = [run[:3] for run in runs]
 
     def _draw_coarse(self, in_view: np.ndarray) -> None:
         """Draw the coarse surfaces of the tiles `in_view` in one call, none culled (at the march's resolution

@@ -149,27 +149,34 @@ TILE_VERTICES = _SIDE_VERTICES * _SIDE_VERTICES + len(_PERIMETER)
 
 
 def tile_faces(stride: int = 1) -> np.ndarray:
-    """One tile's triangles: its grid's (counter-clockwise from above), then its skirt's; with a `stride` (a
-    divisor of `TILE_CELLS`), those of the grid of every `stride`-th vertex, a coarser surface over the same
-    vertices."""
+    """One tile's triangles: its grid's (counter-clockwise from above), then its skirt's (counter-clockwise seen
+    from outside the tile); with a `stride` (a divisor of `TILE_CELLS`), those of the grid of every `stride`-th
+    vertex, a coarser surface over the same vertices.
+
+    The grid's cells come row after row, a cell's two triangles together: llvmpipe shades a draw's vertices through
+    a small cache of the indices it last saw, and a cell's second triangles drawn after all the firsts came back to
+    vertices it had let go (docs/performance.md, "The terrain's triangles on llvmpipe")."""
     n = _SIDE_VERTICES
     i = np.arange(0, TILE_CELLS, stride)
     corner = (i[:, None] * n + i[None, :]).ravel()
     across, down = stride, stride * n
-    grid = np.concatenate(
+    grid = np.stack(
         [
             np.stack([corner, corner + down, corner + across], axis=1),
             np.stack([corner + across, corner + down, corner + down + across], axis=1),
-        ]
-    )
+        ],
+        axis=1,
+    ).reshape(-1, 3)
     kept = np.arange(0, len(_PERIMETER), stride)
     top, following = _PERIMETER[kept], np.roll(_PERIMETER[kept], -1)
     bottom = n * n + kept
     bottom_following = np.roll(bottom, -1)
     # a quad's two triangles together, the quads in the perimeter's order: each side's skirt a run of its own
-    # (`SKIRT_SIDES`), which the world pass draws or leaves out (`skirted_sides`)
+    # (`SKIRT_SIDES`), which the world pass draws or leaves out (`skirted_sides`).  Facing out of the tile: a gap
+    # at the tile's edge is seen from the neighbour's side, and from inside the tile its own ground stands in front
+    # of its skirt, so the world pass culls the skirts' back faces as the grids'
     skirt = np.stack(
-        [np.stack([top, bottom, following], axis=1), np.stack([following, bottom, bottom_following], axis=1)], axis=1
+        [np.stack([top, following, bottom], axis=1), np.stack([following, bottom_following, bottom], axis=1)], axis=1
     ).reshape(-1, 3)
     return np.concatenate([grid, skirt])
 
@@ -335,6 +342,12 @@ class TerrainTiles:
         across = (x.max(axis=1) > -1.0) & (x.min(axis=1) < width + 1.0)
         up = (y.max(axis=1) > -1.0) & (y.min(axis=1) < height + 1.0)
         return across & up & (s.max(axis=1) > 0.0)
+
+    def reaching(self, eye, distance_m: float) -> np.ndarray:
+        """(tiles,) bool: whether any point of each tile's box lies farther than `distance_m` from `eye`: its box's
+        corner farthest from the eye along each axis."""
+        farthest = np.maximum(np.abs(self.boxes[:, 0] - eye), np.abs(self.boxes[:, 1] - eye))
+        return np.linalg.norm(farthest, axis=1) > distance_m
 
     def in_view(self, planes: np.ndarray) -> np.ndarray:
         """(tiles,) bool: whether each tile's box meets the view volume of `planes` (`camera.frustum_planes`):

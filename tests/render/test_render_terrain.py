@@ -1,5 +1,5 @@
-"""The terrain's tiles as the world pass draws them: their back faces culled, their two-sided skirts still close
-every gap between tiles of different sizes (`cloudcore.world.terrain_tiles`)."""
+"""The terrain's tiles as the world pass draws them: their back faces culled, the skirts' faces into their own tiles
+too, and the skirts still close every gap between tiles of different sizes (`cloudcore.world.terrain_tiles`)."""
 
 import dataclasses
 

@@ -31,7 +31,10 @@ uniform mat4 world_to_cloud_shadow;  // cloud_shadow.glsl's
 #include "aerial_perspective.glsl"
 #endif
 #if FAR_GROUND
+// compiled for the tiles that reach past far_air_from alone (cloudcore/gl/world.py): llvmpipe runs a branch's both
+// sides, so every vertex would pay the sky table's reads (docs/performance.md, "The terrain's triangles on llvmpipe")
 #include "sky_view.glsl"
+uniform float far_air_from;  // aerial_perspective.FAR_AIR_FROM of air_max_distance, metres
 #endif
 #if LIGHT_SHAFTS
 #include "light_shafts_read.glsl"
@@ -50,11 +53,11 @@ void main()
     air_toward(position - eye_position, air_let_through, air_added);
 #if FAR_GROUND
     // the air's volume ends at air_max_distance; past it the sky draws the planet's ground through the air it
-    // tables to the ground: over the volume's last eighth the terrain's air turns into that one, so that the
+    // tables to the ground: from far_air_from on the terrain's air turns into that one, so that the
     // terrain's edge, anywhere past the volume, meets the ground drawn past it without a line (a vertex over the
     // horizon keeps the volume's: the table's rays there do not end on the ground)
     vec3 from_eye = position - eye_position;
-    float beyond = smoothstep(0.875 * air_max_distance, air_max_distance, length(from_eye));
+    float beyond = smoothstep(far_air_from, air_max_distance, length(from_eye));
     vec3 ray = normalize(from_eye);
     if (beyond > 0.0 && ray.y < horizon_cosine) {
         vec3 far_let_through, far_added;

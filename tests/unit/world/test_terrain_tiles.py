@@ -150,6 +150,53 @@ def test_each_side_s_skirt_is_a_run_of_its_own():
             assert set(on_the_grid.tolist()) <= set(edge(grid, mine).tolist()), (stride, side)
 
 
+@pytest.mark.parametrize("stride", [1, 4])
+def test_the_grids_face_up_and_the_skirts_out_of_their_tiles(stride):
+    """Counter-clockwise (the world pass's front faces, its back faces culled): the grid's triangles seen from above,
+    and each skirt's seen from outside its tile, where a gap at the tile's edge is seen from (from inside, the tile's
+    own ground stands in front of its skirt)."""
+    terrain = dataclasses.replace(VALLEY_TERRAIN, reach=12000.0)
+    frame = tile_frame(terrain)
+    tiles = leaf_tiles(frame, EYES[0])
+    positions, _ = tile_meshes(terrain, frame, tiles)
+    faces = tile_faces(stride)
+    grid = 2 * (TILE_CELLS // stride) ** 2
+    corners = positions[:, faces]  # (tiles, triangles, 3 corners, xyz)
+    normals = np.cross(corners[:, :, 1] - corners[:, :, 0], corners[:, :, 2] - corners[:, :, 0])
+    # (a tile pulled onto the drawn square's edge has cells of no width there)
+    assert np.all(normals[:, :grid, 1] >= 0.0) and np.mean(normals[:, :grid, 1] > 0.0) > 0.9
+    centres = positions[:, : (TILE_CELLS + 1) ** 2].mean(axis=1)
+    outward = corners[:, grid:].mean(axis=2) - centres[:, None, :]
+    hanging = np.linalg.norm(normals[:, grid:], axis=-1) > 0.0  # a skirt on the square's edge above 0 m has height
+    along = np.einsum("tfk,tfk->tf", normals[:, grid:, [0, 2]], outward[:, :, [0, 2]])
+    assert hanging.any() and np.all(along[hanging] > 0.0)
+
+
+def test_a_tile_s_cells_come_row_after_row_their_two_triangles_together():
+    """llvmpipe shades a draw's vertices through a small cache of the indices it last saw: a cell's two triangles
+    drawn together reuse their vertices, and the grid's rows come in order."""
+    n = TILE_CELLS + 1
+    cells = TILE_FACES[: 2 * TILE_CELLS**2].reshape(TILE_CELLS**2, 2, 3)
+    corner = (np.arange(TILE_CELLS)[:, None] * n + np.arange(TILE_CELLS)[None, :]).ravel()
+    np.testing.assert_array_equal(cells.min(axis=(1, 2)), corner)
+    assert all(len(set(cell.ravel().tolist())) == 4 for cell in cells)
+
+
+def test_a_tile_reaches_a_distance_where_the_farthest_point_of_its_mesh_lies_beyond_it():
+    """`reaching` picks the tiles whose vertices may lie past a distance from the eye (those drawn with the air to
+    the planet's ground): every tile with a vertex past it, and none whose box lies wholly within it."""
+    tiles = TerrainTiles(VALLEY_TERRAIN)
+    eye = np.array(EYES[0])
+    tiles.update(eye)
+    vertices = tiles.positions.reshape(len(tiles.tiles), TILE_VERTICES, 3)
+    farthest = np.linalg.norm(vertices - eye, axis=-1).max(axis=1)
+    distance = float(np.median(farthest))
+    reaching = tiles.reaching(eye, distance)
+    assert np.all(reaching[farthest > distance])
+    assert 0 < reaching.sum() < len(reaching)
+    assert not tiles.reaching(eye, 2.0 * float(farthest.max())).any()
+
+
 def test_moving_the_eye_meshes_only_the_new_tiles_and_a_still_eye_nothing(monkeypatch):
     meshed = []
     original = terrain_tiles.tile_meshes
