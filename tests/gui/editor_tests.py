@@ -1011,7 +1011,10 @@ def turbulence_is_relit_in_the_worker(ctx, app: EditorUnderTest):
     period = app.editor.scene.wind.relight_period_s
     ctx.item_input_value("Scene time (s)", period + 5.0)  # into the next period: new shapes to light
     ctx.yield_(2)
-    CHECK(app.viewport.lit_at == 0.0)  # the shapes lit before, carried on to now
+    # the shapes lit before, carried on to now, until the worker has the new ones: a frame waits up to
+    # `LiveIllumination.pause` for it, so on a quiet machine it may have them already (the check below that nothing
+    # was shaded here is what tells the worker lit them)
+    CHECK(app.viewport.lit_at in (0.0, period))
     asked = time.perf_counter()
     for _ in range(1200):
         if app.viewport.lit_at == period:
