@@ -157,7 +157,6 @@ class FrameRenderer:
         #: compute pass won in full 3D and lost in auto mode, whose full-3D draws are a few near clouds
         self.compositing: dict[str, MeasuredWay] = {}
         self._shadow_source = (None, MAP_RESOLUTION)  # the sun and the size of the clouds' transmittance map
-        self._shadows_kind = (False, False)  # whether the map is a dragged slider's look's, a cloud field's
         self._steady_shadows = False  # whether it is a map the world pass bakes on the ground (`steady_map`)
         self._overdraw_target = None
         self._display = None  # (RGBA8 target, program): the frame in sRGB for the editor
@@ -323,8 +322,9 @@ class FrameRenderer:
             sun,
             PREVIEW_MAP_RESOLUTION if preview else FIELD_MAP_RESOLUTION if scene.cloud_field else MAP_RESOLUTION,
         )
-        self._shadows_kind = (preview, bool(scene.cloud_field))  # `steady_map`'s first two
-        illumination_ms = clouds.illumination_ms + self._update_shadows(clouds, asked.time_s)
+        illumination_ms = clouds.illumination_ms + self._update_shadows(
+            clouds, asked.time_s, preview=preview, field=bool(scene.cloud_field)
+        )
         return _FrameScene(lighting, camera, clouds, illumination_ms)
 
     def _plan(self, ready: _FrameScene, settings: RenderSettings, time_s: float, costs) -> CloudPassFrame:
@@ -551,20 +551,21 @@ class FrameRenderer:
         objects, lights, _, size = source
         return ObjectPass(objects, lights, ambient, size) if objects else None
 
-    def _update_shadows(self, clouds: PreparedClouds, time_s: float) -> float:
+    def _update_shadows(self, clouds: PreparedClouds, time_s: float, *, preview: bool, field: bool) -> float:
         """Make the clouds' transmittance map again for another particle buffer, sun or size, or when the clouds'
         opacities change (`CloudShadowMap.update`): every frame while a cloud forms or dissipates, when a field's
         clouds' blend weights leave their steps (`fade_keys`: they fade in and out, their shadows with them), never
         while none does; ms spent making it (0 when it was held).  A wind that moves every cloud alike moves the map
         made of their buffer at rest with them; one that changes them otherwise makes it again each frame, of the
-        particles where they are (carried, weighed)."""
+        particles where they are (carried, weighed).  Whether the world pass bakes the map on the ground
+        (`steady_map`) follows from it: not a dragged slider's look's (`preview`), nor a cloud `field`'s."""
         if self._shadows is None:
             return 0.0
         start, made = time.perf_counter(), self.shadow_map.made
         forming = self.clouds.forming(clouds.scene, time_s)
         opacity = (clouds.particles.opacity_factors(time_s), (forming, clouds.fade_keys))
         motion = clouds.motion
-        self._steady_shadows = steady_map(*self._shadows_kind, moving=motion is not None, forming=bool(forming))
+        self._steady_shadows = steady_map(preview, field, moving=motion is not None, forming=bool(forming))
         if motion is not None and not reshapes(motion.wind):
             at_rest = self.clouds.lit.value.particles
             self.shadow_map.update(at_rest, *self._shadow_source, *opacity, motion.drifts[0])

@@ -8,6 +8,7 @@ import pytest
 
 from cloudcore.gl import FrameRenderer, frame
 from cloudcore.light.cloud_shadows import sample_map
+from cloudcore.measure.imagecompare import compare
 from cloudcore.model.cloud_records import Formation
 from cloudcore.model.settings import FULL_3D
 from cloudcore.scenes.files import load_scene
@@ -18,9 +19,14 @@ from tests.render.test_cloud_shadows import shadow_scene
 pytestmark = pytest.mark.gl
 
 
-def psnr(a: np.ndarray, b: np.ndarray) -> float:
-    error = np.mean((a.astype(np.float64) - b.astype(np.float64)) ** 2)
-    return float("inf") if error == 0 else float(10.0 * np.log10(255.0**2 / error))
+def map_read_at_the_texels_centres(renderer, terrain) -> np.ndarray:
+    """(across, along): the share of the sun the renderer's clouds' map lets reach the ground of `terrain` at the
+    centre of each texel of its baked texture, read from the map as the terrain's pixels read it unbaked."""
+    frame = renderer.ground_shadows.frame
+    xz = frame.texel_centres().reshape(-1, 2)
+    points = np.column_stack([xz[:, 0], height_at(terrain, xz[:, 0], xz[:, 1]), xz[:, 1]])
+    shadow_map = renderer.shadow_map
+    return np.exp(-sample_map(shadow_map.space, shadow_map.read(), points)).reshape(frame.size[1], frame.size[0])
 
 
 def test_the_baked_shadow_is_the_map_read_at_its_texels_centres(renderer):
@@ -29,10 +35,7 @@ def test_the_baked_shadow_is_the_map_read_at_its_texels_centres(renderer):
     renderer.context.make_current()
     baked, frame = renderer.ground_shadows.read(), renderer.ground_shadows.frame
     assert baked.shape == (frame.size[1], frame.size[0])
-    xz = frame.texel_centres().reshape(-1, 2)
-    points = np.column_stack([xz[:, 0], height_at(scene.terrain, xz[:, 0], xz[:, 1]), xz[:, 1]])
-    shadow_map = renderer.shadow_map
-    expected = np.exp(-sample_map(shadow_map.space, shadow_map.read(), points)).reshape(baked.shape)
+    expected = map_read_at_the_texels_centres(renderer, scene.terrain)
     assert expected.min() < 0.2 and expected.max() == 1.0  # a shadow, and the ground around it
     error = np.abs(baked - expected)
     # 8 bits, and the terrain's triangles a metre off the ground's height where the shadow's edge is steep
@@ -49,9 +52,9 @@ def test_the_terrain_drawn_from_the_bake_is_the_terrain_drawn_from_the_map(rende
     baked = renderer.ground_shadows.baked
     monkeypatch.setattr(frame, "steady_map", lambda *args, **kwargs: False)
     read, _ = renderer.render(scene, settings=FULL_3D)
-    assert psnr(read, without) < 30.0  # the shadow is there
+    assert compare(read, without).psnr_db < 30.0  # the shadow is there
     assert not np.array_equal(baked_pictures[0], read)
-    assert psnr(baked_pictures[0], read) > 45.0
+    assert compare(baked_pictures[0], read).psnr_db > 45.0
     assert np.array_equal(baked_pictures[1], baked_pictures[0])
     assert renderer.ground_shadows.baked == baked
 
@@ -90,10 +93,8 @@ def test_a_moved_eye_bakes_only_the_tiles_it_did_not_hold_and_gets_a_fresh_bake_
     assert np.mean(after != afresh) < 0.01
     assert np.abs(after - afresh).max() < 0.05
     # no texel left out between tiles of two levels (a lit speck in a shadow): the map's read there
-    xz = renderer.ground_shadows.frame.texel_centres().reshape(-1, 2)
-    points = np.column_stack([xz[:, 0], height_at(scene.terrain, xz[:, 0], xz[:, 1]), xz[:, 1]])
-    shadow_map = renderer.shadow_map
-    expected = np.exp(-sample_map(shadow_map.space, shadow_map.read(), points)).reshape(after.shape)
+    expected = map_read_at_the_texels_centres(renderer, scene.terrain)
+    assert expected.shape == after.shape
     assert np.abs(afresh - expected).max() < 0.5
 
 
